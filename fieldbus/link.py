@@ -1,0 +1,78 @@
+"""The bus link seam: one `exchange` per bench cycle, whatever the wire.
+
+`SimLink` is the in-process bus: it hands each slave its outputs, advances simulated time by
+exactly one cycle, and returns the inputs (lock-step). EtherCAT and CANopen links implement the
+same protocol over a real wire.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any, Protocol, runtime_checkable
+
+from nc.alarms import Alarm
+
+
+@dataclass
+class SlaveInfo:
+    position: int  # 0-based position on the bus (axis order)
+    name: str
+    kind: str  # "drive" or "io"
+    vendor_id: int = 0
+    product_code: int = 0
+    state: str = ""
+    layout: str = ""
+
+
+class BusError(Exception):
+    """A bus fault the bench must turn into an alarm and a controlled stop."""
+
+    def __init__(self, alarm: Alarm) -> None:
+        self.alarm = alarm
+        super().__init__(str(alarm))
+
+
+@runtime_checkable
+class BusLink(Protocol):
+    cycle_time: float
+
+    def open(self) -> list[SlaveInfo]: ...
+
+    def exchange(self, outputs: Sequence[Any]) -> list[Any]: ...
+
+    def close(self) -> None: ...
+
+
+@runtime_checkable
+class SimSlave(Protocol):
+    """Anything SimLink can carry: takes outputs, advances dt, returns inputs."""
+
+    name: str
+
+    def exchange(self, rx: Any, dt: float) -> Any: ...
+
+
+@dataclass
+class SimLink:
+    slaves: Sequence[SimSlave]
+    cycle_time: float = 0.001
+    time: float = 0.0
+    cycles: int = 0
+    infos: list[SlaveInfo] = field(default_factory=list)
+
+    def open(self) -> list[SlaveInfo]:
+        self.infos = [SlaveInfo(i, s.name, getattr(s, "kind", "drive"), 0x000001DD, 0, "OP", "sim")
+                      for i, s in enumerate(self.slaves)]
+        return self.infos
+
+    def exchange(self, outputs: Sequence[Any]) -> list[Any]:
+        if len(outputs) != len(self.slaves):
+            raise ValueError(f"{len(outputs)} output images for {len(self.slaves)} slaves")
+        inputs = [s.exchange(o, self.cycle_time) for s, o in zip(self.slaves, outputs)]
+        self.time += self.cycle_time
+        self.cycles += 1
+        return inputs
+
+    def close(self) -> None:
+        pass

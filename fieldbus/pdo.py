@@ -1,0 +1,133 @@
+"""Process data: the per-cycle images exchanged with a CiA 402 drive, and PDO layouts that say
+which objects travel and how they pack on the wire.
+
+The Delta ASDA preset follows the objects a Delta ASDA-A2-E/A3-E drive maps for CSP
+(the same set lcec's `deasda` driver uses). Values are in drive units: positions in counts,
+velocities in counts/s, torque in 0.1 % of rated.
+"""
+
+from __future__ import annotations
+
+import struct
+from dataclasses import dataclass, field
+
+
+@dataclass(slots=True)
+class RxPdo:
+    """Master → drive, one per drive per cycle."""
+
+    controlword: int = 0  # 0x6040
+    target_position: int = 0  # 0x607A, counts
+    mode: int = 8  # 0x6060 (8 = CSP, 9 = CSV, 6 = homing)
+    target_velocity: int = 0  # 0x60FF, counts/s (CSV)
+    touch_probe_function: int = 0  # 0x60B8
+    digital_outputs: int = 0  # 0x60FE:1
+
+
+@dataclass(slots=True)
+class TxPdo:
+    """Drive → master, one per drive per cycle."""
+
+    statusword: int = 0  # 0x6041
+    position_actual: int = 0  # 0x6064, counts
+    velocity_actual: int = 0  # 0x606C, counts/s
+    torque_actual: int = 0  # 0x6077, 0.1 % of rated
+    following_error: int = 0  # 0x60F4, counts
+    error_code: int = 0  # 0x603F
+    mode_display: int = 0  # 0x6061
+    touch_probe_status: int = 0  # 0x60B9
+    touch_probe_pos1: int = 0  # 0x60BA, counts
+    digital_inputs: int = 0  # 0x60FD (bit0 negative limit, bit1 positive limit, bit2 home)
+
+
+@dataclass(frozen=True, slots=True)
+class PdoEntry:
+    index: int
+    subindex: int
+    bits: int
+    attr: str  # RxPdo / TxPdo field it carries
+    signed: bool = False
+
+    @property
+    def struct_code(self) -> str:
+        codes = {8: "b", 16: "h", 32: "i"}
+        c = codes[self.bits]
+        return c if self.signed else c.upper()
+
+
+@dataclass(frozen=True)
+class PdoLayout:
+    """An ordered RxPDO and TxPDO mapping, packed little-endian as EtherCAT and CANopen do."""
+
+    name: str
+    rx: tuple[PdoEntry, ...]
+    tx: tuple[PdoEntry, ...]
+    rx_struct: struct.Struct = field(init=False, repr=False, compare=False)
+    tx_struct: struct.Struct = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "rx_struct", struct.Struct("<" + "".join(e.struct_code for e in self.rx)))
+        object.__setattr__(self, "tx_struct", struct.Struct("<" + "".join(e.struct_code for e in self.tx)))
+
+    @property
+    def rx_bytes(self) -> int:
+        return self.rx_struct.size
+
+    @property
+    def tx_bytes(self) -> int:
+        return self.tx_struct.size
+
+    def pack_rx(self, pdo: RxPdo) -> bytes:
+        return self.rx_struct.pack(*(_fit(getattr(pdo, e.attr), e) for e in self.rx))
+
+    def unpack_rx(self, data: bytes, into: RxPdo | None = None) -> RxPdo:
+        pdo = into or RxPdo()
+        for e, v in zip(self.rx, self.rx_struct.unpack(data[: self.rx_bytes])):
+            setattr(pdo, e.attr, v)
+        return pdo
+
+    def pack_tx(self, pdo: TxPdo) -> bytes:
+        return self.tx_struct.pack(*(_fit(getattr(pdo, e.attr), e) for e in self.tx))
+
+    def unpack_tx(self, data: bytes, into: TxPdo | None = None) -> TxPdo:
+        pdo = into or TxPdo()
+        for e, v in zip(self.tx, self.tx_struct.unpack(data[: self.tx_bytes])):
+            setattr(pdo, e.attr, v)
+        return pdo
+
+
+def _fit(value: int, e: PdoEntry) -> int:
+    """Wrap to the entry's width the way the drive's registers would."""
+    v = int(value) & ((1 << e.bits) - 1)
+    if e.signed and v >= 1 << (e.bits - 1):
+        v -= 1 << e.bits
+    return v
+
+
+_RX_CSP = (
+    PdoEntry(0x6040, 0, 16, "controlword"),
+    PdoEntry(0x607A, 0, 32, "target_position", True),
+    PdoEntry(0x6060, 0, 8, "mode", True),
+)
+_TX_CSP = (
+    PdoEntry(0x6041, 0, 16, "statusword"),
+    PdoEntry(0x6064, 0, 32, "position_actual", True),
+    PdoEntry(0x606C, 0, 32, "velocity_actual", True),
+    PdoEntry(0x6077, 0, 16, "torque_actual", True),
+    PdoEntry(0x60F4, 0, 32, "following_error", True),
+    PdoEntry(0x603F, 0, 16, "error_code"),
+)
+
+# The preset named in the foundation issue: CSP objects only.
+ASDA_CSP = PdoLayout("asda-csp", _RX_CSP, _TX_CSP)
+
+# Spindle / C-axis drives switch between CSV and CSP, so they also carry target velocity,
+# the mode display and the touch probe (index latch) objects.
+ASDA_CSP_CSV = PdoLayout(
+    "asda-csp-csv",
+    _RX_CSP + (PdoEntry(0x60FF, 0, 32, "target_velocity", True), PdoEntry(0x60B8, 0, 16, "touch_probe_function")),
+    _TX_CSP + (PdoEntry(0x6061, 0, 8, "mode_display", True), PdoEntry(0x60B9, 0, 16, "touch_probe_status"),
+               PdoEntry(0x60BA, 0, 32, "touch_probe_pos1", True), PdoEntry(0x60FD, 0, 32, "digital_inputs")),
+)
+
+LAYOUTS: dict[str, PdoLayout] = {l.name: l for l in (ASDA_CSP, ASDA_CSP_CSV)}

@@ -1,0 +1,58 @@
+"""The `hil` command line. Each subcommand lives in `hil.commands.<name>` and registers itself,
+so capabilities can be added without touching this file.
+
+Exit codes: 0 success, 1 the run or program raised an alarm or a check failed, 2 bad usage or
+a bad input file. No Python traceback reaches the user: an unexpected error is reported as
+NC internal alarm 0x0000.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import pkgutil
+import sys
+from collections.abc import Sequence
+
+import hil.commands
+from nc.alarms import internal_error
+
+EXIT_OK, EXIT_ALARM, EXIT_USAGE = 0, 1, 2
+
+
+class UsageError(Exception):
+    """Bad arguments or a bad input file: exit 2 with a message naming what is wrong."""
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="hil", description="Delta NC5 hardware-in-the-loop bench driver")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    sub.required = True
+    for mod in sorted(pkgutil.iter_modules(hil.commands.__path__), key=lambda m: m.name):
+        module = importlib.import_module(f"hil.commands.{mod.name}")
+        register = getattr(module, "register", None)
+        if register is not None:
+            register(sub)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return int(args.func(args) or 0)
+    except UsageError as exc:
+        print(f"hil {args.command}: {exc}", file=sys.stderr)
+        return EXIT_USAGE
+    except KeyboardInterrupt:
+        print("hil: interrupted", file=sys.stderr)
+        return 130
+    except BrokenPipeError:
+        return EXIT_OK
+    except Exception as exc:  # never a traceback: report as the NC's internal alarm
+        print(str(internal_error(exc)), file=sys.stderr)
+        return EXIT_ALARM
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,226 @@
+"""The bench cycle: receive feedback → MLC scan → NC channel step → send setpoints, once per cycle.
+
+In lock-step mode the link advances simulated time by exactly one cycle per exchange, so a run
+is deterministic and faster than real time.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from fieldbus.cia402 import SW_INTERNAL_LIMIT, Cia402Master, State, Target
+from fieldbus.link import BusError, BusLink
+from fieldbus.pdo import RxPdo, TxPdo
+from hil.bench import Bench
+from hil.trace import TraceWriter
+from mlc.basic import BasicMlc
+from nc.alarms import SERVO_ALARM, Alarm, NcAlarm, internal_error
+from nc.channel import Channel, RunState
+from nc.interp import Interpreter
+from nc.motion import Planner
+from nc.moves import Event
+from nc.profiles import make_profile
+from nc.program import Program
+
+MODE_CSP = 8
+MODE_CSV = 9
+
+
+@dataclass
+class RunResult:
+    cycles: int = 0
+    sim_time: float = 0.0
+    program_time: float = 0.0
+    enable_cycles: int = 0
+    max_ferr: dict[str, float] = field(default_factory=dict)
+    final: dict[str, float] = field(default_factory=dict)
+    alarms: list[Alarm] = field(default_factory=list)
+    finished: bool = False
+
+    @property
+    def ok(self) -> bool:
+        return self.finished and not self.alarms
+
+
+class BenchRunner:
+    def __init__(self, bench: Bench, link: BusLink, trace: TraceWriter | None = None, mlc: BasicMlc | None = None,
+                 on_cycle: Callable[["BenchRunner"], None] | None = None) -> None:
+        self.bench = bench
+        self.link = link
+        self.trace = trace
+        self.mlc = mlc or BasicMlc(max_rpm=min((s.max_rpm for s in bench.spindles), default=6000.0))
+        self.on_cycle = on_cycle
+        self.axes = bench.axis_names
+        n_axes, n_sp = len(bench.axes), len(bench.spindles)
+        self.masters = [Cia402Master() for _ in range(n_axes + n_sp)]
+        self.rx = [RxPdo(mode=MODE_CSP) for _ in range(n_axes)] + [RxPdo(mode=MODE_CSV) for _ in range(n_sp)]
+        self.tx: list[TxPdo] = [TxPdo() for _ in self.rx]
+        self.scales = [a.scaling for a in bench.axes] + [s.scaling for s in bench.spindles]
+        self.result = RunResult(max_ferr={a: 0.0 for a in self.axes})
+        self.channel: Channel | None = None
+        self.cycle = 0
+        self.time = 0.0
+        self.line = 0
+        self.actual = np.zeros(n_axes)
+        self._alarmed_drives: set[int] = set()
+        self._commands = np.zeros(n_axes)
+
+    # ---- public ---------------------------------------------------------------------------
+    def run_program(self, program: Program) -> RunResult:
+        try:
+            if not self.power_up():
+                return self._finish()
+            profile = make_profile(self.bench.profile, self.axes, self.bench.params)
+            start = dict(zip(self.axes, self.actual.tolist()))
+            interp = Interpreter(profile, start)
+            self.run_events(interp.run(program))
+        except BusError as exc:
+            self._alarm(exc.alarm)
+        except NcAlarm as exc:
+            self._alarm(exc.alarm)
+        finally:
+            self._shutdown()
+        return self._finish()
+
+    def power_up(self) -> bool:
+        """Bring every drive to operation enabled, one state-machine step per cycle."""
+        self.link.open()
+        for m in self.masters:
+            m.request(Target.ENABLED)
+        limit = max(1, int(round(self.bench.enable_timeout / self.bench.cycle)))
+        for _ in range(limit):
+            self._exchange()
+            if all(m.enabled for m in self.masters):
+                self.result.enable_cycles = self.cycle
+                return True
+            if any(m.faulted for m in self.masters):
+                break
+        bad = [self._name(i) for i, m in enumerate(self.masters) if not m.enabled]
+        states = ", ".join(f"{self._name(i)}: {self.masters[i].state.value}" for i in range(len(self.masters))
+                           if not self.masters[i].enabled)
+        self._alarm(Alarm(0x0A07, f"servo not ready: {states} after {self.cycle} cycles", axis=bad[0]))
+        return False
+
+    def run_events(self, events: Iterator[Event]) -> None:
+        planner = Planner(self.bench.motion_config(), dict(zip(self.axes, self.actual.tolist())),
+                          spindle_rpm=lambda: self.mlc.spindle.rpm)
+        self.channel = ch = Channel(planner)
+        for a in self.result.alarms:
+            ch.alarms.append(a)
+        ch.load(events)
+        ch.cycle_start()
+        t0 = self.time
+        max_cycles = int(self.bench.max_time / self.bench.cycle)
+        while ch.busy:
+            self._exchange()
+            if self.cycle >= max_cycles:
+                ch.raise_alarm(Alarm(0x0000, f"run exceeded the bench's max_time of {self.bench.max_time:g} s"))
+                break
+        self.result.program_time = self.time - t0
+        self.result.finished = ch.state is RunState.FINISHED
+        self._settle()
+
+    # ---- the cycle ------------------------------------------------------------------------
+    def _exchange(self) -> None:
+        self.tx = self.link.exchange(self.rx)
+        self.cycle += 1
+        self.time += self.bench.cycle
+        n_axes = len(self.axes)
+        for i, (m, tx) in enumerate(zip(self.masters, self.tx)):
+            self.rx[i].controlword = m.step(tx.statusword)
+            if m.faulted and i not in self._alarmed_drives:
+                self._alarmed_drives.add(i)
+                self._alarm(Alarm(SERVO_ALARM, f"servo alarm on {self._name(i)}: drive error code 0x{tx.error_code:04X}",
+                                  line=self.line or None, axis=self._name(i), info=tx.error_code))
+            if tx.statusword & SW_INTERNAL_LIMIT and i < n_axes and i not in self._alarmed_drives:
+                self._alarmed_drives.add(i)
+                self._alarm(Alarm(0x0402, f"hardware limit reached on axis {self._name(i)}", line=self.line or None,
+                                  axis=self._name(i)))
+        for i in range(n_axes):
+            self.actual[i] = self.scales[i].to_units(self.tx[i].position_actual)
+        ch = self.channel
+        if ch is not None:
+            self.mlc.scan(ch)
+            sp = ch.step()
+            self._commands[:] = sp.positions
+            self.line = sp.line or self.line
+        for i in range(n_axes):
+            m, rx = self.masters[i], self.rx[i]
+            if m.enabled and ch is not None:
+                rx.target_position = self.scales[i].to_counts(self._commands[i])
+            else:
+                # Not enabled: follow the actual position so enabling never jumps.
+                rx.target_position = self.tx[i].position_actual
+                self._commands[i] = self.actual[i]
+            ferr = abs(self.scales[i].to_units(self.tx[i].following_error))
+            if ferr > self.result.max_ferr[self.axes[i]]:
+                self.result.max_ferr[self.axes[i]] = ferr
+        for k, sc in enumerate(self.scales[n_axes:]):
+            rpm = self.mlc.spindle.signed_rpm if (ch is not None and ch.state is not RunState.ALARM) else 0.0
+            self.rx[n_axes + k].target_velocity = sc.rpm_to_counts_per_s(rpm)
+        if self.trace is not None:
+            self.trace.write(self._row())
+        if self.on_cycle is not None:
+            self.on_cycle(self)
+
+    def _row(self) -> list:
+        row: list = [f"{self.time:.6f}", self.line]
+        n_axes = len(self.axes)
+        for i in range(n_axes):
+            tx, sc = self.tx[i], self.scales[i]
+            row += [f"{self._commands[i]:.6f}", f"{self.actual[i]:.6f}", f"{sc.to_units(tx.velocity_actual):.4f}",
+                    f"{tx.torque_actual / 10.0:.2f}", f"{sc.to_units(tx.following_error):.6f}", tx.statusword]
+        for k, sc in enumerate(self.scales[n_axes:]):
+            tx = self.tx[n_axes + k]
+            row += [f"{sc.counts_per_s_to_rpm(self.rx[n_axes + k].target_velocity):.2f}",
+                    f"{sc.counts_per_s_to_rpm(tx.velocity_actual):.2f}", f"{tx.torque_actual / 10.0:.2f}", tx.statusword]
+        return row
+
+    # ---- endings ---------------------------------------------------------------------------
+    def _alarm(self, alarm: Alarm) -> None:
+        if self.channel is not None:
+            self.channel.raise_alarm(alarm)
+        self.result.alarms.append(alarm)
+
+    def _settle(self) -> None:
+        """Keep cycling on the final setpoints until the axes stand still (or the settle time ends)."""
+        for _ in range(int(self.bench.settle_time / self.bench.cycle)):
+            self._exchange()
+            still = all(abs(tx.velocity_actual) < 1 and abs(tx.following_error) <= 1 for tx in self.tx[: len(self.axes)])
+            if still:
+                break
+
+    def _shutdown(self) -> None:
+        """Disable every drive in order (operation enabled → ready → switch on disabled)."""
+        for m in self.masters:
+            m.request(Target.DISABLED)
+        try:
+            for _ in range(20):
+                self._exchange()
+                if all(m.state in (State.SWITCH_ON_DISABLED, State.READY_TO_SWITCH_ON, State.FAULT) for m in self.masters):
+                    break
+        except BusError as exc:
+            self.result.alarms.append(exc.alarm)
+        try:
+            self.link.close()
+        finally:
+            if self.trace is not None:
+                self.trace.close()
+
+    def _finish(self) -> RunResult:
+        r = self.result
+        r.cycles = self.cycle
+        r.sim_time = self.time
+        r.final = dict(zip(self.axes, self.actual.tolist()))
+        if self.channel is not None:
+            for a in self.channel.alarms:
+                if a not in r.alarms:
+                    r.alarms.append(a)
+        return r
+
+    def _name(self, i: int) -> str:
+        n = len(self.axes)
+        return self.axes[i] if i < n else self.bench.spindles[i - n].name

@@ -1,0 +1,92 @@
+"""What the subcommands share: loading programs and benches, making links, printing alarms."""
+
+from __future__ import annotations
+
+import json
+import sys
+from dataclasses import replace
+from pathlib import Path
+
+from fieldbus.factory import parse_bus
+from fieldbus.link import BusLink, SimLink
+from fieldbus.pdo import RxPdo
+from hil.bench import Bench, default_lathe
+from nc.alarms import Alarm, NcAlarm
+from nc.profiles import PROFILE_NAMES
+from nc.program import Program, parse_program
+from virtual_bus.drive import Cia402Drive
+
+
+class InputError(Exception):
+    """A program, bench or bus that cannot be used; carries a Delta alarm where one applies."""
+
+    def __init__(self, message: str, alarm: Alarm | None = None) -> None:
+        self.alarm = alarm
+        super().__init__(message)
+
+
+def load_program(path: str) -> Program:
+    p = Path(path)
+    try:
+        text = p.read_text(encoding="utf-8", errors="replace")
+    except OSError as exc:
+        raise NcAlarm(0x0002, f"program file {path} cannot be read: {exc.strerror}", program=p.name) from None
+    try:
+        return parse_program(text, name=p.name)
+    except NcAlarm as exc:
+        raise exc.at(None, None, p.name)
+
+
+def load_bench(path: str | None, profile: str | None = None, bus: str | None = None) -> Bench:
+    if path:
+        from hil.bench_file import load_bench_file  # TOML loader
+
+        bench = load_bench_file(path)
+    else:
+        bench = default_lathe()
+    if profile:
+        if profile not in PROFILE_NAMES:
+            raise InputError(f"unknown profile {profile!r}; choose one of {', '.join(PROFILE_NAMES)}")
+        bench.profile = profile
+    if bus:
+        bench.bus = bus
+    return bench
+
+
+def sim_slaves(bench: Bench) -> list[Cia402Drive]:
+    """Virtual drives for every axis and spindle, at the bench's power-on positions."""
+    drives = []
+    for a in bench.axes:
+        d = Cia402Drive(params=replace(a.drive, counts_per_rev=a.scaling.counts_per_rev), name=a.name)
+        d.position = float(a.scaling.to_counts(a.start))
+        d.command = d.position
+        drives.append(d)
+    for s in bench.spindles:
+        d = Cia402Drive(params=replace(s.drive, counts_per_rev=s.scaling.counts_per_rev), name=s.name, mode=9)
+        d.apply(RxPdo(mode=9))
+        drives.append(d)
+    return drives
+
+
+def make_link(bench: Bench) -> BusLink:
+    try:
+        spec = parse_bus(bench.bus)
+    except ValueError as exc:
+        raise InputError(str(exc)) from None
+    if spec.kind == "sim":
+        return SimLink(sim_slaves(bench), bench.cycle)
+    if spec.kind == "ethercat":
+        from fieldbus.ethercat.link import EthercatLink
+
+        return EthercatLink.for_bench(bench, spec.interface)
+    from fieldbus.canopen.link import CanopenLink
+
+    return CanopenLink.for_bench(bench, spec.interface, spec.channel)
+
+
+def print_alarm(alarm: Alarm, as_json: bool = False, stream=None) -> None:
+    stream = stream or (sys.stdout if as_json else sys.stderr)
+    if as_json:
+        print(json.dumps(alarm.as_dict()), file=stream)
+    else:
+        print(str(alarm), file=stream)

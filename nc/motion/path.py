@@ -1,0 +1,88 @@
+"""Path geometry of one move as a function of path length s, evaluated for many s at once."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from nc.interp.arcs import sweep
+from nc.moves import Move
+
+
+@dataclass
+class Segment:
+    """A line or a helical arc through the channel axes, parametrised by path length."""
+
+    axes: tuple[str, ...]
+    start: np.ndarray
+    end: np.ndarray
+    length: float
+    kind: str  # "line" or "arc"
+    # arc data (plane axis indices, centre in the plane, radius, start angle, sweep)
+    i1: int = 0
+    i2: int = 0
+    center: tuple[float, float] = (0.0, 0.0)
+    radius: float = 0.0
+    a0: float = 0.0
+    theta: float = 0.0
+    arc_len: float = 0.0
+
+    @classmethod
+    def of(cls, move: Move, axes: tuple[str, ...]) -> "Segment":
+        s = np.array([move.start.get(a, 0.0) for a in axes], dtype=float)
+        e = np.array([move.end.get(a, 0.0) for a in axes], dtype=float)
+        if move.kind != "arc" or move.center is None:
+            return cls(axes, s, e, float(np.linalg.norm(e - s)), "line")
+        p1, p2 = move.plane
+        i1, i2 = axes.index(p1), axes.index(p2)
+        c = (move.center[p1], move.center[p2])
+        theta = sweep((s[i1], s[i2]), (e[i1], e[i2]), c, move.dir == "cw")
+        r = math.hypot(s[i1] - c[0], s[i2] - c[1])
+        a0 = math.atan2(s[i2] - c[1], s[i1] - c[0])
+        arc_len = abs(theta) * r
+        lin = e - s
+        lin[i1] = lin[i2] = 0.0
+        length = math.hypot(arc_len, float(np.linalg.norm(lin)))
+        return cls(axes, s, e, length, "arc", i1, i2, c, r, a0, theta, arc_len)
+
+    def points(self, s: np.ndarray) -> np.ndarray:
+        """Positions (len(s) × axes) at path lengths s."""
+        s = np.asarray(s, dtype=float)
+        if self.length <= 0.0:
+            return np.repeat(self.start[None, :], len(s), axis=0)
+        u = (s / self.length)[:, None]
+        p = self.start[None, :] + u * (self.end - self.start)[None, :]
+        if self.kind == "arc":
+            ang = self.a0 + self.theta * u[:, 0]
+            p[:, self.i1] = self.center[0] + self.radius * np.cos(ang)
+            p[:, self.i2] = self.center[1] + self.radius * np.sin(ang)
+        return p
+
+    def unit_tangent(self, at_end: bool) -> np.ndarray:
+        """Direction of travel (per unit path length) at the start or end."""
+        if self.length <= 0.0:
+            return np.zeros(len(self.axes))
+        d = (self.end - self.start) / self.length
+        if self.kind == "arc":
+            ang = self.a0 + (self.theta if at_end else 0.0)
+            k = self.theta * self.radius / self.length
+            d = d.copy()
+            d[self.i1] = -math.sin(ang) * k
+            d[self.i2] = math.cos(ang) * k
+        return d
+
+    def max_direction_cosines(self) -> np.ndarray:
+        """Largest |d axis / d s| over the segment, per axis (for projecting axis limits)."""
+        if self.length <= 0.0:
+            return np.zeros(len(self.axes))
+        d = np.abs((self.end - self.start) / self.length)
+        if self.kind == "arc":
+            k = abs(self.theta) * self.radius / self.length
+            d[self.i1] = d[self.i2] = k  # a swept arc may pass through any direction: be safe
+            if abs(self.theta) < math.pi:
+                a = np.linspace(self.a0, self.a0 + self.theta, 33)
+                d[self.i1] = float(np.max(np.abs(np.sin(a)))) * k
+                d[self.i2] = float(np.max(np.abs(np.cos(a)))) * k
+        return d

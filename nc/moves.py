@@ -1,0 +1,97 @@
+"""The canonical output of the interpreter: motion in machine coordinates plus auxiliary events.
+
+This is the narrow seam between `nc.interp` and everything downstream (`nc.motion`, `hil path`).
+Coordinates are machine coordinates per axis name, as the axis travels (a lathe X is a radius);
+``work`` is the end point as the program writes it in the active work system (X as a diameter
+in diameter mode).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Literal, Union
+
+MoveKind = Literal["rapid", "line", "arc", "thread", "dwell"]
+
+
+@dataclass(slots=True)
+class Move:
+    kind: MoveKind
+    line: int
+    block: str
+    start: dict[str, float]
+    end: dict[str, float]
+    work: dict[str, float]
+    center: dict[str, float] | None = None
+    dir: Literal["cw", "ccw"] | None = None
+    feed: float | None = None  # mm/min, or mm/rev when per_rev
+    duration: float | None = None  # dwell seconds
+    per_rev: bool = False
+    plane: tuple[str, str] = ("Z", "X")  # (first, second) axis of the arc plane
+    exact_stop: bool = False  # G09 / G61: stop at the end of this move
+    lead: float | None = None  # thread lead per spindle revolution (mm/rev)
+    lead_change: float = 0.0  # G34 lead increment per revolution
+    start_angle: float = 0.0  # thread start angle Q (degrees)
+    turns: float = 0.0  # helix: full turns in addition to the plane arc (G02/G03 with P)
+    program: str | None = None
+    tags: tuple[str, ...] = ()  # e.g. ("G71", "rough") so checks can tell passes apart
+
+    def as_dict(self) -> dict:
+        return {
+            "kind": self.kind,
+            "line": self.line,
+            "block": self.block,
+            "start": self.start,
+            "end": self.end,
+            "work": self.work,
+            "center": self.center,
+            "dir": self.dir,
+            "feed": self.feed,
+            "duration": self.duration,
+        }
+
+
+@dataclass(slots=True)
+class Aux:
+    """An M, S or T code (or G900 / spindle mode request) the MLC must acknowledge."""
+
+    kind: Literal["M", "S", "T", "G900"]
+    value: float
+    line: int
+    block: str
+    args: dict[str, float] = field(default_factory=dict)
+    wait: bool = True  # the block waits for the MLC finish signal
+    program: str | None = None
+
+    def as_dict(self) -> dict:
+        return {"kind": "aux", "code": self.kind, "value": self.value, "line": self.line,
+                "block": self.block, "args": self.args}
+
+
+@dataclass(slots=True)
+class Sync:
+    """A preview stop: the interpreter may not read further until motion has finished
+    (G05, G10, G31, G53, halt M codes, reads of live positions)."""
+
+    line: int
+    block: str
+    reason: str
+
+    def as_dict(self) -> dict:
+        return {"kind": "sync", "line": self.line, "block": self.block, "reason": self.reason}
+
+
+@dataclass(slots=True)
+class ProgramEnd:
+    """M02 / M30 (or end of file): the channel finishes once motion drains."""
+
+    line: int
+    block: str
+    code: int  # 2, 30, or 0 for the end of the text
+    rewind: bool = True
+
+    def as_dict(self) -> dict:
+        return {"kind": "end", "line": self.line, "block": self.block, "code": self.code}
+
+
+Event = Union[Move, Aux, Sync, ProgramEnd]

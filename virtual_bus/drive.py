@@ -1,0 +1,263 @@
+"""A CiA 402 servo drive model: the slave-side state machine, CSP and CSV modes, a cascaded
+position/velocity loop with second-order dynamics, feedback objects, travel limits and faults.
+
+Units are the drive's: counts, counts/s, torque in 0.1 % of rated. The physics is stepped in
+substeps per bus cycle so the velocity loop stays stable at any cycle time.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+from fieldbus.cia402 import (STATE_BITS, SW_FOLLOWING, SW_FOLLOWING_ERROR, SW_INTERNAL_LIMIT, SW_REMOTE,
+                             SW_TARGET_REACHED, SW_VOLTAGE, SW_QUICK_STOP, State, command_of)
+from fieldbus.pdo import RxPdo, TxPdo
+
+# Delta ASDA alarm numbers as the drive reports them in 0x603F (the NC shows 0xF002 + this code)
+AL_OVERSPEED = 0x0007
+AL_FOLLOWING_ERROR = 0x0009
+AL_REVERSE_LIMIT = 0x0014
+AL_FORWARD_LIMIT = 0x0015
+AL_EMERGENCY = 0x0013
+
+
+@dataclass
+class DriveParams:
+    counts_per_rev: int = 1_280_000
+    kp: float = 120.0  # position loop gain, 1/s (ASDA P2-00 style)
+    kff: float = 0.95  # velocity feed-forward fraction (P2-02 style)
+    velocity_bandwidth: float = 800.0  # rad/s of the velocity loop
+    max_speed_rpm: float = 5000.0
+    inertia: float = 1.0e-4  # kg·m², motor plus reflected load
+    rated_torque: float = 2.39  # N·m (750 W ASDA-A3 class)
+    viscous: float = 2.0e-4  # N·m per rad/s
+    coulomb: float = 0.05  # N·m
+    following_error_window: int = 3_840_000  # 0x6065 counts (3 motor revs)
+    quick_stop_decel: float = 2.0e8  # counts/s² (0x6085)
+    csv_accel: float = 5.0e7  # counts/s², the CSV ramp the drive applies (spindle)
+    negative_limit: int | None = None  # hardware limit switch positions in counts
+    positive_limit: int | None = None
+    home_switch: int | None = None  # counts where the home switch toggles (position < this reads active)
+    index_pulse_every: int | None = None  # counts between encoder index pulses; None = counts_per_rev
+    substeps: int = 4
+
+
+@dataclass
+class Cia402Drive:
+    params: DriveParams = field(default_factory=DriveParams)
+    name: str = "drive"
+    state: State = State.SWITCH_ON_DISABLED
+    position: float = 0.0  # counts (load side, as the encoder reads)
+    velocity: float = 0.0  # counts/s
+    acceleration: float = 0.0
+    command: float = 0.0  # interpolated position command, counts
+    target_velocity: float = 0.0
+    mode: int = 8
+    error_code: int = 0
+    torque: float = 0.0  # 0.1 % of rated
+    time: float = 0.0
+    external_fault: int = 0  # set by a test/fault injector: the drive faults with this code
+    _prev_target: float | None = None
+    _rx: RxPdo = field(default_factory=RxPdo)
+    _last_cw: int = 0
+    _probe_latched: bool = False
+    _probe_pos: int = 0
+    _limit_flags: int = 0
+
+    # ---- process data -----------------------------------------------------------------
+    def apply(self, rx: RxPdo) -> None:
+        """Latch the master's outputs (what a SYNC event does on a real drive)."""
+        self._rx = rx
+        self._state_machine(rx.controlword)
+        if rx.mode != self.mode:
+            self.mode = rx.mode
+            self._prev_target = None
+
+    def feedback(self) -> TxPdo:
+        sw = STATE_BITS[self.state] | SW_REMOTE
+        if self.state not in (State.SWITCH_ON_DISABLED, State.NOT_READY_TO_SWITCH_ON):
+            sw |= SW_VOLTAGE
+        if self.state is not State.QUICK_STOP_ACTIVE:
+            sw |= SW_QUICK_STOP if self.state is not State.FAULT else 0
+        if self.state is State.OPERATION_ENABLED:
+            sw |= SW_FOLLOWING
+            if abs(self.velocity) < 0.001 * self._max_cps and abs(self.command - self.position) < 10:
+                sw |= SW_TARGET_REACHED
+        if self._limit_flags:
+            sw |= SW_INTERNAL_LIMIT
+        if abs(self.command - self.position) > self.params.following_error_window:
+            sw |= SW_FOLLOWING_ERROR
+        di = self._limit_flags
+        if self.params.home_switch is not None and self.position < self.params.home_switch:
+            di |= 0x4
+        return TxPdo(
+            statusword=sw,
+            position_actual=int(round(self.position)),
+            velocity_actual=int(round(self.velocity)),
+            torque_actual=int(round(self.torque)),
+            following_error=int(round(self.command - self.position)) if self.mode == 8 else 0,
+            error_code=self.error_code,
+            mode_display=self.mode,
+            touch_probe_status=0x0003 if self._probe_latched else (0x0001 if self._rx.touch_probe_function & 1 else 0),
+            touch_probe_pos1=self._probe_pos,
+            digital_inputs=di,
+        )
+
+    def exchange(self, rx: RxPdo, dt: float) -> TxPdo:
+        self.apply(rx)
+        self.step(dt)
+        return self.feedback()
+
+    # ---- state machine ------------------------------------------------------------------
+    def _state_machine(self, cw: int) -> None:
+        cmd = command_of(cw)
+        rising_reset = bool(cw & 0x80) and not (self._last_cw & 0x80)
+        self._last_cw = cw
+        s = self.state
+        if s is State.FAULT:
+            if rising_reset and not self.external_fault:
+                self.error_code = 0
+                self.state = State.SWITCH_ON_DISABLED
+            return
+        if s is State.FAULT_REACTION_ACTIVE:
+            return
+        if cmd == "disable_voltage":
+            if s is not State.QUICK_STOP_ACTIVE or abs(self.velocity) < 1:
+                self.state = State.SWITCH_ON_DISABLED
+            return
+        if cmd == "quick_stop":
+            if s is State.OPERATION_ENABLED:
+                self.state = State.QUICK_STOP_ACTIVE
+            elif s in (State.READY_TO_SWITCH_ON, State.SWITCHED_ON):
+                self.state = State.SWITCH_ON_DISABLED
+            return
+        if cmd == "shutdown":
+            if s in (State.SWITCH_ON_DISABLED, State.SWITCHED_ON, State.OPERATION_ENABLED):
+                self.state = State.READY_TO_SWITCH_ON
+        elif cmd == "switch_on":
+            if s is State.READY_TO_SWITCH_ON:
+                self.state = State.SWITCHED_ON
+            elif s is State.OPERATION_ENABLED:
+                self.state = State.SWITCHED_ON
+        elif cmd == "enable_operation":
+            if s is State.SWITCHED_ON:
+                # The drive takes over the actual position so enabling never jumps.
+                self.command = self.position
+                self._prev_target = None
+                self.state = State.OPERATION_ENABLED
+            elif s is State.READY_TO_SWITCH_ON:
+                self.state = State.SWITCHED_ON
+
+    def fault(self, code: int) -> None:
+        if self.state not in (State.FAULT, State.FAULT_REACTION_ACTIVE):
+            self.error_code = code
+            self.state = State.FAULT_REACTION_ACTIVE
+
+    # ---- physics ------------------------------------------------------------------------
+    @property
+    def _max_cps(self) -> float:
+        return self.params.max_speed_rpm / 60.0 * self.params.counts_per_rev
+
+    @property
+    def _counts_to_rad(self) -> float:
+        return 2.0 * math.pi / self.params.counts_per_rev
+
+    def step(self, dt: float) -> None:
+        p = self.params
+        if self.external_fault:
+            self.fault(self.external_fault)
+        n = max(1, p.substeps)
+        h = dt / n
+        energised = self.state in (State.OPERATION_ENABLED, State.QUICK_STOP_ACTIVE, State.FAULT_REACTION_ACTIVE)
+        target = float(self._rx.target_position)
+        # CSP: the drive's interpolator spreads the new target over the cycle.
+        if self.state is State.OPERATION_ENABLED and self.mode == 8:
+            prev = self._prev_target if self._prev_target is not None else self.command
+            ff_vel = (target - prev) / dt
+            self._prev_target = target
+        else:
+            prev = target = self.command
+            ff_vel = 0.0
+        v_before = self.velocity
+        for k in range(1, n + 1):
+            if not energised:
+                # Brake engaged / motor free: friction stops it within a few ms.
+                self.velocity *= math.exp(-h * 400.0)
+                v_cmd = self.velocity
+                self.command = self.position
+            elif self.state is State.OPERATION_ENABLED and self.mode == 8:
+                self.command = prev + (target - prev) * k / n
+                v_cmd = p.kff * ff_vel + p.kp * (self.command - self.position)
+            elif self.state is State.OPERATION_ENABLED and self.mode == 9:
+                want = float(self._rx.target_velocity)
+                step = p.csv_accel * h
+                self.target_velocity += max(-step, min(step, want - self.target_velocity))
+                v_cmd = self.target_velocity
+                self.command = self.position
+            else:  # quick stop or fault reaction: ramp down at the quick-stop deceleration
+                step = p.quick_stop_decel * h
+                v_cmd = self.velocity - max(-step, min(step, self.velocity))
+                self.command = self.position
+            v_cmd = max(-self._max_cps, min(self._max_cps, v_cmd))
+            if energised:
+                alpha = 1.0 - math.exp(-p.velocity_bandwidth * h)
+                self.velocity += (v_cmd - self.velocity) * alpha
+            new_pos = self.position + self.velocity * h
+            new_pos = self._limit(new_pos)
+            self._probe(self.position, new_pos)
+            self.position = new_pos
+            self.time += h
+        self.acceleration = (self.velocity - v_before) / dt
+        rad = self._counts_to_rad
+        torque_nm = (p.inertia * self.acceleration * rad + p.viscous * self.velocity * rad
+                     + (math.copysign(p.coulomb, self.velocity) if abs(self.velocity) > 1 else 0.0))
+        self.torque = torque_nm / p.rated_torque * 1000.0 if energised else 0.0
+        self._supervise()
+
+    def _limit(self, new_pos: float) -> float:
+        p = self.params
+        self._limit_flags = 0
+        if p.negative_limit is not None and new_pos <= p.negative_limit:
+            self._limit_flags |= 0x1
+            if new_pos < self.position or new_pos < p.negative_limit:
+                new_pos = max(new_pos, min(self.position, float(p.negative_limit)))
+                self.velocity = max(self.velocity, 0.0)
+                self.error_code = AL_REVERSE_LIMIT
+        if p.positive_limit is not None and new_pos >= p.positive_limit:
+            self._limit_flags |= 0x2
+            if new_pos > self.position or new_pos > p.positive_limit:
+                new_pos = min(new_pos, max(self.position, float(p.positive_limit)))
+                self.velocity = min(self.velocity, 0.0)
+                self.error_code = AL_FORWARD_LIMIT
+        if not self._limit_flags and self.error_code in (AL_REVERSE_LIMIT, AL_FORWARD_LIMIT) \
+                and self.state is not State.FAULT:
+            self.error_code = 0
+        return new_pos
+
+    def _probe(self, old: float, new: float) -> None:
+        """Touch probe 1 latches the encoder index (0x60B8 bit 0 enable, bit 2 = index source)."""
+        tp = self._rx.touch_probe_function
+        if not tp & 1:
+            self._probe_latched = False
+            return
+        if self._probe_latched:
+            return
+        every = self.params.index_pulse_every or self.params.counts_per_rev
+        a, b = math.floor(old / every), math.floor(new / every)
+        if a != b:
+            edge = max(a, b) * every
+            self._probe_pos = int(edge)
+            self._probe_latched = True
+
+    def _supervise(self) -> None:
+        p = self.params
+        if self.state is State.OPERATION_ENABLED and self.mode == 8:
+            if abs(self.command - self.position) > p.following_error_window:
+                self.fault(AL_FOLLOWING_ERROR)
+        if abs(self.velocity) > 1.2 * self._max_cps:
+            self.fault(AL_OVERSPEED)
+        if self.state is State.QUICK_STOP_ACTIVE and abs(self.velocity) < 1:
+            self.state = State.SWITCH_ON_DISABLED
+        if self.state is State.FAULT_REACTION_ACTIVE and abs(self.velocity) < 1:
+            self.state = State.FAULT
