@@ -35,6 +35,10 @@ class Move:
     turns: float = 0.0  # helix: full turns in addition to the plane arc (G02/G03 with P)
     program: str | None = None
     tags: tuple[str, ...] = ()  # e.g. ("G71", "rough") so checks can tell passes apart
+    comp: str | None = None  # "G41" / "G42" while tool radius compensation is active for this move
+    comp_radius: float = 0.0  # nose / cutter radius in effect (mm)
+    tip: int = 0  # lathe imaginary tool-tip number 0-9
+    css: float | None = None  # G96 surface speed (m/min) in effect, None under G97
 
     def as_dict(self) -> dict:
         return {
