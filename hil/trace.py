@@ -30,6 +30,7 @@ class CsvTrace:
         self.columns = columns
         # Written to a side file and renamed on close, so a failed run never leaves half a trace
         # that looks complete.
+        self.path.parent.mkdir(parents=True, exist_ok=True)
         self._tmp = self.path.with_name(self.path.name + ".part")
         self._fh: IO[str] = open(self._tmp, "w", newline="")
         self._w = csv.writer(self._fh)

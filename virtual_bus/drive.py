@@ -195,12 +195,13 @@ class Cia402Drive:
                 self.target_velocity += max(-step, min(step, want - self.target_velocity))
                 v_cmd = self.target_velocity
                 self.command = self.position
-            else:  # quick stop or fault reaction: ramp down at the quick-stop deceleration
+            else:  # quick stop or fault reaction: the drive ramps speed down itself at 0x6085
                 step = p.quick_stop_decel * h
-                v_cmd = self.velocity - max(-step, min(step, self.velocity))
+                self.velocity -= max(-step, min(step, self.velocity))
+                v_cmd = self.velocity
                 self.command = self.position
             v_cmd = max(-self._max_cps, min(self._max_cps, v_cmd))
-            if energised:
+            if energised and v_cmd != self.velocity:
                 alpha = 1.0 - math.exp(-p.velocity_bandwidth * h)
                 self.velocity += (v_cmd - self.velocity) * alpha
             new_pos = self.position + self.velocity * h
