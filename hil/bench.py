@@ -16,6 +16,9 @@ class AxisConfig:
     limits: AxisLimits = field(default_factory=AxisLimits)
     drive: DriveParams = field(default_factory=DriveParams)
     start: float = 0.0  # machine position of the simulated axis at power-on, mm
+    units: str = "mm"  # "mm" (linear) or "deg" (rotary)
+    soft_limits: tuple[float, float] | None = None  # machine-coordinate travel window, units
+    drive_model: str = "asda-a3"
 
 
 @dataclass
@@ -24,6 +27,37 @@ class SpindleConfig:
     scaling: AxisScaling = field(default_factory=lambda: AxisScaling(counts_per_rev=1_280_000, lead=360.0))
     max_rpm: float = 4000.0
     drive: DriveParams = field(default_factory=lambda: DriveParams(max_speed_rpm=6000.0, csv_accel=1.0e8))
+
+
+@dataclass
+class ChecksConfig:
+    """Pass/fail limits a run (or `hil check`) is judged by; None leaves a check out."""
+
+    max_following_error: dict[str, float] = field(default_factory=dict)  # axis → mm
+    contour_error: float | None = None  # mm from the programmed path
+    limits: bool = False  # setpoint v/a/j within the axes' limits
+    limit_tolerance: float = 0.02  # fraction above a limit still accepted (numeric differentiation noise)
+    thread_phase: float | None = None  # degrees: max spread of spindle angle at each thread pass start
+    jitter_p99: float | None = None  # s of |period - cycle|
+    jitter_p999: float | None = None
+    jitter_max: float | None = None
+
+    @property
+    def any(self) -> bool:
+        return bool(self.max_following_error or self.contour_error is not None or self.limits
+                    or self.thread_phase is not None or self.jitter_p99 is not None
+                    or self.jitter_p999 is not None or self.jitter_max is not None)
+
+
+@dataclass
+class RealtimeConfig:
+    """How the real-time pacer asks the system for determinism, and what an overrun does."""
+
+    priority: int = 80  # SCHED_FIFO priority (1..99)
+    cpu: int | None = None  # CPU to pin the cycle thread to
+    busy_wait: float = 0.0002  # s spun on the clock before each deadline instead of sleeping
+    overrun: str = "warn"  # "warn" or "alarm"
+    lock_memory: bool = True  # mlockall so page faults don't hit the cycle
 
 
 @dataclass
@@ -38,6 +72,10 @@ class Bench:
     enable_timeout: float = 0.5  # s allowed for every drive to reach operation enabled
     settle_time: float = 0.3  # s the bench keeps cycling after the program to let axes settle
     max_time: float = 3600.0  # s of simulated time before the run is abandoned with an alarm
+    mlc: str = "basic"  # MLC logic: "basic", "package.module[:attr]" or a path to a .py file
+    checks: ChecksConfig = field(default_factory=ChecksConfig)
+    realtime: RealtimeConfig = field(default_factory=RealtimeConfig)
+    source: str = ""  # the bench file this came from, for messages
 
     @property
     def axis_names(self) -> tuple[str, ...]:

@@ -1,0 +1,362 @@
+"""Bench files (TOML): read, validate every field, build a `Bench`.
+
+Every error names the file and the field path (`axes[1].counts_per_rev`) with what was expected
+and what was found; unknown keys are errors too, because a misspelt key silently ignored is how a
+bench ends up running with a default nobody chose. All problems in a file are reported at once.
+See docs/guide/bench-file.md for the format.
+"""
+
+from __future__ import annotations
+
+import tomllib
+from dataclasses import fields
+from pathlib import Path
+from typing import Any
+
+from fieldbus.factory import parse_bus
+from fieldbus.units import AxisScaling
+from hil.bench import AxisConfig, Bench, ChecksConfig, RealtimeConfig, SpindleConfig
+from hil.session import InputError
+from nc.motion.limits import AxisLimits
+from nc.profiles import PROFILE_NAMES
+from virtual_bus.drive import DriveParams
+
+AXIS_LETTERS = "XYZABCUVW"
+# DriveParams fields a bench may override, with whether they are integers (counts) or reals.
+_DRIVE_INT = {"following_error_window", "negative_limit", "positive_limit", "home_switch", "index_pulse_every",
+              "substeps"}
+_DRIVE_KEYS = {f.name for f in fields(DriveParams)} - {"counts_per_rev"}
+
+
+class BenchFileError(InputError):
+    """A bench file that cannot be used; `errors` holds one `path: message` per bad field."""
+
+    def __init__(self, source: str, errors: list[str]) -> None:
+        self.errors = errors
+        super().__init__("\n".join(f"{source}: {e}" for e in errors))
+
+
+def _kind(v: Any) -> str:
+    if isinstance(v, bool):
+        return f"{str(v).lower()} (a boolean)"
+    if isinstance(v, dict):
+        return "a table"
+    if isinstance(v, list):
+        return "an array"
+    if isinstance(v, str):
+        return repr(v)
+    return repr(v)
+
+
+class _Reader:
+    """Takes fields out of a TOML table, recording an error per bad field instead of stopping."""
+
+    def __init__(self) -> None:
+        self.errors: list[str] = []
+
+    def err(self, path: str, msg: str) -> None:
+        self.errors.append(f"{path}: {msg}")
+
+    def table(self, data: dict, key: str, path: str) -> dict:
+        v = data.pop(key, {})
+        if not isinstance(v, dict):
+            self.err(path, f"must be a table, got {_kind(v)}")
+            return {}
+        return v
+
+    def unknown(self, data: dict, prefix: str, allowed: set[str] | None = None) -> None:
+        for k in data:
+            hint = ""
+            if allowed:
+                close = [a for a in sorted(allowed) if a[:3] == k[:3]]
+                hint = f" (did you mean {close[0]!r}?)" if close else ""
+            self.err(f"{prefix}{k}", f"unknown key{hint}")
+
+    def number(self, data: dict, key: str, path: str, default: float | None, *, positive: bool = False,
+               minimum: float | None = None, maximum: float | None = None) -> float | None:
+        if key not in data:
+            return default
+        v = data.pop(key)
+        if isinstance(v, bool) or not isinstance(v, (int, float)):
+            self.err(path, f"must be a number, got {_kind(v)}")
+            return default
+        v = float(v)
+        if v != v or v in (float("inf"), float("-inf")):
+            self.err(path, f"must be a finite number, got {v}")
+        elif positive and v <= 0:
+            self.err(path, f"must be a positive number, got {v:g}")
+        elif minimum is not None and v < minimum:
+            self.err(path, f"must be at least {minimum:g}, got {v:g}")
+        elif maximum is not None and v > maximum:
+            self.err(path, f"must be at most {maximum:g}, got {v:g}")
+        else:
+            return v
+        return default
+
+    def integer(self, data: dict, key: str, path: str, default: int | None, *, positive: bool = False,
+                choices: tuple[int, ...] | None = None, minimum: int | None = None,
+                maximum: int | None = None) -> int | None:
+        if key not in data:
+            return default
+        v = data.pop(key)
+        what = "a positive integer" if positive else "an integer"
+        if isinstance(v, bool) or not isinstance(v, int):
+            self.err(path, f"must be {what}, got {_kind(v)}")
+        elif positive and v <= 0:
+            self.err(path, f"must be {what}, got {v}")
+        elif choices is not None and v not in choices:
+            self.err(path, f"must be one of {', '.join(map(str, choices))}, got {v}")
+        elif minimum is not None and v < minimum:
+            self.err(path, f"must be at least {minimum}, got {v}")
+        elif maximum is not None and v > maximum:
+            self.err(path, f"must be at most {maximum}, got {v}")
+        else:
+            return v
+        return default
+
+    def string(self, data: dict, key: str, path: str, default: str | None,
+               choices: tuple[str, ...] | None = None) -> str | None:
+        if key not in data:
+            return default
+        v = data.pop(key)
+        if not isinstance(v, str) or not v.strip():
+            self.err(path, f"must be a non-empty string, got {_kind(v)}")
+        elif choices is not None and v not in choices:
+            self.err(path, f"must be one of {', '.join(repr(c) for c in choices)}, got {v!r}")
+        else:
+            return v
+        return default
+
+    def boolean(self, data: dict, key: str, path: str, default: bool) -> bool:
+        if key not in data:
+            return default
+        v = data.pop(key)
+        if not isinstance(v, bool):
+            self.err(path, f"must be true or false, got {_kind(v)}")
+            return default
+        return v
+
+    def pair(self, data: dict, key: str, path: str, *, integers: bool, positive: bool) -> tuple | None:
+        if key not in data:
+            return None
+        v = data.pop(key)
+        ok_type = (lambda x: isinstance(x, int) and not isinstance(x, bool)) if integers else \
+            (lambda x: isinstance(x, (int, float)) and not isinstance(x, bool))
+        what = "positive integers" if integers and positive else "numbers"
+        if not isinstance(v, list) or len(v) != 2 or not all(ok_type(x) for x in v):
+            self.err(path, f"must be an array of two {what}, got {_kind(v)}")
+            return None
+        if positive and any(x <= 0 for x in v):
+            self.err(path, f"must be an array of two {what}, got {v}")
+            return None
+        return tuple(v)
+
+
+def load_bench_file(path: str | Path) -> Bench:
+    source = str(path)
+    try:
+        text = Path(path).read_text(encoding="utf-8")
+    except OSError as exc:
+        raise BenchFileError(source, [f"cannot be read: {exc.strerror}"]) from None
+    except UnicodeDecodeError:
+        raise BenchFileError(source, ["is not UTF-8 text"]) from None
+    return parse_bench(text, source)
+
+
+def parse_bench(text: str, source: str = "bench.toml") -> Bench:
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise BenchFileError(source, [f"not valid TOML: {exc}"]) from None
+    r = _Reader()
+    b = Bench(source=source)
+    b.name = r.string(data, "name", "name", Path(source).stem) or b.name
+    b.profile = r.string(data, "profile", "profile", b.profile, PROFILE_NAMES) or b.profile
+    cycle_ms = r.number(data, "cycle_ms", "cycle_ms", b.cycle * 1000.0, minimum=0.125, maximum=100.0)
+    b.cycle = (cycle_ms or 1.0) / 1000.0
+    bus = r.string(data, "bus", "bus", b.bus)
+    if bus is not None:
+        try:
+            parse_bus(bus)
+            b.bus = bus
+        except ValueError as exc:
+            r.err("bus", str(exc))
+    b.mlc = r.string(data, "mlc", "mlc", b.mlc) or b.mlc
+    b.enable_timeout = r.number(data, "enable_timeout", "enable_timeout", b.enable_timeout, positive=True) or 0.5
+    b.settle_time = r.number(data, "settle_time", "settle_time", b.settle_time, minimum=0.0)
+    b.max_time = r.number(data, "max_time", "max_time", b.max_time, positive=True) or b.max_time
+
+    params = r.table(data, "params", "params")
+    for k, v in params.items():
+        if isinstance(v, bool) or not isinstance(v, (int, float)):
+            r.err(f"params.{k!r}" if " " in k else f"params.{k}", f"must be a number, got {_kind(v)}")
+        else:
+            b.params[k] = float(v)
+
+    axes = data.pop("axes", None)
+    if axes is None:
+        r.err("axes", "missing: a bench needs at least one [[axes]] table")
+        axes = []
+    elif not isinstance(axes, list) or not all(isinstance(a, dict) for a in axes):
+        r.err("axes", f"must be an array of tables ([[axes]]), got {_kind(axes)}")
+        axes = []
+    elif not axes:
+        r.err("axes", "must list at least one axis")
+    for i, a in enumerate(axes):
+        ax = _axis(r, dict(a), f"axes[{i}]")
+        if ax is not None:
+            if ax.name in b.axis_names:
+                r.err(f"axes[{i}].name", f"duplicate axis name {ax.name!r}")
+            else:
+                b.axes.append(ax)
+
+    spindles = data.pop("spindles", [])
+    if not isinstance(spindles, list) or not all(isinstance(s, dict) for s in spindles):
+        r.err("spindles", f"must be an array of tables ([[spindles]]), got {_kind(spindles)}")
+        spindles = []
+    for i, s in enumerate(spindles):
+        sp = _spindle(r, dict(s), f"spindles[{i}]")
+        if sp is not None:
+            if any(o.name == sp.name for o in b.spindles):
+                r.err(f"spindles[{i}].name", f"duplicate spindle name {sp.name!r}")
+            else:
+                b.spindles.append(sp)
+
+    b.realtime = _realtime(r, r.table(data, "realtime", "realtime"))
+    b.checks = _checks(r, r.table(data, "checks", "checks"), b.axis_names)
+    r.unknown(data, "", {"name", "profile", "cycle_ms", "bus", "mlc", "enable_timeout", "settle_time", "max_time",
+                         "params", "axes", "spindles", "realtime", "checks"})
+
+    names = b.axis_names
+    if b.axes and b.profile != "nc5-mill" and "X" not in names:
+        r.err("axes", f"a lathe profile ({b.profile}) needs an X axis, got {', '.join(names)}")
+    if b.axes and b.profile == "nc5-mill" and not {"X", "Y", "Z"} <= set(names):
+        r.err("axes", f"profile nc5-mill needs X, Y and Z axes, got {', '.join(names)}")
+    if r.errors:
+        raise BenchFileError(source, r.errors)
+    return b
+
+
+def _scaling(r: _Reader, d: dict, p: str, default_lead: float) -> AxisScaling:
+    base = AxisScaling()
+    cpr = r.integer(d, "counts_per_rev", f"{p}.counts_per_rev", base.counts_per_rev, positive=True)
+    ratio = r.pair(d, "ratio", f"{p}.ratio", integers=True, positive=True) or (1, 1)
+    lead = r.number(d, "lead", f"{p}.lead", default_lead, positive=True)
+    direction = r.integer(d, "direction", f"{p}.direction", 1, choices=(1, -1))
+    return AxisScaling(counts_per_rev=cpr or base.counts_per_rev, gear_motor=int(ratio[0]), gear_load=int(ratio[1]),
+                       lead=lead or default_lead, direction=direction or 1)
+
+
+def _drive(r: _Reader, d: Any, p: str, base: DriveParams) -> tuple[DriveParams, str]:
+    if not isinstance(d, dict):
+        r.err(p, f"must be a table, got {_kind(d)}")
+        return base, "asda-a3"
+    d = dict(d)
+    model = r.string(d, "model", f"{p}.model", "asda-a3") or "asda-a3"
+    values: dict[str, Any] = {}
+    for key in sorted(_DRIVE_KEYS & set(d)):
+        if key in _DRIVE_INT:
+            v = r.integer(d, key, f"{p}.{key}", None, positive=key in ("substeps", "index_pulse_every",
+                                                                       "following_error_window"))
+        else:
+            v = r.number(d, key, f"{p}.{key}", None, positive=True)
+        if v is not None:
+            values[key] = v
+    r.unknown(d, f"{p}.", _DRIVE_KEYS | {"model"})
+    kw = {f.name: getattr(base, f.name) for f in fields(DriveParams)}
+    kw.update(values)
+    return DriveParams(**kw), model
+
+
+def _axis(r: _Reader, d: dict, p: str) -> AxisConfig | None:
+    if "name" not in d:
+        r.err(f"{p}.name", "missing: every axis needs a name (X, Y, Z, C ...)")
+    name = r.string(d, "name", f"{p}.name", None)
+    if name is not None and (len(name) != 1 or name not in AXIS_LETTERS):
+        r.err(f"{p}.name", f"must be one axis letter of {AXIS_LETTERS}, got {name!r}")
+        name = None
+    units = r.string(d, "units", f"{p}.units", "mm", ("mm", "deg")) or "mm"
+    scaling = _scaling(r, d, p, 360.0 if units == "deg" else 10.0)
+    start = r.number(d, "start", f"{p}.start", 0.0) or 0.0
+    soft = r.pair(d, "soft_limits", f"{p}.soft_limits", integers=False, positive=False)
+    if soft is not None:
+        if soft[0] >= soft[1]:
+            r.err(f"{p}.soft_limits", f"lower limit must be below the upper, got [{soft[0]:g}, {soft[1]:g}]")
+            soft = None
+        elif not soft[0] <= start <= soft[1]:
+            r.err(f"{p}.start", f"{start:g} lies outside soft_limits [{soft[0]:g}, {soft[1]:g}]")
+    lim = r.table(d, "limits", f"{p}.limits")
+    base = AxisLimits()
+    limits = AxisLimits(r.number(lim, "velocity", f"{p}.limits.velocity", base.max_velocity, positive=True),
+                        r.number(lim, "acceleration", f"{p}.limits.acceleration", base.max_acceleration,
+                                 positive=True),
+                        r.number(lim, "jerk", f"{p}.limits.jerk", base.max_jerk, positive=True))
+    r.unknown(lim, f"{p}.limits.", {"velocity", "acceleration", "jerk"})
+    drive, model = _drive(r, d.pop("drive", {}), f"{p}.drive", DriveParams())
+    r.unknown(d, f"{p}.", {"name", "units", "counts_per_rev", "ratio", "lead", "direction", "start", "soft_limits",
+                           "limits", "drive"})
+    if name is None:
+        return None
+    return AxisConfig(name, scaling, limits, drive, start=start, units=units,
+                      soft_limits=(float(soft[0]), float(soft[1])) if soft else None, drive_model=model)
+
+
+def _spindle(r: _Reader, d: dict, p: str) -> SpindleConfig | None:
+    base = SpindleConfig()
+    name = r.string(d, "name", f"{p}.name", "S1") or "S1"
+    if not (name[0] == "S" and name[1:].isdigit()):
+        r.err(f"{p}.name", f"must be S1, S2, ..., got {name!r}")
+    cpr = r.integer(d, "counts_per_rev", f"{p}.counts_per_rev", base.scaling.counts_per_rev, positive=True)
+    ratio = r.pair(d, "ratio", f"{p}.ratio", integers=True, positive=True) or (1, 1)
+    direction = r.integer(d, "direction", f"{p}.direction", 1, choices=(1, -1))
+    max_rpm = r.number(d, "max_rpm", f"{p}.max_rpm", base.max_rpm, positive=True)
+    drive, _model = _drive(r, d.pop("drive", {}), f"{p}.drive", base.drive)
+    r.unknown(d, f"{p}.", {"name", "counts_per_rev", "ratio", "direction", "max_rpm", "drive"})
+    scaling = AxisScaling(counts_per_rev=cpr or base.scaling.counts_per_rev, gear_motor=int(ratio[0]),
+                          gear_load=int(ratio[1]), lead=360.0, direction=direction or 1)
+    return SpindleConfig(name, scaling, max_rpm or base.max_rpm, drive)
+
+
+def _realtime(r: _Reader, d: dict) -> RealtimeConfig:
+    base = RealtimeConfig()
+    d = dict(d)
+    rt = RealtimeConfig(
+        priority=r.integer(d, "priority", "realtime.priority", base.priority, minimum=1, maximum=99) or base.priority,
+        cpu=r.integer(d, "cpu", "realtime.cpu", None, minimum=0),
+        busy_wait=(r.number(d, "busy_wait_us", "realtime.busy_wait_us", base.busy_wait * 1e6, minimum=0.0,
+                            maximum=100_000.0) or 0.0) / 1e6,
+        overrun=r.string(d, "overrun", "realtime.overrun", base.overrun, ("warn", "alarm")) or base.overrun,
+        lock_memory=r.boolean(d, "lock_memory", "realtime.lock_memory", base.lock_memory))
+    r.unknown(d, "realtime.", {"priority", "cpu", "busy_wait_us", "overrun", "lock_memory"})
+    return rt
+
+
+def _checks(r: _Reader, d: dict, axes: tuple[str, ...]) -> ChecksConfig:
+    d = dict(d)
+    c = ChecksConfig()
+    if "max_following_error" in d:
+        v = d.pop("max_following_error")
+        if isinstance(v, dict):
+            for axis, lim in v.items():
+                pth = f"checks.max_following_error.{axis}"
+                if axis not in axes:
+                    r.err(pth, f"no axis {axis!r} on this bench (axes: {', '.join(axes)})")
+                elif isinstance(lim, bool) or not isinstance(lim, (int, float)) or lim <= 0:
+                    r.err(pth, f"must be a positive number of mm, got {_kind(lim)}")
+                else:
+                    c.max_following_error[axis] = float(lim)
+        elif isinstance(v, (int, float)) and not isinstance(v, bool) and v > 0:
+            c.max_following_error = {a: float(v) for a in axes}
+        else:
+            r.err("checks.max_following_error", f"must be a positive number of mm or a table axis = mm, got {_kind(v)}")
+    c.contour_error = r.number(d, "contour_error", "checks.contour_error", None, positive=True)
+    c.limits = r.boolean(d, "limits", "checks.limits", False)
+    c.limit_tolerance = r.number(d, "limit_tolerance", "checks.limit_tolerance", c.limit_tolerance, minimum=0.0,
+                                 maximum=1.0)
+    c.thread_phase = r.number(d, "thread_phase", "checks.thread_phase", None, positive=True)
+    for key in ("jitter_p99", "jitter_p999", "jitter_max"):
+        us = r.number(d, f"{key}_us", f"checks.{key}_us", None, positive=True)
+        setattr(c, key, us / 1e6 if us is not None else None)
+    r.unknown(d, "checks.", {"max_following_error", "contour_error", "limits", "limit_tolerance", "thread_phase",
+                             "jitter_p99_us", "jitter_p999_us", "jitter_max_us"})
+    return c
