@@ -15,7 +15,8 @@ from fieldbus.cia402 import SW_INTERNAL_LIMIT, Cia402Master, State, Target
 from fieldbus.link import BusError, BusLink
 from fieldbus.pdo import RxPdo, TxPdo
 from hil.bench import Bench
-from hil.trace import TraceWriter
+from hil.clock import CycleTiming, LockStepClock, RealTimeClock
+from hil.trace import TraceSource, TraceWriter, trace_columns
 from mlc.basic import BasicMlc
 from nc.alarms import SERVO_ALARM, Alarm, NcAlarm, internal_error
 from nc.channel import Channel, RunState
@@ -39,6 +40,10 @@ class RunResult:
     final: dict[str, float] = field(default_factory=dict)
     alarms: list[Alarm] = field(default_factory=list)
     finished: bool = False
+    realtime: bool = False
+    timing: dict[str, dict[str, float]] = field(default_factory=dict)  # jitter/latency/exec percentiles, s
+    overruns: int = 0
+    granted: str = ""  # what the system granted the real-time loop
 
     @property
     def ok(self) -> bool:
@@ -47,7 +52,8 @@ class RunResult:
 
 class BenchRunner:
     def __init__(self, bench: Bench, link: BusLink, trace: TraceWriter | None = None, mlc: BasicMlc | None = None,
-                 on_cycle: Callable[["BenchRunner"], None] | None = None) -> None:
+                 on_cycle: Callable[["BenchRunner"], None] | None = None, *,
+                 clock: LockStepClock | RealTimeClock | None = None, progress: object | None = None) -> None:
         self.bench = bench
         self.link = link
         self.trace = trace
@@ -67,6 +73,19 @@ class BenchRunner:
         self.actual = np.zeros(n_axes)
         self._alarmed_drives: set[int] = set()
         self._commands = np.zeros(n_axes)
+        # The pacer: lock-step virtual time unless a real-time clock is given.
+        self.clock = clock or LockStepClock(bench.cycle)
+        self.timing = CycleTiming(bench.cycle, 0.0)
+        self.progress = progress  # anything with update(runner) and close(); see hil.progress
+        # Extra trace columns (MLC signals ...): append TraceSources before the run starts and open
+        # the trace with `trace_columns()`.
+        self.trace_sources: list[TraceSource] = []
+        self._seen_alarms: set[int] = set()
+        self._overrun_alarmed = False
+
+    def trace_columns(self) -> list[str]:
+        extra = [c for src in self.trace_sources for c in src.columns]
+        return trace_columns(self.axes, [s.name for s in self.bench.spindles], extra)
 
     # ---- public ---------------------------------------------------------------------------
     def run_program(self, program: Program) -> RunResult:
@@ -76,6 +95,8 @@ class BenchRunner:
             profile = make_profile(self.bench.profile, self.axes, self.bench.params)
             start = dict(zip(self.axes, self.actual.tolist()))
             interp = Interpreter(profile, start)
+            if hasattr(self.mlc, "attach_variables"):  # MLC ↔ #25000–#25511 exchange (issue 8)
+                self.mlc.attach_variables(interp.vars)
             self.run_events(interp.run(program))
         except BusError as exc:
             self._alarm(exc.alarm)
@@ -88,6 +109,7 @@ class BenchRunner:
     def power_up(self) -> bool:
         """Bring every drive to operation enabled, one state-machine step per cycle."""
         self.link.open()
+        self.clock.start(self.link)
         for m in self.masters:
             m.request(Target.ENABLED)
         limit = max(1, int(round(self.bench.enable_timeout / self.bench.cycle)))
@@ -125,6 +147,9 @@ class BenchRunner:
 
     # ---- the cycle ------------------------------------------------------------------------
     def _exchange(self) -> None:
+        self.timing = self.clock.tick()
+        if self.timing.overrun:
+            self._overrun()
         self.tx = self.link.exchange(self.rx)
         self.cycle += 1
         self.time += self.bench.cycle
@@ -143,6 +168,10 @@ class BenchRunner:
             self.actual[i] = self.scales[i].to_units(self.tx[i].position_actual)
         ch = self.channel
         if ch is not None:
+            if hasattr(self.mlc, "bus_feedback"):  # drive status for the MLC's special M/D (issue 8)
+                from hil.mlc_bridge import drive_status
+
+                self.mlc.bus_feedback(drive_status(self))
             self.mlc.scan(ch)
             sp = ch.step()
             self._commands[:] = sp.positions
@@ -165,18 +194,40 @@ class BenchRunner:
             self.trace.write(self._row())
         if self.on_cycle is not None:
             self.on_cycle(self)
+        if self.progress is not None:
+            self.progress.update(self)
+        self.clock.done()
+
+    def _new_alarms(self) -> str:
+        """Codes of the alarms raised since the previous row (by the bench or by the channel)."""
+        pool = self.result.alarms + (self.channel.alarms if self.channel is not None else [])
+        new = [a for a in pool if id(a) not in self._seen_alarms]
+        self._seen_alarms.update(id(a) for a in new)
+        return ";".join(dict.fromkeys(a.code_text for a in new))
+
+    def _overrun(self) -> None:
+        """The previous cycle ran past this cycle's deadline: warn (counted) or alarm, per the bench."""
+        if self.bench.realtime.overrun == "alarm" and not self._overrun_alarmed:
+            self._overrun_alarmed = True
+            self._alarm(Alarm(0x141F, f"cycle overrun: cycle {self.cycle} ran past the {self.bench.cycle * 1e3:g} ms "
+                                      "period", line=self.line or None))
 
     def _row(self) -> list:
-        row: list = [f"{self.time:.6f}", self.line]
+        # Full-precision floats: the trace feeds checks that differentiate positions three times.
+        row: list = [round(self.time, 9), self.line, self.cycle, self.timing.period, self.timing.late,
+                     self._new_alarms()]
         n_axes = len(self.axes)
         for i in range(n_axes):
             tx, sc = self.tx[i], self.scales[i]
-            row += [f"{self._commands[i]:.6f}", f"{self.actual[i]:.6f}", f"{sc.to_units(tx.velocity_actual):.4f}",
-                    f"{tx.torque_actual / 10.0:.2f}", f"{sc.to_units(tx.following_error):.6f}", tx.statusword]
+            row += [float(self._commands[i]), float(self.actual[i]), sc.to_units(tx.velocity_actual),
+                    tx.torque_actual / 10.0, sc.to_units(tx.following_error), tx.statusword]
         for k, sc in enumerate(self.scales[n_axes:]):
             tx = self.tx[n_axes + k]
-            row += [f"{sc.counts_per_s_to_rpm(self.rx[n_axes + k].target_velocity):.2f}",
-                    f"{sc.counts_per_s_to_rpm(tx.velocity_actual):.2f}", f"{tx.torque_actual / 10.0:.2f}", tx.statusword]
+            row += [sc.counts_per_s_to_rpm(self.rx[n_axes + k].target_velocity),
+                    sc.counts_per_s_to_rpm(tx.velocity_actual), sc.to_units(tx.position_actual) % 360.0,
+                    tx.torque_actual / 10.0, tx.statusword]
+        for src in self.trace_sources:
+            row += list(src.values(self))
         return row
 
     # ---- endings ---------------------------------------------------------------------------
@@ -207,14 +258,24 @@ class BenchRunner:
         try:
             self.link.close()
         finally:
+            self.clock.stop()
             if self.trace is not None:
                 self.trace.close()
+            if self.progress is not None:
+                self.progress.close()
 
     def _finish(self) -> RunResult:
         r = self.result
         r.cycles = self.cycle
         r.sim_time = self.time
         r.final = dict(zip(self.axes, self.actual.tolist()))
+        c = self.clock
+        r.realtime = c.realtime
+        r.overruns = c.overruns
+        r.granted = str(c.granted)
+        r.timing = {"jitter": c.jitter.summary(), "exec": c.exec.summary()}
+        if isinstance(c, RealTimeClock):
+            r.timing["latency"] = c.latency.summary()
         if self.channel is not None:
             for a in self.channel.alarms:
                 if a not in r.alarms:

@@ -1,10 +1,19 @@
-"""Per-cycle trace, written row by row so memory stays flat on long runs."""
+"""Per-cycle trace, written row by row so memory stays flat on long runs.
+
+One row per bench cycle: time and cycle number, the executing program line, the cycle's timing
+(period and lateness), any alarm raised in it, each axis's setpoint and feedback, each spindle's
+commanded and actual speed and angle, then any extra columns added by `TraceSource`s (the MLC
+adds its signals of interest this way). `open_trace` picks the format from the file name:
+`.parquet`/`.pq` → Parquet (columnar, written in row groups), anything else → CSV.
+"""
 
 from __future__ import annotations
 
 import csv
 from pathlib import Path
-from typing import IO, Protocol, Sequence
+from typing import IO, Any, Protocol, Sequence
+
+INT_COLUMNS = ("cycle", "line")  # plus every *_sw statusword column
 
 
 class TraceWriter(Protocol):
@@ -15,13 +24,35 @@ class TraceWriter(Protocol):
     def close(self) -> None: ...
 
 
-def trace_columns(axes: Sequence[str], spindles: Sequence[str]) -> list[str]:
-    cols = ["t", "line"]
+class TraceSource(Protocol):
+    """Extra trace columns: `columns` names them, `values(runner)` gives this cycle's values
+    (ints for bits and words, floats for quantities; the same type every cycle)."""
+
+    columns: list[str]
+
+    def values(self, runner: Any) -> Sequence[float | int | str]: ...
+
+
+def trace_columns(axes: Sequence[str], spindles: Sequence[str], extra: Sequence[str] = ()) -> list[str]:
+    cols = ["t", "line", "cycle", "period", "late", "alarm"]
     for a in axes:
         cols += [f"{a}_cmd", f"{a}_act", f"{a}_vel", f"{a}_torque", f"{a}_ferr", f"{a}_sw"]
     for s in spindles:
-        cols += [f"{s}_rpm_cmd", f"{s}_rpm_act", f"{s}_torque", f"{s}_sw"]
-    return cols
+        cols += [f"{s}_rpm_cmd", f"{s}_rpm_act", f"{s}_angle", f"{s}_torque", f"{s}_sw"]
+    return cols + list(extra)
+
+
+def axes_of(columns: Sequence[str]) -> list[str]:
+    return [c[:-4] for c in columns if c.endswith("_cmd") and not c.endswith("_rpm_cmd")]
+
+
+def spindles_of(columns: Sequence[str]) -> list[str]:
+    return [c[:-8] for c in columns if c.endswith("_rpm_cmd")]
+
+
+def _csv_value(v: float | int | str) -> float | int | str:
+    # repr of a float is the shortest text that reads back to the same double: CSV round-trips exactly.
+    return repr(v) if isinstance(v, float) else v
 
 
 class CsvTrace:
@@ -30,16 +61,27 @@ class CsvTrace:
         self.columns = columns
         # Written to a side file and renamed on close, so a failed run never leaves half a trace
         # that looks complete.
-        self.path.parent.mkdir(parents=True, exist_ok=True)
         self._tmp = self.path.with_name(self.path.name + ".part")
         self._fh: IO[str] = open(self._tmp, "w", newline="")
         self._w = csv.writer(self._fh)
         self._w.writerow(columns)
 
     def write(self, row: Sequence[float | int | str]) -> None:
-        self._w.writerow(row)
+        self._w.writerow([_csv_value(v) for v in row])
 
     def close(self) -> None:
         if not self._fh.closed:
             self._fh.close()
             self._tmp.replace(self.path)
+
+
+def is_parquet(path: str | Path) -> bool:
+    return Path(path).suffix.lower() in (".parquet", ".pq")
+
+
+def open_trace(path: str | Path, columns: list[str]) -> TraceWriter:
+    if is_parquet(path):
+        from hil.trace_parquet import ParquetTrace
+
+        return ParquetTrace(path, columns)
+    return CsvTrace(path, columns)

@@ -3,13 +3,18 @@
 from __future__ import annotations
 
 import argparse
+import os
 import sys
+import tempfile
+from pathlib import Path
 
 from hil.bench import Bench
 from hil.cli import EXIT_ALARM, EXIT_OK, EXIT_USAGE
+from hil.clock import make_clock
+from hil.progress import Progress, wants_progress
 from hil.runner import BenchRunner, RunResult
 from hil.session import InputError, load_bench, load_program, make_link, print_alarm
-from hil.trace import CsvTrace, trace_columns
+from hil.trace import open_trace
 from nc.alarms import NcAlarm
 
 
@@ -19,7 +24,14 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--bench", help="bench file (TOML); default: the built-in 2-axis lathe")
     p.add_argument("--bus", help="sim | ethercat:IFACE | canopen:INTERFACE[:CHANNEL] (overrides the bench)")
     p.add_argument("--profile", help="controller profile (overrides the bench)")
-    p.add_argument("--trace", metavar="FILE.csv", help="write every cycle to this CSV file")
+    p.add_argument("--trace", metavar="FILE", help="write every cycle to this file: .parquet/.pq → Parquet, else CSV")
+    p.add_argument("--realtime", action="store_true",
+                   help="pace cycles in real time (SCHED_FIFO, CPU pinning, DC alignment where allowed)")
+    p.add_argument("--overrun", choices=("warn", "alarm"), help="what a cycle overrun does (overrides the bench)")
+    p.add_argument("--check", action=argparse.BooleanOptionalAction, default=None,
+                   help="judge the run by the bench's [checks] (default: on when the bench has checks)")
+    p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
+                   help="progress bar on stderr (default: only when stderr is a terminal)")
     p.set_defaults(func=cmd_run)
 
 
@@ -39,18 +51,77 @@ def cmd_run(args: argparse.Namespace) -> int:
     except InputError as exc:
         print(f"hil run: {exc}", file=sys.stderr)
         return EXIT_USAGE
-    trace = None
-    if args.trace:
-        spindles = [s.name for s in bench.spindles]
+    if args.overrun:
+        bench.realtime.overrun = args.overrun
+    clock = make_clock(bench.cycle, args.realtime, bench.realtime)
+    progress = None
+    if wants_progress(args.progress):
+        progress = Progress(max((b.line for b in program.blocks), default=1))
+    runner = BenchRunner(bench, link, None, clock=clock, progress=progress)
+    # Extra trace columns (e.g. the MLC's --trace-signals) are TraceSources appended here,
+    # before the trace is opened with the runner's columns.
+    trace_path = args.trace
+    want_checks = bench.checks.any and args.check is not False
+    if want_checks and not trace_path:
+        trace_path = _temp_trace()  # checks read a trace; keep it only if asked for
+    if trace_path:
         try:
-            trace = CsvTrace(args.trace, trace_columns(bench.axis_names, spindles))
+            runner.trace = open_trace(trace_path, runner.trace_columns())
         except OSError as exc:
-            print(f"hil run: cannot write trace {args.trace}: {exc.strerror}", file=sys.stderr)
+            print(f"hil run: cannot write trace {trace_path}: {exc.strerror}", file=sys.stderr)
             return EXIT_USAGE
-    runner = BenchRunner(bench, link, trace)
     result = runner.run_program(program)
     print_summary(args.program, bench, result)
-    return EXIT_OK if result.ok else EXIT_ALARM
+    print_timing(result)
+    code = EXIT_OK if result.ok else EXIT_ALARM
+    if trace_path and want_checks:
+        checks_ok = run_bench_checks(trace_path, bench, program)
+        if not checks_ok:
+            code = EXIT_ALARM
+    if trace_path and trace_path != args.trace:
+        Path(trace_path).unlink(missing_ok=True)
+    return code
+
+
+def _temp_trace() -> str:
+    fd, name = tempfile.mkstemp(prefix="hil-run-", suffix=".parquet")
+    os.close(fd)
+    return name
+
+
+def run_bench_checks(trace_path: str, bench: Bench, program) -> bool:
+    """Judge the run's trace by the bench's [checks]; print one line per check."""
+    from hil.checks import program_moves, run_checks
+    from hil.trace_read import TraceFile
+
+    try:
+        moves = program_moves(program, bench)
+    except NcAlarm:
+        moves = None
+    results = run_checks(TraceFile(trace_path), bench.checks, bench, moves)
+    print("checks", file=sys.stdout)
+    for r in results:
+        print(f"  {r}", file=sys.stdout)
+    return all(r.ok for r in results)
+
+
+def print_timing(r: RunResult) -> None:
+    out = sys.stdout
+    if r.realtime:
+        j = r.timing.get("jitter", {})
+        print(f"real time      {r.granted}", file=out)
+        print("cycle jitter   " + "  ".join(f"{k} {j.get(k, 0.0) * 1e6:.1f} µs" for k in ("p50", "p99", "p99.9", "max")),
+              file=out)
+        lat = r.timing.get("latency", {})
+        if lat:
+            print("wake latency   " + "  ".join(f"{k} {lat.get(k, 0.0) * 1e6:.1f} µs"
+                                            for k in ("p50", "p99", "p99.9", "max")), file=out)
+    e = r.timing.get("exec", {})
+    if e:
+        print("cycle work     " + "  ".join(f"{k} {e.get(k, 0.0) * 1e6:.1f} µs" for k in ("p50", "p99", "max"))
+              + ("  (wall clock, lock-step)" if not r.realtime else ""), file=out)
+    if r.overruns:
+        print(f"overruns       {r.overruns} cycles ran past their deadline", file=sys.stderr if not r.alarms else out)
 
 
 def print_summary(program: str, bench: Bench, r: RunResult) -> None:

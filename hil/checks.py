@@ -1,0 +1,292 @@
+"""Checks on a trace: following error, contour error against the programmed path, setpoint v/a/j
+limits, thread phase on each pass, and cycle jitter. Each check returns a `CheckResult` that names
+the worst (or first offending) cycle, its time and its program line.
+
+Checks read only the columns they need, so a long Parquet trace costs a few columns of memory.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import defaultdict
+from dataclasses import dataclass
+
+import numpy as np
+
+from hil.bench import Bench, ChecksConfig
+from hil.trace import axes_of, spindles_of
+from hil.trace_read import TraceFile
+from nc.interp import Interpreter
+from nc.motion.path import Segment
+from nc.moves import Move
+from nc.profiles import make_profile
+from nc.program import Program
+
+FEED_KINDS = ("line", "arc", "thread")
+
+
+@dataclass
+class CheckResult:
+    name: str
+    ok: bool
+    value: float = 0.0
+    limit: float = 0.0
+    unit: str = ""
+    cycle: int | None = None
+    line: int | None = None
+    t: float | None = None
+    detail: str = ""
+    skipped: bool = False
+
+    def __str__(self) -> str:
+        if self.skipped:
+            return f"SKIP  {self.name}: {self.detail}"
+        head = "ok  " if self.ok else "FAIL"
+        where = ""
+        if self.cycle is not None:
+            where = f" at cycle {self.cycle}"
+            if self.t is not None:
+                where += f" (t={self.t:.3f} s)"
+            if self.line:
+                where += f", line {self.line}"
+        cmp = "<=" if self.ok else ">"
+        text = f"{head}  {self.name}: {_fmt(self.value, self.unit)} {cmp} {_fmt(self.limit, self.unit)}{where}"
+        return text + (f"; {self.detail}" if self.detail else "")
+
+    def as_dict(self) -> dict:
+        return {"check": self.name, "ok": self.ok, "skipped": self.skipped, "value": self.value, "limit": self.limit,
+                "unit": self.unit, "cycle": self.cycle, "line": self.line, "t": self.t, "detail": self.detail}
+
+
+def _fmt(v: float, unit: str) -> str:
+    if unit == "s":
+        return f"{v * 1e6:.1f} µs"
+    return f"{v:.4g} {unit}".strip()
+
+
+class _Cols:
+    """The trace's columns, loaded once each on first use."""
+
+    def __init__(self, trace: TraceFile) -> None:
+        self.trace = trace
+        self._c: dict[str, np.ndarray] = {}
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        if name not in self._c:
+            self._c.update(self.trace.arrays([name]))
+        return self._c[name]
+
+    def where(self, i: int) -> dict:
+        return {"cycle": int(self["cycle"][i]) if "cycle" in self.trace.columns else i + 1,
+                "line": int(self["line"][i]), "t": float(self["t"][i])}
+
+
+def program_moves(program: Program, bench: Bench) -> list[Move]:
+    """The programmed path in machine coordinates, from the axes' power-on positions."""
+    profile = make_profile(bench.profile, bench.axis_names, bench.params)
+    interp = Interpreter(profile, {a.name: a.start for a in bench.axes})
+    return [ev for ev in interp.run(program) if isinstance(ev, Move)]
+
+
+def run_checks(trace: TraceFile, checks: ChecksConfig, bench: Bench | None = None,
+               moves: list[Move] | None = None) -> list[CheckResult]:
+    cols = _Cols(trace)
+    axes = axes_of(trace.columns)
+    out: list[CheckResult] = []
+    for axis, limit in checks.max_following_error.items():
+        out.append(check_following_error(cols, axis, limit) if axis in axes else
+                   CheckResult(f"following error {axis}", False, detail=f"no column {axis}_ferr in the trace"))
+    if checks.contour_error is not None:
+        if moves is None:
+            out.append(CheckResult("contour error", True, skipped=True, detail="needs the program (--program)"))
+        else:
+            out.append(check_contour(cols, axes, moves, checks.contour_error))
+    if checks.limits:
+        if bench is None:
+            out.append(CheckResult("setpoint limits", True, skipped=True, detail="needs the bench (--bench)"))
+        else:
+            out += check_limits(cols, bench, checks.limit_tolerance)
+    if checks.thread_phase is not None:
+        out.append(check_thread_phase(cols, axes, spindles_of(trace.columns), moves, checks.thread_phase))
+    jitter = [(n, getattr(checks, k)) for n, k in (("p99", "jitter_p99"), ("p99.9", "jitter_p999"),
+                                                    ("max", "jitter_max")) if getattr(checks, k) is not None]
+    if jitter:
+        out += check_jitter(cols, bench.cycle if bench else None, jitter)
+    return out
+
+
+# ---- individual checks ----------------------------------------------------------------------
+def check_following_error(cols: _Cols, axis: str, limit: float) -> CheckResult:
+    ferr = np.abs(cols[f"{axis}_ferr"])
+    if ferr.size == 0:
+        return CheckResult(f"following error {axis}", True, 0.0, limit, "mm", detail="empty trace")
+    i = int(np.argmax(ferr))
+    over = np.flatnonzero(ferr > limit)
+    detail = f"{over.size} cycles over, first at cycle {cols.where(int(over[0]))['cycle']}" if over.size else ""
+    return CheckResult(f"following error {axis}", not over.size, float(ferr[i]), limit, "mm", detail=detail,
+                       **cols.where(i))
+
+
+def _polyline(moves: list[Move], axes: list[str]) -> tuple[np.ndarray, np.ndarray]:
+    """Segment end points (A, B) approximating each move; arcs to 0.1 µm chord error."""
+    a_list, b_list = [], []
+    for m in moves:
+        if m.kind == "dwell":
+            continue
+        seg = Segment.of(m, tuple(axes))
+        n = 1
+        if seg.kind == "arc" and seg.radius > 0:
+            step = math.sqrt(8 * 1e-4 / seg.radius)
+            n = int(min(20_000, max(4, math.ceil(abs(seg.theta) * (1 + abs(m.turns)) / step))))
+        pts = seg.points(np.linspace(0.0, seg.length, n + 1)) if seg.length > 0 else np.vstack([seg.start, seg.end])
+        a_list.append(pts[:-1])
+        b_list.append(pts[1:])
+    if not a_list:
+        return np.zeros((0, len(axes))), np.zeros((0, len(axes)))
+    return np.vstack(a_list), np.vstack(b_list)
+
+
+def distance_to_polyline(p: np.ndarray, a: np.ndarray, b: np.ndarray, chunk: int = 512) -> np.ndarray:
+    """Distance from each point (P × k) to the nearest of the segments a→b (S × k)."""
+    out = np.empty(len(p))
+    ab = b - a
+    ab2 = np.einsum("ij,ij->i", ab, ab)
+    ab2 = np.where(ab2 > 0, ab2, 1.0)
+    for s in range(0, len(p), chunk):
+        q = p[s:s + chunk]
+        ap = q[:, None, :] - a[None, :, :]
+        u = np.clip(np.einsum("psk,sk->ps", ap, ab) / ab2, 0.0, 1.0)
+        d = ap - u[..., None] * ab[None, :, :]
+        out[s:s + chunk] = np.sqrt(np.min(np.einsum("psk,psk->ps", d, d), axis=1))
+    return out
+
+
+def check_contour(cols: _Cols, axes: list[str], moves: list[Move], limit: float) -> CheckResult:
+    """Distance of the actual position from the programmed path, on cycles executing a feed move.
+
+    Candidates for a cycle on line L are the moves of L and their neighbours, because the actual
+    position lags the command into the previous move and a move's corner may be blended."""
+    mv_axes = [a for a in axes if any(a in m.end for m in moves)]
+    by_line: dict[int, set[int]] = defaultdict(set)
+    for i, m in enumerate(moves):
+        if m.kind in FEED_KINDS:
+            by_line[m.line].update(j for j in (i - 1, i, i + 1) if 0 <= j < len(moves))
+    line = cols["line"]
+    act = np.column_stack([cols[f"{a}_act"] for a in mv_axes]) if mv_axes else np.zeros((len(line), 0))
+    dist = np.zeros(len(line))
+    for ln, idx in by_line.items():
+        rows = np.flatnonzero(line == ln)
+        if rows.size == 0:
+            continue
+        a, b = _polyline([moves[j] for j in sorted(idx)], mv_axes)
+        dist[rows] = distance_to_polyline(act[rows], a, b)
+    if not by_line:
+        return CheckResult("contour error", True, 0.0, limit, "mm", detail="no feed moves in the program")
+    i = int(np.argmax(dist))
+    over = np.flatnonzero(dist > limit)
+    detail = f"{over.size} cycles over, first at cycle {cols.where(int(over[0]))['cycle']}" if over.size else ""
+    return CheckResult("contour error", not over.size, float(dist[i]), limit, "mm", detail=detail, **cols.where(i))
+
+
+def check_limits(cols: _Cols, bench: Bench, tolerance: float) -> list[CheckResult]:
+    """Velocity, acceleration and jerk of each axis's setpoints (backward differences per cycle)."""
+    out = []
+    t = cols["t"]
+    dt = float(np.median(np.diff(t))) if len(t) > 1 else bench.cycle
+    for ax in bench.axes:
+        name = f"{ax.name}_cmd"
+        if name not in cols.trace.columns:
+            continue
+        x = cols[name]
+        unit = "deg" if ax.units == "deg" else "mm"
+        for order, (label, lim) in enumerate((("velocity", ax.limits.max_velocity),
+                                              ("acceleration", ax.limits.max_acceleration),
+                                              ("jerk", ax.limits.max_jerk)), start=1):
+            d = np.abs(np.diff(x, n=order)) / dt ** order
+            u = f"{unit}/s" + ("" if order == 1 else f"^{order}")
+            if d.size == 0:
+                out.append(CheckResult(f"{label} {ax.name}", True, 0.0, lim, u))
+                continue
+            i = int(np.argmax(d))
+            bad = np.flatnonzero(d > lim * (1 + tolerance))
+            detail = f"{bad.size} cycles over, first at cycle {cols.where(int(bad[0]) + order)['cycle']}" \
+                if bad.size else ""
+            out.append(CheckResult(f"{label} {ax.name}", not bad.size, float(d[i]), lim, u, detail=detail,
+                                   **cols.where(i + order)))
+    return out
+
+
+def check_thread_phase(cols: _Cols, axes: list[str], spindles: list[str], moves: list[Move] | None,
+                       limit: float) -> CheckResult:
+    """Each pass of a thread must meet the spindle at the same phase.
+
+    For every threading line, a reference point on the thread axis common to all passes is chosen
+    (the middle of their overlap); on each pass the spindle angle when the actual axis position
+    crosses it, less the angle that pass's own start offset accounts for (compound infeed shifts
+    the start on purpose), must agree across passes within `limit` degrees."""
+    name = "thread phase"
+    if moves is None:
+        return CheckResult(name, True, skipped=True, detail="needs the program (--program)")
+    if not spindles or f"{spindles[0]}_angle" not in cols.trace.columns:
+        return CheckResult(name, True, skipped=True, detail="the trace has no spindle angle column")
+    threads: dict[int, list[Move]] = defaultdict(list)
+    for m in moves:
+        if m.kind == "thread" and m.lead:
+            threads[m.line].append(m)
+    if not threads:
+        return CheckResult(name, True, skipped=True, detail="no thread moves in the program")
+    angle = cols[f"{spindles[0]}_angle"]
+    line_col = cols["line"]
+    worst = CheckResult(name, True, 0.0, limit, "deg")
+    for ln, passes in threads.items():
+        first = passes[0]
+        ax = max((a for a in first.end if a in axes), key=lambda a: abs(first.end[a] - first.start.get(a, 0.0)))
+        sign = 1.0 if first.end[ax] > first.start[ax] else -1.0
+        lo = max(min(m.start[ax], m.end[ax]) for m in passes)
+        hi = min(max(m.start[ax], m.end[ax]) for m in passes)
+        ref = 0.5 * (lo + hi)
+        pos = cols[f"{ax}_act"]
+        rows = np.flatnonzero(line_col == ln)
+        crossings = []
+        for r in rows:
+            if r == 0:
+                continue
+            p0, p1 = pos[r - 1], pos[r]
+            if (p0 - ref) * sign < 0 <= (p1 - ref) * sign:
+                f = (ref - p0) / (p1 - p0)
+                a0, a1 = angle[r - 1], angle[r]
+                da = (a1 - a0 + 180.0) % 360.0 - 180.0
+                crossings.append((r, (a0 + f * da) % 360.0))
+        if len(crossings) != len(passes):
+            return CheckResult(name, False, float(len(crossings)), float(len(passes)), "passes",
+                               detail=f"line {ln}: {len(passes)} thread passes programmed, {len(crossings)} "
+                                      f"crossed {ax}={ref:.3f}", **(cols.where(crossings[-1][0]) if crossings else {}))
+        phases = np.array([(ang - abs(ref - m.start[ax]) / m.lead * 360.0) % 360.0
+                           for (_, ang), m in zip(crossings, passes)])
+        mean = math.degrees(math.atan2(np.mean(np.sin(np.radians(phases))), np.mean(np.cos(np.radians(phases)))))
+        dev = np.abs((phases - mean + 180.0) % 360.0 - 180.0)
+        spread = float(2 * np.max(dev))  # peak-to-peak around the circular mean
+        k = int(np.argmax(dev))
+        if spread >= worst.value:
+            worst = CheckResult(name, spread <= limit, spread, limit, "deg",
+                                detail=f"line {ln}: {len(passes)} passes, pass {k + 1} farthest from the others",
+                                **cols.where(crossings[k][0]))
+    return worst
+
+
+def check_jitter(cols: _Cols, cycle: float | None, limits: list[tuple[str, float]]) -> list[CheckResult]:
+    period = cols["period"]
+    nominal = cycle if cycle is not None else (float(np.median(period)) if period.size else 0.0)
+    jit = np.abs(period - nominal)
+    out = []
+    for label, lim in limits:
+        if jit.size == 0:
+            out.append(CheckResult(f"jitter {label}", True, 0.0, lim, "s"))
+            continue
+        value = float(np.max(jit)) if label == "max" else float(np.percentile(jit, float(label[1:])))
+        ok = value <= lim
+        bad = np.flatnonzero(jit > lim)
+        i = int(bad[0]) if (not ok and bad.size) else int(np.argmax(jit))
+        detail = f"{bad.size} cycles over {_fmt(lim, 's')}" if bad.size else ""
+        out.append(CheckResult(f"jitter {label}", ok, value, lim, "s", detail=detail, **cols.where(i)))
+    return out

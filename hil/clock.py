@@ -1,0 +1,268 @@
+"""Cycle pacers: lock-step virtual time and paced real time, and per-cycle timing statistics.
+
+The runner calls `tick()` at the start of every cycle and `done()` when the cycle's work is over.
+`tick()` returns the cycle's timing: the period since the previous cycle started and how late the
+cycle started against its deadline. In lock-step mode both are virtual (period = cycle, late = 0),
+so traces stay reproducible; in real-time mode they are measured on CLOCK_MONOTONIC.
+
+Real time: sleep until shortly before the deadline, then spin on the clock for the last stretch
+(`busy_wait`), because a sleeping thread wakes tens of microseconds late on a stock kernel while
+spinning is exact to the clock's resolution. SCHED_FIFO, CPU pinning and mlockall are requested
+and whatever the system refuses is reported, never fatal. On EtherCAT the link may expose
+`dc_time() -> int` (ns of the reference clock); the pacer then steers its deadlines so the frame
+leaves at a fixed phase to SYNC0, like a DC master must.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import ctypes.util
+import os
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from hil.bench import RealtimeConfig
+
+
+@dataclass(frozen=True, slots=True)
+class CycleTiming:
+    period: float  # s since the previous cycle started
+    late: float  # s the cycle started after its deadline
+    overrun: bool = False  # the previous cycle's work ran past this cycle's deadline
+
+
+class TimingStats:
+    """Streaming distribution of a non-negative duration: a 100 ns histogram up to 50 ms plus the
+    exact maximum, so percentiles of hours-long runs need fixed memory (4 MB)."""
+
+    BIN = 1e-7
+    NBINS = 500_000
+
+    def __init__(self) -> None:
+        self.hist = np.zeros(self.NBINS + 1, dtype=np.int64)
+        self.count = 0
+        self.max = 0.0
+        self.max_at = 0  # cycle number of the maximum
+
+    def add(self, value: float, cycle: int = 0) -> None:
+        v = abs(value)
+        self.hist[min(int(v / self.BIN), self.NBINS)] += 1
+        self.count += 1
+        if v > self.max:
+            self.max, self.max_at = v, cycle
+
+    def percentile(self, q: float) -> float:
+        if self.count == 0:
+            return 0.0
+        k = int(np.searchsorted(np.cumsum(self.hist), q / 100.0 * self.count, side="left"))
+        return min((k + 0.5) * self.BIN, self.max) if k < self.NBINS else self.max
+
+    def summary(self) -> dict[str, float]:
+        return {"p50": self.percentile(50), "p99": self.percentile(99), "p99.9": self.percentile(99.9),
+                "max": self.max, "count": float(self.count)}
+
+
+@dataclass
+class Granted:
+    """What the system granted the real-time loop (reported, never required)."""
+
+    sched: str = "SCHED_OTHER"
+    priority: int = 0
+    cpus: str = ""
+    memory_locked: bool = False
+    dc_aligned: bool = False
+    notes: list[str] = field(default_factory=list)
+
+    def __str__(self) -> str:
+        parts = [f"{self.sched}" + (f" prio {self.priority}" if self.priority else ""),
+                 f"cpus {self.cpus}" if self.cpus else "cpus any",
+                 "memory locked" if self.memory_locked else "memory not locked",
+                 "aligned to DC SYNC0" if self.dc_aligned else "free-running"]
+        return ", ".join(parts) + "".join(f"; {n}" for n in self.notes)
+
+
+class LockStepClock:
+    """Virtual time: every cycle is exactly one period long; nothing waits."""
+
+    realtime = False
+
+    def __init__(self, cycle: float) -> None:
+        self.cycle = cycle
+        self.exec = TimingStats()  # wall-clock work per cycle, for the summary only (not the trace)
+        self.jitter = TimingStats()
+        self.overruns = 0
+        self.granted = Granted(notes=["lock-step virtual time"])
+        self._t0 = 0
+        self._n = 0
+
+    def start(self, link: object | None = None) -> None:
+        pass
+
+    def tick(self) -> CycleTiming:
+        self._t0 = time.perf_counter_ns()
+        self._n += 1
+        self.jitter.add(0.0, self._n)
+        return CycleTiming(self.cycle, 0.0)
+
+    def done(self) -> None:
+        self.exec.add((time.perf_counter_ns() - self._t0) * 1e-9, self._n)
+
+    def stop(self) -> None:
+        pass
+
+
+class RealTimeClock:
+    """Holds the cycle period on CLOCK_MONOTONIC, optionally phase-locked to EtherCAT DC."""
+
+    realtime = True
+
+    def __init__(self, cycle: float, config: RealtimeConfig | None = None,
+                 now_ns: Callable[[], int] = time.monotonic_ns, sleep: Callable[[float], None] = time.sleep,
+                 dc_offset: float = 0.5) -> None:
+        self.cycle = cycle
+        self.config = config or RealtimeConfig()
+        self.period_ns = int(round(cycle * 1e9))
+        self.now_ns = now_ns
+        self.sleep = sleep
+        self.dc_offset_ns = int(dc_offset * self.period_ns)  # where in the SYNC0 period the frame should go
+        self.exec = TimingStats()
+        self.jitter = TimingStats()  # |period - cycle|
+        self.latency = TimingStats()  # wake-up lateness against the deadline
+        self.overruns = 0
+        self.first_overrun: int | None = None
+        self.granted = Granted()
+        self._deadline = 0
+        self._last_start: int | None = None
+        self._start_ns = 0
+        self._n = 0
+        self._dc: Callable[[], int] | None = None
+        self._integral = 0.0
+        self._saved_affinity: set[int] | None = None
+        self._saved_sched: tuple[int, int] | None = None
+
+    # ---- setup ------------------------------------------------------------------------------
+    def start(self, link: object | None = None) -> None:
+        self.granted = acquire_realtime(self.config, self)
+        dc = getattr(link, "dc_time", None)
+        if callable(dc):
+            self._dc = dc
+            self.granted.dc_aligned = True
+        self._deadline = self.now_ns() + self.period_ns
+
+    def stop(self) -> None:
+        release_realtime(self)
+
+    # ---- the cycle ----------------------------------------------------------------------------
+    def tick(self) -> CycleTiming:
+        now = self.now_ns()
+        overrun = now > self._deadline
+        if overrun:
+            self.overruns += 1
+            if self.first_overrun is None:
+                self.first_overrun = self._n + 1
+            # Skip the missed deadlines: keep the phase, never try to catch up with a burst.
+            missed = (now - self._deadline) // self.period_ns + 1
+            self._deadline += missed * self.period_ns
+        self._wait_until(self._deadline)
+        start = self.now_ns()
+        self._n += 1
+        late = (start - self._deadline) * 1e-9
+        period = (start - self._last_start) * 1e-9 if self._last_start is not None else self.cycle
+        self._last_start = start
+        self._start_ns = start
+        self.latency.add(late, self._n)
+        self.jitter.add(period - self.cycle, self._n)
+        self._deadline += self.period_ns + self._dc_correction()
+        return CycleTiming(period, late, overrun)
+
+    def done(self) -> None:
+        self.exec.add((self.now_ns() - self._start_ns) * 1e-9, self._n)
+
+    def _wait_until(self, deadline: int) -> None:
+        spin_ns = int(self.config.busy_wait * 1e9)
+        remaining = deadline - self.now_ns()
+        if remaining > spin_ns:
+            self.sleep((remaining - spin_ns) * 1e-9)
+        while self.now_ns() < deadline:
+            pass
+
+    def _dc_correction(self) -> int:
+        """PI steering of the next deadline so DC time modulo the period sits at the target offset."""
+        if self._dc is None:
+            return 0
+        try:
+            t = int(self._dc())
+        except Exception:  # a link without a DC reading this cycle: free-run for one period
+            return 0
+        if t <= 0:
+            return 0
+        err = (t - self.dc_offset_ns) % self.period_ns
+        if err > self.period_ns // 2:
+            err -= self.period_ns
+        self._integral += err
+        # Gains small against the period: the loop settles in ~100 cycles and never jumps.
+        corr = -(0.1 * err + 0.005 * self._integral)
+        limit = self.period_ns * 0.05
+        return int(max(-limit, min(limit, corr)))
+
+
+# ---- system real-time requests ------------------------------------------------------------------
+def acquire_realtime(config: RealtimeConfig, owner: RealTimeClock) -> Granted:
+    g = Granted()
+    try:
+        owner._saved_sched = (os.sched_getscheduler(0), os.sched_getparam(0).sched_priority)
+        os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(config.priority))
+        g.sched, g.priority = "SCHED_FIFO", config.priority
+    except (OSError, AttributeError) as exc:
+        owner._saved_sched = None
+        g.notes.append(f"SCHED_FIFO refused ({getattr(exc, 'strerror', None) or exc})")
+    if config.cpu is not None:
+        try:
+            owner._saved_affinity = os.sched_getaffinity(0)
+            os.sched_setaffinity(0, {config.cpu})
+        except (OSError, AttributeError) as exc:
+            owner._saved_affinity = None
+            g.notes.append(f"CPU {config.cpu} pinning refused ({getattr(exc, 'strerror', None) or exc})")
+    try:
+        g.cpus = ",".join(str(c) for c in sorted(os.sched_getaffinity(0)))
+    except (OSError, AttributeError):
+        g.cpus = ""
+    if config.lock_memory:
+        g.memory_locked = _mlockall(g)
+    return g
+
+
+def release_realtime(owner: RealTimeClock) -> None:
+    if owner._saved_sched is not None:
+        try:
+            policy, prio = owner._saved_sched
+            os.sched_setscheduler(0, policy, os.sched_param(prio))
+        except OSError:
+            pass
+        owner._saved_sched = None
+    if owner._saved_affinity is not None:
+        try:
+            os.sched_setaffinity(0, owner._saved_affinity)
+        except OSError:
+            pass
+        owner._saved_affinity = None
+
+
+def _mlockall(g: Granted) -> bool:
+    name = ctypes.util.find_library("c")
+    if not name:
+        g.notes.append("mlockall unavailable")
+        return False
+    libc = ctypes.CDLL(name, use_errno=True)
+    MCL_CURRENT, MCL_FUTURE = 1, 2
+    if libc.mlockall(MCL_CURRENT | MCL_FUTURE) != 0:
+        g.notes.append(f"mlockall refused ({os.strerror(ctypes.get_errno())})")
+        return False
+    return True
+
+
+def make_clock(cycle: float, realtime: bool, config: RealtimeConfig | None = None) -> LockStepClock | RealTimeClock:
+    return RealTimeClock(cycle, config) if realtime else LockStepClock(cycle)
