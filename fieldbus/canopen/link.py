@@ -1,0 +1,390 @@
+"""`CanopenLink`: the bench's bus link over CANopen (CiA 301 + CiA 402), on python-canopen.
+
+open():  node scan → NMT reset communication → boot-ups → identity and device type over SDO →
+         heartbeat producer (0x1017), interpolation time period (0x60C2) and the RPDO/TPDO
+         communication and mapping records (0x1400/0x1600, 0x1800/0x1A00) written over SDO →
+         NMT operational.
+exchange(): RPDOs out, one SYNC, the TPDOs every node sends on that SYNC in; heartbeat consumer,
+         NMT state watch and EMCYs checked after each cycle, faults raised as `BusError`.
+
+Interfaces: `virtual` (in-process, lock-step: delivery is pumped, time is simulated, nothing
+sleeps), and any python-can interface in real time (`socketcan` on benches, `udp_multicast`
+between processes in tests). The same code configures and runs all of them.
+"""
+
+from __future__ import annotations
+
+import copy
+import itertools
+import logging
+import threading
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import can
+import canopen
+from canopen.sdo.exceptions import SdoAbortedError, SdoCommunicationError
+
+from fieldbus.canopen.budget import DEFAULT_BITRATE, BusLoad, bus_load, check_budget
+from fieldbus.canopen.emcy import ALARM_COMMUNICATION, ALARM_PDO_MAPPING, Emcy, emcy_alarm
+from fieldbus.canopen.lockstep import LockstepNetwork
+from fieldbus.canopen.objects import ASDA_B3_EDS, MAX_PDOS, frame_layouts
+from fieldbus.link import BusError, SlaveInfo
+from fieldbus.pdo import ASDA_CSP, ASDA_CSP_CSV, PdoLayout, RxPdo, TxPdo
+from nc.alarms import Alarm
+
+log = logging.getLogger("fieldbus.canopen")
+
+ALARM_NOT_FOUND = 0x142B  # fieldbus slave devices not found
+ALARM_ESTABLISH = 0x1420  # fieldbus communication establish failed
+ALARM_INTERPOLATION = 0x141F  # the servo does not support the interpolation time
+
+NMT_BOOTUP, NMT_STOPPED, NMT_OPERATIONAL, NMT_PREOP = 0, 4, 5, 127
+NMT_NAMES = {0: "BOOT-UP", 4: "STOPPED", 5: "OPERATIONAL", 127: "PRE-OPERATIONAL"}
+CIA402_DEVICE_PROFILE = 402
+_channels = itertools.count(1)
+
+
+@dataclass
+class NodeConfig:
+    node_id: int
+    name: str  # axis or spindle name
+    layout: PdoLayout
+    eds: str | Path = ASDA_B3_EDS  # EDS or DCF of the device
+
+
+@dataclass
+class _Node:
+    cfg: NodeConfig
+    remote: canopen.RemoteNode
+    rx_frames: list[PdoLayout]
+    tx_frames: list[PdoLayout]
+    tx: TxPdo = field(default_factory=TxPdo)
+    tx_cobs: dict[int, PdoLayout] = field(default_factory=dict)
+    received: set[int] = field(default_factory=set)
+    nmt_state: int | None = None
+    last_heartbeat: float = 0.0
+    lost: bool = False
+    tpdo_misses: int = 0
+
+
+def interpolation_period(cycle: float) -> tuple[int, int]:
+    """0x60C2: the cycle as value (sub 1, 1-255) × 10^index s (sub 2)."""
+    for index in range(-3, -7, -1):
+        value = cycle / 10.0 ** index
+        if abs(value - round(value)) < 1e-6 and 1 <= round(value) <= 255:
+            return int(round(value)), index
+    raise ValueError(f"cycle {cycle * 1000:g} ms cannot be written as 0x60C2 (1-255 × 10^-3..-6 s)")
+
+
+class CanopenLink:
+    def __init__(self, nodes: Sequence[NodeConfig], interface: str, channel: str = "", cycle: float = 0.001,
+                 bitrate: int = DEFAULT_BITRATE, heartbeat_period: float = 0.02, heartbeat_timeout: float = 0.05,
+                 tpdo_timeout: float | None = None) -> None:
+        if not nodes:
+            raise ValueError("a CANopen bus needs at least one node")
+        if interface == "udp_multicast" and not channel:
+            raise ValueError("canopen:udp_multicast needs an explicit multicast group, e.g. "
+                             "canopen:udp_multicast:239.74.163.2")
+        self.nodes_cfg = list(nodes)
+        self.interface = interface
+        self.lockstep = interface == "virtual"
+        self.channel = channel or (f"deltahil-canopen-{next(_channels)}" if self.lockstep else
+                                   "can0" if interface == "socketcan" else "")
+        self.cycle_time = cycle
+        self.bitrate = bitrate
+        self.heartbeat_period = heartbeat_period
+        self.heartbeat_timeout = heartbeat_timeout
+        self.tpdo_timeout = tpdo_timeout if tpdo_timeout is not None else max(0.8 * cycle, 0.002)
+        self.ip_period = interpolation_period(cycle)
+        for cfg in self.nodes_cfg:
+            frame_layouts(cfg.layout)  # refuse layouts that don't fit the node's PDOs
+        self.budget: BusLoad = bus_load([c.layout for c in self.nodes_cfg], cycle, bitrate, heartbeat_period)
+        # Raises BusBudgetError above 100 % on a wire with a bitrate; the virtual bus only warns.
+        self.budget_note = check_budget(self.budget, enforce=not self.lockstep)
+        if self.budget_note:
+            log.warning("%s", self.budget_note)
+        self.network: canopen.Network | None = None
+        self.peers: list[Callable[[], None]] = []  # in-process slaves pumped in lock-step
+        self.on_close: list[Callable[[], None]] = []
+        self.time = 0.0
+        self.cycles = 0
+        self.infos: list[SlaveInfo] = []
+        self.found: list[int] = []
+        self._nodes: list[_Node] = []
+        self._opened = False
+        self._lock = threading.Condition()
+        self._emcys: list[Alarm] = []
+        self._next_sync = 0.0
+        self._opened_at = 0.0
+
+    @classmethod
+    def for_bench(cls, bench: Any, interface: str, channel: str = "") -> "CanopenLink":
+        """Node IDs 1, 2, … in axis order, then the spindles; CSP set for axes, CSP+CSV for spindles."""
+        eds = getattr(bench, "canopen_eds", None) or ASDA_B3_EDS
+        nodes = [NodeConfig(i + 1, a.name, ASDA_CSP, eds) for i, a in enumerate(bench.axes)]
+        nodes += [NodeConfig(len(nodes) + k + 1, s.name, ASDA_CSP_CSV, eds) for k, s in enumerate(bench.spindles)]
+        return cls(nodes, interface, channel, bench.cycle,
+                   bitrate=int(getattr(bench, "canopen_bitrate", None) or DEFAULT_BITRATE))
+
+    # ---- clock ------------------------------------------------------------------------
+    def _now(self) -> float:
+        return self.time if self.lockstep else time.monotonic()
+
+    def _wait(self, done: Callable[[], bool], timeout: float) -> bool:
+        """Lock-step: everything was delivered already. Real time: wait for the receive thread."""
+        if self.lockstep:
+            return done()
+        end = time.monotonic() + timeout
+        with self._lock:
+            while not done():
+                left = end - time.monotonic()
+                if left <= 0:
+                    return False
+                self._lock.wait(left)
+        return True
+
+    # ---- open ---------------------------------------------------------------------------
+    def open(self) -> list[SlaveInfo]:
+        if self.lockstep:
+            net = LockstepNetwork(self.channel, auto_deliver=True)
+            net.peers = self.peers
+            self.network = net
+        else:
+            self.network = canopen.Network()
+            self.network.connect(interface=self.interface, channel=self.channel)
+        net = self.network
+        for cfg in self.nodes_cfg:
+            remote = canopen.RemoteNode(cfg.node_id, canopen.import_od(str(cfg.eds), cfg.node_id))
+            net.add_node(remote)
+            rx, tx = frame_layouts(cfg.layout)
+            node = _Node(cfg, remote, rx, tx)
+            self._nodes.append(node)
+            net.subscribe(0x700 + cfg.node_id, self._heartbeat_cb(node))
+            net.subscribe(0x80 + cfg.node_id, self._emcy_cb(node))
+        self._scan()
+        self._nmt_all(0x82, "RESET COMMUNICATION")
+        if not self._wait(lambda: all(n.nmt_state == NMT_BOOTUP or n.nmt_state == NMT_PREOP for n in self._nodes), 1.0):
+            missing = [n for n in self._nodes if n.nmt_state is None]
+            self._fail(Alarm(ALARM_NOT_FOUND, "no boot-up after NMT reset communication from "
+                             + ", ".join(self._label(n) for n in missing), axis=missing[0].cfg.name))
+        self._nmt_all(0x80, "PRE-OPERATIONAL")
+        self.infos = [self._identify(i, n) for i, n in enumerate(self._nodes)]
+        for n in self._nodes:
+            self._configure(n)
+        self._nmt_all(0x01, "OPERATIONAL")
+        now = self._now()
+        with self._lock:
+            for n, info in zip(self._nodes, self.infos):
+                n.last_heartbeat = now
+                n.nmt_state = None  # known again from the first heartbeat after NMT start
+                info.state = "OPERATIONAL"
+        self._opened_at = now
+        self._opened = True
+        self._next_sync = time.monotonic()
+        return self.infos
+
+    def _scan(self) -> None:
+        """python-canopen's NodeScanner asks every ID for 0x1000; our nodes must be among those answering."""
+        net = self.network
+        net.scanner.reset()
+        net.scanner.search()
+        want = {n.cfg.node_id for n in self._nodes}
+        self._wait(lambda: want <= set(net.scanner.nodes), 0.5)
+        self.found = sorted(net.scanner.nodes)
+        missing = [n for n in self._nodes if n.cfg.node_id not in self.found]
+        if missing:
+            self._fail(Alarm(ALARM_NOT_FOUND, "CANopen node scan on " + self.describe_bus() + " found "
+                             + (", ".join(map(str, self.found)) or "no node") + "; missing "
+                             + ", ".join(self._label(n) for n in missing), axis=missing[0].cfg.name))
+
+    def _nmt_all(self, code: int, name: str) -> None:
+        for n in self._nodes:
+            if code == 0x82:
+                n.nmt_state = None
+            n.remote.nmt.send_command(code)
+        log.info("NMT %s sent to nodes %s", name, [n.cfg.node_id for n in self._nodes])
+
+    def _identify(self, pos: int, n: _Node) -> SlaveInfo:
+        sdo = n.remote.sdo
+        device_type = self._sdo(n, lambda: sdo[0x1000].raw, 0x1000)
+        vendor = self._sdo(n, lambda: sdo[0x1018][1].raw, 0x1018)
+        product = self._sdo(n, lambda: sdo[0x1018][2].raw, 0x1018)
+        if device_type & 0xFFFF != CIA402_DEVICE_PROFILE:
+            self._fail(Alarm(ALARM_PDO_MAPPING, f"{self._label(n)} is not a CiA 402 drive "
+                             f"(device type 0x{device_type:08X})", axis=n.cfg.name))
+        return SlaveInfo(pos, n.cfg.name, "drive", vendor, product, "PRE-OPERATIONAL", n.cfg.layout.name)
+
+    def _configure(self, n: _Node) -> None:
+        sdo, nid = n.remote.sdo, n.cfg.node_id
+        value, index = self.ip_period
+        self._sdo(n, lambda: setattr(sdo[0x60C2][1], "raw", value), 0x60C2)
+        self._sdo(n, lambda: setattr(sdo[0x60C2][2], "raw", index), 0x60C2)
+        self._sdo(n, lambda: setattr(sdo[0x1017], "raw", int(round(self.heartbeat_period * 1000))), 0x1017)
+        for maps, frames, base in ((n.remote.rpdo, n.rx_frames, 0x200), (n.remote.tpdo, n.tx_frames, 0x180)):
+            for k in range(MAX_PDOS):
+                m = maps[k + 1]
+                m.clear()
+                m.cob_id = base + 0x100 * k + nid
+                m.trans_type = 1  # synchronous: RPDOs act, TPDOs are sent, on every SYNC
+                m.rtr_allowed = False
+                m.enabled = k < len(frames)
+                if m.enabled:
+                    for e in (frames[k].rx or frames[k].tx):
+                        m.add_variable(e.index, e.subindex, e.bits)
+                self._sdo(n, m.save, m.com_record.od.index)
+        # The library subscribed its own PdoMap handlers; we decode TPDOs with our structs instead.
+        for k, frame in enumerate(n.tx_frames):
+            cob = 0x180 + 0x100 * k + nid
+            self.network.unsubscribe(cob)
+            n.tx_cobs[cob] = frame
+            self.network.subscribe(cob, self._tpdo_cb(n))
+
+    def _sdo(self, n: _Node, op: Callable[[], Any], index: int) -> Any:
+        try:
+            return op()
+        except SdoAbortedError as exc:
+            code = (ALARM_INTERPOLATION if index == 0x60C2 else
+                    ALARM_PDO_MAPPING if 0x1400 <= index <= 0x1BFF else ALARM_ESTABLISH)
+            self._fail(Alarm(code, f"SDO abort 0x{exc.code:08X} ({_abort_text(exc)}) from {self._label(n)} "
+                                   f"on object 0x{index:04X}", axis=n.cfg.name, info=n.cfg.node_id))
+        except SdoCommunicationError as exc:
+            self._fail(Alarm(ALARM_NOT_FOUND, f"{self._label(n)} does not answer SDO 0x{index:04X}: {exc}",
+                             axis=n.cfg.name, info=n.cfg.node_id))
+
+    def _fail(self, alarm: Alarm) -> None:
+        raise BusError(alarm)
+
+    # ---- receive callbacks (the Notifier thread in real time) -----------------------------
+    def _heartbeat_cb(self, n: _Node) -> Callable[[int, bytes, float], None]:
+        def cb(can_id: int, data: bytes, timestamp: float) -> None:
+            with self._lock:
+                n.nmt_state = data[0] & 0x7F if data else None
+                n.last_heartbeat = self._now()
+                self._lock.notify_all()
+        return cb
+
+    def _emcy_cb(self, n: _Node) -> Callable[[int, bytes, float], None]:
+        def cb(can_id: int, data: bytes, timestamp: float) -> None:
+            alarm = emcy_alarm(Emcy.decode(data), n.cfg.node_id, n.cfg.name)
+            if alarm is not None:
+                with self._lock:
+                    self._emcys.append(alarm)
+        return cb
+
+    def _tpdo_cb(self, n: _Node) -> Callable[[int, bytes, float], None]:
+        def cb(can_id: int, data: bytes, timestamp: float) -> None:
+            frame = n.tx_cobs[can_id]
+            if len(data) < frame.tx_bytes:
+                return  # a short TPDO is not processed (CiA 301 PDO length error)
+            with self._lock:
+                frame.unpack_tx(data, into=n.tx)
+                n.received.add(can_id)
+                self._lock.notify_all()
+        return cb
+
+    # ---- the cycle ------------------------------------------------------------------------
+    def exchange(self, outputs: Sequence[Any]) -> list[Any]:
+        if len(outputs) != len(self._nodes or self.nodes_cfg):
+            raise ValueError(f"{len(outputs)} output images for {len(self.nodes_cfg)} CANopen nodes")
+        if not self._opened:
+            return [TxPdo() for _ in self.nodes_cfg]
+        net = self.network
+        live = [n for n in self._nodes if not n.lost]
+        if not self.lockstep:
+            # The SYNC producer runs at the bench cycle, whatever the caller's loop does.
+            self._next_sync += self.cycle_time
+            delay = self._next_sync - time.monotonic()
+            if delay > 0:
+                time.sleep(delay)
+            else:
+                self._next_sync = time.monotonic()
+        with self._lock:
+            for n in live:
+                n.received.clear()
+        for n, rx in zip(self._nodes, outputs):
+            if n.lost:
+                continue
+            for k, frame in enumerate(n.rx_frames):
+                data = frame.pack_rx(rx)
+                cob = 0x200 + 0x100 * k + n.cfg.node_id
+                if self.lockstep:
+                    net.send_raw(cob, data)
+                else:
+                    net.send_message(cob, data)
+        net.sync.transmit()  # lock-step: delivers RPDOs + SYNC, the slaves answer, we collect
+        self.cycles += 1
+        if self.lockstep:
+            self.time += self.cycle_time
+        else:
+            self._wait(lambda: all(len(n.received) == len(n.tx_frames) for n in live), self.tpdo_timeout)
+        with self._lock:
+            for n in live:
+                if len(n.received) < len(n.tx_frames):
+                    n.tpdo_misses += 1  # keep the last values: the heartbeat decides if the node is gone
+            out = [copy.copy(n.tx) for n in self._nodes]
+            emcys, self._emcys = self._emcys, []
+        self._supervise(emcys)
+        return out
+
+    def _supervise(self, emcys: list[Alarm]) -> None:
+        now = self._now()
+        for n in self._nodes:
+            if n.lost:
+                continue
+            if now - n.last_heartbeat > self.heartbeat_timeout + 1e-9:
+                self._lose(n)
+                raise BusError(Alarm(ALARM_COMMUNICATION, f"heartbeat of {self._label(n)} lost: none for "
+                                     f"{(now - n.last_heartbeat) * 1000:.0f} ms (consumer time "
+                                     f"{self.heartbeat_timeout * 1000:g} ms)", axis=n.cfg.name, info=n.cfg.node_id))
+            # A heartbeat sent just before the node saw NMT start may still say PRE-OPERATIONAL.
+            if n.nmt_state not in (None, NMT_OPERATIONAL) and n.last_heartbeat - self._opened_at > self.heartbeat_period:
+                state = NMT_NAMES.get(n.nmt_state, str(n.nmt_state))
+                self._lose(n)
+                raise BusError(Alarm(ALARM_COMMUNICATION, f"{self._label(n)} left OPERATIONAL: heartbeat "
+                                     f"reports {state}", axis=n.cfg.name, info=n.cfg.node_id))
+        if emcys:
+            raise BusError(emcys[0])
+
+    def _lose(self, n: _Node) -> None:
+        """A lost node reads 'not ready to switch on' and is no longer served or supervised."""
+        n.lost = True
+        n.tx = TxPdo(position_actual=n.tx.position_actual, error_code=n.tx.error_code)
+        if self.infos:
+            self.infos[self._nodes.index(n)].state = "LOST"
+
+    # ---- close ----------------------------------------------------------------------------
+    def close(self) -> None:
+        net, self.network = self.network, None
+        self._opened = False
+        try:
+            if net is not None and net.bus is not None:
+                for n in self._nodes:
+                    if not n.lost:
+                        n.remote.nmt.send_command(0x02)  # NMT stop: no more PDOs from the drives
+                net.disconnect()
+        except (can.CanError, OSError) as exc:
+            log.warning("closing the CANopen network: %s", exc)
+        finally:
+            for fn in self.on_close:
+                fn()
+
+    # ---- helpers ----------------------------------------------------------------------------
+    def describe_bus(self) -> str:
+        return f"canopen:{self.interface}" + (f":{self.channel}" if self.channel else "")
+
+    @staticmethod
+    def _label(n: _Node) -> str:
+        return f"node {n.cfg.node_id} ({n.cfg.name})"
+
+    @property
+    def tpdo_misses(self) -> dict[str, int]:
+        return {n.cfg.name: n.tpdo_misses for n in self._nodes}
+
+
+def _abort_text(exc: SdoAbortedError) -> str:
+    text = str(exc)
+    return text.split(": ", 1)[-1] if ": " in text else text

@@ -1,0 +1,6 @@
+"""Simulated CANopen CiA 402 servo drives (python-canopen LocalNode + our drive model)."""
+
+from virtual_bus.canopen.node import Cia402Slave
+from virtual_bus.canopen.nodes import SlaveBus, attach_lockstep, serve
+
+__all__ = ["Cia402Slave", "SlaveBus", "attach_lockstep", "serve"]

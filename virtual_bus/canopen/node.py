@@ -1,0 +1,232 @@
+"""A simulated CiA 402 servo on CAN: python-canopen's `LocalNode` for the communication objects
+(SDO server, NMT slave, heartbeat producer, EMCY producer) and `virtual_bus.drive.Cia402Drive`
+for the drive.
+
+`LocalNode` leaves the PDO logic to the application (its docstring; canopen#328/#555/#558:
+TPDOs are never sent on SYNC by themselves), so this class reads the 0x1400/0x1600 and
+0x1800/0x1A00 records the master wrote, latches RPDOs, and on every SYNC applies them, steps the
+drive by the interpolation time period (0x60C2) and sends its TPDOs.
+"""
+
+from __future__ import annotations
+
+import copy
+import logging
+import struct
+from dataclasses import dataclass
+
+import canopen
+from canopen import objectdictionary as odmod
+from canopen.sdo.exceptions import SdoAbortedError
+
+from fieldbus.canopen.emcy import Emcy, emcy_for_delta
+from fieldbus.canopen.objects import ASDA_B3_EDS, MAX_PDO_BYTES, MAX_PDOS, OBJECT_ATTRS
+from fieldbus.cia402 import State
+from fieldbus.pdo import PdoEntry, PdoLayout, RxPdo
+from virtual_bus.drive import Cia402Drive
+
+log = logging.getLogger("virtual_bus.canopen")
+
+ABORT_NOT_MAPPABLE = 0x06040041
+ABORT_PDO_LENGTH = 0x06040042
+ABORT_VALUE_RANGE = 0x06090030
+
+_RX_OBJECTS = {0x6040, 0x607A, 0x6060, 0x60FF, 0x60B8, 0x60FE}
+_SIGNED = {odmod.INTEGER8, odmod.INTEGER16, odmod.INTEGER32}
+
+
+@dataclass
+class _Pdo:
+    cob_id: int
+    layout: PdoLayout
+
+
+class Cia402Slave:
+    def __init__(self, node_id: int, drive: Cia402Drive, eds: str = str(ASDA_B3_EDS),
+                 reject_writes: dict[tuple[int, int], int] | None = None) -> None:
+        self.node = canopen.LocalNode(node_id, canopen.import_od(eds, node_id))
+        self.drive = drive
+        self.rx = RxPdo(mode=drive.mode)
+        # Fault injection: (index, subindex) → SDO abort code the firmware answers a write with.
+        self.reject_writes = dict(reject_writes or {})
+        self.alive = True
+        self.network: canopen.Network | None = None
+        self.syncs = 0
+        self.emcys_sent: list[Emcy] = []
+        self._rpdos: dict[int, PdoLayout] = {}
+        self._tpdos: list[_Pdo] = []
+        self._latched: dict[int, bytes] = {}
+        self._dirty = True
+        self._fault_reported = 0
+        self.node.add_read_callback(self._on_read)
+        self.node.add_write_callback(self._on_write)
+
+    @property
+    def node_id(self) -> int:
+        return self.node.id
+
+    # ---- network ---------------------------------------------------------------------------
+    def attach(self, network: canopen.Network) -> None:
+        """Join the bus and power up: boot-up message, then PRE-OPERATIONAL (CiA 301)."""
+        self.network = network
+        network.add_node(self.node)
+        network.subscribe(0, self._after_nmt)  # after the NmtSlave's own handler
+        self.node.nmt.send_command(0x82)  # INITIALISING: sends the boot-up
+        self.node.nmt.send_command(0x80)  # PRE-OPERATIONAL: starts the heartbeat from 0x1017
+
+    def power_off(self) -> None:
+        """The node vanishes from the bus (cable pulled, supply lost): no SDO, PDO, heartbeat."""
+        self.alive = False
+        self.node.nmt.stop_heartbeat()
+        if self.network is not None:
+            self.network.unsubscribe(0, self._after_nmt)
+            for cob in self._rpdos:
+                self.network.unsubscribe(cob, self._on_rpdo)
+            self.node.remove_network()
+
+    @property
+    def nmt_state(self) -> str:
+        return self.node.nmt.state
+
+    def _after_nmt(self, can_id: int, data: bytes, timestamp: float) -> None:
+        cmd, target = struct.unpack_from("BB", data)
+        if target not in (0, self.node_id) or not self.alive:
+            return
+        if cmd in (0x81, 0x82):
+            # Reset node / communication: communication objects back to their EDS defaults.
+            for index in [i for i in self.node.data_store if 0x1000 <= i <= 0x1FFF]:
+                del self.node.data_store[index]
+            if cmd == 0x81:
+                self.drive.external_fault = 0
+            self.node.nmt.stop_heartbeat()
+            self._dirty = True
+            self.node.nmt.send_command(0x82)  # boot-up
+            self.node.nmt.send_command(0x80)
+        self._refresh_mapping()
+
+    # ---- object dictionary callbacks ---------------------------------------------------------
+    def _on_read(self, index: int, subindex: int, od: odmod.ODVariable):
+        attr = OBJECT_ATTRS.get((index, subindex))
+        if attr is None:
+            if index == 0x1001:
+                return 0x01 if self.drive.state in (State.FAULT, State.FAULT_REACTION_ACTIVE) else 0
+            return None
+        if index in _RX_OBJECTS:
+            return getattr(self.rx, attr)
+        return getattr(self.drive.feedback(), attr)
+
+    def _on_write(self, index: int, subindex: int, od: odmod.ODVariable, data: bytes) -> None:
+        code = self.reject_writes.get((index, subindex))
+        if code is not None:
+            raise SdoAbortedError(code)
+        if 0x1400 <= index <= 0x1BFF:
+            self._check_mapping_write(index, subindex, od.decode_raw(data))
+            self._dirty = True
+            return
+        attr = OBJECT_ATTRS.get((index, subindex))
+        if attr is not None and index in _RX_OBJECTS:
+            setattr(self.rx, attr, od.decode_raw(data))
+            if index in (0x6040, 0x6060):
+                self.drive.apply(copy.copy(self.rx))  # acyclic (SDO) device control acts at once
+
+    def _check_mapping_write(self, index: int, subindex: int, value: int) -> None:
+        if index & 0xFF00 in (0x1600, 0x1A00) and subindex >= 1 and value:
+            obj, sub, bits = value >> 16, (value >> 8) & 0xFF, value & 0xFF
+            rx = index & 0xFF00 == 0x1600
+            if (obj, sub) not in OBJECT_ATTRS or (obj in _RX_OBJECTS) != rx or bits % 8:
+                raise SdoAbortedError(ABORT_NOT_MAPPABLE)
+            var = self._od_var(obj, sub)
+            if var is None or not var.pdo_mappable or len(var) != bits:
+                raise SdoAbortedError(ABORT_NOT_MAPPABLE)
+        if index & 0xFF00 in (0x1600, 0x1A00) and subindex == 0 and value:
+            total = sum(self._value(index, k) & 0xFF for k in range(1, value + 1))
+            if total > 8 * MAX_PDO_BYTES:
+                raise SdoAbortedError(ABORT_PDO_LENGTH)
+
+    def _od_var(self, index: int, subindex: int) -> odmod.ODVariable | None:
+        od = self.node.object_dictionary
+        if index not in od:
+            return None
+        obj = od[index]
+        if isinstance(obj, odmod.ODVariable):
+            return obj
+        return obj[subindex] if subindex in obj else None
+
+    def _value(self, index: int, subindex: int) -> int:
+        var = self._od_var(index, subindex)
+        return var.decode_raw(self.node.get_data(index, subindex))
+
+    # ---- PDO mapping --------------------------------------------------------------------------
+    def _refresh_mapping(self) -> None:
+        """Rebuild the RPDO/TPDO codecs from the communication and mapping records."""
+        if not self._dirty or self.network is None:
+            return
+        self._dirty = False
+        for cob in self._rpdos:
+            self.network.unsubscribe(cob, self._on_rpdo)
+        self._rpdos, self._tpdos, self._latched = {}, [], {}
+        for k in range(MAX_PDOS):
+            for com, mapping, rx in ((0x1400, 0x1600, True), (0x1800, 0x1A00, False)):
+                cob = self._value(com + k, 1)
+                if cob & 0x80000000 or self._value(com + k, 2) > 240:
+                    continue  # disabled, or not synchronous (only SYNC-driven PDOs are simulated)
+                entries = []
+                for s in range(1, self._value(mapping + k, 0) + 1):
+                    v = self._value(mapping + k, s)
+                    obj, sub = v >> 16, (v >> 8) & 0xFF
+                    var = self._od_var(obj, sub)
+                    entries.append(PdoEntry(obj, sub, v & 0xFF, OBJECT_ATTRS[(obj, sub)],
+                                            var is not None and var.data_type in _SIGNED))
+                layout = PdoLayout(f"node{self.node_id}-{'r' if rx else 't'}pdo{k + 1}",
+                                   tuple(entries) if rx else (), () if rx else tuple(entries))
+                if rx:
+                    self._rpdos[cob & 0x7FF] = layout
+                else:
+                    self._tpdos.append(_Pdo(cob & 0x7FF, layout))
+        for cob in self._rpdos:
+            self.network.subscribe(cob, self._on_rpdo)
+
+    def _on_rpdo(self, can_id: int, data: bytes, timestamp: float) -> None:
+        layout = self._rpdos.get(can_id)
+        if layout is not None and len(data) >= layout.rx_bytes:
+            self._latched[can_id] = bytes(data)  # synchronous RPDO: acts on the next SYNC
+
+    # ---- SYNC ---------------------------------------------------------------------------------
+    @property
+    def interpolation_period(self) -> float:
+        return self._value(0x60C2, 1) * 10.0 ** self._value(0x60C2, 2)
+
+    def on_sync(self) -> None:
+        """One SYNC: latched RPDOs act, the drive runs one interpolation period, TPDOs go out."""
+        if not self.alive:
+            return
+        self._refresh_mapping()
+        self.syncs += 1
+        dt = self.interpolation_period
+        operational = self.node.nmt.state == "OPERATIONAL"
+        if operational:
+            for cob, data in self._latched.items():
+                self._rpdos[cob].unpack_rx(data, into=self.rx)
+            self._latched.clear()
+            tx = self.drive.exchange(copy.copy(self.rx), dt)
+        else:
+            self.drive.step(dt)
+            tx = self.drive.feedback()
+        self._emcy(tx.error_code)
+        if operational and self.network is not None:
+            for pdo in self._tpdos:
+                self.network.send_message(pdo.cob_id, pdo.layout.pack_tx(tx))
+
+    def _emcy(self, error_code: int) -> None:
+        faulted = self.drive.state in (State.FAULT, State.FAULT_REACTION_ACTIVE)
+        if faulted and error_code and error_code != self._fault_reported:
+            self._send_emcy(emcy_for_delta(error_code))
+            self._fault_reported = error_code
+        elif not faulted and self._fault_reported:
+            self._send_emcy(Emcy(0x0000, 0x00, 0))  # error reset
+            self._fault_reported = 0
+
+    def _send_emcy(self, emcy: Emcy) -> None:
+        self.emcys_sent.append(emcy)
+        if self.network is not None:
+            self.node.emcy.send(emcy.code, emcy.register, emcy.encode()[3:])

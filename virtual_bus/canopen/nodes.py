@@ -1,0 +1,80 @@
+"""The simulated drives of one bench on one CAN bus: node IDs 1, 2, … in axis order.
+
+Two ways to run them:
+- `attach_lockstep(link, drives)`: in the master's process on python-can's `virtual` bus, pumped
+  by the master after each frame it sends (deterministic lock-step, simulated time);
+- `serve(drives, interface, channel)`: in their own process on a real python-can interface
+  (`socketcan`, or `udp_multicast` inside a network namespace), driven by the master's SYNC in
+  real time. This is what `hil sim canopen` runs.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+from collections.abc import Sequence
+
+import canopen
+
+from fieldbus.canopen.lockstep import LockstepNetwork
+from virtual_bus.canopen.node import Cia402Slave
+from virtual_bus.drive import Cia402Drive
+
+log = logging.getLogger("virtual_bus.canopen")
+
+
+class SlaveBus:
+    def __init__(self, drives: Sequence[Cia402Drive], network: canopen.Network, first_id: int = 1) -> None:
+        self.network = network
+        self.slaves = [Cia402Slave(first_id + i, d) for i, d in enumerate(drives)]
+        self.syncs = 0
+        self._lock = threading.Lock()
+        network.subscribe(0x80, self._on_sync)
+        for s in self.slaves:
+            s.attach(network)
+
+    def __getitem__(self, name_or_id: str | int) -> Cia402Slave:
+        for s in self.slaves:
+            if s.node_id == name_or_id or s.drive.name == name_or_id:
+                return s
+        raise KeyError(name_or_id)
+
+    def _on_sync(self, can_id: int, data: bytes, timestamp: float) -> None:
+        with self._lock:
+            self.syncs += 1
+            for s in self.slaves:
+                s.on_sync()
+            if isinstance(self.network, LockstepNetwork):
+                alive = [s for s in self.slaves if s.alive]
+                # Heartbeats run on simulated time: one interpolation period per SYNC.
+                self.network.advance(alive[0].interpolation_period if alive else 0.0)
+
+    def close(self) -> None:
+        for s in self.slaves:
+            s.node.nmt.stop_heartbeat()
+        self.network.disconnect()
+
+
+def attach_lockstep(link, drives: Sequence[Cia402Drive]) -> SlaveBus:
+    """Put the drives on the link's `virtual` channel and let the link pump them each frame."""
+    bus = SlaveBus(drives, LockstepNetwork(link.channel))
+    link.peers.append(bus.network.pump)
+    link.on_close.append(bus.close)
+    return bus
+
+
+def serve(drives: Sequence[Cia402Drive], interface: str, channel: str, stop: threading.Event | None = None,
+          ready: threading.Event | None = None) -> SlaveBus:
+    """Run the nodes on a real python-can interface until `stop` is set (Ctrl-C in `hil sim`)."""
+    network = canopen.Network()
+    network.connect(interface=interface, channel=channel)
+    bus = SlaveBus(drives, network)
+    log.info("CANopen nodes %s on %s:%s", [s.node_id for s in bus.slaves], interface, channel)
+    if ready is not None:
+        ready.set()
+    if stop is not None:
+        try:
+            stop.wait()
+        finally:
+            bus.close()
+    return bus
