@@ -81,7 +81,16 @@ def make_link(bench: Bench) -> BusLink:
         return EthercatLink.for_bench(bench, spec.interface)
     from fieldbus.canopen.link import CanopenLink
 
-    return CanopenLink.for_bench(bench, spec.interface, spec.channel)
+    try:
+        link = CanopenLink.for_bench(bench, spec.interface, spec.channel)
+    except ValueError as exc:  # bus budget above 100 %, missing multicast group, unusable cycle
+        raise InputError(f"bus {spec}: {exc}") from None
+    if spec.interface == "virtual":
+        # In-process simulated CANopen drives on the same virtual channel, pumped in lock-step.
+        from virtual_bus.canopen import attach_lockstep
+
+        attach_lockstep(link, sim_slaves(bench))
+    return link
 
 
 def print_alarm(alarm: Alarm, as_json: bool = False, stream=None) -> None:
