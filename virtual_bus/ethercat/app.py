@@ -1,0 +1,111 @@
+"""What sits behind a virtual slave's process data: a CiA 402 drive or a digital I/O module.
+
+Process data goes through the object dictionary (outputs are written into their objects, inputs
+read from theirs), so the PDO mapping a master configures over SDO is the one that is used.
+"""
+
+from __future__ import annotations
+
+import struct
+from dataclasses import dataclass, field
+
+from fieldbus.pdo import ASDA_CSP_CSV, RxPdo
+from virtual_bus.drive import Cia402Drive
+from virtual_bus.ethercat.coe import ObjectDictionary
+from virtual_bus.ethercat.esc import SlaveApp
+
+# object index -> RxPdo / TxPdo attribute, from the ASDA preset's entries
+RX_ATTR = {e.index: e.attr for e in ASDA_CSP_CSV.rx} | {0x60FE: "digital_outputs"}
+TX_ATTR = {e.index: e.attr for e in ASDA_CSP_CSV.tx}
+
+
+def _unpack(data: bytes, mapping, od: ObjectDictionary) -> None:
+    pos = 0
+    for index, sub, bits in mapping:
+        n = bits // 8
+        e = od.objects[index].entries[sub]
+        od.set(index, sub, int.from_bytes(data[pos:pos + n], "little", signed=e.signed))
+        pos += n
+
+
+def _pack(mapping, od: ObjectDictionary) -> bytes:
+    out = bytearray()
+    for index, sub, bits in mapping:
+        n = bits // 8
+        v = od.value(index, sub)
+        out += (v & ((1 << bits) - 1)).to_bytes(n, "little")
+    return bytes(out)
+
+
+@dataclass
+class DriveApp(SlaveApp):
+    drive: Cia402Drive
+    od: ObjectDictionary | None = None
+    _last_error: int = 0
+
+    def attach(self, od: ObjectDictionary) -> None:
+        self.od = od
+        self._publish()
+
+    def _publish(self) -> None:
+        od = self.od
+        assert od is not None
+        fb = self.drive.feedback()
+        for index, attr in TX_ATTR.items():
+            if index in od.objects:
+                od.set(index, 0, int(getattr(fb, attr)))
+
+    def refresh(self, index: int) -> None:
+        if index in TX_ATTR:
+            self._publish()
+
+    def cycle(self, outputs: bytes, rx_map, tx_map, step: bool, dt: float = 0.0) -> bytes:
+        od = self.od
+        assert od is not None
+        if step:
+            _unpack(outputs, rx_map, od)
+            rx = RxPdo(mode=self.drive.mode)
+            for index, attr in RX_ATTR.items():
+                if index in od.objects:
+                    setattr(rx, attr, od.value(index))
+            self.drive.apply(rx)
+            self.drive.step(dt)
+        self._publish()
+        return _pack(tx_map, od)
+
+    def new_error(self) -> int:
+        """The drive's error code if it changed to a new non-zero value since the last call."""
+        code = self.drive.error_code
+        fresh = code if code and code != self._last_error else 0
+        self._last_error = code
+        return fresh
+
+
+@dataclass
+class DioApp(SlaveApp):
+    """16 digital inputs (0x6000:1) and 16 outputs (0x7000:1); inputs can be driven by a test."""
+
+    inputs: int = 0
+    outputs: int = 0
+    od: ObjectDictionary | None = None
+    history: list[int] = field(default_factory=list)
+
+    def attach(self, od: ObjectDictionary) -> None:
+        self.od = od
+
+    def refresh(self, index: int) -> None:
+        if self.od is not None and index == 0x6000:
+            self.od.set(0x6000, 1, self.inputs)
+
+    def cycle(self, outputs: bytes, rx_map, tx_map, step: bool, dt: float = 0.0) -> bytes:
+        od = self.od
+        assert od is not None
+        if step:
+            _unpack(outputs, rx_map, od)
+            self.outputs = od.value(0x7000, 1)
+        od.set(0x6000, 1, self.inputs)
+        return _pack(tx_map, od)
+
+
+def pack_u16(v: int) -> bytes:
+    return struct.pack("<H", v & 0xFFFF)

@@ -1,0 +1,477 @@
+"""A software EtherCAT Slave Controller: the register file, datagram handling with working
+counters, SII EEPROM access, the AL state machine, SyncManagers (mailbox and process data),
+FMMUs, the process-data watchdog and the distributed-clock registers.
+
+The register map follows the ESC datasheets (ET1100/ET1200 section II); only what masters use
+is active, everything else is plain memory.
+"""
+
+from __future__ import annotations
+
+import struct
+import time
+from collections import deque
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+from virtual_bus.ethercat.coe import CoeServer, ObjectDictionary
+from virtual_bus.ethercat.device import Device
+from virtual_bus.ethercat.sii import build_sii
+
+# datagram commands
+NOP, APRD, APWR, APRW, FPRD, FPWR, FPRW, BRD, BWR, BRW, LRD, LWR, LRW, ARMW, FRMW = range(15)
+CMD_NAMES = ["NOP", "APRD", "APWR", "APRW", "FPRD", "FPWR", "FPRW", "BRD", "BWR", "BRW", "LRD", "LWR", "LRW",
+             "ARMW", "FRMW"]
+
+INIT, PREOP, BOOT, SAFEOP, OP = 1, 2, 3, 4, 8
+AL_ERROR = 0x10
+
+# AL status codes (ETG.1000.6 table 11)
+AL_INVALID_STATE_CHANGE = 0x0011
+AL_UNKNOWN_STATE = 0x0012
+AL_BOOTSTRAP_NOT_SUPPORTED = 0x0013
+AL_INVALID_MAILBOX = 0x0016
+AL_INVALID_SM = 0x0017
+AL_SYNC_ERROR = 0x001A
+AL_SM_WATCHDOG = 0x001B
+AL_INVALID_OUTPUT = 0x001D
+AL_INVALID_INPUT = 0x001E
+AL_INVALID_DC_SYNC = 0x0030
+AL_INVALID_SYNC0_CYCLE = 0x0036
+
+R_TYPE, R_STATION, R_ALIAS, R_DL_CONTROL, R_DL_STATUS = 0x0000, 0x0010, 0x0012, 0x0100, 0x0110
+R_AL_CONTROL, R_AL_STATUS, R_AL_CODE = 0x0120, 0x0130, 0x0134
+R_WD_DIV, R_WD_PD, R_WD_STATUS = 0x0400, 0x0420, 0x0440
+R_EEP_CFG, R_EEP_CTRL, R_EEP_ADDR, R_EEP_DATA = 0x0500, 0x0502, 0x0504, 0x0508
+R_FMMU, R_SM = 0x0600, 0x0800
+R_DC_RECV, R_DC_SYSTIME, R_DC_RECV_PU, R_DC_OFFSET, R_DC_DELAY, R_DC_DIFF = 0x0900, 0x0910, 0x0918, 0x0920, \
+    0x0928, 0x092C
+R_DC_CYCLIC, R_DC_ACTIVATION, R_DC_SYNC0_START, R_DC_SYNC0_CYCLE = 0x0980, 0x0981, 0x0990, 0x09A0
+MBX_TYPE_ERR, MBX_TYPE_COE = 0x00, 0x03
+
+HOP_NS = 500  # forwarding delay per ESC and cable, what the DC delay measurement sees
+
+
+def _ro_mask() -> bytearray:
+    """Registers the EtherCAT side may not write (the PDI or the ESC itself owns them)."""
+    m = bytearray(0x1000)
+    for a, n in ((0x0000, 0x10), (R_ALIAS, 2), (R_DL_STATUS, 2), (R_AL_STATUS, 6), (R_WD_STATUS, 2),
+                 (R_DC_RECV, 0x10), (R_DC_SYSTIME, 8), (R_DC_RECV_PU, 8), (R_DC_DIFF, 4), (0x098E, 2)):
+        m[a:a + n] = b"\x01" * n
+    for k in range(16):
+        m[R_SM + 8 * k + 5] = 1  # SM status
+        m[R_SM + 8 * k + 7] = 1  # SM PDI control
+    return m
+
+
+RO = _ro_mask()
+
+
+@dataclass
+class Sm:
+    start: int
+    length: int
+    control: int
+    enabled: bool
+
+    @property
+    def end(self) -> int:
+        return self.start + self.length
+
+
+class SlaveApp:
+    """What sits behind the process data (drive, I/O). `esc.py` calls these."""
+
+    def attach(self, od: ObjectDictionary) -> None: ...
+
+    def cycle(self, outputs: bytes, rx_map, tx_map, step: bool, dt: float = 0.0) -> bytes:
+        return b""
+
+    def refresh(self, index: int) -> None: ...
+
+
+@dataclass
+class Esc:
+    device: Device
+    app: SlaveApp = field(default_factory=SlaveApp)
+    name: str = ""
+    drift_ppm: float = 0.0
+    clock_base_ns: int = 0  # this slave's local clock at monotonic zero (clocks start unsynchronised)
+    cycle_time: float = 0.001  # bench cycle: the drive model advances this much per process-data frame
+    lockstep: bool = True
+    mem: bytearray = field(default_factory=lambda: bytearray(0x10000))
+
+    def __post_init__(self) -> None:
+        self.name = self.name or self.device.name
+        self.sii = bytearray(build_sii(self.device))
+        self.od = ObjectDictionary(self.device, state=lambda: self.al_state)
+        self.od.before_read = lambda index: self.app.refresh(index)
+        self.app.attach(self.od)
+        self.coe = CoeServer(self.od, self.device.mailbox_out.size)
+        self.mbx_out: deque[bytes] = deque()
+        self.mbx_full = False
+        self.mbx_last = b""
+        self.mbx_counter = 0
+        self.rx_map: list[tuple[int, int, int]] = []
+        self.tx_map: list[tuple[int, int, int]] = []
+        self.position = 0
+        self.chain_len = 1
+        self.frame_ns = 0
+        self.last_output_ns = 0
+        self.last_cycle_ns = 0
+        self.outputs_written = 0
+        self.events: list[str] = []
+        self.wkc_fault = False
+        self.power_on()
+
+    # ---- reset --------------------------------------------------------------------------
+    def power_on(self) -> None:
+        m = self.mem
+        m[:] = bytes(len(m))
+        m[0] = 0x11  # ESC type: ET1100-class
+        m[1] = 0x02  # revision
+        m[4], m[5], m[6], m[7] = 8, 8, 8, 0x0F  # FMMUs, SMs, RAM (KiB), ports 0/1 MII
+        struct.pack_into("<H", m, 0x0008, 0x01CC)  # features: DC, 64-bit DC, enhanced link, FMMU bit ops
+        struct.pack_into("<H", m, R_ALIAS, struct.unpack_from("<H", self.sii, 8)[0])
+        struct.pack_into("<H", m, R_AL_STATUS, INIT)
+        struct.pack_into("<H", m, R_WD_DIV, 0x09C2)  # 100 µs watchdog ticks
+        struct.pack_into("<H", m, 0x0410, 1000)
+        struct.pack_into("<H", m, R_WD_PD, 1000)  # 100 ms process-data watchdog
+        struct.pack_into("<H", m, R_WD_STATUS, 1)
+        struct.pack_into("<H", m, R_EEP_CTRL, 0x0040)  # idle, 8-byte reads
+        struct.pack_into("<H", m, 0x0140, 0x0008)  # PDI: 32-bit digital I/O... any non-zero PDI
+        self.mbx_out.clear()
+        self.mbx_full = False
+        self.rx_map, self.tx_map = [], []
+
+    # ---- small register helpers -----------------------------------------------------------
+    def u16(self, a: int) -> int:
+        return struct.unpack_from("<H", self.mem, a)[0]
+
+    def u32(self, a: int) -> int:
+        return struct.unpack_from("<I", self.mem, a)[0]
+
+    def u64(self, a: int) -> int:
+        return struct.unpack_from("<Q", self.mem, a)[0]
+
+    @property
+    def station(self) -> int:
+        return self.u16(R_STATION)
+
+    @property
+    def al_state(self) -> int:
+        return self.mem[R_AL_STATUS] & 0x0F
+
+    @property
+    def al_code(self) -> int:
+        return self.u16(R_AL_CODE)
+
+    def sm(self, k: int) -> Sm:
+        start, length, control, _status, act = struct.unpack_from("<HHBBB", self.mem, R_SM + 8 * k)
+        return Sm(start, length, control, bool(act & 1))
+
+    # ---- DC clock -------------------------------------------------------------------------
+    def local_ns(self, mono_ns: int | None = None) -> int:
+        t = time.monotonic_ns() if mono_ns is None else mono_ns
+        return (self.clock_base_ns + int(t * (1.0 + self.drift_ppm * 1e-6))) & 0xFFFFFFFFFFFFFFFF
+
+    def system_ns(self, mono_ns: int | None = None) -> int:
+        return (self.local_ns(mono_ns) + self.u64(R_DC_OFFSET)) & 0xFFFFFFFFFFFFFFFF
+
+    def _latch_receive_times(self) -> None:
+        t_in = self.frame_ns + self.position * HOP_NS
+        p0 = self.local_ns(t_in)
+        last = self.position >= self.chain_len - 1
+        p1 = 0 if last else self.local_ns(self.frame_ns + (2 * (self.chain_len - 1) - self.position) * HOP_NS)
+        struct.pack_into("<IIII", self.mem, R_DC_RECV, p0 & 0xFFFFFFFF, p1 & 0xFFFFFFFF, 0, 0)
+        struct.pack_into("<Q", self.mem, R_DC_RECV_PU, p0)
+
+    def _system_time_written(self, value: int) -> None:
+        """A master (FRMW/ARMW) distributes the reference time: the ESC's control loop compares it
+        with its own system time and trims the offset, and shows the difference in 0x092C."""
+        received = (value + self.u32(R_DC_DELAY)) & 0xFFFFFFFFFFFFFFFF
+        own = self.system_ns(self.frame_ns + self.position * HOP_NS)
+        diff = ((received - own + (1 << 63)) % (1 << 64)) - (1 << 63)
+        mag = min(abs(diff), 0x7FFFFFFF)
+        struct.pack_into("<I", self.mem, R_DC_DIFF, mag | (0x80000000 if diff < 0 else 0))
+        step = max(-5000, min(5000, diff // 8)) if abs(diff) < 1_000_000 else diff
+        struct.pack_into("<Q", self.mem, R_DC_OFFSET, (self.u64(R_DC_OFFSET) + step) & 0xFFFFFFFFFFFFFFFF)
+
+    # ---- register access with side effects ------------------------------------------------
+    def read(self, addr: int, n: int) -> bytes | None:
+        end = addr + n
+        if addr < R_DC_SYSTIME + 8 and end > R_DC_SYSTIME:
+            struct.pack_into("<Q", self.mem, R_DC_SYSTIME, self.system_ns(self.frame_ns + self.position * HOP_NS))
+        mi = self.sm(1)
+        if mi.enabled and mi.length and addr < mi.end and end > mi.start:
+            if not self.mbx_full:
+                return None  # an empty read mailbox does not answer (no WKC)
+            data = bytes(self.mem[addr:end])
+            if end >= mi.end:
+                self._mailbox_read_done()
+            return data
+        return bytes(self.mem[addr:end])
+
+    def write(self, addr: int, data: bytes) -> bool:
+        end = addr + len(data)
+        mo = self.sm(0)
+        if mo.enabled and mo.length and addr < mo.end and end > mo.start:
+            self.mem[addr:end] = data
+            if end >= mo.end:
+                self._mailbox_written()
+            return True
+        if addr < 0x1000:
+            for i, b in enumerate(data):
+                a = addr + i
+                if a < 0x1000 and not RO[a]:
+                    self.mem[a] = b
+                elif a >= 0x1000:
+                    self.mem[a] = b
+            self._after_register_write(addr, end)
+        else:
+            self.mem[addr:end] = data
+        return True
+
+    def _after_register_write(self, addr: int, end: int) -> None:
+        def hit(a: int, n: int = 1) -> bool:
+            return addr < a + n and end > a
+
+        if hit(R_AL_CONTROL, 2):
+            self._al_request(self.u16(R_AL_CONTROL))
+        if hit(R_EEP_CTRL, 2):
+            self._eeprom_command()
+        if hit(R_DC_RECV, 4):
+            self._latch_receive_times()
+        if hit(0x0300, 0x14):
+            self.mem[0x0300:0x0314] = bytes(0x14)  # writing any error counter clears them
+        if hit(R_SM + 6, 1) or hit(R_SM + 8 + 6, 1):
+            self._mailbox_repeat()
+
+    def dc_write(self, addr: int, data: bytes) -> None:
+        """System-time write from ARMW/FRMW (not a plain register write)."""
+        if addr == R_DC_SYSTIME and len(data) in (4, 8):
+            value = int.from_bytes(data, "little")
+            if len(data) == 4:
+                value = (self.system_ns() & ~0xFFFFFFFF) | value
+            self._system_time_written(value)
+        else:
+            self.write(addr, data)
+
+    # ---- EEPROM ---------------------------------------------------------------------------
+    def _eeprom_command(self) -> None:
+        ctrl = self.u16(R_EEP_CTRL)
+        cmd = ctrl & 0x0700
+        word = self.u32(R_EEP_ADDR) & 0xFFFF
+        status = 0x0040  # 8-byte reads supported
+        if cmd == 0x0100:  # read
+            off = 2 * word
+            chunk = bytes(self.sii[off:off + 8]).ljust(8, b"\xff")
+            self.mem[R_EEP_DATA:R_EEP_DATA + 8] = chunk
+        elif cmd == 0x0200:  # write one word
+            self.sii[2 * word:2 * word + 2] = self.mem[R_EEP_DATA:R_EEP_DATA + 2]
+        elif cmd == 0x0400:  # reload
+            pass
+        elif cmd:
+            status |= 0x2000  # command error
+        struct.pack_into("<H", self.mem, R_EEP_CTRL, status)
+
+    # ---- AL state machine -----------------------------------------------------------------
+    def al_error(self, code: int, state: int | None = None) -> None:
+        s = state if state is not None else self.al_state
+        struct.pack_into("<H", self.mem, R_AL_STATUS, s | AL_ERROR)
+        struct.pack_into("<H", self.mem, R_AL_CODE, code)
+        self.events.append(f"AL error 0x{code:04X} in state {s}")
+
+    def _set_state(self, s: int) -> None:
+        struct.pack_into("<H", self.mem, R_AL_STATUS, s)
+        struct.pack_into("<H", self.mem, R_AL_CODE, 0)
+
+    def _al_request(self, ctrl: int) -> None:
+        req, ack = ctrl & 0x0F, bool(ctrl & 0x10)
+        cur, err = self.al_state, bool(self.mem[R_AL_STATUS] & AL_ERROR)
+        if err and not ack and req > cur:
+            return  # an error must be acknowledged before going up
+        if err and ack:
+            self._set_state(cur)
+        if req == cur:
+            return
+        if req not in (INIT, PREOP, BOOT, SAFEOP, OP):
+            self.al_error(AL_UNKNOWN_STATE, cur)
+            return
+        if req == BOOT:
+            self.al_error(AL_BOOTSTRAP_NOT_SUPPORTED, cur)
+            return
+        if req < cur:
+            self._set_state(req)
+            if req <= PREOP:
+                self.rx_map, self.tx_map = [], []
+            return
+        allowed = {INIT: (PREOP,), PREOP: (SAFEOP,), SAFEOP: (OP,)}
+        if req not in allowed.get(cur, ()):
+            self.al_error(AL_INVALID_STATE_CHANGE, cur)
+            return
+        check = {PREOP: self._check_mailbox, SAFEOP: self._check_process_data, OP: self._check_sync}[req]
+        code = check()
+        if code:
+            self.al_error(code, cur)
+            return
+        self._set_state(req)
+        if req == OP:
+            self.last_output_ns = time.monotonic_ns()
+
+    def _check_mailbox(self) -> int:
+        for k, d in ((0, self.device.mailbox_out), (1, self.device.mailbox_in)):
+            s = self.sm(k)
+            if not s.enabled or s.start != d.start or s.length != d.size:
+                return AL_INVALID_MAILBOX
+        return 0
+
+    def _check_process_data(self) -> int:
+        """SM2/SM3 must match the PDO mapping in the object dictionary, and FMMUs must cover them."""
+        rx = self.od.mapping(0x1C12) if 0x1C12 in self.od.objects else []
+        tx = self.od.mapping(0x1C13) if 0x1C13 in self.od.objects else []
+        rx_bytes = (sum(b for *_, b in rx) + 7) // 8
+        tx_bytes = (sum(b for *_, b in tx) + 7) // 8
+        for k, nbytes, code, ftype in ((2, rx_bytes, AL_INVALID_OUTPUT, 2), (3, tx_bytes, AL_INVALID_INPUT, 1)):
+            d, s = self.device.sms[k], self.sm(k)
+            if nbytes == 0:
+                continue
+            if not s.enabled or s.start != d.start or s.length != nbytes:
+                return code
+            if not any(f[2] & ftype and f[1] <= s.start < f[1] + max(f[3], 1) for f in self.fmmus()):
+                return code
+        self.rx_map, self.tx_map = rx, tx
+        self._write_inputs(self.app.cycle(bytes(rx_bytes), rx, tx, step=False))
+        return 0
+
+    def _check_sync(self) -> int:
+        act = self.mem[R_DC_ACTIVATION]
+        if act & 0x01 and act & 0x02:
+            if not self.device.assign_activate:
+                return AL_INVALID_DC_SYNC
+            cyc = self.u32(R_DC_SYNC0_CYCLE)
+            d = self.device
+            if cyc < d.sync0_min or cyc > d.sync0_max or (d.sync0_step and cyc % d.sync0_step):
+                return AL_INVALID_SYNC0_CYCLE
+        return 0
+
+    # ---- FMMUs and process data -------------------------------------------------------------
+    def fmmus(self) -> list[tuple[int, int, int, int]]:
+        """Active FMMUs as (logical start, physical start, type, length)."""
+        out = []
+        for k in range(8):
+            ls, ln, _sb, _eb, ps, _pb, typ, act = struct.unpack_from("<IHBBHBBB", self.mem, R_FMMU + 16 * k)
+            if act & 1 and ln:
+                out.append((ls, ps, typ, ln))
+        return out
+
+    def _write_inputs(self, data: bytes) -> None:
+        if data:
+            s = self.sm(3)
+            self.mem[s.start:s.start + len(data)] = data
+
+    def logical(self, cmd: int, addr: int, data: bytearray) -> int:
+        """LRD/LWR/LRW through the FMMUs. Returns the WKC increment. In lock-step the outputs are
+        applied and the model advanced before the inputs are copied, so one frame = one cycle."""
+        state = self.al_state
+        if state not in (SAFEOP, OP):
+            return 0
+        n = len(data)
+        reads, writes = [], []
+        for ls, ps, typ, ln in self.fmmus():
+            lo, hi = max(addr, ls), min(addr + n, ls + ln)
+            if lo >= hi:
+                continue
+            if typ & 2 and cmd in (LWR, LRW):
+                writes.append((lo, hi, ps + lo - ls))
+            if typ & 1 and cmd in (LRD, LRW):
+                reads.append((lo, hi, ps + lo - ls))
+        inc = 0
+        if writes and state == OP:
+            for lo, hi, p in writes:
+                self.mem[p:p + hi - lo] = data[lo - addr:hi - addr]
+            now = time.monotonic_ns()
+            dt = self.cycle_time
+            if not self.lockstep and self.last_cycle_ns:
+                dt = min(10 * self.cycle_time, max(0.0, (now - self.last_cycle_ns) * 1e-9))
+            self.last_cycle_ns = now
+            self.last_output_ns = now
+            self.outputs_written += 1
+            s2 = self.sm(2)
+            self._write_inputs(self.app.cycle(bytes(self.mem[s2.start:s2.end]), self.rx_map, self.tx_map,
+                                              step=True, dt=dt))
+            inc += 2 if cmd == LRW else 1
+        elif reads and state == SAFEOP:
+            s2 = self.sm(2)
+            self._write_inputs(self.app.cycle(bytes(self.mem[s2.start:s2.end]), self.rx_map, self.tx_map,
+                                              step=False))
+        if reads:
+            for lo, hi, p in reads:
+                data[lo - addr:hi - addr] = self.mem[p:p + hi - lo]
+            inc += 1
+        return 0 if self.wkc_fault else inc
+
+    # ---- watchdog -------------------------------------------------------------------------
+    def watchdog_ns(self) -> int:
+        return self.u16(R_WD_PD) * (self.u16(R_WD_DIV) + 2) * 40
+
+    def check_watchdog(self, now_ns: int) -> None:
+        s2 = self.sm(2)
+        if self.al_state != OP or not (s2.control & 0x40) or not self.rx_map:
+            return
+        wd = self.watchdog_ns()
+        if wd and now_ns - self.last_output_ns > wd:
+            struct.pack_into("<H", self.mem, R_WD_STATUS, 0)
+            self.al_error(AL_SM_WATCHDOG, SAFEOP)
+
+    # ---- mailbox --------------------------------------------------------------------------
+    def _mailbox_written(self) -> None:
+        mo = self.sm(0)
+        raw = bytes(self.mem[mo.start:mo.end])
+        length, _addr, _chan, typ = struct.unpack_from("<HHBB", raw, 0)
+        payload = raw[6:6 + length]
+        if typ & 0x0F == MBX_TYPE_COE:
+            for resp in self.coe.handle(payload):
+                if resp:
+                    self.post(MBX_TYPE_COE, resp)
+        else:
+            self.post(MBX_TYPE_ERR, struct.pack("<HH", 0x0001, 0x0002))  # unsupported protocol
+
+    def post(self, typ: int, payload: bytes) -> None:
+        self.mbx_counter = self.mbx_counter % 7 + 1
+        msg = struct.pack("<HHBB", len(payload), 0, 0, typ | (self.mbx_counter << 4)) + payload
+        if len(self.mbx_out) < 64:
+            self.mbx_out.append(msg)
+        self._mailbox_fill()
+
+    def emergency(self, code: int, register: int = 0x01, data: bytes = b"") -> None:
+        if self.al_state >= PREOP:
+            self.post(MBX_TYPE_COE, self.coe.emergency(code, register, data))
+
+    def _mailbox_fill(self) -> None:
+        mi = self.sm(1)
+        if self.mbx_full or not self.mbx_out or not mi.enabled:
+            return
+        msg = self.mbx_out.popleft()
+        self.mem[mi.start:mi.end] = msg[:mi.length].ljust(mi.length, b"\x00")
+        self.mbx_last = msg
+        self.mbx_full = True
+        self.mem[R_SM + 8 + 5] |= 0x08
+
+    def _mailbox_read_done(self) -> None:
+        self.mbx_full = False
+        self.mem[R_SM + 8 + 5] &= ~0x08 & 0xFF
+        self._mailbox_fill()
+
+    def _mailbox_repeat(self) -> None:
+        """Mailbox repeat: the master toggles SM1 activate bit 1; put the last message back."""
+        req = self.mem[R_SM + 8 + 6] & 0x02
+        if req != self.mem[R_SM + 8 + 7] & 0x02:
+            if self.mbx_last and not self.mbx_full:
+                self.mbx_out.appendleft(self.mbx_last)
+                self._mailbox_fill()
+            self.mem[R_SM + 8 + 7] = (self.mem[R_SM + 8 + 7] & ~0x02 & 0xFF) | req
+
+    def idle(self) -> None:
+        """Refresh mailbox availability after SM writes."""
+        self._mailbox_fill()

@@ -1,0 +1,230 @@
+"""The virtual line: a chain of software ESCs behind one raw socket (AF_PACKET, EtherType 0x88A4).
+
+A frame walks the chain in order; every slave processes every datagram (auto-increment
+addresses count down as they pass, working counters go up), then the frame goes back to the
+master with the locally administered bit set in the source MAC, as an ESC's port 0 returns it.
+"""
+
+from __future__ import annotations
+
+import select
+import socket
+import struct
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+
+from virtual_bus.ethercat.esc import (APRD, APRW, APWR, ARMW, BRD, BRW, BWR, FPRD, FPRW, FPWR, FRMW, LRD, LRW,
+                                      LWR, R_AL_CODE, Esc)
+from virtual_bus.ethercat.faults import Fault
+
+ETH_P_ECAT = 0x88A4
+_READS = {APRD, FPRD, BRD}
+_WRITES = {APWR, FPWR, BWR}
+_RW = {APRW, FPRW, BRW}
+
+
+@dataclass
+class Chain:
+    slaves: Sequence[Esc]
+    faults: list[Fault] = field(default_factory=list)
+    pd_frames: int = 0  # process-data frames seen (frames with a logical datagram)
+    frames: int = 0
+    log: Callable[[str], None] = lambda msg: None
+    _applied: set[int] = field(default_factory=set)
+    _left: set[int] = field(default_factory=set)
+
+    # ---- faults ---------------------------------------------------------------------------
+    def _fault_step(self, is_pd: bool) -> tuple[bool, float]:
+        """Apply faults due at this frame. Returns (drop the frame, delay in s)."""
+        drop, delay = False, 0.0
+        n = self.pd_frames
+        for k, f in enumerate(self.faults):
+            on = f.active(n) and (is_pd or f.kind == "leave")
+            if f.kind == "drop" and on and is_pd:
+                drop = True
+            elif f.kind == "late" and on and is_pd:
+                delay = max(delay, f.arg / 1000.0)
+            elif f.kind == "leave":
+                if on and f.slave not in self._left:
+                    self._left.add(f.slave)
+                    self.log(f"slave {f.slave} left the line at frame {n}")
+                elif not on and f.slave in self._left and n >= f.at:
+                    self._left.discard(f.slave)
+                    self.log(f"slave {f.slave} back on the line at frame {n}")
+            elif f.kind == "wkc" and f.slave < len(self.slaves):
+                self.slaves[f.slave].wkc_fault = on
+            elif k not in self._applied and n >= f.at and f.slave < len(self.slaves) and is_pd:
+                self._applied.add(k)
+                s = self.slaves[f.slave]
+                if f.kind == "alerr":
+                    s.al_error(int(f.arg), min(s.al_state, 4))
+                    self.log(f"slave {f.slave} AL error 0x{int(f.arg):04X} at frame {n}")
+                elif f.kind == "drivefault":
+                    app = s.app
+                    if hasattr(app, "drive"):
+                        app.drive.external_fault = int(f.arg)
+                        self.log(f"slave {f.slave} drive fault 0x{int(f.arg):04X} at frame {n}")
+        return drop, delay
+
+    def reachable(self) -> list[Esc]:
+        """Slaves the frame reaches: a slave that left the line cuts off everything behind it."""
+        out = []
+        for i, s in enumerate(self.slaves):
+            if i in self._left:
+                break
+            out.append(s)
+        return out
+
+    # ---- frames ---------------------------------------------------------------------------
+    def process(self, frame: bytes) -> tuple[bytes | None, float]:
+        """Process one Ethernet frame; returns (answer or None if lost, delay in s)."""
+        if len(frame) < 16 or struct.unpack_from(">H", frame, 12)[0] != ETH_P_ECAT:
+            return None, 0.0
+        if frame[6] & 0x02:
+            return None, 0.0  # a frame an ESC already returned (our own echo)
+        hdr = struct.unpack_from("<H", frame, 14)[0]
+        if hdr >> 12 != 1:
+            return None, 0.0
+        buf = bytearray(frame)
+        # pre-scan for logical datagrams: those frames are the process-data cycle
+        is_pd, pos, end = False, 16, 16 + (hdr & 0x7FF)
+        while pos + 12 <= len(buf):
+            cmd = buf[pos]
+            ln = struct.unpack_from("<H", buf, pos + 6)[0]
+            if cmd in (LRD, LWR, LRW):
+                is_pd = True
+            pos += 10 + (ln & 0x7FF) + 2
+            if not ln & 0x8000:
+                break
+        self.frames += 1
+        drop, delay = self._fault_step(is_pd)
+        if is_pd:
+            self.pd_frames += 1
+        if drop:
+            return None, 0.0
+        line = self.reachable()
+        now = time.monotonic_ns()
+        for i, s in enumerate(line):
+            s.position, s.chain_len, s.frame_ns = i, len(line), now
+            s.check_watchdog(now)
+            self._walk(s, buf, min(end, len(buf)))
+            s.idle()
+        buf[6] |= 0x02
+        return bytes(buf), delay
+
+    def _walk(self, s: Esc, buf: bytearray, end: int) -> None:
+        pos = 16
+        while pos + 12 <= len(buf):
+            cmd, _idx, adp, ado, ln = struct.unpack_from("<BBHHH", buf, pos)
+            n = ln & 0x7FF
+            dstart = pos + 10
+            wpos = dstart + n
+            if wpos + 2 > len(buf):
+                break
+            data = memoryview(buf)[dstart:wpos]
+            wkc = struct.unpack_from("<H", buf, wpos)[0]
+            inc, adp = self._datagram(s, cmd, adp, ado, data)
+            struct.pack_into("<H", buf, pos + 2, adp)
+            if inc:
+                struct.pack_into("<H", buf, wpos, (wkc + inc) & 0xFFFF)
+            pos = wpos + 2
+            if not ln & 0x8000:
+                break
+
+    @staticmethod
+    def _datagram(s: Esc, cmd: int, adp: int, ado: int, data: memoryview) -> tuple[int, int]:
+        n = len(data)
+        if cmd in (APRD, APWR, APRW, ARMW):
+            addressed = adp == 0
+            new_adp = (adp + 1) & 0xFFFF
+        elif cmd in (FPRD, FPWR, FPRW, FRMW):
+            addressed = adp == s.station or (bool(s.mem[0x0103] & 0x01) and adp == s.u16(0x0012))
+            new_adp = adp
+        elif cmd in (BRD, BWR, BRW):
+            addressed = True
+            new_adp = (adp + 1) & 0xFFFF
+        elif cmd in (LRD, LWR, LRW):
+            logical = adp | (ado << 16)
+            tmp = bytearray(data)
+            inc = s.logical(cmd, logical, tmp)
+            data[:] = tmp
+            return inc, adp
+        else:
+            return 0, adp
+        inc = 0
+        if cmd in (ARMW, FRMW):
+            if addressed:
+                got = s.read(ado, n)
+                if got is not None:
+                    data[:] = got
+                    inc = 1
+            else:
+                s.dc_write(ado, bytes(data))
+                inc = 1
+            return (0 if s.wkc_fault else inc), new_adp
+        if not addressed:
+            return 0, new_adp
+        if cmd in _READS:
+            got = s.read(ado, n)
+            if got is not None:
+                if cmd == BRD:
+                    data[:] = bytes(a | b for a, b in zip(data, got))
+                else:
+                    data[:] = got
+                inc = 1
+        elif cmd in _WRITES:
+            inc = 1 if s.write(ado, bytes(data)) else 0
+        elif cmd in _RW:
+            old = s.read(ado, n)
+            ok = s.write(ado, bytes(data))
+            if old is not None:
+                data[:] = old if cmd != BRW else bytes(a | b for a, b in zip(data, old))
+                inc += 1
+            inc += 2 if ok else 0
+        return (0 if s.wkc_fault else inc), new_adp
+
+    def tick(self) -> None:
+        """Between frames: the process-data watchdog keeps running."""
+        now = time.monotonic_ns()
+        for s in self.reachable():
+            s.check_watchdog(now)
+
+    def states(self) -> list[tuple[str, int, int]]:
+        return [(s.name, s.al_state, s.u16(R_AL_CODE)) for s in self.slaves]
+
+
+class RawSocketLine:
+    """Serves a `Chain` on an interface until stopped."""
+
+    def __init__(self, chain: Chain, iface: str) -> None:
+        self.chain = chain
+        self.iface = iface
+        self.sock = socket.socket(socket.AF_PACKET, socket.SOCK_RAW, socket.htons(ETH_P_ECAT))
+        self.sock.bind((iface, ETH_P_ECAT))
+        self.running = True
+
+    def serve(self, duration: float | None = None) -> None:
+        deadline = None if duration is None else time.monotonic() + duration
+        sock = self.sock
+        while self.running and (deadline is None or time.monotonic() < deadline):
+            r, _, _ = select.select([sock], [], [], 0.01)
+            if not r:
+                self.chain.tick()
+                continue
+            try:
+                frame, addr = sock.recvfrom(2048)
+            except BlockingIOError:
+                continue
+            if len(addr) > 2 and addr[2] == socket.PACKET_OUTGOING:
+                continue
+            answer, delay = self.chain.process(frame)
+            if answer is None:
+                continue
+            if delay:
+                time.sleep(delay)
+            sock.send(answer)
+
+    def close(self) -> None:
+        self.running = False
+        self.sock.close()
