@@ -31,6 +31,7 @@ from canopen.sdo.exceptions import SdoAbortedError, SdoCommunicationError
 from fieldbus.canopen.budget import DEFAULT_BITRATE, BusLoad, bus_load, check_budget
 from fieldbus.canopen.emcy import ALARM_COMMUNICATION, ALARM_PDO_MAPPING, Emcy, emcy_alarm
 from fieldbus.canopen.lockstep import LockstepNetwork
+from fieldbus.canopen.netns import check_multicast_allowed
 from fieldbus.canopen.objects import ASDA_B3_EDS, MAX_PDOS, frame_layouts
 from fieldbus.link import BusError, SlaveInfo
 from fieldbus.pdo import ASDA_CSP, ASDA_CSP_CSV, PdoLayout, RxPdo, TxPdo
@@ -89,6 +90,7 @@ class CanopenLink:
         if interface == "udp_multicast" and not channel:
             raise ValueError("canopen:udp_multicast needs an explicit multicast group, e.g. "
                              "canopen:udp_multicast:239.74.163.2")
+        check_multicast_allowed(interface)
         self.nodes_cfg = list(nodes)
         self.interface = interface
         self.lockstep = interface == "virtual"

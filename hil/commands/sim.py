@@ -13,6 +13,7 @@ from collections.abc import Callable
 
 from hil.cli import EXIT_OK, EXIT_USAGE
 from hil.session import InputError, load_bench, sim_slaves
+from hil.sim_canopen import add_canopen
 
 
 def _add_ethercat(sims: argparse._SubParsersAction) -> None:
@@ -40,6 +41,7 @@ def _fault_help() -> str:
 # name -> registrar; the CANopen simulator adds its own entry here.
 SIMULATORS: dict[str, Callable[[argparse._SubParsersAction], None]] = {
     "ethercat": _add_ethercat,
+    "canopen": add_canopen,
 }
 
 
