@@ -1,0 +1,151 @@
+"""Hole cycles: milling G73, G74, G76, G81–G89 and lathe G83–G85, G87–G89, in machine coordinates.
+
+One hole = position (rapid) → drill axis rapid to R → the cycle's own motion → return to the
+initial level (G98) or the R level (G99). Spindle changes go out as `Aux("M", …)` events so the MLC
+sees them in order with the motion (decisions A50/A51).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from nc.alarms import NcAlarm
+from nc.cycles.builder import PathBuilder
+
+MAX_PECKS = 100000
+
+
+@dataclass
+class Hole:
+    kind: str  # drill | peck_full | peck_chip | tap | bore_feed | bore_stop | fine_bore | back_bore | manual
+    code: str  # tag, e.g. "G81"
+    axis: str  # drilling axis name
+    position: dict[str, float]  # positioning axes (machine)
+    r_level: float  # machine
+    bottom: float  # machine
+    initial: float  # machine
+    return_r: bool  # G99
+    peck: float = 0.0  # Q (peck depth), > 0 to peck
+    clearance: float = 0.0  # d: chip-break retract (G73) / re-approach clearance (G83)
+    dwell: float = 0.0  # seconds at the bottom
+    shift: dict[str, float] | None = None  # G76/G87 tool shift (machine delta)
+    spindle_dir: int = 1  # direction before the cycle (+1 M03, -1 M04, 0 stopped)
+    reverse_tap: bool = False  # G74 left-hand tapping
+
+
+def _levels(start: float, end: float, step: float) -> list[float]:
+    if step <= 0:
+        return [end]
+    sgn = 1.0 if end > start else -1.0
+    total = abs(end - start)
+    out = []
+    k = 1
+    while k * step < total - 1e-9:
+        out.append(start + sgn * k * step)
+        k += 1
+        if k > MAX_PECKS:
+            raise NcAlarm(0x0246, "too many pecks in the drilling cycle")
+    out.append(end)
+    return out
+
+
+def _spindle_code(direction: int) -> int:
+    return {1: 3, -1: 4}.get(direction, 5)
+
+
+def drill_hole(b: PathBuilder, h: Hole) -> None:
+    ax = h.axis
+    tag = (h.code,)
+    b.rapid_axes(h.position, tag + ("position",))
+    sgn = 1.0 if h.bottom < h.r_level else -1.0  # toward the workpiece is toward `bottom`
+    ret_level = h.r_level if h.return_r else h.initial
+
+    if h.kind == "back_bore":
+        # G87: orient, shift, rapid to the R level below the hole, shift back, bore upward to Z
+        b.aux("M", 19)
+        b.rapid_axes({a: b.position[a] + v for a, v in (h.shift or {}).items()}, tag + ("shift",))
+        b.rapid_axes({ax: h.r_level}, tag + ("approach",))
+        b.rapid_axes({a: b.position[a] - v for a, v in (h.shift or {}).items()}, tag + ("shift",))
+        b.aux("M", 3)
+        b.line_axes({ax: h.bottom}, tag + ("cut",))
+        if h.dwell > 0:
+            b.dwell(h.dwell, tag + ("dwell",))
+        b.aux("M", 19)
+        b.rapid_axes({a: b.position[a] + v for a, v in (h.shift or {}).items()}, tag + ("shift",))
+        b.rapid_axes({ax: h.initial}, tag + ("return",))
+        b.rapid_axes({a: b.position[a] - v for a, v in (h.shift or {}).items()}, tag + ("shift",))
+        b.aux("M", _spindle_code(h.spindle_dir or 1))
+        return
+
+    b.rapid_axes({ax: h.r_level}, tag + ("approach",))
+    if h.kind == "drill":
+        b.line_axes({ax: h.bottom}, tag + ("cut",))
+        if h.dwell > 0:
+            b.dwell(h.dwell, tag + ("dwell",))
+        b.rapid_axes({ax: ret_level}, tag + ("return",))
+    elif h.kind in ("peck_full", "peck_chip"):
+        depths = _levels(h.r_level, h.bottom, h.peck)
+        prev = h.r_level
+        for i, d in enumerate(depths, start=1):
+            if h.kind == "peck_full" and i > 1:
+                # re-approach rapidly to just above the previous bottom
+                b.rapid_axes({ax: prev + sgn * h.clearance}, tag + ("reapproach",))
+            b.line_axes({ax: d}, tag + ("peck", str(i)))
+            if d != depths[-1]:
+                if h.kind == "peck_full":
+                    b.rapid_axes({ax: h.r_level}, tag + ("retract",))
+                else:
+                    b.rapid_axes({ax: d + sgn * h.clearance}, tag + ("retract",))
+            prev = d
+        if h.dwell > 0:
+            b.dwell(h.dwell, tag + ("dwell",))
+        b.rapid_axes({ax: ret_level}, tag + ("return",))
+    elif h.kind == "tap":
+        into = -1 if h.reverse_tap else 1
+        depths = _levels(h.r_level, h.bottom, h.peck) if h.peck > 0 else [h.bottom]
+        if h.spindle_dir != into:
+            b.aux("M", _spindle_code(into))
+        for i, d in enumerate(depths, start=1):
+            if i > 1:
+                b.aux("M", _spindle_code(into))
+            b.line_axes({ax: d}, tag + ("tap", str(i)))
+            if h.dwell > 0 and d == depths[-1]:
+                b.dwell(h.dwell, tag + ("dwell",))
+            b.aux("M", _spindle_code(-into))  # spindle reversal at the bottom of each peck
+            b.line_axes({ax: h.r_level}, tag + ("tap_out", str(i)))
+        b.aux("M", _spindle_code(h.spindle_dir if h.spindle_dir else into))
+        if not h.return_r:
+            b.rapid_axes({ax: h.initial}, tag + ("return",))
+    elif h.kind == "bore_feed":
+        b.line_axes({ax: h.bottom}, tag + ("cut",))
+        if h.dwell > 0:
+            b.dwell(h.dwell, tag + ("dwell",))
+        b.line_axes({ax: h.r_level}, tag + ("cut_out",))
+        if not h.return_r:
+            b.rapid_axes({ax: h.initial}, tag + ("return",))
+    elif h.kind == "bore_stop":
+        b.line_axes({ax: h.bottom}, tag + ("cut",))
+        if h.dwell > 0:
+            b.dwell(h.dwell, tag + ("dwell",))
+        b.aux("M", 5)
+        b.rapid_axes({ax: ret_level}, tag + ("return",))
+        b.aux("M", _spindle_code(h.spindle_dir or 1))
+    elif h.kind == "fine_bore":
+        b.line_axes({ax: h.bottom}, tag + ("cut",))
+        if h.dwell > 0:
+            b.dwell(h.dwell, tag + ("dwell",))
+        b.aux("M", 19)  # spindle orientation before the tool leaves the bore wall
+        b.rapid_axes({a: b.position[a] + v for a, v in (h.shift or {}).items()}, tag + ("shift",))
+        b.rapid_axes({ax: ret_level}, tag + ("return",))
+        b.rapid_axes({a: b.position[a] - v for a, v in (h.shift or {}).items()}, tag + ("shift",))
+        b.aux("M", _spindle_code(h.spindle_dir or 1))
+    elif h.kind == "manual":
+        b.line_axes({ax: h.bottom}, tag + ("cut",))
+        if h.dwell > 0:
+            b.dwell(h.dwell, tag + ("dwell",))
+        b.aux("M", 5)
+        b.aux("M", 0)  # G88: the operator retracts by hand, then presses cycle start
+        b.rapid_axes({ax: ret_level}, tag + ("return",))
+        b.aux("M", _spindle_code(h.spindle_dir or 1))
+    else:
+        raise NcAlarm(0x021D, f"unknown hole cycle kind {h.kind}")
