@@ -54,6 +54,17 @@ class TimingStats:
         if v > self.max:
             self.max, self.max_at = v, cycle
 
+    def add_many(self, values: np.ndarray, first_cycle: int = 1) -> None:
+        v = np.abs(np.asarray(values, dtype=float))
+        if v.size == 0:
+            return
+        idx = np.minimum((v / self.BIN).astype(np.int64), self.NBINS)
+        self.hist += np.bincount(idx, minlength=self.NBINS + 1)
+        self.count += int(v.size)
+        i = int(np.argmax(v))
+        if v[i] > self.max:
+            self.max, self.max_at = float(v[i]), first_cycle + i
+
     def percentile(self, q: float) -> float:
         if self.count == 0:
             return 0.0

@@ -1,0 +1,87 @@
+"""`hil check TRACE`: judge a trace by the bench's [checks] and/or limits given on the command line.
+Exit 0 when every check passes, 1 when one fails (naming its cycle and line), 2 on bad input."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+
+from hil.bench import Bench, ChecksConfig
+from hil.cli import EXIT_ALARM, EXIT_OK, EXIT_USAGE
+from hil.session import InputError, load_bench, load_program, print_alarm
+from hil.trace_read import TraceFile, TraceReadError
+from nc.alarms import NcAlarm
+
+
+def add_check_options(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--bench", help="bench file: axes, limits and its [checks]")
+    p.add_argument("--program", help="the G-code program the trace ran (for contour and thread checks)")
+    p.add_argument("--max-ferr", type=float, metavar="MM", help="max following error on every axis, mm")
+    p.add_argument("--contour", type=float, metavar="MM", help="max distance from the programmed path, mm")
+    p.add_argument("--limits", action="store_true", help="setpoint velocity/acceleration/jerk within axis limits")
+    p.add_argument("--thread-phase", type=float, metavar="DEG", help="max phase spread of thread passes, degrees")
+    p.add_argument("--jitter-p99", type=float, metavar="US", help="p99 of |period - cycle|, µs")
+    p.add_argument("--jitter-max", type=float, metavar="US", help="max |period - cycle|, µs")
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("check", help="check a trace: following/contour error, v/a/j limits, thread phase, jitter")
+    p.add_argument("trace", help="trace file (CSV or Parquet) from hil run --trace")
+    add_check_options(p)
+    p.add_argument("--json", action="store_true", help="one JSON object per check")
+    p.set_defaults(func=cmd_check)
+
+
+def checks_from_args(args: argparse.Namespace, bench: Bench) -> ChecksConfig:
+    c = bench.checks
+    if args.max_ferr is not None:
+        c.max_following_error = {a: args.max_ferr for a in bench.axis_names}
+    if args.contour is not None:
+        c.contour_error = args.contour
+    if args.limits:
+        c.limits = True
+    if args.thread_phase is not None:
+        c.thread_phase = args.thread_phase
+    if args.jitter_p99 is not None:
+        c.jitter_p99 = args.jitter_p99 / 1e6
+    if args.jitter_max is not None:
+        c.jitter_max = args.jitter_max / 1e6
+    return c
+
+
+def prepare(args: argparse.Namespace, cmd: str):
+    """Bench, checks, trace and the programmed moves; raises SystemExit-style codes via return."""
+    from hil.checks import program_moves
+
+    bench = load_bench(args.bench)
+    checks = checks_from_args(args, bench)
+    tf = TraceFile(args.trace)
+    missing = [a for a in bench.axis_names if f"{a}_cmd" not in tf.columns]
+    if args.bench and missing:
+        raise InputError(f"{args.trace} has no columns for axis {', '.join(missing)} of bench {bench.name}")
+    moves = program_moves(load_program(args.program), bench) if args.program else None
+    return bench, checks, tf, moves
+
+
+def cmd_check(args: argparse.Namespace) -> int:
+    from hil.checks import run_checks
+
+    try:
+        bench, checks, tf, moves = prepare(args, "check")
+    except (InputError, TraceReadError) as exc:
+        print(f"hil check: {exc}", file=sys.stderr)
+        return EXIT_USAGE
+    except NcAlarm as exc:
+        print_alarm(exc.alarm)
+        return EXIT_ALARM
+    if not checks.any:
+        print("hil check: no checks to run: give a --bench with [checks] or limits such as --max-ferr", file=sys.stderr)
+        return EXIT_USAGE
+    results = run_checks(tf, checks, bench if (args.bench or checks.limits) else None, moves)
+    for r in results:
+        print(json.dumps(r.as_dict()) if args.json else str(r))
+    failed = [r for r in results if not r.ok]
+    if not args.json:
+        print(f"{len(results) - len(failed)} passed, {len(failed)} failed")
+    return EXIT_ALARM if failed else EXIT_OK

@@ -1,0 +1,49 @@
+"""`hil report TRACE --out DIR`: an HTML report with PNG plots (path, following error, velocity
+and torque, jitter histogram, MLC signal timeline), plus the checks when a bench or limits are given."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from hil.cli import EXIT_ALARM, EXIT_OK, EXIT_USAGE
+from hil.commands.check import add_check_options, prepare
+from hil.session import InputError, print_alarm
+from hil.trace_read import TraceReadError
+from nc.alarms import NcAlarm
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("report", help="write an HTML report with plots of a trace")
+    p.add_argument("trace", help="trace file (CSV or Parquet) from hil run --trace")
+    p.add_argument("--out", required=True, metavar="DIR", help="directory for index.html and the PNGs")
+    p.add_argument("--title", help="report title")
+    add_check_options(p)
+    p.set_defaults(func=cmd_report)
+
+
+def cmd_report(args: argparse.Namespace) -> int:
+    from hil.checks import run_checks
+    from hil.report import write_report
+
+    try:
+        bench, checks, tf, moves = prepare(args, "report")
+    except (InputError, TraceReadError) as exc:
+        print(f"hil report: {exc}", file=sys.stderr)
+        return EXIT_USAGE
+    except NcAlarm as exc:
+        print_alarm(exc.alarm)
+        return EXIT_ALARM
+    results = run_checks(tf, checks, bench if (args.bench or checks.limits) else None, moves) if checks.any else None
+    try:
+        rep = write_report(args.trace, args.out, bench if args.bench else None, moves, results, args.title)
+    except OSError as exc:
+        print(f"hil report: cannot write {args.out}: {exc.strerror}", file=sys.stderr)
+        return EXIT_USAGE
+    print(f"wrote {rep.html}")
+    for img in rep.images:
+        print(f"  {img}")
+    if results and not all(r.ok for r in results):
+        print("checks failed: see the report", file=sys.stderr)
+        return EXIT_ALARM
+    return EXIT_OK

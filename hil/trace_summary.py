@@ -1,0 +1,177 @@
+"""Trace summaries and slices, streamed batch by batch so hours-long traces need little memory."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pyarrow as pa
+import pyarrow.csv as pacsv
+import pyarrow.parquet as pq
+
+from hil.clock import TimingStats
+from hil.trace import axes_of, is_parquet, spindles_of
+from hil.trace_read import TraceFile
+
+
+@dataclass
+class Bound:
+    """A slice bound: a time in seconds or a program line."""
+
+    time: float | None = None
+    line: int | None = None
+
+    @classmethod
+    def parse(cls, text: str) -> "Bound":
+        t = text.strip()
+        try:
+            if t[:1] in "Ll" or t.lower().startswith("line:"):
+                return cls(line=int(t.split(":", 1)[1] if ":" in t else t[1:]))
+            return cls(time=float(t[:-1] if t.endswith("s") else t))
+        except ValueError:
+            raise ValueError(f"bad bound {text!r}: a time in seconds (1.5, 1.5s) or a line (L12, line:12)") from None
+
+
+def slice_mask(batch: pa.RecordBatch, lo: Bound | None, hi: Bound | None, state: dict) -> pa.Array:
+    """Rows from the first reaching `lo` to the last before passing `hi` (a line bound ends when a
+    later line starts). `state` carries whether the slice has started/ended across batches."""
+    n = batch.num_rows
+    t = batch.column("t").to_numpy()
+    line = batch.column("line").to_numpy()
+    keep = np.ones(n, dtype=bool)
+    if lo is not None:
+        started = state.get("started", False)
+        hit = t >= lo.time if lo.time is not None else line >= lo.line
+        on = np.logical_or.accumulate(hit) | started
+        state["started"] = bool(on[-1]) if n else started
+        keep &= on
+    if hi is not None:
+        ended = state.get("ended", False)
+        past = t > hi.time if hi.time is not None else line > hi.line
+        off = np.logical_or.accumulate(past) | ended
+        state["ended"] = bool(off[-1]) if n else ended
+        keep &= ~off
+    return pa.array(keep)
+
+
+@dataclass
+class Summary:
+    rows: int = 0
+    t0: float | None = None
+    t1: float | None = None
+    lines: set[int] = field(default_factory=set)
+    alarms: list[tuple[int, float, int, str]] = field(default_factory=list)  # cycle, t, line, codes
+    ferr: dict[str, tuple[float, float, int]] = field(default_factory=dict)  # max |ferr|, t, line
+    ranges: dict[str, tuple[float, float]] = field(default_factory=dict)  # actual min, max
+    rpm: dict[str, float] = field(default_factory=dict)
+    jitter: TimingStats = field(default_factory=TimingStats)
+    period: float | None = None
+
+
+def summarise(tf: TraceFile, lo: Bound | None = None, hi: Bound | None = None) -> Summary:
+    s = Summary()
+    axes, spindles = axes_of(tf.columns), spindles_of(tf.columns)
+    state: dict = {}
+    for batch in tf.batches():
+        if lo is not None or hi is not None:
+            batch = batch.filter(slice_mask(batch, lo, hi, state))
+        if batch.num_rows == 0:
+            continue
+        cols = {n: batch.column(n) for n in batch.schema.names}
+        t = cols["t"].to_numpy()
+        line = cols["line"].to_numpy()
+        s.rows += batch.num_rows
+        s.t0 = float(t[0]) if s.t0 is None else s.t0
+        s.t1 = float(t[-1])
+        s.lines.update(int(x) for x in np.unique(line) if x)
+        if "alarm" in cols:
+            al = cols["alarm"].to_pylist()
+            cyc = cols["cycle"].to_numpy() if "cycle" in cols else np.arange(len(al))
+            s.alarms += [(int(cyc[i]), float(t[i]), int(line[i]), a) for i, a in enumerate(al) if a]
+        for a in axes:
+            if f"{a}_ferr" not in cols or f"{a}_act" not in cols:
+                continue
+            f = np.abs(cols[f"{a}_ferr"].to_numpy())
+            i = int(np.argmax(f))
+            if a not in s.ferr or f[i] > s.ferr[a][0]:
+                s.ferr[a] = (float(f[i]), float(t[i]), int(line[i]))
+            act = cols[f"{a}_act"].to_numpy()
+            lo_, hi_ = s.ranges.get(a, (np.inf, -np.inf))
+            s.ranges[a] = (min(lo_, float(act.min())), max(hi_, float(act.max())))
+        for sp in [sp for sp in spindles if f"{sp}_rpm_act" in cols]:
+            s.rpm[sp] = max(s.rpm.get(sp, 0.0), float(np.max(np.abs(cols[f"{sp}_rpm_act"].to_numpy()))))
+        if "period" in cols:
+            per = cols["period"].to_numpy()
+            if s.period is None:
+                s.period = float(np.median(per))
+            s.jitter.add_many(per - s.period)
+    return s
+
+
+def format_summary(tf: TraceFile, s: Summary) -> str:
+    out = [f"trace          {tf.path}  ({'Parquet' if tf.parquet else 'CSV'}, {len(tf.columns)} columns)"]
+    if s.rows == 0:
+        return "\n".join(out + ["rows           0"])
+    out.append(f"rows           {s.rows}  (t {s.t0:.3f} … {s.t1:.3f} s)")
+    if s.period:
+        j = s.jitter
+        out.append(f"cycle          {s.period * 1e3:g} ms; jitter p50 {j.percentile(50) * 1e6:.1f} µs  "
+                   f"p99 {j.percentile(99) * 1e6:.1f} µs  p99.9 {j.percentile(99.9) * 1e6:.1f} µs  "
+                   f"max {j.max * 1e6:.1f} µs")
+    lines = sorted(s.lines)
+    out.append(f"program lines  {len(lines)}" + (f" ({lines[0]} … {lines[-1]})" if lines else ""))
+    for a, (v, t, ln) in s.ferr.items():
+        lo, hi = s.ranges[a]
+        out.append(f"axis {a:<9} range {lo:.4f} … {hi:.4f}; max following error {v:.4f} at t={t:.3f} s line {ln}")
+    for sp, rpm in s.rpm.items():
+        out.append(f"spindle {sp:<6} max {rpm:.1f} rpm")
+    extra = [c for c in tf.columns if c not in _standard(tf.columns)]
+    if extra:
+        out.append(f"signals        {', '.join(extra)}")
+    out.append(f"alarms         {len(s.alarms) or 'none'}")
+    for cyc, t, ln, codes in s.alarms[:20]:
+        out.append(f"  {codes} at cycle {cyc} (t={t:.3f} s), line {ln}")
+    return "\n".join(out)
+
+
+def _standard(columns: list[str]) -> set[str]:
+    from hil.trace import trace_columns
+
+    return set(trace_columns(axes_of(columns), spindles_of(columns)))
+
+
+def export(tf: TraceFile, out: str | Path, lo: Bound | None = None, hi: Bound | None = None,
+           columns: list[str] | None = None) -> int:
+    """Write the slice (and columns) to CSV or Parquet by the output's extension; returns rows."""
+    if columns:
+        missing = [c for c in columns if c not in tf.columns]
+        if missing:
+            raise ValueError(f"no column {', '.join(missing)} in {tf.path}")
+    need = None if not columns else list(dict.fromkeys(["t", "line"] + columns))
+    state: dict = {}
+    writer = None
+    rows = 0
+    tmp = Path(str(out) + ".part")
+    try:
+        for batch in tf.batches(need):
+            if lo is not None or hi is not None:
+                batch = batch.filter(slice_mask(batch, lo, hi, state))
+            if columns:
+                batch = batch.select(columns)
+            if writer is None:
+                writer = pq.ParquetWriter(tmp, batch.schema, compression="zstd") if is_parquet(out) else \
+                    pacsv.CSVWriter(tmp, batch.schema)
+            if batch.num_rows:
+                writer.write_batch(batch) if is_parquet(out) else writer.write(batch)
+                rows += batch.num_rows
+    finally:
+        if writer is not None:
+            writer.close()
+    if writer is None:
+        raise ValueError(f"{tf.path}: empty trace")
+    tmp.replace(out)
+    return rows
+
+
+__all__ = ["Bound", "Summary", "export", "format_summary", "summarise"]
