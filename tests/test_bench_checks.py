@@ -1,0 +1,169 @@
+"""Each check fails on a crafted trace and names the offending cycle and line; CLI exit codes."""
+
+import numpy as np
+import pytest
+
+from hil.bench import ChecksConfig, default_lathe
+from hil.checks import run_checks
+from hil.cli import main
+from hil.trace import CsvTrace, trace_columns
+from hil.trace_read import TraceFile
+from nc.moves import Move
+
+N = 400
+
+
+def base(n=N):
+    t = np.arange(1, n + 1) * 0.001
+    d = {"t": t, "line": np.full(n, 2), "cycle": np.arange(1, n + 1), "period": np.full(n, 0.001),
+         "late": np.zeros(n), "alarm": [""] * n}
+    for a in ("X", "Z"):
+        for k in ("cmd", "act", "vel", "torque", "ferr"):
+            d[f"{a}_{k}"] = np.zeros(n)
+        d[f"{a}_sw"] = np.full(n, 0x1637)
+    for k in ("rpm_cmd", "rpm_act", "angle", "torque"):
+        d[f"S1_{k}"] = np.zeros(n)
+    d["S1_sw"] = np.full(n, 0x1637)
+    return d
+
+
+def write(tmp_path, d, name="t.csv"):
+    cols = trace_columns(["X", "Z"], ["S1"])
+    w = CsvTrace(tmp_path / name, cols)
+    for i in range(len(d["t"])):
+        w.write([d[c][i].item() if hasattr(d[c][i], "item") else d[c][i] for c in cols])
+    w.close()
+    return TraceFile(tmp_path / name)
+
+
+def only(results, name):
+    (r,) = [r for r in results if r.name == name]
+    return r
+
+
+def test_following_error_names_cycle_and_line(tmp_path):
+    d = base()
+    d["line"][200:] = 7
+    d["Z_ferr"][250] = -0.2
+    d["Z_ferr"][251] = 0.08
+    res = run_checks(write(tmp_path, d), ChecksConfig(max_following_error={"X": 0.1, "Z": 0.1}))
+    assert only(res, "following error X").ok
+    z = only(res, "following error Z")
+    assert not z.ok and z.cycle == 251 and z.line == 7 and z.value == pytest.approx(0.2)
+    assert "cycle 251" in str(z) and "line 7" in str(z)
+
+
+def line_moves():
+    return [Move("line", 3, "G01 Z-20.", {"X": 10.0, "Z": 0.0}, {"X": 10.0, "Z": -20.0}, {"X": 20.0, "Z": -20.0},
+                 feed=300.0),
+            Move("arc", 4, "G02 X30. Z-25. R5.", {"X": 10.0, "Z": -20.0}, {"X": 15.0, "Z": -25.0},
+                 {"X": 30.0, "Z": -25.0}, center={"X": 15.0, "Z": -20.0}, dir="cw", plane=("Z", "X"), feed=300.0)]
+
+
+def contour_trace():
+    d = base()
+    s = np.linspace(0, 1, N)
+    d["line"][:] = np.where(s < 0.5, 3, 4)
+    z = np.where(s < 0.5, -40 * s, 0)
+    x = np.full(N, 10.0)
+    arc = s >= 0.5
+    ang = (s[arc] - 0.5) * 2 * (np.pi / 2)  # quarter circle, centre (Z-20, X15), r=5
+    z[arc] = -20 - 5 * np.sin(ang)
+    x[arc] = 15 - 5 * np.cos(ang)
+    d["Z_act"], d["X_act"] = z.copy(), x.copy()
+    d["Z_cmd"], d["X_cmd"] = z.copy(), x.copy()
+    return d
+
+
+def test_contour_error_on_arc(tmp_path):
+    d = contour_trace()
+    res = run_checks(write(tmp_path, d, "ok.csv"), ChecksConfig(contour_error=0.005), moves=line_moves())
+    assert only(res, "contour error").ok and only(res, "contour error").value < 1e-3
+    rz, rx = d["Z_act"][330] + 20.0, d["X_act"][330] - 15.0  # push 30 µm radially off the arc
+    d["Z_act"][330] += 0.03 * rz / 5.0
+    d["X_act"][330] += 0.03 * rx / 5.0
+    r = only(run_checks(write(tmp_path, d), ChecksConfig(contour_error=0.005), moves=line_moves()), "contour error")
+    assert not r.ok and r.cycle == 331 and r.line == 4 and r.value == pytest.approx(0.03, abs=2e-3)
+
+
+def test_contour_needs_program_is_skipped_not_passed_silently(tmp_path):
+    r = only(run_checks(write(tmp_path, base()), ChecksConfig(contour_error=0.01)), "contour error")
+    assert r.skipped and "--program" in str(r)
+
+
+@pytest.mark.parametrize("kind, order", [("velocity", 1), ("acceleration", 2), ("jerk", 3)])
+def test_limit_checks(tmp_path, kind, order):
+    bench = default_lathe()  # Z: 400 mm/s, 4000 mm/s², 200000 mm/s³
+    d = base()
+    d["line"][300:] = 9
+    lim = {1: 400.0, 2: 4000.0, 3: 200_000.0}[order]
+    # A single step in the order-th derivative of 1.5 × the limit at cycle 311 (row 310).
+    bump = np.zeros(N)
+    bump[310] = 1.5 * lim * 0.001 ** order
+    z = bump
+    for _ in range(order):
+        z = np.cumsum(z)
+    d["Z_cmd"] = z
+    res = run_checks(write(tmp_path, d), ChecksConfig(limits=True), bench)
+    r = only(res, f"{kind} Z")
+    assert not r.ok and r.cycle == 311 and r.line == 9 and r.value == pytest.approx(1.5 * lim, rel=1e-6)
+    for other in ("velocity X", "acceleration X", "jerk X"):
+        assert only(res, other).ok
+
+
+def thread_moves():
+    return [Move("thread", 5, "G32 Z-20. F2.", {"X": r, "Z": 0.0}, {"X": r, "Z": -20.0}, {"X": 2 * r, "Z": -20.0},
+                 feed=2.0, per_rev=True, lead=2.0) for r in (10.0, 9.8, 9.6)]
+
+
+def thread_trace(phases):
+    """Three passes at 600 rpm (10 rev/s, 20 mm/s), spindle at `phase` when each pass starts."""
+    per = 1200
+    d = base(per * len(phases))
+    d["line"][:] = 5
+    z_all, a_all, x_all = [], [], []
+    for ph, m in zip(phases, thread_moves()):
+        k = np.arange(per)
+        z = np.where(k < 100, 0.0, -0.02 * (k - 100))  # standing until cycle 100, then 20 mm/s
+        z = np.maximum(z, -20.0)
+        z[-100:] = 0.0  # rapid return
+        ang = (ph + 3.6 * (k - 100)) % 360.0  # 10 rev/s = 3.6° per ms
+        z_all.append(z)
+        a_all.append(ang)
+        x_all.append(np.full(per, m.start["X"]))
+    d["Z_act"], d["S1_angle"], d["X_act"] = np.concatenate(z_all), np.concatenate(a_all), np.concatenate(x_all)
+    return d
+
+
+def test_thread_phase_each_pass(tmp_path):
+    good = run_checks(write(tmp_path, thread_trace([30.0, 30.0, 30.0]), "g.csv"), ChecksConfig(thread_phase=2.0),
+                      moves=thread_moves())
+    assert only(good, "thread phase").ok and only(good, "thread phase").value < 0.01
+    bad = run_checks(write(tmp_path, thread_trace([30.0, 30.0, 70.0])), ChecksConfig(thread_phase=2.0),
+                     moves=thread_moves())
+    r = only(bad, "thread phase")
+    assert not r.ok and "pass 3" in r.detail and r.line == 5
+    assert 2400 < r.cycle <= 3600 and r.value > 30
+
+
+def test_jitter_percentiles(tmp_path):
+    d = base()
+    d["period"][::50] = 0.00105  # 50 µs late every 50th cycle: 2 %
+    d["period"][123] = 0.0014
+    res = run_checks(write(tmp_path, d), ChecksConfig(jitter_p99=20e-6, jitter_max=300e-6), default_lathe())
+    p99, mx = only(res, "jitter p99"), only(res, "jitter max")
+    assert not p99.ok and p99.value == pytest.approx(50e-6, abs=1e-9) and p99.cycle == 1
+    assert not mx.ok and mx.cycle == 124 and mx.value == pytest.approx(400e-6)
+
+
+def test_hil_check_cli_exit_codes(tmp_path, capsys):
+    d = base()
+    d["X_ferr"][99] = 0.5
+    write(tmp_path, d)
+    path = str(tmp_path / "t.csv")
+    assert main(["check", path, "--max-ferr", "1.0"]) == 0
+    assert main(["check", path, "--max-ferr", "0.1"]) == 1
+    out = capsys.readouterr().out
+    assert "FAIL  following error X" in out and "cycle 100" in out
+    assert main(["check", path]) == 2  # nothing to check
+    assert main(["check", str(tmp_path / "none.csv"), "--max-ferr", "1"]) == 2
