@@ -237,7 +237,9 @@ class CanopenLink:
                 if m.enabled:
                     for e in (frames[k].rx or frames[k].tx):
                         m.add_variable(e.index, e.subindex, e.bits)
-                self._sdo(n, m.save, m.com_record.od.index)
+                com = m.com_record.od.index
+                self._sdo(n, m.save, com, f"{'RPDO' if base == 0x200 else 'TPDO'}{k + 1} "
+                                          f"(0x{com:04X}/0x{m.map_array.od.index:04X})")
         # The library subscribed its own PdoMap handlers; we decode TPDOs with our structs instead.
         for k, frame in enumerate(n.tx_frames):
             cob = 0x180 + 0x100 * k + nid
@@ -245,14 +247,14 @@ class CanopenLink:
             n.tx_cobs[cob] = frame
             self.network.subscribe(cob, self._tpdo_cb(n))
 
-    def _sdo(self, n: _Node, op: Callable[[], Any], index: int) -> Any:
+    def _sdo(self, n: _Node, op: Callable[[], Any], index: int, what: str = "") -> Any:
         try:
             return op()
         except SdoAbortedError as exc:
             code = (ALARM_INTERPOLATION if index == 0x60C2 else
                     ALARM_PDO_MAPPING if 0x1400 <= index <= 0x1BFF else ALARM_ESTABLISH)
             self._fail(Alarm(code, f"SDO abort 0x{exc.code:08X} ({_abort_text(exc)}) from {self._label(n)} "
-                                   f"on object 0x{index:04X}", axis=n.cfg.name, info=n.cfg.node_id))
+                                   f"writing {what or f'object 0x{index:04X}'}", axis=n.cfg.name, info=n.cfg.node_id))
         except SdoCommunicationError as exc:
             self._fail(Alarm(ALARM_NOT_FOUND, f"{self._label(n)} does not answer SDO 0x{index:04X}: {exc}",
                              axis=n.cfg.name, info=n.cfg.node_id))
@@ -388,5 +390,5 @@ class CanopenLink:
 
 
 def _abort_text(exc: SdoAbortedError) -> str:
-    text = str(exc)
-    return text.split(": ", 1)[-1] if ": " in text else text
+    text = str(exc)  # "Code 0x06040041, Object cannot be mapped to the PDO"
+    return text.split(", ", 1)[-1] if text.startswith("Code ") else text
