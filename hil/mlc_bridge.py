@@ -1,0 +1,22 @@
+"""Bus feedback → the MLC's drive status (servo on, connected, torque, velocity), each cycle."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from fieldbus.cia402 import State
+from mlc.nc_link import DriveStatus
+
+
+def drive_status(runner: Any) -> list[DriveStatus]:
+    out = []
+    n_axes = len(runner.axes)
+    for i, (m, tx, sc) in enumerate(zip(runner.masters, runner.tx, runner.scales)):
+        spindle = i >= n_axes
+        vel = sc.to_units(tx.velocity_actual)
+        rpm = sc.counts_per_s_to_rpm(tx.velocity_actual)
+        out.append(DriveStatus(runner._name(i), connected=True, servo_on=m.state is State.OPERATION_ENABLED,
+                               fault=m.faulted, torque=tx.torque_actual, velocity=vel, rpm=rpm,
+                               position=sc.to_units(tx.position_actual), spindle=spindle,
+                               mode=getattr(tx, "mode_display", 8)))
+    return out

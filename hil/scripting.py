@@ -1,0 +1,336 @@
+"""Exercising scripts: drive the bench through the MLC's special relays, as an operator panel would.
+
+A script is a Python file with ``def main(machine): ...`` (or top-level code using the global
+``machine``). `hil script FILE.py` builds the bench, powers the drives up and hands the script a
+`Machine`; afterwards it prints what every drive did. Everything the script does goes through the
+NC5 special M/D devices (mode D2x000, jog M2x384…, MPG D2x008/D2x009 + pulses, home M2x320…,
+cycle start M2x000 …) and the real NC channel, never around them.
+
+    def main(machine):
+        machine.mode("MPG")
+        machine.mpg("X", pulses=100, ratio=10)     # 100 detents at ×10 → 1.000 mm
+        machine.spindle(1200)                      # M03 S1200 through MDI
+        machine.wait(1.0)
+        machine.report()
+"""
+
+from __future__ import annotations
+
+import runpy
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Callable
+
+from hil.bench import Bench
+from hil.runner import BenchRunner
+from hil.session import make_link
+from mlc.machine import Mlc
+from mlc.nc_link import MODE_NAMES
+from mlc.signals import d2, d3, m2, m3
+from nc.alarms import Alarm, NcAlarm
+from nc.channel import Channel
+from nc.interp import Interpreter
+from nc.motion import Planner
+from nc.profiles import make_profile
+from nc.program import parse_program
+
+
+class ScriptError(Exception):
+    """A script asked for something the bench cannot do (unknown axis, timeout …)."""
+
+
+@dataclass
+class OperatorPanel:
+    """The operator: presses Cycle Start `resume_after` seconds after an M00/M01 hold."""
+
+    mlc: Mlc
+    resume_after: float | None = 0.5
+    _held_since: float | None = None
+    _pressed: bool = False
+
+    def __call__(self, runner: BenchRunner) -> None:
+        x, mem = self.mlc.link.x, self.mlc.mem
+        if self._pressed:
+            mem.set_bit(m2(x, 0), False)
+            self._pressed = False
+        held = mem.bit(m3(x, 37)) or mem.bit(m3(x, 38))
+        if not held or self.resume_after is None:
+            self._held_since = None
+            return
+        if self._held_since is None:
+            self._held_since = runner.time
+        if runner.time - self._held_since >= self.resume_after - 1e-12:
+            mem.set_bit(m2(x, 0), True)
+            self._pressed = True
+            self._held_since = None
+
+
+@dataclass
+class DriveRecord:
+    start: float = 0.0
+    end: float = 0.0
+    min: float = float("inf")
+    max: float = float("-inf")
+    peak_velocity: float = 0.0
+    peak_rpm: float = 0.0
+    modes: list[int] = field(default_factory=list)  # modes of operation seen (0x6061), in order
+
+
+class Machine:
+    """One bench, powered up, cycling in lock-step; the script's handle."""
+
+    def __init__(self, bench: Bench, mlc: Mlc | None = None, link: Any = None, trace: Any = None) -> None:
+        self.bench = bench
+        self.mlc = mlc or Mlc(axes=bench.axis_names, cycle=bench.cycle, motion=bench.motion_config(),
+                              max_rpm=min((s.max_rpm for s in bench.spindles), default=6000.0))
+        self.panel = OperatorPanel(self.mlc)
+        self.link = link or make_link(bench)
+        self.runner = BenchRunner(bench, self.link, trace, self.mlc, on_cycle=self._on_cycle)
+        self.x = self.mlc.link.x
+        self.records: dict[str, DriveRecord] = {}
+        self.watchers: list[Callable[["Machine"], None]] = []
+        self._mpg_count = 0
+        self.alarms: list[Alarm] = []
+
+    # ---- life cycle ----------------------------------------------------------------------------
+    def power_up(self) -> None:
+        r = self.runner
+        for name in self._names():
+            self.records[name] = DriveRecord()
+        if not r.power_up():
+            raise ScriptError("; ".join(str(a) for a in r.result.alarms) or "drives did not enable")
+        start = dict(zip(r.axes, r.actual.tolist()))
+        r.channel = Channel(Planner(self.bench.motion_config(), start, spindle_rpm=lambda: self.mlc.spindle.rpm))
+        self.mlc.manual.position[:] = r.actual
+        self.mlc.manual.take_over(r.actual.copy())
+        self._record(first=True)
+
+    def close(self) -> None:
+        self.runner._shutdown()
+
+    def _names(self) -> list[str]:
+        return list(self.runner.axes) + [s.name for s in self.bench.spindles]
+
+    def _on_cycle(self, runner: BenchRunner) -> None:
+        self.panel(runner)
+        self._record()
+        for w in self.watchers:
+            w(self)
+
+    def _record(self, first: bool = False) -> None:
+        r = self.runner
+        n = len(r.axes)
+        for i, name in enumerate(self._names()):
+            rec, tx, sc = self.records[name], r.tx[i], r.scales[i]
+            pos = sc.to_units(tx.position_actual)
+            if first:
+                rec.start = pos
+            rec.end = pos
+            rec.min, rec.max = min(rec.min, pos), max(rec.max, pos)
+            rec.peak_velocity = max(rec.peak_velocity, abs(sc.to_units(tx.velocity_actual)))
+            if i >= n:
+                rec.peak_rpm = max(rec.peak_rpm, abs(sc.counts_per_s_to_rpm(tx.velocity_actual)))
+            mode = getattr(tx, "mode_display", 0)
+            if not rec.modes or rec.modes[-1] != mode:
+                rec.modes.append(mode)
+
+    # ---- time ------------------------------------------------------------------------------------
+    @property
+    def time(self) -> float:
+        return self.runner.time
+
+    def cycle(self, n: int = 1) -> None:
+        for _ in range(n):
+            self.runner._exchange()
+
+    def wait(self, seconds: float) -> None:
+        self.cycle(max(1, int(round(seconds / self.bench.cycle))))
+
+    def wait_until(self, predicate: Callable[[], bool], timeout: float = 10.0, what: str = "condition") -> float:
+        """Cycle until `predicate()` is true; returns the simulated time it took."""
+        t0 = self.time
+        limit = int(round(timeout / self.bench.cycle))
+        for _ in range(limit):
+            if predicate():
+                return self.time - t0
+            self.cycle()
+        raise ScriptError(f"{what} not reached within {timeout:g} s simulated")
+
+    # ---- devices ---------------------------------------------------------------------------------
+    def get(self, address: str) -> int:
+        return self.mlc.get(address)
+
+    def set(self, address: str, value: int | bool = True) -> None:
+        self.mlc.put(address, int(value))
+
+    def pulse(self, relay: int, cycles: int = 2) -> None:
+        """Press a button relay for a few cycles (edge-triggered commands)."""
+        self.mlc.mem.set_bit(relay, True)
+        self.cycle(cycles)
+        self.mlc.mem.set_bit(relay, False)
+        self.cycle(1)
+
+    def axis_index(self, axis: str) -> int:
+        try:
+            return self.runner.axes.index(axis.upper())
+        except ValueError:
+            raise ScriptError(f"axis {axis!r} is not on the bench (axes: {', '.join(self.runner.axes)})") from None
+
+    def position(self, axis: str) -> float:
+        return float(self.runner.actual[self.axis_index(axis)])
+
+    def command(self, axis: str) -> float:
+        return float(self.runner._commands[self.axis_index(axis)])
+
+    # ---- operator actions through the special relays -------------------------------------------------
+    def mode(self, name: str) -> None:
+        name = name.upper()
+        if name not in MODE_NAMES:
+            raise ScriptError(f"unknown mode {name!r}; choose one of {', '.join(MODE_NAMES)}")
+        k = MODE_NAMES.index(name)
+        self.mlc.mem.set_u16(d2(self.x, 0), k)
+        self.wait_until(lambda: self.mlc.mem.bit(m3(self.x, k)), 1.0, f"mode {name}")
+
+    def mpg(self, axis: str, pulses: int, ratio: int = 1, rate: float = 100.0) -> None:
+        """Turn the handwheel `pulses` detents (negative: backwards) at `rate` detents/s on `axis`."""
+        i = self.axis_index(axis)
+        mem = self.mlc.mem
+        mem.set_u16(d2(self.x, 8), i)
+        mem.set_u16(d2(self.x, 9), ratio)
+        if not mem.bit(m3(self.x, 3)):
+            self.mode("MPG")
+        per_cycle = rate * self.bench.cycle
+        done, acc = 0, 0.0
+        step = 1 if pulses >= 0 else -1
+        while done != pulses:
+            acc += per_cycle
+            while acc >= 1.0 and done != pulses:
+                acc -= 1.0
+                done += step
+                self._mpg_count = (self._mpg_count + step) & 0xFFFF
+            mem.set_u16(d3(0, 4), self._mpg_count)
+            self.cycle()
+        self.settle(axis)
+
+    def settle(self, axis: str | None = None, timeout: float = 10.0) -> None:
+        mm = self.mlc.manual
+        self.wait_until(lambda: not mm.busy, timeout, "manual motion to finish")
+        self.cycle(int(0.05 / self.bench.cycle))
+
+    def jog(self, axis: str, direction: int, seconds: float, percent: int = 100) -> None:
+        i = self.axis_index(axis)
+        if not self.mlc.mem.bit(m3(self.x, 4)):
+            self.mode("JOG")
+        self.mlc.mem.set_u16(d2(self.x, 6), percent)
+        relay = m2(self.x, (384 if direction > 0 else 400) + i)
+        self.mlc.mem.set_bit(relay, True)
+        self.wait(seconds)
+        self.mlc.mem.set_bit(relay, False)
+        self.settle(axis)
+
+    def inc(self, axis: str, steps: int, units: int = 1000) -> None:
+        """`steps` presses of the INC key, each `units` × N9.013 (default 1000 × 0.001 = 1 mm)."""
+        i = self.axis_index(axis)
+        if not self.mlc.mem.bit(m3(self.x, 6)):
+            self.mode("INC")
+        self.mlc.mem.set_u32(d2(self.x, 14), units)
+        relay = m2(self.x, (384 if steps > 0 else 400) + i)
+        for _ in range(abs(steps)):
+            self.pulse(relay)
+            self.settle(axis)
+
+    def home(self, axis: str, timeout: float = 60.0) -> float:
+        i = self.axis_index(axis)
+        if not self.mlc.mem.bit(m3(self.x, 7)):
+            self.mode("HOME")
+        self.pulse(m2(self.x, 320 + i))
+        return self.wait_until(lambda: self.mlc.mem.bit(m3(self.x, 336 + i)), timeout, f"{axis} homing")
+
+    def mdi(self, text: str, timeout: float = 60.0) -> float:
+        """Run program text (MDI/AUTO) through cycle start and the M/S/T handshakes; returns its time."""
+        return self.run_program(text, name="MDI", timeout=timeout)
+
+    def run_program(self, text: str, name: str = "program", timeout: float = 600.0) -> float:
+        r = self.runner
+        prev_mode = self.mlc.link.mode
+        self.mlc.mem.set_u16(d2(self.x, 0), 0)
+        self.wait_until(lambda: self.mlc.link.mode == 0 and not self.mlc.manual.busy, 5.0, "AUTO mode")
+        program = parse_program(text, name=name)
+        profile = make_profile(self.bench.profile, r.axes, self.bench.params)
+        interp = Interpreter(profile, dict(zip(r.axes, r.channel.planner.position.tolist())))
+        self.mlc.attach_variables(interp.vars)
+        ch = Channel(Planner(self.bench.motion_config(), dict(zip(r.axes, r.channel.planner.position.tolist())),
+                             spindle_rpm=lambda: self.mlc.spindle.rpm))
+        r.channel = ch
+        ch.load(interp.run(program))
+        t0 = self.time
+        self.pulse(m2(self.x, 0))
+        limit = int(round(timeout / self.bench.cycle))
+        for _ in range(limit):
+            if not ch.busy:
+                break
+            self.cycle()
+        else:
+            raise ScriptError(f"{name} did not finish within {timeout:g} s simulated")
+        self.alarms += [a for a in ch.alarms if a not in self.alarms]
+        if prev_mode != 0:
+            self.mlc.mem.set_u16(d2(self.x, 0), prev_mode)
+            self.cycle(2)
+        return self.time - t0
+
+    def spindle(self, rpm: float, direction: int = 1, wait: bool = True) -> float:
+        """Start (M03/M04 S…) or stop (rpm 0: M05) the spindle through MDI and the handshake."""
+        if rpm == 0 or direction == 0:
+            return self.mdi("M05")
+        return self.mdi(f"{'M03' if direction > 0 else 'M04'} S{abs(rpm):g}")
+
+    def estop(self, on: bool = True) -> None:
+        self.mlc.mem.set_bit(m2(self.x, 13), on)
+        self.cycle()
+
+    def feed_hold(self) -> None:
+        self.pulse(m2(self.x, 1))
+
+    def reset(self) -> None:
+        self.pulse(m2(self.x, 4))
+
+    # ---- what the drives did -----------------------------------------------------------------------
+    def summary(self) -> list[str]:
+        lines = []
+        n = len(self.runner.axes)
+        for i, (name, rec) in enumerate(self.records.items()):
+            if i < n:
+                lines.append(f"{name:<4} {rec.start:10.4f} → {rec.end:10.4f}  (moved {rec.end - rec.start:+.4f}, "
+                             f"range {rec.min:.4f}…{rec.max:.4f}, peak {rec.peak_velocity:.3f}/s)  "
+                             f"modes {'/'.join(_mode_name(m) for m in rec.modes)}")
+            else:
+                lines.append(f"{name:<4} peak {rec.peak_rpm:8.1f} rpm, now "
+                             f"{self.runner.scales[i].counts_per_s_to_rpm(self.runner.tx[i].velocity_actual):8.1f} rpm  "
+                             f"modes {'/'.join(_mode_name(m) for m in rec.modes)}")
+        alarms = self.alarms + [a for a in (self.runner.channel.alarms if self.runner.channel else [])
+                                if a not in self.alarms]
+        lines.append("alarms  " + ("; ".join(str(a) for a in alarms) if alarms else "none"))
+        return lines
+
+    def report(self) -> None:
+        for line in self.summary():
+            print(line)
+
+
+def _mode_name(mode: int) -> str:
+    return {8: "CSP", 9: "CSV", 10: "CST", 6: "HM", 1: "PP", 3: "PV"}.get(mode, str(mode))
+
+
+def run_script(path: str, machine: Machine, args: list[str] | None = None) -> Any:
+    """Execute a script file against `machine`: its `main(machine, *args)` or its top-level code."""
+    p = Path(path)
+    if not p.is_file():
+        raise ScriptError(f"script {path} does not exist")
+    ns = runpy.run_path(str(p), init_globals={"machine": machine, "args": args or []}, run_name="__hil_script__")
+    main = ns.get("main")
+    if callable(main):
+        return main(machine, *(args or [])) if args else main(machine)
+    return None
+
+
+__all__ = ["Machine", "OperatorPanel", "ScriptError", "run_script", "NcAlarm"]

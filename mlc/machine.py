@@ -1,0 +1,162 @@
+"""The MLC as the bench runs it: device memory, the NC side of the special M/D interface for the
+channel, remote I/O, and a user scan program, scanned once per bench cycle.
+
+    mlc = Mlc.load("examples/mlc/my_lathe.py", axes=("X", "Z"))   # or Mlc() for the default lathe MLC
+    runner = BenchRunner(bench, link, trace, mlc)
+
+Per cycle (`scan(channel)`, called by the runner before the channel step):
+  1. the NC reads the relays/registers the MLC wrote in its previous scan and acts on them;
+  2. the NC publishes its status for this cycle (modes, strobes + code data, drive status …);
+  3. the user program's `scan(ctx)` runs;
+  4. the spindle command the drives get is taken from the spindle relays.
+"""
+
+from __future__ import annotations
+
+import importlib
+import importlib.util
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+from types import ModuleType
+from typing import Any
+
+import numpy as np
+
+from mlc.memory import DeviceMemory
+from mlc.nc_link import ChannelLink, DriveStatus
+from mlc.program import ScanContext
+from mlc.signals import d2, m2
+from nc.channel import Channel
+from nc.manual import ManualMotion
+from nc.motion.limits import MotionConfig
+
+
+class MlcLoadError(ValueError):
+    """The MLC module cannot be loaded or has no scan function."""
+
+
+@dataclass
+class SpindleOutput:
+    """What the spindle drive is told (the runner reads `signed_rpm`; the planner reads `rpm`)."""
+
+    rpm: float = 0.0
+    direction: int = 0
+
+    @property
+    def signed_rpm(self) -> float:
+        return self.rpm * self.direction
+
+
+def load_program(spec: str | None) -> Any:
+    """An MLC program by file path (``examples/mlc/x.py``) or module name (``mlc.lathe``)."""
+    if spec is None:
+        import mlc.lathe as default
+
+        return default
+    path = Path(spec)
+    try:
+        if path.suffix == ".py" or path.exists():
+            if not path.is_file():
+                raise MlcLoadError(f"MLC module {spec} does not exist")
+            name = f"mlc_user_{path.stem}"
+            mod_spec = importlib.util.spec_from_file_location(name, path)
+            if mod_spec is None or mod_spec.loader is None:
+                raise MlcLoadError(f"MLC module {spec} cannot be loaded")
+            module: ModuleType = importlib.util.module_from_spec(mod_spec)
+            sys.modules[name] = module
+            mod_spec.loader.exec_module(module)
+        else:
+            module = importlib.import_module(spec)
+    except MlcLoadError:
+        raise
+    except Exception as exc:  # a syntax error in the user's file is a usage error, not a crash
+        raise MlcLoadError(f"MLC module {spec} failed to load: {type(exc).__name__}: {exc}") from None
+    if not callable(getattr(module, "scan", None)):
+        raise MlcLoadError(f"MLC module {spec} has no scan(mlc) function")
+    return module
+
+
+class Mlc:
+    def __init__(self, program: Any = None, axes: tuple[str, ...] = ("X", "Z"), cycle: float = 0.001,
+                 motion: MotionConfig | None = None, max_rpm: float = 6000.0, channel: int = 1,
+                 word_order: str = "low-first", start: dict[str, float] | None = None) -> None:
+        self.program = program if program is not None else load_program(None)
+        self.mem = DeviceMemory(word_order=word_order)  # type: ignore[arg-type]
+        self.cycle = cycle
+        self.axes = tuple(axes)
+        cfg = motion or MotionConfig(cycle=cycle, axes=self.axes)
+        pos = np.array([(start or {}).get(a, 0.0) for a in self.axes])
+        self.manual = ManualMotion(cfg, pos)
+        self.link = ChannelLink(self.mem, channel, self.axes, self.manual, spindle_max_rpm=max_rpm)
+        self.ctx = ScanContext(self.mem, channel, cycle, params={"max_rpm": max_rpm})
+        self.spindle = SpindleOutput()
+        self.drives: list[DriveStatus] | None = None
+        self.io_modules: list[Any] = []  # virtual_bus.io modules (or real ones) exchanged every scan
+        self.time = 0.0
+        self._power_on_image(channel)
+        setup = getattr(self.program, "setup", None)
+        if callable(setup):
+            setup(self.ctx)
+
+    @classmethod
+    def load(cls, spec: str | None, **kw: Any) -> "Mlc":
+        return cls(load_program(spec), **kw)
+
+    def _power_on_image(self, x: int) -> None:
+        """Override switches at 100 %, MPG ratio ×1, INC step 1 unit (a panel's usual power-on state)."""
+        for i in (2, 4, 6, 26):
+            self.mem.set_u16(d2(x, i), 100)
+        self.mem.set_u16(d2(x, 9), 1)
+        self.mem.set_u32(d2(x, 14), 1)
+        self.mem.set_bit(m2(x, 12), True)  # servo ON request
+        self.mem.set_bit(29035, True)  # "remaining ON"
+
+    # ---- wiring from the bench -------------------------------------------------------------------
+    def attach_variables(self, variables: Any) -> None:
+        """Share the interpreter's # variable store (#25000–#25511, #20020)."""
+        self.link.variables = variables
+
+    def bus_feedback(self, drives: list[DriveStatus]) -> None:
+        self.drives = drives
+
+    # ---- the scan ---------------------------------------------------------------------------------
+    def scan(self, channel: Channel) -> None:
+        self.time += self.cycle
+        self._clocks()
+        self._exchange_io()
+        self.link.nc_inputs(channel)
+        self.link.nc_outputs(channel, self.drives)
+        ctx = self.ctx
+        ctx.time, ctx.scan_count = self.time, ctx.scan_count + 1
+        self.program.scan(ctx)
+        rpm = self.link.commanded_rpm(0)
+        self.spindle.rpm, self.spindle.direction = abs(rpm), (1 if rpm > 0 else -1 if rpm < 0 else 0)
+        if self.link._estop:
+            self.spindle.direction = 0
+
+    def _clocks(self) -> None:
+        t = self.time
+        self.mem.set_bit(29032, int(t / 0.5) % 2 == 1)
+        self.mem.set_bit(29033, int(t / 0.05) % 2 == 1)
+
+    def _exchange_io(self) -> None:
+        io = self.ctx.io
+        assert io is not None
+        while len(io.inputs) < len(self.io_modules):
+            io.inputs.append(0)
+        for k, module in enumerate(self.io_modules):
+            outs = io.outputs[k] if k < len(io.outputs) else 0
+            analog_out = [self.mem.u16(20200 + 4 * k + w) for w in range(4)]
+            di, analog_in = module.exchange_io(outs, analog_out, self.cycle)
+            io.inputs[k] = di
+            for w, v in enumerate(analog_in[:4]):
+                self.mem.set_u16(30200 + 4 * k + w, v)
+            self.mem.set_bit(30032 + k, True)  # EIO node 501+k connected
+
+    # ---- convenience for scripts and tests ---------------------------------------------------------
+    def get(self, address: str) -> int:
+        return self.mem.get(address)
+
+    def put(self, address: str, value: int) -> None:
+        self.mem.put(address, value)

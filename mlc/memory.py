@@ -1,0 +1,131 @@
+"""MLC device memory: M bits, D words (16-bit, with 32-bit integer and float pairs) and the
+user alarm bits A0–A511.
+
+Word order of a pair (NC5 App. B never states it, ambiguity B4): by default the LOW word sits at
+the LOWER address (``D31048`` = low 16 bits, ``D31049`` = high 16 bits), which is how Delta's DVP/AS
+PLCs store 32-bit ``DD`` devices. ``word_order="high-first"`` swaps it for benches that need it.
+Floats are IEEE-754 single precision in the same two words.
+"""
+
+from __future__ import annotations
+
+import re
+import struct
+from dataclasses import dataclass, field
+from typing import Literal
+
+import numpy as np
+
+M_SIZE = 100_000  # M0 … M99999 (covers the special blocks M2xxxx … M5xxxx)
+D_SIZE = 100_000
+A_SIZE = 512  # user-defined alarms A0 … A511 (NC5 App. A.1)
+
+_ADDR = re.compile(r"^\s*([MDA])\s*(\d{1,5})\s*$", re.IGNORECASE)
+
+WordOrder = Literal["low-first", "high-first"]
+
+
+class DeviceError(ValueError):
+    """An address that does not name a device."""
+
+
+def parse_address(text: str) -> tuple[str, int]:
+    """``"M21000"`` → ``("M", 21000)``; raises DeviceError for anything else."""
+    m = _ADDR.match(text)
+    if not m:
+        raise DeviceError(f"{text!r} is not a device address (M<n>, D<n> or A<n>)")
+    kind, n = m.group(1).upper(), int(m.group(2))
+    size = {"M": M_SIZE, "D": D_SIZE, "A": A_SIZE}[kind]
+    if n >= size:
+        raise DeviceError(f"{text!r} is outside the {kind} device range 0…{size - 1}")
+    return kind, n
+
+
+@dataclass
+class DeviceMemory:
+    word_order: WordOrder = "low-first"
+    m: bytearray = field(default_factory=lambda: bytearray(M_SIZE))
+    d: np.ndarray = field(default_factory=lambda: np.zeros(D_SIZE, dtype=np.uint16))
+    a: bytearray = field(default_factory=lambda: bytearray(A_SIZE))
+
+    # ---- bits ---------------------------------------------------------------------------
+    def bit(self, n: int) -> bool:
+        return bool(self.m[n])
+
+    def set_bit(self, n: int, on: bool | int = True) -> None:
+        self.m[n] = 1 if on else 0
+
+    def alarm(self, n: int) -> bool:
+        return bool(self.a[n])
+
+    def set_alarm(self, n: int, on: bool = True) -> None:
+        if not 0 <= n < A_SIZE:
+            raise DeviceError(f"A{n} is outside the user alarm range A0…A{A_SIZE - 1}")
+        self.a[n] = 1 if on else 0
+
+    def active_alarms(self) -> list[int]:
+        return [i for i, v in enumerate(self.a) if v]
+
+    # ---- single words ---------------------------------------------------------------------
+    def u16(self, n: int) -> int:
+        return int(self.d[n])
+
+    def s16(self, n: int) -> int:
+        v = int(self.d[n])
+        return v - 0x10000 if v & 0x8000 else v
+
+    def set_u16(self, n: int, value: int) -> None:
+        """Stores the low 16 bits; a negative value is kept as its two's complement."""
+        self.d[n] = int(value) & 0xFFFF
+
+    set_s16 = set_u16
+
+    # ---- pairs ----------------------------------------------------------------------------
+    def _pair(self, n: int) -> tuple[int, int]:
+        lo, hi = int(self.d[n]), int(self.d[n + 1])
+        return (lo, hi) if self.word_order == "low-first" else (hi, lo)
+
+    def _set_pair(self, n: int, raw: int) -> None:
+        lo, hi = raw & 0xFFFF, (raw >> 16) & 0xFFFF
+        if self.word_order == "low-first":
+            self.d[n], self.d[n + 1] = lo, hi
+        else:
+            self.d[n], self.d[n + 1] = hi, lo
+
+    def u32(self, n: int) -> int:
+        lo, hi = self._pair(n)
+        return lo | (hi << 16)
+
+    def s32(self, n: int) -> int:
+        v = self.u32(n)
+        return v - 0x1_0000_0000 if v & 0x8000_0000 else v
+
+    def set_u32(self, n: int, value: int) -> None:
+        self._set_pair(n, int(value) & 0xFFFF_FFFF)
+
+    set_s32 = set_u32
+
+    def f32(self, n: int) -> float:
+        return struct.unpack("<f", struct.pack("<I", self.u32(n)))[0]
+
+    def set_f32(self, n: int, value: float) -> None:
+        self.set_u32(n, struct.unpack("<I", struct.pack("<f", float(value)))[0])
+
+    # ---- by name --------------------------------------------------------------------------
+    def get(self, address: str) -> int:
+        """The raw value of a device by name: a bit as 0/1, a D word as unsigned 16 bits."""
+        kind, n = parse_address(address)
+        if kind == "M":
+            return self.m[n]
+        if kind == "A":
+            return self.a[n]
+        return int(self.d[n])
+
+    def put(self, address: str, value: int) -> None:
+        kind, n = parse_address(address)
+        if kind == "M":
+            self.set_bit(n, bool(value))
+        elif kind == "A":
+            self.set_alarm(n, bool(value))
+        else:
+            self.set_u16(n, int(value))

@@ -1,0 +1,438 @@
+"""The NC side of Delta's special M/D interface for one channel, driven by the real `nc.channel`.
+
+Every scan the NC first reads what the MLC wrote in its previous scan (commands: modes, cycle
+start, feed hold, reset, E-stop, overrides, the M/S/T finish, jog/INC/MPG/home relays) and applies
+it to the channel and the manual-motion generator, then publishes its status (mode bits, running,
+hold, strobes with their code data, drive and bus status). The MLC user scan runs after that and
+sees the status of this cycle. The decisions behind the handshake are in docs/decisions/mlc.md.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+from mlc.memory import DeviceMemory
+from mlc.signals import d2, d3, m2, m3
+from nc.alarms import Alarm
+from nc.channel import Channel, RunState
+from nc.manual import ManualMotion
+from nc.moves import Aux
+
+AUTO, EDIT, MDI, MPG, JOG, RAPID, INC, HOME = range(8)
+MODE_NAMES = ("AUTO", "EDIT", "MDI", "MPG", "JOG", "RAPID", "INC", "HOME")
+MANUAL_MODES = (MPG, JOG, RAPID, INC, HOME)
+SYSTEM_M = {0, 1, 2, 30, 98, 99}  # never handed to the MLC (NC5 §3.8.1)
+ESTOP_ALARM = 0x0401
+SPINDLE_ALARM = 0x0C0A
+
+
+@dataclass
+class DriveStatus:
+    """What the bus tells the NC about one drive, in user units (filled by the bench each cycle)."""
+
+    name: str
+    connected: bool = True
+    servo_on: bool = False
+    fault: bool = False
+    torque: float = 0.0  # 0.1 % of rated (0x6077)
+    velocity: float = 0.0  # mm/s or deg/s (0x606C scaled)
+    rpm: float = 0.0  # motor/load rev per minute
+    position: float = 0.0
+    spindle: bool = False
+    mode: int = 8
+
+
+@dataclass
+class ChannelLink:
+    mem: DeviceMemory
+    x: int = 1  # channel digit
+    axes: tuple[str, ...] = ("X", "Z")
+    manual: ManualMotion | None = None
+    unit: float = 0.001  # N9.013: the INC/MPG unit (mm per count of D2x014 / per detent × ratio)
+    jog_speed: float = 1000.0 / 60.0  # N2.030: JOG speed at 100 %, mm/s
+    spindle_max_rpm: float = 6000.0
+    tool_range: tuple[int, int] = (0, 9999)  # T codes inside the magazine range get a strobe (B.2.2.1)
+    mode: int = AUTO
+    variables: Any = None  # the interpreter's variable store, for #25000–#25511 and #20020
+    alarms: list[Alarm] = field(default_factory=list)  # raised by this layer (E-stop, user alarms …)
+    # handshake state
+    _handed: Aux | None = None  # the code the strobe currently stands for
+    _strobe: int | None = None  # index 64/65/66 of the raised strobe
+    _system_hold: Aux | None = None  # M00 / M01 waiting for cycle start
+    _last_done: Aux | None = None  # the code this layer completed last (held, so its id is never reused)
+    _prev: dict[int, bool] = field(default_factory=dict)  # previous level of edge-triggered relays
+    _mpg_last: int | None = None
+    _estop: bool = False
+    _reset_pending: bool = False
+    _alarms_seen: set[int] = field(default_factory=set)
+    _var_cache: dict = field(default_factory=dict)
+    _program_end: int | None = None
+    _mode_switch_cycles: int = 0
+    handshake_log: list[tuple[int, str, float]] = field(default_factory=list)  # (cycle, kind, value)
+    cycle: int = 0
+
+    # ---- helpers --------------------------------------------------------------------------------
+    def _m2(self, i: int) -> bool:
+        return self.mem.bit(m2(self.x, i))
+
+    def _set3(self, i: int, on: bool) -> None:
+        self.mem.set_bit(m3(self.x, i), on)
+
+    def _rising(self, address: int) -> bool:
+        now = self.mem.bit(address)
+        before = self._prev.get(address, False)
+        self._prev[address] = now
+        return now and not before
+
+    def _raise(self, ch: Channel | None, alarm: Alarm) -> None:
+        self.alarms.append(alarm)
+        if ch is not None:
+            ch.raise_alarm(alarm)
+
+    # ---- NC reads the MLC's outputs ----------------------------------------------------------------
+    def nc_inputs(self, ch: Channel) -> None:
+        self.cycle += 1
+        x = self.x
+        self._estop_input(ch)
+        self._mode_input(ch)
+        if self._rising(m2(x, 4)):
+            self._reset(ch)
+        if self._rising(m2(x, 1)):
+            self._feed_hold(ch)
+        if self._rising(m2(x, 0)):
+            self._cycle_start(ch)
+        self._finish_input(ch)
+        self._overrides(ch)
+        self._spindle_alarm(ch)
+        self._user_alarms(ch)
+        self._exchange_variables(ch)
+        if self.manual is not None:
+            self._manual(ch)
+
+    def _estop_input(self, ch: Channel) -> None:
+        on = self._m2(13)
+        if on and not self._estop:
+            alarm = Alarm(ESTOP_ALARM, "emergency stop signal is triggered (M2x013)")
+            self.alarms.append(alarm)
+            ch.emergency_stop(alarm)
+            if self.manual is not None:
+                self.manual.halt()
+            self._drop_handshake()
+        self._estop = on
+
+    def _mode_input(self, ch: Channel) -> None:
+        want = self.mem.u16(d2(self.x, 0))
+        self._mode_switch_cycles = max(0, self._mode_switch_cycles - 1)
+        if want == self.mode or want > HOME:
+            return
+        # A running program or a moving manual axis keeps its mode (decision D8).
+        if ch.busy or (self.manual is not None and self.manual.busy):
+            return
+        self.mode = want
+        self._mode_switch_cycles = 1
+        if want in MANUAL_MODES and self.manual is not None:
+            self.manual.take_over(ch.planner.position)
+        if want == MPG:
+            self._mpg_last = None
+
+    def _reset(self, ch: Channel) -> None:
+        self._drop_handshake()
+        self._program_end = None
+        if self.manual is not None:
+            self.manual.stop()
+        reset = getattr(ch, "reset", None)
+        if callable(reset):
+            reset()
+        else:
+            ch.planner.stop()
+            ch.pending_aux = None
+            ch._deferred_aux = None
+            ch.events = None
+            ch.end = None
+            ch.alarms.clear()
+            ch.state = RunState.IDLE
+        self.alarms.clear()
+        self._alarms_seen.clear()
+        self._reset_pending = True
+
+    def _feed_hold(self, ch: Channel) -> None:
+        hold = getattr(ch, "feed_hold", None)
+        if callable(hold):
+            hold()
+        if self.manual is not None and self.mode in MANUAL_MODES:
+            self.manual.stop()
+
+    def _cycle_start(self, ch: Channel) -> None:
+        if self._estop or self.mode not in (AUTO, MDI):
+            return
+        self._program_end = None
+        self._reset_pending = False
+        if self._system_hold is not None:  # M00 / M01 released by cycle start (ambiguity C9)
+            aux, self._system_hold = self._system_hold, None
+            self._set3(37, False)
+            self._set3(38, False)
+            self._complete(ch, aux)
+            return
+        if getattr(ch, "held", False):
+            resume = getattr(ch, "resume", None) or getattr(ch, "cycle_start")
+            resume()
+            return
+        ch.cycle_start()
+
+    def _finish_input(self, ch: Channel) -> None:
+        if self._handed is None:
+            return
+        if ch.pending_aux is not self._handed:  # reset / alarm flushed the code: abort the handshake
+            self._drop_handshake()
+            return
+        if self._m2(16):
+            self.handshake_log.append((self.cycle, "FIN", self._handed.value))
+            aux = self._handed
+            self._drop_handshake()
+            self._complete(ch, aux)
+
+    def _complete(self, ch: Channel, aux: Aux) -> None:
+        self._last_done = aux
+        if ch.pending_aux is aux:
+            ch.finish_aux()
+
+    def _drop_handshake(self) -> None:
+        if self._strobe is not None:
+            self._set3(self._strobe, False)
+        self._strobe = None
+        self._handed = None
+        if self._system_hold is not None:
+            self._system_hold = None
+            self._set3(37, False)
+            self._set3(38, False)
+
+    def _overrides(self, ch: Channel) -> None:
+        feed = min(self.mem.u16(d2(self.x, 2)), 150)
+        rapid = self.mem.u16(d2(self.x, 4))
+        for name, value in (("set_feed_override", feed), ("set_rapid_override", rapid)):
+            fn = getattr(ch, name, None)
+            if callable(fn):
+                fn(value / 100.0)
+        for name, on in (("set_single_block", self._m2(8)), ("set_dry_run", self._m2(5)),
+                         ("set_block_skip", self._m2(10))):
+            fn = getattr(ch, name, None)
+            if callable(fn):
+                fn(on)
+
+    def _spindle_alarm(self, ch: Channel) -> None:
+        for k in range(8):
+            if self._rising(m2(self.x, 711 + 16 * k)):
+                self._raise(ch, Alarm(SPINDLE_ALARM, f"MLC activated the alarm of spindle {k + 1}"))
+
+    def _user_alarms(self, ch: Channel) -> None:
+        active = set(self.mem.active_alarms())
+        for n in sorted(active - self._alarms_seen):
+            self._raise(ch, Alarm(f"A{n}", f"MLC user-defined alarm A{n}"))
+        self._alarms_seen = active
+
+    def _exchange_variables(self, ch: Channel) -> None:
+        """#25000–#25255 mirror the MLC's M2x128…/D2x128… (re-sent only when they change);
+        #25256–#25511 reach M3x128…/D3x128… as the program writes them (`on_write` hook).
+        #20020 macro alarms are raised by the interpreter itself."""
+        v = self.variables
+        ex = getattr(v, "mlc", None)
+        if ex is None:
+            return
+        if ex.on_write is None:
+            ex.on_write = self._variable_written
+        x, mem = self.x, self.mem
+        for (lo, hi, is_bit) in ex.input_ranges:
+            dev = ex.device(lo, x)
+            kind, first = dev[0], int(dev[1:])
+            count = hi - lo + 1
+            raw = bytes(mem.m[first:first + count]) if kind == "M" else mem.d[first:first + count].tobytes()
+            key = (lo, kind)
+            if self._var_cache.get(key) == raw:
+                continue
+            self._var_cache[key] = raw
+            for k in range(count):
+                ex.set_input(lo + k, float(mem.bit(first + k)) if kind == "M" else float(mem.s16(first + k)))
+
+    def _variable_written(self, number: int, value: float) -> None:
+        ex = self.variables.mlc
+        dev = ex.device(number, self.x)
+        n = int(dev[1:])
+        if dev[0] == "M":
+            self.mem.set_bit(n, value != 0)
+        else:
+            self.mem.set_s16(n, max(-32768, min(32767, int(value))))  # truncated toward zero (B.3.6.4)
+
+    # ---- manual motion ----------------------------------------------------------------------------
+    def _manual(self, ch: Channel) -> None:
+        mm, x = self.manual, self.x
+        assert mm is not None
+        for i, a in enumerate(self.axes):
+            st = mm.axes[a]
+            st.lock_pos = self._m2(336 + i)
+            st.lock_neg = self._m2(352 + i)
+            st.soft_limit_disabled = self._m2(368 + i)
+        if self._estop or self.mode not in MANUAL_MODES or ch.busy:
+            return
+        pct = self.mem.u16(d2(x, 6))
+        jog = self.jog_speed * pct / 100.0
+        if self.mode in (JOG, RAPID):
+            for i, a in enumerate(self.axes):
+                fwd, rev = self._m2(384 + i), self._m2(400 + i)
+                speed = jog if self.mode == JOG else mm.cfg.limit(a).max_velocity * self.mem.u16(d2(x, 4)) / 100.0
+                mm.jog(a, (1 if fwd else 0) - (1 if rev else 0), speed)
+        elif self.mode == INC:
+            step = self.mem.u32(d2(x, 14)) * self.unit
+            for i, a in enumerate(self.axes):
+                if self._rising(m2(x, 384 + i)):
+                    mm.move_by(a, step, jog)
+                if self._rising(m2(x, 400 + i)):
+                    mm.move_by(a, -step, jog)
+        elif self.mode == MPG:
+            count = self.mem.u16(d3(0, 4))
+            if self._mpg_last is None:
+                self._mpg_last = count
+            delta = (count - self._mpg_last + 0x8000) % 0x10000 - 0x8000  # 16-bit counter wraps
+            self._mpg_last = count
+            i = self.mem.u16(d2(x, 8))
+            if delta and i < len(self.axes):
+                mm.move_by(self.axes[i], delta * self.mem.u16(d2(x, 9)) * self.unit)
+        elif self.mode == HOME:
+            for i, a in enumerate(self.axes):
+                if self._rising(m2(x, 320 + i)):
+                    mm.home(a)
+        pos = mm.step()
+        if ch.planner.idle:
+            ch.planner.position[:] = pos
+
+    # ---- NC publishes its status -------------------------------------------------------------------
+    def nc_outputs(self, ch: Channel, drives: list[DriveStatus] | None = None) -> None:
+        x, mem = self.x, self.mem
+        for k in range(8):
+            self._set3(k, self.mode == k)
+        self._set3(32, self._mode_switch_cycles > 0)
+        self._handshake_output(ch)
+        held = bool(getattr(ch, "held", False))
+        running = ch.busy and ch.state is not RunState.STOPPING and not held and self._system_hold is None
+        self._set3(16, running)
+        self._set3(17, held)
+        self._set3(18, self._m2(13))
+        if self._reset_pending and ch.planner.idle:
+            self._set3(19, True)
+        elif not self._reset_pending:
+            self._set3(19, False)
+        self._set3(25, ch.state is RunState.ALARM or any(not isinstance(a.code, str) for a in self.alarms))
+        self._set3(40, bool(mem.active_alarms()))
+        self._set3(24, bool(getattr(ch, "single_block_hold", False)))
+        if ch.state is RunState.FINISHED and ch.end is not None and self._program_end is None:
+            self._program_end = ch.end.code
+        end = self._program_end
+        self._set3(21, end is not None)
+        self._set3(22, end == 2)
+        self._set3(23, end == 30)
+        mem.set_bit(m3(0, 80 + x - 1), True)
+        if drives is not None:
+            self._drive_outputs(drives)
+        if self.manual is not None:
+            mm = self.manual
+            for i, a in enumerate(self.axes):
+                st = mm.axes[a]
+                self._set3(320 + i, st.homed)
+                self._set3(336 + i, st.home_done)
+                self._set3(352 + i, abs(ch.planner.position[i]) < 1e-6)
+        mem.set_u32(d3(x, 320), len(ch.planner.queue))
+
+    def _handshake_output(self, ch: Channel) -> None:
+        aux = ch.pending_aux
+        if aux is None or aux is self._handed or aux is self._system_hold or aux is self._last_done:
+            return
+        x, mem = self.x, self.mem
+        if aux.kind == "G900":
+            p, q = int(aux.args.get("P", 0)), aux.args.get("Q", 0.0)
+            if 30200 <= p <= 30399:  # out of range is ignored (ambiguity C5)
+                mem.set_bit(p, q != 0)
+            self._complete(ch, aux)
+            return
+        if aux.kind == "M" and int(aux.value) in SYSTEM_M:
+            code = int(aux.value)
+            if code == 0 or (code == 1 and self._m2(9)):
+                self._system_hold = aux
+                self._set3(37 if code == 0 else 38, True)
+                self.handshake_log.append((self.cycle, f"M{code:02d}", aux.value))
+            else:
+                self._complete(ch, aux)
+            return
+        if self._m2(11):  # M, S, T lock: the code is not handed over, the block's motion still runs
+            self._complete(ch, aux)
+            return
+        if aux.kind == "T" and not (self.tool_range[0] <= int(aux.value) <= self.tool_range[1]):
+            self._complete(ch, aux)
+            return
+        if self._m2(16):
+            return  # the previous finish is still ON: the next strobe waits for it to drop
+        if aux.kind == "M":
+            mem.set_u32(d3(x, 48), int(aux.value))
+            self._strobe = 64
+        elif aux.kind == "S":
+            rpm = abs(aux.value)
+            mem.set_u32(d3(x, 50), int(round(rpm)))
+            mem.set_f32(d3(x, 24), rpm)
+            self._strobe = 65
+        else:
+            mem.set_u32(d3(x, 52), int(aux.value))
+            mem.set_u16(d3(x, 37), int(aux.value))
+            self._strobe = 66
+        self._handed = aux
+        self._set3(self._strobe, True)
+        self.handshake_log.append((self.cycle, aux.kind, aux.value))
+
+    def _drive_outputs(self, drives: list[DriveStatus]) -> None:
+        mem, x = self.mem, self.x
+        mem.set_bit(m3(0, 0), all(d.connected for d in drives))
+        mem.set_bit(m3(x, 34), any(d.fault for d in drives))
+        axes = [d for d in drives if not d.spindle]
+        spindles = [d for d in drives if d.spindle]
+        mem.set_bit(m3(x, 36), all(d.servo_on for d in drives))
+        for k, d in enumerate(axes[:16]):
+            mem.set_bit(m3(x, 256 + k), d.connected)
+            mem.set_bit(m3(x, 272 + k), d.servo_on)
+            moving = abs(d.velocity) > 1e-4
+            mem.set_bit(m3(x, 464 + k), moving)
+            mem.set_bit(m3(x, 480 + k), d.velocity > 1e-4)
+            mem.set_bit(m3(x, 496 + k), d.velocity < -1e-4)
+        for k, d in enumerate((axes + spindles)[:32]):
+            mem.set_s16(d3(0, 240 + k), int(round(d.torque)))
+            mem.set_f32(d3(0, 272 + 2 * k), d.velocity * 60.0)
+            mem.set_f32(d3(0, 336 + 2 * k), d.rpm)
+            peak = d3(0, 400 + k)
+            mem.set_u16(peak, max(mem.u16(peak), min(abs(int(round(d.torque))), 0xFFFF)) if d.servo_on else 0)
+        for k, d in enumerate(spindles[:8]):
+            mem.set_bit(m3(x, 96 + k), d.connected)
+            mem.set_s16(d3(0, 432 + k), int(round(d.torque)))
+            base = 704 + 16 * k
+            cmd = self.commanded_rpm(k)
+            mem.set_bit(m3(x, base + 1), abs(d.rpm) < 1.0)
+            reached = abs(cmd) > 0 and abs(d.rpm - cmd) <= max(1.0, 0.02 * abs(cmd))
+            mem.set_bit(m3(x, base), reached)
+            mem.set_bit(m3(x, base + 6), d.servo_on)
+            mem.set_bit(m3(x, base + 5), d.mode == 8)
+            if k == 0:
+                mem.set_f32(d3(x, 26), d.rpm)
+                mem.set_f32(d3(x, 28), d.position % 360.0)
+
+    def commanded_rpm(self, k: int = 0) -> float:
+        """Signed spindle speed the MLC relays ask for: direction M2x704/M2x705, speed from S (D3x024) or
+        from D2x024 when M2x710 is ON, times the spindle override D2x026."""
+        x, mem = self.x, self.mem
+        base = 704 + 16 * k
+        fwd, rev = mem.bit(m2(x, base)), mem.bit(m2(x, base + 1))
+        if fwd == rev:
+            return 0.0
+        if k == 0:
+            src = mem.u32(d2(x, 24)) if mem.bit(m2(x, base + 6)) else mem.f32(d3(x, 24))
+            pct = mem.u16(d2(x, 26))
+        else:
+            src, pct = 0.0, 100
+        rpm = min(abs(src) * pct / 100.0, self.spindle_max_rpm)
+        return rpm if fwd else -rpm
+

@@ -1,0 +1,130 @@
+"""The user scan API: what an MLC program (a Python module) sees once per scan.
+
+An MLC program is a module (or any object) with
+
+    def scan(mlc: ScanContext) -> None          # required, called once per bench cycle
+    def setup(mlc: ScanContext) -> None         # optional, called once before the first scan
+
+Inside `scan` it reads inputs and writes outputs through `mlc`:
+
+    mlc.m("M_STROBE")          # a relay by App. B name (this channel) or address ("M31064")
+    mlc.set("MST_FINISH")      # set / clear a relay: mlc.set(name, False)
+    mlc.d("M_CODE")            # a D register, read with the signal's width (u16/s16/u32/f32)
+    mlc.put("SPINDLE_ANALOG_1", 500)
+    mlc.rising("M_STROBE")     # True in the one scan where the relay went 0 → 1
+    mlc.timer("turret", 0.5, running)  # on-delay timer (TON): True once `running` held 0.5 s
+    mlc.alarm(12)              # raise user alarm A12 (mlc.alarm(12, False) clears it)
+    mlc.io.out(0, 3, True)     # remote I/O module 0, digital output 3; mlc.io.inp(0, 1); analog words
+    mlc.state                  # a dict that survives between scans, for the program's own data
+    mlc.time, mlc.dt, mlc.scan_count
+
+See docs/guide/mlc.md for a worked example.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+from mlc.memory import DeviceMemory
+from mlc.signals import Signal, resolve
+
+
+@dataclass
+class RemoteIo:
+    """Remote I/O modules as the MLC sees them: digital points per module, and the four analog
+    words per module of App. B (D20200+4k outputs, D30200+4k inputs)."""
+
+    mem: DeviceMemory
+    inputs: list[int] = field(default_factory=list)  # digital input image per module (bit mask)
+    outputs: list[int] = field(default_factory=list)
+
+    def inp(self, module: int, point: int) -> bool:
+        return bool(self.inputs[module] >> point & 1) if module < len(self.inputs) else False
+
+    def out(self, module: int, point: int, on: bool | None = None) -> bool:
+        while module >= len(self.outputs):
+            self.outputs.append(0)
+        if on is not None:
+            mask = 1 << point
+            self.outputs[module] = (self.outputs[module] | mask) if on else (self.outputs[module] & ~mask)
+        return bool(self.outputs[module] >> point & 1)
+
+    def analog_in(self, module: int, word: int) -> int:
+        return self.mem.s16(30200 + 4 * module + word)
+
+    def analog_out(self, module: int, word: int, value: int) -> None:
+        self.mem.set_s16(20200 + 4 * module + word, value)
+
+
+@dataclass
+class ScanContext:
+    mem: DeviceMemory
+    channel: int = 1
+    dt: float = 0.001
+    time: float = 0.0
+    scan_count: int = 0
+    state: dict[str, Any] = field(default_factory=dict)
+    io: RemoteIo | None = None
+    params: dict[str, Any] = field(default_factory=dict)  # machine data for the program (max rpm, …)
+    _prev: dict[str, bool] = field(default_factory=dict)
+    _timers: dict[str, float] = field(default_factory=dict)
+    _sig: dict[str, Signal] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        if self.io is None:
+            self.io = RemoteIo(self.mem)
+
+    def signal(self, spec: str) -> Signal:
+        sig = self._sig.get(spec)
+        if sig is None:
+            sig = self._sig[spec] = resolve(spec, self.channel)
+        return sig
+
+    # ---- relays ------------------------------------------------------------------------------
+    def m(self, spec: str) -> bool:
+        return self.mem.bit(self.signal(spec).number)
+
+    def set(self, spec: str, on: bool = True) -> None:
+        self.mem.set_bit(self.signal(spec).number, on)
+
+    def rising(self, spec: str) -> bool:
+        now = self.m(spec)
+        before = self._prev.get(spec, False)
+        self._prev[spec] = now
+        return now and not before
+
+    def falling(self, spec: str) -> bool:
+        key = "~" + spec
+        now = self.m(spec)
+        before = self._prev.get(key, False)
+        self._prev[key] = now
+        return before and not now
+
+    # ---- registers ------------------------------------------------------------------------------
+    def d(self, spec: str) -> float:
+        sig = self.signal(spec)
+        n, mem = sig.number, self.mem
+        return {"u16": mem.u16, "s16": mem.s16, "u32": mem.u32, "f32": mem.f32}.get(sig.width, mem.u16)(n)
+
+    def put(self, spec: str, value: float) -> None:
+        sig = self.signal(spec)
+        n, mem = sig.number, self.mem
+        if sig.width == "f32":
+            mem.set_f32(n, value)
+        elif sig.width == "u32":
+            mem.set_u32(n, int(value))
+        else:
+            mem.set_u16(n, int(value))
+
+    # ---- timers and alarms ----------------------------------------------------------------------
+    def timer(self, name: str, seconds: float, run: bool) -> bool:
+        """On-delay timer: True once `run` has been held for `seconds` (resets when `run` drops)."""
+        if not run:
+            self._timers.pop(name, None)
+            return False
+        start = self._timers.setdefault(name, self.time)
+        return self.time - start >= seconds - 1e-12
+
+    def alarm(self, n: int, on: bool = True) -> None:
+        self.mem.set_alarm(n, on)
