@@ -8,13 +8,15 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+from pathlib import Path
 
 from hil.cli import EXIT_ALARM, EXIT_OK, EXIT_USAGE
 from hil.session import InputError, load_bench, load_program, print_alarm
 from nc.alarms import NcAlarm, internal_error
 from nc.interp import Interpreter
-from nc.moves import Move
+from nc.moves import Move, Sync
 from nc.profiles import make_profile
+from nc.store import ProgramStore
 
 
 def parse_ranges(text: str) -> list[int]:
@@ -43,6 +45,14 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--bench", help="bench file: its profile, axes and parameters")
     p.add_argument("--json", action="store_true", help="JSON Lines, one object per move (stable format)")
     p.add_argument("--vars", metavar="RANGES", help="append the values of these # variables, e.g. 100-199,500")
+    p.add_argument("--lib", action="append", default=[], metavar="DIR|FILE",
+                   help="where subprograms and macros (O numbers) are found: a folder searched in the NC5 order "
+                        "(PATH_1, PATH_1/O_MACRO, GLOBAL, GLOBAL/O_MACRO, the folder itself) or a file of O programs")
+    p.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
+                   help="set a controller parameter, e.g. --param 'N8.018 Bit10=1' (overrides the bench)")
+    p.add_argument("--block-skip", action="store_true", help="block skip switch on: '/' blocks are skipped")
+    p.add_argument("--preview-log", action="store_true",
+                   help="also print which macro statement ran ahead of which motion block (preview)")
     p.set_defaults(func=cmd_path)
 
 
@@ -64,31 +74,84 @@ def cmd_path(args: argparse.Namespace) -> int:
     try:
         bench = load_bench(args.bench, args.profile)
         var_ids = parse_ranges(args.vars) if args.vars else []
-        profile = make_profile(bench.profile, bench.axis_names if args.bench else None, bench.params)
+        params = dict(bench.params)
+        for item in args.param:
+            name, sep, value = item.partition("=")
+            if not sep:
+                raise InputError(f"bad --param {item!r}: use NAME=VALUE")
+            params[name.strip()] = float(value)
+        if args.block_skip:
+            params["M2x010"] = 1
+        profile = make_profile(bench.profile, bench.axis_names if args.bench else None, params)
     except (InputError, ValueError) as exc:
         print(f"hil path: {exc}", file=sys.stderr)
         return EXIT_USAGE
-    interp = Interpreter(profile)
+    store = ProgramStore(usb_first=bool(profile.param("N8.22 Bit5")))
+    for lib in args.lib:
+        lp = Path(lib)
+        if lp.is_file():
+            store.add_file(lp)
+        elif lp.is_dir():
+            store.roots.append(lp)
+        else:
+            print(f"hil path: --lib {lib}: no such file or folder", file=sys.stderr)
+            return EXIT_USAGE
+    interp = Interpreter(profile, store=store)
     out = sys.stdout
     try:
-        program = load_program(args.program)
+        program = _load_main(args.program, store)
         for ev in interp.run(program):
             if isinstance(ev, Move):
                 if args.json:
                     print(json.dumps(move_dict(ev)), file=out)
                 else:
                     print(_human(ev), file=out)
+            elif args.preview_log and isinstance(ev, Sync):
+                print(json.dumps(ev.as_dict()) if args.json else f"{ev.line:5d} sync   {ev.reason}", file=out)
     except NcAlarm as exc:
+        _print_preview(interp, args)
         print_alarm(exc.alarm, as_json=args.json)
         return EXIT_ALARM
     except Exception as exc:  # a bug, reported as the NC internal alarm, never a traceback
         print_alarm(internal_error(exc), as_json=args.json)
         return EXIT_ALARM
+    _print_preview(interp, args)
     if var_ids:
         values = {str(i): interp.variable(i) for i in var_ids}
         print(json.dumps({"kind": "vars", "values": values}) if args.json else
               "vars " + " ".join(f"#{k}={'vacant' if v is None else v}" for k, v in values.items()), file=out)
     return EXIT_OK
+
+
+def _load_main(path: str, store: ProgramStore):
+    """The main program; every further O program in the same file goes to the store (A23)."""
+    p = Path(path)
+    try:
+        text = p.read_text(encoding="utf-8", errors="replace")
+    except OSError as exc:
+        raise NcAlarm(0x0002, f"program file {path} cannot be read: {exc.strerror}", program=p.name) from None
+    store.main_dir = p.parent
+    try:
+        progs = store.add_text(text, p.name)
+    except NcAlarm as exc:
+        raise exc.at(None, None, p.name)
+    main = progs[0]
+    main.name = p.name
+    return main
+
+
+def _print_preview(interp: Interpreter, args: argparse.Namespace) -> None:
+    if not args.preview_log:
+        return
+    for r in interp.preview_log:
+        if args.json:
+            print(json.dumps({"kind": "preview", "line": r.line, "block": r.block, "program": r.program,
+                              "ahead_of_line": r.ahead_of_line, "ahead_of_block": r.ahead_of_block,
+                              "blocks_ahead": r.blocks_ahead}))
+        else:
+            where = f"while line {r.ahead_of_line} ({r.ahead_of_block}) runs, {r.blocks_ahead} motion block(s) " \
+                    "buffered" if r.ahead_of_line is not None else "before any motion"
+            print(f"preview {r.line:5d} {r.block:30s} ran {where}")
 
 
 def _human(m: Move) -> str:

@@ -1,4 +1,4 @@
-"""Modal state of one NC channel and its coordinate frames."""
+"""Modal state of one NC channel (32 G-code groups) and its coordinate frames."""
 
 from __future__ import annotations
 
@@ -7,42 +7,79 @@ from dataclasses import dataclass, field
 from nc.profiles import Profile
 
 PLANES: dict[int, tuple[str, str]] = {17: ("X", "Y"), 18: ("Z", "X"), 19: ("Y", "Z")}
+N_EXT_WCS = 64  # G54 P1–P64 (N§3.6.5)
+
+
+def power_on_groups(profile: Profile) -> dict[int, float]:
+    """Group number -> G code at power-on (decisions A3: the manual's bold defaults are lost).
+
+    Values are the code numbers *of this profile's dialect* (type A lathe: G98 = feed/min)."""
+    if not profile.is_lathe:
+        return {1: 0, 2: 17, 3: 90, 5: 94, 6: 21, 7: 40, 8: 49, 9: 80, 10: 98, 11: 50, 12: 54, 13: 64,
+                14: 67, 15: 69, 16: 15, 17: 97, 18: 25, 31: 0}
+    t = profile.lathe_type
+    g = {1: 0, 2: 18, 6: 21 if t != "C" else 71, 7: 40, 9: 80, 12: 54, 13: 64, 14: 67, 17: 97, 18: 50.1, 31: 0}
+    if t == "A":
+        g[5] = 99
+    else:
+        g.update({3: 90, 5: 95, 10: 98, 11: 50})
+    return g
 
 
 @dataclass
 class ModalState:
-    motion: int = 0  # group 01: 0, 1, 2, 3 (G00/G01/G02/G03)
+    groups: dict[int, float] = field(default_factory=dict)  # group -> code as programmed
+    motion: float = 0  # group 01 function: 0, 1, 2, 3, 2.4, 3.4, 32 (thread), 34
     plane: int = 18  # group 02
-    inch: bool = False  # group 06: G20 / G21
-    per_rev: bool = True  # G99 (type A) / G95: feed per revolution
-    absolute: bool = True  # G90 / G91 (types B and C, mill)
+    inch: bool = False  # group 06
+    per_rev: bool = True  # group 05
+    absolute: bool = True  # group 03 (types B/C, mill)
     exact_stop_modal: bool = False  # G61
-    feed: float | None = None  # F as programmed (mm/min or mm/rev)
-    spindle_speed: float = 0.0  # S, rpm
+    feed: float | None = None  # F as programmed (mm/min or mm/rev, or inch)
+    spindle_speed: float = 0.0  # S, rpm (or m/min under G96)
+    spindle_max: float | None = None  # G50 S / G92 S clamp
+    css: bool = False  # G96
     spindle_dir: int = 0  # +1 M03, -1 M04, 0 M05
-    tool: int = 0  # T number as programmed
-    wcs: int = 0  # 0 = G54 ... 5 = G59
+    tool: int = 0  # T as programmed
+    tool_offset: int = 0  # lathe: offset number (last two digits of T)
+    wcs: int = 0  # 0 = G54 ... 5 = G59, 6+ = G54 P1...
+    comp: int = 40  # group 07: 40 / 41 / 42
+    d_number: int = 0  # D (mill radius comp)
+    length_comp: int = 49  # group 08: 43 / 44 / 49
+    h_number: int = 0
+    cycle: str | None = None  # active modal cycle function name (group 09)
+    cycle_return: int = 98  # group 10 (mill, lathe B/C): 98 initial level, 99 R level
+    polar: bool = False  # G16
+    scaling: bool = False  # G51
+    rotation: bool = False  # G68
+    macro_modal: bool = False  # G66
 
     @classmethod
     def power_on(cls, profile: Profile) -> "ModalState":
-        if profile.is_lathe:
-            return cls(motion=0, plane=18, per_rev=True, absolute=True)
-        return cls(motion=0, plane=17, per_rev=False, absolute=True)
+        g = power_on_groups(profile)
+        st = cls(groups=g, plane=int(g[2]))
+        st.per_rev = profile.is_lathe
+        return st
 
 
 @dataclass
 class Frames:
-    """Machine = work + work offset (G54–G59) + local shift (G52) + coordinate shift (G92/G50)."""
+    """Machine = work + external offset (G10 L2 P0) + work offset (G54–G59, G54 P1–P64)
+    + local shift (G52) + coordinate shift (G92/G50) + tool offset.  All in machine units
+    (a lathe X in radius)."""
 
     axes: tuple[str, ...]
-    work_offsets: list[dict[str, float]] = field(default_factory=list)
+    work_offsets: list[dict[str, float]] = field(default_factory=list)  # 0..5 G54–G59, 6.. P1–P64
+    external: dict[str, float] = field(default_factory=dict)
     local_shift: dict[str, float] = field(default_factory=dict)
     set_shift: dict[str, float] = field(default_factory=dict)
+    tool_shift: dict[str, float] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         if not self.work_offsets:
-            self.work_offsets = [{a: 0.0 for a in self.axes} for _ in range(6)]
+            self.work_offsets = [{a: 0.0 for a in self.axes} for _ in range(6 + N_EXT_WCS)]
 
     def origin(self, wcs: int, axis: str) -> float:
-        return (self.work_offsets[wcs].get(axis, 0.0) + self.local_shift.get(axis, 0.0)
-                + self.set_shift.get(axis, 0.0))
+        return (self.external.get(axis, 0.0) + self.work_offsets[wcs].get(axis, 0.0)
+                + self.local_shift.get(axis, 0.0) + self.set_shift.get(axis, 0.0)
+                + self.tool_shift.get(axis, 0.0))

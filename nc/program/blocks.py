@@ -1,16 +1,23 @@
-"""Lexing and parsing of Delta NC program text into blocks of address words.
+"""Lexing and parsing of Delta NC program text into blocks of address words and macro statements.
 
-Comment rules (docs/decisions.md A7): ``(`` … ``)`` is a comment and code may follow the ``)``;
-an unclosed ``(`` runs to the end of the line; ``;``, ``//`` and ``%`` start a comment that runs
-to the end of the line (``;`` is also the end of block).
+Comment rules (decisions A7): ``(`` … ``)`` is a comment and code may follow the ``)``; an unclosed
+``(`` runs to the end of the line; ``;``, ``//`` and ``%`` start a comment that runs to the end of
+the line (``;`` is also the end of block).  ``/`` at the start of a block is block skip (A8).
+
+A word's value is a number, or an expression (``X#1``, ``X-#20``, ``X[#1+2]``, ``G#20``) kept in
+``Word.expr`` until the interpreter evaluates the block (`Block.resolved`).  A block carries at
+most one macro statement (``Block.stmt``): assignment, GOTO, IF…GOTO / IF…THEN / ELSEIF / ELSE /
+ENDIF / IF…EXITW, WHILE…DOm / ENDm / EXITW (nc5) or WHILE / ENDW (lathe-2018).
 """
 
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
+from typing import Union
 
 from nc.alarms import NcAlarm
+from nc.program.expr import Expr, ExprParser, Num, Var
 
 
 @dataclass(slots=True)
@@ -18,7 +25,65 @@ class Word:
     letter: str  # address, upper case ("X", "G", or a multi-letter axis name such as "XA1")
     value: float
     text: str  # as written, for alarms
-    has_point: bool  # the number carried a decimal point
+    has_point: bool  # the number carried a decimal point (expressions count as having one)
+    expr: Expr | None = None  # unevaluated value (macro expression)
+
+
+# ---- statements -------------------------------------------------------------------------------
+@dataclass(frozen=True, slots=True)
+class Assign:
+    target: Var
+    value: Expr
+
+
+@dataclass(frozen=True, slots=True)
+class Goto:
+    target: Expr
+
+
+@dataclass(frozen=True, slots=True)
+class IfGoto:
+    cond: Expr
+    target: Expr
+
+
+@dataclass(frozen=True, slots=True)
+class IfThen:
+    cond: Expr
+
+
+@dataclass(frozen=True, slots=True)
+class ElseIf:
+    cond: Expr
+
+
+@dataclass(frozen=True, slots=True)
+class Else:
+    pass
+
+
+@dataclass(frozen=True, slots=True)
+class EndIf:
+    pass
+
+
+@dataclass(frozen=True, slots=True)
+class ExitW:
+    cond: Expr | None = None  # IF[..]EXITW
+
+
+@dataclass(frozen=True, slots=True)
+class While:
+    cond: Expr
+    do: int | None  # None: lathe-2018 WHILE … ENDW
+
+
+@dataclass(frozen=True, slots=True)
+class End:
+    do: int | None  # None: ENDW
+
+
+Statement = Union[Assign, Goto, IfGoto, IfThen, ElseIf, Else, EndIf, ExitW, While, End]
 
 
 @dataclass(slots=True)
@@ -30,6 +95,8 @@ class Block:
     skip: bool = False  # starts with '/'
     comma: dict[str, float] = field(default_factory=dict)  # ,C ,R ,A
     comment: str = ""
+    stmt: Statement | None = None
+    comma_expr: dict[str, Expr] = field(default_factory=dict)
 
     def get(self, letter: str) -> Word | None:
         """The last word with this address (repeated axis words: last wins, decisions A9)."""
@@ -44,15 +111,32 @@ class Block:
     def has(self, letter: str) -> bool:
         return any(w.letter == letter for w in self.words)
 
+    @property
+    def has_expr(self) -> bool:
+        return any(w.expr is not None for w in self.words) or bool(self.comma_expr)
+
+    def copy(self) -> "Block":
+        return replace(self, words=list(self.words), comma=dict(self.comma))
+
 
 @dataclass
 class Program:
     name: str
     blocks: list[Block]
     number: int | None = None  # O number
+    path: str | None = None  # file it came from (program store search order)
+    labels: dict[int, list[int]] = field(default_factory=dict)  # N -> block indexes
+
+    def __post_init__(self) -> None:
+        if not self.labels:
+            for i, b in enumerate(self.blocks):
+                if b.n is not None:
+                    self.labels.setdefault(b.n, []).append(i)
 
 
 _NUMBER = re.compile(r"[+-]?\s*(\d+\.?\d*|\.\d+)")
+_KEYWORDS = ("ELSEIF", "ENDIF", "EXITW", "WHILE", "GOTO", "THEN", "ELSE", "ENDW", "END", "IF", "DO")
+MAX_DIGITS = 9
 
 
 def strip_comments(text: str) -> tuple[str, str]:
@@ -78,6 +162,224 @@ def strip_comments(text: str) -> tuple[str, str]:
     return "".join(out), " ".join(s.strip() for s in comment if s.strip())
 
 
+class _BlockParser:
+    def __init__(self, line: int, text: str, code: str) -> None:
+        self.line, self.text = line, text
+        self.p = ExprParser(code)
+
+    @property
+    def s(self) -> str:
+        return self.p.s
+
+    def alarm(self, code: int, msg: str) -> NcAlarm:
+        return NcAlarm(code, msg, line=self.line, block=self.text)
+
+    def at_end(self) -> bool:
+        self.p.skip()
+        return self.p.pos >= len(self.s)
+
+    def keyword(self) -> str:
+        w = self.p.peek_word()
+        return w if w in _KEYWORDS else ""
+
+    def take(self, kw: str) -> None:
+        self.p.skip()
+        self.p.pos += len(kw)
+
+    def cond(self) -> Expr:
+        self.p.skip()
+        if not self.s.startswith("[", self.p.pos):
+            raise self.alarm(0x020E, "IF/WHILE needs a [condition]")
+        self.p.pos += 1
+        old = self.p.eq_is_compare
+        self.p.eq_is_compare = True
+        e = self.p.parse()
+        self.p.eq_is_compare = old
+        self.p.expect("]")
+        return e
+
+    def int_value(self, what: str) -> Expr:
+        self.p.skip()
+        if self.at_end():
+            raise self.alarm(0x0225 if what == "END" else 0x0226 if what == "DO" else 0x0224,
+                             f"no value after {what}")
+        return self.p.primary() if self.s[self.p.pos] in "#[" else self._number_expr()
+
+    def _number_expr(self) -> Expr:
+        m = _NUMBER.match(self.s, self.p.pos)
+        if not m:
+            raise self.alarm(0x0222, f"no value at {self.s[self.p.pos:]!r}")
+        self.p.pos = m.end()
+        return Num(float(m.group(0).replace(" ", "")))
+
+    def statement(self, kw: str, first: bool) -> Statement:
+        if not first and kw in ("IF", "WHILE"):
+            raise self.alarm(0x0203, f"{kw} must be at the beginning of the block")
+        if first and kw in ("DO", "THEN"):
+            raise self.alarm(0x0204, f"{kw} cannot start a block")
+        self.take(kw)
+        if kw == "GOTO":
+            return Goto(self.int_value("GOTO"))
+        if kw == "IF":
+            c = self.cond()
+            nxt = self.keyword()
+            if nxt == "GOTO":
+                self.take("GOTO")
+                return IfGoto(c, self.int_value("GOTO"))
+            if nxt == "THEN":
+                self.take("THEN")
+                return IfThen(c)
+            if nxt == "EXITW":
+                self.take("EXITW")
+                return ExitW(c)
+            raise self.alarm(0x0238, "IF must be followed by GOTO, THEN or EXITW")
+        if kw == "ELSEIF":
+            c = self.cond()
+            if self.keyword() != "THEN":
+                raise self.alarm(0x023A, "ELSEIF [..] needs THEN")
+            self.take("THEN")
+            return ElseIf(c)
+        if kw == "ELSE":
+            return Else()
+        if kw == "ENDIF":
+            return EndIf()
+        if kw == "EXITW":
+            return ExitW()
+        if kw == "WHILE":
+            self.p.skip()
+            if not self.s.startswith("[", self.p.pos):
+                raise self.alarm(0x020F, "WHILE needs a [condition]")
+            c = self.cond()
+            if self.keyword() == "DO":
+                self.take("DO")
+                return While(c, self._loop_id("DO", 0x0226))
+            return While(c, None)
+        if kw == "ENDW":
+            return End(None)
+        if kw == "END":
+            return End(self._loop_id("END", 0x0225))
+        raise self.alarm(0x0207, f"{kw} out of place")
+
+    def _loop_id(self, what: str, code: int) -> int:
+        self.p.skip()
+        m = _NUMBER.match(self.s, self.p.pos)
+        if not m:
+            raise self.alarm(code, f"no value after {what}")
+        self.p.pos = m.end()
+        v = float(m.group(0).replace(" ", ""))
+        if v != int(v):
+            raise self.alarm(0x0214, f"{what} number must be an integer")
+        return int(v)
+
+    def word_value(self, letter: str) -> tuple[float, str, bool, Expr | None]:
+        p = self.p
+        p.skip()
+        start = p.pos
+        if p.pos < len(self.s) and self.s[p.pos] == "=":
+            p.pos += 1
+            p.skip()
+        neg = False
+        if p.pos < len(self.s) and self.s[p.pos] in "+-":
+            j = p.pos + 1
+            while j < len(self.s) and self.s[j].isspace():
+                j += 1
+            if j < len(self.s) and self.s[j] in "#[":
+                neg = self.s[p.pos] == "-"
+                p.pos = j
+        if p.pos < len(self.s) and self.s[p.pos] in "#[":
+            e = p.primary()
+            if neg:
+                from nc.program.expr import Unary
+                e = Unary("-", e)
+            return 0.0, letter + self.s[start:p.pos], True, e
+        m = _NUMBER.match(self.s, p.pos)
+        if not m:
+            raise self.alarm(0x0222, f"address {letter} has no value")
+        raw = m.group(0).replace(" ", "")
+        digits = len(re.sub(r"[^0-9]", "", raw).lstrip("0"))
+        if digits > MAX_DIGITS + 3:
+            raise self.alarm(0x0223, f"{letter}{raw} has too many digits")
+        p.pos = m.end()
+        return float(raw), letter + raw, "." in raw, None
+
+    def parse(self, block: Block) -> None:
+        p = self.p
+        first = True
+        while not self.at_end():
+            c = self.s[p.pos]
+            if c == "#":
+                if not first:
+                    raise self.alarm(0x0208, "an assignment and other words cannot share a block")
+                target = p.variable()
+                p.skip()
+                if not self.s.startswith("=", p.pos):
+                    raise self.alarm(0x0211, "# variable without '=' (assignment expected)")
+                p.pos += 1
+                if self.at_end():
+                    raise self.alarm(0x0211, "nothing after '='")
+                value = p.parse()
+                if not self.at_end():
+                    raise self.alarm(0x0208, f"unexpected {self.s[p.pos:]!r} after the assignment")
+                block.stmt = Assign(target, value)
+                return
+            if c == ",":
+                p.pos += 1
+                p.skip()
+                if self.at_end() or self.s[p.pos].upper() not in "CRA":
+                    raise self.alarm(0x0207, f"',' must be followed by C, R or A")
+                letter = self.s[p.pos].upper()
+                p.pos += 1
+                v, _, _, e = self.word_value(letter)
+                if e is not None:
+                    block.comma_expr[letter] = e
+                else:
+                    block.comma[letter] = v
+                first = False
+                continue
+            if not c.isalpha():
+                raise self.alarm(0x0209 if c in "[]" else 0x0206,
+                                 f"unexpected character {c!r}")
+            kw = self.keyword()
+            if kw:
+                if block.stmt is not None or (kw in ("IF", "WHILE") and block.words):
+                    raise self.alarm(0x0203 if kw in ("IF", "WHILE") else 0x0207, f"{kw} out of place")
+                block.stmt = self.statement(kw, first)
+                if kw in ("END", "ENDW", "ENDIF", "ELSE", "EXITW") or isinstance(block.stmt, (IfThen, ElseIf)):
+                    if not self.at_end():
+                        raise self.alarm(0x0205, f"{kw} must be at the end of the block")
+                first = False
+                continue
+            if block.stmt is not None and not isinstance(block.stmt, (Goto, IfGoto)):
+                raise self.alarm(0x0208, "statement and NC words in one block")
+            m = re.compile(r"[A-Za-z]+").match(self.s, p.pos)
+            run = m.group(0).upper()
+            if len(run) > 1:
+                # a multi-character axis name must be followed by '=' (XA1=100., N§3.1.1)
+                m2 = re.compile(r"[A-Za-z]{1,2}[0-9]{0,2}\s*=").match(self.s, p.pos)
+                if not m2:
+                    raise self.alarm(0x0201, f"undefined operator {run!r}")
+                name = re.sub(r"[\s=]", "", m2.group(0)).upper()
+                p.pos = m2.end() - 1
+                letter = name
+            else:
+                letter = run
+                p.pos += 1
+                m2 = re.compile(r"[0-9]{1,2}\s*=").match(self.s, p.pos)
+                if m2 and letter in "XYZUVWABC":
+                    letter += re.sub(r"[\s=]", "", m2.group(0))
+                    p.pos = m2.end() - 1
+            value, text, point, e = self.word_value(letter)
+            if letter == "N" and first and block.n is None and e is None:
+                if point or value != int(value) or value < 0:
+                    raise self.alarm(0x0207, f"sequence number {text} must be a whole number")
+                block.n = int(value)
+                continue
+            if letter == "O":
+                raise self.alarm(0x0201, "O is only allowed at the start of a program")
+            block.words.append(Word(letter, value, text, point, e))
+            first = False
+
+
 def parse_block(line: int, text: str) -> Block:
     code, comment = strip_comments(text)
     block = Block(line=line, text=text.rstrip("\r\n"), comment=comment)
@@ -85,56 +387,53 @@ def parse_block(line: int, text: str) -> Block:
     if s.startswith("/"):
         block.skip = True
         s = s[1:]
-    i, n = 0, len(s)
-    while i < n:
-        c = s[i]
-        if c.isspace():
-            i += 1
-            continue
-        if c == ",":
-            j = i + 1
-            while j < n and s[j].isspace():
-                j += 1
-            if j >= n or s[j].upper() not in "CRA":
-                raise NcAlarm(0x0207, f"',' must be followed by C, R or A: {s[i:].strip()!r}", line=line, block=text)
-            letter = s[j].upper()
-            m = _NUMBER.match(s, j + 1)
-            if not m:
-                raise NcAlarm(0x0222, f"no value after ',{letter}'", line=line, block=text)
-            block.comma[letter] = float(m.group(0).replace(" ", ""))
-            i = m.end()
-            continue
-        if not c.isalpha():
-            raise NcAlarm(0x0206, f"unexpected character {c!r}", line=line, block=text)
-        letter = c.upper()
-        m = _NUMBER.match(s, i + 1)
-        if not m:
-            raise NcAlarm(0x0222, f"address {letter} has no value", line=line, block=text)
-        raw = m.group(0).replace(" ", "")
-        value = float(raw)
-        if letter == "N" and not block.words and block.n is None:
-            block.n = int(value)
-        else:
-            block.words.append(Word(letter, value, letter + raw, "." in raw))
-        i = m.end()
+    _BlockParser(line, text.rstrip("\r\n"), s).parse(block)
     return block
 
 
-def parse_program(text: str, name: str = "program") -> Program:
-    """Parse a whole file. Raises NcAlarm (with line and block) on the first malformed block."""
+_O_LINE = re.compile(r"\s*[Oo](\d+)")
+
+
+def parse_program(text: str, name: str = "program", number: int | None = None) -> Program:
+    """Parse one program (one O number).  The first line starting with ``O`` is its description
+    (N ch.2).  Raises NcAlarm (with line and block) on the first malformed block."""
     blocks: list[Block] = []
-    number: int | None = None
     for idx, raw in enumerate(text.splitlines(), start=1):
         stripped = raw.strip()
         if not stripped:
             continue
-        if stripped.upper().startswith("O") and idx == 1 or (stripped.upper().startswith("O") and not blocks
-                                                                and re.match(r"[Oo]\d+", stripped)):
-            m = re.match(r"[Oo](\d+)", stripped)
-            if m:
-                number = int(m.group(1))
-            continue  # the O line is the file description (NC5 ch.2)
+        m = _O_LINE.match(stripped)
+        if m and not blocks and number is None:
+            number = int(m.group(1))
+            continue
+        if m and not blocks:
+            continue
         block = parse_block(idx, raw)
-        if block.words or block.n is not None or block.comma:
+        if block.words or block.n is not None or block.comma or block.stmt is not None or block.comma_expr:
             blocks.append(block)
     return Program(name=name, blocks=blocks, number=number)
+
+
+def parse_programs(text: str, name: str = "program") -> list[Program]:
+    """A file holding several O programs: each line starting with ``O<n>`` (outside a comment)
+    begins a new program.  Text before the first O line (if any code) is an unnamed program."""
+    lines = text.splitlines()
+    starts: list[tuple[int, int]] = []
+    for i, raw in enumerate(lines):
+        m = _O_LINE.match(raw)
+        if m and not raw.strip().startswith("("):
+            starts.append((i, int(m.group(1))))
+    out: list[Program] = []
+    first = starts[0][0] if starts else len(lines)
+    head = "\n".join(lines[:first])
+    if strip_comments(head.replace("\n", " "))[0].strip() or not starts:
+        prog = parse_program(head, name)
+        prog.number = None
+        out.append(prog)
+    for k, (i, num) in enumerate(starts):
+        end = starts[k + 1][0] if k + 1 < len(starts) else len(lines)
+        chunk = "\n" * i + "\n".join(lines[i:end])  # keep file line numbers
+        prog = parse_program(chunk, f"O{num:04d}" if len(starts) > 1 or out else name)
+        prog.number = num
+        out.append(prog)
+    return out

@@ -1,0 +1,64 @@
+"""Preview (look-ahead) window: the interpreter reads up to ``depth`` motion blocks ahead of the
+one the machine executes, so macro statements run early (N§3.2.2, decisions A27).
+
+`PreviewWindow` wraps the event stream.  It pulls from the interpreter until ``depth`` Moves are
+buffered; every macro statement run meanwhile is logged (`Interpreter.preview_log`) with the
+motion block the machine was executing at that moment (the oldest buffered Move).  A `Sync` (G05,
+G10, G11, G31, G53, halt M codes of N1.118/N1.119, writes to live # variables) empties the window
+before anything after it is read.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from collections.abc import Iterator
+from typing import TYPE_CHECKING
+
+from nc.moves import Event, Move, Sync
+
+if TYPE_CHECKING:  # pragma: no cover
+    from nc.interp.interpreter import Interpreter
+
+
+class PreviewWindow:
+    def __init__(self, interp: "Interpreter", events: Iterator[Event], depth: int) -> None:
+        self.interp = interp
+        self.events = events
+        self.depth = max(0, depth)
+        self.buf: deque[Event] = deque()
+        self.executing: Move | None = None  # the motion block the machine is running now
+        interp.on_statement = self._statement
+
+    def _statement(self, block, program: str) -> None:
+        from nc.interp.interpreter import PreviewRecord
+        ahead = next((e for e in self.buf if isinstance(e, Move)), None) or self.executing
+        n_ahead = sum(1 for e in self.buf if isinstance(e, Move))
+        self.interp.preview_log.append(PreviewRecord(
+            block.line, block.text.strip(), program,
+            ahead.line if ahead is not None else None,
+            ahead.block.strip() if ahead is not None else None, n_ahead))
+
+    def _moves_buffered(self) -> int:
+        return sum(1 for e in self.buf if isinstance(e, Move))
+
+    def __iter__(self) -> Iterator[Event]:
+        done = False
+        failure: Exception | None = None
+        while True:
+            # read ahead until the window is full, a Sync arrives, or the program ends
+            while not done and self._moves_buffered() <= self.depth and not any(isinstance(e, Sync) for e in self.buf):
+                try:
+                    self.buf.append(next(self.events))
+                except StopIteration:
+                    done = True
+                except Exception as exc:  # an alarm read ahead is raised when execution reaches it
+                    failure = exc
+                    done = True
+            if not self.buf:
+                if failure is not None:
+                    raise failure
+                return
+            ev = self.buf.popleft()
+            if isinstance(ev, Move):
+                self.executing = ev
+            yield ev

@@ -1,0 +1,78 @@
+"""Program store: O-numbered subprograms and macros, found the way NC5 searches its folders.
+
+NC5 ch.2 / N§3.11 (seed-catalog §2.10): a library root is a "(DISK)" with ``PATH_1``,
+``PATH_1/O_MACRO``, ``GLOBAL`` and ``GLOBAL/O_MACRO``.  With ``N8.22 Bit5 = 0``:
+
+* M98 / M96 / G65 / G66 search (1) the folder of the main program, (2) (DISK)/PATH_□,
+  (3) (DISK)/PATH_□/O_MACRO, (4) (DISK)/GLOBAL, (5) (DISK)/GLOBAL/O_MACRO;
+* G-, M- and T-code macros (and the initial macro) search (2)…(5) first and the main program's
+  folder last.
+
+(``N8.22 Bit5 = 1`` puts a USB root first; a bench gives it as ``usb``.)  A file is named
+``O0001``, ``O0001.NC`` (any case) or ``O1`` …; a file may also hold several O programs, and every
+O program of the main file and of files given with ``--lib FILE`` is registered first (decisions A23).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from nc.alarms import NcAlarm
+from nc.program.blocks import Program, parse_programs
+
+SUFFIXES = ("", ".NC", ".nc", ".txt", ".TXT", ".ngc")
+
+
+@dataclass
+class ProgramStore:
+    roots: list[Path] = field(default_factory=list)  # (DISK) roots, searched in order
+    main_dir: Path | None = None
+    usb: Path | None = None
+    path_index: int = 1  # NC path number (PATH_1)
+    usb_first: bool = False  # N8.22 Bit5
+    loaded: dict[int, Program] = field(default_factory=dict)
+
+    def add_text(self, text: str, name: str = "program") -> list[Program]:
+        """Register every O program of a text; returns them (the first is the main program)."""
+        progs = parse_programs(text, name)
+        for p in progs:
+            if p.number is not None:
+                self.loaded.setdefault(p.number, p)
+        return progs
+
+    def add_file(self, path: Path) -> list[Program]:
+        return self.add_text(path.read_text(errors="replace"), path.name)
+
+    def folders(self, macro_call: bool) -> list[Path]:
+        disk: list[Path] = []
+        for r in self.roots:
+            disk += [r / f"PATH_{self.path_index}", r / f"PATH_{self.path_index}" / "O_MACRO",
+                     r / "GLOBAL", r / "GLOBAL" / "O_MACRO", r]
+        main = [self.main_dir] if self.main_dir is not None else []
+        order = disk + main if macro_call else main + disk
+        if self.usb_first and self.usb is not None:
+            order = [self.usb] + order
+        return order
+
+    def find(self, number: int, macro_call: bool = False, code: int = 0x0263) -> Program:
+        """The program O<number>; raises NcAlarm(code) if no folder holds it."""
+        if number in self.loaded:
+            return self.loaded[number]
+        names = {f"O{number:04d}", f"O{number}", f"O{number:05d}"}
+        for folder in self.folders(macro_call):
+            if not folder.is_dir():
+                continue
+            for base in names:
+                for suf in SUFFIXES:
+                    for cand in (folder / (base + suf), folder / (base.lower() + suf)):
+                        if cand.is_file():
+                            progs = self.add_file(cand)
+                            hit = next((p for p in progs if p.number == number), progs[0])
+                            hit.number = number
+                            hit.path = str(cand)
+                            self.loaded[number] = hit
+                            return hit
+        raise NcAlarm(code, f"program O{number:04d} not found"
+                      + (f" (searched {', '.join(str(f) for f in self.folders(macro_call) if f.is_dir())})"
+                         if self.roots or self.main_dir else ""))
