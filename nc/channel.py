@@ -1,8 +1,20 @@
-"""One NC channel in AUTO: pulls the interpreter, feeds the planner, runs the M/S/T handshake,
-and turns any alarm into a controlled stop.
+"""One NC channel in AUTO: pulls the interpreter, feeds the planner's look-ahead queue, runs the
+M/S/T handshake, and turns any alarm into a controlled stop.
 
 The MLC side of the handshake is reached only through `pending_aux` / `finish_aux()`, so the
 channel runs the same with Delta's special M/D relays behind it or with no MLC at all.
+
+Operator controls (what the MLC maps Delta's relays/registers onto, e.g. M2x001 feed hold,
+D2x002 feed override, D2x004 rapid override; all take effect in the next cycle, jerk-limited):
+
+- ``feed_override``  float 0.0–1.5 (0–150 %); 0 stops cutting moves along the path.
+- ``rapid_override`` float 0.0–1.0; 0 means the slow rapid speed (``MotionConfig.slow_rapid``).
+- ``feed_hold()``    decelerate along the path and stay (state HOLD); ``cycle_start()`` resumes.
+- ``single_block``   bool; when set, the channel stops after every block (state BLOCK_STOP,
+                     moves end at rest); ``cycle_start()`` runs the next block.
+- ``dry_run``        bool; cutting moves run at ``dry_run_feed`` (mm/min) × feed override.
+- ``reset()``        controlled stop along the path, then flush the queue and the program
+                     (state IDLE once at rest).
 """
 
 from __future__ import annotations
@@ -10,8 +22,6 @@ from __future__ import annotations
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from enum import Enum
-
-import numpy as np
 
 from nc.alarms import Alarm, NcAlarm, internal_error
 from nc.motion.planner import Planner, Setpoint
@@ -22,7 +32,10 @@ class RunState(Enum):
     IDLE = "idle"
     RUNNING = "running"
     WAIT_AUX = "waiting for MLC finish"
+    HOLD = "feed hold"
+    BLOCK_STOP = "single block stop"
     STOPPING = "stopping"
+    RESETTING = "resetting"
     FINISHED = "finished"
     ALARM = "alarm"
 
@@ -36,21 +49,71 @@ class Channel:
     pending_aux: Aux | None = None
     spindle_rpm: float = 0.0  # programmed S with direction, for feed per revolution
     end: ProgramEnd | None = None
-    _waiting_sync: bool = False
-    _aux_issued: bool = False
-    _deferred_aux: Aux | None = None
+    single_block: bool = False
+    dry_run_feed: float = 5000.0  # mm/min
+    _deferred: Aux | Sync | None = None
+    _block_moves: int = 0  # moves pushed since the last single-block stop
 
     def load(self, events: Iterator[Event]) -> None:
         self.events = events
+        self.end = None
         self.state = RunState.IDLE
 
     def cycle_start(self) -> None:
-        if self.events is not None and self.state in (RunState.IDLE,):
+        """Start the loaded program, resume after a feed hold, or run the next single block."""
+        if self.events is not None and self.state is RunState.IDLE:
+            self.state = RunState.RUNNING
+        elif self.state is RunState.HOLD:
+            self.planner.resume()
+            self.state = RunState.RUNNING if self.pending_aux is None else RunState.WAIT_AUX
+        elif self.state is RunState.BLOCK_STOP:
+            self._block_moves = 0
             self.state = RunState.RUNNING
 
     @property
     def busy(self) -> bool:
-        return self.state in (RunState.RUNNING, RunState.WAIT_AUX, RunState.STOPPING)
+        return self.state in (RunState.RUNNING, RunState.WAIT_AUX, RunState.STOPPING, RunState.HOLD,
+                              RunState.BLOCK_STOP, RunState.RESETTING)
+
+    # ---- operator controls --------------------------------------------------------------
+    @property
+    def feed_override(self) -> float:
+        return self.planner.feed_override
+
+    @feed_override.setter
+    def feed_override(self, value: float) -> None:
+        self.planner.feed_override = value
+
+    @property
+    def rapid_override(self) -> float:
+        return self.planner.rapid_override
+
+    @rapid_override.setter
+    def rapid_override(self, value: float) -> None:
+        self.planner.rapid_override = value
+
+    @property
+    def dry_run(self) -> bool:
+        return self.planner.dry_run
+
+    @dry_run.setter
+    def dry_run(self, on: bool) -> None:
+        self.planner.set_dry_run(on, self.dry_run_feed)
+
+    def feed_hold(self) -> None:
+        if self.state in (RunState.RUNNING, RunState.WAIT_AUX, RunState.BLOCK_STOP):
+            self.planner.hold()
+            self.state = RunState.HOLD
+
+    def reset(self) -> None:
+        """Controlled stop, then flush motion, the pending M/S/T and the rest of the program."""
+        if self.state in (RunState.IDLE, RunState.FINISHED):
+            return
+        self.planner.stop()
+        self.pending_aux = None
+        self._deferred = None
+        self.events = None
+        self.state = RunState.RESETTING if not self.planner.idle else RunState.IDLE
 
     # ---- MLC side ---------------------------------------------------------------------
     def finish_aux(self) -> None:
@@ -72,8 +135,7 @@ class Channel:
     def emergency_stop(self, alarm: Alarm) -> None:
         """E-stop: setpoints freeze this cycle (the drives' own quick stop does the braking)."""
         self.alarms.append(alarm)
-        self.planner.queue.clear()
-        self.planner.active = None
+        self.planner.abort()
         self.state = RunState.ALARM
         self.pending_aux = None
 
@@ -81,20 +143,38 @@ class Channel:
     def step(self) -> Setpoint:
         if self.state is RunState.RUNNING:
             self._feed_planner()
-        sp = self.planner.step()
+        try:
+            sp = self.planner.step()
+        except NcAlarm as exc:
+            self.raise_alarm(exc.alarm)
+            sp = self.planner.step()
         if self.state is RunState.STOPPING and self.planner.idle:
             self.state = RunState.ALARM
+        if self.state is RunState.RESETTING and self.planner.idle:
+            self.state = RunState.IDLE
+        if self.state is RunState.RUNNING and self.single_block and self._block_moves and self.planner.idle:
+            self.state = RunState.BLOCK_STOP
         if self.state is RunState.RUNNING and self.planner.idle and self.end is not None \
                 and self.pending_aux is None:
             self.state = RunState.FINISHED
         return sp
 
     def _feed_planner(self) -> None:
-        """Read events until the planner has work or the channel must wait."""
-        while self.state is RunState.RUNNING and self.planner.idle and self.end is None:
-            if self._deferred_aux is not None:
-                self._issue(self._deferred_aux)
-                self._deferred_aux = None
+        """Read events into the look-ahead queue until it is full or the channel must wait.
+
+        M/S/T codes and preview stops are barriers: motion before them runs out to rest first.
+        """
+        pl = self.planner
+        while self.state is RunState.RUNNING and self.end is None and not pl.full:
+            if self._deferred is not None:
+                if not pl.idle:
+                    return
+                ev, self._deferred = self._deferred, None
+                if isinstance(ev, Aux):
+                    self._issue(ev)
+                    return
+                continue  # a Sync: motion has drained, read on
+            if self.single_block and self._block_moves:
                 return
             try:
                 ev = next(self.events)  # type: ignore[arg-type]
@@ -108,20 +188,22 @@ class Channel:
                 self.raise_alarm(internal_error(exc))
                 return
             if isinstance(ev, Move):
-                self.planner.push(ev)
+                pl.push(ev)
+                self._block_moves += 1
             elif isinstance(ev, Aux):
                 if ev.kind == "S":
                     self.spindle_rpm = ev.value
-                self._issue(ev)
+                if pl.idle:
+                    self._issue(ev)
+                    return
+                self._deferred = ev
             elif isinstance(ev, ProgramEnd):
                 self.end = ev
             elif isinstance(ev, Sync):
-                continue  # the planner is already drained here: nothing more to wait for
+                if not pl.idle:
+                    self._deferred = ev
 
     def _issue(self, aux: Aux) -> None:
-        if not self.planner.idle:
-            self._deferred_aux = aux
-            return
         self.pending_aux = aux
         if aux.wait:
             self.state = RunState.WAIT_AUX

@@ -17,6 +17,31 @@ class MotionConfig:
     cycle: float = 0.001  # s
     axes: tuple[str, ...] = ("X", "Z")
     limits: dict[str, AxisLimits] = field(default_factory=dict)
+    # Look-ahead depth in blocks; None = max(100, v_max / (2·a_max·T)) (LinuxCNC's sizing rule).
+    lookahead: int | None = None
+    # G64 path tolerance (mm) at corners; None = no tolerance limit (best speed), 0 = stop at every corner.
+    path_tolerance: float | None = None
+    # N1.20 bit 18: 0 = G00 interpolated along a line, 1 = every axis independently at its own speed.
+    rapid_independent: bool = False
+    # P315 / 0 % rapid override: the slow rapid speed, mm/s along the path.
+    slow_rapid: float = 10.0
+    # Each segment lasts at least this many cycles (LinuxCNC TP_MIN_SEGMENT_CYCLES).
+    min_segment_cycles: float = 1.02
+    # Shares of each axis' acceleration and jerk budget: tangential path profile, corner
+    # (tangent jumps at junctions) and curvature (arcs, curvature jumps). They add up to 1 so the
+    # setpoint stream stays inside the axis limits when all three act in the same cycle.
+    share_tangential: float = 0.5
+    share_corner: float = 0.25
+    share_curvature: float = 0.25
 
     def limit(self, axis: str) -> AxisLimits:
         return self.limits.get(axis, AxisLimits())
+
+    def lookahead_depth(self) -> int:
+        if self.lookahead is not None:
+            return max(1, int(self.lookahead))
+        n = 0.0
+        for a in self.axes:
+            lim = self.limit(a)
+            n = max(n, lim.max_velocity / (2.0 * lim.max_acceleration * self.cycle))
+        return max(100, int(n + 0.999))

@@ -7,8 +7,19 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from nc.interp.arcs import sweep
 from nc.moves import Move
+
+
+def sweep(s: tuple[float, float], e: tuple[float, float], c: tuple[float, float], cw: bool) -> float:
+    """Signed swept angle (radians), CCW positive; coincident start and end mean a full circle."""
+    a0 = math.atan2(s[1] - c[1], s[0] - c[0])
+    a1 = math.atan2(e[1] - c[1], e[0] - c[0])
+    ccw = (a1 - a0) % (2 * math.pi)
+    if math.hypot(e[0] - s[0], e[1] - s[1]) < 1e-9:
+        ccw = 0.0
+    if cw:
+        return ccw - 2 * math.pi if ccw > 0 else -2 * math.pi
+    return ccw if ccw > 0 else 2 * math.pi
 
 
 @dataclass
@@ -39,6 +50,8 @@ class Segment:
         i1, i2 = axes.index(p1), axes.index(p2)
         c = (move.center[p1], move.center[p2])
         theta = sweep((s[i1], s[i2]), (e[i1], e[i2]), c, move.dir == "cw")
+        if move.turns:
+            theta += math.copysign(2.0 * math.pi * float(move.turns), theta)
         r = math.hypot(s[i1] - c[0], s[i2] - c[1])
         a0 = math.atan2(s[i2] - c[1], s[i1] - c[0])
         arc_len = abs(theta) * r
@@ -72,6 +85,18 @@ class Segment:
             d[self.i1] = -math.sin(ang) * k
             d[self.i2] = math.cos(ang) * k
         return d
+
+    def curvature_vector(self, at_end: bool) -> np.ndarray:
+        """d²(position)/ds² at the start or end: zero on a line, towards the centre on an arc."""
+        c = np.zeros(len(self.axes))
+        if self.kind != "arc" or self.length <= 0.0 or self.radius <= 0.0:
+            return c
+        ang = self.a0 + (self.theta if at_end else 0.0)
+        k = self.theta * self.radius / self.length  # d(angle·r)/ds
+        mag = (k * k) / self.radius
+        c[self.i1] = -math.cos(ang) * mag
+        c[self.i2] = -math.sin(ang) * mag
+        return c
 
     def max_direction_cosines(self) -> np.ndarray:
         """Largest |d axis / d s| over the segment, per axis (for projecting axis limits)."""

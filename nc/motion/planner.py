@@ -1,7 +1,15 @@
-"""The planner: a queue of moves turned into one setpoint per bus cycle.
+"""The planner: a look-ahead queue of blocks turned into one setpoint per bus cycle.
 
-The foundation plans every move from rest to rest (exact stop); look-ahead blending across
-blocks is layered on the same queue/segment/profile split.
+`push` adds a move to the look-ahead queue (junction speed + incremental backward pass).
+When a block starts, the forward pass caps its end speed by what its entry speed can reach,
+and ruckig solves ONE 1-DoF profile along its path length, (s, v, a) → (L, v_end, 0). The
+profile's phases are sampled a chunk of cycles at a time with numpy and mapped through the
+block geometry. A profile is re-solved only on an event: a feed/rapid override change, a feed
+hold, a reset, a change of the spindle's actual speed under feed per revolution.
+
+Operator controls (the channel maps the MLC's relays onto them):
+  feed_override (0..1.5), rapid_override (0..1; 0 = slow rapid), hold()/resume(), stop(),
+  dry_run (feed of every cutting block replaced by `dry_run_feed`).
 """
 
 from __future__ import annotations
@@ -15,9 +23,12 @@ import numpy as np
 
 from nc.alarms import NcAlarm
 from nc.motion.limits import MotionConfig
+from nc.motion.lookahead import MARGIN, Block, Limits, backward, reach
 from nc.motion.path import Segment
-from nc.motion.profile import PathProfile, solve
+from nc.motion.profile import Piecewise, solve_axes, solve_position, solve_velocity
 from nc.moves import Move
+
+CHUNK = 64  # cycles sampled per vectorised step
 
 
 @dataclass
@@ -29,13 +40,14 @@ class Setpoint:
 
 
 @dataclass
-class _Active:
-    move: Move
-    segment: Segment | None  # None for a dwell
-    profile: PathProfile | None
+class _Plan:
+    kind: str  # "path" (to the block end), "ramp" (velocity change, may span blocks), "dwell", "indep"
+    pw: Piecewise | None
     duration: float
-    t: float = 0.0
-    stopping: bool = False  # the profile ends short of the segment end (controlled stop)
+    t_next: float  # plan time of the next sample
+    base: float = 0.0  # plan position at the start of blocks[0] (ramps that cross blocks)
+    target: float = 0.0  # ramp target speed
+    rpm: float = 0.0  # spindle speed the feed-per-rev cap used
 
 
 class Planner:
@@ -43,140 +55,431 @@ class Planner:
                  spindle_rpm: Callable[[], float] | None = None) -> None:
         self.cfg = cfg
         self.axes = cfg.axes
+        self.lim = Limits(cfg)
         self.position = np.array([(start or {}).get(a, 0.0) for a in self.axes], dtype=float)
-        self.queue: deque[Move] = deque()
-        self.active: _Active | None = None
+        self.blocks: deque[Block] = deque()
         self.spindle_rpm = spindle_rpm or (lambda: 0.0)
+        self.depth = cfg.lookahead_depth()
         self.line = 0
-        self._vmax = np.array([cfg.limit(a).max_velocity for a in self.axes])
-        self._amax = np.array([cfg.limit(a).max_acceleration for a in self.axes])
-        self._jmax = np.array([cfg.limit(a).max_jerk for a in self.axes])
+        # operator controls
+        self._feed_ovr = 1.0
+        self._rapid_ovr = 1.0
+        self.dry_run = False
+        self.dry_run_feed = 5000.0 / 60.0  # mm/s
+        self.held = False  # feed hold active (or reached)
+        self._stopping = False  # reset: flush once at rest
+        # execution state: path position in blocks[0], speed, acceleration
+        self.s = 0.0
+        self.v = 0.0
+        self.a = 0.0
+        self._axis_v = np.zeros(len(self.axes))  # independent rapids keep per-axis state
+        self._axis_a = np.zeros(len(self.axes))
+        self.plan: _Plan | None = None
+        self._started = False  # blocks[0] has begun executing
+        self._carry = cfg.cycle  # plan time of the first sample of the next plan
+        self._buf_pos: np.ndarray | None = None
+        self._buf_vel: np.ndarray | None = None
+        self._buf_line: list[int] = []
+        self._buf_i = 0
+        self._buf_state: list[tuple[float, float, float]] = []
+        self.solves = 0  # ruckig solves so far (one per block plus one per event)
 
     # ---- queue ----------------------------------------------------------------------------
     def push(self, move: Move) -> None:
-        self.queue.append(move)
+        b = self._block(move)
+        if b is None:
+            return
+        self._update_cap(b)
+        if self.blocks:
+            prev = self.blocks[-1]
+            prev.vjunc = self.lim.junction(prev, b)
+        self.blocks.append(b)
+        backward(self.blocks, 0)
+
+    @property
+    def queue(self) -> deque[Block]:
+        return self.blocks
+
+    @property
+    def active(self) -> Block | None:
+        return self.blocks[0] if self._started and self.blocks else None
+
+    @property
+    def full(self) -> bool:
+        return len(self.blocks) >= self.depth
 
     @property
     def idle(self) -> bool:
-        return self.active is None and not self.queue
+        return not self.blocks and self.plan is None and self._buf_done
+
+    @property
+    def at_rest(self) -> bool:
+        return abs(self.v) < 1e-9 and not np.any(self._axis_v)
+
+    @property
+    def _buf_done(self) -> bool:
+        return self._buf_pos is None or self._buf_i >= len(self._buf_pos)
 
     def reset_position(self, pos: dict[str, float]) -> None:
         """Take over the actual position (after enable, or after a stop)."""
         self.position = np.array([pos.get(a, 0.0) for a in self.axes], dtype=float)
 
-    # ---- per cycle ------------------------------------------------------------------------
-    def step(self) -> Setpoint:
-        dt = self.cfg.cycle
-        carry = dt
-        velocity = 0.0
-        while carry > 0.0:
-            if self.active is None:
-                if not self.queue:
-                    break
-                self.active = self._start(self.queue.popleft())
-            act = self.active
-            act.t += carry
-            if act.t >= act.duration - 1e-12:
-                carry = act.t - act.duration
-                self._finish(act)
-                self.active = None
-                if carry <= 1e-12:
-                    break
-                continue
-            carry = 0.0
-            if act.segment is not None and act.profile is not None:
-                s, velocity, _ = act.profile.at(act.t)
-                self.position = act.segment.points(np.array([s]))[0]
-        move = self.active.move if self.active else None
-        return Setpoint(self.position.copy(), self.line, velocity, move)
+    # ---- operator controls ----------------------------------------------------------------
+    @property
+    def feed_override(self) -> float:
+        return self._feed_ovr
+
+    @feed_override.setter
+    def feed_override(self, value: float) -> None:
+        value = min(max(float(value), 0.0), 1.5)
+        if value != self._feed_ovr:
+            self._feed_ovr = value
+            self._limits_changed()
+
+    @property
+    def rapid_override(self) -> float:
+        return self._rapid_ovr
+
+    @rapid_override.setter
+    def rapid_override(self, value: float) -> None:
+        value = min(max(float(value), 0.0), 1.0)
+        if value != self._rapid_ovr:
+            self._rapid_ovr = value
+            self._limits_changed()
+
+    def set_dry_run(self, on: bool, feed_mm_min: float | None = None) -> None:
+        self.dry_run = bool(on)
+        if feed_mm_min:
+            self.dry_run_feed = feed_mm_min / 60.0
+        self._limits_changed()
+
+    def hold(self) -> None:
+        """Feed hold: jerk-limited stop along the path (across blocks if need be); keeps the queue."""
+        if self.held:
+            return
+        self.held = True
+        self._replan()
+
+    def resume(self) -> None:
+        if self.held and not self._stopping:
+            self.held = False
+            self._replan()
 
     def stop(self) -> None:
-        """Controlled stop: decelerate along the current path at the path limits, then flush the queue."""
-        self.queue.clear()
-        act = self.active
-        if act is None or act.segment is None or act.profile is None:
-            self.active = None
-            return
-        s, v, a = act.profile.at(act.t)
-        if v <= 1e-9:
-            self.active = None
-            return
-        _, amax, jmax = self._limits(act.move, act.segment)
-        s_end, traj = _stop_profile(s, v, a, amax, jmax)
-        if s_end >= act.segment.length:
-            return  # the segment already ends at rest sooner than a fresh stop would
-        # The stop trajectory starts at the current absolute path length s, so it samples in place.
-        self.active = _Active(act.move, act.segment, PathProfile(s_end, traj.duration, traj), traj.duration,
-                              stopping=True)
+        """Reset: controlled stop along the path, then flush the queue once at rest."""
+        self._stopping = True
+        self.held = True
+        self._replan()
+        if self.at_rest and self.plan is None:
+            self._flush()
 
-    def _finish(self, act: _Active) -> None:
-        if act.segment is None:
-            return
-        if act.stopping and act.profile is not None:
-            self.position = act.segment.points(np.array([act.profile.length]))[0]
-        else:
-            self.position = act.segment.end.copy()
+    def abort(self) -> None:
+        """E-stop: forget every plan this cycle; the setpoint freezes where it is."""
+        self._flush()
+        self.v = self.a = 0.0
+        self._axis_v[:] = 0.0
+        self._axis_a[:] = 0.0
 
-    def _start(self, move: Move) -> _Active:
-        self.line = move.line
+    # ---- per cycle ------------------------------------------------------------------------
+    def step(self) -> Setpoint:
+        self._check_spindle()
+        if self._buf_done:
+            self._refill()
+        if self._buf_done:  # standing still (idle, held, or waiting)
+            self.v = self.a = 0.0
+            blk = self.blocks[0].move if self._started and self.blocks else None
+            return Setpoint(self.position.copy(), self.line, 0.0, blk)
+        i = self._buf_i
+        self._buf_i += 1
+        self.position = self._buf_pos[i]
+        self.line = self._buf_line[i]
+        self.s, self.v, self.a = self._buf_state[i]
+        blk = self.blocks[0].move if self.blocks else None
+        return Setpoint(self.position.copy(), self.line, float(self._buf_vel[i]), blk)
+
+    # ---- planning -------------------------------------------------------------------------
+    def _block(self, move: Move) -> Block | None:
         if move.kind == "dwell":
-            return _Active(move, None, None, float(move.duration or 0.0))
+            return Block(move, "dwell", None, 0.0, 0.0, 1.0, 1.0, None)
         seg = Segment.of(move, self.axes)
-        seg.start = self.position.copy() if np.allclose(seg.start, self.position, atol=1e-6) else seg.start
         if seg.length < 1e-9:
-            return _Active(move, None, None, 0.0)
-        v, a, j = self._limits(move, seg)
-        prof = solve(seg.length, v, a, j)
-        return _Active(move, seg, prof, prof.duration)
+            return None
+        if move.kind == "rapid" and self.cfg.rapid_independent:
+            return Block(move, "indep", seg, seg.length, 0.0, 1.0, 1.0, None, rapid=True)
+        v, a, j = self.lim.block_limits(seg)
+        feed = None if move.kind == "rapid" else (move.feed or 0.0) / (1.0 if move.per_rev else 60.0)
+        kind = "thread" if move.kind == "thread" else "path"
+        return Block(move, kind, seg, seg.length, v, a, j, feed, rapid=move.kind == "rapid")
 
-    def _limits(self, move: Move, seg: Segment) -> tuple[float, float, float]:
-        d = seg.max_direction_cosines()
-        mask = d > 1e-12
-        v = float(np.min(self._vmax[mask] / d[mask]))
-        a = float(np.min(self._amax[mask] / d[mask]))
-        j = float(np.min(self._jmax[mask] / d[mask]))
-        if move.kind != "rapid":
-            feed = self._feed_mm_s(move)
-            v = min(v, feed)
-        if seg.kind == "arc" and seg.radius > 0:
-            # Keep centripetal acceleration and jerk inside the plane axes' limits.
-            pa = min(self._amax[seg.i1], self._amax[seg.i2])
-            pj = min(self._jmax[seg.i1], self._jmax[seg.i2])
-            r = seg.radius
-            k = seg.arc_len / seg.length  # fraction of path speed that is circular
-            v = min(v, math.sqrt(0.5 * pa * r) / k, (0.25 * pj * r * r) ** (1.0 / 3.0) / k)
-            a = min(a, 0.5 * pa, pj * r / (12.0 * max(v * k, 1e-9)))
-            j = min(j, 0.5 * pj)
-        return v, a, j
+    def _update_cap(self, b: Block, rpm: float | None = None) -> float:
+        if b.kind != "path" and b.kind != "thread":
+            b.cap = 0.0
+            return 0.0
+        cap = b.cap_hard
+        if b.rapid:
+            cap = cap * self._rapid_ovr if self._rapid_ovr > 0.0 else min(cap, self.cfg.slow_rapid)
+        elif self.dry_run:
+            cap = min(cap, self.dry_run_feed * self._feed_ovr)
+        else:
+            feed = b.feed or 0.0
+            if b.move.per_rev:
+                feed *= abs(rpm if rpm is not None else self.spindle_rpm()) / 60.0
+            cap = min(cap, feed * self._feed_ovr)
+        b.cap = cap
+        return cap
 
-    def _feed_mm_s(self, move: Move) -> float:
-        feed = move.feed or 0.0
-        if move.per_rev:
-            rpm = abs(self.spindle_rpm())
-            if rpm <= 0:
-                raise NcAlarm(0x1001, "feed per revolution with the spindle stopped (S0)", line=move.line,
-                              block=move.block, program=move.program)
-            feed *= rpm
-        return feed / 60.0
+    def _limits_changed(self) -> None:
+        for b in self.blocks:
+            self._update_cap(b)
+        backward(self.blocks, 0, full=True)
+        self._replan()
 
+    def _replan(self) -> None:
+        """Drop the sampled-ahead cycles and plan again from the last emitted state."""
+        if self.plan is None and self._buf_done:
+            return
+        if self.plan is not None and self.plan.kind == "dwell":
+            return  # a dwell holds position anyway; the next plan sees the new settings
+        self._buf_pos = None
+        self._buf_i = 0
+        self.plan = None
+        self._carry = self.cfg.cycle
 
-def _stop_profile(s: float, v: float, a: float, a_max: float, j_max: float) -> tuple[float, "object"]:
-    """Jerk-limited stop from (v, a): returns the distance it needs and the ruckig trajectory."""
-    from ruckig import ControlInterface, InputParameter, Result, Ruckig, Trajectory
+    def _check_spindle(self) -> None:
+        p = self.plan
+        if p is None or p.kind != "path" or not self.blocks or not self.blocks[0].move.per_rev:
+            return
+        rpm = abs(self.spindle_rpm())
+        if abs(rpm - p.rpm) > 0.02 * max(p.rpm, 1.0):
+            self._update_cap(self.blocks[0], rpm)
+            self._replan()
 
-    otg = Ruckig(1)
-    inp = InputParameter(1)
-    inp.control_interface = ControlInterface.Velocity
-    inp.current_position = [s]
-    inp.current_velocity = [v]
-    inp.current_acceleration = [a]
-    inp.target_velocity = [0.0]
-    inp.target_acceleration = [0.0]
-    inp.max_velocity = [max(abs(v), 1e-6)]
-    inp.max_acceleration = [a_max]
-    inp.max_jerk = [j_max]
-    traj = Trajectory(1)
-    if otg.calculate(inp, traj) not in (Result.Working, Result.Finished):
-        raise NcAlarm(0x0000, "stop trajectory failed")
-    p, _, _ = traj.at_time(traj.duration)
-    return p[0], traj
+    def _flush(self) -> None:
+        self.blocks.clear()
+        self.plan = None
+        self._buf_pos = None
+        self._started = False
+        self._stopping = False
+        self.held = False
+        self.s = self.v = self.a = 0.0
+
+    def _refill(self) -> None:
+        T = self.cfg.cycle
+        for _ in range(1000):
+            if self.plan is None:
+                self.plan = self._start_plan()
+                if self.plan is None:
+                    return
+            p = self.plan
+            n = int(math.floor((p.duration - p.t_next) / T + 1e-9)) + 1
+            if p.t_next <= p.duration + 1e-12 and n > 0:
+                self._sample(p, min(n, CHUNK))
+                if not self._buf_done:
+                    return
+                if self.plan is None:
+                    continue  # re-solve at a block boundary
+            self._end_plan(p)
+
+    def _start_plan(self) -> _Plan | None:
+        """Plan from the current state; None when there is nothing to do (idle or held at rest)."""
+        T = self.cfg.cycle
+        t0 = self._carry
+        self._carry = T
+        while self.blocks:
+            b = self.blocks[0]
+            if not self._started:
+                self._started = True
+                self.s = 0.0
+                self.line = b.move.line
+                if b.seg is not None and np.allclose(b.seg.start, self.position, atol=1e-6):
+                    b.seg.start = self.position.copy()
+            if b.kind == "dwell":
+                if self.held:
+                    return None
+                return _Plan("dwell", None, float(b.move.duration or 0.0), t0)
+            if b.kind == "indep":
+                return self._plan_indep(b, t0)
+            if self.s >= b.length - 1e-12 and abs(self.v) < 1e-9:
+                self._finish_block()
+                continue
+            return self._plan_path(b, t0)
+        if self._stopping:
+            self._flush()
+        self._started = False
+        return None
+
+    def _plan_path(self, b: Block, t0: float) -> _Plan | None:
+        s, v, a = self.s, self.v, self.a
+        rpm = abs(self.spindle_rpm()) if b.move.per_rev else 0.0
+        cap = self._update_cap(b, rpm if b.move.per_rev else None)
+        if b.move.per_rev and rpm <= 0.0 and not self.dry_run:
+            raise NcAlarm(0x1001, "feed per revolution with the spindle stopped (S0)", line=b.move.line,
+                          block=b.move.block, program=b.move.program)
+        self.solves += 1
+        if self.held or cap <= 1e-9:
+            if abs(v) < 1e-9 and abs(a) < 1e-9:
+                if self._stopping:
+                    self._flush()
+                return None  # at rest: wait for resume / override
+            pw = solve_velocity(s, v, a, 0.0, b.a, b.j)
+            return _Plan("ramp", pw, pw.duration, t0, 0.0, 0.0)
+        # The run: following blocks the profile may cross without a binding junction (same or
+        # higher cap, end speed not below the cap); the target is the end of that run.
+        dist, v1, ra, rj = self._run_target(cap)
+        # Forward pass: no more than the entry state can reach (a braking state first ramps its
+        # deceleration out, losing a²/2j of speed over v·|a|/j of path).
+        ve, de = (v - a * a / (2.0 * rj), dist - s - v * abs(a) / rj) if a < 0.0 else (v, dist - s)
+        v1 = min(v1, reach(max(ve, 0.0), max(de, 0.0), MARGIN * ra, MARGIN * rj))
+        pw = solve_position(s, v, a, dist, v1, cap, ra, rj)
+        if pw is None or pw.p.max() > dist + 1e-7 or pw.v.min() < -1e-7:
+            # Cannot meet the target from this state (an override just cut the cap): ramp down
+            # to the cap first, then plan the rest from there.
+            pw = solve_velocity(s, v, a, min(cap, max(v1, 0.0)), b.a, b.j)
+            return _Plan("ramp", pw, pw.duration, t0, 0.0, min(cap, v1))
+        return _Plan("path", pw, pw.duration, t0, target=dist, rpm=rpm)
+
+    def _run_target(self, cap: float) -> tuple[float, float, float, float]:
+        """(distance, end speed, acceleration, jerk) of the run that starts with blocks[0]."""
+        blocks = self.blocks
+        b = blocks[0]
+        dist, ra, rj = b.length, b.a, b.j
+        k = 0
+        n = len(blocks)
+        while True:
+            b = blocks[k]
+            if k + 1 >= n:
+                return dist, min(b.vend, cap), ra, rj
+            nx = blocks[k + 1]
+            if nx.kind != "path" or min(b.vjunc, nx.cap) < cap - 1e-9 or b.vend <= 0.0 or k >= 2 * self.depth:
+                return dist, min(b.vend, cap), ra, rj
+            dist += nx.length
+            ra, rj = min(ra, nx.a), min(rj, nx.j)
+            k += 1
+
+    def _plan_indep(self, b: Block, t0: float) -> _Plan | None:
+        assert b.seg is not None
+        lim = self.lim
+        ovr = self._rapid_ovr
+        vmax = lim.v * ovr if ovr > 0 else np.minimum(lim.v, self.cfg.slow_rapid)
+        self.solves += 1
+        if self.held:
+            if not np.any(np.abs(self._axis_v) > 1e-9):
+                if self._stopping:
+                    self._flush()
+                return None
+            pw = solve_axes(self.position, self._axis_v, self._axis_a, self.position, vmax, lim.acc, lim.jerk,
+                            velocity=True)
+        else:
+            pw = solve_axes(self.position, self._axis_v, self._axis_a, b.seg.end, vmax, lim.acc, lim.jerk)
+        return _Plan("indep", pw, pw.duration, t0)
+
+    def _sample(self, p: _Plan, n: int) -> None:
+        T = self.cfg.cycle
+        t = p.t_next + T * np.arange(n)
+        p.t_next = float(t[-1] + T)
+        line = self.blocks[0].move.line if self.blocks else self.line
+        if p.kind == "dwell":
+            self._buf_pos = np.repeat(self.position[None, :], n, axis=0)
+            self._buf_vel = np.zeros(n)
+            self._buf_line = [line] * n
+            self._buf_state = [(self.s, 0.0, 0.0)] * n
+            self._buf_i = 0
+            return
+        if p.kind == "indep":
+            cols = [p.pw.sample(t, k) for k in range(len(self.axes))]
+            self._buf_pos = np.stack([c[0] for c in cols], axis=1)
+            vel = np.stack([c[1] for c in cols], axis=1)
+            self._axis_v = vel[-1].copy()
+            self._axis_a = np.array([c[2][-1] for c in cols])
+            self._buf_vel = np.linalg.norm(vel, axis=1)
+            self._buf_line = [line] * n
+            self._buf_state = [(0.0, 0.0, 0.0)] * n
+            self._buf_i = 0
+            return
+        s, v, a = p.pw.sample(t)
+        s = s - p.base
+        blocks = self.blocks
+        more = len(blocks) > 1 and blocks[1].kind == "path"
+        if more and s[0] > blocks[0].length + 1e-12:
+            if p.kind == "path":
+                # The next sample lies in the next block: re-solve there from the last emitted
+                # state (once per block), now that more of the queue may be known.
+                length = blocks[0].length
+                s_last = self.s
+                self._finish_block(keep_plan=True)
+                self.s = s_last - length
+                self.plan = None
+                self._carry = T
+                self._buf_pos = None
+                return
+            # A ramp runs on into the next block without a new solve.
+            while len(blocks) > 1 and blocks[1].kind == "path" and s[0] > blocks[0].length + 1e-12:
+                p.base += blocks[0].length
+                s = s - blocks[0].length
+                self._finish_block(keep_plan=True)
+            more = len(blocks) > 1 and blocks[1].kind == "path"
+        if more:
+            cut = int(np.searchsorted(s, blocks[0].length + 1e-12, side="right"))
+            if 0 < cut < n:
+                n = cut
+                s, v, a = s[:n], v[:n], a[:n]
+                p.t_next = float(t[n])
+        b = blocks[0]
+        line = b.move.line
+        self._buf_pos = b.seg.points(np.clip(s, 0.0, b.length))
+        self._buf_vel = v
+        self._buf_line = [line] * n
+        self._buf_i = 0
+        self._buf_state = list(zip(s.tolist(), v.tolist(), a.tolist()))
+
+    def _end_plan(self, p: _Plan) -> None:
+        T = self.cfg.cycle
+        self._carry = p.t_next - p.duration
+        if self._carry <= 1e-12:
+            self._carry += T
+        self.plan = None
+        if p.kind == "path":
+            # The run may end past blocks shorter than a cycle that no sample fell into.
+            d = p.target
+            while len(self.blocks) > 1 and d > self.blocks[0].length + 1e-9:
+                d -= self.blocks[0].length
+                self._finish_block(keep_plan=True)
+            b = self.blocks[0]
+            self.s, self.v, self.a = b.length, float(p.pw.v[0][-1]), 0.0
+            self.position = b.seg.end.copy() if b.seg is not None else self.position
+            self._finish_block()
+        elif p.kind == "dwell":
+            self._finish_block()
+        elif p.kind == "indep":
+            self._axis_v[:] = 0.0
+            self._axis_a[:] = 0.0
+            if not self.held:
+                b = self.blocks[0]
+                self.position = b.seg.end.copy()
+                self._finish_block()
+        else:  # ramp: continue in the current block from where it ended
+            end_s, end_v, _ = p.pw.sample(np.array([p.duration]))
+            self.s = float(end_s[0] - p.base)
+            self.v = float(end_v[0])
+            self.a = 0.0
+            while len(self.blocks) > 1 and self.blocks[1].kind == "path" and self.s > self.blocks[0].length + 1e-12:
+                self.s -= self.blocks[0].length
+                self._finish_block(keep_plan=True)
+            b = self.blocks[0] if self.blocks else None
+            if b is not None and b.seg is not None:
+                self.s = min(self.s, b.length)
+                self.position = b.seg.points(np.array([self.s]))[0]
+            if abs(self.v) < 1e-9 and self._stopping:
+                self._flush()
+
+    def _finish_block(self, keep_plan: bool = False) -> None:
+        if self.blocks:
+            self.blocks.popleft()
+        self._started = False
+        if not keep_plan:
+            self.s = 0.0
+        if self.blocks and not keep_plan:
+            self.line = self.blocks[0].move.line
+        if keep_plan and self.blocks:
+            self._started = True
+            self.line = self.blocks[0].move.line

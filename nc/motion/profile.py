@@ -1,4 +1,8 @@
-"""A jerk-limited 1-DoF profile along path length, solved once by ruckig and sampled per cycle.
+"""Jerk-limited profiles solved once by ruckig and sampled for many cycles at once.
+
+A ruckig `Trajectory` is piecewise constant in jerk; `Piecewise` copies its phases (brake
+pre-phases, then the seven main phases) into numpy arrays so a whole chunk of cycles is
+evaluated in one vectorised polynomial step instead of one `at_time` call per cycle.
 
 Never pass intermediate positions to ruckig: the community build sends those to a web service.
 """
@@ -7,45 +11,147 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ruckig import InputParameter, Result, Ruckig, Trajectory
+import numpy as np
+from ruckig import ControlInterface, InputParameter, Result, Ruckig, Synchronization, Trajectory
 
 from nc.alarms import NcAlarm
 
-_OTG = Ruckig(1)
-_INP = InputParameter(1)
+_OK = (Result.Working, Result.Finished)
+_POOL: dict[int, tuple[Ruckig, InputParameter]] = {}  # one calculator per DoF count, never per cycle
+
+
+def _calc(dofs: int) -> tuple[Ruckig, InputParameter]:
+    if dofs not in _POOL:
+        _POOL[dofs] = (Ruckig(dofs), InputParameter(dofs))
+    return _POOL[dofs]
 
 
 @dataclass
-class PathProfile:
-    length: float
+class Piecewise:
+    """Phases of a jerk-limited trajectory, one row per DoF: start times and the state there."""
+
+    t0: np.ndarray  # (dofs, phases) phase start times
+    p: np.ndarray
+    v: np.ndarray
+    a: np.ndarray
+    j: np.ndarray
     duration: float
-    _traj: Trajectory
 
-    def at(self, t: float) -> tuple[float, float, float]:
-        """(s, ds/dt, d²s/dt²) at time t, clamped to the profile's ends."""
-        if t >= self.duration:
-            p, v, a = self._traj.at_time(self.duration)
-            return self.length, v[0], a[0]
-        p, v, a = self._traj.at_time(max(t, 0.0))
-        return p[0], v[0], a[0]
+    @classmethod
+    def of(cls, traj: Trajectory) -> "Piecewise":
+        rows = [_phases(pr) for pr in traj.profiles[0]]
+        n = max(len(r[0]) for r in rows)
+        arrs = []
+        for k in range(5):
+            m = np.empty((len(rows), n))
+            for i, r in enumerate(rows):
+                col = r[k]
+                m[i, : len(col)] = col
+                # pad with a copy of the final (resting) phase
+                m[i, len(col):] = col[-1] if k else np.inf
+            arrs.append(m)
+        return cls(arrs[0], arrs[1], arrs[2], arrs[3], arrs[4], float(traj.duration))
+
+    def sample(self, t: np.ndarray, dof: int = 0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(position, velocity, acceleration) of one DoF at times t (clamped to [0, duration])."""
+        t = np.clip(t, 0.0, self.duration)
+        t0 = self.t0[dof]
+        k = np.searchsorted(t0, t, side="right") - 1
+        k = np.clip(k, 0, len(t0) - 1)
+        dt = t - t0[k]
+        j = self.j[dof][k]
+        a = self.a[dof][k]
+        v = self.v[dof][k]
+        p = self.p[dof][k]
+        pos = p + dt * (v + dt * (a / 2.0 + dt * j / 6.0))
+        vel = v + dt * (a + dt * j / 2.0)
+        acc = a + dt * j
+        return pos, vel, acc
 
 
-def solve(length: float, v_max: float, a_max: float, j_max: float, v0: float = 0.0, a0: float = 0.0,
-          v1: float = 0.0) -> PathProfile:
-    """Time-optimal jerk-limited profile from (0, v0, a0) to (length, v1, 0)."""
-    if v_max <= 0 or a_max <= 0 or j_max <= 0:
-        raise NcAlarm(0x1001, f"non-positive path limit (v={v_max:g}, a={a_max:g}, j={j_max:g})")
-    _INP.current_position = [0.0]
-    _INP.current_velocity = [v0]
-    _INP.current_acceleration = [a0]
-    _INP.target_position = [length]
-    _INP.target_velocity = [v1]
-    _INP.target_acceleration = [0.0]
-    _INP.max_velocity = [v_max]
-    _INP.max_acceleration = [a_max]
-    _INP.max_jerk = [j_max]
+def _phases(pr) -> tuple[list, list, list, list, list]:
+    t0, p, v, a, j = [], [], [], [], []
+    t = 0.0
+    b = pr.brake
+    if b.duration > 0.0:
+        for k in range(2):
+            if b.t[k] > 0.0:
+                t0.append(t), p.append(b.p[k]), v.append(b.v[k]), a.append(b.a[k]), j.append(b.j[k])
+                t += b.t[k]
+    for k in range(7):
+        if pr.t[k] > 0.0:
+            t0.append(t), p.append(pr.p[k]), v.append(pr.v[k]), a.append(pr.a[k]), j.append(pr.j[k])
+            t += pr.t[k]
+    # The final state, integrated from the last phase (pf is not kept for velocity control).
+    if len(t0) > 0:
+        h = t - t0[-1]
+        pe = p[-1] + h * (v[-1] + h * (a[-1] / 2.0 + h * j[-1] / 6.0))
+        ve = v[-1] + h * (a[-1] + h * j[-1] / 2.0)
+        ae = a[-1] + h * j[-1]
+    else:
+        pe, ve, ae = pr.p[0], pr.v[0], pr.a[0]
+    t0.append(t), p.append(pe), v.append(ve), a.append(ae), j.append(0.0)
+    return t0, p, v, a, j
+
+
+def solve_position(p0: float, v0: float, a0: float, p1: float, v1: float, v_max: float, a_max: float,
+                   j_max: float) -> Piecewise | None:
+    """Time-optimal 1-DoF profile (p0, v0, a0) → (p1, v1, 0); None when ruckig cannot solve it."""
+    otg, inp = _calc(1)
+    inp.control_interface = ControlInterface.Position
+    inp.synchronization = Synchronization.Time
+    inp.current_position = [p0]
+    inp.current_velocity = [v0]
+    inp.current_acceleration = [a0]
+    inp.target_position = [p1]
+    inp.target_velocity = [v1]
+    inp.target_acceleration = [0.0]
+    inp.max_velocity = [max(v_max, 1e-9)]
+    inp.max_acceleration = [a_max]
+    inp.max_jerk = [j_max]
     traj = Trajectory(1)
-    result = _OTG.calculate(_INP, traj)
-    if result not in (Result.Working, Result.Finished):
-        raise NcAlarm(0x0000, f"trajectory generation failed ({result}) for a {length:g} mm segment")
-    return PathProfile(length, traj.duration, traj)
+    if otg.calculate(inp, traj) not in _OK:
+        return None
+    return Piecewise.of(traj)
+
+
+def solve_velocity(p0: float, v0: float, a0: float, v1: float, a_max: float, j_max: float) -> Piecewise:
+    """Jerk-limited change of velocity to v1 (ends with a = 0), e.g. a feed hold or override ramp."""
+    otg, inp = _calc(1)
+    inp.control_interface = ControlInterface.Velocity
+    inp.synchronization = Synchronization.Time
+    inp.current_position = [p0]
+    inp.current_velocity = [v0]
+    inp.current_acceleration = [a0]
+    inp.target_position = [p0]
+    inp.target_velocity = [v1]
+    inp.target_acceleration = [0.0]
+    inp.max_velocity = [max(abs(v0), abs(v1), 1e-9)]
+    inp.max_acceleration = [a_max]
+    inp.max_jerk = [j_max]
+    traj = Trajectory(1)
+    if otg.calculate(inp, traj) not in _OK:
+        raise NcAlarm(0x0000, f"velocity ramp {v0:g} → {v1:g} mm/s cannot be planned")
+    return Piecewise.of(traj)
+
+
+def solve_axes(p0, v0, a0, p1, v_max, a_max, j_max, velocity: bool = False) -> Piecewise:
+    """Every axis independently (no synchronisation) to rest at p1, or to v = 0 when `velocity`."""
+    n = len(p0)
+    otg, inp = _calc(n)
+    inp.control_interface = ControlInterface.Velocity if velocity else ControlInterface.Position
+    inp.synchronization = Synchronization.No
+    inp.current_position = list(map(float, p0))
+    inp.current_velocity = list(map(float, v0))
+    inp.current_acceleration = list(map(float, a0))
+    inp.target_position = list(map(float, p1))
+    inp.target_velocity = [0.0] * n
+    inp.target_acceleration = [0.0] * n
+    inp.max_velocity = list(map(float, v_max))
+    inp.max_acceleration = list(map(float, a_max))
+    inp.max_jerk = list(map(float, j_max))
+    traj = Trajectory(n)
+    result = otg.calculate(inp, traj)
+    if result not in _OK:
+        raise NcAlarm(0x0000, f"independent-axis rapid cannot be planned ({result})")
+    return Piecewise.of(traj)

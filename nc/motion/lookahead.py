@@ -1,0 +1,171 @@
+"""Look-ahead: per-block path limits, junction speeds and the backward pass.
+
+Every block gets a path speed cap (feed, axis speeds projected on its direction, centripetal
+limits, minimum duration) and tangential acceleration/jerk limits from the axis limits it
+projects onto. The junction speed between two blocks is bounded by what one bus cycle of the
+setpoint stream can absorb: a tangent jump of |Δu| at speed v changes each axis' finite-difference
+velocity within one cycle, so v·|Δu_a|·2/T² must fit in the axis' corner jerk share (the 2 covers
+two corners in one 3-sample stencil once segments last at least one cycle), and a curvature jump
+|Δκ_a| changes the axis acceleration within one cycle: v²·|Δκ_a|/T must fit in the curvature share.
+
+End speeds follow from a backward pass with the closed-form distance a jerk-limited speed change
+needs when it starts and ends at zero acceleration (the plans execute exactly such profiles), so
+no block ever has to brake harder than its limits.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from nc.motion.limits import MotionConfig
+from nc.motion.path import Segment
+from nc.moves import Move
+
+MARGIN = 0.98  # the passes plan with 98 % of the limits ruckig gets, so plans are never borderline
+
+
+@dataclass(slots=True)
+class Block:
+    move: Move
+    kind: str  # "path" (line/arc/interpolated rapid), "indep" (independent rapid), "dwell", "thread"
+    seg: Segment | None
+    length: float
+    cap_hard: float  # geometric cap: axis speeds, centripetal limits, minimum duration (mm/s)
+    a: float  # tangential path acceleration limit (mm/s²)
+    j: float  # tangential path jerk limit (mm/s³)
+    feed: float | None  # programmed feed in mm/s (mm/rev when per_rev); None for rapids
+    rapid: bool = False
+    cap: float = 0.0  # effective cap with feed, override and spindle speed applied
+    vjunc: float = 0.0  # speed allowed at the junction to the next block
+    vend: float = 0.0  # planned end speed after the backward pass
+    anchor_v: float = 0.0  # nearest binding speed downstream of this block's end ...
+    anchor_d: float = 0.0  # ... and the path length to it
+    anchor_a: float = 0.0  # least tangential acceleration and jerk over that stretch
+    anchor_j: float = 0.0
+    binding: bool = True  # vend is this junction's own limit, not a downstream one
+
+
+def change_distance(v0: float, v1: float, a: float, j: float) -> float:
+    """Path length a jerk-limited speed change v0 → v1 needs, zero acceleration at both ends."""
+    dv = abs(v1 - v0)
+    if dv * j <= a * a:
+        return (v0 + v1) * math.sqrt(dv / j)
+    return 0.5 * (v0 + v1) * (dv / a + a / j)
+
+
+def reach(v0: float, length: float, a: float, j: float) -> float:
+    """Highest speed reachable from v0 within `length` (zero acceleration at both ends).
+
+    By time symmetry it is also the highest entry speed that can still brake to v0 within `length`.
+    """
+    if length <= 0.0:
+        return v0
+    # No constant-acceleration phase: (2·v0 + x²)·x = L·√j with x = √Δv (one real root).
+    q = length * math.sqrt(j)
+    p = 2.0 * v0
+    disc = math.sqrt(q * q / 4.0 + p ** 3 / 27.0)
+    x = _cbrt(q / 2.0 + disc) + _cbrt(q / 2.0 - disc)
+    dv = x * x
+    if dv * j <= a * a:
+        return v0 + dv
+    # With a constant-acceleration phase: Δv²/a + Δv·(2·v0/a + a/j) + 2·v0·a/j − 2·L = 0.
+    qa = 1.0 / a
+    qb = 2.0 * v0 / a + a / j
+    qc = 2.0 * v0 * a / j - 2.0 * length
+    dv = (-qb + math.sqrt(qb * qb - 4.0 * qa * qc)) / (2.0 * qa)
+    return v0 + max(dv, 0.0)
+
+
+def _cbrt(x: float) -> float:
+    return math.cbrt(x)
+
+
+class Limits:
+    """Axis limit vectors and the planner settings, prepared once."""
+
+    def __init__(self, cfg: MotionConfig) -> None:
+        self.cfg = cfg
+        self.T = cfg.cycle
+        self.v = np.array([cfg.limit(a).max_velocity for a in cfg.axes])
+        self.acc = np.array([cfg.limit(a).max_acceleration for a in cfg.axes])
+        self.jerk = np.array([cfg.limit(a).max_jerk for a in cfg.axes])
+
+    def block_limits(self, seg: Segment) -> tuple[float, float, float]:
+        """(speed cap, tangential acceleration, tangential jerk) of a path segment."""
+        cfg = self.cfg
+        d = seg.max_direction_cosines()
+        mask = d > 1e-12
+        if not mask.any():
+            return 0.0, 1.0, 1.0
+        v = float(np.min(self.v[mask] / d[mask]))
+        a = cfg.share_tangential * float(np.min(self.acc[mask] / d[mask]))
+        j = cfg.share_tangential * float(np.min(self.jerk[mask] / d[mask]))
+        if seg.kind == "arc" and seg.radius > 0.0:
+            k = seg.arc_len / seg.length
+            rc = seg.radius / max(k * k, 1e-12)  # radius of curvature of the (helical) path
+            pa = min(self.acc[seg.i1], self.acc[seg.i2])
+            pj = min(self.jerk[seg.i1], self.jerk[seg.i2])
+            sc = cfg.share_curvature
+            v = min(v, math.sqrt(sc * pa * rc), (0.3 * sc * pj * rc * rc) ** (1.0 / 3.0))
+            # d/dt of the centripetal term couples tangential acceleration into jerk: 3·v·a_t/r.
+            a = min(a, 0.3 * sc * pj * rc / (3.0 * max(v, 1e-9)))
+        v = min(v, seg.length / (cfg.min_segment_cycles * self.T))
+        return v, a, j
+
+    def junction(self, b1: Block, b2: Block) -> float:
+        """Highest speed at the junction b1 → b2."""
+        if b1.kind != "path" or b2.kind != "path" or b1.rapid or b2.rapid or b1.move.exact_stop:
+            return 0.0  # G00, G09/G61, dwells, threads and independent rapids stop at their ends
+        s1, s2 = b1.seg, b2.seg
+        assert s1 is not None and s2 is not None
+        v = min(b1.cap_hard, b2.cap_hard)
+        du = np.abs(s2.unit_tangent(False) - s1.unit_tangent(True))
+        dmax = float(du.max())
+        cfg, T = self.cfg, self.T
+        if dmax > 1e-9:
+            m = du > 1e-12
+            v = min(v, cfg.share_corner * float(np.min(self.jerk[m] * T * T / (2.0 * du[m]))),
+                    cfg.share_corner * float(np.min(self.acc[m] * T / du[m])))
+            if cfg.path_tolerance is not None:
+                v = min(v, 4.0 * cfg.path_tolerance / (T * float(np.linalg.norm(du))))
+        dk = np.abs(s2.curvature_vector(False) - s1.curvature_vector(True))
+        if float(dk.max()) > 1e-12:
+            m = dk > 1e-12
+            v = min(v, float(np.min(np.sqrt(0.4 * cfg.share_curvature * self.jerk[m] * T / dk[m]))))
+        return max(v, 0.0)
+
+
+def backward(blocks: Sequence[Block], lo: int = 0, full: bool = False) -> None:
+    """Backward pass from the queue tail (which ends at rest) down to index lo.
+
+    A junction's end speed is the least of its own limit and what the nearest *binding* junction
+    downstream allows over the whole path length in between (braking may carry acceleration
+    through intermediate junctions, so chains of short blocks are not forced to a = 0 at each).
+    Appending a block only raises end speeds, so the incremental pass stops once a junction is
+    binding and unchanged (LinuxCNC's "rising tide"); `full` recomputes everything.
+    """
+    n = len(blocks)
+    if n == 0:
+        return
+    tail = blocks[n - 1]
+    tail.vend, tail.binding = 0.0, True
+    for i in range(n - 2, lo - 1, -1):
+        b, nx = blocks[i], blocks[i + 1]
+        local = min(b.vjunc, b.cap, nx.cap)
+        if local <= 0.0:
+            v, av, ad, aa, aj = 0.0, 0.0, 0.0, nx.a, nx.j
+        else:
+            if nx.binding:
+                av, ad, aa, aj = nx.vend, nx.length, nx.a, nx.j
+            else:
+                av, ad, aa, aj = nx.anchor_v, nx.anchor_d + nx.length, min(nx.anchor_a, nx.a), min(nx.anchor_j, nx.j)
+            v = min(local, reach(av, ad, MARGIN * aa, MARGIN * aj))
+        binding = v >= local - 1e-12
+        if not full and abs(v - b.vend) <= 1e-12 and binding and b.binding:
+            break
+        b.vend, b.binding = v, binding
+        b.anchor_v, b.anchor_d, b.anchor_a, b.anchor_j = av, ad, aa, aj
