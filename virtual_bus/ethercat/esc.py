@@ -387,9 +387,12 @@ class Esc:
             if typ & 1 and cmd in (LRD, LRW):
                 reads.append((lo, hi, ps + lo - ls))
         inc = 0
-        if writes and state == OP:
+        if writes:
+            # The ESC takes outputs from SAFE-OP on (the SM is enabled); only OP applies them.
             for lo, hi, p in writes:
                 self.mem[p:p + hi - lo] = data[lo - addr:hi - addr]
+            inc += 2 if cmd == LRW else 1
+        if writes and state == OP:
             now = time.monotonic_ns()
             dt = self.cycle_time
             if not self.lockstep and self.last_cycle_ns:
@@ -400,7 +403,6 @@ class Esc:
             s2 = self.sm(2)
             self._write_inputs(self.app.cycle(bytes(self.mem[s2.start:s2.end]), self.rx_map, self.tx_map,
                                               step=True, dt=dt))
-            inc += 2 if cmd == LRW else 1
         elif reads and state == SAFEOP:
             s2 = self.sm(2)
             self._write_inputs(self.app.cycle(bytes(self.mem[s2.start:s2.end]), self.rx_map, self.tx_map,

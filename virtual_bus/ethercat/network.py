@@ -81,8 +81,6 @@ class Chain:
         """Process one Ethernet frame; returns (answer or None if lost, delay in s)."""
         if len(frame) < 16 or struct.unpack_from(">H", frame, 12)[0] != ETH_P_ECAT:
             return None, 0.0
-        if frame[6] & 0x02:
-            return None, 0.0  # a frame an ESC already returned (our own echo)
         hdr = struct.unpack_from("<H", frame, 14)[0]
         if hdr >> 12 != 1:
             return None, 0.0

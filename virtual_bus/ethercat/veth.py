@@ -52,3 +52,48 @@ def can_create() -> str | None:
     except (OSError, subprocess.CalledProcessError) as exc:
         return f"cannot create a veth pair here: {getattr(exc, 'stderr', '') or exc}"
     return None
+
+
+class SimProcess:
+    """`hil sim ethercat` running in the namespace end of a veth pair, as a context manager:
+    creates the pair, starts the slaves, waits until they listen, and cleans everything up."""
+
+    def __init__(self, *sim_args: str, tag: str = "") -> None:
+        self.sim_args = list(sim_args)
+        self.tag = tag
+        self.pair: VethPair | None = None
+        self.proc: subprocess.Popen | None = None
+        self.log = ""
+
+    @property
+    def iface(self) -> str:
+        assert self.pair is not None
+        return self.pair.master_if
+
+    def __enter__(self) -> "SimProcess":
+        import sys
+
+        self.pair = VethPair.create(self.tag)
+        try:
+            cmd = self.pair.exec_prefix() + [sys.executable, "-m", "hil.cli", "sim", "ethercat",
+                                             "--iface", self.pair.slave_if, "--verbose", *self.sim_args]
+            self.proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+            line = self.proc.stdout.readline() if self.proc.stdout else ""
+            if "slaves on" not in line:
+                self.proc.wait(5)
+                raise RuntimeError(f"hil sim ethercat did not start: {line}{self.proc.stderr.read() if self.proc.stderr else ''}")
+        except BaseException:
+            self.__exit__(None, None, None)
+            raise
+        return self
+
+    def __exit__(self, *exc) -> None:
+        if self.proc is not None and self.proc.poll() is None:
+            self.proc.terminate()
+            try:
+                _, self.log = self.proc.communicate(timeout=5)
+            except subprocess.TimeoutExpired:
+                self.proc.kill()
+                self.proc.wait()
+        if self.pair is not None:
+            self.pair.delete()
