@@ -352,6 +352,7 @@ class Interpreter:
             elif fn in ("G70", "G71", "G72", "G73", "G74", "G75", "G76"):
                 yield from context.run_cycle(self, fn, block)
                 moved = True
+                self._skip_contour(fn, block)
         if not any(fn in ("G04", "G10", "G11", "G28", "G29", "G30", "G31", "G52", "G53", "set", "G05",
                           "G70", "G71", "G72", "G73", "G74", "G75", "G76", "G900") for fn in nonmodal):
             for ev in self._motion(block, funcs):
@@ -678,7 +679,10 @@ class Interpreter:
 
     def _geometry(self, block: Block, base: dict[str, float] | None = None) -> _Geometry:
         st = self.state
+        tr = _transforms(self)
         work = dict(base) if base is not None else self.work_position()
+        if tr is not None:
+            work = tr.inverse(self, work)  # incremental moves count in the programmed frame
         words = self._axis_words(block)
         if st.polar and not self.profile.is_lathe:
             return self._polar_geometry(block, work, words)
@@ -688,7 +692,7 @@ class Interpreter:
         axes = set(words)
         if "A" in block.comma and len(axes & set(PLANES[st.plane])) == 1:
             self._linear_angle(block, work, axes)
-        machine = self.to_machine(work)
+        machine = self.to_machine(tr.apply(self, work) if tr is not None else work)
         for a in self.axes:
             if not math.isfinite(machine[a]) or abs(machine[a]) > 1e9:
                 raise NcAlarm(0x120E, f"{a} target is out of range")
@@ -730,9 +734,10 @@ class Interpreter:
             work[a1] = start[a1] + d2 / t / k1
         axes.update((a1, a2))
 
-    def target(self, block: Block) -> tuple[dict[str, float], dict[str, float], bool]:
+    def target(self, block: Block) -> dict[str, float]:
+        """Programmed end point of the block's axis words (work coordinates, after transforms)."""
         g = self._geometry(block)
-        return g.target_work, g.target_machine, g.moved
+        return self.to_work(g.target_machine)
 
     # ---- motion ------------------------------------------------------------------------
     def feed(self, block: Block | None = None) -> float:
@@ -758,6 +763,9 @@ class Interpreter:
         move.exact_stop = exact or st.exact_stop_modal
         if st.comp in (41, 42):
             move.comp = f"G{st.comp}"
+            tr = _transforms(self)
+            if tr is not None:
+                move.comp = tr.comp_code(self, move.plane, move.comp)
             move.comp_radius, move.tip = self._comp_radius()
         if st.css:
             move.css = st.spindle_speed
@@ -827,6 +835,9 @@ class Interpreter:
         if a1 not in self.axes or a2 not in self.axes:
             raise NcAlarm(0x025D, f"G{st.plane} plane needs axes {a1} and {a2}")
         cw = st.motion == 2
+        tr = _transforms(self)
+        if tr is not None:
+            cw = tr.arc_cw(self, (a1, a2), cw)
         start, end = common["start"], common["end"]
         s = (start[a1], start[a2])
         e = (end[a1], end[a2])
@@ -841,6 +852,14 @@ class Interpreter:
         elif ci is not None or cj is not None:
             # I/J/K are always radius values from the start point (decisions A6)
             c = (s[0] + (self.distance(ci) if ci else 0.0), s[1] + (self.distance(cj) if cj else 0.0))
+            if tr is not None:  # the centre is a programmed point: take it through the transforms
+                pw = tr.inverse(self, self.to_work(start))
+                k1 = 2.0 if a1 in self.profile.diameter_axes else 1.0
+                k2 = 2.0 if a2 in self.profile.diameter_axes else 1.0
+                pw[a1] += (self.distance(ci) if ci else 0.0) * k1
+                pw[a2] += (self.distance(cj) if cj else 0.0) * k2
+                cm = self.to_machine(tr.apply(self, pw))
+                c = (cm[a1], cm[a2])
             check_center(s, e, c, tol)
             self.last_arc_ijk = (self.distance(ci) if ci else 0.0, self.distance(cj) if cj else 0.0, 0.0)
         else:
@@ -1137,6 +1156,9 @@ class Interpreter:
         if not self.profile.is_lathe:
             st.groups[8] = 49
         self.frames.tool_shift = {}
+        tr = _transforms(self)
+        if tr is not None:
+            tr.reset(self)
 
     # ---- calls ---------------------------------------------------------------------------------
     def _args(self, block: Block, skip: set[str]) -> dict[int, float]:
@@ -1328,6 +1350,17 @@ class Interpreter:
     def _interrupt_return(self) -> None:
         return None
 
+    def _skip_contour(self, fn: str, block: Block) -> None:
+        """After G71/G72/G73 P..Q the contour blocks that follow are not run again as moves."""
+        p, q = block.get("P"), block.get("Q")
+        if fn not in ("G71", "G72", "G73") or p is None or q is None:
+            return
+        fr = self.frame
+        if fr.pc < len(fr.program.blocks) and fr.program.blocks[fr.pc].n == int(p.value):
+            qs = fr.program.labels.get(int(q.value))
+            if qs:
+                fr.pc = qs[-1] + 1
+
     # ---- contour access for cycles (context.CycleHost) -----------------------------------------
     def contour_blocks(self, p: int, q: int) -> list[Block]:
         prog = self.frame.program
@@ -1405,6 +1438,18 @@ class Interpreter:
     def emit_aux(self, kind: str, value: float) -> Event:
         b = self.block
         return Aux(kind, value, b.line if b else 0, b.text if b else "", program=self.program_name)  # type: ignore[arg-type]
+
+
+def _transforms(host: "Interpreter"):
+    """`nc.transforms` (issue 4) when scaling, mirror or rotation is active, else None."""
+    try:
+        import nc.transforms as tr
+    except ImportError:
+        return None
+    try:
+        return tr if tr.stack(host).active else None
+    except AttributeError:
+        return None
 
 
 def _compensation():
