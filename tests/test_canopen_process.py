@@ -1,0 +1,103 @@
+"""CANopen between processes over python-can udp_multicast, inside a network namespace this test
+creates (lo up, multicast on, 224.0.0.0/4 via lo) and deletes: `hil sim canopen` serves the
+drives; python-canopen's independent BaseNode402 client enables one in CSP, and `hil run` runs a
+program against them in real time."""
+
+from __future__ import annotations
+
+import json
+import re
+import os
+import shutil
+import subprocess
+import sys
+import uuid
+from pathlib import Path
+
+import pytest
+
+from tests.conftest import ROOT
+
+CLIENT = Path(__file__).parent / "canopen_clients" / "basenode402_csp.py"
+
+
+def _ip(*args: str) -> subprocess.CompletedProcess:
+    return subprocess.run(["ip", *args], capture_output=True, text=True)
+
+
+@pytest.fixture
+def netns():
+    if os.geteuid() != 0 or shutil.which("ip") is None:
+        pytest.skip("needs root and iproute2 to create a network namespace for udp_multicast")
+    name = f"dhco-{uuid.uuid4().hex[:8]}"
+    made = _ip("netns", "add", name)
+    if made.returncode != 0:
+        pytest.skip(f"cannot create a network namespace: {made.stderr.strip()}")
+    try:
+        for cmd in (("link", "set", "lo", "up"), ("link", "set", "lo", "multicast", "on"),
+                    ("route", "add", "224.0.0.0/4", "dev", "lo")):
+            r = _ip("-n", name, *cmd)
+            assert r.returncode == 0, r.stderr
+        yield name
+    finally:
+        _ip("netns", "del", name)
+
+
+def _in_ns(ns: str, *args: str) -> list[str]:
+    return ["ip", "netns", "exec", ns, sys.executable, *args]
+
+
+class _Sim:
+    """`hil sim canopen` in the namespace, started and stopped by the test."""
+
+    def __init__(self, ns: str, group: str, *extra: str) -> None:
+        self.proc = subprocess.Popen(_in_ns(ns, "-m", "hil.cli", "sim", "canopen", "--interface", "udp_multicast",
+                                            "--channel", group, "--duration", "60", *extra),
+                                     stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=ROOT)
+        self.banner = self.proc.stdout.readline()  # printed once the nodes are on the bus
+
+    def stop(self) -> str:
+        self.proc.terminate()
+        _, err = self.proc.communicate(timeout=10)
+        return err
+
+
+def test_basenode402_from_another_process_enables_the_simulated_drive_in_csp(netns):
+    group = "239.74.163.2"
+    sim = _Sim(netns, group)
+    try:
+        assert sim.banner.startswith("hil sim canopen: nodes 1=X, 2=Z, 3=S1"), sim.banner
+        run = subprocess.run(_in_ns(netns, str(CLIENT), group), capture_output=True, text=True, timeout=60, cwd=ROOT)
+    finally:
+        err = sim.stop()
+    assert run.returncode == 0, run.stderr[-2000:]
+    seen = json.loads(run.stdout.strip().splitlines()[-1])
+    assert seen["device_type"] & 0xFFFF == 402
+    assert seen["state"] == "OPERATION ENABLED"
+    assert seen["op_mode"] == "CYCLIC SYNCHRONOUS POSITION"
+    assert seen["statusword_sdo"] & 0x6F == 0x27
+    assert seen["start"] == 60 * 256_000  # X at its bench start, 60 mm on a 5 mm lead
+    assert abs(seen["position"] - seen["target"]) <= 64  # followed the CSP target (0.02 rev) to 1/20000 rev
+    assert seen["final_state"] == "SWITCH ON DISABLED"
+    assert "1 OPERATIONAL switch on disabled" in err
+
+
+def test_hil_run_drives_hil_sim_canopen_across_processes_in_real_time(netns, tmp_path):
+    group = "239.74.163.3"
+    bench = tmp_path / "lathe-4ms.toml"
+    bench.write_text((ROOT / "benches" / "lathe-2axis.toml").read_text().replace("cycle_ms = 1.0", "cycle_ms = 4.0"))
+    prog = tmp_path / "short.nc"
+    prog.write_text("G21 G18 G98\nG01 X50. Z90. F1200\nM30\n")
+    sim = _Sim(netns, group, "--bench", str(bench))
+    try:
+        run = subprocess.run(_in_ns(netns, "-m", "hil.cli", "run", str(prog), "--bench", str(bench),
+                                    "--bus", f"canopen:udp_multicast:{group}"),
+                             capture_output=True, text=True, timeout=60, cwd=ROOT)
+    finally:
+        err = sim.stop()
+    assert run.returncode == 0, run.stdout + run.stderr
+    assert "final machine position  X 25.0000  Z 90.0000" in run.stdout  # X50. is a diameter
+    cycles = int(run.stdout.split("cycles", 1)[1].split()[0])
+    # Every bench cycle was one SYNC that each node served (UDP may drop a frame); NMT stop at the end.
+    served = [int(n) for n in re.findall(r"\d STOPPED [a-z ]+, (\d+) SYNC", err)]
+    assert len(served) == 3 and all(cycles - 5 <= n <= cycles for n in served), err
