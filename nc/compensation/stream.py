@@ -18,6 +18,7 @@ stage replaces the programmed path by the compensated one (decisions A52–A54):
 from __future__ import annotations
 
 from collections.abc import Iterable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
 
 from nc.alarms import NcAlarm
@@ -262,8 +263,24 @@ class Compensator:
         return out
 
 
+_ENABLED = [True]
+
+
+@contextmanager
+def disabled() -> Iterator[None]:
+    """Interpret the programmed (uncompensated) path, e.g. to draw it next to the compensated one."""
+    _ENABLED.append(False)
+    try:
+        yield
+    finally:
+        _ENABLED.pop()
+
+
 def compensate(events: Iterable[Event], profile: object | None = None) -> Iterator[Event]:
     """Wrap an event stream; moves without `comp` pass through unchanged and in order."""
+    if not _ENABLED[-1]:
+        yield from events
+        return
     comp = Compensator()
     for ev in events:
         yield from comp.push(ev)

@@ -74,8 +74,8 @@ def rough(b: PathBuilder, contour_segs: list[Seg], spec: RoughSpec) -> None:
     a_f, a_d = frame.to_fd(start)
     if a_d < prof.d_min - 1e-9:
         raise NcAlarm(0x0246, f"{spec.code}: the start point lies inside the finished contour")
-    if a_f < prof.f_start - 1e-6:
-        raise NcAlarm(0x0246, f"{spec.code}: the start point lies past the beginning of the contour")
+    # a start point level with the contour start (the allowance may shift the contour past it) is
+    # fine: the layers begin at the farther of the two
     e = spec.retract
     safe = max(a_d, prof.d_max) + max(e, 0.0)
     infeed_rapid = bool(approach) or contour_segs[0].rapid
