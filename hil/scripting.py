@@ -334,3 +334,48 @@ def run_script(path: str, machine: Machine, args: list[str] | None = None) -> An
 
 
 __all__ = ["Machine", "OperatorPanel", "ScriptError", "run_script", "NcAlarm"]
+
+
+# ---- `hil run --mlc MODULE --trace-signals LIST --m00-resume S` --------------------------------------
+def build_mlc(bench: Bench, spec: str | None) -> Any:
+    """The bench's MLC: "basic" → the foundation's BasicMlc; "lathe" / "default" → the Delta MLC with the
+    default lathe program (mlc.lathe); anything else → the Delta MLC running that user module."""
+    from mlc.basic import BasicMlc
+
+    spec = spec or getattr(bench, "mlc", "basic") or "basic"
+    max_rpm = min((s.max_rpm for s in bench.spindles), default=6000.0)
+    if spec == "basic":
+        return BasicMlc(max_rpm=max_rpm)
+    program = None if spec in ("lathe", "default") else load_mlc_program(spec)
+    return Mlc(program, axes=bench.axis_names, cycle=bench.cycle, motion=bench.motion_config(), max_rpm=max_rpm)
+
+
+def load_mlc_program(spec: str) -> Any:
+    from mlc.machine import load_program
+
+    module_spec = spec.split(":")[0] if not spec.endswith(".py") else spec
+    return load_program(module_spec)
+
+
+def mlc_setup(bench: Bench, mlc_spec: str | None, signals: str | None, m00_resume: float | None):
+    """(mlc, on_cycle, trace sources) for `hil run`; raises InputError naming a bad module or device."""
+    from hil.session import InputError
+    from mlc.machine import MlcLoadError
+    from mlc.memory import DeviceError
+    from mlc.tracing import SignalSource, parse_signal_list
+
+    if signals and not mlc_spec and getattr(bench, "mlc", "basic") == "basic":
+        mlc_spec = "lathe"  # device columns need the Delta MLC
+    try:
+        mlc = build_mlc(bench, mlc_spec)
+    except MlcLoadError as exc:
+        raise InputError(str(exc)) from None
+    if not isinstance(mlc, Mlc):
+        return mlc, None, []
+    sources = []
+    if signals:
+        try:
+            sources.append(SignalSource(mlc.mem, parse_signal_list(signals, mlc.link.x)))
+        except DeviceError as exc:
+            raise InputError(f"--trace-signals: {exc}") from None
+    return mlc, OperatorPanel(mlc, m00_resume), sources

@@ -174,11 +174,7 @@ class ChannelLink:
             self._set3(38, False)
             self._complete(ch, aux)
             return
-        if getattr(ch, "held", False):
-            resume = getattr(ch, "resume", None) or getattr(ch, "cycle_start")
-            resume()
-            return
-        ch.cycle_start()
+        ch.cycle_start()  # starts, resumes after feed hold, or runs the next single block
 
     def _finish_input(self, ch: Channel) -> None:
         if self._handed is None:
@@ -208,17 +204,17 @@ class ChannelLink:
             self._set3(38, False)
 
     def _overrides(self, ch: Channel) -> None:
-        feed = min(self.mem.u16(d2(self.x, 2)), 150)
-        rapid = self.mem.u16(d2(self.x, 4))
-        for name, value in (("set_feed_override", feed), ("set_rapid_override", rapid)):
-            fn = getattr(ch, name, None)
-            if callable(fn):
-                fn(value / 100.0)
-        for name, on in (("set_single_block", self._m2(8)), ("set_dry_run", self._m2(5)),
-                         ("set_block_skip", self._m2(10))):
-            fn = getattr(ch, name, None)
-            if callable(fn):
-                fn(on)
+        """Overrides and program-flow switches are levels: applied whenever they differ from the channel."""
+        x = self.x
+        want = {
+            "feed_override": min(self.mem.u16(d2(x, 2)), 150) / 100.0,  # 0–150 %
+            "rapid_override": self.mem.u16(d2(x, 4)) / 100.0,
+            "dry_run": self._m2(5),
+            "single_block": self._m2(8),
+        }
+        for name, value in want.items():
+            if hasattr(ch, name) and getattr(ch, name) != value:
+                setattr(ch, name, value)
 
     def _spindle_alarm(self, ch: Channel) -> None:
         for k in range(8):
@@ -312,8 +308,8 @@ class ChannelLink:
             self._set3(k, self.mode == k)
         self._set3(32, self._mode_switch_cycles > 0)
         self._handshake_output(ch)
-        held = bool(getattr(ch, "held", False))
-        running = ch.busy and ch.state is not RunState.STOPPING and not held and self._system_hold is None
+        held = ch.state.name == "HOLD"
+        running = ch.state in (RunState.RUNNING, RunState.WAIT_AUX) and self._system_hold is None
         self._set3(16, running)
         self._set3(17, held)
         self._set3(18, self._m2(13))
@@ -323,7 +319,9 @@ class ChannelLink:
             self._set3(19, False)
         self._set3(25, ch.state is RunState.ALARM or any(not isinstance(a.code, str) for a in self.alarms))
         self._set3(40, bool(mem.active_alarms()))
-        self._set3(24, bool(getattr(ch, "single_block_hold", False)))
+        block_stop = ch.state.name == "BLOCK_STOP"
+        self._set3(24, block_stop)
+        self._set3(39, block_stop)
         if ch.state is RunState.FINISHED and ch.end is not None and self._program_end is None:
             self._program_end = ch.end.code
         end = self._program_end
