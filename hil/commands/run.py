@@ -13,6 +13,7 @@ from hil.cli import EXIT_ALARM, EXIT_OK, EXIT_USAGE
 from hil.clock import make_clock
 from hil.progress import Progress, wants_progress
 from hil.runner import BenchRunner, RunResult
+from hil.scripting import mlc_setup
 from hil.session import InputError, load_bench, load_program, make_link, print_alarm
 from hil.trace import open_trace
 from nc.alarms import NcAlarm
@@ -32,6 +33,12 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="judge the run by the bench's [checks] (default: on when the bench has checks)")
     p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
                    help="progress bar on stderr (default: only when stderr is a terminal)")
+    p.add_argument("--mlc", metavar="MODULE",
+                   help="MLC program: basic | lathe (the default lathe MLC) | module name | path.py (overrides the bench)")
+    p.add_argument("--trace-signals", metavar="DEVICES",
+                   help="extra trace columns, one per MLC device: M31064,M21016,D31048 or App. B names")
+    p.add_argument("--m00-resume", metavar="SECONDS", type=float, default=0.5,
+                   help="the simulated operator presses Cycle Start this long after an M00/M01 hold (default 0.5)")
     p.set_defaults(func=cmd_run)
 
 
@@ -57,7 +64,13 @@ def cmd_run(args: argparse.Namespace) -> int:
     progress = None
     if wants_progress(args.progress):
         progress = Progress(max((b.line for b in program.blocks), default=1))
-    runner = BenchRunner(bench, link, None, clock=clock, progress=progress)
+    try:  # the MLC, its operator panel and --trace-signals columns (issue 8)
+        mlc, panel, signal_sources = mlc_setup(bench, args.mlc, args.trace_signals, args.m00_resume)
+    except InputError as exc:
+        print(f"hil run: {exc}", file=sys.stderr)
+        return EXIT_USAGE
+    runner = BenchRunner(bench, link, None, mlc, panel, clock=clock, progress=progress)
+    runner.trace_sources += signal_sources
     # Extra trace columns (e.g. the MLC's --trace-signals) are TraceSources appended here,
     # before the trace is opened with the runner's columns.
     trace_path = args.trace
