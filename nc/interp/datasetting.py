@@ -75,9 +75,10 @@ def g10(ip: "Interpreter", block: "Block") -> Iterator[Event]:
                 table[(a, P)] = table.get((a, P), 0.0) + v if inc else v
             if r is not None and ip.profile.is_lathe:
                 (t.radius if L == 10 else t.radius_wear)[P] = ip.distance(r)
-            elif r is not None:
+            elif r is not None:  # mill: R is the length (G91: an increment, N§3.8.3)
                 z = "Z" if "Z" in ip.axes else ip.axes[-1]
-                table[(z, P)] = ip.distance(r)
+                v = ip.distance(r)
+                table[(z, P)] = v if ip.state.absolute else table.get((z, P), 0.0) + v
             q = block.get("Q")
             if q is not None and ip.profile.is_lathe:
                 t.tip[P] = q.value

@@ -387,7 +387,10 @@ def parse_block(line: int, text: str) -> Block:
     if s.startswith("/"):
         block.skip = True
         s = s[1:]
-    _BlockParser(line, text.rstrip("\r\n"), s).parse(block)
+    try:
+        _BlockParser(line, text.rstrip("\r\n"), s).parse(block)
+    except NcAlarm as exc:
+        raise exc.at(line, block.text) from None
     return block
 
 
