@@ -299,6 +299,10 @@ class Planner:
                 return _Plan("dwell", None, float(b.move.duration or 0.0), t0)
             if b.kind == "indep":
                 return self._plan_indep(b, t0)
+            if self.s >= b.length - 1e-9 and len(self.blocks) > 1 and self.blocks[1].kind == "path":
+                self.s -= b.length
+                self._finish_block(keep_plan=True)
+                continue
             if self.s >= b.length - 1e-12 and abs(self.v) < 1e-9:
                 self._finish_block()
                 continue
@@ -334,8 +338,13 @@ class Planner:
         if pw is None or pw.p.max() > dist + 1e-7 or pw.v.min() < -1e-7:
             # Cannot meet the target from this state (an override just cut the cap): ramp down
             # to the cap first, then plan the rest from there.
-            pw = solve_velocity(s, v, a, min(cap, max(v1, 0.0)), b.a, b.j)
-            return _Plan("ramp", pw, pw.duration, t0, 0.0, min(cap, v1))
+            target = min(cap, max(v1, 0.0))
+            pw = solve_velocity(s, v, a, target, b.a, b.j)
+            if target > 1e-9:
+                # after the ramp, cruise at the target speed to the end of the run
+                pw.duration = max(pw.duration, (dist - s) / target)
+                pw.t0[:, -1] = np.minimum(pw.t0[:, -1], pw.duration)
+            return _Plan("ramp", pw, pw.duration, t0, 0.0, target)
         return _Plan("path", pw, pw.duration, t0, target=dist, rpm=rpm)
 
     def _run_target(self, cap: float) -> tuple[float, float, float, float]:

@@ -1,0 +1,50 @@
+"""Shared builders for the motion tests: moves straight from point lists (the Move seam)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from nc.motion import AxisLimits, MotionConfig
+from nc.motion.offline import Stream
+from nc.moves import Move
+
+AX = ("X", "Y", "Z")
+
+
+def mill_cfg(**kw) -> MotionConfig:
+    lim = {"X": AxisLimits(400, 4000, 200_000), "Y": AxisLimits(400, 4000, 200_000), "Z": AxisLimits(200, 2000, 100_000)}
+    return MotionConfig(axes=AX, limits=lim, **kw)
+
+
+def lines(pts, feed, kind="line", first_line=1, **kw) -> list[Move]:
+    out = []
+    for k in range(1, len(pts)):
+        s = dict(zip(AX, map(float, pts[k - 1])))
+        e = dict(zip(AX, map(float, pts[k])))
+        out.append(Move(kind, first_line + k - 1, "", s, e, e, feed=feed, plane=("X", "Y"), **kw))
+    return out
+
+
+def arc(s, e, c, d, feed, line=0) -> Move:
+    s = dict(zip(AX, map(float, s)))
+    e = dict(zip(AX, map(float, e)))
+    return Move("arc", line, "", s, e, e, center={"X": c[0], "Y": c[1], "Z": 0.0}, dir=d, feed=feed, plane=("X", "Y"))
+
+
+def circle_chords(radius: float, chord: float) -> list[tuple[float, float, float]]:
+    n = int(2 * math.pi * radius / chord)
+    return [(radius * math.cos(2 * math.pi * k / n), radius * math.sin(2 * math.pi * k / n), 0.0) for k in range(n + 1)]
+
+
+def worst_ratio(st: Stream, cfg: MotionConfig) -> dict[str, float]:
+    """Largest |v|/v_max, |a|/a_max, |j|/j_max over every cycle and axis (finite differences)."""
+    v, a, j = st.derivatives()
+    out = {"v": 0.0, "a": 0.0, "j": 0.0}
+    for i, ax in enumerate(cfg.axes):
+        lim = cfg.limit(ax)
+        out["v"] = max(out["v"], float(np.abs(v[:, i]).max()) / lim.max_velocity)
+        out["a"] = max(out["a"], float(np.abs(a[:, i]).max()) / lim.max_acceleration)
+        out["j"] = max(out["j"], float(np.abs(j[:, i]).max()) / lim.max_jerk)
+    return out

@@ -1,0 +1,77 @@
+"""Every cycle of the setpoint stream stays inside each axis' velocity, acceleration and jerk
+limits (finite differences of the per-cycle positions, tiny float tolerance only)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from nc.motion.offline import run
+from tests.motion_helpers import AX, arc, circle_chords, lines, mill_cfg, worst_ratio
+
+TOL = 1.0 + 1e-6
+
+
+def check(moves, cfg, start=(0.0, 0.0, 0.0)):
+    st = run(moves, cfg, dict(zip(AX, start)))
+    assert st.state.value == "finished" and not st.alarms
+    r = worst_ratio(st, cfg)
+    assert r["v"] <= TOL and r["a"] <= TOL and r["j"] <= TOL, r
+    return st
+
+
+def test_corners_and_reversals_end_exactly():
+    pts = [(0, 0, 0), (10, 0, 0), (10, 10, 0), (0, 10, 0), (0, 0, 0), (20, 5, 0), (0, 0, 0), (10, 0, 0), (0, 0, 0)]
+    st = check(lines(pts, 3000), mill_cfg())
+    assert np.allclose(st.positions[-1], 0.0, atol=1e-9)
+    # every corner of the square is visited (the path is followed, not cut)
+    for p in pts:
+        assert np.min(np.linalg.norm(st.positions - np.array(p, float), axis=1)) < 1e-4
+
+
+def test_arcs_lines_and_full_circle():
+    moves = [lines([(0, 0, 0), (10, 0, 0)], 3000)[0], arc((10, 0, 0), (20, 10, 0), (10, 10), "ccw", 3000),
+             arc((20, 10, 0), (30, 20, 0), (30, 10), "cw", 3000), lines([(20, 10, 0), (30, 40, 0)], 3000)[0],
+             arc((30, 40, 0), (30, 40, 0), (30, 30), "cw", 3000, line=9)]
+    moves[3].start = {"X": 30.0, "Y": 20.0, "Z": 0.0}
+    st = check(moves, mill_cfg())
+    assert np.allclose(st.positions[-1], [30, 40, 0], atol=1e-9)
+    # the full circle keeps its radius on every cycle
+    idx = st.lines == 9
+    r = np.hypot(st.positions[idx, 0] - 30, st.positions[idx, 1] - 30)
+    assert np.all(np.abs(r[r > 1] - 10.0) < 1e-6)
+
+
+def test_tiny_cam_segments_on_a_smooth_curve():
+    rng = np.random.default_rng(5)
+    s = np.cumsum(rng.uniform(0.01, 0.1, 1500))
+    pts = [(0.0, 0.0, 0.0)] + [(x, 3.0 * math.sin(x / 4.0), 0.2 * math.cos(x / 3.0) - 0.2) for x in s]
+    check(lines(pts, 3000), mill_cfg())
+
+
+def test_jagged_cam_segments_and_z_moves():
+    rng = np.random.default_rng(1)
+    p, d, pts = np.zeros(3), np.array([1.0, 0, 0]), [np.zeros(3)]
+    for _ in range(300):
+        d = d + rng.normal(0, 0.3, 3) * [1, 1, 0.5]
+        d /= np.linalg.norm(d)
+        p = p + d * rng.uniform(0.01, 0.1)
+        pts.append(p)
+    check(lines(pts, 6000), mill_cfg())
+
+
+@pytest.mark.parametrize("independent", [False, True])
+def test_rapids(independent):
+    cfg = mill_cfg(rapid_independent=independent)
+    st = check(lines([(0, 0, 0), (50, 30, -20), (0, 0, 0), (5, 0, 0)], None, kind="rapid"), cfg)
+    assert np.allclose(st.positions[-1], [5, 0, 0], atol=1e-9)
+
+
+def test_chord_circle_within_5_percent_of_feed_limited_time():
+    cfg = mill_cfg()
+    pts = circle_chords(100.0, 0.05)
+    st = check(lines(pts, 3000), cfg, start=pts[0])
+    feed_limited = 2 * math.pi * 100.0 / 50.0
+    assert st.time < 1.05 * feed_limited
