@@ -1029,6 +1029,9 @@ class Interpreter:
         end = dict(self.position)
         for a in words:
             end[a] = refpt[a]
+        self.unit_locked = True
+        if end == self.position:
+            return
         mv = Move("rapid", block.line, block.text, dict(self.position), end, self.to_work(end),
                   program=self.program_name, plane=PLANES[self.state.plane], tags=(tag, "reference"),
                   exact_stop=True)
