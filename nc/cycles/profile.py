@@ -127,7 +127,7 @@ class Contour:
                         out.append(p[0])
         return out
 
-    def intervals(self, level: float) -> list[tuple[float, float]]:
+    def intervals(self, level: float, tol: float = 1e-7) -> list[tuple[float, float]]:
         """Spans (f_hi, f_lo) of f, in cutting order, where the contour lies below `level`."""
         cuts = sorted({self.f_start, self.f_end, *[f for f in self.crossings(level)
                                                     if self.f_end - TOL <= f <= self.f_start + TOL]},
@@ -136,7 +136,7 @@ class Contour:
         for hi, lo in zip(cuts, cuts[1:]):
             if hi - lo < 1e-6:
                 continue
-            if self.depth_at((hi + lo) / 2) < level:
+            if self.depth_at((hi + lo) / 2) < level + tol:
                 if spans and abs(spans[-1][1] - hi) < 1e-9:
                     spans[-1] = (spans[-1][0], lo)
                 else:

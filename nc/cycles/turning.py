@@ -116,7 +116,7 @@ def rough(b: PathBuilder, contour_segs: list[Seg], spec: RoughSpec) -> None:
     prev_level = a_d
     simple = True  # the tool sits at a retract point from which a straight rapid back to the face is clear
     for n, lv in enumerate(levels, start=1):
-        spans = prof.intervals(lv + 1e-7)
+        spans = prof.intervals(lv)
         for hi, lo in spans:
             tags = (code, "rough", str(n))
             if hi >= prof.f_start - 1e-7:  # the layer starts at the stock face
