@@ -264,6 +264,11 @@ class Interpreter:
         block = self._resolve(raw)
         self.block = block
         st = self.state
+        # code-called macros: the calling code must be first in the block (N§3.2.1)
+        called = self._code_call(block)
+        if called is not None:
+            yield from called
+            return
         gcodes = self._gcodes(block)
         funcs = {fn for _, fn, _ in gcodes}
         self._check_letters(block, funcs)
@@ -280,11 +285,6 @@ class Interpreter:
         if 98 in mvals and len(mvals) > 1:
             raise NcAlarm(0x0249, "M98 must be the only M code of its block")
 
-        # code-called macros: the calling code must be first in the block (N§3.2.1)
-        called = self._code_call(block)
-        if called is not None:
-            yield from called
-            return
         if "G65" in funcs:
             self._macro_call(block, modal=False)
             return
