@@ -250,21 +250,30 @@ class Machine:
         """Run program text (MDI/AUTO) through cycle start and the M/S/T handshakes; returns its time."""
         return self.run_program(text, name="MDI", timeout=timeout)
 
-    def run_program(self, text: str, name: str = "program", timeout: float = 600.0) -> float:
+    def start_program(self, text: str, name: str = "program") -> Channel:
+        """Load program text in AUTO and press Cycle Start; returns at once (the channel runs on as the
+        script cycles), so a script can feed-hold, reset or E-stop it mid-way."""
         r = self.runner
-        prev_mode = self.mlc.link.mode
         self.mlc.mem.set_u16(d2(self.x, 0), 0)
         self.wait_until(lambda: self.mlc.link.mode == 0 and not self.mlc.manual.busy, 5.0, "AUTO mode")
-        program = parse_program(text, name=name)
-        profile = make_profile(self.bench.profile, r.axes, self.bench.params)
-        interp = Interpreter(profile, dict(zip(r.axes, r.channel.planner.position.tolist())))
+        try:
+            program = parse_program(text, name=name)
+        except NcAlarm as exc:
+            raise ScriptError(str(exc.alarm)) from None
+        here = dict(zip(r.axes, r.channel.planner.position.tolist()))
+        interp = Interpreter(make_profile(self.bench.profile, r.axes, self.bench.params), here)
         self.mlc.attach_variables(interp.vars)
-        ch = Channel(Planner(self.bench.motion_config(), dict(zip(r.axes, r.channel.planner.position.tolist())),
-                             spindle_rpm=lambda: self.mlc.spindle.rpm))
+        ch = Channel(Planner(self.bench.motion_config(), here, spindle_rpm=lambda: self.mlc.spindle.rpm))
         r.channel = ch
         ch.load(interp.run(program))
-        t0 = self.time
         self.pulse(m2(self.x, 0))
+        return ch
+
+    def run_program(self, text: str, name: str = "program", timeout: float = 600.0) -> float:
+        """Run program text to its end through cycle start and the handshakes; returns its time."""
+        prev_mode = self.mlc.link.mode
+        t0 = self.time
+        ch = self.start_program(text, name)
         limit = int(round(timeout / self.bench.cycle))
         for _ in range(limit):
             if not ch.busy:

@@ -45,7 +45,9 @@ class ManualMotion:
         self.velocity = np.zeros(n)
         self.acceleration = np.zeros(n)
         self.axes = {a: AxisState() for a in self.cfg.axes}
-        self._otg = Ruckig(1, self.cfg.cycle)
+        # One online generator and output per axis: ruckig keeps the running trajectory in them.
+        self._otg = [Ruckig(1, self.cfg.cycle) for _ in range(n)]
+        self._out = [OutputParameter(1) for _ in range(n)]
         self._inp = [self._make_input(i) for i in range(n)]
         self._mode: list[str | None] = [None] * n  # "velocity", "position" or None (at rest)
         self._target = self.position.copy()
@@ -148,8 +150,8 @@ class ManualMotion:
             inp.current_acceleration = [self.acceleration[i]]
             if mode == "velocity":
                 inp.max_velocity = [self._vcap[i]]
-            out = OutputParameter(1)
-            res = self._otg.update(inp, out)
+            out = self._out[i]
+            res = self._otg[i].update(inp, out)
             if res not in (Result.Working, Result.Finished):
                 self.halt()
                 break
@@ -160,7 +162,9 @@ class ManualMotion:
             self.velocity[i] = out.new_velocity[0] if clamped == new else 0.0
             self.acceleration[i] = out.new_acceleration[0] if clamped == new else 0.0
             at_rest = abs(self.velocity[i]) < 1e-9 and abs(self.acceleration[i]) < 1e-9
-            if res == Result.Finished or (mode == "velocity" and at_rest and inp.target_velocity[0] == 0.0):
+            # In the velocity interface "Finished" only means the target velocity is reached.
+            done = at_rest and inp.target_velocity[0] == 0.0 if mode == "velocity" else res == Result.Finished
+            if done:
                 self._mode[i] = None
                 self.velocity[i] = self.acceleration[i] = 0.0
                 st = self.axes[a]

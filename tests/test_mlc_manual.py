@@ -1,0 +1,113 @@
+"""Manual motion through the special relays (MPG, JOG, INC, HOME, interlocks), feed hold and
+E-stop, on the simulated bench with the default lathe MLC."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from hil.bench import default_lathe
+from hil.scripting import Machine
+
+
+@pytest.fixture
+def machine() -> Machine:
+    m = Machine(default_lathe())
+    m.power_up()
+    return m
+
+
+@pytest.mark.parametrize("pulses", [1, 37, -250])
+def test_mpg_moves_pulses_times_ratio_times_unit(machine, pulses):
+    x0 = machine.command("X")
+    machine.mpg("X", pulses, ratio=10)
+    assert machine.command("X") - x0 == pytest.approx(pulses * 10 * 0.001, abs=1e-9)
+    assert machine.position("X") - x0 == pytest.approx(pulses * 10 * 0.001, abs=2e-4)
+    assert machine.get("M31003") == 1  # MPG mode status
+
+
+def test_mpg_counter_wraps_at_16_bits(machine):
+    machine._mpg_count = 0xFFF0
+    machine.mlc.mem.set_u16(30004, 0xFFF0)
+    z0 = machine.command("Z")
+    machine.mpg("Z", 40, ratio=100)  # crosses 0xFFFF → 0x0000
+    assert machine.command("Z") - z0 == pytest.approx(4.0, abs=1e-9)
+
+
+def test_jog_is_hold_to_run_at_the_jog_speed(machine):
+    z0 = machine.command("Z")
+    machine.jog("Z", -1, 0.5, percent=50)  # N2.030 1000 mm/min × 50 %
+    moved = z0 - machine.command("Z")
+    assert moved == pytest.approx(0.5 * 500 / 60.0, rel=0.01)
+
+
+def test_inc_steps_by_d2x014_units(machine):
+    x0 = machine.command("X")
+    machine.inc("X", -3, units=1234)
+    assert machine.command("X") - x0 == pytest.approx(-3 * 1.234, abs=1e-9)
+
+
+def test_interlock_blocks_the_locked_direction_only(machine):
+    machine.set("M21336")  # X positive direction locked
+    x0 = machine.command("X")
+    machine.jog("X", 1, 0.2)
+    assert machine.command("X") == pytest.approx(x0, abs=1e-12)
+    machine.jog("X", -1, 0.2)
+    assert machine.command("X") < x0 - 1.0
+
+
+def test_homing_sets_homed_and_done_status(machine):
+    assert machine.get("M31320") == 0
+    took = machine.home("Z")
+    assert machine.command("Z") == pytest.approx(0.0, abs=1e-9)
+    assert machine.get("M31321") == 1 and machine.get("M31337") == 1 and machine.get("M31353") == 1
+    assert took > 0.1  # 100 mm at the homing speed, not a jump
+
+
+def _stop_distance(v: float, a: float, j: float) -> float:
+    """Shortest jerk-limited stop from speed v with zero acceleration."""
+    if v >= a * a / j:
+        return v * (v / a + a / j) / 2.0
+    return v * math.sqrt(v / j)
+
+
+def test_feed_hold_stops_within_the_jerk_limited_distance_and_resumes(machine):
+    ch = machine.start_program("G98 G01 W-80. F6000\nM30\n")
+    machine.wait(0.4)  # at 100 mm/s on Z
+    samples = []
+    machine.watchers.append(lambda m: samples.append(m.command("Z")))
+    z_hold = machine.command("Z")
+    machine.set("M21001")  # feed hold relay: acted on at the next NC scan
+    machine.wait(0.3)
+    machine.set("M21001", False)
+    assert machine.get("M31017") == 1 and machine.get("M31016") == 0
+    z_stop = machine.command("Z")
+    lim = machine.bench.axes[1].limits
+    share = machine.bench.motion_config().share_tangential  # the path profile's share of the axis budget
+    ideal = _stop_distance(100.0, share * lim.max_acceleration, share * lim.max_jerk)
+    latency = 100.0 * 0.002  # the relay is read at the next NC scan, the stop starts the cycle after
+    assert ideal - 1e-6 <= z_hold - z_stop <= ideal + latency
+    assert abs(samples[-1] - samples[-2]) < 1e-9  # standing still
+    machine.pulse(21000)  # cycle start resumes
+    machine.wait_until(lambda: not ch.busy, 5.0)
+    assert machine.command("Z") == pytest.approx(100.0 - 80.0, abs=1e-6)
+
+
+def test_estop_freezes_every_setpoint_within_one_cycle_with_alarm_0401(machine):
+    machine.mdi("M03 S800")
+    ch = machine.start_program("G98 G01 U-40. W-80. F6000\nM30\n")
+    machine.wait(0.3)
+    rows = []
+    machine.watchers.append(lambda m: rows.append((m.command("X"), m.command("Z"),
+                                                   m.runner.rx[2].target_velocity)))
+    machine.estop()  # M21013 set, then one cycle
+    machine.wait(0.05)
+    assert machine.get("M31018") == 1
+    assert [a.code for a in ch.alarms] == [0x0401]
+    # the first cycle after the relay already holds the setpoints and the spindle command at zero
+    assert rows[0][2] == 0 and all(r == rows[0] for r in rows)
+    machine.estop(False)
+    machine.reset()
+    machine.wait(0.05)
+    assert machine.get("M31019") == 1 and machine.get("M31025") == 0 and not ch.busy
