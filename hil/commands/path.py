@@ -53,6 +53,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--block-skip", action="store_true", help="block skip switch on: '/' blocks are skipped")
     p.add_argument("--preview-log", action="store_true",
                    help="also print which macro statement ran ahead of which motion block (preview)")
+    p.add_argument("--plot", metavar="FILE.png",
+                   help="also draw the tool path in the active plane (rapids dashed, feeds solid, "
+                        "programmed contour vs compensated path)")
     p.set_defaults(func=cmd_path)
 
 
@@ -67,6 +70,14 @@ def move_dict(m: Move) -> dict:
     for key in ("start", "end", "work", "center"):
         if d[key] is not None:
             d[key] = {a: fmt(v) for a, v in d[key].items()}
+    if m.exact_stop:  # additive key (issue 3): G09 / G61 / G53 / G28 exact stop at the end of this move
+        d["exact_stop"] = True
+    if m.tags:  # additive keys (issue 4): which cycle / pass / compensation produced the move
+        d["tags"] = list(m.tags)
+    if m.kind == "thread":
+        d.update(lead=m.lead, lead_change=m.lead_change, start_angle=m.start_angle)
+    if m.comp:
+        d.update(comp=m.comp, comp_radius=m.comp_radius, tip=m.tip)
     return d
 
 
@@ -100,8 +111,11 @@ def cmd_path(args: argparse.Namespace) -> int:
     out = sys.stdout
     try:
         program = _load_main(args.program, store)
+        plotted: list[Move] = []
         for ev in interp.run(program):
             if isinstance(ev, Move):
+                if getattr(args, "plot", None):
+                    plotted.append(ev)
                 if args.json:
                     print(json.dumps(move_dict(ev)), file=out)
                 else:
@@ -116,6 +130,16 @@ def cmd_path(args: argparse.Namespace) -> int:
         print_alarm(internal_error(exc), as_json=args.json)
         return EXIT_ALARM
     _print_preview(interp, args)
+    if getattr(args, "plot", None):
+        from hil.plot import plot_program
+        try:
+            plot_program(plotted, args.plot, profile, lambda: Interpreter(profile, store=store), program)
+        except NcAlarm as exc:
+            print_alarm(exc.alarm, as_json=args.json)
+            return EXIT_ALARM
+        except OSError as exc:
+            print(f"hil path: cannot write {args.plot}: {exc.strerror}", file=sys.stderr)
+            return EXIT_USAGE
     if var_ids:
         values = {str(i): interp.variable(i) for i in var_ids}
         print(json.dumps({"kind": "vars", "values": values}) if args.json else
