@@ -293,6 +293,11 @@ class Machine:
             return self.mdi("M05")
         return self.mdi(f"{'M03' if direction > 0 else 'M04'} S{abs(rpm):g}")
 
+    def get_rpm(self, spindle: int = 0) -> float:
+        """Actual speed of a spindle drive (0x606C), rpm."""
+        i = len(self.runner.axes) + spindle
+        return self.runner.scales[i].counts_per_s_to_rpm(self.runner.tx[i].velocity_actual)
+
     def estop(self, on: bool = True) -> None:
         self.mlc.mem.set_bit(m2(self.x, 13), on)
         self.cycle()

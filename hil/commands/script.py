@@ -1,0 +1,73 @@
+"""`hil script SCRIPT.py [ARGS…]`: run an exercising script against the bench, then report what
+every drive did (see hil.scripting and docs/guide/mlc.md)."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from hil.cli import EXIT_ALARM, EXIT_OK, EXIT_USAGE
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("script", help="run an exercising script (MPG, jog, homing, spindle …) on the bench")
+    p.add_argument("script", help="Python file with main(machine) or top-level code using `machine`")
+    p.add_argument("args", nargs="*", help="passed to main(machine, *args)")
+    add_bench_options(p)
+    p.set_defaults(func=cmd_script)
+
+
+def add_bench_options(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--bench", help="bench file (TOML); default: the built-in 2-axis lathe")
+    p.add_argument("--bus", help="sim | ethercat:IFACE | canopen:INTERFACE[:CHANNEL]")
+    p.add_argument("--mlc", metavar="MODULE", default="lathe",
+                   help="MLC program: lathe (default) | module name | path.py")
+
+
+def open_machine(args: argparse.Namespace):
+    """Build and power up the bench for a script; returns (machine, exit code or None)."""
+    from hil.scripting import Machine, ScriptError, mlc_setup
+    from hil.session import InputError, load_bench, make_link
+
+    try:
+        bench = load_bench(args.bench, None, args.bus)
+        mlc, _, _ = mlc_setup(bench, args.mlc if args.mlc != "basic" else "lathe", None, 0.5)
+        machine = Machine(bench, mlc, make_link(bench))
+    except InputError as exc:
+        print(f"hil {args.command}: {exc}", file=sys.stderr)
+        return None, EXIT_USAGE
+    try:
+        machine.power_up()
+    except ScriptError as exc:
+        print(f"hil {args.command}: {exc}", file=sys.stderr)
+        return None, EXIT_ALARM
+    return machine, None
+
+
+def finish(machine, ok: bool = True) -> int:
+    machine.report()
+    machine.close()
+    alarms = machine.alarms + (machine.runner.channel.alarms if machine.runner.channel else [])
+    return EXIT_OK if ok and not alarms else EXIT_ALARM
+
+
+def cmd_script(args: argparse.Namespace) -> int:
+    from hil.scripting import ScriptError, run_script
+    from nc.alarms import NcAlarm
+
+    machine, code = open_machine(args)
+    if machine is None:
+        return code
+    try:
+        run_script(args.script, machine, args.args)
+    except ScriptError as exc:
+        print(f"hil script: {exc}", file=sys.stderr)
+        machine.report()
+        machine.close()
+        return EXIT_ALARM if "does not exist" not in str(exc) else EXIT_USAGE
+    except NcAlarm as exc:
+        print(str(exc.alarm), file=sys.stderr)
+        machine.report()
+        machine.close()
+        return EXIT_ALARM
+    return finish(machine)
