@@ -85,7 +85,10 @@ def test_basenode402_from_another_process_enables_the_simulated_drive_in_csp(net
 def test_hil_run_drives_hil_sim_canopen_across_processes_in_real_time(netns, tmp_path):
     group = "239.74.163.3"
     bench = tmp_path / "lathe-4ms.toml"
-    bench.write_text((ROOT / "benches" / "lathe-2axis.toml").read_text().replace("cycle_ms = 1.0", "cycle_ms = 4.0"))
+    # The shipped lathe at a 4 ms cycle (44 % of 1 Mbit/s), without its [checks]: a Python process on
+    # UDP is no real-time wire, so late TPDOs may repeat a position (the link counts them).
+    text = (ROOT / "benches" / "lathe-2axis.toml").read_text().replace("cycle_ms = 1.0", "cycle_ms = 4.0")
+    bench.write_text(text.split("[checks]")[0])
     prog = tmp_path / "short.nc"
     prog.write_text("G21 G18 G98\nG01 X50. Z90. F1200\nM30\n")
     sim = _Sim(netns, group, "--bench", str(bench))

@@ -83,8 +83,8 @@ def interpolation_period(cycle: float) -> tuple[int, int]:
 
 class CanopenLink:
     def __init__(self, nodes: Sequence[NodeConfig], interface: str, channel: str = "", cycle: float = 0.001,
-                 bitrate: int = DEFAULT_BITRATE, heartbeat_period: float = 0.02, heartbeat_timeout: float = 0.05,
-                 tpdo_timeout: float | None = None) -> None:
+                 bitrate: int = DEFAULT_BITRATE, heartbeat_period: float | None = None,
+                 heartbeat_timeout: float | None = None, tpdo_timeout: float | None = None) -> None:
         if not nodes:
             raise ValueError("a CANopen bus needs at least one node")
         if interface == "udp_multicast" and not channel:
@@ -98,13 +98,15 @@ class CanopenLink:
                                    "can0" if interface == "socketcan" else "")
         self.cycle_time = cycle
         self.bitrate = bitrate
-        self.heartbeat_period = heartbeat_period
-        self.heartbeat_timeout = heartbeat_timeout
+        # Heartbeat producer (0x1017) / consumer time: tight in lock-step, where time is exact; on a
+        # real wire wide enough that thread and network jitter of a non-RT host never trips it.
+        self.heartbeat_period = heartbeat_period or (0.02 if self.lockstep else 0.1)
+        self.heartbeat_timeout = heartbeat_timeout or 2.5 * self.heartbeat_period
         self.tpdo_timeout = tpdo_timeout if tpdo_timeout is not None else max(0.8 * cycle, 0.002)
         self.ip_period = interpolation_period(cycle)
         for cfg in self.nodes_cfg:
             frame_layouts(cfg.layout)  # refuse layouts that don't fit the node's PDOs
-        self.budget: BusLoad = bus_load([c.layout for c in self.nodes_cfg], cycle, bitrate, heartbeat_period)
+        self.budget: BusLoad = bus_load([c.layout for c in self.nodes_cfg], cycle, bitrate, self.heartbeat_period)
         # Raises BusBudgetError above 100 % on a wire with a bitrate; the virtual bus only warns.
         self.budget_note = check_budget(self.budget, enforce=not self.lockstep)
         if self.budget_note:
@@ -254,10 +256,10 @@ class CanopenLink:
             code = (ALARM_INTERPOLATION if index == 0x60C2 else
                     ALARM_PDO_MAPPING if 0x1400 <= index <= 0x1BFF else ALARM_ESTABLISH)
             self._fail(Alarm(code, f"SDO abort 0x{exc.code:08X} ({_abort_text(exc)}) from {self._label(n)} "
-                                   f"writing {what or f'object 0x{index:04X}'}", axis=n.cfg.name, info=n.cfg.node_id))
+                                   f"writing {what or f'object 0x{index:04X}'}", axis=n.cfg.name))
         except SdoCommunicationError as exc:
             self._fail(Alarm(ALARM_NOT_FOUND, f"{self._label(n)} does not answer SDO 0x{index:04X}: {exc}",
-                             axis=n.cfg.name, info=n.cfg.node_id))
+                             axis=n.cfg.name))
 
     def _fail(self, alarm: Alarm) -> None:
         raise BusError(alarm)
@@ -343,13 +345,13 @@ class CanopenLink:
                 self._lose(n)
                 raise BusError(Alarm(ALARM_COMMUNICATION, f"heartbeat of {self._label(n)} lost: none for "
                                      f"{(now - n.last_heartbeat) * 1000:.0f} ms (consumer time "
-                                     f"{self.heartbeat_timeout * 1000:g} ms)", axis=n.cfg.name, info=n.cfg.node_id))
+                                     f"{self.heartbeat_timeout * 1000:g} ms)", axis=n.cfg.name))
             # A heartbeat sent just before the node saw NMT start may still say PRE-OPERATIONAL.
             if n.nmt_state not in (None, NMT_OPERATIONAL) and n.last_heartbeat - self._opened_at > self.heartbeat_period:
                 state = NMT_NAMES.get(n.nmt_state, str(n.nmt_state))
                 self._lose(n)
                 raise BusError(Alarm(ALARM_COMMUNICATION, f"{self._label(n)} left OPERATIONAL: heartbeat "
-                                     f"reports {state}", axis=n.cfg.name, info=n.cfg.node_id))
+                                     f"reports {state}", axis=n.cfg.name))
         if emcys:
             raise BusError(emcys[0])
 
