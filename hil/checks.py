@@ -276,7 +276,7 @@ def check_thread_phase(cols: _Cols, axes: list[str], spindles: list[str], moves:
 
 def check_jitter(cols: _Cols, cycle: float | None, limits: list[tuple[str, float]]) -> list[CheckResult]:
     period = cols["period"]
-    nominal = cycle if cycle is not None else (float(np.median(period)) if period.size else 0.0)
+    nominal = cycle if cycle is not None else (round(float(np.median(period)), 7) if period.size else 0.0)
     jit = np.abs(period - nominal)
     out = []
     for label, lim in limits:

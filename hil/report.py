@@ -131,7 +131,7 @@ def write_report(trace_path: str | Path, out: str | Path, bench: Bench | None = 
     period = cols.get("period")
     fig, ax = plt.subplots(figsize=(8, 4), dpi=110)
     if period is not None and len(period):
-        nominal = bench.cycle if bench else float(np.median(period))
+        nominal = bench.cycle if bench else round(float(np.median(period)), 7)
         jit = (period - nominal) * 1e6
         ax.hist(jit, bins=100, color="tab:purple", log=True)
         p99 = float(np.percentile(np.abs(jit), 99))

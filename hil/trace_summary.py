@@ -104,7 +104,7 @@ def summarise(tf: TraceFile, lo: Bound | None = None, hi: Bound | None = None) -
         if "period" in cols:
             per = cols["period"].to_numpy()
             if s.period is None:
-                s.period = float(np.median(per))
+                s.period = round(float(np.median(per)), 7)
             s.jitter.add_many(per - s.period)
     return s
 
