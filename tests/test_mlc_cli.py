@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import pytest
+
 from tests.conftest import ROOT
 
 
@@ -31,3 +33,18 @@ def test_hil_script_runs_the_shipped_spindle_example(hil):
 def test_hil_script_missing_file(hil, tmp_path):
     r = hil("script", str(tmp_path / "nope.py"))
     assert r.code == 2 and "does not exist" in r.err
+
+
+def test_hil_run_with_a_user_mlc_module(hil, tmp_path):
+    import csv
+
+    prog = tmp_path / "p.nc"
+    prog.write_text("M08\nM09\nM30\n")
+    trace = tmp_path / "t.csv"
+    r = hil("run", str(prog), "--mlc", str(ROOT / "examples" / "mlc" / "coolant_only.py"), "--trace", str(trace),
+            "--trace-signals", "M_STROBE,MST_FINISH,M_CODE")
+    assert r.code == 0, r.err
+    rows = list(csv.DictReader(trace.open()))
+    on = [float(x["t"]) for x in rows if x["M31064"] == "1"]
+    fin = [float(x["t"]) for x in rows if x["M21016"] == "1"]
+    assert fin and min(fin) - min(on) == pytest.approx(0.05, abs=0.0015)  # the module's 50 ms timer
