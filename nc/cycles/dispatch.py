@@ -82,6 +82,16 @@ def _modal_target(host: Any, block: Block, code: str, axes_letters: dict[str, st
     return tgt
 
 
+def _modal_taper(host: Any, block: Block, code: str) -> float:
+    """R of G90/G92/G94 is modal like X and Z (Fanuc): a repeat block without R keeps it."""
+    mem = _mem(host).setdefault("taper", {})
+    if block.has("R"):
+        mem[code] = host.distance(block.get("R"))
+    elif _explicit(host, block, code):
+        mem[code] = 0.0
+    return mem.get(code, 0.0)
+
+
 def _explicit(host: Any, block: Block, code: str) -> bool:
     """Does the block itself carry the cycle's G code (a new cycle rather than a modal repeat)?"""
     from nc.interp.context import LATHE_CYCLES, MILL_CYCLES
@@ -235,11 +245,11 @@ def _g76(host: Any, block: Block) -> list[Event]:
 
 def _g92(host: Any, block: Block) -> list[Event]:
     tgt = _modal_target(host, block, "G92", {"X": "U", "Z": "W"})
+    taper = _modal_taper(host, block, "G92")
     mem = _mem(host).setdefault("g92", {})
     if block.has("F"):
         mem["lead"] = host.feed(block)
     lead = mem.get("lead") or host.feed(block)
-    taper = _d(host, block, "R", 0.0) or 0.0
     angle = (_raw(block, "Q", 0.0) or 0.0) / 1000.0
     chamfer, ch_angle = _thread_chamfer(host, lead)
     b = _builder(host, block)
@@ -265,7 +275,7 @@ def _g32_g34(host: Any, code: str, block: Block) -> list[Event]:
 # ---- single cycles --------------------------------------------------------------------------
 def _g90_g94(host: Any, code: str, block: Block) -> list[Event]:
     tgt = _modal_target(host, block, code, {"X": "U", "Z": "W"})
-    taper = _d(host, block, "R", 0.0) or 0.0
+    taper = _modal_taper(host, block, code)
     b = _builder(host, block)
     b.feed = host.feed(block)
     if code == "G90":
@@ -288,9 +298,9 @@ def _hole_state(host: Any, block: Block, code: str, axis: str) -> dict:
     mem = _mem(host)
     st = mem.get("hole")
     here = host.position[axis]
-    fresh = st is None or st.get("code") != code and _explicit(host, block, code)
-    if st is not None and _explicit(host, block, code) and abs(here - st.get("last_level", here)) > 1e-9:
-        fresh = True
+    # the initial level and the modal words (Z R Q P F) survive a change of hole cycle; a cycle
+    # commanded again after the tool left the cycle's last level (G80, then a move) starts afresh
+    fresh = st is None or (_explicit(host, block, code) and abs(here - st.get("last_level", here)) > 1e-9)
     if fresh:
         st = {"code": code, "initial": here}
         mem["hole"] = st
