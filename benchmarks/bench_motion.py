@@ -1,0 +1,95 @@
+"""Motion benchmarks: print figures, assert nothing.  Run: python benchmarks/bench_motion.py"""
+
+from __future__ import annotations
+
+import math
+import sys
+import time
+import tracemalloc
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+from nc.motion.offline import run  # noqa: E402
+from nc.motion.planner import Planner  # noqa: E402
+from nc.moves import Move  # noqa: E402
+from tests.motion_helpers import AX, arc, circle_chords, lines, mill_cfg  # noqa: E402
+
+
+def cam_moves(n: int, seed: int = 3):
+    """A stream (generator) of n segments 0.01–0.1 mm on a smooth curve."""
+    rng = np.random.default_rng(seed)
+    x, prev = 0.0, {"X": 0.0, "Y": 0.0, "Z": 0.0}
+    for k in range(n):
+        x += float(rng.uniform(0.01, 0.1))
+        e = {"X": x, "Y": 20.0 * math.sin(x / 40.0), "Z": 0.0}
+        yield Move("line", k + 1, "", prev, e, e, feed=3000.0, plane=("X", "Y"))
+        prev = e
+
+
+def bench_a2() -> None:
+    cfg = mill_cfg()
+    moves = []
+    for i in range(20):
+        moves += lines([(0, 0, 0), (40, 0, -1), (40, 30, -1)], 6000)
+        moves.append(arc((40, 30, -1), (0, 30, -1), (20, 30), "ccw", 6000))
+        moves += lines([(0, 30, -1), (0, 0, 0)], 6000)
+    t = time.perf_counter()
+    st = run(moves, cfg, {"X": 0.0, "Y": 0.0, "Z": 0.0})
+    w = time.perf_counter() - t
+    cycles = len(st.positions) - 1
+    print(f"(a) 3-axis offline setpoints: {cycles} cycles in {w:.3f} s = {cycles / w:,.0f} cycles/s, "
+          f"{st.time / w:.0f}x real time at 1 ms")
+
+
+def bench_b(n: int = 100_000) -> None:
+    cfg = mill_cfg()
+    pl = Planner(cfg, {"X": 0.0, "Y": 0.0, "Z": 0.0})
+    t = time.perf_counter()
+    pushed = 0
+    for mv in cam_moves(n):
+        pl.push(mv)
+        pushed += 1
+        if len(pl.blocks) > pl.depth:
+            pl.blocks.popleft()  # planning only: keep the window at the look-ahead depth
+    w = time.perf_counter() - t
+    print(f"(b) look-ahead planning (push + junction + backward pass) of {n} CAM segments: "
+          f"{n / w:,.0f} blocks/s")
+    t = time.perf_counter()
+    st = run(cam_moves(20_000), cfg, {"X": 0.0, "Y": 0.0, "Z": 0.0}, keep=False)
+    w = time.perf_counter() - t
+    print(f"(b') full execution incl. per-block ruckig and sampling, 20000 CAM segments: {20_000 / w:,.0f} blocks/s "
+          f"({st.time:.2f} s simulated)")
+
+
+def bench_c() -> None:
+    cfg = mill_cfg()
+    pts = circle_chords(100.0, 0.05)
+    t = time.perf_counter()
+    st = run(lines(pts, 3000), cfg, dict(zip(AX, pts[0])))
+    w = time.perf_counter() - t
+    ideal = 2 * math.pi * 100.0 / 50.0
+    print(f"(c) circle R100 of 0.05 mm chords at F3000: {st.time:.3f} s vs feed-limited {ideal:.3f} s "
+          f"(+{100 * (st.time / ideal - 1):.1f} %), wall {w:.2f} s ({(len(st.positions) - 1) / w:,.0f} cycles/s)")
+    sq = lines([(0, 0, 0), (100, 0, 0)], 6000)
+    st = run(sq, cfg, {"X": 0.0, "Y": 0.0, "Z": 0.0})
+    print(f"(c) single 100 mm line at F6000: {st.time:.3f} s vs lower bound (v={100:.0f} mm/s, half-budget a/j) "
+          f"{100 / 100:.3f} s + ramps")
+
+
+def bench_d() -> None:
+    cfg = mill_cfg()
+    for n in (2_000, 20_000):
+        tracemalloc.start()
+        run(cam_moves(n), cfg, {"X": 0.0, "Y": 0.0, "Z": 0.0}, keep=False)
+        _, peak = tracemalloc.get_traced_memory()
+        tracemalloc.stop()
+        print(f"(d) peak traced memory, {n} streamed segments: {peak / 1e6:.2f} MB")
+
+
+if __name__ == "__main__":
+    bench_a2()
+    bench_b()
+    bench_c()
+    bench_d()
