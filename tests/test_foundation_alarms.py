@@ -53,11 +53,15 @@ def test_run_stops_under_control_at_an_impossible_arc(hil, program, tmp_path):
     assert "0x0259" in r.out
     assert "line 3" in r.out
     assert "Traceback" not in r.out + r.err
-    # the axes completed block 2 and stopped there: nothing moved after the alarm
+    # The bad block is found by read-ahead: the axes stop under control somewhere on block 2's
+    # straight path from (X60, Z100) to (X50, Z50) and stand still; nothing heads toward block 3.
     import csv
     rows = list(csv.DictReader(open(trace)))
+    for row in rows:
+        x, z = float(row["X_cmd"]), float(row["Z_cmd"])
+        assert 50.0 - 1e-6 <= x <= 60.0 + 1e-6 and 50.0 - 1e-6 <= z <= 100.0 + 1e-6
+        assert abs((x - 60.0) * 50.0 - (z - 100.0) * 10.0) < 1e-6  # on the G00 line
     last = rows[-1]
-    assert abs(float(last["X_cmd"]) - 50.0) < 1e-6 and abs(float(last["Z_cmd"]) - 50.0) < 1e-6
     assert abs(float(last["X_vel"])) < 0.01 and abs(float(last["Z_vel"])) < 0.01
 
 
