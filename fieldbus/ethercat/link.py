@@ -69,9 +69,9 @@ class EthercatLink:
     names: Sequence[str] = ()  # one per drive, in bus order (axes, then spindles)
     layouts: Sequence[PdoLayout] = ()  # per drive; default the ASDA CSP/CSV preset
     dc: bool = True
-    receive_timeout_us: int = 20_000  # Python slaves are slow: SOEM's 2 ms default is raised
+    receive_timeout_us: int = 100_000  # Python slaves on a loaded CI host: SOEM's 2 ms is far too short
     max_bad_cycles: int = 3  # consecutive bad cycles ridden through before the alarm
-    watchdog_ms: float = 100.0
+    watchdog_ms: float = 500.0  # SM watchdog programmed into every slave
     drift_check_every: int = 250  # cycles between DC drift reads
     drift_limit_ns: int = 50_000
     stats: LinkStats = field(default_factory=LinkStats)
@@ -186,6 +186,7 @@ class EthercatLink:
             if m.state_check(pysoem.OP_STATE, 5_000) == pysoem.OP_STATE:
                 break
         self._expect(m, pysoem.OP_STATE, "OP", wait_us=1_000)
+        m.read_state()
         self._last = [layout.unpack_tx(s.input) for s, layout in zip(self.drives, layouts)]
         self.infos = [SlaveInfo(i, name, "drive", s.man, s.id, state_name(s.state), layout.name)
                       for i, (s, name, layout) in enumerate(zip(self.drives, self.names, layouts))]
