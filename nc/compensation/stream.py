@@ -110,7 +110,7 @@ class Compensator:
         tv = self._tipv() if tip else (0.0, 0.0)
         for ev in held:
             if isinstance(ev, Move) and self.plane is not None:
-                a1, a2 = ev.plane
+                a1, a2 = self.plane  # a dwell carries a default plane; the compensation plane counts
                 s, e = dict(ev.start), dict(ev.end)
                 for d in (s, e):
                     if a1 in d and a2 in d:
