@@ -387,8 +387,9 @@ class Esc:
             if typ & 1 and cmd in (LRD, LRW):
                 reads.append((lo, hi, ps + lo - ls))
         inc = 0
-        if writes:
-            # The ESC takes outputs from SAFE-OP on (the SM is enabled); only OP applies them.
+        if writes and not self.mem[R_AL_STATUS] & AL_ERROR:
+            # The ESC takes outputs from SAFE-OP on (the SM is enabled); only OP applies them. After
+            # an error (watchdog, sync) the application deactivates the output SM: no write WKC.
             for lo, hi, p in writes:
                 self.mem[p:p + hi - lo] = data[lo - addr:hi - addr]
             inc += 2 if cmd == LRW else 1

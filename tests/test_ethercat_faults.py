@@ -1,0 +1,123 @@
+"""Bus and drive faults on the virtual EtherCAT line, each with the controller's reaction: the
+alarm, a stop, and no other axis moving afterwards. Needs root (veth pair)."""
+
+from __future__ import annotations
+
+import time
+
+import pytest
+
+from fieldbus.ethercat.link import EthercatLink
+from hil.bench import default_lathe
+from hil.runner import BenchRunner
+from nc.program import parse_program
+from virtual_bus.ethercat.veth import SimProcess, can_create
+
+REASON = can_create()
+pytestmark = pytest.mark.skipif(REASON is not None, reason=REASON or "")
+
+# ~1.2 s of simulated motion on X and Z with the spindle running; faults hit at frame 500.
+PROGRAM = "G21 G18 G98\nS500 M03\nG01 X80. Z50. F3000\nG01 X100. Z80. F3000\nM30\n"
+
+
+def run(*faults: str, stall_at: int = 0, stall: float = 0.0):
+    bench = default_lathe()
+    with SimProcess(*(f"--fault={f}" for f in faults), tag="f") as sim:
+        link = EthercatLink.for_bench(bench, sim.iface)
+        history: list[tuple[int, list[float], int]] = []
+
+        def on_cycle(r: BenchRunner) -> None:
+            history.append((r.cycle, r.actual.tolist(), len(r.result.alarms)))
+            if stall_at and r.cycle == stall_at:
+                time.sleep(stall)
+
+        result = BenchRunner(bench, link, on_cycle=on_cycle).run_program(parse_program(PROGRAM, name="fault.nc"))
+    return result, history, link
+
+
+def moved_after_alarm(history, axis: int, result=None) -> float:
+    """How far an axis travelled from the last cycle before the alarm to the end of the run."""
+    at = next((k for k, h in enumerate(history) if h[2]), len(history) - 1)
+    ref = history[max(0, at - 1)][1][axis]
+    seen = [h[1][axis] for h in history[at:]]
+    if result is not None:
+        seen.append(list(result.final.values())[axis])
+    return max(abs(p - ref) for p in seen)
+
+
+def test_single_dropped_frame_is_ridden_through():
+    result, _, link = run("drop@300")
+    assert result.ok and link.stats.lost_frames == 1
+
+
+def test_dropped_frames_beyond_tolerance_raise_0x0601_and_stop():
+    result, history, _ = run("drop@300x20")
+    assert not result.finished and result.alarms[0].code == 0x0601
+    assert "no frame returned" in result.alarms[0].message
+    assert max(moved_after_alarm(history, 0, result), moved_after_alarm(history, 1, result)) < 0.01
+
+
+def test_late_frames_raise_0x0601():
+    result, _, _ = run("late@300x6:150")  # answers 150 ms late, after the 100 ms receive timeout
+    assert not result.finished and result.alarms[0].code == 0x0601
+
+
+def test_slave_leaving_the_line_raises_0x0601_on_its_axis_and_x_stays():
+    result, history, _ = run("leave:1@300")
+    a = result.alarms[0]
+    assert not result.finished and a.code == 0x0601 and a.axis == "Z"
+    assert moved_after_alarm(history, 0, result) < 0.01  # X (still on the line) does not move on
+
+
+def test_slave_that_comes_back_quickly_is_recovered():
+    result, _, link = run("leave:2@300+2")
+    assert result.ok and link.stats.bad_cycles >= 1
+
+
+def test_working_counter_mismatch_raises_0x0601():
+    result, history, _ = run("wkc:0@300x50")
+    assert not result.finished and result.alarms[0].code == 0x0601
+    assert "working counter" in result.alarms[0].message
+    assert moved_after_alarm(history, 1, result) < 0.01
+
+
+def test_sm_watchdog_expiry_drops_to_safeop_with_0x001b():
+    result, history, _ = run(stall_at=300, stall=0.8)  # master stalls past the 500 ms watchdog
+    a = result.alarms[0]
+    assert a.code == 0x0601 and a.info == 0x001B and "SAFE-OP+ERR" in a.message
+    assert moved_after_alarm(history, 0, result) < 0.05 and moved_after_alarm(history, 1, result) < 0.05
+
+
+def test_al_error_raises_0x0601_with_the_al_code():
+    result, _, _ = run("alerr:2@300:0x001A")
+    a = result.alarms[0]
+    assert a.code == 0x0601 and a.axis == "S1" and a.info == 0x001A
+
+
+def test_drive_fault_mid_program_is_servo_alarm_and_others_stop():
+    result, history, _ = run("drivefault:0@300:0x0009")
+    a = result.alarms[0]
+    assert a.code == 0xF002 and a.axis == "X" and a.info == 0x0009
+    assert not result.finished
+    assert moved_after_alarm(history, 1, result) < 2.0  # Z decelerates to a stop (~1 mm at 48 mm/s), not driven on
+
+
+def test_link_recover_brings_the_line_back_to_op_after_an_outage():
+    bench = default_lathe()
+    with SimProcess("--fault=leave:1@100+30", tag="r") as sim:
+        link = EthercatLink.for_bench(bench, sim.iface)
+        link.open()
+        try:
+            from fieldbus.link import BusError
+            from fieldbus.pdo import RxPdo
+
+            rx = [RxPdo(mode=8), RxPdo(mode=8), RxPdo(mode=9)]
+            with pytest.raises(BusError):
+                for _ in range(200):
+                    link.exchange(rx)
+            assert link.recover(timeout=10.0)
+            for _ in range(20):
+                link.exchange(rx)
+            assert link.stats.recoveries == 1
+        finally:
+            link.close()
