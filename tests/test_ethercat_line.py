@@ -132,3 +132,37 @@ def test_kickcat_master_brings_the_virtual_slaves_to_op(line):
     assert statusword & 0x4F == 0x40  # CiA 402 "switch on disabled", straight from the drive model
     ident = bus.read_sdo(slaves[0], 0x1018, 2, kickcat.Access.PARTIAL, 4, 1.0)
     assert int.from_bytes(bytes(ident), "little") == 0x6010
+
+
+def test_frames_decode_cleanly_in_tshark(line, tmp_path):
+    import shutil
+    import time
+
+    from fieldbus.pdo import RxPdo
+
+    if shutil.which("tshark") is None:
+        pytest.skip("tshark is not installed (its EtherCAT dissector is the independent decoder)")
+    pcap = tmp_path / "ecat.pcap"
+    cap = subprocess.Popen(["tshark", "-q", "-i", line.iface, "-w", str(pcap)], stdout=subprocess.DEVNULL,
+                           stderr=subprocess.PIPE, text=True)
+    try:
+        deadline = time.monotonic() + 10
+        while not pcap.exists() and time.monotonic() < deadline:
+            time.sleep(0.1)
+        time.sleep(0.5)
+        link = EthercatLink(line.iface, names=["X", "Z", "S1"])
+        link.open()
+        try:
+            link.sdo_read(0, 0x1008, 0)
+            for _ in range(20):
+                link.exchange([RxPdo(mode=8), RxPdo(mode=8), RxPdo(mode=9)])
+        finally:
+            link.close()
+        time.sleep(0.5)
+    finally:
+        cap.terminate()
+        cap.wait(10)
+    out = subprocess.run(["tshark", "-r", str(pcap), "-V"], capture_output=True, text=True, timeout=60).stdout
+    assert "EtherCAT datagram" in out and "LRW" in out and "FRMW" in out
+    assert "EtherCAT Mailbox Protocol" in out and "CoE" in out
+    assert "Malformed" not in out and "Expert Info (Error" not in out
