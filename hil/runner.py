@@ -25,6 +25,7 @@ from nc.motion import Planner
 from nc.moves import Event
 from nc.profiles import make_profile
 from nc.program import Program
+from nc.softlimits import SoftLimits
 
 MODE_CSP = 8
 MODE_CSV = 9
@@ -95,6 +96,7 @@ class BenchRunner:
             profile = make_profile(self.bench.profile, self.axes, self.bench.params)
             start = dict(zip(self.axes, self.actual.tolist()))
             interp = Interpreter(profile, start)
+            self.profile = profile  # G10 L21 soft limits live in its params (issue 8)
             if hasattr(self.mlc, "attach_variables"):  # MLC ↔ #25000–#25511 exchange (issue 8)
                 self.mlc.attach_variables(interp.vars)
             self.run_events(interp.run(program))
@@ -130,6 +132,7 @@ class BenchRunner:
         planner = Planner(self.bench.motion_config(), dict(zip(self.axes, self.actual.tolist())),
                           spindle_rpm=lambda: self.mlc.spindle.rpm)
         self.channel = ch = Channel(planner)
+        ch.soft_limits = SoftLimits.for_bench(self.bench, getattr(self, "profile", None))
         for a in self.result.alarms:
             ch.alarms.append(a)
         ch.load(events)

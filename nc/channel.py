@@ -26,6 +26,7 @@ from enum import Enum
 from nc.alarms import Alarm, NcAlarm, internal_error
 from nc.motion.planner import Planner, Setpoint
 from nc.moves import Aux, Event, Move, ProgramEnd, Sync
+from nc.softlimits import SoftLimits
 
 
 class RunState(Enum):
@@ -53,6 +54,8 @@ class Channel:
     dry_run_feed: float = 5000.0  # mm/min
     _deferred: Aux | Sync | None = None
     _block_moves: int = 0  # moves pushed since the last single-block stop
+    soft_limits: SoftLimits | None = None  # checked before a move reaches the planner (issue 8)
+    _limit_alarm: Alarm | None = None  # raised once the moves before the offending one have run out
 
     def load(self, events: Iterator[Event]) -> None:
         self.events = events
@@ -112,6 +115,7 @@ class Channel:
         self.planner.stop()
         self.pending_aux = None
         self._deferred = None
+        self._limit_alarm = None
         self.events = None
         self.state = RunState.RESETTING if not self.planner.idle else RunState.IDLE
 
@@ -166,6 +170,11 @@ class Channel:
         """
         pl = self.planner
         while self.state is RunState.RUNNING and self.end is None and not pl.full:
+            if self._limit_alarm is not None:
+                if pl.idle:  # the legal moves before it have run out: the offending one never starts
+                    alarm, self._limit_alarm = self._limit_alarm, None
+                    self.raise_alarm(alarm)
+                return
             if self._deferred is not None:
                 if not pl.idle:
                     return
@@ -188,6 +197,9 @@ class Channel:
                 self.raise_alarm(internal_error(exc))
                 return
             if isinstance(ev, Move):
+                if self.soft_limits is not None and (crossing := self.soft_limits.check(ev)) is not None:
+                    self._limit_alarm = crossing
+                    continue
                 pl.push(ev)
                 self._block_moves += 1
             elif isinstance(ev, Aux):

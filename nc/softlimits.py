@@ -1,0 +1,103 @@
+"""Software travel limits, checked when the channel hands a move to the planner.
+
+Two segments, as NC5 §3.8.3.7 (G10 L21) numbers them:
+
+- 1st segment: the bench's axis ``soft_limits`` (machine coordinates), overridden per axis by
+  ``G10 L21 P1`` (positive) / ``P2`` (negative); crossing it raises 0x0A01.
+- 2nd segment: only when a program sets it with ``G10 L21 P3`` / ``P4``; crossing raises 0x0A03.
+
+G10 L21 values are stored by the interpreter in ``profile.params["soft limit P<n> <axis>"]`` as
+programmed, so an X value on a lathe in diameter mode is a diameter and is halved here (machine X
+is a radius).  The check runs on the whole path of a move — an arc that bulges past a limit is
+caught even when both of its end points lie inside — so a move that would cross never starts.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass, field
+
+from nc.alarms import Alarm
+from nc.moves import Move
+
+_EPS = 1e-9
+
+
+@dataclass
+class SoftLimits:
+    first: dict[str, tuple[float, float]] = field(default_factory=dict)  # bench axis config, machine units
+    params: Mapping[str, float] = field(default_factory=dict)  # the interpreter's profile params (G10 L21)
+    diameter_axes: tuple[str, ...] = ()
+    disabled: set[str] = field(default_factory=set)  # axes whose 1st segment is off (MLC M2x368)
+
+    @classmethod
+    def for_bench(cls, bench, profile=None) -> "SoftLimits":
+        first = {a.name: a.soft_limits for a in bench.axes if a.soft_limits is not None}
+        if profile is None:
+            return cls(first)
+        return cls(first, profile.params, tuple(profile.diameter_axes))
+
+    def window(self, axis: str, segment: int) -> tuple[float | None, float | None]:
+        """(lower, upper) of one segment for one axis, machine coordinates; None where unset."""
+        lo: float | None
+        hi: float | None
+        lo, hi = self.first.get(axis, (None, None)) if segment == 1 else (None, None)
+        scale = 0.5 if axis in self.diameter_axes else 1.0
+        pos = self.params.get(f"soft limit {2 * segment - 1} {axis}")
+        neg = self.params.get(f"soft limit {2 * segment} {axis}")
+        if pos is not None:
+            hi = pos * scale
+        if neg is not None:
+            lo = neg * scale
+        return lo, hi
+
+    def check(self, move: Move) -> Alarm | None:
+        """The limit alarm this move would raise, or None when its whole path stays inside."""
+        if move.kind == "dwell":
+            return None
+        ranges = _path_ranges(move)
+        for segment, code in ((1, 0x0A01), (2, 0x0A03)):
+            for axis, (mn, mx) in ranges.items():
+                if segment == 1 and axis in self.disabled:
+                    continue
+                lo, hi = self.window(axis, segment)
+                side = None
+                if hi is not None and mx > hi + _EPS:
+                    side, value, lim = "+", mx, hi
+                elif lo is not None and mn < lo - _EPS:
+                    side, value, lim = "-", mn, lo
+                if side is not None:
+                    return Alarm(code, f"software limit {segment} {side} of axis {axis}: the move would reach "
+                                       f"{value:.4f}, limit {lim:.4f} (machine coordinates); the move was not started",
+                                 line=move.line, block=move.block, program=move.program, axis=axis)
+        return None
+
+
+def _path_ranges(move: Move) -> dict[str, tuple[float, float]]:
+    """Per axis (min, max) of the machine-coordinate path of a line, rapid, thread or arc."""
+    axes: Iterable[str] = set(move.start) | set(move.end)
+    r = {a: (min(move.start.get(a, move.end.get(a, 0.0)), move.end.get(a, move.start.get(a, 0.0))),
+             max(move.start.get(a, move.end.get(a, 0.0)), move.end.get(a, move.start.get(a, 0.0)))) for a in axes}
+    if move.kind != "arc" or not move.center:
+        return r
+    a1, a2 = move.plane
+    c1, c2 = move.center.get(a1, 0.0), move.center.get(a2, 0.0)
+    s1, s2 = move.start.get(a1, 0.0) - c1, move.start.get(a2, 0.0) - c2
+    e1, e2 = move.end.get(a1, 0.0) - c1, move.end.get(a2, 0.0) - c2
+    radius = math.hypot(s1, s2)
+    t0, t1 = math.atan2(s2, s1), math.atan2(e2, e1)
+    ccw = move.dir == "ccw"
+    sweep = (t1 - t0) % (2 * math.pi) if ccw else (t0 - t1) % (2 * math.pi)
+    if sweep < 1e-12 or move.turns:
+        sweep = 2 * math.pi  # full circle (or a helix with extra turns)
+    # The plane axes reach an extreme at the quadrant angles the arc sweeps through.
+    for k in range(4):
+        q = k * math.pi / 2
+        d = (q - t0) % (2 * math.pi) if ccw else (t0 - q) % (2 * math.pi)
+        if d <= sweep + 1e-12:
+            p1, p2 = c1 + radius * math.cos(q), c2 + radius * math.sin(q)
+            for ax, v in ((a1, p1), (a2, p2)):
+                lo, hi = r.get(ax, (v, v))
+                r[ax] = (min(lo, v), max(hi, v))
+    return r
