@@ -6,6 +6,7 @@ import json
 import sys
 from dataclasses import replace
 from pathlib import Path
+from typing import Sequence
 
 from fieldbus.factory import parse_bus
 from fieldbus.link import BusLink, SimLink
@@ -25,16 +26,17 @@ class InputError(Exception):
         super().__init__(message)
 
 
-def load_program(path: str) -> Program:
-    p = Path(path)
+def load_program(path: str, libs: Sequence[str] = ()) -> Program:
+    """The file's main program.  Every O program of the file and of ``libs`` (``--lib DIR|FILE``)
+    goes to the program store the program carries, so M98/G65 calls resolve (issue 3)."""
+    from nc.store import ProgramStore
+
+    store = ProgramStore()
     try:
-        text = p.read_text(encoding="utf-8", errors="replace")
-    except OSError as exc:
-        raise NcAlarm(0x0002, f"program file {path} cannot be read: {exc.strerror}", program=p.name) from None
-    try:
-        return parse_program(text, name=p.name)
-    except NcAlarm as exc:
-        raise exc.at(None, None, p.name)
+        store.add_libs(libs)
+    except ValueError as exc:
+        raise InputError(str(exc)) from None
+    return store.load_main(path)
 
 
 def load_bench(path: str | None, profile: str | None = None, bus: str | None = None) -> Bench:

@@ -44,6 +44,36 @@ class ProgramStore:
     def add_file(self, path: Path) -> list[Program]:
         return self.add_text(path.read_text(errors="replace"), path.name)
 
+    def add_libs(self, libs: list[str] | tuple[str, ...]) -> None:
+        """``--lib DIR|FILE``: a file's O programs are registered now, a folder is a (DISK) root
+        searched in the NC5 order.  Raises ValueError naming a path that is neither."""
+        for lib in libs:
+            lp = Path(lib)
+            if lp.is_file():
+                self.add_file(lp)
+            elif lp.is_dir():
+                self.roots.append(lp)
+            else:
+                raise ValueError(f"--lib {lib}: no such file or folder")
+
+    def load_main(self, path: str) -> Program:
+        """The main program of a file; every further O program of the file is registered (A23).
+        The program keeps this store, so any interpreter that runs it finds its subprograms."""
+        p = Path(path)
+        try:
+            text = p.read_text(encoding="utf-8", errors="replace")
+        except OSError as exc:
+            raise NcAlarm(0x0002, f"program file {path} cannot be read: {exc.strerror}", program=p.name) from None
+        self.main_dir = p.parent
+        try:
+            progs = self.add_text(text, p.name)
+        except NcAlarm as exc:
+            raise exc.at(None, None, p.name)
+        main = progs[0]
+        main.name = p.name
+        main.store = self
+        return main
+
     def folders(self, macro_call: bool) -> list[Path]:
         disk: list[Path] = []
         for r in self.roots:

@@ -8,10 +8,9 @@ from __future__ import annotations
 import argparse
 import json
 import sys
-from pathlib import Path
 
 from hil.cli import EXIT_ALARM, EXIT_OK, EXIT_USAGE
-from hil.session import InputError, load_bench, load_program, print_alarm
+from hil.session import InputError, load_bench, print_alarm
 from nc.alarms import NcAlarm, internal_error
 from nc.interp import Interpreter
 from nc.moves import Move, Sync
@@ -98,19 +97,18 @@ def cmd_path(args: argparse.Namespace) -> int:
         print(f"hil path: {exc}", file=sys.stderr)
         return EXIT_USAGE
     store = ProgramStore(usb_first=bool(profile.param("N8.22 Bit5")))
-    for lib in args.lib:
-        lp = Path(lib)
-        if lp.is_file():
-            store.add_file(lp)
-        elif lp.is_dir():
-            store.roots.append(lp)
-        else:
-            print(f"hil path: --lib {lib}: no such file or folder", file=sys.stderr)
-            return EXIT_USAGE
     interp = Interpreter(profile, store=store)
     out = sys.stdout
     try:
-        program = _load_main(args.program, store)
+        store.add_libs(args.lib)
+    except ValueError as exc:
+        print(f"hil path: {exc}", file=sys.stderr)
+        return EXIT_USAGE
+    except NcAlarm as exc:
+        print_alarm(exc.alarm, as_json=args.json)
+        return EXIT_ALARM
+    try:
+        program = store.load_main(args.program)
         plotted: list[Move] = []
         for ev in interp.run(program):
             if isinstance(ev, Move):
@@ -145,23 +143,6 @@ def cmd_path(args: argparse.Namespace) -> int:
         print(json.dumps({"kind": "vars", "values": values}) if args.json else
               "vars " + " ".join(f"#{k}={'vacant' if v is None else v}" for k, v in values.items()), file=out)
     return EXIT_OK
-
-
-def _load_main(path: str, store: ProgramStore):
-    """The main program; every further O program in the same file goes to the store (A23)."""
-    p = Path(path)
-    try:
-        text = p.read_text(encoding="utf-8", errors="replace")
-    except OSError as exc:
-        raise NcAlarm(0x0002, f"program file {path} cannot be read: {exc.strerror}", program=p.name) from None
-    store.main_dir = p.parent
-    try:
-        progs = store.add_text(text, p.name)
-    except NcAlarm as exc:
-        raise exc.at(None, None, p.name)
-    main = progs[0]
-    main.name = p.name
-    return main
 
 
 def _print_preview(interp: Interpreter, args: argparse.Namespace) -> None:

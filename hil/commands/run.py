@@ -25,6 +25,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--bench", help="bench file (TOML); default: the built-in 2-axis lathe")
     p.add_argument("--bus", help="sim | ethercat:IFACE | canopen:INTERFACE[:CHANNEL] (overrides the bench)")
     p.add_argument("--profile", help="controller profile (overrides the bench)")
+    p.add_argument("--lib", action="append", default=[], metavar="DIR|FILE",
+                   help="where subprograms and macros (O numbers) are found, as for `hil path --lib`")
     p.add_argument("--trace", metavar="FILE", help="write every cycle to this file: .parquet/.pq → Parquet, else CSV")
     p.add_argument("--realtime", action="store_true",
                    help="pace cycles in real time (SCHED_FIFO, CPU pinning, DC alignment where allowed)")
@@ -49,10 +51,13 @@ def cmd_run(args: argparse.Namespace) -> int:
         print(f"hil run: {exc}", file=sys.stderr)
         return EXIT_USAGE
     try:
-        program = load_program(args.program)
+        program = load_program(args.program, args.lib)
     except NcAlarm as exc:
         print_alarm(exc.alarm)
         return EXIT_ALARM
+    except InputError as exc:  # a --lib that is neither file nor folder
+        print(f"hil run: {exc}", file=sys.stderr)
+        return EXIT_USAGE
     try:
         link = make_link(bench)
     except InputError as exc:

@@ -89,6 +89,7 @@ class Interpreter:
             self.position.update({a: v for a, v in start.items() if a in self.position})
         self.program_name = ""
         self.store = store or ProgramStore()
+        self._own_store = store is not None  # else the program's own store (Program.store) is searched
         self.tools = ToolTable()
         self.sys = SystemVariables(self)
         self.vars = Variables(legacy=profile.legacy, system_read=self.sys.read, system_write=self.sys.write)
@@ -162,6 +163,8 @@ class Interpreter:
     def _run(self, program: Program) -> Iterator[Event]:
         self.program_name = program.name
         self.stack = [Frame(program)]
+        if not self._own_store and program.store is not None:
+            self.store = program.store
         if program.number is not None:
             self.store.loaded.setdefault(program.number, program)
         limit = int(self.profile.param("max blocks", 1_000_000))

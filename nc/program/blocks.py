@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass, field, replace
-from typing import Union
+from typing import Any, Union
 
 from nc.alarms import NcAlarm
 from nc.program.expr import Expr, ExprParser, Num, Var
@@ -126,6 +126,9 @@ class Program:
     number: int | None = None  # O number
     path: str | None = None  # file it came from (program store search order)
     labels: dict[int, list[int]] = field(default_factory=dict)  # N -> block indexes
+    # The ProgramStore the program was loaded with (nc.store.ProgramStore.load_main): an interpreter
+    # built without a store of its own searches it, so M98/G65 work wherever the program runs.
+    store: Any = field(default=None, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         if not self.labels:
