@@ -64,6 +64,8 @@ class BenchRunner:
         n_axes, n_sp = len(bench.axes), len(bench.spindles)
         self.masters = [Cia402Master() for _ in range(n_axes + n_sp)]
         self.rx = [RxPdo(mode=MODE_CSP) for _ in range(n_axes)] + [RxPdo(mode=MODE_CSV) for _ in range(n_sp)]
+        for rx in self.rx[n_axes:]:
+            rx.touch_probe_function = 0x0001  # latch the spindle encoder index (thread sync)
         self.tx: list[TxPdo] = [TxPdo() for _ in self.rx]
         self.scales = [a.scaling for a in bench.axes] + [s.scaling for s in bench.spindles]
         self.result = RunResult(max_ferr={a: 0.0 for a in self.axes})
@@ -130,7 +132,8 @@ class BenchRunner:
 
     def run_events(self, events: Iterator[Event]) -> None:
         planner = Planner(self.bench.motion_config(), dict(zip(self.axes, self.actual.tolist())),
-                          spindle_rpm=lambda: self.mlc.spindle.rpm)
+                          spindle_rpm=self.spindle_actual_rpm, spindle_angle=self.spindle_actual_angle,
+                          spindle_index=self.spindle_index_angle)
         self.channel = ch = Channel(planner)
         ch.soft_limits = SoftLimits.for_bench(self.bench, getattr(self, "profile", None))
         for a in self.result.alarms:
@@ -147,6 +150,27 @@ class BenchRunner:
         self.result.program_time = self.time - t0
         self.result.finished = ch.state is RunState.FINISHED
         self._settle()
+
+    # ---- spindle feedback for the planner (issue 5: feed per rev, CSS, threading) -----------
+    def spindle_actual_rpm(self) -> float:
+        """The first spindle drive's measured speed (signed rpm); the MLC's command without a spindle."""
+        n = len(self.axes)
+        if len(self.scales) <= n:
+            return self.mlc.spindle.rpm
+        return self.scales[n].counts_per_s_to_rpm(self.tx[n].velocity_actual)
+
+    def spindle_actual_angle(self) -> float:
+        """The first spindle's measured angle, cumulative degrees (position_actual, not wrapped)."""
+        n = len(self.axes)
+        return self.scales[n].to_units(self.tx[n].position_actual) if len(self.scales) > n else 0.0
+
+    def spindle_index_angle(self) -> float:
+        """Angle of the spindle encoder index from the drive's touch probe (0x60B8 bit 0 armed at
+        power-up, 0x60B9 bit 1 latched, 0x60BA position); 0 until the index has been seen."""
+        n = len(self.axes)
+        if len(self.scales) <= n or not self.tx[n].touch_probe_status & 0x0002:
+            return 0.0
+        return self.scales[n].to_units(self.tx[n].touch_probe_pos1)
 
     # ---- the cycle ------------------------------------------------------------------------
     def _exchange(self) -> None:

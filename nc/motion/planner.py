@@ -26,6 +26,7 @@ from nc.motion.limits import MotionConfig
 from nc.motion.lookahead import MARGIN, Block, Limits, backward, reach
 from nc.motion.path import Segment
 from nc.motion.profile import Piecewise, solve_axes, solve_position, solve_velocity
+from nc.motion import threading as thr
 from nc.moves import Move
 
 CHUNK = 64  # cycles sampled per vectorised step
@@ -52,13 +53,23 @@ class _Plan:
 
 class Planner:
     def __init__(self, cfg: MotionConfig, start: dict[str, float] | None = None,
-                 spindle_rpm: Callable[[], float] | None = None) -> None:
+                 spindle_rpm: Callable[[], float] | None = None,
+                 spindle_angle: Callable[[], float] | None = None,
+                 spindle_index: Callable[[], float] | None = None) -> None:
         self.cfg = cfg
         self.axes = cfg.axes
         self.lim = Limits(cfg)
         self.position = np.array([(start or {}).get(a, 0.0) for a in self.axes], dtype=float)
         self.blocks: deque[Block] = deque()
         self.spindle_rpm = spindle_rpm or (lambda: 0.0)
+        # Spindle actual angle (cumulative degrees) and the angle of one index pulse; without a
+        # spindle_angle source an ideal spindle at spindle_rpm() is integrated (offline runs).
+        self._sim_angle = 0.0
+        self.spindle_angle = spindle_angle or (lambda: self._sim_angle)
+        self._integrate_angle = spindle_angle is None
+        self.spindle_index = spindle_index or (lambda: 0.0)
+        self._thread: thr.ThreadState | None = None
+        self.thread_log: list[tuple[int, float, float]] = []  # (line, sync angle, ramp start angle) per chain
         self.depth = cfg.lookahead_depth()
         self.line = 0
         # operator controls
@@ -182,9 +193,13 @@ class Planner:
 
     # ---- per cycle ------------------------------------------------------------------------
     def step(self) -> Setpoint:
+        if self._integrate_angle:
+            self._sim_angle += self.spindle_rpm() * 6.0 * self.cfg.cycle
         self._check_spindle()
         if self._buf_done:
             self._refill()
+        if self._buf_done and self.plan is None and self.blocks and self.blocks[0].kind == "thread":
+            return self._thread_step()
         if self._buf_done:  # standing still (idle, held, or waiting)
             self.v = self.a = 0.0
             blk = self.blocks[0].move if self._started and self.blocks else None
@@ -196,6 +211,53 @@ class Planner:
         self.s, self.v, self.a = self._buf_state[i]
         blk = self.blocks[0].move if self.blocks else None
         return Setpoint(self.position.copy(), self.line, float(self._buf_vel[i]), blk)
+
+    # ---- threads --------------------------------------------------------------------------
+    def _thread_step(self) -> Setpoint:
+        """One cycle of a spindle-locked thread chain (see nc.motion.threading)."""
+        T = self.cfg.cycle
+        b = self.blocks[0]
+        self._started = True
+        angle = float(self.spindle_angle())
+        st = self._thread
+        if st is None:
+            if self._stopping:
+                self._flush()
+                return Setpoint(self.position.copy(), self.line, 0.0, None)
+            if b.seg is not None and np.allclose(b.seg.start, self.position, atol=1e-6):
+                b.seg.start = self.position.copy()
+            self.line = b.move.line
+            st = self._thread = thr.arm(b, angle, float(self.spindle_rpm()), float(self.spindle_index()),
+                                        b.move.line)
+            self.thread_log.append((b.move.line, st.sync_angle, st.ramp_start))
+            self.solves += 1
+        if self._stopping and not st.stopping:
+            if st.v <= 1e-9 and not st.locked:
+                self._flush()
+                return Setpoint(self.position.copy(), self.line, 0.0, None)
+            thr.stop(st, b)
+        while True:
+            last = not (len(self.blocks) > 1 and self.blocks[1].kind == "thread") or st.stopping
+            s = thr.advance(st, b, angle, T, last)
+            if s is not None:
+                break
+            if last:
+                self.position = b.seg.end.copy()
+                self._thread = None
+                self.s = self.v = self.a = 0.0
+                self._finish_block()
+                return Setpoint(self.position.copy(), b.move.line, 0.0, b.move)
+            self._finish_block(keep_plan=True)
+            nb = self.blocks[0]
+            thr.next_block(st, b, nb)
+            b = nb
+        self.position = b.seg.points(np.array([s]))[0]
+        self.line = b.move.line
+        self.s, self.v, self.a = s, st.v, 0.0
+        if st.halted:
+            self._flush()
+            self.v = 0.0
+        return Setpoint(self.position.copy(), self.line, st.v, b.move)
 
     # ---- planning -------------------------------------------------------------------------
     def _block(self, move: Move) -> Block | None:
@@ -255,6 +317,7 @@ class Planner:
             self._replan()
 
     def _flush(self) -> None:
+        self._thread = None
         self.blocks.clear()
         self.plan = None
         self._buf_pos = None
@@ -299,6 +362,8 @@ class Planner:
                 return _Plan("dwell", None, float(b.move.duration or 0.0), t0)
             if b.kind == "indep":
                 return self._plan_indep(b, t0)
+            if b.kind == "thread":
+                return None  # spindle-locked: stepped cycle by cycle (_thread_step)
             if self.s >= b.length - 1e-9 and len(self.blocks) > 1 and self.blocks[1].kind == "path":
                 self.s -= b.length
                 self._finish_block(keep_plan=True)

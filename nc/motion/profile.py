@@ -110,7 +110,18 @@ def solve_position(p0: float, v0: float, a0: float, p1: float, v1: float, v_max:
     inp.max_acceleration = [a_max]
     inp.max_jerk = [j_max]
     traj = Trajectory(1)
-    if otg.calculate(inp, traj) not in _OK:
+    try:
+        ok = otg.calculate(inp, traj) in _OK
+    except Exception:  # ruckig.RuckigError
+        # ruckig 0.19 fails on some inputs exactly at a phase boundary (e.g. 0 → 1.2 + 1 ulp at
+        # a 1500, j 75000, where a/j² … meet): one retry with the jerk 1 ppb lower.
+        inp.max_jerk = [j_max * (1.0 - 1e-9)]
+        traj = Trajectory(1)
+        try:
+            ok = otg.calculate(inp, traj) in _OK
+        except Exception:
+            ok = False
+    if not ok:
         return None
     return Piecewise.of(traj)
 

@@ -1,0 +1,149 @@
+"""Spindle-synchronised threading: thread moves locked to the spindle's ACTUAL angle.
+
+A run of consecutive thread moves (a thread and its chamfer pull-out, say) is one *chain*. The
+chain starts from rest; it is armed on its first cycle: from the spindle's actual speed ω0 it
+solves ONE jerk-limited ramp (ruckig, 1 DoF) from rest to the locked speed lead·ω0/360 along the
+thread's major axis. That ramp ends D behind where a spindle-locked axis would be, so the ramp
+starts 360·D/lead degrees *before* the sync angle (index + Q): after the ramp the axis is exactly
+where lead × revolutions since the sync angle puts it (acceleration-lag compensation). The ramp
+runs on spindle angle, not on time, so every pass with the same spindle speed meets the thread
+at the same phase. Locked, the major-axis travel u integrates lead(n)·Δn per cycle (G34: the lead
+grows by K per revolution). The last move of the chain brakes to rest at its end point with one
+jerk-limited profile, started when the remaining distance is what braking needs.
+
+Feed override, feed hold and dry run do not act on a thread (the override is forced to 100 %).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from nc.alarms import NcAlarm
+from nc.motion.lookahead import MARGIN, Block, change_distance
+from nc.motion.profile import Piecewise, solve_position, solve_velocity
+
+
+def major_factor(b: Block) -> float:
+    """Path length per unit of travel along the thread's major axis (the axis the lead is on)."""
+    assert b.seg is not None
+    major = float(np.max(np.abs(b.seg.end - b.seg.start)))
+    return b.length / major if major > 1e-12 else 1.0
+
+
+@dataclass
+class ThreadState:
+    direction: float  # +1 / -1: the spindle's sense of rotation
+    omega: float  # |deg/s| at arming
+    sync_angle: float  # cumulative spindle angle (deg) of index + Q the chain is locked to
+    ramp_start: float  # cumulative angle where the ramp starts (sync_angle less the lag)
+    ramp: Piecewise  # major-axis travel u(t) from rest to the locked speed
+    ramp_time: float
+    u: float = 0.0  # major-axis travel since the chain start
+    u_block: float = 0.0  # u where the current block began
+    n_block: float = 0.0  # revolutions (since sync) where the current block began
+    locked: bool = False
+    last_angle: float = 0.0
+    brake: Piecewise | None = None  # path profile of the final stop
+    brake_t: float = 0.0
+    s: float = 0.0  # path position in the current block
+    v: float = 0.0  # path speed (finite difference)
+    stopping: bool = False  # a reset brakes the thread where it is
+    halted: bool = False
+
+
+def arm(b: Block, angle: float, rpm: float, index: float, line: int) -> ThreadState:
+    """Plan the chain's start from the spindle's actual angle and speed."""
+    mv = b.move
+    if abs(rpm) < 1.0:
+        raise NcAlarm(0x0C02, "thread: the spindle is not rotating", line=line, block=mv.block, program=mv.program)
+    lead = float(mv.lead or 0.0)
+    if lead <= 0.0:
+        raise NcAlarm(0x1001, "thread without a positive lead", line=line, block=mv.block, program=mv.program)
+    d = 1.0 if rpm > 0 else -1.0
+    omega = abs(rpm) * 6.0  # deg/s
+    f = major_factor(b)
+    v_u = lead * omega / 360.0
+    if v_u * f > b.cap_hard * 1.0001:
+        raise NcAlarm(0xB01D, f"thread: {lead:g} mm/rev at {abs(rpm):.0f} rpm needs {v_u * f * 60:.0f} mm/min, "
+                              f"above the axes' {b.cap_hard * 60:.0f} mm/min", line=line, block=mv.block,
+                      program=mv.program)
+    ramp = solve_velocity(0.0, 0.0, 0.0, v_u, b.a / f, b.j / f)
+    t_r = ramp.duration
+    lag = v_u * t_r - float(ramp.sample(np.array([t_r]))[0][0])  # how far the ramp ends behind the lock
+    lag_deg = 360.0 * lag / lead
+    sync = index + float(mv.start_angle or 0.0)
+    # the first sync angle whose ramp start still lies ahead of the spindle
+    k = math.floor((d * (angle - sync) + lag_deg) / 360.0) + 1
+    sync += d * 360.0 * k
+    return ThreadState(d, omega, sync, sync - d * lag_deg, ramp, t_r, last_angle=angle)
+
+
+def advance(st: ThreadState, b: Block, angle: float, T: float, last_in_chain: bool) -> float | None:
+    """This cycle's path position in block b, or None when the block is done (s = length)."""
+    mv = b.move
+    lead = float(mv.lead or 0.0)
+    f = major_factor(b)
+    if st.brake is not None:
+        st.brake_t += T
+        s = float(st.brake.sample(np.array([st.brake_t]))[0][0])
+        if st.brake_t >= st.brake.duration - 1e-12:
+            if st.stopping:  # a reset: rest wherever the stop ended
+                st.halted = True
+                return _set(st, min(s, b.length), T, False, b)
+            return _set(st, b.length, T, True, b)
+        return _set(st, min(s, b.length), T, False, b)
+    n = st.direction * (angle - st.sync_angle) / 360.0  # revolutions since the sync angle
+    if not st.locked:
+        t = st.direction * (angle - st.ramp_start) / st.omega
+        if t <= 0.0:
+            st.last_angle = angle
+            return _set(st, 0.0, T, False, b)
+        if t < st.ramp_time:
+            st.u = float(st.ramp.sample(np.array([t]))[0][0])
+        else:
+            st.locked = True
+            st.u = lead * n
+    else:
+        n0 = st.direction * (st.last_angle - st.sync_angle) / 360.0
+        k = float(mv.lead_change or 0.0)
+        mid = 0.5 * (n0 + n) - st.n_block
+        st.u += (lead + k * mid) * (n - n0)  # G34: lead grows by K per revolution within the block
+    st.last_angle = angle
+    s = (st.u - st.u_block) * f
+    if s >= b.length - 1e-9 and not last_in_chain:
+        return _set(st, b.length, T, True, b)
+    if last_in_chain and st.locked:
+        v = st.v if st.v > 0.0 else lead * st.omega / 360.0 * f
+        need = change_distance(v, 0.0, MARGIN * b.a, MARGIN * b.j)
+        if b.length - s - v * T <= need:
+            st.brake = solve_position(s, v, 0.0, b.length, 0.0, 1.01 * v + 1e-6, b.a, b.j)
+            if st.brake is None:
+                raise NcAlarm(0x0000, "thread: the pull-out stop cannot be planned", line=mv.line, block=mv.block,
+                              program=mv.program)
+            st.brake_t = 0.0
+    return _set(st, min(s, b.length), T, False, b)
+
+
+def _set(st: ThreadState, s: float, T: float, done: bool, b: Block) -> float | None:
+    st.v = (s - st.s) / T if s >= st.s else 0.0
+    st.s = s
+    return None if done else s
+
+
+def next_block(st: ThreadState, b: Block, nb: Block) -> None:
+    """The chain runs on from b into the next thread block nb: carry the travel over."""
+    st.u_block += b.length / major_factor(b)
+    st.u = max(st.u, st.u_block)
+    st.n_block = st.direction * (st.last_angle - st.sync_angle) / 360.0
+    st.s = (st.u - st.u_block) * major_factor(nb)
+
+
+def stop(st: ThreadState, b: Block) -> None:
+    """Reset or alarm during a thread: jerk-limited stop along the path from the current state."""
+    st.stopping = True
+    if st.brake is None:
+        st.brake = solve_velocity(st.s, st.v, 0.0, 0.0, b.a, b.j)
+        st.brake_t = 0.0

@@ -1,0 +1,146 @@
+"""Issue 5 §4: spindle-synchronised threading and feed per revolution from the spindle's ACTUAL
+speed, run in lock-step on the simulated bench (virtual CSP axes + CSV spindle drive)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from fieldbus.link import SimLink
+from hil.bench import default_lathe
+from hil.runner import BenchRunner
+from hil.session import sim_slaves
+from nc.program import parse_program
+
+LEAD = 1.5
+
+
+def passes_program(xs: list[float], q: list[float] | None = None, lead: float = LEAD, rpm: int = 600,
+                   k: float | None = None) -> str:
+    """Repeated G32 passes at different X (a hand-written multi-pass thread), optional Q per pass."""
+    out = ["G21 G18 G99", f"S{rpm} M03", "G00 X30. Z5."]
+    for i, x in enumerate(xs):
+        qw = f" Q{int(q[i] * 1000)}" if q else ""
+        code = f"G34 Z-20. F{lead} K{k}" if k is not None else f"G32 Z-20. F{lead}{qw}"
+        out += [f"G00 X{x}", code, "G00 X30.", "Z5."]
+    out.append("M30")
+    return "\n".join(out) + "\n"
+
+
+def run_bench(text: str, **drive):
+    bench = default_lathe()
+    for key, v in drive.items():
+        setattr(bench.spindles[0].drive, key, v)
+    runner = BenchRunner(bench, SimLink(sim_slaves(bench), bench.cycle))
+    rows = []
+
+    def grab(r):
+        if r.channel is not None:
+            rows.append((r.line, r._commands[0], r._commands[1], r.actual[1], r.spindle_actual_angle(),
+                         r.spindle_actual_rpm()))
+
+    runner.on_cycle = grab
+    result = runner.run_program(parse_program(text))
+    return result, np.array(rows), runner
+
+
+def thread_rows(rows: np.ndarray, line: int) -> np.ndarray:
+    return rows[rows[:, 0] == line]
+
+
+def locked(m: np.ndarray, lo: float = -15.0, hi: float = 0.0, col: int = 2) -> np.ndarray:
+    return m[(m[:, col] > lo) & (m[:, col] < hi)]
+
+
+def phase(m: np.ndarray, col: int, lead: float = LEAD) -> np.ndarray:
+    """Thread phase: spindle angle less the angle Z's travel from the start accounts for."""
+    return (m[:, 4] - 360.0 * (5.0 - m[:, col]) / lead) % 360.0
+
+
+def circ_spread(deg: np.ndarray) -> float:
+    ref = deg[0]
+    d = (deg - ref + 180.0) % 360.0 - 180.0
+    return float(d.max() - d.min())
+
+
+def test_every_pass_starts_on_the_same_spindle_phase():
+    xs = [19.4, 19.0, 18.6, 18.3]
+    result, rows, runner = run_bench(passes_program(xs))
+    assert result.ok, result.alarms
+    lines = [5 + 4 * i for i in range(len(xs))]
+    # the sync angles the planner locked each pass to: index + Q, whole revolutions apart
+    log = runner.channel.planner.thread_log
+    assert [ln for ln, _, _ in log] == lines
+    assert circ_spread(np.array([sync % 360.0 for _, sync, _ in log])) < 0.5
+    # the spindle's measured angle when each pass starts moving
+    starts = []
+    for ln in lines:
+        m = thread_rows(rows, ln)
+        moving = np.flatnonzero(np.abs(np.diff(m[:, 2])) > 0)
+        starts.append(m[moving[0], 4] % 360.0)
+    assert circ_spread(np.array(starts)) < 0.5
+    # the commanded and the actual Z meet the thread at the same phase on every pass
+    cmd = np.concatenate([phase(locked(thread_rows(rows, ln)), 2) for ln in lines])
+    act = np.concatenate([phase(locked(thread_rows(rows, ln), col=3), 3) for ln in lines])
+    assert circ_spread(cmd) < 0.5
+    assert circ_spread(act) < 0.5
+
+
+def test_z_advances_one_lead_per_spindle_revolution():
+    result, rows, _ = run_bench(passes_program([19.4]))
+    assert result.ok, result.alarms
+    m = locked(thread_rows(rows, 5))
+    assert len(m) > 500
+    revs = (m[-1, 4] - m[0, 4]) / 360.0
+    assert abs((m[0, 2] - m[-1, 2]) / revs - LEAD) < 1e-6
+    # and cycle by cycle
+    dz = -np.diff(m[:, 2])
+    drev = np.diff(m[:, 4]) / 360.0
+    assert np.allclose(dz / drev, LEAD, atol=1e-6)
+
+
+def test_start_angle_q_shifts_the_phase():
+    result, rows, _ = run_bench(passes_program([19.4, 19.4], q=[0.0, 90.0]))
+    assert result.ok, result.alarms
+    p0 = phase(locked(thread_rows(rows, 5)), 2)
+    p1 = phase(locked(thread_rows(rows, 9)), 2)
+    shift = (np.median(p1) - np.median(p0)) % 360.0
+    assert abs(shift - 90.0) < 0.5
+
+
+def test_g34_lead_grows_per_revolution():
+    result, rows, _ = run_bench(passes_program([19.4], lead=1.0, k=0.1))
+    assert result.ok, result.alarms
+    m = locked(thread_rows(rows, 5), lo=-18.0, hi=2.0)
+    dz = -np.diff(m[:, 2])
+    drev = np.diff(m[:, 4]) / 360.0
+    lead_now = dz / drev
+    # the lead rises by K = 0.1 mm per spindle revolution
+    slope = np.polyfit(np.cumsum(drev), lead_now, 1)[0]
+    assert abs(slope - 0.1) < 0.005
+
+
+def test_feed_per_rev_follows_the_measured_spindle_speed():
+    # A slow spindle ramp (csv_accel) makes the measured speed lag the commanded S by seconds:
+    # the feed must follow what the spindle really does.
+    text = "G21 G18 G99\nS600 M03\nG00 X30. Z5.\nG01 Z-40. F0.2\nM30\n"
+    result, rows, _ = run_bench(text, csv_accel=2.0e6)  # counts/s²: ≈ 94 rpm/s
+    assert result.ok, result.alarms
+    m = thread_rows(rows, 4)
+    v = -np.diff(m[:, 2]) / 0.001
+    rpm = m[1:, 5]
+    mid = (rpm > 100) & (rpm < 500) & (np.abs(np.diff(v, prepend=v[0])) < 0.05)
+    mid[-200:] = False  # not the stop at the block end
+    assert mid.sum() > 200  # the cut ran while the spindle was still coming up to speed
+    expected = 0.2 * rpm[mid] / 60.0
+    assert np.all(np.abs(v[mid] - expected) <= 0.03 * expected + 0.01)
+
+
+def test_g76_phase_check_from_the_command_line(hil, program, tmp_path):
+    prog = program("G21 G18 G99\nS800 M03\nG00 X28. Z5.\nG76 P020060 Q100 R0.05\n"
+                   "G76 X21.4 Z-22. P1300 Q400 F2.\nG00 X60. Z20.\nM30\n")
+    trace = tmp_path / "t.csv"
+    r = hil("run", prog, "--trace", trace)
+    assert r.code == 0, r.out + r.err
+    r = hil("check", trace, "--program", prog, "--thread-phase", "0.5", "--limits")
+    assert r.code == 0, r.out
+    assert "ok    thread phase" in r.out
