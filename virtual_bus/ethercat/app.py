@@ -6,7 +6,6 @@ read from theirs), so the PDO mapping a master configures over SDO is the one th
 
 from __future__ import annotations
 
-import struct
 from dataclasses import dataclass, field
 
 from fieldbus.pdo import ASDA_CSP_CSV, RxPdo
@@ -105,7 +104,3 @@ class DioApp(SlaveApp):
             self.outputs = od.value(0x7000, 1)
         od.set(0x6000, 1, self.inputs)
         return _pack(tx_map, od)
-
-
-def pack_u16(v: int) -> bytes:
-    return struct.pack("<H", v & 0xFFFF)
