@@ -45,8 +45,15 @@ class PathBuilder:
         return dict(line=self.line, block=self.block, start=dict(self.position), end=end,
                     work=self.to_work(end), program=self.program, plane=self.plane, tags=tags, css=self.css)
 
-    def rapid(self, p: Pt, tags: tuple[str, ...] = ()) -> Move | None:
+    def _same(self, p: Pt) -> bool:
+        """A move shorter than float noise is dropped; the position snaps to the exact target."""
         if abs(p[0] - self.here[0]) < 1e-12 and abs(p[1] - self.here[1]) < 1e-12:
+            self.position[self.plane[0]], self.position[self.plane[1]] = p
+            return True
+        return False
+
+    def rapid(self, p: Pt, tags: tuple[str, ...] = ()) -> Move | None:
+        if self._same(p):
             return None
         return self._emit(Move("rapid", **self._common(self._end(p), tags)))
 
@@ -66,7 +73,7 @@ class PathBuilder:
                                **self._common(end, tags)))
 
     def feed_to(self, p: Pt, tags: tuple[str, ...] = (), feed: float | None = None) -> Move | None:
-        if abs(p[0] - self.here[0]) < 1e-12 and abs(p[1] - self.here[1]) < 1e-12:
+        if self._same(p):
             return None
         return self._emit(Move("line", feed=feed if feed is not None else self.feed, per_rev=self.per_rev,
                                **self._common(self._end(p), tags)))

@@ -1,0 +1,51 @@
+"""Property test of G71 roughing on random contours (pure geometry, no interpreter):
+no move of the cycle enters the finished contour, no layer is deeper than the programmed depth,
+the cycle ends where it started."""
+
+from __future__ import annotations
+
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from cycles_helpers import contour_x
+from nc.cycles.builder import PathBuilder
+from nc.cycles.geometry import Seg, point_seg_distance
+from nc.cycles.turning import RoughSpec, rough
+
+
+@st.composite
+def contours(draw):
+    """Type II contours: Z strictly decreasing steps, X anywhere in 2..18 (pockets included)."""
+    n = draw(st.integers(2, 7))
+    z = 0.0
+    pts = [(z, draw(st.floats(2.0, 18.0)))]
+    for _ in range(n):
+        z -= draw(st.floats(1.0, 12.0))
+        pts.append((z, draw(st.floats(2.0, 18.0))))
+    pts.append((pts[-1][0], 20.0))
+    return pts
+
+
+@settings(max_examples=200, deadline=None)
+@given(pts=contours(), depth=st.floats(0.3, 4.0), retract=st.floats(0.0, 1.0), h=st.sampled_from([0, 1]))
+def test_rough_never_enters_contour(pts, depth, retract, h):
+    segs = [Seg(a, b) for a, b in zip(pts, pts[1:])]
+    # the P block also moves Z (type II): a feed from the start point onto the contour start
+    start = (2.0, 20.0)
+    path = [Seg(start, pts[0])] + segs
+    b = PathBuilder({"Z": start[0], "X": start[1]}, ("Z", "X"), 1, "", lambda m: dict(m))
+    b.feed = 0.2
+    rough(b, path, RoughSpec("G71", depth, retract, 0.0, 0.0, h))
+    cont = path
+    levels = [20.0]
+    for m in b.events:
+        s = Seg((m.start["Z"], m.start["X"]), (m.end["Z"], m.end["X"]))
+        for z, x in s.samples(6):
+            if pts[-1][0] + 1e-9 < z < start[0] - 1e-9:
+                c = contour_x(cont, z)
+                assert x >= c - 1e-6 or min(point_seg_distance((z, x), q) for q in cont) < 1e-6
+        if "rough" in m.tags:
+            levels.append(m.end["X"])
+    lv = sorted(set(round(v, 9) for v in levels), reverse=True)
+    assert all(a - b_ <= depth + 1e-9 for a, b_ in zip(lv, lv[1:]))
+    assert (b.position["Z"], b.position["X"]) == start
