@@ -19,6 +19,13 @@ class Profile:
     axes: tuple[str, ...]
     diameter_axes: tuple[str, ...] = ()
     params: dict[str, float] = field(default_factory=dict)
+    # Rotary axes (degrees): G20 never scales their words.  Default: axes named A, B or C
+    # (N2.01 axis configuration, ISO 841); a bench names them by `units = "deg"`.
+    rotary_axes: tuple[str, ...] = ()
+
+    def __post_init__(self) -> None:
+        if not self.rotary_axes:
+            self.rotary_axes = tuple(a for a in self.axes if a[:1] in ("A", "B", "C"))
 
     @property
     def is_lathe(self) -> bool:
@@ -57,17 +64,18 @@ def default_params() -> dict[str, float]:
     }
 
 
-def make_profile(name: str, axes: tuple[str, ...] | None = None, params: dict[str, float] | None = None) -> Profile:
+def make_profile(name: str, axes: tuple[str, ...] | None = None, params: dict[str, float] | None = None,
+                 rotary: tuple[str, ...] = ()) -> Profile:
     if name not in PROFILE_NAMES:
         raise ValueError(f"unknown profile {name!r}; choose one of {', '.join(PROFILE_NAMES)}")
     p = default_params()
     if params:
         p.update(params)
     if name == "nc5-mill":
-        return Profile(name, "mill", None, axes or ("X", "Y", "Z"), (), p)
+        return Profile(name, "mill", None, axes or ("X", "Y", "Z"), (), p, rotary)
     lathe_type = {"nc5-lathe-a": "A", "nc5-lathe-b": "B", "nc5-lathe-c": "C", "lathe-2018": "A"}[name]
     if name == "lathe-2018":  # L ch.1: P306 = 0/1/2 selects type A/B/C
         lathe_type = "ABC"[int(p.get("P306", 0)) % 3]
     p.setdefault("N1.08", "ABC".index(lathe_type))
     dia = () if p.get("N2.001 Bit10", 0) else ("X",)
-    return Profile(name, "lathe", lathe_type, axes or ("X", "Z"), dia, p)
+    return Profile(name, "lathe", lathe_type, axes or ("X", "Z"), dia, p, rotary)

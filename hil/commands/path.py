@@ -92,7 +92,8 @@ def cmd_path(args: argparse.Namespace) -> int:
             params[name.strip()] = float(value)
         if args.block_skip:
             params["M2x010"] = 1
-        profile = make_profile(bench.profile, bench.axis_names if args.bench else None, params)
+        rotary = tuple(a.name for a in bench.axes if a.units == "deg") if args.bench else ()
+        profile = make_profile(bench.profile, bench.axis_names if args.bench else None, params, rotary)
     except (InputError, ValueError) as exc:
         print(f"hil path: {exc}", file=sys.stderr)
         return EXIT_USAGE

@@ -60,7 +60,7 @@ def g10(ip: "Interpreter", block: "Block") -> Iterator[Event]:
             raise NcAlarm(0x0243, "G10 L21 P must be 1-4")
         for a, (w, inc) in words.items():
             key = f"soft limit {P} {a}"
-            v = ip.distance(w)
+            v = ip.distance(w, a)
             ip.profile.params[key] = ip.profile.params.get(key, 0.0) + v if inc else v
         return
     if L in (10, 11, 12, 13, 14, 15):
@@ -71,7 +71,7 @@ def g10(ip: "Interpreter", block: "Block") -> Iterator[Event]:
         if L in (10, 11):
             table = t.lengths if L == 10 else t.wears
             for a, (w, inc) in words.items():
-                v = ip.distance(w)
+                v = ip.distance(w, a)
                 table[(a, P)] = table.get((a, P), 0.0) + v if inc else v
             if r is not None and ip.profile.is_lathe:
                 (t.radius if L == 10 else t.radius_wear)[P] = ip.distance(r)
@@ -125,7 +125,7 @@ def g10(ip: "Interpreter", block: "Block") -> Iterator[Event]:
 
 def _set_axes(ip: "Interpreter", target: dict[str, float], words) -> None:
     for a, (w, inc) in words.items():
-        v = ip.distance(w)
+        v = ip.distance(w, a)
         if a in ip.profile.diameter_axes:
             v /= 2.0
         target[a] = target.get(a, 0.0) + v if inc else v

@@ -329,6 +329,8 @@ class Interpreter:
             st.spindle_speed = s.value
             spindle = block.get("P")
             args = {"P": spindle.value} if spindle is not None and not funcs & {"G04", "G10", "G30", "G31", "G900", "G05"} and 98 not in mvals else {}
+            if st.css:  # G96: S is a surface speed (m/min); the channel turns it into rpm (issue 5)
+                args = {**args, "css": 1.0}
             yield Aux("S", s.value, block.line, block.text, args=args, program=self.program_name)
         t = block.get("T")
         if t is not None and not self._cycle_fn(funcs):
@@ -654,11 +656,12 @@ class Interpreter:
 
     # ---- numbers and geometry ------------------------------------------------------------------
     def distance(self, w: Word, axis: str | None = None) -> float:
-        """Apply the decimal-point rule (N8.018 Bit10, decisions A4) and inch input."""
+        """Apply the decimal-point rule (N8.018 Bit10, decisions A4) and inch input; a rotary
+        axis word (``axis`` in profile.rotary_axes) stays in degrees under G20."""
         v = w.value
         if not w.has_point and not self.profile.param("N8.018 Bit10"):
             v *= 0.001
-        if self.state.inch:
+        if self.state.inch and (axis is None or axis not in self.profile.rotary_axes):
             v *= 25.4
         return v
 
@@ -712,7 +715,7 @@ class Interpreter:
             elif a == a2:
                 t = t + w.value if inc else w.value  # angles are degrees as written
             else:
-                v = self.distance(w)
+                v = self.distance(w, a)
                 work[a] = work[a] + v if inc else v
         if a1 in words or a2 in words:
             work[a1] = r * math.cos(math.radians(t))
@@ -965,7 +968,7 @@ class Interpreter:
     def _g_G52(self, block: Block) -> None:
         words = self._axis_words(block)
         for a, (w, _inc) in words.items():
-            v = self.distance(w)
+            v = self.distance(w, a)
             self.frames.local_shift[a] = v / 2.0 if a in self.profile.diameter_axes else v
 
     def _g_set(self, block: Block) -> Iterator[Event]:
@@ -976,7 +979,7 @@ class Interpreter:
             yield Aux("S", s.value, block.line, block.text, args={"max": 1.0}, program=self.program_name)
         words = self._axis_words(block)
         for a, (w, inc) in words.items():
-            v = self.distance(w)
+            v = self.distance(w, a)
             cur = self.work_position()[a]
             want = cur + v if inc else v
             m = want / 2.0 if a in self.profile.diameter_axes else want
@@ -993,7 +996,7 @@ class Interpreter:
             return
         end = dict(self.position)
         for a, (w, _inc) in words.items():
-            v = self.distance(w)
+            v = self.distance(w, a)
             end[a] = v / 2.0 if a in self.profile.diameter_axes else v
         if end == self.position:
             return
