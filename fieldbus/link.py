@@ -76,3 +76,17 @@ class SimLink:
 
     def close(self) -> None:
         pass
+
+    # SDO to a simulated slave's object dictionary (Delta servo parameters 0x2000+); same signature
+    # as EthercatLink.sdo_read / sdo_write.
+    def sdo_read(self, position: int, index: int, sub: int = 0, size: int = 0) -> bytes:
+        return self._object_dictionary(position).sdo_read(index, sub)
+
+    def sdo_write(self, position: int, index: int, sub: int, data: bytes, complete: bool = False) -> None:
+        self._object_dictionary(position).sdo_write(index, sub, data)
+
+    def _object_dictionary(self, position: int) -> Any:
+        od = getattr(self.slaves[position], "servo_params", None)
+        if od is None:
+            raise ValueError(f"slave {position} ({self.slaves[position].name}) has no object dictionary")
+        return od

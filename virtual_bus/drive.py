@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 from fieldbus.cia402 import (STATE_BITS, SW_FOLLOWING, SW_FOLLOWING_ERROR, SW_INTERNAL_LIMIT, SW_REMOTE,
                              SW_TARGET_REACHED, SW_VOLTAGE, SW_QUICK_STOP, State, command_of)
 from fieldbus.pdo import RxPdo, TxPdo
+from virtual_bus.servo_params import ServoParams
 
 # Delta ASDA alarm numbers as the drive reports them in 0x603F (the NC shows 0xF002 + this code)
 AL_OVERSPEED = 0x0007
@@ -64,6 +65,7 @@ class Cia402Drive:
     _probe_latched: bool = False
     _probe_pos: int = 0
     _limit_flags: int = 0
+    servo_params: ServoParams = field(default_factory=ServoParams)  # P0-xx…P6-xx over SDO / Modbus (issue 8)
 
     # ---- process data -----------------------------------------------------------------
     def apply(self, rx: RxPdo) -> None:
