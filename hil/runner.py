@@ -216,6 +216,8 @@ class BenchRunner:
                 self.result.max_ferr[self.axes[i]] = ferr
         for k, sc in enumerate(self.scales[n_axes:]):
             rpm = self.mlc.spindle.signed_rpm if (ch is not None and ch.state is not RunState.ALARM) else 0.0
+            if k == 0 and rpm and ch is not None and ch.css_rpm is not None:  # G96 (issue 5)
+                rpm = min(ch.css_rpm, self.bench.spindles[0].max_rpm) * (1.0 if rpm > 0 else -1.0)
             self.rx[n_axes + k].target_velocity = sc.rpm_to_counts_per_s(rpm)
         if self.trace is not None:
             self.trace.write(self._row())

@@ -31,7 +31,9 @@ class BasicMlc:
         aux: Aux | None = channel.pending_aux
         if aux is None:
             return
-        if aux.kind == "S":
+        if aux.kind == "S" and aux.args.get("max"):
+            pass  # G50/G92 S: a speed limit, not a speed (the channel clamps G96 with it)
+        elif aux.kind == "S":
             self.spindle.rpm = min(abs(aux.value), self.max_rpm)
         elif aux.kind == "M":
             code = int(aux.value)

@@ -24,6 +24,7 @@ from dataclasses import dataclass, field
 from enum import Enum
 
 from nc.alarms import Alarm, NcAlarm, internal_error
+from nc.motion.css import css_rpm
 from nc.motion.planner import Planner, Setpoint
 from nc.moves import Aux, Event, Move, ProgramEnd, Sync
 from nc.softlimits import SoftLimits
@@ -53,6 +54,12 @@ class Channel:
     single_block: bool = False
     dry_run_feed: float = 5000.0  # mm/min
     _deferred: Aux | Sync | None = None
+    # G96 (issue 5): the spindle speed constant surface speed asks for now (rpm), None under G97;
+    # the runner/MLC sends it to the spindle drive. spindle_max is the G50/G92 S clamp.
+    css_rpm: float | None = None
+    spindle_max: float | None = None
+    _css_surface: float | None = None
+    _css_move: Move | None = None
     _block_moves: int = 0  # moves pushed since the last single-block stop
     soft_limits: SoftLimits | None = None  # checked before a move reaches the planner (issue 8)
     _limit_alarm: Alarm | None = None  # raised once the moves before the offending one have run out
@@ -152,6 +159,7 @@ class Channel:
         except NcAlarm as exc:
             self.raise_alarm(exc.alarm)
             sp = self.planner.step()
+        self._update_css(sp)
         if self.state is RunState.STOPPING and self.planner.idle:
             self.state = RunState.ALARM
         if self.state is RunState.RESETTING and self.planner.idle:
@@ -203,6 +211,12 @@ class Channel:
                 pl.push(ev)
                 self._block_moves += 1
             elif isinstance(ev, Aux):
+                if ev.kind == "S" and ev.args.get("max"):
+                    self.spindle_max = ev.value
+                elif ev.kind == "S" and ev.args.get("css"):
+                    self._css_surface = ev.value
+                elif ev.kind == "S":
+                    self._css_surface = None
                 if ev.kind == "S":
                     self.spindle_rpm = ev.value
                 if pl.idle:
@@ -214,6 +228,24 @@ class Channel:
             elif isinstance(ev, Sync):
                 if not pl.idle:
                     self._deferred = ev
+
+    def _update_css(self, sp: Setpoint) -> None:
+        """G96: the active move's surface speed at the current X diameter; between moves the last
+        S decides (an S under G96 is m/min, any other S ends it)."""
+        mv = sp.move
+        if mv is not None:
+            self._css_surface = mv.css
+            if mv.css is None:
+                self.css_rpm = None
+                return
+        if self._css_surface is None:
+            self.css_rpm = None
+            return
+        ref = mv if mv is not None else self._css_move
+        if ref is None:
+            return
+        self._css_move = ref
+        self.css_rpm = css_rpm(ref, sp.positions, self.planner.axes, self._css_surface, self.spindle_max)
 
     def _issue(self, aux: Aux) -> None:
         self.pending_aux = aux
