@@ -76,3 +76,23 @@ def test_lathe_chamfer_and_fillet_next_to_arcs(capsys, tmp_path):
 def test_corner_next_to_arc_alarms(capsys, tmp_path, text, code):
     r = run_path(capsys, tmp_path, text)
     assert r.code == 1 and r.alarm["code"] == code and r.alarm["line"] == 2
+
+
+def test_two_block_linear_angle_lathe(capsys, tmp_path):
+    """L l.2449 pattern 2: `,A1` alone, then `X Z ,A2`; angles from +Z, CCW, in ZX (A32)."""
+    r = run_path(capsys, tmp_path, "G98 G00 X20. Z0\nG01 F100 ,A180.\nX60. Z-30. ,A135.\nZ-40.\nM30\n",
+                 profile="nc5-lathe-a")
+    assert r.code == 0, r.alarm
+    assert r.ends("X", "Z") == [(20.0, 0.0), (20.0, -10.0), (60.0, -30.0), (60.0, -40.0)]
+    assert r.moves[1]["line"] == 2 and r.moves[2]["line"] == 3
+
+
+def test_two_block_linear_angle_mill_and_alarms(capsys, tmp_path):
+    r = run_path(capsys, tmp_path, "G17 G90 G94 G00 X0 Y0\nG01 F100 ,A30.\nX20. Y0 ,A-30.\nM30\n")
+    assert r.code == 0, r.alarm
+    assert close(r.ends("X", "Y")[1], (10.0, 10.0 * math.tan(math.radians(30.0))))
+    assert r.ends("X", "Y")[2] == (20.0, 0.0)
+    r = run_path(capsys, tmp_path, "G17 G90 G94 G00 X0 Y0\nG01 F100 ,A30.\nX20. Y0 ,A30.\nM30\n")
+    assert r.code == 1 and r.alarm["code"] == "0x0207"
+    r = run_path(capsys, tmp_path, "G17 G90 G94 G00 X0 Y0\nG01 F100 ,A30.\nX20. Y5.\nM30\n")
+    assert r.code == 1 and r.alarm["code"] == "0x0207" and r.alarm["line"] == 2

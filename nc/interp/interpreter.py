@@ -100,6 +100,7 @@ class Interpreter:
         self.macro_modal: tuple[int, int, dict[int, float]] | None = None  # G66 (program, L, args)
         self.interrupt_program: int | None = None  # M96 P
         self._interrupt_pending = False
+        self._angle_pending: tuple[Block, dict] | None = None  # two-block ,A form: first block held (A32)
         self.reference_via: dict[str, float] | None = None  # G28/G30 intermediate point (machine)
         self.skip_position: dict[str, float] | None = None  # G31 trigger (machine), set by motion
         self.last_target: dict[str, float] = self.work_position()
@@ -793,6 +794,18 @@ class Interpreter:
             self.unit_locked = True
             yield from self._thread(block, geo, "G32" if st.motion == 32 else "G34")
             return
+        if st.motion == 1 and "A" in block.comma:
+            a1, a2 = PLANES[st.plane]
+            if not geo.axes & {a1, a2}:  # `,A1` alone: its end is the intersection with the next block
+                if "C" in block.comma or "R" in block.comma:
+                    raise NcAlarm(0x021D, "the two-block ,A form with ,C/,R is not supported")
+                self._angle_pending = (block, self._move_common(block, geo.target_machine, geo.target_work))
+                return
+            if self._angle_pending is not None:
+                yield from self._angle_intersection(block, geo)
+        if self._angle_pending is not None:
+            raise NcAlarm(0x0207, ",A without an end point must be followed by G01 with both plane "
+                          "coordinates and ,A", line=self._angle_pending[0].line, block=self._angle_pending[0].text)
         has_centre = any(block.has(c) for c in ("I", "J", "K"))
         if not geo.moved:
             if st.motion in (2, 3) and has_centre and funcs & {"G02", "G03"} | ({"G02", "G03"} if has_centre else set()):
@@ -816,6 +829,27 @@ class Interpreter:
         self.position = dict(geo.target_machine)
         self.last_target = dict(geo.target_work)
         yield self._decorate(move, exact)
+
+    def _angle_intersection(self, block: Block, geo: _Geometry) -> Iterator[Event]:
+        """Two-block `,A` (L l.2449 pattern 2): the held block runs from the start at its angle to the
+        intersection with the line into this block's end point at this block's angle (A32)."""
+        first, common = self._angle_pending  # type: ignore[misc]
+        self._angle_pending = None
+        a1, a2 = PLANES[self.state.plane]
+        s = (self.position[a1], self.position[a2])  # machine coordinates (lathe X radius)
+        e = (geo.target_machine[a1], geo.target_machine[a2])
+        t1, t2 = math.radians(first.comma["A"]), math.radians(block.comma["A"])
+        d1, d2 = (math.cos(t1), math.sin(t1)), (math.cos(t2), math.sin(t2))
+        den = d1[0] * d2[1] - d1[1] * d2[0]
+        if abs(den) < 1e-12:
+            raise NcAlarm(0x0207, "the two ,A lines are parallel")
+        t = ((e[0] - s[0]) * d2[1] - (e[1] - s[1]) * d2[0]) / den
+        mid = dict(self.position)
+        mid[a1], mid[a2] = s[0] + d1[0] * t, s[1] + d1[1] * t
+        common.update(start=dict(self.position), end=dict(mid), work=self.to_work(mid))
+        move = Move("line", feed=self.feed(), per_rev=self.state.per_rev, **common)
+        self.position = dict(mid)
+        yield self._decorate(move)
 
     def _thread(self, block: Block, geo: _Geometry, fn: str) -> Iterator[Event]:
         if context.cycle_runner() is not None:
