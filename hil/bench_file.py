@@ -24,7 +24,7 @@ from virtual_bus.drive import DriveParams
 AXIS_LETTERS = "XYZABCUVW"
 # DriveParams fields a bench may override, with whether they are integers (counts) or reals.
 _DRIVE_INT = {"following_error_window", "negative_limit", "positive_limit", "home_switch", "index_pulse_every",
-              "substeps"}
+              "substeps", "probe_position"}
 _DRIVE_KEYS = {f.name for f in fields(DriveParams)} - {"counts_per_rev"}
 
 

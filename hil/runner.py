@@ -19,7 +19,7 @@ from hil.clock import CycleTiming, LockStepClock, RealTimeClock
 from hil.trace import TraceSource, TraceWriter, trace_columns
 from mlc.basic import BasicMlc
 from nc.alarms import SERVO_ALARM, Alarm, NcAlarm, internal_error
-from nc.channel import Channel, RunState
+from nc.channel import Channel, RunState, skip_hook
 from nc.interp import Interpreter
 from nc.motion import Planner
 from nc.moves import Event
@@ -98,6 +98,7 @@ class BenchRunner:
             profile = make_profile(self.bench.profile, self.axes, self.bench.params)
             start = dict(zip(self.axes, self.actual.tolist()))
             interp = Interpreter(profile, start)
+            self._interp = interp  # G31 skip hands the latch back to it (issue 5)
             self.profile = profile  # G10 L21 soft limits live in its params (issue 8)
             if hasattr(self.mlc, "attach_variables"):  # MLC ↔ #25000–#25511 exchange (issue 8)
                 self.mlc.attach_variables(interp.vars)
@@ -136,6 +137,8 @@ class BenchRunner:
                           spindle_index=self.spindle_index_angle)
         self.channel = ch = Channel(planner)
         ch.soft_limits = SoftLimits.for_bench(self.bench, getattr(self, "profile", None))
+        if getattr(self, "_interp", None) is not None:  # G31 skip (issue 5)
+            ch.on_skip = skip_hook(self._interp)
         for a in self.result.alarms:
             ch.alarms.append(a)
         ch.load(events)
@@ -172,6 +175,20 @@ class BenchRunner:
             return 0.0
         return self.scales[n].to_units(self.tx[n].touch_probe_pos1)
 
+    def _skip_probe(self, ch: Channel) -> None:
+        """G31 (issue 5): arm touch probe 1 (0x60B8 bit 0) on the axes whose drive has a probe while
+        a skip move is pending; a latch (0x60B9 bit 1, position 0x60BA) is the skip input."""
+        armed = ch.skip_armed
+        latched: dict[str, float] = {}
+        for i, ax in enumerate(self.bench.axes):
+            if ax.drive.probe_position is None:
+                continue
+            if armed and self.rx[i].touch_probe_function & 1 and self.tx[i].touch_probe_status & 0x0002:
+                latched[ax.name] = self.scales[i].to_units(self.tx[i].touch_probe_pos1)
+            self.rx[i].touch_probe_function = 0x0001 if armed else 0
+        if latched:
+            ch.skip(latched)
+
     # ---- the cycle ------------------------------------------------------------------------
     def _exchange(self) -> None:
         self.timing = self.clock.tick()
@@ -200,6 +217,7 @@ class BenchRunner:
 
                 self.mlc.bus_feedback(drive_status(self))
             self.mlc.scan(ch)
+            self._skip_probe(ch)
             sp = ch.step()
             self._commands[:] = sp.positions
             self.line = sp.line or self.line

@@ -19,7 +19,7 @@ D2x002 feed override, D2x004 rapid override; all take effect in the next cycle, 
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from enum import Enum
 
@@ -63,6 +63,11 @@ class Channel:
     _block_moves: int = 0  # moves pushed since the last single-block stop
     soft_limits: SoftLimits | None = None  # checked before a move reaches the planner (issue 8)
     _limit_alarm: Alarm | None = None  # raised once the moves before the offending one have run out
+    # G31 skip (issue 5): the runner feeds the probe latch through skip(); on_skip(latched, stop)
+    # hands the trigger position and the stop point to the interpreter before it reads on.
+    on_skip: Callable[[dict[str, float], dict[str, float]], None] | None = None
+    skip_latched: dict[str, float] | None = None
+    _skip_move: Move | None = None
 
     def load(self, events: Iterator[Event]) -> None:
         self.events = events
@@ -123,6 +128,7 @@ class Channel:
         self.pending_aux = None
         self._deferred = None
         self._limit_alarm = None
+        self._skip_move = None
         self.events = None
         self.state = RunState.RESETTING if not self.planner.idle else RunState.IDLE
 
@@ -133,6 +139,32 @@ class Channel:
             self.pending_aux = None
             if self.state is RunState.WAIT_AUX:
                 self.state = RunState.RUNNING
+
+    # ---- G31 skip -----------------------------------------------------------------------
+    @property
+    def skip_armed(self) -> bool:
+        """A G31 move is queued or running and no skip signal has been taken yet (arm the probe)."""
+        return self._skip_move is not None and self.skip_latched is None
+
+    def skip(self, latched: dict[str, float]) -> None:
+        """The skip input: `latched` holds the probe's latched position for the axes that saw the
+        edge. The G31 move brakes from this cycle on (jerk-limited, the planner's stop) and the
+        rest of the move is dropped; the other axes' latch is the path point at the same place."""
+        mv = self._skip_move
+        if mv is None or self.skip_latched is not None or not latched:
+            return
+        self.skip_latched = _on_path(mv, latched)
+        self.planner.stop()
+
+    def _skip_done(self) -> None:
+        """The G31 Sync drained: report the latch (the end point when nothing triggered, as Fanuc
+        and Delta do) and the stop point, then read on from there."""
+        mv, self._skip_move = self._skip_move, None
+        stop = dict(zip(self.planner.axes, self.planner.position.tolist()))
+        latched = self.skip_latched if self.skip_latched is not None else dict(mv.end)
+        self.skip_latched = latched
+        if self.on_skip is not None:
+            self.on_skip(latched, stop)
 
     # ---- faults -----------------------------------------------------------------------
     def raise_alarm(self, alarm: Alarm) -> None:
@@ -190,6 +222,8 @@ class Channel:
                 if isinstance(ev, Aux):
                     self._issue(ev)
                     return
+                if self._skip_move is not None:
+                    self._skip_done()
                 continue  # a Sync: motion has drained, read on
             if self.single_block and self._block_moves:
                 return
@@ -208,6 +242,9 @@ class Channel:
                 if self.soft_limits is not None and (crossing := self.soft_limits.check(ev)) is not None:
                     self._limit_alarm = crossing
                     continue
+                if "G31" in ev.tags:
+                    self._skip_move = ev
+                    self.skip_latched = None
                 pl.push(ev)
                 self._block_moves += 1
             elif isinstance(ev, Aux):
@@ -228,6 +265,8 @@ class Channel:
             elif isinstance(ev, Sync):
                 if not pl.idle:
                     self._deferred = ev
+                elif self._skip_move is not None:
+                    self._skip_done()
 
     def _update_css(self, sp: Setpoint) -> None:
         """G96: the active move's surface speed at the current X diameter; between moves the last
@@ -251,3 +290,26 @@ class Channel:
         self.pending_aux = aux
         if aux.wait:
             self.state = RunState.WAIT_AUX
+
+
+def _on_path(mv: Move, latched: dict[str, float]) -> dict[str, float]:
+    """The G31 line's point where the latched axes were: the path parameter comes from the latched
+    axis that travels furthest (best resolution), the other axes follow the straight line."""
+    moving = {a: mv.end[a] - mv.start.get(a, mv.end[a]) for a in mv.end}
+    key = max((a for a in latched if a in moving), key=lambda a: abs(moving[a]), default=None)
+    if key is None or abs(moving[key]) < 1e-12:
+        return {a: latched.get(a, mv.start.get(a, v)) for a, v in mv.end.items()}
+    u = (latched[key] - mv.start[key]) / moving[key]
+    u = min(max(u, 0.0), 1.0)
+    out = {a: mv.start.get(a, mv.end[a]) + moving[a] * u for a in mv.end}
+    out.update({a: v for a, v in latched.items() if a in out})
+    return out
+
+
+def skip_hook(interp) -> Callable[[dict[str, float], dict[str, float]], None]:
+    """Channel.on_skip for an Interpreter: #21048…/#21064… read the latch, and the next block
+    starts from where the axes stopped (not from the programmed G31 end point)."""
+    def record(latched: dict[str, float], stop: dict[str, float]) -> None:
+        interp.record_skip(latched)
+        interp.position.update({a: v for a, v in stop.items() if a in interp.position})
+    return record

@@ -41,6 +41,7 @@ class DriveParams:
     positive_limit: int | None = None
     home_switch: int | None = None  # counts where the home switch toggles (position < this reads active)
     index_pulse_every: int | None = None  # counts between encoder index pulses; None = counts_per_rev
+    probe_position: int | None = None  # counts where a touch-probe input (G31 skip) switches; None = no probe
     substeps: int = 4
 
 
@@ -245,6 +246,12 @@ class Cia402Drive:
             self._probe_latched = False
             return
         if self._probe_latched:
+            return
+        pp = self.params.probe_position
+        if pp is not None:  # a probe wired to touch probe 1 (G31): latch the encoder at the switch point
+            if old != new and (old - pp) * (new - pp) <= 0:
+                self._probe_pos = int(pp)
+                self._probe_latched = True
             return
         every = self.params.index_pulse_every or self.params.counts_per_rev
         a, b = math.floor(old / every), math.floor(new / every)
