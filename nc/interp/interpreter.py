@@ -31,6 +31,8 @@ from nc.store import ProgramStore
 
 M_BEFORE_MOTION = {3, 4, 8, 19, 29}  # issued to the MLC before the block's motion starts
 M_END = {2, 30}
+# Codes whose axis words name a centre or the axes concerned, never a target: no motion in their block.
+TRANSFORM_ARG_FUNCS = frozenset({"scale", "mirror", "mirror_off", "G68"})
 MAX_M_PER_BLOCK = 4
 MAX_MACRO_DEPTH = 8  # G65/G66/G-M-T calls (0x0212)
 MAX_SUB_DEPTH = 8  # M98 (0x022D)
@@ -360,7 +362,8 @@ class Interpreter:
                 moved = True
                 self._skip_contour(fn, block)
         if not any(fn in ("G04", "G10", "G11", "G28", "G29", "G30", "G31", "G52", "G53", "set", "G05",
-                          "G70", "G71", "G72", "G73", "G74", "G75", "G76", "G900") for fn in nonmodal):
+                          "G70", "G71", "G72", "G73", "G74", "G75", "G76", "G900") for fn in nonmodal) \
+                and not funcs & TRANSFORM_ARG_FUNCS:
             for ev in self._motion(block, funcs):
                 if isinstance(ev, Move) and ev.kind != "dwell":
                     moved = True
