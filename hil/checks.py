@@ -231,7 +231,8 @@ def check_thread_phase(cols: _Cols, axes: list[str], spindles: list[str], moves:
         return CheckResult(name, True, skipped=True, detail="the trace has no spindle angle column")
     threads: dict[int, list[Move]] = defaultdict(list)
     for m in moves:
-        if m.kind == "thread" and m.lead:
+        # A pass's chamfer pull-out continues the same pass; it is not a pass of its own.
+        if m.kind == "thread" and m.lead and "chamfer" not in m.tags:
             threads[m.line].append(m)
     if not threads:
         return CheckResult(name, True, skipped=True, detail="no thread moves in the program")
