@@ -7,19 +7,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from nc.interp.arcs import sweep
 from nc.moves import Move
-
-
-def sweep(s: tuple[float, float], e: tuple[float, float], c: tuple[float, float], cw: bool) -> float:
-    """Signed swept angle (radians), CCW positive; coincident start and end mean a full circle."""
-    a0 = math.atan2(s[1] - c[1], s[0] - c[0])
-    a1 = math.atan2(e[1] - c[1], e[0] - c[0])
-    ccw = (a1 - a0) % (2 * math.pi)
-    if math.hypot(e[0] - s[0], e[1] - s[1]) < 1e-9:
-        ccw = 0.0
-    if cw:
-        return ccw - 2 * math.pi if ccw > 0 else -2 * math.pi
-    return ccw if ccw > 0 else 2 * math.pi
 
 
 @dataclass
