@@ -236,6 +236,9 @@ class BenchRunner:
             rpm = self.mlc.spindle.signed_rpm if (ch is not None and ch.state is not RunState.ALARM) else 0.0
             if k == 0 and rpm and ch is not None and ch.css_rpm is not None:  # G96 (issue 5)
                 rpm = min(ch.css_rpm, self.bench.spindles[0].max_rpm) * (1.0 if rpm > 0 else -1.0)
+            elif k == 0 and rpm and ch is not None and ch.spindle_max is not None:
+                # The G50/G92 S clamp holds under G97 too (lathe manual E-L32; decisions A39).
+                rpm = max(-ch.spindle_max, min(ch.spindle_max, rpm))
             self.rx[n_axes + k].target_velocity = sc.rpm_to_counts_per_s(rpm)
         if self.trace is not None:
             self.trace.write(self._row())

@@ -6,6 +6,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pytest
 
 from fieldbus.link import SimLink
 from hil.bench import default_lathe
@@ -72,3 +73,15 @@ def test_g96_surface_speed_never_exceeds_the_spindle_maximum():
     assert result.ok, result.alarms
     face = rows[rows[:, 0] == 6]
     assert abs(face[:, 2].max() - 4000.0) < 0.01
+
+
+def test_g50_clamp_also_holds_under_g97(hil, program, tmp_path):
+    """A39: G50 S caps the spindle even in constant-rpm mode (lathe manual E-L32)."""
+    import csv
+
+    prog = program("G21 G18 G98\nG50 S800\nG97 S1500 M03\nG04 P500\nM05\nM30\n")
+    trace = tmp_path / "t.csv"
+    r = hil("run", prog, "--trace", trace)
+    assert r.code == 0, r.out + r.err
+    rpm = [float(row["S1_rpm_act"]) for row in csv.DictReader(open(trace))]
+    assert max(rpm) == pytest.approx(800.0, rel=0.01)
