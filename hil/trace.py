@@ -80,6 +80,7 @@ def is_parquet(path: str | Path) -> bool:
 
 
 def open_trace(path: str | Path, columns: list[str]) -> TraceWriter:
+    Path(path).parent.mkdir(parents=True, exist_ok=True)  # `--trace out/run.csv` on a fresh clone
     if is_parquet(path):
         from hil.trace_parquet import ParquetTrace
 

@@ -174,3 +174,9 @@ def test_unit_scaling():
     assert s.to_units(384_000) == pytest.approx(1.0)
     spindle = AxisScaling(counts_per_rev=1_280_000, lead=360.0)
     assert spindle.rpm_to_counts_per_s(60.0) == 1_280_000
+
+
+def test_trace_directory_is_created(hil, tmp_path):
+    trace = tmp_path / "new" / "dir" / "demo.csv"
+    r = hil("run", ROOT / "examples" / "lathe_demo.nc", "--trace", trace)
+    assert r.code == 0 and trace.exists()
