@@ -11,9 +11,12 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+from nc.interp import Interpreter  # noqa: E402
 from nc.motion.offline import run  # noqa: E402
 from nc.motion.planner import Planner  # noqa: E402
 from nc.moves import Move  # noqa: E402
+from nc.profiles import make_profile  # noqa: E402
+from nc.program.blocks import parse_program  # noqa: E402
 from tests.motion_helpers import AX, arc, circle_chords, lines, mill_cfg  # noqa: E402
 
 
@@ -63,6 +66,37 @@ def bench_b(n: int = 100_000) -> None:
           f"({st.time:.2f} s simulated)")
 
 
+def cam_program(n: int, seed: int = 3) -> str:
+    """The same CAM curve as cam_moves, as an NC program of n G01 blocks."""
+    rng = np.random.default_rng(seed)
+    x, out = 0.0, ["G90 G17 G94 G01 F3000"]
+    for _ in range(n):
+        x += float(rng.uniform(0.01, 0.1))
+        out.append(f"X{x:.4f} Y{20.0 * math.sin(x / 40.0):.4f}")
+    out.append("M30")
+    return "\n".join(out) + "\n"
+
+
+def bench_b_interp(n: int = 100_000) -> None:
+    cfg = mill_cfg()
+    text = cam_program(n)
+    t = time.perf_counter()
+    prog = parse_program(text)
+    wp = time.perf_counter() - t
+    pl = Planner(cfg, {"X": 0.0, "Y": 0.0, "Z": 0.0})
+    moves = 0
+    t = time.perf_counter()
+    for ev in Interpreter(make_profile("nc5-mill", AX)).run(prog):
+        if isinstance(ev, Move):
+            pl.push(ev)
+            moves += 1
+            if len(pl.blocks) > pl.depth:
+                pl.blocks.popleft()
+    w = time.perf_counter() - t
+    print(f"(b) interpreter + look-ahead planning of a {n}-block CAM program: {moves / w:,.0f} blocks/s "
+          f"(parsing the text first: {n / wp:,.0f} blocks/s; parse + interpret + plan {moves / (w + wp):,.0f} blocks/s)")
+
+
 def bench_c() -> None:
     cfg = mill_cfg()
     pts = circle_chords(100.0, 0.05)
@@ -91,5 +125,6 @@ def bench_d() -> None:
 if __name__ == "__main__":
     bench_a2()
     bench_b()
+    bench_b_interp()
     bench_c()
     bench_d()

@@ -4,7 +4,10 @@
                      "speed reached" (M3x704) or "zero speed" (M3x705) from the spindle drive
     S                the NC publishes the speed command (D3x024); the analog output D20160 follows
     M08 / M09        coolant on / off: remote I/O module 0, output 0
-    M19 / M20        spindle orientation (M2x706, finish on M3x706) / cancel
+    M19 / M20        spindle orientation: stop (as M05), M2x706, finish on M3x706 / cancel
+    M66 / M77        spindle → C axis / back (lathe P358 / P359, `params["c_axis_m"]`): stop the
+                     spindle (as M05), M2x708 + M1126 ON / OFF, finish when the NC reports the
+                     switch done on M2239 (mlc/spindle_axis.py does the NC side)
     T                turret: station = T // 100 (T0202 → station 2); the finish comes after the
                      turret delay per station indexed, then the current tool D2x036 is updated
     anything else    finished at once
@@ -20,6 +23,7 @@ NAME = "default lathe MLC"
 STATIONS = 12
 TURRET_DELAY = 0.15  # s per station indexed
 COOLANT = (0, 0)  # (remote I/O module, digital output)
+C_AXIS_M = (66, 77)  # lathe parameters 358 / 359: spindle → C axis, C axis → spindle
 
 
 def setup(mlc: ScanContext) -> None:
@@ -58,9 +62,18 @@ def _start(mlc: ScanContext) -> tuple:
         elif code in (8, 9):
             mlc.io.out(*COOLANT, code == 8)
         elif code == 19:
+            mlc.set("SPINDLE1_FWD", False)
+            mlc.set("SPINDLE1_REV", False)
             mlc.set("SPINDLE1_ORIENT")
         elif code == 20:
             mlc.set("SPINDLE1_ORIENT", False)
+        elif code in _c_axis_m(mlc):
+            to_c = code == _c_axis_m(mlc)[0]
+            if to_c:  # the spindle stops before it becomes the C axis (lathe manual §3.2.2 note 2)
+                mlc.set("SPINDLE1_FWD", False)
+                mlc.set("SPINDLE1_REV", False)
+            mlc.set("SPINDLE1_CS_SWITCH", to_c)
+            mlc.set("M1126", to_c)
         return ("M", code)
     if mlc.m("S_STROBE"):
         return ("S", mlc.d("S_CODE"))
@@ -82,6 +95,8 @@ def _done(mlc: ScanContext, job: tuple) -> bool:
             return not spindle or mlc.m("SPINDLE1_ZERO_SPEED")
         if value == 19:
             return not spindle or mlc.m("SPINDLE1_TARGET_REACHED")
+        if value in _c_axis_m(mlc):
+            return not spindle or mlc.m("M2239") == (value == _c_axis_m(mlc)[0])
         return True
     if kind == "T":
         if mlc.timer("turret", value, True):
@@ -91,6 +106,10 @@ def _done(mlc: ScanContext, job: tuple) -> bool:
             return True
         return False
     return True
+
+
+def _c_axis_m(mlc: ScanContext) -> tuple[int, int]:
+    return tuple(mlc.params.get("c_axis_m", C_AXIS_M))  # type: ignore[return-value]
 
 
 def _spindle_analog(mlc: ScanContext) -> None:

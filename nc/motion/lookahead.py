@@ -68,7 +68,7 @@ def reach(v0: float, length: float, a: float, j: float) -> float:
     q = length * math.sqrt(j)
     p = 2.0 * v0
     disc = math.sqrt(q * q / 4.0 + p ** 3 / 27.0)
-    x = _cbrt(q / 2.0 + disc) + _cbrt(q / 2.0 - disc)
+    x = math.cbrt(q / 2.0 + disc) + math.cbrt(q / 2.0 - disc)
     dv = x * x
     if dv * j <= a * a:
         return v0 + dv
@@ -80,12 +80,9 @@ def reach(v0: float, length: float, a: float, j: float) -> float:
     return v0 + max(dv, 0.0)
 
 
-def _cbrt(x: float) -> float:
-    return math.cbrt(x)
-
-
 class Limits:
-    """Axis limit vectors and the planner settings, prepared once."""
+    """Axis limits (plain float tuples: per-block math on 3 axes is faster without numpy) and
+    the planner settings, prepared once. The numpy vectors serve the independent rapids."""
 
     def __init__(self, cfg: MotionConfig) -> None:
         self.cfg = cfg
@@ -93,22 +90,31 @@ class Limits:
         self.v = np.array([cfg.limit(a).max_velocity for a in cfg.axes])
         self.acc = np.array([cfg.limit(a).max_acceleration for a in cfg.axes])
         self.jerk = np.array([cfg.limit(a).max_jerk for a in cfg.axes])
+        self._v = tuple(self.v.tolist())
+        self._acc = tuple(self.acc.tolist())
+        self._jerk = tuple(self.jerk.tolist())
+        T = self.T
+        self._corner_j = tuple(x * T * T / 2.0 for x in self._jerk)  # divided by |Δu| per junction
+        self._corner_a = tuple(x * T for x in self._acc)
 
     def block_limits(self, seg: Segment) -> tuple[float, float, float]:
         """(speed cap, tangential acceleration, tangential jerk) of a path segment."""
         cfg = self.cfg
-        d = seg.max_direction_cosines()
-        mask = d > 1e-12
-        if not mask.any():
+        v = a = j = math.inf
+        for d, vl, al, jl in zip(seg.direction_cosines(), self._v, self._acc, self._jerk):
+            if d > 1e-12:
+                v = min(v, vl / d)
+                a = min(a, al / d)
+                j = min(j, jl / d)
+        if v == math.inf:
             return 0.0, 1.0, 1.0
-        v = float(np.min(self.v[mask] / d[mask]))
-        a = cfg.share_tangential * float(np.min(self.acc[mask] / d[mask]))
-        j = cfg.share_tangential * float(np.min(self.jerk[mask] / d[mask]))
+        a *= cfg.share_tangential
+        j *= cfg.share_tangential
         if seg.kind == "arc" and seg.radius > 0.0:
             k = seg.arc_len / seg.length
             rc = seg.radius / max(k * k, 1e-12)  # radius of curvature of the (helical) path
-            pa = min(self.acc[seg.i1], self.acc[seg.i2])
-            pj = min(self.jerk[seg.i1], self.jerk[seg.i2])
+            pa = min(self._acc[seg.i1], self._acc[seg.i2])
+            pj = min(self._jerk[seg.i1], self._jerk[seg.i2])
             sc = cfg.share_curvature
             v = min(v, math.sqrt(sc * pa * rc), (0.3 * sc * pj * rc * rc) ** (1.0 / 3.0))
             # d/dt of the centripetal term couples tangential acceleration into jerk: 3·v·a_t/r.
@@ -123,19 +129,22 @@ class Limits:
         s1, s2 = b1.seg, b2.seg
         assert s1 is not None and s2 is not None
         v = min(b1.cap_hard, b2.cap_hard)
-        du = np.abs(s2.unit_tangent(False) - s1.unit_tangent(True))
-        dmax = float(du.max())
-        cfg, T = self.cfg, self.T
-        if dmax > 1e-9:
-            m = du > 1e-12
-            v = min(v, cfg.share_corner * float(np.min(self.jerk[m] * T * T / (2.0 * du[m]))),
-                    cfg.share_corner * float(np.min(self.acc[m] * T / du[m])))
+        du = [abs(p - q) for p, q in zip(s2.tangent(False), s1.tangent(True))]
+        cfg = self.cfg
+        if max(du) > 1e-9:
+            vj = va = math.inf
+            for d, cj, ca in zip(du, self._corner_j, self._corner_a):
+                if d > 1e-12:
+                    vj = min(vj, cj / d)
+                    va = min(va, ca / d)
+            v = min(v, cfg.share_corner * vj, cfg.share_corner * va)
             if cfg.path_tolerance is not None:
-                v = min(v, 4.0 * cfg.path_tolerance / (T * float(np.linalg.norm(du))))
-        dk = np.abs(s2.curvature_vector(False) - s1.curvature_vector(True))
-        if float(dk.max()) > 1e-12:
-            m = dk > 1e-12
-            v = min(v, float(np.min(np.sqrt(0.4 * cfg.share_curvature * self.jerk[m] * T / dk[m]))))
+                v = min(v, 4.0 * cfg.path_tolerance / (self.T * math.sqrt(sum(d * d for d in du))))
+        if s1.kind == "arc" or s2.kind == "arc":  # a line has no curvature: line-line skips this
+            dk = np.abs(s2.curvature_vector(False) - s1.curvature_vector(True))
+            if float(dk.max()) > 1e-12:
+                m = dk > 1e-12
+                v = min(v, float(np.min(np.sqrt(0.4 * cfg.share_curvature * self.jerk[m] * self.T / dk[m]))))
         return max(v, 0.0)
 
 
@@ -151,10 +160,11 @@ def backward(blocks: Sequence[Block], lo: int = 0, full: bool = False) -> None:
     n = len(blocks)
     if n == 0:
         return
-    tail = blocks[n - 1]
-    tail.vend, tail.binding = 0.0, True
-    for i in range(n - 2, lo - 1, -1):
-        b, nx = blocks[i], blocks[i + 1]
+    it = reversed(blocks)  # a deque indexes its middle in O(n); iterate instead
+    nx = next(it)
+    nx.vend, nx.binding = 0.0, True
+    for _ in range(n - 1 - lo):
+        b = next(it)
         local = min(b.vjunc, b.cap, nx.cap)
         if local <= 0.0:
             v, av, ad, aa, aj = 0.0, 0.0, 0.0, nx.a, nx.j
@@ -169,3 +179,4 @@ def backward(blocks: Sequence[Block], lo: int = 0, full: bool = False) -> None:
             break
         b.vend, b.binding = v, binding
         b.anchor_v, b.anchor_d, b.anchor_a, b.anchor_j = av, ad, aa, aj
+        nx = b

@@ -28,13 +28,20 @@ class Segment:
     a0: float = 0.0
     theta: float = 0.0
     arc_len: float = 0.0
+    # A line's unit direction as plain floats, computed once: the look-ahead reads it per
+    # junction and per block, where numpy calls on 3-element arrays cost more than the math.
+    _dir: tuple[float, ...] | None = None
 
     @classmethod
     def of(cls, move: Move, axes: tuple[str, ...]) -> "Segment":
-        s = np.array([move.start.get(a, 0.0) for a in axes], dtype=float)
-        e = np.array([move.end.get(a, 0.0) for a in axes], dtype=float)
+        ls = [float(move.start.get(a, 0.0)) for a in axes]
+        le = [float(move.end.get(a, 0.0)) for a in axes]
+        s = np.array(ls, dtype=float)
+        e = np.array(le, dtype=float)
         if move.kind != "arc" or move.center is None:
-            return cls(axes, s, e, float(np.linalg.norm(e - s)), "line")
+            length = math.dist(ls, le)
+            d = tuple((q - p) / length for p, q in zip(ls, le)) if length > 0.0 else (0.0,) * len(axes)
+            return cls(axes, s, e, length, "line", _dir=d)
         p1, p2 = move.plane
         i1, i2 = axes.index(p1), axes.index(p2)
         c = (move.center[p1], move.center[p2])
@@ -74,6 +81,18 @@ class Segment:
             d[self.i1] = -math.sin(ang) * k
             d[self.i2] = math.cos(ang) * k
         return d
+
+    def tangent(self, at_end: bool) -> tuple[float, ...]:
+        """unit_tangent as plain floats (cached for lines)."""
+        if self._dir is not None:
+            return self._dir
+        return tuple(self.unit_tangent(at_end).tolist())
+
+    def direction_cosines(self) -> tuple[float, ...]:
+        """max_direction_cosines as plain floats."""
+        if self._dir is not None:
+            return tuple(abs(x) for x in self._dir)
+        return tuple(self.max_direction_cosines().tolist())
 
     def curvature_vector(self, at_end: bool) -> np.ndarray:
         """d²(position)/ds² at the start or end: zero on a line, towards the centre on an arc."""
