@@ -25,6 +25,27 @@ class SlaveInfo:
     layout: str = ""
 
 
+@dataclass
+class LinkStatus:
+    """The bus as the NC sees it this cycle (M30000, EIO relays M30032+k, drive "connected").
+
+    `states` holds each slave's AL state name ("OP", "SAFE-OP+ERR", "NONE" …) in the order `open()`
+    listed the slaves (drives, then I/O modules)."""
+
+    connected: bool  # every slave in OP and no bus alarm raised
+    names: list[str] = field(default_factory=list)
+    kinds: list[str] = field(default_factory=list)
+    states: list[str] = field(default_factory=list)
+
+    def slave_ok(self, position: int) -> bool:
+        return position < len(self.states) and self.states[position] == "OP"
+
+    @property
+    def io(self) -> list[bool]:
+        """One entry per I/O slave in bus (connection) order: True while it is in OP."""
+        return [st == "OP" for st, k in zip(self.states, self.kinds) if k == "io"]
+
+
 class BusError(Exception):
     """A bus fault the bench must turn into an alarm and a controlled stop."""
 
@@ -76,6 +97,11 @@ class SimLink:
 
     def close(self) -> None:
         pass
+
+    def status(self) -> LinkStatus:
+        """In-process slaves never leave the line: connected once opened."""
+        return LinkStatus(bool(self.infos), [i.name for i in self.infos], [i.kind for i in self.infos],
+                          [i.state for i in self.infos])
 
     # SDO to a simulated slave's object dictionary (Delta servo parameters 0x2000+); same signature
     # as EthercatLink.sdo_read / sdo_write.

@@ -11,11 +11,13 @@ from mlc.nc_link import DriveStatus
 def drive_status(runner: Any) -> list[DriveStatus]:
     out = []
     n_axes = len(runner.axes)
+    status = runner.link.status() if callable(getattr(runner.link, "status", None)) else None
     for i, (m, tx, sc) in enumerate(zip(runner.masters, runner.tx, runner.scales)):
         spindle = i >= n_axes
         vel = sc.to_units(tx.velocity_actual)
         rpm = sc.counts_per_s_to_rpm(tx.velocity_actual)
-        out.append(DriveStatus(runner._name(i), connected=True, servo_on=m.state is State.OPERATION_ENABLED,
+        connected = status is None or status.slave_ok(i)  # the slave in OP (issue 6)
+        out.append(DriveStatus(runner._name(i), connected=connected, servo_on=m.state is State.OPERATION_ENABLED,
                                fault=m.faulted, torque=tx.torque_actual, velocity=vel, rpm=rpm,
                                position=sc.to_units(tx.position_actual), spindle=spindle,
                                mode=getattr(tx, "mode_display", 8)))

@@ -26,7 +26,6 @@ import numpy as np
 from mlc.memory import DeviceMemory
 from mlc.nc_link import ChannelLink, DriveStatus
 from mlc.program import ScanContext
-from mlc.spindle_axis import SpindleAxisSwitch
 from mlc.signals import d2, m2
 from nc.channel import Channel
 from nc.manual import ManualMotion
@@ -94,8 +93,8 @@ class Mlc:
         self.spindle = SpindleOutput()
         self.drives: list[DriveStatus] | None = None
         self.io_modules: list[Any] = []  # virtual_bus.io modules (or real ones) exchanged every scan
+        self.bus: Any = None  # fieldbus.link.LinkStatus of this cycle, when the bench's link reports one
         self.time = 0.0
-        self.caxis = SpindleAxisSwitch(self.mem, channel, cycle)  # spindle ↔ C axis, M19 (issue 8 item 5)
         self._power_on_image(channel)
         setup = getattr(self.program, "setup", None)
         if callable(setup):
@@ -122,6 +121,10 @@ class Mlc:
     def bus_feedback(self, drives: list[DriveStatus]) -> None:
         self.drives = drives
 
+    def bus_status(self, status: Any) -> None:
+        """The link's state this cycle (`fieldbus.link.LinkStatus`): drives M30000 and the EIO relays."""
+        self.bus = status
+
     # ---- the scan ---------------------------------------------------------------------------------
     def scan(self, channel: Channel) -> None:
         self.time += self.cycle
@@ -129,6 +132,7 @@ class Mlc:
         self._exchange_io()
         self.link.nc_inputs(channel)
         self.link.nc_outputs(channel, self.drives)
+        self._bus_relays()
         ctx = self.ctx
         ctx.time, ctx.scan_count = self.time, ctx.scan_count + 1
         self.program.scan(ctx)
@@ -136,15 +140,6 @@ class Mlc:
         self.spindle.rpm, self.spindle.direction = abs(rpm), (1 if rpm > 0 else -1 if rpm < 0 else 0)
         if self.link._estop:
             self.spindle.direction = 0
-
-    def spindle_drive(self, runner: Any) -> tuple[int, float | None, float | None]:
-        """The first spindle drive's (mode, position setpoint deg, speed override rpm) this cycle:
-        CSV as a spindle, CSP while positioning (M29/M19) or while it is the channel's C axis."""
-        n = len(runner.axes)
-        tx = runner.tx[n]
-        index = runner.spindle_index_angle() if tx.touch_probe_status & 0x0002 else None
-        c_cmd = float(runner._commands[runner.axes.index("C")]) if "C" in runner.axes else None
-        return self.caxis.drive(runner.spindle_actual_angle(), runner.spindle_actual_rpm(), index, c_cmd)
 
     def _clocks(self) -> None:
         t = self.time
@@ -163,7 +158,17 @@ class Mlc:
             io.inputs[k] = di
             for w, v in enumerate(analog_in[:4]):
                 self.mem.set_u16(30200 + 4 * k + w, v)
-            self.mem.set_bit(30032 + k, True)  # EIO node 501+k connected
+
+    def _bus_relays(self) -> None:
+        """M30000 (EtherCAT communication status: every slave in OP, not servo on) and M30032+k (EIO
+        node 501+k connected): the k-th I/O slave on the bus in connection order; an in-process module
+        with no bus behind it counts as connected while it answers (its `connected`, default True)."""
+        bus_io = self.bus.io if self.bus is not None else []
+        if self.bus is not None:
+            self.mem.set_bit(30000, bool(self.bus.connected))
+        for k in range(min(20, max(len(bus_io), len(self.io_modules)))):
+            on = bus_io[k] if k < len(bus_io) else bool(getattr(self.io_modules[k], "connected", True))
+            self.mem.set_bit(30032 + k, on)  # EIO node 501+k connected
 
     # ---- convenience for scripts and tests ---------------------------------------------------------
     def get(self, address: str) -> int:

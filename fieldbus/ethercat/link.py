@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 import pysoem
 
 from fieldbus.ethercat import alarms as A
-from fieldbus.link import BusError, SlaveInfo
+from fieldbus.link import BusError, LinkStatus, SlaveInfo
 from fieldbus.pdo import ASDA_CSP_CSV, LAYOUTS, PdoLayout, RxPdo, TxPdo
 from nc.alarms import Alarm
 
@@ -84,6 +84,8 @@ class EthercatLink:
         self._last: list[TxPdo] = []
         self._bad = 0
         self._structs: list[PdoLayout] = []
+        self._states: list[str] = []  # per slave as `infos` lists them, refreshed on every bad cycle
+        self._failed = False  # a bus alarm was raised and the line was not recovered since
 
     @classmethod
     def for_bench(cls, bench, iface: str) -> "EthercatLink":
@@ -192,6 +194,8 @@ class EthercatLink:
                       for i, (s, name, layout) in enumerate(zip(self.drives, self.names, layouts))]
         self.infos += [SlaveInfo(len(self.infos) + k, s.name, "io", s.man, s.id, state_name(s.state))
                        for k, s in enumerate(self.io)]
+        self._states = [i.state for i in self.infos]
+        self._failed = False
         return self.infos
 
     def _mapper(self, s, layout: PdoLayout, name: str, errors: list[Alarm]):
@@ -233,6 +237,8 @@ class EthercatLink:
         self.stats.cycles += 1
         if wkc == m.expected_wkc:
             self._bad = 0
+            if not self._failed:  # the full working counter: every slave exchanged, so every slave is in OP
+                self._states = ["OP"] * len(self.infos)
             self._last = [layout.unpack_tx(s.input, tx) for s, layout, tx in zip(self.drives, self._structs, self._last)]
             if self.dc and self.drift_check_every and self.stats.cycles % self.drift_check_every == 0:
                 self._check_drift()
@@ -245,6 +251,14 @@ class EthercatLink:
         if wkc < 0:
             self.stats.lost_frames += 1
         m.read_state()
+        self._states = [state_name(s.state) for s in self.drives + self.io]
+        try:
+            return self._judge_bad_cycle(m, wkc)
+        except BusError:
+            self._failed = True
+            raise
+
+    def _judge_bad_cycle(self, m, wkc: int) -> list[TxPdo]:
         for s, name in self._named(m):
             if s.state & pysoem.STATE_ERROR:
                 raise BusError(Alarm(A.DISCONNECTED, f"EtherCAT slave {name} dropped to {state_name(s.state)}: "
@@ -258,6 +272,13 @@ class EthercatLink:
                                                  f"not in OP: {', '.join(bad) or 'none'}", axis=self._axis(who)))
         self.stats.events.append(f"cycle {self.stats.cycles}: bad working counter {wkc}, riding through")
         return list(self._last)
+
+    def status(self) -> LinkStatus:
+        """Connected (M30000) while every slave reads OP and no bus alarm stands; per-slave states as
+        last seen (a good working counter means OP; a bad cycle re-reads the AL states)."""
+        ok = self.master is not None and not self._failed and bool(self._states) \
+            and all(st == "OP" for st in self._states)
+        return LinkStatus(ok, [i.name for i in self.infos], [i.kind for i in self.infos], list(self._states))
 
     def _axis(self, name: str) -> str | None:
         return name if name in self.names else None
@@ -305,6 +326,8 @@ class EthercatLink:
                     s.reconfig()
             if not pending:
                 self._bad = 0
+                self._failed = False
+                self._states = ["OP"] * len(self.infos)
                 self.stats.recoveries += 1
                 return True
         return False
@@ -330,6 +353,7 @@ class EthercatLink:
     def close(self) -> None:
         m = self.master
         self.master = None
+        self._states = ["INIT"] * len(self.infos)
         if m is None:
             return
         try:
