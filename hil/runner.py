@@ -242,6 +242,14 @@ class BenchRunner:
                 # The G50/G92 S clamp holds under G97 too (lathe manual E-L32; decisions A39).
                 rpm = max(-ch.spindle_max, min(ch.spindle_max, rpm))
             self.rx[n_axes + k].target_velocity = sc.rpm_to_counts_per_s(rpm)
+            hook = getattr(self.mlc, "spindle_drive", None)  # spindle ↔ C axis, M19: CSV ↔ CSP (issue 8)
+            if k == 0 and ch is not None and callable(hook):
+                rx = self.rx[n_axes]
+                rx.mode, deg, vel = hook(self)
+                if deg is not None:
+                    rx.target_position = sc.to_counts(deg)
+                if vel is not None:
+                    rx.target_velocity = sc.rpm_to_counts_per_s(vel)
         if self.trace is not None:
             self.trace.write(self._row())
         if self.on_cycle is not None:

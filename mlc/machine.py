@@ -26,6 +26,7 @@ import numpy as np
 from mlc.memory import DeviceMemory
 from mlc.nc_link import ChannelLink, DriveStatus
 from mlc.program import ScanContext
+from mlc.spindle_axis import SpindleAxisSwitch
 from mlc.signals import d2, m2
 from nc.channel import Channel
 from nc.manual import ManualMotion
@@ -95,6 +96,7 @@ class Mlc:
         self.io_modules: list[Any] = []  # virtual_bus.io modules (or real ones) exchanged every scan
         self.bus: Any = None  # fieldbus.link.LinkStatus of this cycle, when the bench's link reports one
         self.time = 0.0
+        self.caxis = SpindleAxisSwitch(self.mem, channel, cycle)  # spindle ↔ C axis, M19 (issue 8 item 5)
         self._power_on_image(channel)
         setup = getattr(self.program, "setup", None)
         if callable(setup):
@@ -140,6 +142,15 @@ class Mlc:
         self.spindle.rpm, self.spindle.direction = abs(rpm), (1 if rpm > 0 else -1 if rpm < 0 else 0)
         if self.link._estop:
             self.spindle.direction = 0
+
+    def spindle_drive(self, runner: Any) -> tuple[int, float | None, float | None]:
+        """The first spindle drive's (mode, position setpoint deg, speed override rpm) this cycle:
+        CSV as a spindle, CSP while positioning (M29/M19) or while it is the channel's C axis."""
+        n = len(runner.axes)
+        tx = runner.tx[n]
+        index = runner.spindle_index_angle() if tx.touch_probe_status & 0x0002 else None
+        c_cmd = float(runner._commands[runner.axes.index("C")]) if "C" in runner.axes else None
+        return self.caxis.drive(runner.spindle_actual_angle(), runner.spindle_actual_rpm(), index, c_cmd)
 
     def _clocks(self) -> None:
         t = self.time
