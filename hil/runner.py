@@ -76,6 +76,8 @@ class BenchRunner:
         self.actual = np.zeros(n_axes)
         self._alarmed_drives: set[int] = set()
         self._commands = np.zeros(n_axes)
+        # Machine position minus drive position per axis (units); NC-side homing sets it (issue 5).
+        self.origin = np.zeros(n_axes)
         # The pacer: lock-step virtual time unless a real-time clock is given.
         self.clock = clock or LockStepClock(bench.cycle)
         self.timing = CycleTiming(bench.cycle, 0.0)
@@ -175,6 +177,20 @@ class BenchRunner:
             return 0.0
         return self.scales[n].to_units(self.tx[n].touch_probe_pos1)
 
+    def home_input(self, axis: str) -> tuple[bool, float] | None:
+        """Home switch (0x60FD bit 2) and actual machine position of an axis; None without a switch."""
+        i = self.axes.index(axis)
+        if self.bench.axes[i].drive.home_switch is None:
+            return None
+        return bool(self.tx[i].digital_inputs & 0x4), float(self.actual[i])
+
+    def shift_origin(self, axis: str, shift: float) -> None:
+        """NC-side homing: machine coordinates of the axis move by `shift` against the drive counts."""
+        i = self.axes.index(axis)
+        self.origin[i] += shift
+        self.actual[i] += shift
+        self._commands[i] += shift
+
     def _skip_probe(self, ch: Channel) -> None:
         """G31 (issue 5): arm touch probe 1 (0x60B8 bit 0) on the axes whose drive has a probe while
         a skip move is pending; a latch (0x60B9 bit 1, position 0x60BA) is the skip input."""
@@ -184,7 +200,7 @@ class BenchRunner:
             if ax.drive.probe_position is None:
                 continue
             if armed and self.rx[i].touch_probe_function & 1 and self.tx[i].touch_probe_status & 0x0002:
-                latched[ax.name] = self.scales[i].to_units(self.tx[i].touch_probe_pos1)
+                latched[ax.name] = self.scales[i].to_units(self.tx[i].touch_probe_pos1) + self.origin[i]
             self.rx[i].touch_probe_function = 0x0001 if armed else 0
         if latched:
             ch.skip(latched)
@@ -209,7 +225,7 @@ class BenchRunner:
                 self._alarm(Alarm(0x0402, f"hardware limit reached on axis {self._name(i)}", line=self.line or None,
                                   axis=self._name(i)))
         for i in range(n_axes):
-            self.actual[i] = self.scales[i].to_units(self.tx[i].position_actual)
+            self.actual[i] = self.scales[i].to_units(self.tx[i].position_actual) + self.origin[i]
         ch = self.channel
         if ch is not None:
             if hasattr(self.mlc, "bus_feedback"):  # drive status for the MLC's special M/D (issue 8)
@@ -226,7 +242,7 @@ class BenchRunner:
         for i in range(n_axes):
             m, rx = self.masters[i], self.rx[i]
             if m.enabled and ch is not None:
-                rx.target_position = self.scales[i].to_counts(self._commands[i])
+                rx.target_position = self.scales[i].to_counts(self._commands[i] - self.origin[i])
             else:
                 # Not enabled: follow the actual position so enabling never jumps.
                 rx.target_position = self.tx[i].position_actual
