@@ -103,6 +103,8 @@ class Machine:
         r.channel = Channel(Planner(self.bench.motion_config(), start, spindle_rpm=lambda: self.mlc.spindle.rpm))
         self.mlc.manual.position[:] = r.actual
         self.mlc.manual.take_over(r.actual.copy())
+        self.mlc.manual.home_input = r.home_input  # NC-side homing on the drive's home switch (issue 5)
+        self.mlc.manual.shift_origin = r.shift_origin
         self._record(first=True)
 
     def close(self) -> None:

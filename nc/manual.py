@@ -11,6 +11,7 @@ M/D devices into the calls below, once per cycle, before the channel step.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -38,6 +39,15 @@ class ManualMotion:
     home_position: dict[str, float] = field(default_factory=dict)
     jog_speed: dict[str, float] = field(default_factory=dict)  # mm/s at 100 % (N2.030 role)
     home_speed: float = 20.0  # mm/s
+    # NC-side homing against a home switch (active on the negative side of its edge). The bench
+    # wires `home_input(axis) -> (switch active, actual machine position)` or None when the axis
+    # has no switch (then HOME is a plain move to the home position), and `shift_origin(axis, d)`
+    # which adds d to the drive-count → machine-coordinate offset of the axis.
+    home_input: Callable[[str], tuple[bool, float] | None] | None = None
+    shift_origin: Callable[[str, float], None] | None = None
+    home_creep: float = 1.0  # mm/s, the first approach of the edge from the active side
+    home_fine: float = 0.002  # mm/s, the latching approach (about one drive count per cycle)
+    home_backoff: float = 0.01  # mm, backed off into the active side before the fine approach
 
     def __post_init__(self) -> None:
         n = len(self.cfg.axes)
@@ -52,6 +62,8 @@ class ManualMotion:
         self._mode: list[str | None] = [None] * n  # "velocity", "position" or None (at rest)
         self._target = self.position.copy()
         self._vcap = np.array([self.cfg.limit(a).max_velocity for a in self.cfg.axes])
+        # homing phase per axis: None, "leave", "search", "creep", "back", "fine", "return"
+        self._phase: list[str | None] = [None] * n
 
     def _make_input(self, i: int) -> InputParameter:
         lim = self.cfg.limit(self.cfg.axes[i])
@@ -104,7 +116,85 @@ class ManualMotion:
     def home(self, axis: str) -> None:
         st = self.axes[axis]
         st.homing, st.home_done = True, False
-        self.move_to(axis, self.home_position.get(axis, 0.0), self.home_speed)
+        sw = self.home_input(axis) if self.home_input is not None else None
+        if sw is None:
+            self.move_to(axis, self.home_position.get(axis, 0.0), self.home_speed)
+            return
+        # Leave the switch first when starting on it, so every homing latches the same edge
+        # from the same side at the same (fine) speed.
+        self._home_jog(axis, "leave" if sw[0] else "search")
+
+    def _home_jog(self, axis: str, phase: str) -> None:
+        i = self.index(axis)
+        self._phase[i] = phase
+        speed = {"leave": self.home_speed, "search": -self.home_speed, "creep": self.home_creep,
+                 "fine": self.home_fine}[phase]
+        st = self.axes[axis]
+        locks = st.lock_pos, st.lock_neg
+        st.lock_pos = st.lock_neg = False  # homing is the one manual move allowed before limits are known
+        self.jog(axis, 1 if speed > 0 else -1, abs(speed))
+        st.lock_pos, st.lock_neg = locks
+
+    def _home_cycle(self, i: int) -> None:
+        """One cycle of the homing sequence of axis i (after its generator stepped)."""
+        a = self.cfg.axes[i]
+        phase = self._phase[i]
+        sw = self.home_input(a) if self.home_input is not None else None
+        if sw is None:
+            self._phase[i] = None
+            return
+        active, actual = sw
+        inp = self._inp[i]
+        stopping = inp.control_interface == ControlInterface.Velocity and inp.target_velocity[0] == 0.0
+        if phase in ("leave", "creep", "fine") and not stopping and not active:
+            if phase == "fine":
+                # The edge: this machine position becomes the home position.
+                shift = self.home_position.get(a, 0.0) - actual
+                if self.shift_origin is not None:
+                    self.shift_origin(a, shift)
+                self.position[i] += shift
+                self._target[i] += shift
+            self._stop_axis(i)
+        elif phase == "search" and not stopping and active:
+            self._stop_axis(i)
+        if self._mode[i] is not None:
+            return
+        # at rest: next phase
+        if phase == "leave":
+            self._home_jog(a, "search")
+        elif phase == "search":
+            self._home_jog(a, "creep")
+        elif phase == "creep":
+            self._phase[i] = "back"
+            self._move_raw(i, self.position[i] - self.home_backoff, self.home_speed)
+        elif phase == "back":
+            self._home_jog(a, "fine")
+        elif phase == "fine":
+            self._phase[i] = "return"
+            self._move_raw(i, self.home_position.get(a, 0.0), self.home_creep)
+        elif phase == "return":
+            self._phase[i] = None
+            st = self.axes[a]
+            st.homing = False
+            st.homed = st.home_done = abs(self.position[i] - self.home_position.get(a, 0.0)) < 1e-9
+
+    def _stop_axis(self, i: int) -> None:
+        self._mode[i] = "velocity"
+        inp = self._inp[i]
+        inp.control_interface = ControlInterface.Velocity
+        inp.target_velocity = [0.0]
+        inp.target_acceleration = [0.0]
+
+    def _move_raw(self, i: int, target: float, speed: float) -> None:
+        """Position move without soft limits or interlocks (they assume a homed axis)."""
+        self._target[i] = target
+        self._mode[i] = "position"
+        inp = self._inp[i]
+        inp.control_interface = ControlInterface.Position
+        inp.target_position = [target]
+        inp.target_velocity = [0.0]
+        inp.target_acceleration = [0.0]
+        inp.max_velocity = [min(speed, self._vcap[i])]
 
     def stop(self, axis: str | None = None) -> None:
         """Jerk-limited stop of one or every axis (feed hold, mode change, reset)."""
@@ -117,12 +207,14 @@ class ManualMotion:
                 inp.target_velocity = [0.0]
                 inp.target_acceleration = [0.0]
             self.axes[a].homing = False
+            self._phase[i] = None
 
     def halt(self) -> None:
         """E-stop: the setpoints freeze where they are this cycle."""
         self.velocity[:] = 0.0
         self.acceleration[:] = 0.0
         self._mode = [None] * len(self._mode)
+        self._phase = [None] * len(self._phase)
         for st in self.axes.values():
             st.homing = False
 
@@ -143,6 +235,8 @@ class ManualMotion:
     def step(self) -> np.ndarray:
         for i, mode in enumerate(self._mode):
             if mode is None:
+                if self._phase[i] is not None:
+                    self._home_cycle(i)
                 continue
             inp = self._inp[i]
             inp.current_position = [self.position[i]]
@@ -168,9 +262,13 @@ class ManualMotion:
                 self._mode[i] = None
                 self.velocity[i] = self.acceleration[i] = 0.0
                 st = self.axes[a]
-                if st.homing:
+                if self._phase[i] is not None:
+                    self._home_cycle(i)
+                elif st.homing:
                     st.homing = False
                     st.homed = st.home_done = abs(self.position[i] - self.home_position.get(a, 0.0)) < 1e-9
+            elif self._phase[i] is not None:
+                self._home_cycle(i)
         return self.position
 
     def _clamp(self, axis: str, value: float) -> float:
