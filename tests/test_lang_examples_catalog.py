@@ -220,3 +220,19 @@ M30
     assert min(m["work"]["Z"] for m in pecks) == -30.0 and {m["feed"] for m in pecks} == {100.0}
     assert {m["work"]["Z"] for m in tagged(moves, "G73", "return")} == {10.0}  # G99: back to R between holes
     assert [m["end"] for m in moves[-1:]] == [{"X": 0.0, "Y": 0.0, "Z": 0.0}]  # G91 G28 X0 Y0 Z0: reference
+
+
+def test_e_l29_g92_threading_o0010(path):
+    # `; comment` annotations of the listing stripped
+    prog = ("O0010\nT0202\nM03 S2000\nG0 Z5.\nX30.\nG92 X17.65 Z-25.0 F1.5\nX17.45\nX17.25\nX17.05\nX16.85\n"
+            "X16.65\nX16.45\nX16.25\nX16.05\nX15.9\nM5\nG0X50.\nZ10.\nM30\n")
+    code, moves, _ = path(prog)
+    assert code == 0
+    body = [m for m in tagged(moves, "G92", "thread") if "chamfer" not in m["tags"]]
+    assert [m["work"]["X"] for m in body] == [17.65, 17.45, 17.25, 17.05, 16.85, 16.65, 16.45, 16.25, 16.05, 15.9]
+    assert {m["lead"] for m in body} == {1.5}
+    chamfers = tagged(moves, "G92", "chamfer")
+    assert len(chamfers) == 10 and {m["work"]["Z"] for m in chamfers} == {-25.0}
+    assert {work(m, "X", "Z") for m in tagged(moves, "G92", "return")} == {(30.0, 5.0)}
+    assert len(tagged(moves, "G92", "approach")) == 10  # `M5` alone does not repeat the cycle
+    assert [work(m, "X", "Z") for m in moves[-2:]] == [(50.0, 5.0), (50.0, 10.0)]  # G0X50. cancels G92
