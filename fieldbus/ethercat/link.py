@@ -72,8 +72,8 @@ class EthercatLink:
     receive_timeout_us: int = 100_000  # Python slaves on a loaded CI host: SOEM's 2 ms is far too short
     max_bad_cycles: int = 3  # consecutive bad cycles ridden through before the alarm
     watchdog_ms: float = 500.0  # SM watchdog programmed into every slave
-    drift_check_every: int = 250  # cycles between DC drift reads
-    drift_limit_ns: int = 50_000
+    drift_check_every: int = 250  # cycles between DC drift reads (0x092C of every drive)
+    drift_limit_ns: int = 50_000  # |system time difference| above this raises 0x141F; 0 = only record it
     stats: LinkStats = field(default_factory=LinkStats)
 
     def __post_init__(self) -> None:
@@ -92,7 +92,12 @@ class EthercatLink:
         names = list(bench.axis_names) + [s.name for s in bench.spindles]
         layout = LAYOUTS.get(str(bench.params.get("ethercat_pdo", "")), ASDA_CSP_CSV) \
             if hasattr(bench, "params") else ASDA_CSP_CSV
-        return cls(iface, bench.cycle, names, [layout] * len(names))
+        params = getattr(bench, "params", {}) or {}
+        link = cls(iface, bench.cycle, names, [layout] * len(names))
+        # bench [params]: ethercat_drift_limit_ns, ethercat_drift_check_every (docs/decisions E8)
+        link.drift_limit_ns = int(params.get("ethercat_drift_limit_ns", link.drift_limit_ns))
+        link.drift_check_every = int(params.get("ethercat_drift_check_every", link.drift_check_every))
+        return link
 
     # ---- bring-up -----------------------------------------------------------------------
     def open(self) -> list[SlaveInfo]:
@@ -284,17 +289,23 @@ class EthercatLink:
         return name if name in self.names else None
 
     def _check_drift(self) -> None:
-        worst = 0
-        for s in self.drives:
+        """Read each drive's system time difference (0x092C, sign-magnitude ns): past the limit the
+        drive can no longer follow SYNC0, so the run stops with 0x141F on that axis (E8)."""
+        worst, who = 0, ""
+        for s, name in zip(self.drives, self.names):
             try:
                 raw = s._fprd(R_DC_DIFF, 4)
             except Exception:
                 continue
-            v = struct.unpack("<I", raw[:4])[0]
-            worst = max(worst, v & 0x7FFFFFFF)
+            v = struct.unpack("<I", raw[:4])[0] & 0x7FFFFFFF
+            if v > worst:
+                worst, who = v, name
         self.stats.max_drift_ns = max(self.stats.max_drift_ns, worst)
-        if worst > self.drift_limit_ns:
+        if self.drift_limit_ns and worst > self.drift_limit_ns:
             self.stats.events.append(f"cycle {self.stats.cycles}: DC drift {worst} ns above {self.drift_limit_ns} ns")
+            self._failed = True
+            raise BusError(Alarm(A.DC_DRIFT, f"EtherCAT DC drift on {who}: system time difference {worst} ns, "
+                                             f"limit {self.drift_limit_ns} ns", axis=self._axis(who), info=worst))
 
     # ---- recovery, SDO, close -------------------------------------------------------------
     def recover(self, timeout: float = 5.0) -> bool:

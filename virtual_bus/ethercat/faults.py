@@ -8,6 +8,8 @@ Spec grammar (`hil sim ethercat --fault SPEC`, repeatable):
   wkc:S@N[xK]             slave S stops counting the working counter for K frames
   alerr:S@N[:CODE]        slave S drops to SAFE-OP with AL status code CODE (default 0x001A)
   drivefault:S@N[:CODE]   the drive behind slave S faults with error code CODE (default 0x0009)
+  drift:S@N:NS            from frame N on, slave S's local DC clock gains NS ns per frame (a bad
+                          oscillator its control loop, trimming at most 5 µs a frame, cannot follow)
 """
 
 from __future__ import annotations
@@ -15,7 +17,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 
-_RE = re.compile(r"^(?P<kind>drop|late|leave|wkc|alerr|drivefault)(?::(?P<slave>\d+))?@(?P<at>\d+)"
+_RE = re.compile(r"^(?P<kind>drop|late|leave|wkc|alerr|drivefault|drift)(?::(?P<slave>\d+))?@(?P<at>\d+)"
                  r"(?:x(?P<count>\d+))?(?:\+(?P<back>\d+))?(?::(?P<arg>(?:0x)?[0-9a-fA-F.]+))?$")
 
 
@@ -29,6 +31,8 @@ class Fault:
     arg: float = 0.0
 
     def active(self, frame: int) -> bool:
+        if self.kind == "drift":
+            return frame >= self.at
         if self.kind == "leave":
             return frame >= self.at and (not self.back or frame < self.at + self.back)
         return self.at <= frame < self.at + self.count
@@ -39,7 +43,7 @@ def parse_fault(spec: str) -> Fault:
     if not m:
         raise ValueError(f"bad fault spec {spec!r} (see `hil sim ethercat --help`)")
     kind = m["kind"]
-    if kind in ("leave", "wkc", "alerr", "drivefault") and m["slave"] is None:
+    if kind in ("leave", "wkc", "alerr", "drivefault", "drift") and m["slave"] is None:
         raise ValueError(f"fault {kind} needs a slave: {kind}:S@N")
     arg = m["arg"]
     value = float(int(arg, 16)) if arg and arg.lower().startswith("0x") else float(arg or 0)

@@ -52,6 +52,9 @@ class Chain:
                 elif not on and f.slave in self._left and n >= f.at:
                     self._left.discard(f.slave)
                     self.log(f"slave {f.slave} back on the line at frame {n}")
+            elif f.kind == "drift":
+                if on and is_pd and f.slave < len(self.slaves):
+                    self.slaves[f.slave].clock_base_ns += int(f.arg)
             elif f.kind == "wkc" and f.slave < len(self.slaves):
                 self.slaves[f.slave].wkc_fault = on
             elif k not in self._applied and n >= f.at and f.slave < len(self.slaves) and is_pd:
