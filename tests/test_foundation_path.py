@@ -84,3 +84,9 @@ def test_vars_line_reports_vacant_variables(hil, program):
     assert last["kind"] == "vars"
     assert set(last["values"]) == {"100", "101", "102", "500"}
     assert all(v is None for v in last["values"].values())
+
+
+def test_feed_per_revolution_is_flagged(hil, program):
+    moves = hil("path", program("G99 S500 M03\nG01 Z-5. F0.2\nG98\nG01 Z-10. F100\n"), "--json").json_lines()
+    assert moves[0]["feed"] == 0.2 and moves[0]["per_rev"] is True
+    assert moves[1]["feed"] == 100.0 and "per_rev" not in moves[1]

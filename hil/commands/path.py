@@ -69,6 +69,8 @@ def move_dict(m: Move) -> dict:
     for key in ("start", "end", "work", "center"):
         if d[key] is not None:
             d[key] = {a: fmt(v) for a, v in d[key].items()}
+    if m.per_rev and m.feed is not None:  # additive key: `feed` is mm/rev (G99 / G95)
+        d["per_rev"] = True
     if m.exact_stop:  # additive key (issue 3): G09 / G61 / G53 / G28 exact stop at the end of this move
         d["exact_stop"] = True
     if m.tags:  # additive keys (issue 4): which cycle / pass / compensation produced the move
