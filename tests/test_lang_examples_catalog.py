@@ -119,12 +119,19 @@ def test_e_n06_linear_angle_lathe_diameter(path):
     assert code == 0 and work(moves[-1], "X", "Z") == (100.0, 100.0)
 
 
-@pytest.mark.xfail(strict=True, reason="nc5-mill in G17: 'G01 Z100.0,A45.0' (Z outside the XY plane) is "
-                   "silently dropped — no move and no alarm")
 def test_e_n06_linear_angle_mill_g17_not_dropped(path):
     code, moves, other = path("G90 G00 X50.0 Z50.0\nG01 Z100.0,A45.0 F100\n", MILL)
     alarmed = code != 0 and any(d["kind"] == "alarm" for d in other)
     assert alarmed or (len(moves) == 2 and moves[-1]["work"]["Z"] == 100.0)
+    # decided: ,A with only an out-of-plane axis is an instruction error on its own line
+    assert [d["code"] for d in other if d["kind"] == "alarm"] == ["0x0207"]
+    assert [d["line"] for d in other if d["kind"] == "alarm"] == [2]
+
+
+def test_held_linear_angle_without_partner_alarms(path):
+    code, moves, other = path("G90 G00 X50.0 Y0.\nG01 ,A30. F100\nM30\n", MILL)
+    assert code == 1
+    assert [(d["code"], d["line"]) for d in other if d["kind"] == "alarm"] == [("0x0207", 2)]
 
 
 def test_e_n07_arc_radius_sign(path):

@@ -206,7 +206,16 @@ class Interpreter:
             except (ValueError, ArithmeticError, OverflowError) as exc:
                 raise NcAlarm(0x0257, f"numerical error: {exc}", line=block.line, block=block.text,
                               program=fr.program.name) from None
+        self._check_no_pending_angle()
         yield ProgramEnd(last.line if last else 0, last.text if last else "", 0)
+
+    def _check_no_pending_angle(self) -> None:
+        """A held two-block `,A` block never gets its partner at the end of the program."""
+        if self._angle_pending is not None:
+            blk = self._angle_pending[0]
+            self._angle_pending = None
+            raise NcAlarm(0x0207, ",A without an end point must be followed by G01 with both plane coordinates "
+                          "and ,A", line=blk.line, block=blk.text, program=self.program_name)
 
     @property
     def frame(self) -> Frame:
@@ -376,6 +385,7 @@ class Interpreter:
                 st.spindle_dir = 0
             if m in M_END:
                 yield Aux("M", m, block.line, block.text, program=self.program_name)
+                self._check_no_pending_angle()
                 self._reset_at_end()
                 yield ProgramEnd(block.line, block.text, m)
                 return
@@ -800,6 +810,9 @@ class Interpreter:
         if st.motion == 1 and "A" in block.comma:
             a1, a2 = PLANES[st.plane]
             if not geo.axes & {a1, a2}:  # `,A1` alone: its end is the intersection with the next block
+                if geo.axes:  # only axes outside the plane: an angle in the plane cannot apply to them
+                    raise NcAlarm(0x0207, f",A needs an end coordinate in the active plane ({a1}/{a2}), "
+                                          f"not only {'/'.join(sorted(geo.axes))}")
                 if "C" in block.comma or "R" in block.comma:
                     raise NcAlarm(0x021D, "the two-block ,A form with ,C/,R is not supported")
                 self._angle_pending = (block, self._move_common(block, geo.target_machine, geo.target_work))
