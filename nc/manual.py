@@ -104,14 +104,7 @@ class ManualMotion:
         target = self._clamp(axis, target)
         if (target > self.position[i] and st.lock_pos) or (target < self.position[i] and st.lock_neg):
             return
-        self._target[i] = target
-        self._mode[i] = "position"
-        inp = self._inp[i]
-        inp.control_interface = ControlInterface.Position
-        inp.target_position = [target]
-        inp.target_velocity = [0.0]
-        inp.target_acceleration = [0.0]
-        inp.max_velocity = [min(speed, self._vcap[i]) if speed else self._vcap[i]]
+        self._move_raw(i, target, speed or self._vcap[i])
 
     def home(self, axis: str) -> None:
         st = self.axes[axis]
