@@ -50,8 +50,20 @@ def checks_from_args(args: argparse.Namespace, bench: Bench) -> ChecksConfig:
     return c
 
 
+def prepared(args: argparse.Namespace, cmd: str):
+    """`prepare`, with a bad input reported for `hil CMD`: returns the tuple, or the exit code."""
+    try:
+        return prepare(args, cmd)
+    except (InputError, TraceReadError) as exc:
+        print(f"hil {cmd}: {exc}", file=sys.stderr)
+        return EXIT_USAGE
+    except NcAlarm as exc:
+        print_alarm(exc.alarm)
+        return EXIT_ALARM
+
+
 def prepare(args: argparse.Namespace, cmd: str):
-    """Bench, checks, trace and the programmed moves; raises SystemExit-style codes via return."""
+    """Bench, checks, trace and the programmed moves; bad input raises InputError / TraceReadError / NcAlarm."""
     from hil.checks import program_moves
 
     bench = load_bench(args.bench)
@@ -67,14 +79,10 @@ def prepare(args: argparse.Namespace, cmd: str):
 def cmd_check(args: argparse.Namespace) -> int:
     from hil.checks import run_checks
 
-    try:
-        bench, checks, tf, moves = prepare(args, "check")
-    except (InputError, TraceReadError) as exc:
-        print(f"hil check: {exc}", file=sys.stderr)
-        return EXIT_USAGE
-    except NcAlarm as exc:
-        print_alarm(exc.alarm)
-        return EXIT_ALARM
+    ready = prepared(args, "check")
+    if isinstance(ready, int):
+        return ready
+    bench, checks, tf, moves = ready
     if not checks.any:
         print("hil check: no checks to run: give a --bench with [checks] or limits such as --max-ferr", file=sys.stderr)
         return EXIT_USAGE

@@ -7,10 +7,7 @@ import argparse
 import sys
 
 from hil.cli import EXIT_ALARM, EXIT_OK, EXIT_USAGE
-from hil.commands.check import add_check_options, prepare
-from hil.session import InputError, print_alarm
-from hil.trace_read import TraceReadError
-from nc.alarms import NcAlarm
+from hil.commands.check import add_check_options, prepared
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -26,14 +23,10 @@ def cmd_report(args: argparse.Namespace) -> int:
     from hil.checks import run_checks
     from hil.report import write_report
 
-    try:
-        bench, checks, tf, moves = prepare(args, "report")
-    except (InputError, TraceReadError) as exc:
-        print(f"hil report: {exc}", file=sys.stderr)
-        return EXIT_USAGE
-    except NcAlarm as exc:
-        print_alarm(exc.alarm)
-        return EXIT_ALARM
+    ready = prepared(args, "report")
+    if isinstance(ready, int):
+        return ready
+    bench, checks, tf, moves = ready
     results = run_checks(tf, checks, bench if (args.bench or checks.limits) else None, moves) if checks.any else None
     try:
         rep = write_report(args.trace, args.out, bench if args.bench else None, moves, results, args.title)
