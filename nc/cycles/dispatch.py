@@ -29,6 +29,9 @@ _memory: "weakref.WeakKeyDictionary[Any, dict]" = weakref.WeakKeyDictionary()
 
 
 def _mem(host: Any) -> dict:
+    own = getattr(host, "cycle_memory", None)
+    if isinstance(own, dict):  # the interpreter's own store, so G80 can clear it (`Interpreter._set_modal`)
+        return own
     try:
         return _memory.setdefault(host, {})
     except TypeError:  # not weak-referenceable: keep the memory on the host itself
@@ -312,6 +315,9 @@ def _mill_hole(host: Any, code: str, block: Block) -> list[Event]:
     plane = int(host.state.plane)
     axis = MILL_DRILL_AXIS.get(plane, "Z")
     pos_axes = PLANE_AXES.get(plane, ("X", "Y"))
+    if code in ("MG74", "MG84") and not block.has("F") and _explicit(host, block, code):
+        # N§3.13.2 note 3: F is a required word of the tapping block (a modal F of a G01 is no lead)
+        raise NcAlarm(0x1001, f"G{code[2:]} needs F in its block (tapping feed = lead x S)")
     st = _hole_state(host, block, code, axis)
     absolute = bool(host.state.absolute)
     for letter in ("R", "Q"):

@@ -49,6 +49,11 @@ def _levels(start: float, end: float, step: float) -> list[float]:
     return out
 
 
+def _not_past(level: float, r_level: float, sgn: float) -> float:
+    """A chip-break retract or re-approach level, clamped so it never lies beyond R (away from the hole)."""
+    return min(level, r_level) if sgn > 0 else max(level, r_level)
+
+
 def _spindle_code(direction: int) -> int:
     return {1: 3, -1: 4}.get(direction, 5)
 
@@ -88,14 +93,15 @@ def drill_hole(b: PathBuilder, h: Hole) -> None:
         prev = h.r_level
         for i, d in enumerate(depths, start=1):
             if h.kind == "peck_full" and i > 1:
-                # re-approach rapidly to just above the previous bottom
-                b.rapid_axes({ax: prev + sgn * h.clearance}, tag + ("reapproach",))
+                # re-approach rapidly to just above the previous bottom, never above R (a peck
+                # shallower than d, e.g. `Q4` = 4 µm, would otherwise cut air from above R)
+                b.rapid_axes({ax: _not_past(prev + sgn * h.clearance, h.r_level, sgn)}, tag + ("reapproach",))
             b.line_axes({ax: d}, tag + ("peck", str(i)))
             if d != depths[-1]:
                 if h.kind == "peck_full":
                     b.rapid_axes({ax: h.r_level}, tag + ("retract",))
                 else:
-                    b.rapid_axes({ax: d + sgn * h.clearance}, tag + ("retract",))
+                    b.rapid_axes({ax: _not_past(d + sgn * h.clearance, h.r_level, sgn)}, tag + ("retract",))
             prev = d
         if h.dwell > 0:
             b.dwell(h.dwell, tag + ("dwell",))

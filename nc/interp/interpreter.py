@@ -585,6 +585,8 @@ class Interpreter:
         if grp == 1:
             st.motion = {"G00": 0, "G01": 1, "G02": 2, "G03": 3, "G2.4": 2.4, "G3.4": 3.4, "G32": 32,
                          "G34": 34}[fn]
+            if st.cycle is not None:  # a group-01 code cancels the cycle as G80 does
+                self.cycle_memory.pop("hole", None)
             st.cycle = None
             self._three_point = None
         elif grp == 2:
@@ -621,6 +623,7 @@ class Interpreter:
             if fn == "G80":
                 st.cycle = None
                 self.cycle_modal = {}
+                self.cycle_memory.pop("hole", None)  # the next hole cycle starts afresh (initial level, R, Q, P)
             else:
                 st.cycle = fn
                 self.cycle_modal = {x.letter: x.value for x in block.words if x.letter != "G"}
