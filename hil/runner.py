@@ -101,6 +101,10 @@ class BenchRunner:
             start = dict(zip(self.axes, self.actual.tolist()))
             interp = Interpreter(profile, start)
             self._interp = interp  # G31 skip hands the latch back to it (issue 5)
+            from hil.servo_link import BusServoAccess  # G10 L40-L46 → SDO / Modbus on this bench (issue 8)
+
+            interp.servo.handler = BusServoAccess(self.link, [self._name(i) for i in range(len(self.masters))],
+                                                  getattr(self, "servo_modbus", None))
             self.profile = profile  # G10 L21 soft limits live in its params (issue 8)
             if hasattr(self.mlc, "attach_variables"):  # MLC ↔ #25000–#25511 exchange (issue 8)
                 self.mlc.attach_variables(interp.vars)

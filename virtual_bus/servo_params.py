@@ -87,6 +87,12 @@ def coe_index(group: int, number: int) -> int:
     return 0x2000 + group * 0x100 + number
 
 
+def coe_objects() -> list[tuple[int, ParamDef]]:
+    """(object index, definition) of every parameter, for a slave that lists them in its object
+    dictionary (virtual EtherCAT and CANopen drives); values stay in the drive's `ServoParams`."""
+    return [(coe_index(p.group, p.number), p) for p in ASDA_PARAMS]
+
+
 def modbus_address(group: int, number: int) -> int:
     return 0x0100 * group + 2 * number
 

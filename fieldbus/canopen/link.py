@@ -378,6 +378,23 @@ class CanopenLink:
             for fn in self.on_close:
                 fn()
 
+    # ---- acyclic SDO (servo parameters, issue 8); same signature as EthercatLink.sdo_read ----
+    def sdo_read(self, position: int, index: int, sub: int = 0, size: int = 0) -> bytes:
+        """SDO upload from the node at `position` (bench order); SdoAbortedError (`.code`) when
+        the node refuses, BusError when it does not answer."""
+        return self._acyclic(position, index, lambda sdo: sdo.upload(index, sub))
+
+    def sdo_write(self, position: int, index: int, sub: int, data: bytes, complete: bool = False) -> None:
+        self._acyclic(position, index, lambda sdo: sdo.download(index, sub, data))
+
+    def _acyclic(self, position: int, index: int, op: Callable[[Any], Any]) -> Any:
+        n = self._nodes[position]
+        try:
+            return op(n.remote.sdo)
+        except SdoCommunicationError as exc:
+            raise BusError(Alarm(ALARM_NOT_FOUND, f"{self._label(n)} does not answer SDO 0x{index:04X}: {exc}",
+                                 axis=n.cfg.name)) from None
+
     # ---- helpers ----------------------------------------------------------------------------
     def describe_bus(self) -> str:
         return f"canopen:{self.interface}" + (f":{self.channel}" if self.channel else "")

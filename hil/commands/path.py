@@ -113,7 +113,9 @@ def cmd_path(args: argparse.Namespace) -> int:
     try:
         program = store.load_main(args.program)
         plotted: list[Move] = []
+        listed = 0  # G10 L40-L46 servo accesses are listed where they happen (issue 8)
         for ev in interp.run(program):
+            listed = _print_servo(interp, args, listed)
             if isinstance(ev, Move):
                 if getattr(args, "plot", None):
                     plotted.append(ev)
@@ -124,12 +126,14 @@ def cmd_path(args: argparse.Namespace) -> int:
             elif args.preview_log and isinstance(ev, Sync):
                 print(json.dumps(ev.as_dict()) if args.json else f"{ev.line:5d} sync   {ev.reason}", file=out)
     except NcAlarm as exc:
+        _print_servo(interp, args, listed)
         _print_preview(interp, args)
         print_alarm(exc.alarm, as_json=args.json)
         return EXIT_ALARM
     except Exception as exc:  # a bug, reported as the NC internal alarm, never a traceback
         print_alarm(internal_error(exc), as_json=args.json)
         return EXIT_ALARM
+    _print_servo(interp, args, listed)
     _print_preview(interp, args)
     if getattr(args, "plot", None):
         from hil.plot import plot_program
@@ -146,6 +150,21 @@ def cmd_path(args: argparse.Namespace) -> int:
         print(json.dumps({"kind": "vars", "values": values}) if args.json else
               "vars " + " ".join(f"#{k}={'vacant' if v is None else v}" for k, v in values.items()), file=out)
     return EXIT_OK
+
+
+def _print_servo(interp: Interpreter, args: argparse.Namespace, listed: int) -> int:
+    """Print the servo parameter accesses (G10 L40/L41/L45/L46) logged since `listed`; offline
+    nothing is sent to a drive, so a read leaves #20023 vacant and #20024 = -2."""
+    log = interp.servo.log
+    for req, reply in log[listed:]:
+        if args.json:
+            print(json.dumps({"kind": "servo", "line": req.line, "block": req.block, "station": req.station,
+                              "object": req.label, "write": req.value, "value": reply.value,
+                              "result": reply.result}))
+        else:
+            print(f"{req.line:5d} servo  {req.describe()} -- not sent (offline, #20024 = {reply.result})"
+                  if reply.value is None else f"{req.line:5d} servo  {req.describe()} = {reply.value}")
+    return len(log)
 
 
 def _print_preview(interp: Interpreter, args: argparse.Namespace) -> None:

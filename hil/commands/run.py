@@ -41,6 +41,10 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="extra trace columns, one per MLC device: M31064,M21016,D31048 or App. B names")
     p.add_argument("--m00-resume", metavar="SECONDS", type=float, default=0.5,
                    help="the simulated operator presses Cycle Start this long after an M00/M01 hold (default 0.5)")
+    p.add_argument("--servo-modbus", metavar="DEVICE",
+                   help="G10 L40/L41 servo parameters go over this RS-485 port (Modbus RTU, station = I) "
+                        "instead of SDO on the bench's bus")
+    p.add_argument("--servo-baud", type=int, default=38400, help="baud rate of --servo-modbus (default 38400)")
     p.set_defaults(func=cmd_run)
 
 
@@ -88,7 +92,20 @@ def cmd_run(args: argparse.Namespace) -> int:
         except OSError as exc:
             print(f"hil run: cannot write trace {trace_path}: {exc.strerror}", file=sys.stderr)
             return EXIT_USAGE
-    result = runner.run_program(program)
+    if args.servo_modbus:  # G10 L40/L41 over the drives' RS-485 port (issue 8)
+        import serial
+
+        from fieldbus.modbus import ModbusRtuMaster
+        try:
+            runner.servo_modbus = ModbusRtuMaster.open(args.servo_modbus, baudrate=args.servo_baud)
+        except (serial.SerialException, OSError) as exc:
+            print(f"hil run: cannot open {args.servo_modbus}: {exc}", file=sys.stderr)
+            return EXIT_USAGE
+    try:
+        result = runner.run_program(program)
+    finally:
+        if args.servo_modbus:
+            runner.servo_modbus.close()
     print_summary(args.program, bench, result)
     print_timing(result)
     code = EXIT_OK if result.ok else EXIT_ALARM

@@ -3,7 +3,8 @@
 L2 P0–P6 work offsets (P0 = external/common offset), L10/L11 tool length / wear (lathe R nose radius,
 Q tip), L12/L13 radius / radius wear (mill), L14 tolerance, L15 tool life, L20 G54 P1–P64, L21 soft
 limits, and lathe-2018's L30 (spindle positioning offset), L1100 (spindle analog), L3100/L4100
-(set / clear M2080–M2111) and the L-less forms ``G10 P10000+n`` (= L10) and ``G10 P n`` (= L11).
+(set / clear M2080–M2111) and the L-less forms ``G10 P10000+n`` (= L10) and ``G10 P n`` (= L11);
+NC5's servo parameter forms L40/L41/L45/L46 are in `nc.interp.servo`.
 Values follow the decimal-point rule; an X value is a diameter in diameter mode (A6).  G10 stops
 preview; the data take effect from the next motion block (7.3.29).
 """
@@ -14,6 +15,7 @@ from collections.abc import Iterator
 from typing import TYPE_CHECKING
 
 from nc.alarms import NcAlarm
+from nc.interp.servo import SERVO_L, servo_g10
 from nc.interp.state import N_EXT_WCS
 from nc.moves import Aux, Event
 
@@ -34,6 +36,9 @@ def _int(block: "Block", letter: str, code: int = 0x0243) -> int | None:
 def g10(ip: "Interpreter", block: "Block") -> Iterator[Event]:
     legacy = ip.profile.legacy
     L = _int(block, "L")
+    if L in SERVO_L and not legacy:  # servo parameter read / write through the bench's bus (App. B.3.4.1)
+        servo_g10(ip, block, L)
+        return
     P = _int(block, "P")
     if L is None:
         if not legacy or P is None:

@@ -18,6 +18,7 @@ from nc.interp import context
 from nc.interp.arcs import center_from_radius, check_center, sweep
 from nc.interp.corners import expand_corners
 from nc.interp.gcodes import STOP_PREVIEW, lookup
+from nc.interp.servo import ServoPort
 from nc.interp.state import N_EXT_WCS, PLANES, Frames, ModalState
 from nc.interp.sysvars import SystemVariables
 from nc.interp.tools import ToolTable
@@ -110,6 +111,7 @@ class Interpreter:
         self.unit_locked = False
         self.block_skip = bool(profile.param("M2x010"))
         self.preview_log: list[PreviewRecord] = []
+        self.servo = ServoPort(alarm_on_error=bool(profile.param("servo param alarm", 1.0)))  # G10 L40-L46
         self.on_statement = None  # callable(block, program) set by the preview window
         self.p_scale = 1.0
         self._executed = 0

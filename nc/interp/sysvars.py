@@ -85,8 +85,12 @@ class SystemVariables:
             return CONSTANTS[n - 20000]
         if n == 20020:
             return 0.0
-        if n in (20021, 20022, 20023, 20024):
+        if n in (20021, 20022):
             return 0.0
+        if n == 20023:  # the value of the last G10 L40/L41/L45/L46 (App. B.3.4.1)
+            return i.servo.value
+        if n == 20024:  # its execution result, 0 = done
+            return i.servo.result
         if n == 20025:
             t = time.localtime()
             return float((t.tm_year % 100) * 10000 + t.tm_mon * 100 + t.tm_mday)

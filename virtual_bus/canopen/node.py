@@ -24,6 +24,7 @@ from fieldbus.canopen.objects import ASDA_B3_EDS, MAX_PDO_BYTES, MAX_PDOS, OBJEC
 from fieldbus.cia402 import State
 from fieldbus.pdo import PdoEntry, PdoLayout, RxPdo
 from virtual_bus.drive import Cia402Drive
+from virtual_bus.servo_params import ServoParamError, ServoParams, coe_objects
 
 log = logging.getLogger("virtual_bus.canopen")
 
@@ -58,6 +59,7 @@ class Cia402Slave:
         self._latched: dict[int, bytes] = {}
         self._dirty = True
         self._fault_reported = 0
+        self._add_servo_params()
         self.node.add_read_callback(self._on_read)
         self.node.add_write_callback(self._on_write)
 
@@ -105,7 +107,19 @@ class Cia402Slave:
         self._refresh_mapping()
 
     # ---- object dictionary callbacks ---------------------------------------------------------
+    def _add_servo_params(self) -> None:
+        """Delta parameters Pn-xx as objects 0x2000 + n*0x100 + xx (INTEGER32), served from the
+        drive's `ServoParams` so SDO, Modbus and the drive see one table (issue 8)."""
+        od = self.node.object_dictionary
+        for index, p in coe_objects():
+            var = odmod.ODVariable(p.label, index, 0)
+            var.data_type = odmod.INTEGER32
+            var.access_type = "rw" if p.writable else "ro"
+            od.add_object(var)
+
     def _on_read(self, index: int, subindex: int, od: odmod.ODVariable):
+        if 0x2000 <= index <= 0x26FF:
+            return self.drive.servo_params.read(ServoParams.from_index(index, subindex))
         attr = OBJECT_ATTRS.get((index, subindex))
         if attr is None:
             if index == 0x1001:
@@ -119,6 +133,12 @@ class Cia402Slave:
         code = self.reject_writes.get((index, subindex))
         if code is not None:
             raise SdoAbortedError(code)
+        if 0x2000 <= index <= 0x26FF:  # a servo parameter: the drive checks range and access
+            try:
+                self.drive.servo_params.sdo_write(index, subindex, data)
+            except ServoParamError as exc:
+                raise SdoAbortedError(exc.code) from None
+            return
         if 0x1400 <= index <= 0x1BFF:
             self._check_mapping_write(index, subindex, od.decode_raw(data))
             self._dirty = True

@@ -10,8 +10,10 @@ from dataclasses import dataclass, field
 
 from fieldbus.pdo import ASDA_CSP_CSV, RxPdo
 from virtual_bus.drive import Cia402Drive
-from virtual_bus.ethercat.coe import ObjectDictionary
+from virtual_bus.ethercat.coe import ObjectDictionary, SdoAbort
+from virtual_bus.ethercat.device import OBJ_VAR, TYPES, OdEntry, OdObject
 from virtual_bus.ethercat.esc import SlaveApp
+from virtual_bus.servo_params import ServoParamError, ServoParams, coe_objects
 
 # object index -> RxPdo / TxPdo attribute, from the ASDA preset's entries
 RX_ATTR = {e.index: e.attr for e in ASDA_CSP_CSV.rx} | {0x60FE: "digital_outputs"}
@@ -44,7 +46,26 @@ class DriveApp(SlaveApp):
 
     def attach(self, od: ObjectDictionary) -> None:
         self.od = od
+        # Delta parameters Pn-xx as objects 0x2000 + n*0x100 + xx (DINT), served from the drive's
+        # `ServoParams` so SDO, Modbus and the drive see one table (issue 8).
+        dtype, bits, signed = TYPES["DINT"]
+        for index, p in coe_objects():
+            od.objects[index] = OdObject(index, p.label, OBJ_VAR, {0: OdEntry(
+                0, p.label, dtype, bits, signed, "rw" if p.writable else "ro", value=p.default)})
+        od.after_write = self._after_write
         self._publish()
+
+    def _after_write(self, index: int, sub: int) -> None:
+        """A servo parameter written over SDO goes through the drive's checks; a refusal restores
+        the old value and aborts the transfer with the drive's code."""
+        od, params = self.od, self.drive.servo_params
+        if od is None or not 0x2000 <= index <= 0x26FF:
+            return
+        try:
+            params.write(ServoParams.from_index(index, sub), od.value(index, sub))
+        except ServoParamError as exc:
+            od.set(index, sub, params.read(ServoParams.from_index(index, sub)))
+            raise SdoAbort(exc.code) from None
 
     def _publish(self) -> None:
         od = self.od
@@ -57,6 +78,8 @@ class DriveApp(SlaveApp):
     def refresh(self, index: int) -> None:
         if index in TX_ATTR:
             self._publish()
+        elif 0x2000 <= index <= 0x26FF and self.od is not None and index in self.od.objects:
+            self.od.set(index, 0, self.drive.servo_params.read(ServoParams.from_index(index, 0)))
 
     def cycle(self, outputs: bytes, rx_map, tx_map, step: bool, dt: float = 0.0) -> bytes:
         od = self.od
