@@ -110,10 +110,10 @@ def cmd_path(args: argparse.Namespace) -> int:
     except NcAlarm as exc:
         print_alarm(exc.alarm, as_json=args.json)
         return EXIT_ALARM
+    listed = 0  # G10 L40-L46 servo accesses are listed where they happen (issue 8)
     try:
         program = store.load_main(args.program)
         plotted: list[Move] = []
-        listed = 0  # G10 L40-L46 servo accesses are listed where they happen (issue 8)
         for ev in interp.run(program):
             listed = _print_servo(interp, args, listed)
             if isinstance(ev, Move):
