@@ -81,6 +81,7 @@ class SimLink:
     time: float = 0.0
     cycles: int = 0
     infos: list[SlaveInfo] = field(default_factory=list)
+    io_devices: list[Any] = field(default_factory=list)  # in-process remote I/O modules (hil/remote_io.py)
 
     def open(self) -> list[SlaveInfo]:
         self.infos = [SlaveInfo(i, s.name, getattr(s, "kind", "drive"), 0x000001DD, 0, "OP", "sim")

@@ -5,6 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from fieldbus.units import AxisScaling
+from mlc.remote_io import IoMap
 from nc.motion.limits import AxisLimits, MotionConfig
 from virtual_bus.drive import DriveParams
 
@@ -27,6 +28,17 @@ class SpindleConfig:
     scaling: AxisScaling = field(default_factory=lambda: AxisScaling(counts_per_rev=1_280_000, lead=360.0))
     max_rpm: float = 4000.0
     drive: DriveParams = field(default_factory=lambda: DriveParams(max_speed_rpm=6000.0, csv_accel=1.0e8))
+
+
+@dataclass
+class IoStationConfig:
+    """A remote I/O station ([[io]] in a bench file): its X/Y mapping and how it sits on each bus.
+    EtherCAT: the k-th I/O slave in connection order (EIO node 501+k); CANopen: `canopen_node`;
+    sim: an in-process `virtual_bus.io.IoModule`."""
+
+    map: IoMap
+    canopen_node: int = 64
+    canopen_tpdo: str = "sync"  # "sync": inputs sent on every SYNC; "change": on change of state
 
 
 @dataclass
@@ -75,6 +87,7 @@ class Bench:
     mlc: str = "basic"  # MLC logic: "basic", "package.module[:attr]" or a path to a .py file
     checks: ChecksConfig = field(default_factory=ChecksConfig)
     realtime: RealtimeConfig = field(default_factory=RealtimeConfig)
+    io: list[IoStationConfig] = field(default_factory=list)  # remote I/O stations, EIO 501, 502, …
     source: str = ""  # the bench file this came from, for messages
 
     @property

@@ -15,7 +15,7 @@ from typing import Any
 
 from fieldbus.factory import parse_bus
 from fieldbus.units import AxisScaling
-from hil.bench import AxisConfig, Bench, ChecksConfig, RealtimeConfig, SpindleConfig
+from hil.bench import AxisConfig, Bench, ChecksConfig, IoStationConfig, RealtimeConfig, SpindleConfig
 from hil.session import InputError
 from nc.motion.limits import AxisLimits
 from nc.profiles import PROFILE_NAMES
@@ -224,8 +224,9 @@ def parse_bench(text: str, source: str = "bench.toml") -> Bench:
 
     b.realtime = _realtime(r, r.table(data, "realtime", "realtime"))
     b.checks = _checks(r, r.table(data, "checks", "checks"), b.axis_names)
+    b.io = _io_stations(r, data.pop("io", []), len(b.axes) + len(b.spindles))
     r.unknown(data, "", {"name", "profile", "cycle_ms", "bus", "mlc", "enable_timeout", "settle_time", "max_time",
-                         "params", "axes", "spindles", "realtime", "checks"})
+                         "params", "axes", "spindles", "realtime", "checks", "io"})
 
     names = b.axis_names
     if b.axes and b.profile != "nc5-mill" and "X" not in names:
@@ -360,3 +361,46 @@ def _checks(r: _Reader, d: dict, axes: tuple[str, ...]) -> ChecksConfig:
     r.unknown(d, "checks.", {"max_following_error", "contour_error", "limits", "limit_tolerance", "thread_phase",
                              "jitter_p99_us", "jitter_p999_us", "jitter_max_us"})
     return c
+
+
+_IO_KEYS = {"name", "inputs", "outputs", "x", "y", "canopen_node", "canopen_tpdo"}
+
+
+def _io_stations(r: _Reader, stations: Any, n_drives: int) -> list[IoStationConfig]:
+    """[[io]]: remote I/O stations in EIO order (node 501, 502, …); see mlc/remote_io.py."""
+    from mlc.remote_io import POINTS_MAX, STATIONS_MAX, IoMap, next_block, overlaps
+    from mlc.memory import XY_SIZE
+
+    if not isinstance(stations, list) or not all(isinstance(s, dict) for s in stations):
+        r.err("io", f"must be an array of tables ([[io]]), got {_kind(stations)}")
+        return []
+    if len(stations) > STATIONS_MAX:
+        r.err("io", f"at most {STATIONS_MAX} stations (EIO nodes 501–520), got {len(stations)}")
+        return []
+    out: list[IoStationConfig] = []
+    next_x = next_y = 0
+    for k, raw in enumerate(stations):
+        d, p = dict(raw), f"io[{k}]"
+        name = r.string(d, "name", f"{p}.name", f"EIO-{501 + k}") or f"EIO-{501 + k}"
+        if any(o.map.name == name for o in out):
+            r.err(f"{p}.name", f"duplicate station name {name!r}")
+        n_in = r.integer(d, "inputs", f"{p}.inputs", 16, minimum=0, maximum=POINTS_MAX)
+        n_out = r.integer(d, "outputs", f"{p}.outputs", 16, minimum=0, maximum=POINTS_MAX)
+        n_in, n_out = 16 if n_in is None else n_in, 16 if n_out is None else n_out
+        if n_in == 0 and n_out == 0:
+            r.err(p, "a station needs at least one input or output point")
+        x = r.integer(d, "x", f"{p}.x", next_x, minimum=0, maximum=XY_SIZE - 1)
+        y = r.integer(d, "y", f"{p}.y", next_y, minimum=0, maximum=XY_SIZE - 1)
+        x, y = next_x if x is None else x, next_y if y is None else y
+        node = r.integer(d, "canopen_node", f"{p}.canopen_node", 64 + k, minimum=1, maximum=127) or 64 + k
+        if node <= n_drives:
+            r.err(f"{p}.canopen_node", f"{node} is taken by a drive (drives are CANopen nodes 1–{n_drives})")
+        elif any(o.canopen_node == node for o in out):
+            r.err(f"{p}.canopen_node", f"duplicate CANopen node {node}")
+        tpdo = r.string(d, "canopen_tpdo", f"{p}.canopen_tpdo", "sync", ("sync", "change")) or "sync"
+        r.unknown(d, f"{p}.", _IO_KEYS)
+        out.append(IoStationConfig(IoMap(name, n_in, n_out, x, y, k), node, tpdo))
+        next_x, next_y = next_block(max(next_x, x + n_in)), next_block(max(next_y, y + n_out))
+    for msg in overlaps([o.map for o in out]):
+        r.err("io", msg)
+    return out

@@ -12,6 +12,9 @@ cycle start M2x000 …) and the real NC channel, never around them.
         machine.spindle(1200)                      # M03 S1200 through MDI
         machine.wait(1.0)
         machine.report()
+
+Remote I/O (bench [[io]] stations): ``machine.set_input("X3")`` switches the simulated terminal,
+``machine.get_output("Y0")`` reads one, ``machine.get("X3")`` / ``machine.set("Y0", 1)`` the MLC devices.
 """
 
 from __future__ import annotations
@@ -22,6 +25,7 @@ from pathlib import Path
 from typing import Any, Callable
 
 from hil.bench import Bench
+from hil.remote_io import attach_remote_io
 from hil.runner import BenchRunner
 from hil.session import make_link
 from mlc.machine import Mlc
@@ -85,6 +89,7 @@ class Machine:
                               max_rpm=min((s.max_rpm for s in bench.spindles), default=6000.0))
         self.panel = OperatorPanel(self.mlc)
         self.link = link or make_link(bench)
+        attach_remote_io(bench, self.mlc, self.link)  # [[io]] stations → X/Y devices (issue 8)
         self.runner = BenchRunner(bench, self.link, trace, self.mlc, on_cycle=self._on_cycle)
         self.x = self.mlc.link.x
         self.records: dict[str, DriveRecord] = {}
@@ -171,6 +176,38 @@ class Machine:
         self.cycle(cycles)
         self.mlc.mem.set_bit(relay, False)
         self.cycle(1)
+
+    # ---- remote I/O terminals of the simulated stations (bench [[io]], mlc/remote_io.py) ------------
+    def _terminal(self, device: str, kind: str) -> tuple[Any, int]:
+        """(simulated station, point) behind X<n> / Y<n>, by the bench's [[io]] mapping."""
+        from mlc.memory import DeviceError, parse_address
+
+        try:
+            k, n = parse_address(device)
+        except DeviceError as exc:
+            raise ScriptError(str(exc)) from None
+        if k != kind:
+            raise ScriptError(f"{device}: expected an {'input X' if kind == 'X' else 'output Y'}<n>")
+        for i, st in enumerate(self.bench.io):
+            m = st.map
+            first, count = (m.x, m.inputs) if kind == "X" else (m.y, m.outputs)
+            if first <= n < first + count:
+                devices = getattr(self.link, "io_devices", None) or []
+                if i >= len(devices):
+                    raise ScriptError(f"station {m.name} is not simulated in this process (bus {self.bench.bus}); "
+                                      "drive its terminals on the slave side")
+                return devices[i], n - first
+        raise ScriptError(f"{device} belongs to no [[io]] station of the bench")
+
+    def set_input(self, device: str, on: bool = True) -> None:
+        """Switch the terminal behind remote input X<n> on its simulated station (seen from the next scan)."""
+        station, point = self._terminal(device, "X")
+        station.set_input(point, bool(on))
+
+    def get_output(self, device: str) -> bool:
+        """What the terminal behind remote output Y<n> drives on its simulated station now."""
+        station, point = self._terminal(device, "Y")
+        return bool(station.output(point))
 
     def axis_index(self, axis: str) -> int:
         try:
@@ -380,8 +417,8 @@ def mlc_setup(bench: Bench, mlc_spec: str | None, signals: str | None, m00_resum
     from mlc.memory import DeviceError
     from mlc.tracing import SignalSource, parse_signal_list
 
-    if signals and not mlc_spec and getattr(bench, "mlc", "basic") == "basic":
-        mlc_spec = "lathe"  # device columns need the Delta MLC
+    if (signals or getattr(bench, "io", None)) and not mlc_spec and getattr(bench, "mlc", "basic") == "basic":
+        mlc_spec = "lathe"  # device columns and remote I/O (X/Y) need the Delta MLC
     try:
         mlc = build_mlc(bench, mlc_spec)
     except MlcLoadError as exc:

@@ -92,6 +92,12 @@ def make_link(bench: Bench) -> BusLink:
         from virtual_bus.canopen import attach_lockstep
 
         attach_lockstep(link, sim_slaves(bench))
+        if bench.io:  # the bench's remote I/O stations as simulated CiA 401 nodes (hil/remote_io.py)
+            from virtual_bus.canopen.dio import Cia401Slave, attach_lockstep_io
+
+            link.io_devices = [Cia401Slave(st.canopen_node, st.map.inputs, st.map.outputs, st.map.name)
+                               for st in bench.io]
+            attach_lockstep_io(link, link.io_devices)
     return link
 
 

@@ -131,13 +131,14 @@ class Mlc:
     def scan(self, channel: Channel) -> None:
         self.time += self.cycle
         self._clocks()
-        self._exchange_io()
+        self._read_io()
         self.link.nc_inputs(channel)
         self.link.nc_outputs(channel, self.drives)
         self._bus_relays()
         ctx = self.ctx
         ctx.time, ctx.scan_count = self.time, ctx.scan_count + 1
         self.program.scan(ctx)
+        self._write_io()
         rpm = self.link.commanded_rpm(0)
         self.spindle.rpm, self.spindle.direction = abs(rpm), (1 if rpm > 0 else -1 if rpm < 0 else 0)
         if self.link._estop:
@@ -157,18 +158,39 @@ class Mlc:
         self.mem.set_bit(29032, int(t / 0.5) % 2 == 1)
         self.mem.set_bit(29033, int(t / 0.05) % 2 == 1)
 
-    def _exchange_io(self) -> None:
+    def attach_io(self, ports: list[Any], maps: list[Any]) -> None:
+        """Remote I/O stations (issue 8): `ports[k]` (a `mlc.remote_io.IoPort`) is station k, `maps[k]`
+        its X/Y range (`mlc.remote_io.IoMap`)."""
+        self.io_modules = list(ports)
+        assert self.ctx.io is not None
+        self.ctx.io.maps = list(maps)
+
+    def _read_io(self) -> None:
+        """Inputs of every station into its X range (or the module image) before the NC and the user
+        scan; a station that is not connected reads 0 (safe state, docs/decisions/mlc.md)."""
         io = self.ctx.io
         assert io is not None
         while len(io.inputs) < len(self.io_modules):
             io.inputs.append(0)
-        for k, module in enumerate(self.io_modules):
-            outs = io.outputs[k] if k < len(io.outputs) else 0
-            analog_out = [self.mem.u16(20200 + 4 * k + w) for w in range(4)]
-            di, analog_in = module.exchange_io(outs, analog_out, self.cycle)
+        for k, port in enumerate(self.io_modules):
+            di, analog_in = port.read_inputs(self.cycle)
+            if not getattr(port, "connected", True):
+                di, analog_in = 0, [0, 0, 0, 0]
             io.inputs[k] = di
+            m = io.maps[k] if k < len(io.maps) else None
+            if m is not None:
+                self.mem.set_bits("X", m.x, m.inputs, di)
             for w, v in enumerate(analog_in[:4]):
                 self.mem.set_u16(30200 + 4 * k + w, v)
+
+    def _write_io(self) -> None:
+        """The Y range (or the module image) of every station to its module, right after the user scan."""
+        io = self.ctx.io
+        assert io is not None
+        for k, port in enumerate(self.io_modules):
+            m = io.maps[k] if k < len(io.maps) else None
+            outs = self.mem.bits("Y", m.y, m.outputs) if m is not None else (io.outputs[k] if k < len(io.outputs) else 0)
+            port.write_outputs(outs, [self.mem.u16(20200 + 4 * k + w) for w in range(4)])
 
     def _bus_relays(self) -> None:
         """M30000 (EtherCAT communication status: every slave in OP, not servo on) and M30032+k (EIO

@@ -1,5 +1,6 @@
-"""MLC device memory: M bits, D words (16-bit, with 32-bit integer and float pairs) and the
-user alarm bits A0–A511.
+"""MLC device memory: M bits, D words (16-bit, with 32-bit integer and float pairs), the
+user alarm bits A0–A511, and the X (input) / Y (output) bits of the remote I/O modules
+(X0–X1023, Y0–Y1023, numbered decimally like M and D; see mlc/remote_io.py for how modules map).
 
 Word order of a pair (NC5 App. B never states it, ambiguity B4): by default the LOW word sits at
 the LOWER address (``D31048`` = low 16 bits, ``D31049`` = high 16 bits), which is how Delta's DVP/AS
@@ -19,8 +20,9 @@ import numpy as np
 M_SIZE = 100_000  # M0 … M99999 (covers the special blocks M2xxxx … M5xxxx)
 D_SIZE = 100_000
 A_SIZE = 512  # user-defined alarms A0 … A511 (NC5 App. A.1)
+XY_SIZE = 1024  # remote I/O points X0 … X1023 / Y0 … Y1023 (docs/decisions/mlc.md, D11)
 
-_ADDR = re.compile(r"^\s*([MDA])\s*(\d{1,5})\s*$", re.IGNORECASE)
+_ADDR = re.compile(r"^\s*([MDAXY])\s*(\d{1,5})\s*$", re.IGNORECASE)
 
 WordOrder = Literal["low-first", "high-first"]
 
@@ -33,9 +35,9 @@ def parse_address(text: str) -> tuple[str, int]:
     """``"M21000"`` → ``("M", 21000)``; raises DeviceError for anything else."""
     m = _ADDR.match(text)
     if not m:
-        raise DeviceError(f"{text!r} is not a device address (M<n>, D<n> or A<n>)")
+        raise DeviceError(f"{text!r} is not a device address (M<n>, D<n>, A<n>, X<n> or Y<n>)")
     kind, n = m.group(1).upper(), int(m.group(2))
-    size = {"M": M_SIZE, "D": D_SIZE, "A": A_SIZE}[kind]
+    size = {"M": M_SIZE, "D": D_SIZE, "A": A_SIZE, "X": XY_SIZE, "Y": XY_SIZE}[kind]
     if n >= size:
         raise DeviceError(f"{text!r} is outside the {kind} device range 0…{size - 1}")
     return kind, n
@@ -47,6 +49,8 @@ class DeviceMemory:
     m: bytearray = field(default_factory=lambda: bytearray(M_SIZE))
     d: np.ndarray = field(default_factory=lambda: np.zeros(D_SIZE, dtype=np.uint16))
     a: bytearray = field(default_factory=lambda: bytearray(A_SIZE))
+    x: bytearray = field(default_factory=lambda: bytearray(XY_SIZE))  # remote inputs, written by the bus
+    y: bytearray = field(default_factory=lambda: bytearray(XY_SIZE))  # remote outputs, written by the MLC
 
     # ---- bits ---------------------------------------------------------------------------
     def bit(self, n: int) -> bool:
@@ -62,6 +66,16 @@ class DeviceMemory:
         if not 0 <= n < A_SIZE:
             raise DeviceError(f"A{n} is outside the user alarm range A0…A{A_SIZE - 1}")
         self.a[n] = 1 if on else 0
+
+    # ---- remote I/O images: `count` consecutive X or Y bits as an integer, point 0 = bit 0 --------
+    def bits(self, kind: str, first: int, count: int) -> int:
+        area = self.x if kind == "X" else self.y
+        return sum(1 << k for k in range(count) if area[first + k])
+
+    def set_bits(self, kind: str, first: int, count: int, value: int) -> None:
+        area = self.x if kind == "X" else self.y
+        for k in range(count):
+            area[first + k] = value >> k & 1
 
     def active_alarms(self) -> list[int]:
         return [i for i, v in enumerate(self.a) if v]
@@ -119,6 +133,8 @@ class DeviceMemory:
             return self.m[n]
         if kind == "A":
             return self.a[n]
+        if kind in "XY":
+            return (self.x if kind == "X" else self.y)[n]
         return int(self.d[n])
 
     def put(self, address: str, value: int) -> None:
@@ -127,5 +143,7 @@ class DeviceMemory:
             self.set_bit(n, bool(value))
         elif kind == "A":
             self.set_alarm(n, bool(value))
+        elif kind in "XY":
+            (self.x if kind == "X" else self.y)[n] = 1 if value else 0
         else:
             self.set_u16(n, int(value))

@@ -15,6 +15,7 @@ Inside `scan` it reads inputs and writes outputs through `mlc`:
     mlc.timer("turret", 0.5, running)  # on-delay timer (TON): True once `running` held 0.5 s
     mlc.alarm(12)              # raise user alarm A12 (mlc.alarm(12, False) clears it)
     mlc.io.out(0, 3, True)     # remote I/O module 0, digital output 3; mlc.io.inp(0, 1); analog words
+    mlc.x(3), mlc.y(3, True)   # remote I/O by device: input X3, output Y3 (the bench's [[io]] mapping)
     mlc.state                  # a dict that survives between scans, for the program's own data
     mlc.time, mlc.dt, mlc.scan_count
 
@@ -27,22 +28,39 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from mlc.memory import DeviceMemory
+from mlc.remote_io import IoMap
 from mlc.signals import Signal, resolve
 
 
 @dataclass
 class RemoteIo:
     """Remote I/O modules as the MLC sees them: digital points per module, and the four analog
-    words per module of App. B (D20200+4k outputs, D30200+4k inputs)."""
+    words per module of App. B (D20200+4k outputs, D30200+4k inputs). A module with an `IoMap`
+    (a bench [[io]] station) keeps its points in X/Y devices, so `inp`/`out` and `mlc.x`/`mlc.y`
+    are the same bits."""
 
     mem: DeviceMemory
     inputs: list[int] = field(default_factory=list)  # digital input image per module (bit mask)
     outputs: list[int] = field(default_factory=list)
+    maps: list[IoMap] = field(default_factory=list)  # module k → its X/Y range (mlc/remote_io.py)
+
+    def _map(self, module: int) -> IoMap | None:
+        return self.maps[module] if module < len(self.maps) else None
 
     def inp(self, module: int, point: int) -> bool:
+        m = self._map(module)
+        if m is not None:
+            return point < m.inputs and bool(self.mem.x[m.x + point])
         return bool(self.inputs[module] >> point & 1) if module < len(self.inputs) else False
 
     def out(self, module: int, point: int, on: bool | None = None) -> bool:
+        m = self._map(module)
+        if m is not None:
+            if point >= m.outputs:
+                return False  # a point the station does not have: nothing to switch
+            if on is not None:
+                self.mem.y[m.y + point] = 1 if on else 0
+            return bool(self.mem.y[m.y + point])
         while module >= len(self.outputs):
             self.outputs.append(0)
         if on is not None:
@@ -83,10 +101,28 @@ class ScanContext:
 
     # ---- relays ------------------------------------------------------------------------------
     def m(self, spec: str) -> bool:
-        return self.mem.bit(self.signal(spec).number)
+        sig = self.signal(spec)
+        if sig.kind in ("X", "Y"):
+            return bool(self.mem.get(sig.address))
+        return self.mem.bit(sig.number)
 
     def set(self, spec: str, on: bool = True) -> None:
-        self.mem.set_bit(self.signal(spec).number, on)
+        sig = self.signal(spec)
+        if sig.kind in ("X", "Y"):
+            self.mem.put(sig.address, on)
+        else:
+            self.mem.set_bit(sig.number, on)
+
+    # ---- remote I/O points (X inputs, Y outputs) -------------------------------------------------
+    def x(self, n: int) -> bool:
+        """Remote input X<n>, as read from its module at the start of this scan."""
+        return bool(self.mem.x[n])
+
+    def y(self, n: int, on: bool | None = None) -> bool:
+        """Remote output Y<n>: set it (on=True/False) or read back what this program last wrote."""
+        if on is not None:
+            self.mem.y[n] = 1 if on else 0
+        return bool(self.mem.y[n])
 
     def rising(self, spec: str) -> bool:
         now = self.m(spec)

@@ -52,7 +52,7 @@ class Row:
 class Signal:
     address: str  # "M21000"
     number: int
-    kind: Literal["M", "D"]
+    kind: Literal["M", "D", "A", "X", "Y"]
     name: str  # "CYCLE_START", "JOG_FWD_X", "TORQUE_FB_3"
     channel: int  # 0 for the general block
     direction: int

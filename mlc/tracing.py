@@ -1,4 +1,4 @@
-"""Trace columns for named devices: `hil run --trace-signals M31064,M21016,D31048,…`.
+"""Trace columns for named devices: `hil run --trace-signals M31064,M21016,D31048,X0,Y3,…`.
 
 `SignalSource` is a trace source (``columns`` + ``values(runner)``): one column per device, named
 by its address, holding 0/1 for a relay and the register's value read with its App. B width.
@@ -24,6 +24,8 @@ def value_of(mem: DeviceMemory, sig: Signal) -> float | int:
         return int(mem.bit(n))
     if sig.kind == "A":
         return int(mem.alarm(n))
+    if sig.kind in ("X", "Y"):  # remote I/O points (mlc/remote_io.py)
+        return int(mem.get(sig.address))
     if sig.width == "f32":
         return float(mem.f32(n))
     return {"u16": mem.u16, "s16": mem.s16, "u32": mem.u32}.get(sig.width, mem.u16)(n)

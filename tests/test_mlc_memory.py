@@ -49,7 +49,7 @@ def test_resolve_by_name_is_channel_relative_and_bad_devices_are_rejected():
     assert resolve("MST_FINISH", 2).address == "M22016"
     assert resolve("m31064").name == "M_STROBE"
     assert resolve("M1000").text == "ordinary MLC device"
-    for bad in ("X12", "M100000", "NOT_A_SIGNAL"):
+    for bad in ("X1024", "Y99999", "Z12", "M100000", "NOT_A_SIGNAL"):
         with pytest.raises(DeviceError):
             resolve(bad)
     with pytest.raises(DeviceError):

@@ -31,6 +31,7 @@ class IoModule:
     wiring: dict[int, tuple[int, float]] = field(default_factory=dict)  # out point → (in point, delay s)
     time: float = 0.0
     history: list[tuple[float, int]] = field(default_factory=list)  # (time, outputs) at each change
+    connected: bool = True  # False: the module is off the line (its inputs read 0 in the MLC)
     _since: dict[int, float] = field(default_factory=dict)
 
     def set_input(self, point: int, on: bool) -> None:
@@ -39,12 +40,24 @@ class IoModule:
     def output(self, point: int) -> bool:
         return bool(self.outputs >> point & 1)
 
-    def exchange_io(self, outputs: int, analog_out: list[int], dt: float) -> tuple[int, list[int]]:
+    # The MLC's side (mlc.remote_io.IoPort): inputs at the start of a scan, outputs after it.
+
+    def read_inputs(self, dt: float) -> tuple[int, list[int]]:
         self.time += dt
-        if outputs != self.outputs:
-            self.history.append((self.time, outputs))
-        self.outputs = outputs
-        self.analog_out = list(analog_out[:4])
+        self._wire()
+        return self.inputs, list(self.analog_in)
+
+    def write_outputs(self, digital: int, analog: list[int]) -> None:
+        if digital != self.outputs:
+            self.history.append((self.time, digital))
+        self.outputs = digital
+        self.analog_out = list(analog[:4])
+
+    def exchange_io(self, outputs: int, analog_out: list[int], dt: float) -> tuple[int, list[int]]:
+        self.write_outputs(outputs, analog_out)
+        return self.read_inputs(dt)
+
+    def _wire(self) -> None:
         for out_pt, (in_pt, delay) in self.wiring.items():
             if self.output(out_pt):
                 start = self._since.setdefault(out_pt, self.time)
@@ -52,7 +65,6 @@ class IoModule:
             else:
                 self._since.pop(out_pt, None)
                 self.set_input(in_pt, False)
-        return self.inputs, list(self.analog_in)
 
     def exchange(self, rx: IoImage, dt: float) -> IoImage:
         di, ai = self.exchange_io(rx.digital, rx.analog, dt)

@@ -32,7 +32,7 @@ from fieldbus.canopen.budget import DEFAULT_BITRATE, BusLoad, bus_load, check_bu
 from fieldbus.canopen.emcy import ALARM_COMMUNICATION, ALARM_PDO_MAPPING, Emcy, emcy_alarm
 from fieldbus.canopen.lockstep import LockstepNetwork
 from fieldbus.canopen.netns import check_multicast_allowed
-from fieldbus.canopen.objects import ASDA_B3_EDS, MAX_PDOS, frame_layouts
+from fieldbus.canopen.objects import ASDA_B3_EDS, DIO_EDS, MAX_PDOS, frame_layouts
 from fieldbus.link import BusError, SlaveInfo
 from fieldbus.pdo import ASDA_CSP, ASDA_CSP_CSV, PdoLayout, RxPdo, TxPdo
 from nc.alarms import Alarm
@@ -46,6 +46,9 @@ ALARM_INTERPOLATION = 0x141F  # the servo does not support the interpolation tim
 NMT_BOOTUP, NMT_STOPPED, NMT_OPERATIONAL, NMT_PREOP = 0, 4, 5, 127
 NMT_NAMES = {0: "BOOT-UP", 4: "STOPPED", 5: "OPERATIONAL", 127: "PRE-OPERATIONAL"}
 CIA402_DEVICE_PROFILE = 402
+CIA401_DEVICE_PROFILE = 401  # generic I/O modules (remote I/O stations)
+ALARM_EIO_FAILED = 0x1426  # the system remote module (EIO) failed
+ALARM_EIO_MISMATCH = 0x142E  # the EIO connection device type does not match the settings
 _channels = itertools.count(1)
 
 
@@ -55,6 +58,32 @@ class NodeConfig:
     name: str  # axis or spindle name
     layout: PdoLayout
     eds: str | Path = ASDA_B3_EDS  # EDS or DCF of the device
+
+
+@dataclass
+class IoNodeConfig:
+    """A CiA 401 remote I/O station (mlc/remote_io.py): `inputs` / `outputs` digital points, inputs sent
+    on every SYNC (`tpdo="sync"`) or on change of state (`"change"`)."""
+
+    node_id: int
+    name: str
+    inputs: int = 16
+    outputs: int = 16
+    tpdo: str = "sync"
+    eds: str | Path = ""  # default: fieldbus/canopen/eds/delta_dio_401.eds
+
+
+@dataclass
+class _IoNode:
+    cfg: IoNodeConfig
+    remote: canopen.RemoteNode
+    inputs: int = 0  # from the last TPDO
+    outputs: int = 0  # what the next RPDO carries
+    received: bool = False
+    nmt_state: int | None = None
+    last_heartbeat: float = 0.0
+    lost: bool = False
+    tpdo_misses: int = 0
 
 
 @dataclass
@@ -84,7 +113,8 @@ def interpolation_period(cycle: float) -> tuple[int, int]:
 class CanopenLink:
     def __init__(self, nodes: Sequence[NodeConfig], interface: str, channel: str = "", cycle: float = 0.001,
                  bitrate: int = DEFAULT_BITRATE, heartbeat_period: float | None = None,
-                 heartbeat_timeout: float | None = None, tpdo_timeout: float | None = None) -> None:
+                 heartbeat_timeout: float | None = None, tpdo_timeout: float | None = None,
+                 io_nodes: Sequence[IoNodeConfig] = ()) -> None:
         if not nodes:
             raise ValueError("a CANopen bus needs at least one node")
         if interface == "udp_multicast" and not channel:
@@ -119,6 +149,8 @@ class CanopenLink:
         self.infos: list[SlaveInfo] = []
         self.found: list[int] = []
         self._nodes: list[_Node] = []
+        self.io_cfg = list(io_nodes)  # remote I/O stations, after the drives (CiA 401)
+        self._io: list[_IoNode] = []
         self._opened = False
         self._lock = threading.Condition()
         self._emcys: list[Alarm] = []
@@ -131,8 +163,10 @@ class CanopenLink:
         eds = getattr(bench, "canopen_eds", None) or ASDA_B3_EDS
         nodes = [NodeConfig(i + 1, a.name, ASDA_CSP, eds) for i, a in enumerate(bench.axes)]
         nodes += [NodeConfig(len(nodes) + k + 1, s.name, ASDA_CSP_CSV, eds) for k, s in enumerate(bench.spindles)]
+        io = [IoNodeConfig(st.canopen_node, st.map.name, st.map.inputs, st.map.outputs, st.canopen_tpdo)
+              for st in getattr(bench, "io", [])]  # [[io]] stations (mlc/remote_io.py)
         return cls(nodes, interface, channel, bench.cycle,
-                   bitrate=int(getattr(bench, "canopen_bitrate", None) or DEFAULT_BITRATE))
+                   bitrate=int(getattr(bench, "canopen_bitrate", None) or DEFAULT_BITRATE), io_nodes=io)
 
     # ---- clock ------------------------------------------------------------------------
     def _now(self) -> float:
@@ -169,20 +203,30 @@ class CanopenLink:
             self._nodes.append(node)
             net.subscribe(0x700 + cfg.node_id, self._heartbeat_cb(node))
             net.subscribe(0x80 + cfg.node_id, self._emcy_cb(node))
+        for icfg in self.io_cfg:
+            io = _IoNode(icfg, canopen.RemoteNode(icfg.node_id, canopen.import_od(str(icfg.eds or DIO_EDS),
+                                                                                  icfg.node_id)))
+            net.add_node(io.remote)
+            self._io.append(io)
+            net.subscribe(0x700 + icfg.node_id, self._heartbeat_cb(io))
         self._scan()
         self._nmt_all(0x82, "RESET COMMUNICATION")
-        if not self._wait(lambda: all(n.nmt_state == NMT_BOOTUP or n.nmt_state == NMT_PREOP for n in self._nodes), 1.0):
-            missing = [n for n in self._nodes if n.nmt_state is None]
+        every = self._nodes + self._io
+        if not self._wait(lambda: all(n.nmt_state == NMT_BOOTUP or n.nmt_state == NMT_PREOP for n in every), 1.0):
+            missing = [n for n in every if n.nmt_state is None]
             self._fail(Alarm(ALARM_NOT_FOUND, "no boot-up after NMT reset communication from "
                              + ", ".join(self._label(n) for n in missing), axis=missing[0].cfg.name))
         self._nmt_all(0x80, "PRE-OPERATIONAL")
         self.infos = [self._identify(i, n) for i, n in enumerate(self._nodes)]
+        self.infos += [self._identify_io(len(self.infos) + k, n) for k, n in enumerate(self._io)]
         for n in self._nodes:
             self._configure(n)
+        for io in self._io:
+            self._configure_io(io)
         self._nmt_all(0x01, "OPERATIONAL")
         now = self._now()
         with self._lock:
-            for n, info in zip(self._nodes, self.infos):
+            for n, info in zip(self._nodes + self._io, self.infos):
                 n.last_heartbeat = now
                 n.nmt_state = None  # known again from the first heartbeat after NMT start
                 info.state = "OPERATIONAL"
@@ -196,21 +240,21 @@ class CanopenLink:
         net = self.network
         net.scanner.reset()
         net.scanner.search()
-        want = {n.cfg.node_id for n in self._nodes}
+        want = {n.cfg.node_id for n in self._nodes + self._io}
         self._wait(lambda: want <= set(net.scanner.nodes), 0.5)
         self.found = sorted(net.scanner.nodes)
-        missing = [n for n in self._nodes if n.cfg.node_id not in self.found]
+        missing = [n for n in self._nodes + self._io if n.cfg.node_id not in self.found]
         if missing:
             self._fail(Alarm(ALARM_NOT_FOUND, "CANopen node scan on " + self.describe_bus() + " found "
                              + (", ".join(map(str, self.found)) or "no node") + "; missing "
                              + ", ".join(self._label(n) for n in missing), axis=missing[0].cfg.name))
 
     def _nmt_all(self, code: int, name: str) -> None:
-        for n in self._nodes:
+        for n in self._nodes + self._io:
             if code == 0x82:
                 n.nmt_state = None
             n.remote.nmt.send_command(code)
-        log.info("NMT %s sent to nodes %s", name, [n.cfg.node_id for n in self._nodes])
+        log.info("NMT %s sent to nodes %s", name, [n.cfg.node_id for n in self._nodes + self._io])
 
     def _identify(self, pos: int, n: _Node) -> SlaveInfo:
         sdo = n.remote.sdo
@@ -248,6 +292,64 @@ class CanopenLink:
             self.network.unsubscribe(cob)
             n.tx_cobs[cob] = frame
             self.network.subscribe(cob, self._tpdo_cb(n))
+
+    # ---- remote I/O stations (CiA 401) ------------------------------------------------------------
+    def _identify_io(self, pos: int, n: _IoNode) -> SlaveInfo:
+        sdo = n.remote.sdo
+        device_type = self._sdo(n, lambda: sdo[0x1000].raw, 0x1000)
+        vendor = self._sdo(n, lambda: sdo[0x1018][1].raw, 0x1018)
+        product = self._sdo(n, lambda: sdo[0x1018][2].raw, 0x1018)
+        if device_type & 0xFFFF != CIA401_DEVICE_PROFILE:
+            self._fail(Alarm(ALARM_EIO_MISMATCH, f"{self._label(n)} is not a CiA 401 I/O station "
+                             f"(device type 0x{device_type:08X})"))
+        return SlaveInfo(pos, n.cfg.name, "io", vendor, product, "PRE-OPERATIONAL", "cia401")
+
+    def _configure_io(self, n: _IoNode) -> None:
+        """Heartbeat, TPDO1 = the input bytes (0x6000:1…), RPDO1 = the output bytes (0x6200:1…); the
+        other PDOs off. Outputs act on SYNC; inputs come on SYNC or on change (`cfg.tpdo`)."""
+        sdo, nid, cfg = n.remote.sdo, n.cfg.node_id, n.cfg
+        self._sdo(n, lambda: setattr(sdo[0x1017], "raw", int(round(self.heartbeat_period * 1000))), 0x1017)
+        for maps, base, index, points, trans in ((n.remote.rpdo, 0x200, 0x6200, cfg.outputs, 1),
+                                                 (n.remote.tpdo, 0x180, 0x6000, cfg.inputs,
+                                                  1 if cfg.tpdo == "sync" else 255)):
+            m = maps[1]
+            m.clear()
+            m.cob_id = base + nid
+            m.trans_type = trans
+            m.rtr_allowed = False
+            if base == 0x180 and trans == 255:
+                m.inhibit_time, m.event_timer = 0, 0
+            m.enabled = points > 0
+            for sub in range(1, (points + 7) // 8 + 1):
+                m.add_variable(index, sub, 8)
+            self._sdo(n, m.save, m.com_record.od.index, f"{'RPDO' if base == 0x200 else 'TPDO'}1 of the I/O station")
+        if cfg.inputs:  # our decoder instead of the library's PdoMap handler
+            self.network.unsubscribe(0x180 + nid)
+            self.network.subscribe(0x180 + nid, self._io_tpdo_cb(n))
+
+    def _io_tpdo_cb(self, n: _IoNode) -> Callable[[int, bytes, float], None]:
+        def cb(can_id: int, data: bytes, timestamp: float) -> None:
+            with self._lock:
+                n.inputs = int.from_bytes(bytes(data), "little") & ((1 << n.cfg.inputs) - 1)
+                n.received = True
+                self._lock.notify_all()
+        return cb
+
+    def io_ok(self, k: int) -> bool:
+        """Station k is on the bus and OPERATIONAL (its inputs are current)."""
+        if not self._opened or k >= len(self._io):
+            return False
+        n = self._io[k]
+        return not n.lost and n.nmt_state in (None, NMT_OPERATIONAL)
+
+    def io_inputs(self, k: int) -> int:
+        """Station k's inputs from its last TPDO; 0 while it is not OPERATIONAL (the safe state)."""
+        return self._io[k].inputs if self.io_ok(k) else 0
+
+    def set_io_outputs(self, k: int, value: int) -> None:
+        """Outputs station k's RPDO carries from the next cycle on."""
+        if k < len(self._io):
+            self._io[k].outputs = value & ((1 << self._io[k].cfg.outputs) - 1)
 
     def _sdo(self, n: _Node, op: Callable[[], Any], index: int, what: str = "") -> Any:
         try:
@@ -321,6 +423,14 @@ class CanopenLink:
                     net.send_raw(cob, data)
                 else:
                     net.send_message(cob, data)
+        for io in self._io:  # remote I/O outputs (mlc/remote_io.py), acting on this SYNC
+            if io.lost or not io.cfg.outputs:
+                continue
+            data = io.outputs.to_bytes((io.cfg.outputs + 7) // 8, "little")
+            if self.lockstep:
+                net.send_raw(0x200 + io.cfg.node_id, data)
+            else:
+                net.send_message(0x200 + io.cfg.node_id, data)
         net.sync.transmit()  # lock-step: delivers RPDOs + SYNC, the slaves answer, we collect
         self.cycles += 1
         if self.lockstep:
@@ -352,6 +462,19 @@ class CanopenLink:
                 self._lose(n)
                 raise BusError(Alarm(ALARM_COMMUNICATION, f"{self._label(n)} left OPERATIONAL: heartbeat "
                                      f"reports {state}", axis=n.cfg.name))
+        for io in self._io:  # a station gone: its inputs read 0 from now on (io_ok), then the alarm
+            if io.lost:
+                continue
+            silent = now - io.last_heartbeat > self.heartbeat_timeout + 1e-9
+            left = io.nmt_state not in (None, NMT_OPERATIONAL) and io.last_heartbeat - self._opened_at > self.heartbeat_period
+            if silent or left:
+                io.lost = True
+                io.inputs = 0
+                if self.infos:
+                    self.infos[len(self._nodes) + self._io.index(io)].state = "LOST"
+                why = (f"no heartbeat for {(now - io.last_heartbeat) * 1000:.0f} ms" if silent else
+                       f"heartbeat reports {NMT_NAMES.get(io.nmt_state, str(io.nmt_state))}")
+                raise BusError(Alarm(ALARM_EIO_FAILED, f"remote I/O station {self._label(io)} lost: {why}"))
         if emcys:
             raise BusError(emcys[0])
 
@@ -368,9 +491,9 @@ class CanopenLink:
         self._opened = False
         try:
             if net is not None and net.bus is not None:
-                for n in self._nodes:
+                for n in self._nodes + self._io:
                     if not n.lost:
-                        n.remote.nmt.send_command(0x02)  # NMT stop: no more PDOs from the drives
+                        n.remote.nmt.send_command(0x02)  # NMT stop: no more PDOs; I/O outputs to their safe state
                 net.disconnect()
         except (can.CanError, OSError) as exc:
             log.warning("closing the CANopen network: %s", exc)

@@ -19,6 +19,8 @@ MAX_PDOS = 4  # 0x1400-0x1403 / 0x1800-0x1803 in the shipped EDS (CiA 301 pre-de
 # The device description of a Delta ASDA-B3-class CANopen servo (CiA 402). Masters read it to
 # build the object dictionary; the simulated slaves are built from the same file.
 ASDA_B3_EDS: Path = Path(str(resources.files("fieldbus.canopen") / "eds" / "delta_asda_b3.eds"))
+# A CiA 401 remote digital I/O station (up to 64 in / 64 out), master and simulated station alike.
+DIO_EDS: Path = Path(str(resources.files("fieldbus.canopen") / "eds" / "delta_dio_401.eds"))
 
 # CiA 402 objects the layouts use, with the names python-canopen gives them from the EDS.
 OBJECT_ATTRS: dict[tuple[int, int], str] = {

@@ -75,6 +75,7 @@ class EthercatLink:
     drift_check_every: int = 250  # cycles between DC drift reads (0x092C of every drive)
     drift_limit_ns: int = 50_000  # |system time difference| above this raises 0x141F; 0 = only record it
     stats: LinkStats = field(default_factory=LinkStats)
+    io_names: Sequence[str] = ()  # remote I/O stations, k-th I/O slave in connection order (EIO node 501+k)
 
     def __post_init__(self) -> None:
         self.master: pysoem.Master | None = None
@@ -86,6 +87,8 @@ class EthercatLink:
         self._structs: list[PdoLayout] = []
         self._states: list[str] = []  # per slave as `infos` lists them, refreshed on every bad cycle
         self._failed = False  # a bus alarm was raised and the line was not recovered since
+        self._io_out: list[bytes] = []  # per I/O slave: the output image the next frame carries
+        self._io_in: list[bytes] = []  # per I/O slave: the input image of the last good frame
 
     @classmethod
     def for_bench(cls, bench, iface: str) -> "EthercatLink":
@@ -94,6 +97,7 @@ class EthercatLink:
             if hasattr(bench, "params") else ASDA_CSP_CSV
         params = getattr(bench, "params", {}) or {}
         link = cls(iface, bench.cycle, names, [layout] * len(names))
+        link.io_names = [st.map.name for st in getattr(bench, "io", [])]
         # bench [params]: ethercat_drift_limit_ns, ethercat_drift_check_every (docs/decisions E8)
         link.drift_limit_ns = int(params.get("ethercat_drift_limit_ns", link.drift_limit_ns))
         link.drift_check_every = int(params.get("ethercat_drift_check_every", link.drift_check_every))
@@ -201,6 +205,8 @@ class EthercatLink:
                        for k, s in enumerate(self.io)]
         self._states = [i.state for i in self.infos]
         self._failed = False
+        self._io_out = [bytes(len(s.output)) for s in self.io]
+        self._io_in = [bytes(s.input) for s in self.io]
         return self.infos
 
     def _mapper(self, s, layout: PdoLayout, name: str, errors: list[Alarm]):
@@ -226,6 +232,8 @@ class EthercatLink:
 
     def _named(self, m):
         names = {id(s): n for s, n in zip(self.drives, self.names)}
+        for k, s in enumerate(self.io):  # remote I/O stations by bench name and EIO node
+            names[id(s)] = f"{self.io_names[k] if k < len(self.io_names) else s.name} (EIO node {501 + k})"
         return [(s, names.get(id(s), s.name)) for s in m.slaves]
 
     # ---- cyclic -------------------------------------------------------------------------
@@ -237,6 +245,8 @@ class EthercatLink:
             raise ValueError(f"{len(outputs)} output images for {len(self.drives)} drives")
         for s, layout, rx in zip(self.drives, self._structs, outputs):
             s.output = layout.pack_rx(rx)
+        for s, data in zip(self.io, self._io_out):  # remote I/O outputs the MLC wrote (mlc/remote_io.py)
+            s.output = data
         m.send_processdata()
         wkc = m.receive_processdata(self.receive_timeout_us)
         self.stats.cycles += 1
@@ -245,6 +255,7 @@ class EthercatLink:
             if not self._failed:  # the full working counter: every slave exchanged, so every slave is in OP
                 self._states = ["OP"] * len(self.infos)
             self._last = [layout.unpack_tx(s.input, tx) for s, layout, tx in zip(self.drives, self._structs, self._last)]
+            self._io_in = [bytes(s.input) for s in self.io]
             if self.dc and self.drift_check_every and self.stats.cycles % self.drift_check_every == 0:
                 self._check_drift()
             return list(self._last)
@@ -264,17 +275,21 @@ class EthercatLink:
             raise
 
     def _judge_bad_cycle(self, m, wkc: int) -> list[TxPdo]:
+        io = {id(s) for s in self.io}
         for s, name in self._named(m):
             if s.state & pysoem.STATE_ERROR:
-                raise BusError(Alarm(A.DISCONNECTED, f"EtherCAT slave {name} dropped to {state_name(s.state)}: "
-                                                     f"{A.al_text(s.al_status)}", axis=self._axis(name),
-                                     info=s.al_status))
+                code = A.EIO_FAILED if id(s) in io else A.DISCONNECTED
+                raise BusError(Alarm(code, f"EtherCAT slave {name} dropped to {state_name(s.state)}: "
+                                           f"{A.al_text(s.al_status)}", axis=self._axis(name), info=s.al_status))
         if self._bad > self.max_bad_cycles:
             what = "no frame returned" if wkc < 0 else f"working counter {wkc}, expected {m.expected_wkc}"
-            bad = [name for s, name in self._named(m) if s.state != pysoem.OP_STATE]
+            lost = [(s, name) for s, name in self._named(m) if s.state != pysoem.OP_STATE]
+            bad = [name for _, name in lost]
             who = bad[0] if bad else (self.names[0] if self.names else "line")
-            raise BusError(Alarm(A.DISCONNECTED, f"EtherCAT communication lost for {self._bad} cycles ({what}); "
-                                                 f"not in OP: {', '.join(bad) or 'none'}", axis=self._axis(who)))
+            # Only remote I/O stations gone, every drive still in OP: the EIO alarm (NC5 App. A 0x1426).
+            code = A.EIO_FAILED if lost and all(id(s) in io for s, _ in lost) else A.DISCONNECTED
+            raise BusError(Alarm(code, f"EtherCAT communication lost for {self._bad} cycles ({what}); "
+                                       f"not in OP: {', '.join(bad) or 'none'}", axis=self._axis(who)))
         self.stats.events.append(f"cycle {self.stats.cycles}: bad working counter {wkc}, riding through")
         return list(self._last)
 
@@ -284,6 +299,31 @@ class EthercatLink:
         ok = self.master is not None and not self._failed and bool(self._states) \
             and all(st == "OP" for st in self._states)
         return LinkStatus(ok, [i.name for i in self.infos], [i.kind for i in self.infos], list(self._states))
+
+    # ---- remote I/O slaves (R1-EC class), k-th in connection order = EIO node 501+k ---------------
+    def io_bits(self, k: int) -> tuple[int, int]:
+        """(input bits, output bits) of the k-th I/O slave's process image; (0, 0) if there is none."""
+        if k >= len(self._io_in):
+            return 0, 0
+        return 8 * len(self._io_in[k]), 8 * len(self._io_out[k])
+
+    def io_ok(self, k: int) -> bool:
+        """The k-th I/O slave is in OP and the link stands (its inputs are current)."""
+        pos = len(self.drives) + k
+        return self.master is not None and not self._failed and pos < len(self._states) \
+            and self._states[pos] == "OP"
+
+    def io_inputs(self, k: int) -> int:
+        """The k-th I/O slave's inputs from the last good frame, little-endian; 0 while it is not in OP."""
+        if not self.io_ok(k):
+            return 0
+        return int.from_bytes(self._io_in[k], "little")
+
+    def set_io_outputs(self, k: int, value: int) -> None:
+        """Outputs the next frame carries to the k-th I/O slave (bits past its image are dropped)."""
+        if k < len(self._io_out):
+            n = len(self._io_out[k])
+            self._io_out[k] = (value & ((1 << 8 * n) - 1)).to_bytes(n, "little")
 
     def _axis(self, name: str) -> str | None:
         return name if name in self.names else None

@@ -12,6 +12,7 @@ from hil.bench import Bench
 from hil.cli import EXIT_ALARM, EXIT_OK, EXIT_USAGE
 from hil.clock import make_clock
 from hil.progress import Progress, wants_progress
+from hil.remote_io import attach_remote_io
 from hil.runner import BenchRunner, RunResult
 from hil.scripting import mlc_setup
 from hil.session import InputError, load_bench, load_program, make_link, print_alarm
@@ -78,6 +79,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     except InputError as exc:
         print(f"hil run: {exc}", file=sys.stderr)
         return EXIT_USAGE
+    attach_remote_io(bench, mlc, link)  # [[io]] stations → X/Y devices (issue 8)
     runner = BenchRunner(bench, link, None, mlc, panel, clock=clock, progress=progress)
     runner.trace_sources += signal_sources
     # Extra trace columns (e.g. the MLC's --trace-signals) are TraceSources appended here,

@@ -52,6 +52,7 @@ def finish(machine, ok: bool = True) -> int:
 
 
 def cmd_script(args: argparse.Namespace) -> int:
+    from fieldbus.link import BusError
     from hil.scripting import ScriptError, run_script
     from nc.alarms import NcAlarm
 
@@ -65,7 +66,7 @@ def cmd_script(args: argparse.Namespace) -> int:
         machine.report()
         machine.close()
         return EXIT_ALARM if "does not exist" not in str(exc) else EXIT_USAGE
-    except NcAlarm as exc:
+    except (NcAlarm, BusError) as exc:  # a bus fault (station lost …) is an alarm, not a traceback
         print(str(exc.alarm), file=sys.stderr)
         machine.report()
         machine.close()

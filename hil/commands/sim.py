@@ -23,7 +23,8 @@ def _add_ethercat(sims: argparse._SubParsersAction) -> None:
                         epilog=_fault_help())
     p.add_argument("--iface", required=True, help="network interface (e.g. one end of a veth pair)")
     p.add_argument("--bench", help="bench file (TOML); default: the built-in 2-axis lathe")
-    p.add_argument("--io", type=int, default=0, metavar="N", help="add N R1-EC class digital I/O slaves after the drives")
+    p.add_argument("--io", type=int, default=0, metavar="N",
+                   help="R1-EC class 16/16 digital I/O slaves after the drives (default: one per [[io]] station of the bench)")
     p.add_argument("--realtime", action="store_true",
                    help="advance drive models by wall-clock time between frames instead of one cycle per frame")
     p.add_argument("--fault", action="append", default=[], metavar="SPEC", help="inject a scripted fault (repeatable)")
@@ -66,9 +67,11 @@ def build_chain(bench, io: int = 0, realtime: bool = False, faults=()):
         # Clocks start apart and run at slightly different rates, so DC has something to do.
         slaves.append(Esc(drive_dev, DriveApp(d), name=d.name, drift_ppm=(-1) ** k * 10.0 * k,
                           clock_base_ns=(k + 1) * 1_234_567_890, cycle_time=bench.cycle, lockstep=not realtime))
-    for k in range(io):
-        slaves.append(Esc(dio_dev, DioApp(), name=f"DIO{k + 1}", clock_base_ns=(len(slaves) + 1) * 987_654_321,
-                          cycle_time=bench.cycle, lockstep=not realtime))
+    stations = [st.map.name for st in getattr(bench, "io", [])]  # the bench's [[io]] stations, then extra ones
+    for k in range(max(io, len(stations))):
+        slaves.append(Esc(dio_dev, DioApp(), name=stations[k] if k < len(stations) else f"DIO{k + 1}",
+                          clock_base_ns=(len(slaves) + 1) * 987_654_321, cycle_time=bench.cycle,
+                          lockstep=not realtime))
     return Chain(slaves, list(faults))
 
 

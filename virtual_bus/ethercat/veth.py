@@ -97,3 +97,87 @@ class SimProcess:
                 self.proc.wait()
         if self.pair is not None:
             self.pair.delete()
+
+
+
+class ForkedLine:
+    """A `Chain` built in this process, served by a forked child on the namespace end of a fresh veth
+    pair (pysoem holds the GIL while it waits for a frame, so the slaves cannot be a thread of the
+    master's process). The DIO slaves' terminals are shared memory: the parent sets inputs and reads
+    outputs while the master runs on `iface`; the child copies them around every frame.
+    Context manager; cleans everything up. Needs root, like `VethPair`."""
+
+    def __init__(self, chain, tag: str = "") -> None:
+        import multiprocessing as mp
+
+        self.chain = chain
+        self.tag = tag
+        self.pair: VethPair | None = None
+        self.proc = None
+        self._dio = [k for k, s in enumerate(chain.slaves) if hasattr(s.app, "inputs")]
+        ctx = mp.get_context("fork")
+        self._ctx = ctx
+        self._in = ctx.Array("Q", max(1, len(self._dio)), lock=False)
+        self._out = ctx.Array("Q", max(1, len(self._dio)), lock=False)
+        self._frames = ctx.Value("Q", 0, lock=False)
+
+    @property
+    def iface(self) -> str:
+        assert self.pair is not None
+        return self.pair.master_if
+
+    # ---- the parent's view of the I/O slaves (k-th DIO slave on the line) ------------------------
+    def set_inputs(self, k: int, value: int) -> None:
+        self._in[k] = value
+
+    def outputs(self, k: int) -> int:
+        return int(self._out[k])
+
+    @property
+    def pd_frames(self) -> int:
+        """Process-data frames the line has answered or dropped so far."""
+        return int(self._frames.value)
+
+    def __enter__(self) -> "ForkedLine":
+        self.pair = VethPair.create(self.tag)
+        ready = self._ctx.Event()
+        self.proc = self._ctx.Process(target=self._serve, args=(ready,), daemon=True)
+        self.proc.start()
+        if not ready.wait(5.0):
+            self.__exit__(None, None, None)
+            raise RuntimeError("the forked EtherCAT line did not start")
+        return self
+
+    def _serve(self, ready) -> None:
+        import ctypes
+
+        from virtual_bus.ethercat.network import RawSocketLine
+
+        assert self.pair is not None
+        libc = ctypes.CDLL(None, use_errno=True)
+        with open(f"/var/run/netns/{self.pair.netns}") as ns:
+            if libc.setns(ns.fileno(), 0x40000000) != 0:  # CLONE_NEWNET
+                raise OSError(ctypes.get_errno(), "setns")
+        line = RawSocketLine(self.chain, self.pair.slave_if)
+        apps = [self.chain.slaves[k].app for k in self._dio]
+        process = self.chain.process
+
+        def shared_process(frame: bytes):
+            for k, app in enumerate(apps):
+                app.inputs = int(self._in[k])
+            answer = process(frame)
+            for k, app in enumerate(apps):
+                self._out[k] = app.outputs
+            self._frames.value = self.chain.pd_frames
+            return answer
+
+        self.chain.process = shared_process  # type: ignore[method-assign]
+        ready.set()
+        line.serve()
+
+    def __exit__(self, *exc) -> None:
+        if self.proc is not None and self.proc.is_alive():
+            self.proc.terminate()
+            self.proc.join(5.0)
+        if self.pair is not None:
+            self.pair.delete()
