@@ -81,3 +81,18 @@ def samples(m: dict, n: int = 12, plane: tuple[str, str] = ("Z", "X")) -> list[t
 
 def distance_to(segs: list[Seg], p: tuple[float, float]) -> float:
     return min(point_seg_distance(p, s) for s in segs)
+
+
+def assert_outside(moves, contour, tol=1e-6, face=False):
+    """No point of any move lies below the contour (X as a function of Z) inside its Z range.
+    face=True (G72 contours with pockets in Z): no point lies below Z as a function of X."""
+    if face:
+        contour = [s.mapped(lambda p: (p[1], p[0]), True) for s in contour]
+    zs = [p[0] for s in contour for p in (s.p0, s.p1)]
+    lo, hi = min(zs), max(zs)
+    for m in moves:
+        for z, x in samples(m, 8):
+            a, b = (x, z) if face else (z, x)
+            if lo + 1e-9 < a < hi - 1e-9:
+                c = contour_x(contour, a)
+                assert b >= c - tol or distance_to(contour, (a, b)) < tol, f"line {m['line']} {m.get('tags')} cuts into the contour at Z{z:.4f}: X{x:.4f}"

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import math
 
-from cycles_helpers import contour_x, distance_to, polyline, run, samples, seg_of, zx
+from cycles_helpers import assert_outside, contour_x, distance_to, polyline, run, samples, seg_of, zx
 from nc.cycles.geometry import Seg
 
 TYPE_I = """G21 G99
@@ -47,17 +47,6 @@ TYPE_II_PTS = [(0.0, 15.0), (-10.0, 15.0), (-20.0, 10.0), (-25.0, 10.0), (-35.0,
 
 def shifted(pts, dz, dx):
     return [(z + dz, x + dx) for z, x in pts]
-
-
-def assert_outside(moves, contour, tol=1e-6):
-    """No point of any move lies below the contour (X as a function of Z) inside its Z range."""
-    zs = [p[0] for s in contour for p in (s.p0, s.p1)]
-    lo, hi = min(zs), max(zs)
-    for m in moves:
-        for z, x in samples(m, 8):
-            if lo + 1e-9 < z < hi - 1e-9:
-                c = contour_x(contour, z)
-                assert x >= c - tol or distance_to(contour, (z, x)) < tol, f"line {m['line']} {m.get('tags')} cuts into the contour at Z{z:.4f}: X{x:.4f} < {c:.4f}"
 
 
 def rough_levels(moves):

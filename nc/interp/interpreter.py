@@ -989,8 +989,11 @@ class Interpreter:
         if seconds < 0:
             raise NcAlarm(0x0223, "negative dwell time")
         here = dict(self.position)
-        yield Move("dwell", block.line, block.text, here, dict(here), self.work_position(), duration=seconds,
-                   program=self.program_name)
+        dwell = Move("dwell", block.line, block.text, here, dict(here), self.work_position(), duration=seconds,
+                     program=self.program_name)
+        if self.state.css:  # G96 holds during the dwell: rpm from the surface speed at the current X
+            dwell.css = self.state.spindle_speed
+        yield dwell
 
     def _computed(self, w: Word) -> bool:
         return not any(ch == "." for ch in w.text) and w.text[1:2] in ("#", "[", "-", "=")
