@@ -154,6 +154,9 @@ def test_over_canopen_virtual(program, hil):
     # a write refused by the CANopen node: its SDO abort code reaches the alarm
     r = hil("run", program("G10 L41 I1 P0 D0 R5\nM30\n"), "--bus", "canopen:virtual")
     assert r.code == 1 and "SDO abort 0x06010002 (read-only)" in r.out and "at line 1" in r.out
+    # and `hil servo` reaches the same object over CANopen
+    r = hil("servo", "set", "Z", "P2-00", "88", "--bus", "canopen:virtual")
+    assert r.code == 0 and "P2-00 set 88 → 88" in r.out and "over SDO (canopen:virtual)" in r.out, r.err
 
 
 def test_over_modbus_rtu_on_a_pty(hil, program):
@@ -206,3 +209,14 @@ def test_over_ethercat_in_a_network_namespace(tmp_path):
         r = hil("run", str(prog), "--bus", bus)
         assert r.returncode == 0, r.stdout + r.stderr
         assert "final machine position  X 10.0000  Z 5.0000" in r.stdout  # read P1-44 and branched
+
+
+def test_the_shipped_example_runs_on_the_default_bench_and_stops_offline(hil):
+    from pathlib import Path
+
+    example = Path(__file__).resolve().parents[1] / "examples" / "servo_params.nc"
+    r = hil("run", example)
+    assert r.code == 0, r.out + r.err
+    assert "final machine position  X 10.0000  Z 5.0000" in r.out and "result         completed" in r.out
+    r = hil("path", example)  # no drive offline: #20024 = -2, the example stops with its macro alarm
+    assert r.code == 1 and "ALARM MR1" in r.err and "line 17" in r.err
