@@ -140,7 +140,8 @@ class BenchRunner:
     def run_events(self, events: Iterator[Event]) -> None:
         planner = Planner(self.bench.motion_config(), dict(zip(self.axes, self.actual.tolist())),
                           spindle_rpm=self.spindle_actual_rpm, spindle_angle=self.spindle_actual_angle,
-                          spindle_index=self.spindle_index_angle)
+                          spindle_index=self.spindle_index_angle,
+                          spindle_command=lambda: self.mlc.spindle.signed_rpm)
         self.channel = ch = Channel(planner)
         ch.soft_limits = SoftLimits.for_bench(self.bench, getattr(self, "profile", None))
         if getattr(self, "_interp", None) is not None:  # G31 skip (issue 5)

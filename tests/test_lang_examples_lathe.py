@@ -802,3 +802,22 @@ def test_E_N66_g34_pass_takes_ten_turns_on_the_bench(hil, program, tmp_path):
         # 10 turns at 600 rpm = 1.0 s (+ the stop at the end of the block), ending at 6 mm/rev = 60 mm/s
         assert float(p[-1]["t"]) - float(p[0]["t"]) == pytest.approx(1.0, abs=0.05)
         assert 55.0 < max(abs(float(r["Z_vel"])) for r in p) <= 60.5
+
+
+def test_E_N11_g99_feed_per_rev_is_35_mm_per_min(hil, program, tmp_path):
+    text = "M3S100 (Spindle positive rotate 100RPM)\nG99 G01 Z-20. F0.35 (Feed 0.35 mm/rev)\n"
+    # the shipped lathe bench with Z starting 3 mm before the end point, so the cut takes a few seconds
+    bench = tmp_path / "lathe.toml"
+    bench.write_text((ROOT / "benches" / "lathe-2axis.toml").read_text().replace("start = 100.0", "start = -17.0"))
+    trace = tmp_path / "t.csv"
+    # G01 follows M3 at once: the feed waits for the spindle's run-up instead of alarming 0x1001
+    res = hil("run", program(text), "--bench", bench, "--trace", trace)
+    assert res.code == 0, res.out + res.err
+    rows = [row for row in csv.DictReader(open(trace)) if row["line"] == "2"]
+    assert float(rows[-1]["Z_cmd"]) == pytest.approx(-20.0)
+    a, b = rows[len(rows) // 4], rows[3 * len(rows) // 4]
+    feed = (float(a["Z_cmd"]) - float(b["Z_cmd"])) / (float(b["t"]) - float(a["t"])) * 60.0
+    assert feed == pytest.approx(100 * 0.35, rel=1e-6)  # 100 rev/min × 0.35 mm/rev = 35 mm/min
+    # 3 mm at 35 mm/min = 5.14 s, plus the start while the spindle runs up from standstill
+    moving = [row for row in rows if float(row["Z_cmd"]) != -17.0]
+    assert 3.0 / 35.0 * 60.0 < float(moving[-1]["t"]) - float(moving[0]["t"]) < 3.0 / 35.0 * 60.0 + 0.15

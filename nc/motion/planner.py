@@ -55,7 +55,8 @@ class Planner:
     def __init__(self, cfg: MotionConfig, start: dict[str, float] | None = None,
                  spindle_rpm: Callable[[], float] | None = None,
                  spindle_angle: Callable[[], float] | None = None,
-                 spindle_index: Callable[[], float] | None = None) -> None:
+                 spindle_index: Callable[[], float] | None = None,
+                 spindle_command: Callable[[], float] | None = None) -> None:
         self.cfg = cfg
         self.axes = cfg.axes
         self.lim = Limits(cfg)
@@ -68,6 +69,9 @@ class Planner:
         self.spindle_angle = spindle_angle or (lambda: self._sim_angle)
         self._integrate_angle = spindle_angle is None
         self.spindle_index = spindle_index or (lambda: 0.0)
+        # The commanded spindle speed (the MLC's): a feed-per-rev move whose spindle is commanded to turn
+        # but still stands (M03 just issued) waits for it instead of alarming. None: measured = commanded.
+        self.spindle_command = spindle_command
         self._thread: thr.ThreadState | None = None
         self.thread_log: list[tuple[int, float, float]] = []  # (line, sync angle, ramp start angle) per chain
         self.depth = cfg.lookahead_depth()
@@ -311,10 +315,22 @@ class Planner:
         p = self.plan
         if p is None or p.kind != "path" or not self.blocks or not self.blocks[0].move.per_rev:
             return
+        rpm, settled = self._feed_rpm()
+        # 2 % hides measurement noise; a spindle that reaches its command re-plans once more, so a feed
+        # planned during the run-up does not stay up to 2 % low (E-N11)
+        if abs(rpm - p.rpm) <= 0.02 * max(p.rpm, 1.0) and (not settled or rpm == p.rpm):
+            return
+        self._update_cap(self.blocks[0], rpm)
+        self._replan()
+
+    def _feed_rpm(self) -> tuple[float, bool]:
+        """Spindle speed for feed per revolution: the measured one, or the command once the measurement
+        is within 0.1 % of it (then noise cannot re-trigger planning). Second value: settled."""
         rpm = abs(self.spindle_rpm())
-        if abs(rpm - p.rpm) > 0.02 * max(p.rpm, 1.0):
-            self._update_cap(self.blocks[0], rpm)
-            self._replan()
+        cmd = abs(self.spindle_command()) if self.spindle_command is not None else 0.0
+        if cmd > 0.0 and abs(rpm - cmd) <= 1e-3 * cmd:
+            return cmd, True
+        return rpm, False
 
     def _flush(self) -> None:
         self._thread = None
@@ -377,11 +393,14 @@ class Planner:
         self._started = False
         return None
 
+    def _spindle_starting(self) -> bool:
+        return self.spindle_command is not None and abs(self.spindle_command()) > 0.0
+
     def _plan_path(self, b: Block, t0: float) -> _Plan | None:
         s, v, a = self.s, self.v, self.a
-        rpm = abs(self.spindle_rpm()) if b.move.per_rev else 0.0
+        rpm = self._feed_rpm()[0] if b.move.per_rev else 0.0
         cap = self._update_cap(b, rpm if b.move.per_rev else None)
-        if b.move.per_rev and rpm <= 0.0 and not self.dry_run:
+        if b.move.per_rev and rpm <= 0.0 and not self.dry_run and not self._spindle_starting():
             raise NcAlarm(0x1001, "feed per revolution with the spindle stopped (S0)", line=b.move.line,
                           block=b.move.block, program=b.move.program)
         self.solves += 1
