@@ -3,7 +3,7 @@
 
 Node IDs are 1, 2, … in axis order, then the spindles. The nodes follow the master's SYNC in
 real time: every SYNC applies the RPDOs, advances each drive by its interpolation time period
-(0x60C2) and sends the TPDOs.
+(0x60C2) and sends the TPDOs. The bench's [[io]] stations join as CiA 401 nodes (`canopen_node`).
 """
 
 from __future__ import annotations
@@ -49,14 +49,23 @@ def cmd_sim_canopen(args: argparse.Namespace) -> int:
     except (OSError, ValueError, ImportError) as exc:
         print(f"hil sim canopen: cannot open {args.interface}:{args.channel}: {exc}", file=sys.stderr)
         return EXIT_USAGE
-    nodes = ", ".join(f"{s.node_id}={s.drive.name}" for s in bus.slaves)
+    from virtual_bus.canopen.dio import Cia401Slave
+
+    io = [Cia401Slave(st.canopen_node, st.map.inputs, st.map.outputs, st.map.name) for st in bench.io]
+    for station in io:  # remote I/O stations on the same bus (mlc/remote_io.py)
+        station.attach(bus.network)
+    nodes = ", ".join([f"{s.node_id}={s.drive.name}" for s in bus.slaves] + [f"{s.node_id}={s.name}" for s in io])
     print(f"hil sim canopen: nodes {nodes} on {args.interface}:{args.channel}", flush=True)
     try:
         stop.wait(args.duration)
     except KeyboardInterrupt:
         pass
     finally:
+        for station in io:
+            station.node.nmt.stop_heartbeat()
         bus.close()
-        states = ", ".join(f"{s.node_id} {s.nmt_state} {s.drive.state.value}, {s.syncs} SYNC" for s in bus.slaves)
+        states = ", ".join([f"{s.node_id} {s.nmt_state} {s.drive.state.value}, {s.syncs} SYNC" for s in bus.slaves]
+                           + [f"{s.node_id} {s.nmt_state}, {s.syncs} SYNC, outputs changed {len(s.history)} times"
+                              for s in io])
         print(f"hil sim canopen: stopped ({states})", file=sys.stderr)
     return EXIT_OK

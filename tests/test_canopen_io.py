@@ -10,6 +10,7 @@ heartbeat is overdue, with alarm 0x1426; NMT stop at the end puts its outputs in
 
 from __future__ import annotations
 
+import subprocess
 from types import SimpleNamespace
 
 import pytest
@@ -19,6 +20,7 @@ from hil.bench_file import parse_bench
 from hil.scripting import Machine
 from hil.session import make_link
 from mlc.machine import Mlc
+from tests.test_canopen_process import netns  # noqa: F401  (fixture: a namespace for udp_multicast)
 
 BENCH = """
 bus = "canopen:virtual"
@@ -134,3 +136,33 @@ def test_hil_run_over_canopen_virtual_switches_coolant_on_the_cia401_station(hil
     y0 = [int(float(r["Y0"])) for r in rows]
     assert 1 in y0 and y0[-1] == 0
     assert int(float(rows[-1]["M30032"])) == 1 and int(float(rows[-1]["M30033"])) == 1
+
+
+def test_hil_run_switches_an_io_station_served_by_hil_sim_canopen_in_another_process(netns, tmp_path):
+    """Real time across processes (udp_multicast in a namespace): `hil sim canopen --bench` serves the
+    drives and the CiA 401 stations; M08/M09 switch Y0 on station 64 and back."""
+    import csv
+
+    from tests.conftest import ROOT
+    from tests.test_canopen_process import _in_ns, _Sim
+
+    group = "239.74.163.4"
+    bench = tmp_path / "lathe-io-4ms.toml"
+    bench.write_text((ROOT / "benches" / "lathe-io.toml").read_text().replace("cycle_ms = 1.0", "cycle_ms = 4.0"))
+    prog = tmp_path / "coolant.nc"
+    prog.write_text("M08\nG04 X0.1\nM09\nM30\n")
+    trace = tmp_path / "t.csv"
+    sim = _Sim(netns, group, "--bench", str(bench))
+    try:
+        assert "64=EIO-501, 65=valves" in sim.banner, sim.banner
+        run = subprocess.run(_in_ns(netns, "-m", "hil.cli", "run", str(prog), "--bench", str(bench),
+                                    "--bus", f"canopen:udp_multicast:{group}", "--trace", str(trace),
+                                    "--trace-signals", "Y0,M30032,M30033"),
+                             capture_output=True, text=True, timeout=60, cwd=ROOT)
+    finally:
+        err = sim.stop()
+    assert run.returncode == 0, run.stdout + run.stderr
+    rows = list(csv.DictReader(trace.open()))
+    assert 1 in [int(float(r["Y0"])) for r in rows] and int(float(rows[-1]["Y0"])) == 0
+    assert int(float(rows[-1]["M30032"])) == 1 and int(float(rows[-1]["M30033"])) == 1
+    assert "64 STOPPED, " in err and "outputs changed 2 times" in err, err  # Y0 on at M08, off at M09

@@ -93,3 +93,23 @@ def test_a_station_leaving_the_line_reads_zero_drops_its_relay_and_raises_0x1426
     assert x16[10:200] == [True] * 190  # the station's inputs while it was on the line
     assert x16[-1] is False  # after it left: the safe state, before the alarm stopped the scans
     assert m.get("M30033") == 0 and m.get("M30032") == 1  # EIO 502 dropped, EIO 501 still connected
+
+
+def test_hil_run_over_ethercat_with_the_io_bench(hil, program, tmp_path):
+    """`hil sim ethercat --bench benches/lathe-io.toml` serves one R1-EC slave per [[io]] station;
+    `hil run` maps them (EIO 501/502 relays on) and switches coolant Y0 through M08/M09."""
+    import csv
+
+    from tests.conftest import ROOT
+    from virtual_bus.ethercat.veth import SimProcess
+
+    bench = ROOT / "benches" / "lathe-io.toml"
+    trace = tmp_path / "ec.csv"
+    with SimProcess("--bench", str(bench), tag="ior") as sim:
+        r = hil("run", program("M08\nG04 X0.05\nM09\nM30\n"), "--bench", bench, "--bus", f"ethercat:{sim.iface}",
+                "--trace", trace, "--trace-signals", "Y0,X0,M30032,M30033")
+    assert r.code == 0, r.out + r.err
+    rows = list(csv.DictReader(trace.open()))
+    y0 = [int(float(r["Y0"])) for r in rows]
+    assert 1 in y0 and y0[-1] == 0
+    assert int(float(rows[-1]["M30032"])) == 1 and int(float(rows[-1]["M30033"])) == 1
