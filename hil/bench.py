@@ -30,6 +30,10 @@ class SpindleConfig:
     drive: DriveParams = field(default_factory=lambda: DriveParams(max_speed_rpm=6000.0, csv_accel=1.0e8))
 
 
+FILTER_MS = 16.0  # default N1.036 and N1.037 (ms)
+PATH_DEVIATION = 0.02  # default N1.053 (mm)
+
+
 @dataclass
 class IoStationConfig:
     """A remote I/O station ([[io]] in a bench file): its X/Y mapping and how it sits on each bus.
@@ -95,7 +99,18 @@ class Bench:
         return tuple(a.name for a in self.axes)
 
     def motion_config(self) -> MotionConfig:
-        return MotionConfig(cycle=self.cycle, axes=self.axis_names, limits={a.name: a.limits for a in self.axes})
+        # N1.036 / N1.037 look-ahead filter and S-curve times (ms), N1.053 path smoothing
+        # deviation (mm; 0 = no limit but the filter's own budget): see docs/decisions/motion.md.
+        p = self.params
+        filt = p.get("N1.036", FILTER_MS) / 1000.0
+        scurve = p.get("N1.037", FILTER_MS) / 1000.0
+        dev = p.get("N1.053", PATH_DEVIATION)
+        cfg = MotionConfig(cycle=self.cycle, axes=self.axis_names, limits={a.name: a.limits for a in self.axes},
+                           filter_time=filt, filter_scurve=scurve, path_tolerance=dev if dev > 0.0 else None)
+        if cfg.filtered:
+            # The filter spreads what several blocks in one cycle do; a block need not last a cycle.
+            cfg.min_segment_cycles = 0.25
+        return cfg
 
 
 def default_lathe() -> Bench:

@@ -33,6 +33,20 @@ class MotionConfig:
     share_tangential: float = 0.5
     share_corner: float = 0.25
     share_curvature: float = 0.25
+    # Post-interpolation position filter (nc.motion.smoothing): N1.036 look-ahead filter time and
+    # N1.037 look-ahead S-curve time, in seconds; 0 leaves that stage out. With the filter on,
+    # corners are limited by what the filter turns a tangent jump into (and by path_tolerance),
+    # not by a one-cycle velocity step.
+    filter_time: float = 0.0
+    filter_scurve: float = 0.0
+
+    def filter_cycles(self) -> tuple[int, int]:
+        """Window lengths (cycles) of the two moving averages; (1, 1) = no filter."""
+        return (max(1, round(self.filter_time / self.cycle)), max(1, round(self.filter_scurve / self.cycle)))
+
+    @property
+    def filtered(self) -> bool:
+        return self.filter_cycles() != (1, 1)
 
     def limit(self, axis: str) -> AxisLimits:
         return self.limits.get(axis, AxisLimits())

@@ -21,6 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from nc.motion.blending import FilterCorners
 from nc.motion.limits import MotionConfig
 from nc.motion.path import Segment
 from nc.moves import Move
@@ -47,6 +48,13 @@ class Block:
     anchor_a: float = 0.0  # least tangential acceleration and jerk over that stretch
     anchor_j: float = 0.0
     binding: bool = True  # vend is this junction's own limit, not a downstream one
+    # Post-interpolation filter corners (nc.motion.blending): path length at this block's end,
+    # |Δu| per axis and its norm at the junction to the next block (None = a stop there).
+    s_end: float = 0.0
+    du: tuple[float, ...] | None = None
+    du_n: float = 0.0
+    cum: tuple[float, ...] = ()  # running Σ|Δu| per axis and Σ|Δu| norms up to this junction
+    vtop: float = 0.0  # the fastest this block can ever run (feed × the top override, or its geometric cap)
 
 
 def change_distance(v0: float, v1: float, a: float, j: float) -> float:
@@ -96,6 +104,7 @@ class Limits:
         T = self.T
         self._corner_j = tuple(x * T * T / 2.0 for x in self._jerk)  # divided by |Δu| per junction
         self._corner_a = tuple(x * T for x in self._acc)
+        self.blend = FilterCorners(cfg, self._acc, self._jerk) if cfg.filtered else None
 
     def block_limits(self, seg: Segment) -> tuple[float, float, float]:
         """(speed cap, tangential acceleration, tangential jerk) of a path segment."""
@@ -119,6 +128,8 @@ class Limits:
             v = min(v, math.sqrt(sc * pa * rc), (0.3 * sc * pj * rc * rc) ** (1.0 / 3.0))
             # d/dt of the centripetal term couples tangential acceleration into jerk: 3·v·a_t/r.
             a = min(a, 0.3 * sc * pj * rc / (3.0 * max(v, 1e-9)))
+        if self.blend is not None and seg.kind == "arc":
+            v = min(v, self.blend.arc_speed(seg.radius))
         v = min(v, seg.length / (cfg.min_segment_cycles * self.T))
         return v, a, j
 
@@ -131,7 +142,12 @@ class Limits:
         v = min(b1.cap_hard, b2.cap_hard)
         du = [abs(p - q) for p, q in zip(s2.tangent(False), s1.tangent(True))]
         cfg = self.cfg
-        if max(du) > 1e-9:
+        if self.blend is not None:
+            b1.du = tuple(du)
+            b1.du_n = math.sqrt(sum(d * d for d in du))
+            if b1.du_n > 1e-9:
+                v = min(v, self.blend.corner(du, max(b1.a, b2.a)))
+        elif max(du) > 1e-9:
             vj = va = math.inf
             for d, cj, ca in zip(du, self._corner_j, self._corner_a):
                 if d > 1e-12:
@@ -144,18 +160,22 @@ class Limits:
             dk = np.abs(s2.curvature_vector(False) - s1.curvature_vector(True))
             if float(dk.max()) > 1e-12:
                 m = dk > 1e-12
-                v = min(v, float(np.min(np.sqrt(0.4 * cfg.share_curvature * self.jerk[m] * self.T / dk[m]))))
+                # A curvature jump steps the axis acceleration: in one cycle without the filter,
+                # spread over its first window T1 with it.
+                t = self.blend.t_a if self.blend is not None else self.T
+                v = min(v, float(np.min(np.sqrt(0.4 * cfg.share_curvature * self.jerk[m] * t / dk[m]))))
         return max(v, 0.0)
 
 
-def backward(blocks: Sequence[Block], lo: int = 0, full: bool = False) -> None:
+def backward(blocks: Sequence[Block], lo: int = 0, full: bool = False, depth: int = 0) -> None:
     """Backward pass from the queue tail (which ends at rest) down to index lo.
 
     A junction's end speed is the least of its own limit and what the nearest *binding* junction
     downstream allows over the whole path length in between (braking may carry acceleration
     through intermediate junctions, so chains of short blocks are not forced to a = 0 at each).
     Appending a block only raises end speeds, so the incremental pass stops once a junction is
-    binding and unchanged (LinuxCNC's "rising tide"); `full` recomputes everything.
+    binding and unchanged (LinuxCNC's "rising tide"); `full` recomputes everything, `depth` at
+    least that many blocks from the tail (junction speeds lowered there since the last pass).
     """
     n = len(blocks)
     if n == 0:
@@ -163,7 +183,7 @@ def backward(blocks: Sequence[Block], lo: int = 0, full: bool = False) -> None:
     it = reversed(blocks)  # a deque indexes its middle in O(n); iterate instead
     nx = next(it)
     nx.vend, nx.binding = 0.0, True
-    for _ in range(n - 1 - lo):
+    for k in range(n - 1 - lo):
         b = next(it)
         local = min(b.vjunc, b.cap, nx.cap)
         if local <= 0.0:
@@ -175,7 +195,7 @@ def backward(blocks: Sequence[Block], lo: int = 0, full: bool = False) -> None:
                 av, ad, aa, aj = nx.anchor_v, nx.anchor_d + nx.length, min(nx.anchor_a, nx.a), min(nx.anchor_j, nx.j)
             v = min(local, reach(av, ad, MARGIN * aa, MARGIN * aj))
         binding = v >= local - 1e-12
-        if not full and abs(v - b.vend) <= 1e-12 and binding and b.binding:
+        if not full and k + 2 > depth and abs(v - b.vend) <= 1e-12 and binding and b.binding:
             break
         b.vend, b.binding = v, binding
         b.anchor_v, b.anchor_d, b.anchor_a, b.anchor_j = av, ad, aa, aj

@@ -23,9 +23,10 @@ import numpy as np
 
 from nc.alarms import NcAlarm
 from nc.motion.limits import MotionConfig
-from nc.motion.lookahead import MARGIN, Block, Limits, backward, reach
+from nc.motion.lookahead import MARGIN, Block, Limits, backward, change_distance, reach
 from nc.motion.path import Segment
 from nc.motion.profile import Piecewise, solve_axes, solve_position, solve_velocity
+from nc.motion.smoothing import PositionFilter
 from nc.motion import threading as thr
 from nc.moves import Move
 
@@ -49,6 +50,7 @@ class _Plan:
     base: float = 0.0  # plan position at the start of blocks[0] (ramps that cross blocks)
     target: float = 0.0  # ramp target speed
     rpm: float = 0.0  # spindle speed the feed-per-rev cap used
+    emitted: bool = False  # some of its samples went out (the planner state is the last of them)
 
 
 class Planner:
@@ -98,18 +100,31 @@ class Planner:
         self._buf_i = 0
         self._buf_state: list[tuple[float, float, float]] = []
         self.solves = 0  # ruckig solves so far (one per block plus one per event)
+        # Post-interpolation filter (N1.036/N1.037); None when both times are zero.
+        self.filter: PositionFilter | None = None
+        if cfg.filtered:
+            self.filter = PositionFilter(*cfg.filter_cycles(), self.position)
+        self._path_s = 0.0  # path length pushed so far (junction windows are measured on it)
+        self.output = self.position.copy()  # the last setpoint handed out (filtered)
 
     # ---- queue ----------------------------------------------------------------------------
     def push(self, move: Move) -> None:
         b = self._block(move)
         if b is None:
             return
+        blend = self.lim.blend
+        if blend is not None:
+            self._path_s += b.length
+            b.s_end = self._path_s
+            b.vtop = b.cap_hard
+            if b.kind == "path" and not b.rapid and not b.move.per_rev:
+                b.vtop = min(b.cap_hard, 1.5 * (self.dry_run_feed if self.dry_run else (b.feed or 0.0)))
         self._update_cap(b)
         if self.blocks:
             prev = self.blocks[-1]
             prev.vjunc = self.lim.junction(prev, b)
         self.blocks.append(b)
-        backward(self.blocks, 0)
+        backward(self.blocks, 0, depth=blend.window(self.blocks) if blend is not None else 0)
 
     @property
     def queue(self) -> deque[Block]:
@@ -125,7 +140,11 @@ class Planner:
 
     @property
     def idle(self) -> bool:
-        return not self.blocks and self.plan is None and self._buf_done
+        return not self.blocks and self.plan is None and self._buf_done and self._settled
+
+    @property
+    def _settled(self) -> bool:
+        return self.filter is None or self.filter.settled
 
     @property
     def at_rest(self) -> bool:
@@ -138,6 +157,9 @@ class Planner:
     def reset_position(self, pos: dict[str, float]) -> None:
         """Take over the actual position (after enable, or after a stop)."""
         self.position = np.array([pos.get(a, 0.0) for a in self.axes], dtype=float)
+        self.output = self.position.copy()
+        if self.filter is not None:
+            self.filter.reset(self.position)
 
     # ---- operator controls ----------------------------------------------------------------
     @property
@@ -191,18 +213,44 @@ class Planner:
     def abort(self) -> None:
         """E-stop: forget every plan this cycle; the setpoint freezes where it is."""
         self._flush()
+        # The drives were given the filtered setpoint: freeze there, not at the filter's input.
+        self.position = self.output.copy()
+        if self.filter is not None:
+            self.filter.reset(self.position)
         self.v = self.a = 0.0
         self._axis_v[:] = 0.0
         self._axis_a[:] = 0.0
 
     # ---- per cycle ------------------------------------------------------------------------
     def step(self) -> Setpoint:
+        f = self.filter
+        if f is None:
+            sp = self._step_path()
+            self.output = sp.positions
+            return sp
+        if f.settled and not self.blocks and self.plan is None and self._buf_done \
+                and not np.array_equal(self.position, f.output):
+            f.reset(self.position)  # the position was taken over at rest (manual modes, homing)
+        sp = self._step_path()
+        mv = sp.move
+        if mv is not None and (mv.kind == "thread" or "G31" in mv.tags):
+            # Spindle-locked threads and skip moves follow the raw interpolation: their timing is
+            # the point (phase, stop within one cycle). They start and end at rest with the
+            # filter settled, so passing it by keeps the stream continuous.
+            f.reset(sp.positions)
+        else:
+            sp.positions = f.push(sp.positions)
+        self.output = sp.positions
+        return sp
+
+    def _step_path(self) -> Setpoint:
         if self._integrate_angle:
             self._sim_angle += self.spindle_rpm() * 6.0 * self.cfg.cycle
         self._check_spindle()
         if self._buf_done:
             self._refill()
-        if self._buf_done and self.plan is None and self.blocks and self.blocks[0].kind == "thread":
+        if self._buf_done and self.plan is None and self.blocks and self.blocks[0].kind == "thread" \
+                and (self._thread is not None or self._settled):
             return self._thread_step()
         if self._buf_done:  # standing still (idle, held, or waiting)
             self.v = self.a = 0.0
@@ -291,6 +339,8 @@ class Planner:
             if b.move.per_rev:
                 feed *= abs(rpm if rpm is not None else self.spindle_rpm()) / 60.0
             cap = min(cap, feed * self._feed_ovr)
+        if b.vtop > 0.0:
+            cap = min(cap, b.vtop)  # the filter windows were sized with it (dry run switched on later)
         b.cap = cap
         return cap
 
@@ -345,6 +395,8 @@ class Planner:
     def _refill(self) -> None:
         T = self.cfg.cycle
         for _ in range(1000):
+            if self.plan is None and not self._settled and self.at_rest:
+                return  # exact stop: the filtered setpoint reaches the point before anything starts
             if self.plan is None:
                 self.plan = self._start_plan()
                 if self.plan is None:
@@ -413,12 +465,15 @@ class Planner:
             return _Plan("ramp", pw, pw.duration, t0, 0.0, 0.0)
         # The run: following blocks the profile may cross without a binding junction (same or
         # higher cap, end speed not below the cap); the target is the end of that run.
-        dist, v1, ra, rj = self._run_target(cap)
-        # Forward pass: no more than the entry state can reach (a braking state first ramps its
-        # deceleration out, losing a²/2j of speed over v·|a|/j of path).
-        ve, de = (v - a * a / (2.0 * rj), dist - s - v * abs(a) / rj) if a < 0.0 else (v, dist - s)
-        v1 = min(v1, reach(max(ve, 0.0), max(de, 0.0), MARGIN * ra, MARGIN * rj))
-        pw = solve_position(s, v, a, dist, v1, cap, ra, rj)
+        for extend in (False, True):
+            dist, v1, ra, rj, vmax = self._run_target(cap, extend, s + change_distance(v, cap, b.a, b.j))
+            # Forward pass: no more than the entry state can reach (a braking state first ramps
+            # its deceleration out, losing a²/2j of speed over v·|a|/j of path).
+            ve, de = (v - a * a / (2.0 * rj), dist - s - v * abs(a) / rj) if a < 0.0 else (v, dist - s)
+            v1 = min(v1, reach(max(ve, 0.0), max(de, 0.0), MARGIN * ra, MARGIN * rj))
+            pw = solve_position(s, v, a, dist, v1, vmax, ra, rj)
+            if pw is not None and pw.p.max() <= dist + 1e-7 and pw.v.min() >= -1e-7:
+                break
         if pw is None or pw.p.max() > dist + 1e-7 or pw.v.min() < -1e-7:
             # Cannot meet the target from this state (an override just cut the cap): ramp down
             # to the cap first, then plan the rest from there.
@@ -431,20 +486,35 @@ class Planner:
             return _Plan("ramp", pw, pw.duration, t0, 0.0, target)
         return _Plan("path", pw, pw.duration, t0, target=dist, rpm=rpm)
 
-    def _run_target(self, cap: float) -> tuple[float, float, float, float]:
-        """(distance, end speed, acceleration, jerk) of the run that starts with blocks[0]."""
+    def _run_target(self, cap: float, extend: bool = False,
+                    cruise_from: float = math.inf) -> tuple[float, float, float, float, float]:
+        """(distance, end speed, acceleration, jerk, top speed) of the run that starts with blocks[0].
+
+        A run ends at the first junction slower than the cap. With `extend` it carries on through
+        junctions whose end speed is set downstream (not binding: a braking chain through short
+        blocks, which cannot be met with zero acceleration at every junction), its top speed then
+        held to the slowest of them so the profile crosses each at no more than it allows.
+        A junction past `cruise_from` (where the cap is reached) that may be crossed at the cap
+        ends the run too: the profile cruises there, so nothing beyond it changes this solve.
+        """
         blocks = self.blocks
         b = blocks[0]
         dist, ra, rj = b.length, b.a, b.j
+        vmax = cap
         k = 0
         n = len(blocks)
         while True:
             b = blocks[k]
             if k + 1 >= n:
-                return dist, min(b.vend, cap), ra, rj
+                return dist, min(b.vend, vmax), ra, rj, vmax
             nx = blocks[k + 1]
-            if nx.kind != "path" or min(b.vjunc, nx.cap) < cap - 1e-9 or b.vend <= 0.0 or k >= 2 * self.depth:
-                return dist, min(b.vend, cap), ra, rj
+            if nx.kind != "path" or nx.cap < cap - 1e-9 or b.vend <= 0.0 or k >= 2 * self.depth \
+                    or (b.vend >= vmax - 1e-9 and dist >= cruise_from):
+                return dist, min(b.vend, vmax), ra, rj, vmax
+            if b.vjunc < cap - 1e-9:
+                if not extend or b.binding:
+                    return dist, min(b.vend, vmax), ra, rj, vmax
+                vmax = min(vmax, b.vjunc)
             dist += nx.length
             ra, rj = min(ra, nx.a), min(rj, nx.j)
             k += 1
@@ -494,7 +564,9 @@ class Planner:
         blocks = self.blocks
         more = len(blocks) > 1 and blocks[1].kind == "path"
         if more and s[0] > blocks[0].length + 1e-12:
-            if p.kind == "path":
+            # A ramp that catches up with the cap also re-solves at the boundary: it must not
+            # carry its speed into blocks that need less (a hold's ramp to rest runs on).
+            if p.kind == "path" or (p.kind == "ramp" and not self.held):
                 # The next sample lies in the next block: re-solve there from the last emitted
                 # state (once per block), now that more of the queue may be known.
                 length = blocks[0].length
@@ -502,7 +574,9 @@ class Planner:
                 self._finish_block(keep_plan=True)
                 self.s = s_last - length
                 self.plan = None
-                self._carry = T
+                # The state re-solved from is the last emitted sample (one cycle back) or, when
+                # none of this plan went out yet, the plan's start (t[0] back).
+                self._carry = T if p.emitted else float(t[0])
                 self._buf_pos = None
                 return
             # A ramp runs on into the next block without a new solve.
@@ -519,6 +593,7 @@ class Planner:
                 p.t_next = float(t[n])
         b = blocks[0]
         line = b.move.line
+        p.emitted = True
         self._buf_pos = b.seg.points(np.clip(s, 0.0, b.length))
         self._buf_vel = v
         self._buf_line = [line] * n

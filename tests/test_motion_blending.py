@@ -1,0 +1,155 @@
+"""Issue 5: the post-interpolation position filter (N1.036/N1.037) keeps feed through corners and
+tightly curved short segments while every cycle of the setpoint stream stays inside the axis
+limits (finite differences, as a drive sees them)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from nc.motion.offline import run
+from nc.motion.planner import Planner
+from nc.motion.smoothing import PositionFilter
+from tests.motion_helpers import AX, arc, circle_chords, lines, mill_cfg, worst_ratio
+
+TOL = 1.0 + 1e-6
+SQUARE = [(0, 0, 0), (10, 0, 0), (10, 10, 0), (0, 10, 0), (0, 0, 0)]
+
+
+def filtered(ms: float = 16.0, tol: float | None = None, **kw):
+    return mill_cfg(filter_time=ms / 1000.0, filter_scurve=ms / 1000.0, path_tolerance=tol,
+                    min_segment_cycles=0.25, **kw)
+
+
+def check(moves, cfg, start=(0.0, 0.0, 0.0)):
+    st = run(moves, cfg, dict(zip(AX, start)))
+    assert st.state.value == "finished" and not st.alarms
+    r = worst_ratio(st, cfg)
+    assert r["v"] <= TOL and r["a"] <= TOL and r["j"] <= TOL, r
+    return st
+
+
+def cam_curve(n: int = 1500) -> list[tuple[float, float, float]]:
+    rng = np.random.default_rng(5)
+    s = np.cumsum(rng.uniform(0.01, 0.1, n))
+    return [(0.0, 0.0, 0.0)] + [(x, 3.0 * math.sin(x / 4.0), 0.2 * math.cos(x / 3.0) - 0.2) for x in s]
+
+
+def path_speed_near(st, point, radius: float) -> float:
+    """Lowest path speed of the stream within `radius` of a point."""
+    v = np.linalg.norm(np.diff(st.positions, axis=0), axis=1) / st.cycle
+    d = np.linalg.norm(st.positions[1:] - np.array(point, float), axis=1)
+    return float(v[d < radius].min())
+
+
+# ---- the filter itself -------------------------------------------------------------------------
+def test_filter_turns_a_velocity_step_into_bounded_acceleration_and_jerk():
+    T, n1, n2, v = 0.001, 16, 8, 10.0
+    f = PositionFilter(n1, n2, np.zeros(1))
+    out = [f.push(np.array([v * T * k]))[0] for k in range(1, 200)]
+    p = np.concatenate([[0.0, 0.0, 0.0], out])
+    vel = np.diff(p) / T
+    acc = np.diff(vel) / T
+    jerk = np.diff(acc) / T
+    assert vel[-1] == pytest.approx(v)
+    assert np.abs(acc).max() == pytest.approx(v / (n1 * T), rel=1e-9)  # Δv / T1
+    assert np.abs(jerk).max() == pytest.approx(v / (n1 * T * n2 * T), rel=1e-9)  # Δv / (T1·T2)
+    # a constant-speed move lags by the group delay: (n1 - 1 + n2 - 1) / 2 cycles
+    assert p[-1] == pytest.approx(v * T * (199 - f.delay))
+
+
+def test_filter_reproduces_a_point_exactly_once_it_stands():
+    f = PositionFilter(16, 16, np.array([1.0, 2.0]))
+    for _ in range(5):
+        f.push(np.array([1.3, 2.7]))
+    assert not f.settled
+    for _ in range(40):
+        y = f.push(np.array([1.3, 2.7]))
+    assert f.settled and y.tolist() == [1.3, 2.7]
+
+
+# ---- corners -----------------------------------------------------------------------------------
+def test_square_corners_keep_speed_within_limits_and_end_exactly():
+    plain = check(lines(SQUARE, 3000), mill_cfg())
+    st = check(lines(SQUARE, 3000), filtered())
+    assert np.allclose(st.positions[-1], 0.0, atol=1e-12)
+    # without the filter a 90° corner must be crossed at a crawl; with it at over 10 mm/s
+    assert path_speed_near(plain, (10, 0, 0), 0.05) < 0.5
+    assert path_speed_near(st, (10, 0, 0), 0.2) > 10.0
+
+
+@pytest.mark.parametrize("ms", [8.0, 16.0])
+def test_corner_rounding_stays_within_the_path_tolerance(ms):
+    for tol in (0.002, 0.005, 0.01, 0.02, 0.05):
+        st = check(lines(SQUARE, 3000), filtered(ms, tol=tol))
+        misses = [float(np.min(np.linalg.norm(st.positions - np.array(c, float), axis=1))) for c in SQUARE[1:4]]
+        assert max(misses) <= tol, (tol, misses)
+    # a generous tolerance really is used: the corners are rounded, not stopped at
+    assert max(misses) > 0.005
+
+
+def test_exact_stop_blocks_visit_the_corner_through_the_filter():
+    st = check(lines(SQUARE, 3000, exact_stop=True), filtered())
+    for corner in SQUARE[1:]:
+        assert np.min(np.linalg.norm(st.positions - np.array(corner, float), axis=1)) < 1e-9
+
+
+# ---- short segments ----------------------------------------------------------------------------
+def test_tight_cam_curve_keeps_most_of_its_feed():
+    pts = cam_curve()
+    feed_limited = float(np.sum(np.linalg.norm(np.diff(np.array(pts), axis=0), axis=1))) / 50.0
+    plain = check(lines(pts, 3000), mill_cfg())
+    st = check(lines(pts, 3000), filtered())
+    assert plain.time > 5.0 * feed_limited  # what corner-by-corner jerk limiting alone gives
+    assert st.time < 1.6 * feed_limited
+
+
+def test_jagged_cam_segments_and_tight_chord_circle_stay_within_limits():
+    rng = np.random.default_rng(1)
+    p, d, pts = np.zeros(3), np.array([1.0, 0, 0]), [np.zeros(3)]
+    for _ in range(300):
+        d = d + rng.normal(0, 0.3, 3) * [1, 1, 0.5]
+        d /= np.linalg.norm(d)
+        p = p + d * rng.uniform(0.01, 0.1)
+        pts.append(p)
+    check(lines(pts, 6000), filtered(8.0))
+    ring = circle_chords(2.0, 0.05)
+    st = check(lines(ring, 3000), filtered(), start=ring[0])
+    assert st.time < 1.2  # 12.6 mm: about 14 mm/s average where corner-by-corner gave 2.5 mm/s
+
+
+def test_arcs_and_lines_with_the_filter_stay_within_limits():
+    moves = [lines([(0, 0, 0), (10, 0, 0)], 3000)[0], arc((10, 0, 0), (20, 10, 0), (10, 10), "ccw", 3000),
+             arc((20, 10, 0), (30, 20, 0), (30, 10), "cw", 3000)]
+    st = check(moves, filtered(tol=0.01))
+    assert np.allclose(st.positions[-1], [30, 20, 0], atol=1e-12)
+    mid = st.positions[len(st.positions) // 2]
+    r1 = math.hypot(mid[0] - 10, mid[1] - 10)
+    r2 = math.hypot(mid[0] - 30, mid[1] - 10)
+    assert min(abs(r1 - 10.0), abs(r2 - 10.0)) < 0.01  # on one of the arcs within the tolerance
+
+
+@pytest.mark.parametrize("ms", [4.0, 8.0, 16.0])
+def test_random_polylines_never_exceed_a_limit(ms):
+    rng = np.random.default_rng(int(ms))
+    pts = [np.zeros(3)]
+    for _ in range(120):
+        step = rng.normal(0, 1, 3) * [1, 1, 0.3]
+        pts.append(pts[-1] + step / np.linalg.norm(step) * rng.choice([0.02, 0.2, 2.0]))
+    check(lines(pts, 6000), filtered(ms, tol=rng.choice([None, 0.01])))
+
+
+# ---- operator controls with the filter -----------------------------------------------------------
+def test_emergency_stop_freezes_the_filtered_setpoint():
+    cfg = filtered()
+    pl = Planner(cfg, dict(zip(AX, (0.0, 0.0, 0.0))))
+    for mv in lines([(0, 0, 0), (50, 0, 0)], 6000):
+        pl.push(mv)
+    for _ in range(200):
+        last = pl.step().positions
+    pl.abort()
+    after = [pl.step().positions for _ in range(5)]
+    assert all(np.array_equal(a, last) for a in after)
+    assert pl.idle
