@@ -377,3 +377,47 @@ def test_same_hole_cycle_after_g80_starts_afresh(capsys, tmp_path, cancel):
     # the initial level is where the new cycle was commanded (Z10), R defaults to it, P500 is gone
     assert [m["kind"] for m in second] == ["rapid", "line", "rapid"]
     assert levels(second) == [10.0, -5.0, 10.0] and "return" in second[-1]["tags"]
+
+
+# ---------------------------------------------------------------- modal state variables, M96 into an arc
+
+
+def test_modal_state_variables_after_g91_g18_g95(capsys, tmp_path):
+    prog = ("G10 L10 P3 R1.\nG10 L12 P4 R2.\nT5 H3 D4\nG91 G18 G95 G01 Z-1. F0.2 S1200 M03\nG99 G43 Z0. H3\n"
+            "#4001=#4001+1\nM30\n")
+    groups = {20301: 1.0, 20302: 18.0, 20303: 91.0, 20305: 95.0, 20306: 21.0, 20307: 40.0, 20308: 43.0,
+              20309: 80.0, 20310: 99.0, 20311: 50.0, 20312: 54.0, 20313: 64.0, 20314: 67.0, 20315: 69.0,
+              20316: 15.0, 20317: 97.0, 20318: 25.0}
+    status = {20400: 0.2, 20401: 3.0, 20402: 4.0, 20403: 5.0, 20404: 1200.0}
+    ids = ",".join(str(n) for n in [*groups, *status, 4001, 20300])
+    r = run_path(capsys, tmp_path, prog.replace("M30\n", ""), "--vars", ids, profile=MILL)
+    assert r.code == 0, r.alarm
+    assert {int(k): v for k, v in r.vars.items()} == {**groups, **status, 4001: 1.0, 20300: None}
+    # #4001 is an extend variable on NC5 (vacant + 1 = 1), not Fanuc's modal G code
+    r = run_path(capsys, tmp_path, "G99 G01 W-1. F0.2\n#100=#2001\n#101=#2005\n#102=#2020\nM30\n",
+                 "--vars", "100-102", profile="lathe-2018")
+    assert r.vars == {"100": 1.0, "101": 99.0, "102": 0.2}  # lathe-2018: #2000 + group, #2020 F
+
+
+M96_ARC = "M96 P50\nG90 G00 X0 Y0\nG03 X0 Y20. R10. F100\nG01 X30.\nM30\nO0050\nG00 Z5.\nZ0.\nM99\n"
+
+
+def test_m96_return_into_an_interrupted_arc_is_linear(capsys, tmp_path):
+    r = run_path(capsys, tmp_path, M96_ARC, "--interrupt", "3@0.25", profile=MILL)
+    assert r.code == 0, r.alarm
+    cut, up, down, resume, nxt = r.moves[1:]
+    # the arc ran a quarter of its length (45° of 180°) about its centre (0,10) when M2x019 fired
+    assert cut["kind"] == "arc" and xy(cut, "center") == (0.0, 10.0) and "M96 stop" in cut["tags"]
+    assert xy(cut) == (round(10 * math.sin(math.pi / 4), 4), round(10 - 10 * math.cos(math.pi / 4), 4))
+    assert (up["line"], up["end"]["Z"], down["end"]["Z"]) == (7, 5.0, 0.0)  # O0050 from the stop point
+    # M99: straight on to the arc's programmed end (N§3.11.4.6 note 2), at the arc's feed, then the next block
+    assert resume["kind"] == "line" and resume["tags"] == ["M96", "resume"] and resume["line"] == 3
+    assert (xy(resume, "start"), xy(resume), resume["feed"]) == (xy(cut), (0.0, 20.0), 100.0)
+    assert (nxt["line"], xy(nxt, "start"), xy(nxt)) == (4, (0.0, 20.0), (30.0, 20.0))
+    # interrupted rapid: the rest is a rapid; no M96 active: the trigger is ignored
+    r = run_path(capsys, tmp_path, M96_ARC.replace("G00 X0 Y0", "G00 X40. Y0"), "--interrupt", "2", profile=MILL)
+    assert [(m["kind"], xy(m)) for m in r.moves[:4]] == [("rapid", (20.0, 0.0)), ("rapid", (20.0, 0.0)),
+                                                        ("rapid", (20.0, 0.0)), ("rapid", (40.0, 0.0))]
+    r = run_path(capsys, tmp_path, M96_ARC.replace("M96 P50", "M97"), "--interrupt", "3", profile=MILL)
+    assert [xy(m) for m in r.moves] == [(0.0, 0.0), (0.0, 20.0), (30.0, 20.0)]
+    assert run_path(capsys, tmp_path, M96_ARC, "--interrupt", "3@2", profile=MILL).code == 2

@@ -6,6 +6,7 @@ The `--json` form (JSON Lines) is the stable verification seam; docs/path-format
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import sys
 
@@ -55,7 +56,34 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--plot", metavar="FILE.png",
                    help="also draw the tool path in the active plane (rapids dashed, feeds solid, "
                         "programmed contour vs compensated path)")
+    p.add_argument("--interrupt", metavar="LINE[@FRACTION]",
+                   help="M96: the MLC's M2x019 fires while the move of main-program line LINE runs, FRACTION "
+                        "(default 0.5) of the way along it; that move is cut there (tag 'M96 stop'), the "
+                        "interrupt program runs, and its M99 goes on to the block's end (program read without "
+                        "preview)")
     p.set_defaults(func=cmd_path)
+
+
+def parse_interrupt(text: str) -> tuple[int, float]:
+    line, _, frac = text.partition("@")
+    try:
+        at = (int(line), float(frac) if frac else 0.5)
+    except ValueError:
+        raise InputError(f"bad --interrupt {text!r}: use LINE or LINE@FRACTION") from None
+    if at[0] < 1 or not 0.0 <= at[1] <= 1.0:
+        raise InputError(f"bad --interrupt {text!r}: LINE >= 1, 0 <= FRACTION <= 1")
+    return at
+
+
+def suspend(interp: Interpreter, move: Move, fraction: float) -> Move:
+    """What the machine ran of `move` before M2x019 stopped it; tells the interpreter where it stopped."""
+    from nc.motion.path import Segment
+
+    axes = tuple(move.start)
+    seg = Segment.of(move, axes)
+    stop = {a: float(v) for a, v in zip(axes, seg.points([fraction * seg.length])[0])}
+    interp.request_interrupt(stop)
+    return dataclasses.replace(move, end=stop, work=interp.to_work(stop), tags=move.tags + ("M96 stop",))
 
 
 def fmt(v: float) -> float:
@@ -94,6 +122,7 @@ def cmd_path(args: argparse.Namespace) -> int:
             params[name.strip()] = float(value)
         if args.block_skip:
             params["M2x010"] = 1
+        interrupt = parse_interrupt(args.interrupt) if getattr(args, "interrupt", None) else None
         rotary = tuple(a.name for a in bench.axes if a.units == "deg") if args.bench else ()
         profile = make_profile(bench.profile, bench.axis_names if args.bench else None, params, rotary)
     except (InputError, ValueError) as exc:
@@ -114,9 +143,12 @@ def cmd_path(args: argparse.Namespace) -> int:
     try:
         program = store.load_main(args.program)
         plotted: list[Move] = []
-        for ev in interp.run(program):
+        for ev in interp.run(program, preview=interrupt is None):
             listed = _print_servo(interp, args, listed)
             if isinstance(ev, Move):
+                if interrupt and ev.line == interrupt[0] and ev.program == program.name \
+                        and interp.interrupt_program is not None:
+                    ev, interrupt = suspend(interp, ev, interrupt[1]), None
                 if getattr(args, "plot", None):
                     plotted.append(ev)
                 if args.json:

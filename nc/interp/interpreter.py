@@ -103,6 +103,8 @@ class Interpreter:
         self.macro_modal: tuple[int, int, dict[int, float]] | None = None  # G66 (program, L, args)
         self.interrupt_program: int | None = None  # M96 P
         self._interrupt_pending = False
+        self._interrupt_stop: dict[str, float] | None = None  # where the motion suspended the block (M2x019)
+        self._interrupt_resume: Move | None = None  # the way to the suspended block's end, due at M99
         self._angle_pending: tuple[Block, dict] | None = None  # two-block ,A form: first block held (A32)
         self.reference_via: dict[str, float] | None = None  # G28/G30 intermediate point (machine)
         self.skip_position: dict[str, float] | None = None  # G31 trigger (machine), set by motion
@@ -122,10 +124,15 @@ class Interpreter:
     def variable(self, number: int) -> float | None:
         return self.vars.get(number)
 
-    def request_interrupt(self) -> None:
-        """The MLC's M2x019 trigger: run the M96 program at the next block boundary."""
+    def request_interrupt(self, stopped_at: dict[str, float] | None = None) -> None:
+        """The MLC's M2x019 trigger: run the M96 program at the next block boundary.
+
+        ``stopped_at`` is the machine position where the motion suspended the block it was running
+        (N§3.11.4.6: "suspended immediately"); M99 of the interrupt program then goes on to that
+        block's end point in a straight line (note 2, also for G02/G03).  None: the block had ended."""
         if self.interrupt_program is not None:
             self._interrupt_pending = True
+            self._interrupt_stop = dict(stopped_at) if stopped_at is not None else None
 
     def record_skip(self, machine: dict[str, float]) -> None:
         """Issue 5 reports where a G31 move stopped; #21048…/#21064… read it back."""
@@ -396,6 +403,8 @@ class Interpreter:
                 return
             if m == 99:
                 self._m99(block)
+                if self._interrupt_resume is not None and not any(f.kind == "m96" for f in self.stack):
+                    yield self._resume_after_interrupt()
                 return
             if m == 96:
                 self._m96(block)
@@ -1411,11 +1420,29 @@ class Interpreter:
             raise NcAlarm(0x0005, "M96 interrupt while G41/G42 or G51 is active")
         prog = self.store.find(self.interrupt_program or 0)
         self.stack.append(Frame(prog, 0, "m96", False, 1))
-        self._interrupt_from = dict(self.position)
+        self._interrupt_resume = None
+        stop, self._interrupt_stop = self._interrupt_stop, None
+        if stop is not None and self.block is not None:
+            # the suspended block still owes the way from `stop` to its end: G00 as a rapid, G01/G02/G03
+            # as a straight cutting move at the block's feed (N§3.11.4.6 note 2); built now, sent at M99
+            end = dict(self.position)
+            kind = "rapid" if st.motion == 0 else "line"
+            self._interrupt_resume = Move(
+                kind, self.block.line, self.block.text, {}, end, self.to_work(end),
+                feed=self.feed() if kind == "line" else None, per_rev=st.per_rev if kind == "line" else False,
+                program=self.program_name, plane=PLANES[st.plane], tags=("M96", "resume"))
+            self.position.update(stop)
         return iter(())
 
     def _interrupt_return(self) -> None:
         return None
+
+    def _resume_after_interrupt(self) -> Move:
+        mv, self._interrupt_resume = self._interrupt_resume, None
+        assert mv is not None
+        mv.start = dict(self.position)  # from wherever the interrupt program left the tool
+        self.position = dict(mv.end)
+        return mv
 
     def _skip_contour(self, fn: str, block: Block) -> None:
         """After G71/G72/G73 P..Q the contour blocks that follow are not run again as moves."""
