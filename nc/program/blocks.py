@@ -109,11 +109,17 @@ class Block:
         return [w for w in self.words if w.letter == letter]
 
     def has(self, letter: str) -> bool:
-        return any(w.letter == letter for w in self.words)
+        for w in self.words:  # a plain loop: this runs several times per block (hot path)
+            if w.letter == letter:
+                return True
+        return False
 
     @property
     def has_expr(self) -> bool:
-        return any(w.expr is not None for w in self.words) or bool(self.comma_expr)
+        for w in self.words:
+            if w.expr is not None:
+                return True
+        return bool(self.comma_expr)
 
     def copy(self) -> "Block":
         return replace(self, words=list(self.words), comma=dict(self.comma))
@@ -140,10 +146,23 @@ class Program:
 _NUMBER = re.compile(r"[+-]?\s*(\d+\.?\d*|\.\d+)")
 _KEYWORDS = ("ELSEIF", "ENDIF", "EXITW", "WHILE", "GOTO", "THEN", "ELSE", "ENDW", "END", "IF", "DO")
 MAX_DIGITS = 9
+_COMMENT_START = re.compile(r"[(;%/]")  # a line without these has no comment and no block skip
+_NOT_DIGIT = re.compile(r"[^0-9]")
+_LETTERS = re.compile(r"[A-Za-z]+")
+_AXIS_NAME = re.compile(r"[A-Za-z]{1,2}[0-9]{0,2}\s*=")
+_AXIS_SUFFIX = re.compile(r"[0-9]{1,2}\s*=")
+_SPACE_EQ = re.compile(r"[\s=]")
+# Fast path (`_plain_block`): a block made only of one-letter addresses each followed directly by a
+# plain number ("G01 X12.5 Y-3", the bulk of CAM output).  ASCII digits and blanks only, so every
+# such block reads exactly as the general parser would read it; anything else takes the general path.
+_PLAIN_BLOCK = re.compile(r"[ \t]*(?:[A-Za-z][+-]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)[ \t]*)+")
+_PLAIN_WORD = re.compile(r"([A-Za-z])([+-]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+))")
 
 
 def strip_comments(text: str) -> tuple[str, str]:
     """Return (code, comment) for one line."""
+    if _COMMENT_START.search(text) is None:
+        return text, ""
     out: list[str] = []
     comment: list[str] = []
     i, n = 0, len(text)
@@ -299,7 +318,7 @@ class _BlockParser:
         if not m:
             raise self.alarm(0x0222, f"address {letter} has no value")
         raw = m.group(0).replace(" ", "")
-        digits = len(re.sub(r"[^0-9]", "", raw).lstrip("0"))
+        digits = len(_NOT_DIGIT.sub("", raw).lstrip("0"))
         if digits > MAX_DIGITS + 3:
             raise self.alarm(0x0223, f"{letter}{raw} has too many digits")
         p.pos = m.end()
@@ -354,22 +373,22 @@ class _BlockParser:
                 continue
             if block.stmt is not None and not isinstance(block.stmt, (Goto, IfGoto)):
                 raise self.alarm(0x0208, "statement and NC words in one block")
-            m = re.compile(r"[A-Za-z]+").match(self.s, p.pos)
+            m = _LETTERS.match(self.s, p.pos)
             run = m.group(0).upper()
             if len(run) > 1:
                 # a multi-character axis name must be followed by '=' (XA1=100., N§3.1.1)
-                m2 = re.compile(r"[A-Za-z]{1,2}[0-9]{0,2}\s*=").match(self.s, p.pos)
+                m2 = _AXIS_NAME.match(self.s, p.pos)
                 if not m2:
                     raise self.alarm(0x0201, f"undefined operator {run!r}")
-                name = re.sub(r"[\s=]", "", m2.group(0)).upper()
+                name = _SPACE_EQ.sub("", m2.group(0)).upper()
                 p.pos = m2.end() - 1
                 letter = name
             else:
                 letter = run
                 p.pos += 1
-                m2 = re.compile(r"[0-9]{1,2}\s*=").match(self.s, p.pos)
+                m2 = _AXIS_SUFFIX.match(self.s, p.pos)
                 if m2 and letter in "XYZUVWABC":
-                    letter += re.sub(r"[\s=]", "", m2.group(0))
+                    letter += _SPACE_EQ.sub("", m2.group(0))
                     p.pos = m2.end() - 1
             value, text, point, e = self.word_value(letter)
             if letter == "N" and first and block.n is None and e is None:
@@ -383,7 +402,40 @@ class _BlockParser:
             first = False
 
 
+def _plain_block(line: int, text: str, code: str) -> Block | None:
+    """The general parser's result for a `_PLAIN_BLOCK` line, without its character scanner;
+    None when the line needs the general path (an O word, a bad N, too many digits), which then
+    raises the alarm."""
+    block = Block(line=line, text=text)
+    words = block.words
+    first = True
+    for letter, raw in _PLAIN_WORD.findall(code):
+        if len(raw) > MAX_DIGITS + 3:
+            return None  # may have too many digits (0x0223)
+        letter = letter.upper()
+        value = float(raw)
+        point = "." in raw
+        if letter == "N" and first and block.n is None:
+            if point or value != int(value) or value < 0:
+                return None
+            block.n = int(value)
+            continue
+        if letter == "O":
+            return None
+        words.append(Word(letter, value, letter + raw, point))
+        first = False
+    return block
+
+
 def parse_block(line: int, text: str) -> Block:
+    if _PLAIN_BLOCK.fullmatch(text) is not None:  # no comment, no line break: text is the code
+        block = _plain_block(line, text, text)
+        if block is not None:
+            return block
+    return _parse_general(line, text)
+
+
+def _parse_general(line: int, text: str) -> Block:
     code, comment = strip_comments(text)
     block = Block(line=line, text=text.rstrip("\r\n"), comment=comment)
     s = code.strip()

@@ -71,6 +71,7 @@ LEVELS: list[set[str]] = [
     {"*", "/", "MOD", "AND", "&"},
 ]
 _NUM = re.compile(r"\d+\.?\d*|\.\d+")
+_WORD = re.compile(r"[A-Za-z]+")
 _SYM = ("||", "&&", "==", "!=", "<>", "<=", ">=", "<", ">", "=", "+", "-", "*", "/", "&", "|", "^", "!")
 
 
@@ -90,7 +91,7 @@ class ExprParser:
 
     def peek_word(self) -> str:
         self.skip()
-        m = re.match(r"[A-Za-z]+", self.s[self.pos:])
+        m = _WORD.match(self.s, self.pos)
         return m.group(0).upper() if m else ""
 
     def peek_sym(self) -> str:
