@@ -34,6 +34,9 @@ M_BEFORE_MOTION = {3, 4, 8, 19, 29}  # issued to the MLC before the block's moti
 M_END = {2, 30}
 # Codes whose axis words name a centre or the axes concerned, never a target: no motion in their block.
 TRANSFORM_ARG_FUNCS = frozenset({"scale", "mirror", "mirror_off", "G68"})
+# Non-modal codes whose block runs no motion of the current motion mode (the code itself moves or not).
+NO_MOTION_FUNCS = frozenset({"G04", "G10", "G11", "G28", "G29", "G30", "G31", "G52", "G53", "set", "G05",
+                             "G70", "G71", "G72", "G73", "G74", "G75", "G76", "G900"})
 MAX_M_PER_BLOCK = 4
 MAX_MACRO_DEPTH = 8  # G65/G66/G-M-T calls (0x0212)
 MAX_SUB_DEPTH = 8  # M98 (0x022D)
@@ -154,21 +157,25 @@ class Interpreter:
         return self.to_work(self.position)
 
     def to_work(self, machine: dict[str, float]) -> dict[str, float]:
+        origin = self.frames.origins(self.state.wcs, self.axes)
+        position, diameter = self.position, self.profile.diameter_axes
         out = {}
         for a in self.axes:
-            v = machine.get(a, self.position.get(a, 0.0)) - self.frames.origin(self.state.wcs, a)
-            out[a] = v * 2.0 if a in self.profile.diameter_axes else v
+            v = machine.get(a, position.get(a, 0.0)) - origin[a]
+            out[a] = v * 2.0 if a in diameter else v
         return out
 
     def to_machine(self, work: dict[str, float]) -> dict[str, float]:
+        origin = self.frames.origins(self.state.wcs, self.axes)
+        diameter = self.profile.diameter_axes
         out = {}
         for a in self.axes:
             v = work.get(a)
             if v is None:
                 out[a] = self.position[a]
                 continue
-            v = v / 2.0 if a in self.profile.diameter_axes else v
-            out[a] = v + self.frames.origin(self.state.wcs, a)
+            v = v / 2.0 if a in diameter else v
+            out[a] = v + origin[a]
         return out
 
     # ---- the program counter -----------------------------------------------------------------
@@ -296,7 +303,7 @@ class Interpreter:
         gcodes = self._gcodes(block)
         funcs = {fn for _, fn, _ in gcodes}
         self._check_letters(block, funcs)
-        mcodes = [w for w in block.all("M")]
+        mcodes = block.all("M")
         for w in mcodes:
             if w.value != int(w.value) or not 0 <= w.value <= 65534:
                 raise NcAlarm(0x0249, f"M code {w.text} out of range")
@@ -312,9 +319,9 @@ class Interpreter:
         if "G65" in funcs:
             self._macro_call(block, modal=False)
             return
-        if any(fn in STOP_PREVIEW for fn in funcs):
+        if not funcs.isdisjoint(STOP_PREVIEW):
             yield Sync(block.line, block.text, next(fn for fn in funcs if fn in STOP_PREVIEW))
-        halt_m = self._halt_m(mvals)
+        halt_m = self._halt_m(mvals) if mvals else None
         if halt_m is not None:
             yield Sync(block.line, block.text, f"M{halt_m}")
 
@@ -379,9 +386,7 @@ class Interpreter:
                 yield from context.run_cycle(self, fn, block)
                 moved = True
                 self._skip_contour(fn, block)
-        if not any(fn in ("G04", "G10", "G11", "G28", "G29", "G30", "G31", "G52", "G53", "set", "G05",
-                          "G70", "G71", "G72", "G73", "G74", "G75", "G76", "G900") for fn in nonmodal) \
-                and not funcs & TRANSFORM_ARG_FUNCS:
+        if NO_MOTION_FUNCS.isdisjoint(nonmodal) and TRANSFORM_ARG_FUNCS.isdisjoint(funcs):
             for ev in self._motion(block, funcs):
                 if isinstance(ev, Move) and ev.kind != "dwell":
                     moved = True
@@ -574,7 +579,7 @@ class Interpreter:
                 continue
             raise NcAlarm(0x0201, f"address {w.letter} is not defined on this machine ({w.text})")
         for a in ("Y", "A", "B", "C", "X", "Z"):
-            if block.has(a) and a not in self.axes and not self._letter_is_arg(a, funcs):
+            if a not in self.axes and block.has(a) and not self._letter_is_arg(a, funcs):
                 raise NcAlarm(0x0201, f"axis {a} is not defined on this machine")
 
     def _letter_is_arg(self, a: str, funcs: set[str]) -> bool:
@@ -836,8 +841,8 @@ class Interpreter:
         if self._angle_pending is not None:
             raise NcAlarm(0x0207, ",A without an end point must be followed by G01 with both plane "
                           "coordinates and ,A", line=self._angle_pending[0].line, block=self._angle_pending[0].text)
-        has_centre = any(block.has(c) for c in ("I", "J", "K"))
         if not geo.moved:
+            has_centre = block.has("I") or block.has("J") or block.has("K")
             if st.motion in (2, 3) and has_centre and funcs & {"G02", "G03"} | ({"G02", "G03"} if has_centre else set()):
                 pass  # full circle with centre words and no end point
             else:

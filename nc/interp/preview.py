@@ -38,27 +38,37 @@ class PreviewWindow:
             ahead.line if ahead is not None else None,
             ahead.block.strip() if ahead is not None else None, n_ahead))
 
-    def _moves_buffered(self) -> int:
-        return sum(1 for e in self.buf if isinstance(e, Move))
-
     def __iter__(self) -> Iterator[Event]:
         done = False
         failure: Exception | None = None
+        buf, events, depth = self.buf, self.events, self.depth
+        # counts of the Moves and Syncs in buf, kept as events enter and leave (hot path: no rescans)
+        moves = syncs = 0
         while True:
             # read ahead until the window is full, a Sync arrives, or the program ends
-            while not done and self._moves_buffered() <= self.depth and not any(isinstance(e, Sync) for e in self.buf):
+            while not done and moves <= depth and not syncs:
                 try:
-                    self.buf.append(next(self.events))
+                    ev = next(events)
                 except StopIteration:
                     done = True
+                    break
                 except Exception as exc:  # an alarm read ahead is raised when execution reaches it
                     failure = exc
                     done = True
-            if not self.buf:
+                    break
+                buf.append(ev)
+                if isinstance(ev, Move):
+                    moves += 1
+                elif isinstance(ev, Sync):
+                    syncs += 1
+            if not buf:
                 if failure is not None:
                     raise failure
                 return
-            ev = self.buf.popleft()
+            ev = buf.popleft()
             if isinstance(ev, Move):
+                moves -= 1
                 self.executing = ev
+            elif isinstance(ev, Sync):
+                syncs -= 1
             yield ev

@@ -79,6 +79,11 @@ class Frames:
         if not self.work_offsets:
             self.work_offsets = [{a: 0.0 for a in self.axes} for _ in range(6 + N_EXT_WCS)]
 
+    def origins(self, wcs: int, axes: tuple[str, ...]) -> dict[str, float]:
+        """`origin` of every axis at once (the interpreter's per-block coordinate conversion)."""
+        e, w, lo, s, t = self.external, self.work_offsets[wcs], self.local_shift, self.set_shift, self.tool_shift
+        return {a: e.get(a, 0.0) + w.get(a, 0.0) + lo.get(a, 0.0) + s.get(a, 0.0) + t.get(a, 0.0) for a in axes}
+
     def origin(self, wcs: int, axis: str) -> float:
         return (self.external.get(axis, 0.0) + self.work_offsets[wcs].get(axis, 0.0)
                 + self.local_shift.get(axis, 0.0) + self.set_shift.get(axis, 0.0)
