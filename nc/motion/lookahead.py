@@ -18,6 +18,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from itertools import islice
 
 import numpy as np
 
@@ -73,10 +74,10 @@ def reach(v0: float, length: float, a: float, j: float) -> float:
     if length <= 0.0:
         return v0
     # No constant-acceleration phase: (2·v0 + x²)·x = L·√j with x = √Δv (one real root).
-    q = length * math.sqrt(j)
+    q = length * _sqrt(j)
     p = 2.0 * v0
-    disc = math.sqrt(q * q / 4.0 + p ** 3 / 27.0)
-    x = math.cbrt(q / 2.0 + disc) + math.cbrt(q / 2.0 - disc)
+    disc = _sqrt(q * q / 4.0 + p ** 3 / 27.0)
+    x = _cbrt(q / 2.0 + disc) + _cbrt(q / 2.0 - disc)
     dv = x * x
     if dv * j <= a * a:
         return v0 + dv
@@ -84,8 +85,11 @@ def reach(v0: float, length: float, a: float, j: float) -> float:
     qa = 1.0 / a
     qb = 2.0 * v0 / a + a / j
     qc = 2.0 * v0 * a / j - 2.0 * length
-    dv = (-qb + math.sqrt(qb * qb - 4.0 * qa * qc)) / (2.0 * qa)
+    dv = (-qb + _sqrt(qb * qb - 4.0 * qa * qc)) / (2.0 * qa)
     return v0 + max(dv, 0.0)
+
+
+_sqrt, _cbrt = math.sqrt, math.cbrt  # reach() runs ≈ 10 times per pushed block
 
 
 class Limits:
@@ -111,10 +115,16 @@ class Limits:
         cfg = self.cfg
         v = a = j = math.inf
         for d, vl, al, jl in zip(seg.direction_cosines(), self._v, self._acc, self._jerk):
-            if d > 1e-12:
-                v = min(v, vl / d)
-                a = min(a, al / d)
-                j = min(j, jl / d)
+            if d > 1e-12:  # v = min(v, vl / d) etc., spelt out: this runs per axis of every block
+                x = vl / d
+                if x < v:
+                    v = x
+                x = al / d
+                if x < a:
+                    a = x
+                x = jl / d
+                if x < j:
+                    j = x
         if v == math.inf:
             return 0.0, 1.0, 1.0
         a *= cfg.share_tangential
@@ -150,9 +160,13 @@ class Limits:
         elif max(du) > 1e-9:
             vj = va = math.inf
             for d, cj, ca in zip(du, self._corner_j, self._corner_a):
-                if d > 1e-12:
-                    vj = min(vj, cj / d)
-                    va = min(va, ca / d)
+                if d > 1e-12:  # vj = min(vj, cj / d) etc., spelt out (per axis of every junction)
+                    x = cj / d
+                    if x < vj:
+                        vj = x
+                    x = ca / d
+                    if x < va:
+                        va = x
             v = min(v, cfg.share_corner * vj, cfg.share_corner * va)
             if cfg.path_tolerance is not None:
                 v = min(v, 4.0 * cfg.path_tolerance / (self.T * math.sqrt(sum(d * d for d in du))))
@@ -183,20 +197,33 @@ def backward(blocks: Sequence[Block], lo: int = 0, full: bool = False, depth: in
     it = reversed(blocks)  # a deque indexes its middle in O(n); iterate instead
     nx = next(it)
     nx.vend, nx.binding = 0.0, True
-    for k in range(n - 1 - lo):
-        b = next(it)
-        local = min(b.vjunc, b.cap, nx.cap)
+    # This runs ≈ 10 times per pushed block (the tail within braking distance changes on every
+    # push), so it works on locals: the downstream block's fields are carried over from the
+    # previous step, and min() is spelt out (same operands, same result, no builtin call).
+    nx_vend, nx_binding, nx_cap, nx_length, nx_a, nx_j = 0.0, True, nx.cap, nx.length, nx.a, nx.j
+    nx_av, nx_ad, nx_aa, nx_aj = nx.anchor_v, nx.anchor_d, nx.anchor_a, nx.anchor_j
+    for k, b in enumerate(islice(it, n - 1 - lo)):
+        b_cap = b.cap
+        local = b.vjunc  # min(b.vjunc, b.cap, nx.cap)
+        if b_cap < local:
+            local = b_cap
+        if nx_cap < local:
+            local = nx_cap
         if local <= 0.0:
-            v, av, ad, aa, aj = 0.0, 0.0, 0.0, nx.a, nx.j
+            v, av, ad, aa, aj = 0.0, 0.0, 0.0, nx_a, nx_j
         else:
-            if nx.binding:
-                av, ad, aa, aj = nx.vend, nx.length, nx.a, nx.j
+            if nx_binding:
+                av, ad, aa, aj = nx_vend, nx_length, nx_a, nx_j
             else:
-                av, ad, aa, aj = nx.anchor_v, nx.anchor_d + nx.length, min(nx.anchor_a, nx.a), min(nx.anchor_j, nx.j)
-            v = min(local, reach(av, ad, MARGIN * aa, MARGIN * aj))
+                av, ad = nx_av, nx_ad + nx_length
+                aa = nx_a if nx_a < nx_aa else nx_aa  # min(nx.anchor_a, nx.a)
+                aj = nx_j if nx_j < nx_aj else nx_aj
+            r = reach(av, ad, MARGIN * aa, MARGIN * aj)
+            v = r if r < local else local
         binding = v >= local - 1e-12
-        if not full and k + 2 > depth and abs(v - b.vend) <= 1e-12 and binding and b.binding:
+        if not full and k + 2 > depth and binding and b.binding and -1e-12 <= v - b.vend <= 1e-12:
             break
         b.vend, b.binding = v, binding
         b.anchor_v, b.anchor_d, b.anchor_a, b.anchor_j = av, ad, aa, aj
-        nx = b
+        nx_vend, nx_binding, nx_cap, nx_length, nx_a, nx_j = v, binding, b_cap, b.length, b.a, b.j
+        nx_av, nx_ad, nx_aa, nx_aj = av, ad, aa, aj
