@@ -97,7 +97,10 @@ _stacks: "weakref.WeakKeyDictionary[Any, TransformStack]" = weakref.WeakKeyDicti
 
 def stack(host: Any) -> TransformStack:
     try:
-        return _stacks.setdefault(host, TransformStack())
+        st = _stacks.get(host)  # asked on every block: build a stack only the first time
+        if st is None:
+            st = _stacks[host] = TransformStack()
+        return st
     except TypeError:
         if not hasattr(host, "_transform_stack"):
             host._transform_stack = TransformStack()

@@ -30,6 +30,11 @@ from nc.program.blocks import (Assign, Block, Else, ElseIf, End, EndIf, ExitW, G
 from nc.program.expr import evaluate, var_index
 from nc.store import ProgramStore
 
+try:  # imported once here: `_transforms` asks it on every block
+    import nc.transforms as _transforms_module
+except ImportError:  # a build without issue 4's transforms
+    _transforms_module = None
+
 M_BEFORE_MOTION = {3, 4, 8, 19, 29}  # issued to the MLC before the block's motion starts
 M_END = {2, 30}
 # Codes whose axis words name a centre or the axes concerned, never a target: no motion in their block.
@@ -122,6 +127,7 @@ class Interpreter:
         self._executed = 0
         self._gcall_depth = 0
         self._three_point: dict[str, float] | None = None  # G2.4/G3.4 middle point
+        self._plain_axes = frozenset(self.axes) - {"G", "M", "T", "F", "S", "D"}  # `_axis_block` letters
 
     # ---- public ---------------------------------------------------------------------------
     def variable(self, number: int) -> float | None:
@@ -295,6 +301,9 @@ class Interpreter:
         block = self._resolve(raw)
         self.block = block
         st = self.state
+        if self._axis_block(block):  # fast path: the steps skipped here are no-ops for such a block
+            yield from self._motion(block, set())
+            return
         # code-called macros: the calling code must be first in the block (N§3.2.1)
         called = self._code_call(block)
         if called is not None:
@@ -423,6 +432,18 @@ class Interpreter:
         if moved and self.macro_modal is not None and not any(f.kind == "g66" for f in self.stack):
             prog, count, args = self.macro_modal
             self._push_macro(prog, count, dict(args), "g66")
+
+    def _axis_block(self, block: Block) -> bool:
+        """A block of absolute axis words only (``X1.5 Y2``: most CAM output) while no G66 is modal.
+        Without G/M/F/S/T/D words or ,C/,R/,A, `_execute` finds no code call, no G or M code, no
+        modal change and no letter to refuse; all that runs is `_motion` (tests/test_lang_fastpath.py)."""
+        if not block.words or block.comma or self.macro_modal is not None:
+            return False
+        plain = self._plain_axes
+        for w in block.words:
+            if w.letter not in plain:
+                return False
+        return True
 
     # ---- statements --------------------------------------------------------------------------
     def _statement(self, block: Block) -> Iterator[Event]:
@@ -1541,9 +1562,8 @@ class Interpreter:
 
 def _transforms(host: "Interpreter"):
     """`nc.transforms` (issue 4) when scaling, mirror or rotation is active, else None."""
-    try:
-        import nc.transforms as tr
-    except ImportError:
+    tr = _transforms_module
+    if tr is None:
         return None
     try:
         return tr if tr.stack(host).active else None

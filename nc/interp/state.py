@@ -82,6 +82,8 @@ class Frames:
     def origins(self, wcs: int, axes: tuple[str, ...]) -> dict[str, float]:
         """`origin` of every axis at once (the interpreter's per-block coordinate conversion)."""
         e, w, lo, s, t = self.external, self.work_offsets[wcs], self.local_shift, self.set_shift, self.tool_shift
+        if not (e or lo or s or t):  # the usual case; 0.0 + w is the sum below bit for bit (even for -0.0)
+            return {a: 0.0 + w.get(a, 0.0) for a in axes}
         return {a: e.get(a, 0.0) + w.get(a, 0.0) + lo.get(a, 0.0) + s.get(a, 0.0) + t.get(a, 0.0) for a in axes}
 
     def origin(self, wcs: int, axis: str) -> float:
