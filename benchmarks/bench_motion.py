@@ -46,24 +46,38 @@ def bench_a2() -> None:
           f"{st.time / w:.0f}x real time at 1 ms")
 
 
+class _Clock:
+    """Wall time and this process's CPU time: on a shared machine the CPU-time rate is the
+    stable figure (wall time also counts the cycles other processes took)."""
+
+    def __enter__(self) -> "_Clock":
+        self.w0, self.c0 = time.perf_counter(), time.process_time()
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.wall = time.perf_counter() - self.w0
+        self.cpu = max(time.process_time() - self.c0, 1e-9)
+
+    def rate(self, n: int) -> str:
+        return f"{n / self.wall:,.0f} blocks/s ({n / self.cpu:,.0f} per CPU-second)"
+
+
 def bench_b(n: int = 100_000) -> None:
     cfg = mill_cfg()
     pl = Planner(cfg, {"X": 0.0, "Y": 0.0, "Z": 0.0})
-    t = time.perf_counter()
-    pushed = 0
-    for mv in cam_moves(n):
-        pl.push(mv)
-        pushed += 1
-        if len(pl.blocks) > pl.depth:
-            pl.blocks.popleft()  # planning only: keep the window at the look-ahead depth
-    w = time.perf_counter() - t
-    print(f"(b) look-ahead planning (push + junction + backward pass) of {n} CAM segments: "
-          f"{n / w:,.0f} blocks/s")
-    t = time.perf_counter()
-    st = run(cam_moves(20_000), cfg, {"X": 0.0, "Y": 0.0, "Z": 0.0}, keep=False)
-    w = time.perf_counter() - t
-    print(f"(b') full execution incl. per-block ruckig and sampling, 20000 CAM segments: {20_000 / w:,.0f} blocks/s "
-          f"({st.time:.2f} s simulated)")
+    moves = cam_moves(n)
+    with _Clock() as c:
+        for mv in moves:
+            pl.push(mv)
+            if len(pl.blocks) > pl.depth:
+                pl.blocks.popleft()  # planning only: keep the window at the look-ahead depth
+    print(f"(b) look-ahead planning (push + junction + backward pass) of {n} CAM segments: {c.rate(n)}")
+    cycles = [0]
+    with _Clock() as c:
+        run(cam_moves(20_000), cfg, {"X": 0.0, "Y": 0.0, "Z": 0.0}, keep=False,
+            on_cycle=lambda k, ch: cycles.__setitem__(0, k + 1))
+    print(f"(b') full execution incl. per-block ruckig and sampling, 20000 CAM segments: {c.rate(20_000)}, "
+          f"{cycles[0] * cfg.cycle:.2f} s simulated")
 
 
 def cam_program(n: int, seed: int = 3) -> str:
@@ -80,21 +94,25 @@ def cam_program(n: int, seed: int = 3) -> str:
 def bench_b_interp(n: int = 100_000) -> None:
     cfg = mill_cfg()
     text = cam_program(n)
-    t = time.perf_counter()
-    prog = parse_program(text)
-    wp = time.perf_counter() - t
+    with _Clock() as cp:
+        prog = parse_program(text)
+    with _Clock() as ci:
+        for ev in Interpreter(make_profile("nc5-mill", AX)).run(prog):
+            pass
     pl = Planner(cfg, {"X": 0.0, "Y": 0.0, "Z": 0.0})
     moves = 0
-    t = time.perf_counter()
-    for ev in Interpreter(make_profile("nc5-mill", AX)).run(prog):
-        if isinstance(ev, Move):
-            pl.push(ev)
-            moves += 1
-            if len(pl.blocks) > pl.depth:
-                pl.blocks.popleft()
-    w = time.perf_counter() - t
-    print(f"(b) interpreter + look-ahead planning of a {n}-block CAM program: {moves / w:,.0f} blocks/s "
-          f"(parsing the text first: {n / wp:,.0f} blocks/s; parse + interpret + plan {moves / (w + wp):,.0f} blocks/s)")
+    with _Clock() as c:
+        for ev in Interpreter(make_profile("nc5-mill", AX)).run(prog):
+            if isinstance(ev, Move):
+                pl.push(ev)
+                moves += 1
+                if len(pl.blocks) > pl.depth:
+                    pl.blocks.popleft()
+    both = _Clock()
+    both.wall, both.cpu = c.wall + cp.wall, c.cpu + cp.cpu
+    print(f"(b) interpreter + look-ahead planning of a {n}-block CAM program: {c.rate(moves)}")
+    print(f"(b) ... parsing the text alone: {cp.rate(n)}; interpreting alone: {ci.rate(moves)}; "
+          f"parse + interpret + plan: {both.rate(moves)}")
 
 
 def bench_c() -> None:
