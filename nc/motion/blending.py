@@ -18,6 +18,7 @@ one window behind W's last junction, whose cap was computed over a sum that hold
 from __future__ import annotations
 
 import math
+from bisect import bisect_left
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
@@ -25,6 +26,10 @@ from nc.motion.limits import MotionConfig
 
 if TYPE_CHECKING:
     from nc.motion.lookahead import Block
+
+
+def _s_end(b: "Block") -> float:
+    return b.s_end
 
 
 class FilterCorners:
@@ -39,6 +44,9 @@ class FilterCorners:
         self.tol = cfg.path_tolerance
         self.dev = (t1 + t2) / 8.0  # corner deviation per unit of v·|ΣΔu|
         self.t2sum = t1 * t1 + t2 * t2
+        self._windows = [(self.t_a, self.budget_a, False), (self.t_j, self.budget_j, False)]
+        if self.tol is not None:
+            self._windows.append((self.t_j, (), True))
         # Junctions still inside some filter window, executed or not (for the sums).
         self._hist: list[Block] = []
         self._h0 = 0  # first entry of _hist still within reach of a window
@@ -146,6 +154,12 @@ class FilterCorners:
                     lo = mid + 1
             return lo, cap_from(lo, budget, norm)
 
+        # Most junctions of gentle curves can never bind: even summed over the longest span any
+        # window can have here, their caps stay above the fastest these blocks can run.
+        if all(cap_from(bisect_left(hist, s_j - (top * t_w + 0.5 * acc * t_w * t_w), h0, last,
+                                    key=_s_end), budget, norm) >= top
+               for t_w, budget, norm in self._windows):
+            return 0
         m_a, c_a = first_taken(self.t_a, self.budget_a, False)
         m_j, c_j = first_taken(self.t_j, self.budget_j, False)
         c_far = c_j
