@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+from hil.bench import FILTER_MS, PATH_DEVIATION  # noqa: E402
 from nc.interp import Interpreter  # noqa: E402
 from nc.motion.offline import run  # noqa: E402
 from nc.motion.planner import Planner  # noqa: E402
@@ -113,6 +114,20 @@ def bench_b_interp(n: int = 100_000) -> None:
     print(f"(b) interpreter + look-ahead planning of a {n}-block CAM program: {c.rate(moves)}")
     print(f"(b) ... parsing the text alone: {cp.rate(n)}; interpreting alone: {ci.rate(moves)}; "
           f"parse + interpret + plan: {both.rate(moves)}")
+    # The same with a bench's default position filter (N1.036/N1.037) and N1.053 tolerance, whose
+    # windowed corner budgets the planner keeps per junction (hil.bench.Bench.motion_config).
+    filt = FILTER_MS / 1000.0
+    cfg = mill_cfg(filter_time=filt, filter_scurve=filt, path_tolerance=PATH_DEVIATION, min_segment_cycles=0.25)
+    pl = Planner(cfg, {"X": 0.0, "Y": 0.0, "Z": 0.0})
+    m = n // 5
+    with _Clock() as c:
+        for ev in Interpreter(make_profile("nc5-mill", AX)).run(parse_program(cam_program(m))):
+            if isinstance(ev, Move):
+                pl.push(ev)
+                if len(pl.blocks) > pl.depth:
+                    pl.blocks.popleft()
+    print(f"(b) ... with the bench default filter {FILTER_MS:g}+{FILTER_MS:g} ms and {PATH_DEVIATION} mm tolerance, "
+          f"{m} blocks, parse + interpret + plan: {c.rate(m)}")
 
 
 def bench_c() -> None:
