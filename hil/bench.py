@@ -88,7 +88,7 @@ class Bench:
     enable_timeout: float = 0.5  # s allowed for every drive to reach operation enabled
     settle_time: float = 0.3  # s the bench keeps cycling after the program to let axes settle
     max_time: float = 3600.0  # s of simulated time before the run is abandoned with an alarm
-    mlc: str = "basic"  # MLC logic: "basic", "package.module[:attr]" or a path to a .py file
+    mlc: str = ""  # MLC logic: "" (by profile, see mlc_program), "basic", "lathe", "package.module" or a .py path
     checks: ChecksConfig = field(default_factory=ChecksConfig)
     realtime: RealtimeConfig = field(default_factory=RealtimeConfig)
     io: list[IoStationConfig] = field(default_factory=list)  # remote I/O stations, EIO 501, 502, …
@@ -97,6 +97,12 @@ class Bench:
     @property
     def axis_names(self) -> tuple[str, ...]:
         return tuple(a.name for a in self.axes)
+
+    @property
+    def mlc_program(self) -> str:
+        """The MLC `hil run` uses when none is given: the bench's, else by profile — Delta's lathe MLC
+        (mlc/lathe.py, the M/S/T handshake) on a lathe, BasicMlc on a mill (no mill MLC is shipped)."""
+        return self.mlc or ("basic" if self.profile == "nc5-mill" else "lathe")
 
     def motion_config(self) -> MotionConfig:
         # N1.036 / N1.037 look-ahead filter and S-curve times (ms), N1.053 path smoothing

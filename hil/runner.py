@@ -22,6 +22,7 @@ from nc.alarms import SERVO_ALARM, Alarm, NcAlarm, internal_error
 from nc.channel import Channel, RunState, skip_hook
 from nc.interp import Interpreter
 from nc.motion import Planner
+from nc.motion.css import spindle_speed
 from nc.moves import Event
 from nc.profiles import make_profile
 from nc.program import Program
@@ -257,11 +258,8 @@ class BenchRunner:
                 self.result.max_ferr[self.axes[i]] = ferr
         for k, sc in enumerate(self.scales[n_axes:]):
             rpm = self.mlc.spindle.signed_rpm if (ch is not None and ch.state is not RunState.ALARM) else 0.0
-            if k == 0 and rpm and ch is not None and ch.css_rpm is not None:  # G96 (issue 5)
-                rpm = min(ch.css_rpm, self.bench.spindles[0].max_rpm) * (1.0 if rpm > 0 else -1.0)
-            elif k == 0 and rpm and ch is not None and ch.spindle_max is not None:
-                # The G50/G92 S clamp holds under G97 too (lathe manual E-L32; decisions A39).
-                rpm = max(-ch.spindle_max, min(ch.spindle_max, rpm))
+            if k == 0 and ch is not None:  # G96 speed, G50/G92 S clamp (issue 5; decisions A39)
+                rpm = spindle_speed(rpm, ch.css_rpm, ch.spindle_max, self.bench.spindles[0].max_rpm)
             self.rx[n_axes + k].target_velocity = sc.rpm_to_counts_per_s(rpm)
             hook = getattr(self.mlc, "spindle_drive", None)  # spindle ↔ C axis, M19: CSV ↔ CSP (issue 8)
             if k == 0 and ch is not None and callable(hook):

@@ -395,7 +395,7 @@ def build_mlc(bench: Bench, spec: str | None) -> Any:
     default lathe program (mlc.lathe); anything else → the Delta MLC running that user module."""
     from mlc.basic import BasicMlc
 
-    spec = spec or getattr(bench, "mlc", "basic") or "basic"
+    spec = spec or bench.mlc_program
     max_rpm = min((s.max_rpm for s in bench.spindles), default=6000.0)
     if spec == "basic":
         return BasicMlc(max_rpm=max_rpm)
@@ -417,7 +417,7 @@ def mlc_setup(bench: Bench, mlc_spec: str | None, signals: str | None, m00_resum
     from mlc.memory import DeviceError
     from mlc.tracing import SignalSource, parse_signal_list
 
-    if (signals or getattr(bench, "io", None)) and not mlc_spec and getattr(bench, "mlc", "basic") == "basic":
+    if (signals or getattr(bench, "io", None)) and not mlc_spec and bench.mlc_program == "basic":
         mlc_spec = "lathe"  # device columns and remote I/O (X/Y) need the Delta MLC
     try:
         mlc = build_mlc(bench, mlc_spec)

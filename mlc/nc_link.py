@@ -17,6 +17,7 @@ from mlc.signals import d2, d3, m2, m3
 from nc.alarms import Alarm
 from nc.channel import Channel, RunState
 from nc.manual import ManualMotion
+from nc.motion.css import spindle_speed
 from nc.moves import Aux
 
 AUTO, EDIT, MDI, MPG, JOG, RAPID, INC, HOME = range(8)
@@ -330,7 +331,7 @@ class ChannelLink:
         self._set3(23, end == 30)
         mem.set_bit(m3(0, 80 + x - 1), True)
         if drives is not None:
-            self._drive_outputs(drives)
+            self._drive_outputs(drives, ch)
         if self.manual is not None:
             mm = self.manual
             for i, a in enumerate(self.axes):
@@ -384,7 +385,7 @@ class ChannelLink:
         self._set3(self._strobe, True)
         self.handshake_log.append((self.cycle, aux.kind, aux.value))
 
-    def _drive_outputs(self, drives: list[DriveStatus]) -> None:
+    def _drive_outputs(self, drives: list[DriveStatus], ch: Channel | None = None) -> None:
         mem, x = self.mem, self.x
         mem.set_bit(m3(0, 0), all(d.connected for d in drives))
         mem.set_bit(m3(x, 34), any(d.fault for d in drives))
@@ -409,6 +410,8 @@ class ChannelLink:
             mem.set_s16(d3(0, 432 + k), int(round(d.torque)))
             base = 704 + 16 * k
             cmd = self.commanded_rpm(k)
+            if k == 0 and ch is not None:  # what the drive is really given: G96, G50 clamp
+                cmd = spindle_speed(cmd, ch.css_rpm, ch.spindle_max, self.spindle_max_rpm)
             mem.set_bit(m3(x, base + 1), abs(d.rpm) < 1.0)
             reached = abs(cmd) > 0 and abs(d.rpm - cmd) <= max(1.0, 0.02 * abs(cmd))
             mem.set_bit(m3(x, base), reached)

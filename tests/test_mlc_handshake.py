@@ -11,6 +11,7 @@ import pytest
 from hil.bench import default_lathe
 from hil.scripting import Machine
 from mlc.machine import Mlc
+from tests.conftest import ROOT
 
 SIGNALS = "M31064,M31065,M31066,M21016,D31048,D31050,D31052,M31037,M31021,M31023,M31016"
 
@@ -184,3 +185,47 @@ def test_bad_mlc_module_and_bad_signal_are_usage_errors(hil, tmp_path):
     assert r.code == 2 and "failed to load" in r.err
     r = hil("run", str(prog), "--mlc", "lathe", "--trace", str(tmp_path / "t.csv"), "--trace-signals", "M31064,Q5")
     assert r.code == 2 and "Q5" in r.err
+
+
+# ---- the lathe MLC is the default on a lathe, BasicMlc on a mill (session 2) -------------------------------
+def _program_time(out: str) -> float:
+    return float(next(line.split()[2] for line in out.splitlines() if line.startswith("program time")))
+
+
+def test_lathe_mlc_is_the_default_and_basic_stays_selectable(hil, tmp_path):
+    prog = tmp_path / "sp.nc"
+    prog.write_text("M03 S1200\nM05\nM30\n")
+    lathe, basic = hil("run", prog), hil("run", prog, "--mlc", "basic")
+    assert lathe.code == 0 and basic.code == 0, lathe.out + basic.out
+    # the lathe MLC finishes M03 at speed reached and M05 at zero speed; BasicMlc in the next scan
+    assert _program_time(basic.out) < 0.01 < 0.2 < _program_time(lathe.out)
+    mill = tmp_path / "mill.nc"
+    mill.write_text("G21 G17 G90\nM03 S1200\nM05\nM30\n")
+    r = hil("run", mill, "--bench", ROOT / "benches" / "mill-3axis.toml")
+    assert r.code == 0 and _program_time(r.out) < 0.01, r.out  # a mill keeps BasicMlc
+
+
+def test_readme_demo_runs_with_the_lathe_mlc(hil, tmp_path):
+    trace = tmp_path / "demo.csv"
+    r = hil("run", ROOT / "examples" / "lathe_demo.nc", "--trace", trace, "--trace-signals", "M31064,M31066,D31048")
+    assert r.code == 0 and "result         completed" in r.out, r.out + r.err
+    rows = list(csv.DictReader(trace.open()))
+    m_codes = [int(float(rows[i]["D31048"])) for i, v in _edges(rows, "M31064") if v == 1]
+    assert m_codes == [3, 5] and [v for _, v in _edges(rows, "M31066")] == [1, 0]  # T0101 strobed too
+
+
+def test_g96_m03_finishes_at_the_css_speed(hil, tmp_path):
+    """Speed reached compares the drive with the G96 speed it is given, not with S150 (m/min)."""
+    bench = tmp_path / "b.toml"
+    text = (ROOT / "benches" / "lathe-2axis.toml").read_text()
+    bench.write_text(text.replace("cycle_ms = 1.0", "cycle_ms = 1.0\nmax_time = 20.0"))  # a hang fails fast
+    prog = tmp_path / "css.nc"
+    prog.write_text("G21 G18 G99\nG50 S2000\nG96 S150 M03\nG01 X80. Z2. F2.\nM05\nM03\nG01 Z0. F0.2\nM05\nM30\n")
+    trace = tmp_path / "t.csv"
+    r = hil("run", prog, "--bench", bench, "--trace", trace, "--trace-signals", "M31064,M21016,D31048")
+    assert r.code == 0, r.out + r.err
+    rows = list(csv.DictReader(trace.open()))
+    m03 = [i for i, v in _edges(rows, "M31064") if v == 1 and rows[i]["D31048"] == "3"][-1]  # the 2nd M03
+    fin = next(i for i, v in _edges(rows, "M21016") if v == 1 and i > m03)
+    want = 1000.0 * 150.0 / (3.141592653589793 * 80.0)  # at X80. (diameter), after the first move
+    assert float(rows[fin]["S1_rpm_act"]) == pytest.approx(want, rel=0.02)

@@ -20,8 +20,8 @@ def register(sub: argparse._SubParsersAction) -> None:
 def add_bench_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--bench", help="bench file (TOML); default: the built-in 2-axis lathe")
     p.add_argument("--bus", help="sim | ethercat:IFACE | canopen:INTERFACE[:CHANNEL]")
-    p.add_argument("--mlc", metavar="MODULE", default="lathe",
-                   help="MLC program: lathe (default) | module name | path.py")
+    p.add_argument("--mlc", metavar="MODULE",
+                   help="MLC program: the bench's (default; lathe where that is basic) | lathe | module name | path.py")
 
 
 def open_machine(args: argparse.Namespace):
@@ -31,7 +31,8 @@ def open_machine(args: argparse.Namespace):
 
     try:
         bench = load_bench(args.bench, None, args.bus)
-        mlc, _, _ = mlc_setup(bench, args.mlc if args.mlc != "basic" else "lathe", None, 0.5)
+        spec = args.mlc or bench.mlc_program  # scripts drive the Delta relays: BasicMlc has none
+        mlc, _, _ = mlc_setup(bench, spec if spec != "basic" else "lathe", None, 0.5)
         machine = Machine(bench, mlc, make_link(bench))
     except InputError as exc:
         print(f"hil {args.command}: {exc}", file=sys.stderr)

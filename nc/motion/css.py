@@ -28,3 +28,17 @@ def css_rpm(move: Move, positions: np.ndarray, axes: tuple[str, ...], surface: f
     if limit is not None and limit > 0.0:
         rpm = min(rpm, limit)
     return rpm
+
+
+def spindle_speed(rpm: float, css: float | None, clamp: float | None, max_rpm: float) -> float:
+    """The signed speed the first spindle's drive is given for the MLC's `rpm` (its sign is the
+    direction): the G96 speed `css` while constant surface speed is on (within `max_rpm`), else `rpm`
+    within the G50/G92 S `clamp`, which holds under G97 too (decisions A39). The runner commands it
+    and the NC's "speed reached" (M3x704) compares the drive with it."""
+    if not rpm:
+        return 0.0
+    if css is not None:
+        return min(css, max_rpm) * (1.0 if rpm > 0 else -1.0)
+    if clamp is not None:
+        return max(-clamp, min(clamp, rpm))
+    return rpm
