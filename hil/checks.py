@@ -94,7 +94,7 @@ def run_checks(trace: TraceFile, checks: ChecksConfig, bench: Bench | None = Non
     axes = axes_of(trace.columns)
     out: list[CheckResult] = []
     for axis, limit in checks.max_following_error.items():
-        out.append(check_following_error(cols, axis, limit) if axis in axes else
+        out.append(check_following_error(cols, axis, limit, _unit(bench, axis)) if axis in axes else
                    CheckResult(f"following error {axis}", False, detail=f"no column {axis}_ferr in the trace"))
     if checks.contour_error is not None:
         if moves is None:
@@ -116,14 +116,20 @@ def run_checks(trace: TraceFile, checks: ChecksConfig, bench: Bench | None = Non
 
 
 # ---- individual checks ----------------------------------------------------------------------
-def check_following_error(cols: _Cols, axis: str, limit: float) -> CheckResult:
+def _unit(bench: Bench | None, axis: str) -> str:
+    """A rotary axis (units = "deg") reports degrees; linear axes, and axes of an unknown bench, mm."""
+    ax = next((a for a in bench.axes if a.name == axis), None) if bench is not None else None
+    return "deg" if ax is not None and ax.units == "deg" else "mm"
+
+
+def check_following_error(cols: _Cols, axis: str, limit: float, unit: str = "mm") -> CheckResult:
     ferr = np.abs(cols[f"{axis}_ferr"])
     if ferr.size == 0:
-        return CheckResult(f"following error {axis}", True, 0.0, limit, "mm", detail="empty trace")
+        return CheckResult(f"following error {axis}", True, 0.0, limit, unit, detail="empty trace")
     i = int(np.argmax(ferr))
     over = np.flatnonzero(ferr > limit)
     detail = f"{over.size} cycles over, first at cycle {cols.where(int(over[0]))['cycle']}" if over.size else ""
-    return CheckResult(f"following error {axis}", not over.size, float(ferr[i]), limit, "mm", detail=detail,
+    return CheckResult(f"following error {axis}", not over.size, float(ferr[i]), limit, unit, detail=detail,
                        **cols.where(i))
 
 

@@ -1,5 +1,7 @@
 """Each check fails on a crafted trace and names the offending cycle and line; CLI exit codes."""
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -167,3 +169,22 @@ def test_hil_check_cli_exit_codes(tmp_path, capsys):
     assert "FAIL  following error X" in out and "cycle 100" in out
     assert main(["check", path]) == 2  # nothing to check
     assert main(["check", str(tmp_path / "none.csv"), "--max-ferr", "1"]) == 2
+
+
+def test_rotary_following_error_is_reported_in_degrees(tmp_path, capsys):
+    """The C axis of benches/lathe-c-axis.toml is in degrees: its check says deg, X's says mm."""
+    d = base()
+    for k in ("cmd", "act", "vel", "torque", "ferr"):
+        d[f"C_{k}"] = np.zeros(N)
+    d["C_sw"] = np.full(N, 0x1637)
+    d["C_ferr"][120] = 0.3
+    cols = trace_columns(["X", "Z", "C"], ["S1"])
+    w = CsvTrace(tmp_path / "c.csv", cols)
+    for i in range(N):
+        w.write([d[c][i].item() if hasattr(d[c][i], "item") else d[c][i] for c in cols])
+    w.close()
+    bench = str(Path(__file__).resolve().parent.parent / "benches" / "lathe-c-axis.toml")
+    assert main(["check", str(tmp_path / "c.csv"), "--bench", bench]) == 1
+    out = capsys.readouterr().out
+    assert "FAIL  following error C: 0.3 deg > 0.2 deg at cycle 121" in out
+    assert "ok    following error X: 0 mm <= 0.1 mm" in out

@@ -14,7 +14,7 @@ BENCH = str(ROOT / "benches" / "lathe-c-axis.toml")
 def _run(hil, tmp_path, text: str, signals: str):
     prog, trace = tmp_path / "p.nc", tmp_path / "t.csv"
     prog.write_text(text)
-    r = hil("run", str(prog), "--bench", BENCH, "--mlc", "lathe", "--no-check", "--trace", str(trace),
+    r = hil("run", str(prog), "--bench", BENCH, "--trace", str(trace),
             "--trace-signals", signals)
     assert r.code == 0, r.out + r.err
     return list(csv.DictReader(trace.open()))

@@ -167,7 +167,8 @@ def print_summary(program: str, bench: Bench, r: RunResult) -> None:
     print(f"cycles         {r.cycles}  ({bench.cycle * 1000:g} ms cycle, {r.sim_time:.3f} s simulated)", file=out)
     print(f"drives enabled after {r.enable_cycles} cycles", file=out)
     print(f"program time   {r.program_time:.3f} s simulated", file=out)
-    ferr = "  ".join(f"{a} {v:.4f} mm" for a, v in r.max_ferr.items())
+    units = {a.name: "deg" if a.units == "deg" else "mm" for a in bench.axes}
+    ferr = "  ".join(f"{a} {v:.4f} {units.get(a, 'mm')}" for a, v in r.max_ferr.items())
     print(f"max following error  {ferr}", file=out)
     final = "  ".join(f"{a} {v:.4f}" for a, v in r.final.items())
     print(f"final machine position  {final}", file=out)
