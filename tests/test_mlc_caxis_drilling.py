@@ -22,22 +22,7 @@ BENCH = ROOT / "benches" / "lathe-c-axis.toml"
 SIGNALS = "M31709,M2239,M31064,M21016,D31048"
 TOL_DEG = 0.01
 
-G83_PROGRAM = """O8301 (face drilling with C positioning, the spindle as C axis)
-G98 G00 X100. Z10.
-M66
-G00 X30. C0.
-G83 X30. C0. Z-10. R2. Q4. F3000. L1
-C90.
-C180.
-C270.
-G80
-G00 Z20.
-M77
-M03 S300
-G04 X0.3
-M05
-M30
-"""
+G83_PROGRAM = (ROOT / "examples" / "lathe_face_drilling_c.nc").read_text()
 
 E_N55 = """N01 (TAPPING)
 N02G00 X50.000

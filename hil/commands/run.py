@@ -37,7 +37,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
                    help="progress bar on stderr (default: only when stderr is a terminal)")
     p.add_argument("--mlc", metavar="MODULE",
-                   help="MLC program: basic | lathe (the default lathe MLC) | module name | path.py (overrides the bench)")
+                   help="MLC program: lathe (Delta's lathe MLC, the default on a lathe) | basic (the default on a "
+                        "mill) | module name | path.py (overrides the bench's mlc)")
     p.add_argument("--trace-signals", metavar="DEVICES",
                    help="extra trace columns, one per MLC device: M31064,M21016,D31048 or App. B names")
     p.add_argument("--m00-resume", metavar="SECONDS", type=float, default=0.5,
