@@ -48,3 +48,15 @@ def worst_ratio(st: Stream, cfg: MotionConfig) -> dict[str, float]:
         out["a"] = max(out["a"], float(np.abs(a[:, i]).max()) / lim.max_acceleration)
         out["j"] = max(out["j"], float(np.abs(j[:, i]).max()) / lim.max_jerk)
     return out
+
+
+def jagged_polyline(n: int = 300, seed: int = 1) -> list[np.ndarray]:
+    """A random walk of 0.01–0.1 mm segments turning sharply in X/Y and less in Z."""
+    rng = np.random.default_rng(seed)
+    p, d, pts = np.zeros(3), np.array([1.0, 0, 0]), [np.zeros(3)]
+    for _ in range(n):
+        d = d + rng.normal(0, 0.3, 3) * [1, 1, 0.5]
+        d /= np.linalg.norm(d)
+        p = p + d * rng.uniform(0.01, 0.1)
+        pts.append(p)
+    return pts

@@ -12,7 +12,7 @@ import pytest
 from nc.motion.offline import run
 from nc.motion.planner import Planner
 from nc.motion.smoothing import PositionFilter
-from tests.motion_helpers import AX, arc, circle_chords, lines, mill_cfg, worst_ratio
+from tests.motion_helpers import AX, arc, circle_chords, jagged_polyline, lines, mill_cfg, worst_ratio
 
 TOL = 1.0 + 1e-6
 SQUARE = [(0, 0, 0), (10, 0, 0), (10, 10, 0), (0, 10, 0), (0, 0, 0)]
@@ -107,13 +107,7 @@ def test_tight_cam_curve_keeps_most_of_its_feed():
 
 
 def test_jagged_cam_segments_and_tight_chord_circle_stay_within_limits():
-    rng = np.random.default_rng(1)
-    p, d, pts = np.zeros(3), np.array([1.0, 0, 0]), [np.zeros(3)]
-    for _ in range(300):
-        d = d + rng.normal(0, 0.3, 3) * [1, 1, 0.5]
-        d /= np.linalg.norm(d)
-        p = p + d * rng.uniform(0.01, 0.1)
-        pts.append(p)
+    pts = jagged_polyline()
     check(lines(pts, 6000), filtered(8.0))
     ring = circle_chords(2.0, 0.05)
     st = check(lines(ring, 3000), filtered(), start=ring[0])

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from nc.motion.offline import run
-from tests.motion_helpers import AX, arc, circle_chords, lines, mill_cfg, worst_ratio
+from tests.motion_helpers import AX, arc, circle_chords, jagged_polyline, lines, mill_cfg, worst_ratio
 
 TOL = 1.0 + 1e-6
 
@@ -52,13 +52,7 @@ def test_tiny_cam_segments_on_a_smooth_curve():
 
 
 def test_jagged_cam_segments_and_z_moves():
-    rng = np.random.default_rng(1)
-    p, d, pts = np.zeros(3), np.array([1.0, 0, 0]), [np.zeros(3)]
-    for _ in range(300):
-        d = d + rng.normal(0, 0.3, 3) * [1, 1, 0.5]
-        d /= np.linalg.norm(d)
-        p = p + d * rng.uniform(0.01, 0.1)
-        pts.append(p)
+    pts = jagged_polyline()
     check(lines(pts, 6000), mill_cfg())
 
 

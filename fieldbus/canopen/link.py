@@ -256,11 +256,14 @@ class CanopenLink:
             n.remote.nmt.send_command(code)
         log.info("NMT %s sent to nodes %s", name, [n.cfg.node_id for n in self._nodes + self._io])
 
-    def _identify(self, pos: int, n: _Node) -> SlaveInfo:
+    def _identity(self, n: _Node | _IoNode) -> tuple[int, int, int]:
+        """Device type (0x1000), vendor and product code (0x1018) of a node, over SDO."""
         sdo = n.remote.sdo
-        device_type = self._sdo(n, lambda: sdo[0x1000].raw, 0x1000)
-        vendor = self._sdo(n, lambda: sdo[0x1018][1].raw, 0x1018)
-        product = self._sdo(n, lambda: sdo[0x1018][2].raw, 0x1018)
+        return (self._sdo(n, lambda: sdo[0x1000].raw, 0x1000), self._sdo(n, lambda: sdo[0x1018][1].raw, 0x1018),
+                self._sdo(n, lambda: sdo[0x1018][2].raw, 0x1018))
+
+    def _identify(self, pos: int, n: _Node) -> SlaveInfo:
+        device_type, vendor, product = self._identity(n)
         if device_type & 0xFFFF != CIA402_DEVICE_PROFILE:
             self._fail(Alarm(ALARM_PDO_MAPPING, f"{self._label(n)} is not a CiA 402 drive "
                              f"(device type 0x{device_type:08X})", axis=n.cfg.name))
@@ -295,10 +298,7 @@ class CanopenLink:
 
     # ---- remote I/O stations (CiA 401) ------------------------------------------------------------
     def _identify_io(self, pos: int, n: _IoNode) -> SlaveInfo:
-        sdo = n.remote.sdo
-        device_type = self._sdo(n, lambda: sdo[0x1000].raw, 0x1000)
-        vendor = self._sdo(n, lambda: sdo[0x1018][1].raw, 0x1018)
-        product = self._sdo(n, lambda: sdo[0x1018][2].raw, 0x1018)
+        device_type, vendor, product = self._identity(n)
         if device_type & 0xFFFF != CIA401_DEVICE_PROFILE:
             self._fail(Alarm(ALARM_EIO_MISMATCH, f"{self._label(n)} is not a CiA 401 I/O station "
                              f"(device type 0x{device_type:08X})"))
