@@ -74,8 +74,10 @@ class FilterCorners:
         |Δu|·a·(T1²+T2²)/192 (measured on 90° corners: 1/240); when that alone exceeds the
         tolerance the corner is an exact stop (0), which the filter then passes exactly."""
         floor = du_n * acc * self.t2sum / 192.0
-        if floor >= self.tol or sum_n <= 1e-12:
-            return 0.0 if floor >= self.tol else math.inf
+        if floor >= self.tol:
+            return 0.0
+        if sum_n <= 1e-12:
+            return math.inf
         return (self.tol - floor) / (self.dev * sum_n)
 
     def arc_speed(self, radius: float) -> float:

@@ -48,9 +48,10 @@ class PositionFilter:
         return (self.n1 - 1 + self.n2 - 1) / 2.0
 
     def push(self, x: np.ndarray) -> np.ndarray:
-        if self._still >= self.span and np.array_equal(x, self._last):
+        same = np.array_equal(x, self._last)
+        if same and self._still >= self.span:
             return self.output.copy()
-        if np.array_equal(x, self._last):
+        if same:
             self._still += 1
         else:
             self._still = 0
