@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from nc.motion.offline import run
+from nc.motion.profile import solve_position
 from tests.motion_helpers import AX, arc, circle_chords, jagged_polyline, lines, mill_cfg, worst_ratio
 
 TOL = 1.0 + 1e-6
@@ -69,3 +70,28 @@ def test_chord_circle_within_5_percent_of_feed_limited_time():
     st = check(lines(pts, 3000), cfg, start=pts[0])
     feed_limited = 2 * math.pi * 100.0 / 50.0
     assert st.time < 1.05 * feed_limited
+
+
+def test_a_profile_that_overshoots_between_phase_boundaries_is_seen():
+    """Braking from 19.7 mm/s at -1232 mm/s² into 6.6 mm/s over 0.09 mm cannot be done: ruckig's
+    time-optimal answer runs past the target and comes back, with both extremes inside phases
+    (a passes zero mid-phase). The planner must see that and brake across the next block instead
+    (found at the end of a filtered CAM program, where it stopped dead at 7 mm/s)."""
+    pw = solve_position(-0.0139, 19.68, -1232.2, 0.0774, 6.6, 28.27, 2000.0, 100_000.0)
+    t = np.linspace(0.0, pw.duration, 20_001)
+    s, v, _ = pw.sample(t)
+    assert pw.p_max == pytest.approx(s.max(), abs=1e-6) and pw.p_max > 0.0774 + 0.03
+    assert pw.v_min() == pytest.approx(v.min(), abs=1e-3) and pw.v_min() < -5.0
+    assert pw.p.max() <= 0.0774 + 1e-9  # the phase boundaries alone look fine
+
+
+def test_filtered_cam_program_ends_within_limits():
+    rng = np.random.default_rng(5)
+    s = np.cumsum(rng.uniform(0.01, 0.1, 1500))
+    pts = [(0.0, 0.0, 0.0)] + [(x, 3.0 * math.sin(x / 4.0), 0.2 * math.cos(x / 3.0) - 0.2) for x in s]
+    for ms in (8.0, 16.0):
+        cfg = mill_cfg(filter_time=ms / 1000, filter_scurve=ms / 1000, min_segment_cycles=0.25)
+        st = run(lines(pts, 3000), cfg, {"X": 0.0, "Y": 0.0, "Z": 0.0})
+        assert st.state.value == "finished"
+        assert max(worst_ratio(st, cfg).values()) <= 1.0 + 1e-6
+        assert np.allclose(st.positions[-1], pts[-1], atol=1e-9)

@@ -36,6 +36,7 @@ class Piecewise:
     a: np.ndarray
     j: np.ndarray
     duration: float
+    p_max: float = np.inf  # highest position of DoF 0 anywhere on the profile (ruckig's extrema)
 
     @classmethod
     def of(cls, traj: Trajectory) -> "Piecewise":
@@ -50,7 +51,22 @@ class Piecewise:
                 # pad with a copy of the final (resting) phase
                 m[i, len(col):] = col[-1] if k else np.inf
             arrs.append(m)
-        return cls(arrs[0], arrs[1], arrs[2], arrs[3], arrs[4], float(traj.duration))
+        return cls(arrs[0], arrs[1], arrs[2], arrs[3], arrs[4], float(traj.duration),
+                   float(traj.position_extrema[0].max))
+
+    def v_min(self, dof: int = 0) -> float:
+        """Lowest velocity anywhere on the profile: at a phase boundary, or inside a phase where
+        the acceleration passes zero (v − a²/2j), which the boundaries alone miss."""
+        t0, v, a, j = self.t0[dof], self.v[dof], self.a[dof], self.j[dof]
+        h = np.diff(np.minimum(t0, self.duration))
+        a, j, v0 = a[:-1], j[:-1], v[:-1]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t_zero = np.where(j != 0.0, -a / j, -1.0)
+        inside = (t_zero > 0.0) & (t_zero < h)
+        low = float(v.min())
+        if inside.any():
+            low = min(low, float(np.min(v0[inside] - a[inside] ** 2 / (2.0 * j[inside]))))
+        return low
 
     def sample(self, t: np.ndarray, dof: int = 0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(position, velocity, acceleration) of one DoF at times t (clamped to [0, duration])."""
