@@ -15,7 +15,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 from nc.motion.offline import run  # noqa: E402
 from nc.motion.planner import Planner  # noqa: E402
 from tests.motion_helpers import AX, circle_chords, lines, mill_cfg, worst_ratio  # noqa: E402
-from benchmarks.bench_motion import cam_moves  # noqa: E402
+from benchmarks.bench_motion import cam_moves, plan_only  # noqa: E402
 
 
 def configs():
@@ -50,10 +50,7 @@ def main() -> None:
         pl = Planner(cfg, {"X": 0.0, "Y": 0.0, "Z": 0.0})
         n = 50_000
         t = time.perf_counter()
-        for mv in cam_moves(n):
-            pl.push(mv)
-            if len(pl.blocks) > pl.depth:
-                pl.blocks.popleft()
+        plan_only(pl, cam_moves(n))
         w = time.perf_counter() - t
         print(f"planning {n} CAM segments, {label:28s}: {n / w:8,.0f} blocks/s")
 

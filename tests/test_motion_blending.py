@@ -6,9 +6,14 @@ from __future__ import annotations
 
 import math
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as hst
 
+from nc.motion.lookahead import backward
 from nc.motion.offline import run
 from nc.motion.planner import Planner
 from nc.motion.smoothing import PositionFilter
@@ -147,3 +152,91 @@ def test_emergency_stop_freezes_the_filtered_setpoint():
     after = [pl.step().positions for _ in range(5)]
     assert all(np.array_equal(a, last) for a in after)
     assert pl.idle
+
+
+# ---- the windowed corner budgets and the look-ahead passes ----------------------------------------
+def planned(moves, cfg, start=(0.0, 0.0, 0.0)) -> tuple[list, Planner]:
+    """Plan a whole program in one look-ahead queue (nothing executes) and bring it up to date."""
+    pl = Planner(replace(cfg, lookahead=len(moves) + 2), dict(zip(AX, start)))
+    for mv in moves:
+        pl.push(mv)
+    pl.lookahead()
+    return list(pl.blocks), pl
+
+
+def worst_window(blocks, pl) -> float:
+    """Largest share of a filter budget any window uses, with every junction crossed at its planned
+    speed. A window (T = T1+T2) that ends at junction J reaches back to junction i only if the
+    path between them can be covered in T: no faster than J's speed plus what the acceleration
+    adds going back (v_J·T + A·T²/2), than a block between junctions no faster than v can reach
+    (√(v² + 2·A·L)), or than the blocks' top speed. Over every such stretch, Σ v·|Δu_i| against
+    the axis budget and Σ v·|Δu|·(T1+T2)/8 against the tolerance left after J's own braking term."""
+    fc = pl.lim.blend
+    T = fc.t_j
+    worst = 0.0
+    for jx in range(len(blocks) - 1):
+        J = blocks[jx]
+        if J.du is None:
+            continue
+        sums = np.zeros(len(AX))
+        sum_n = 0.0
+        amax = lmax = vtop = vjmax = 0.0
+        room = None
+        if fc.tol is not None:
+            room = fc.tol - J.du_n * max(J.a, blocks[jx + 1].a) * fc.t2sum / 192.0
+        for ix in range(jx, -1, -1):
+            b = blocks[ix]
+            if b.du is None:
+                break
+            if ix < jx:  # the stretch from junction ix to J: blocks ix+1 .. jx
+                nb = blocks[ix + 1]
+                amax, lmax, vtop = max(amax, nb.a), max(lmax, nb.length), max(vtop, nb.vtop)
+                vjmax = max(vjmax, nb.vend)
+                reach = min(J.vend * T + 0.5 * amax * T * T, T * math.sqrt(vjmax ** 2 + 2 * amax * lmax), T * vtop)
+                if J.s_end - b.s_end > reach:
+                    break
+            sums += b.vend * np.array(b.du)
+            sum_n += b.vend * b.du_n
+            worst = max(worst, float(np.max(sums / np.array(fc.budget))))
+            if room is not None and sum_n > 0.0:
+                worst = max(worst, sum_n * fc.dev / room if room > 0.0 else math.inf)
+    return worst
+
+
+def zigzag_with_feed_drop() -> list:
+    pts = [(k * 0.1, 0.01 * (k % 2), 0.0) for k in range(200)]
+    return lines(pts[:120], 6000) + lines(pts[119:], 600, first_line=200)
+
+
+@pytest.mark.parametrize("tol", [None, 0.02])
+def test_every_filter_window_stays_within_its_budget(tol):
+    cases = [lines(cam_curve(600), 3000), lines(jagged_polyline(), 6000), lines(circle_chords(2.0, 0.05), 3000),
+             zigzag_with_feed_drop()]
+    for moves in cases:
+        start = tuple(moves[0].start[a] for a in AX)
+        blocks, pl = planned(moves, filtered(tol=tol), start)
+        assert worst_window(blocks, pl) <= 1.0 + 1e-9
+
+
+@given(hst.lists(hst.tuples(hst.floats(-1, 1), hst.floats(-1, 1), hst.sampled_from([0.01, 0.05, 0.3])),
+                min_size=5, max_size=60),
+       hst.sampled_from([600, 3000, 12000]), hst.integers(2, 9))
+@settings(max_examples=40, deadline=None)
+def test_lazy_backward_pass_equals_a_full_one(steps, feed, batch):
+    """Pushing blocks without a pass and running the owed pass later (as the queue does when it
+    refills in batches) gives the end speeds a full backward pass gives."""
+    pts = [(0.0, 0.0, 0.0)]
+    for dx, dy, n in steps:
+        d = np.array([dx, dy, 0.1])
+        pts.append(tuple(np.array(pts[-1]) + d / np.linalg.norm(d) * n))
+    moves = lines(pts, feed)
+    cfg = filtered(tol=0.01)
+    pl = Planner(replace(cfg, lookahead=len(moves) + 2), {"X": 0.0, "Y": 0.0, "Z": 0.0})
+    for k, mv in enumerate(moves):
+        pl.push(mv)
+        if k % batch == 0:
+            pl.lookahead()
+    pl.lookahead()
+    lazy = [(b.vend, b.vjunc) for b in pl.blocks]
+    backward(pl.blocks, 0, full=True)
+    assert lazy == pytest.approx([(b.vend, b.vjunc) for b in pl.blocks], rel=1e-9, abs=1e-9)

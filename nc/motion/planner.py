@@ -77,6 +77,15 @@ class Planner:
         self._thread: thr.ThreadState | None = None
         self.thread_log: list[tuple[int, float, float]] = []  # (line, sync angle, ramp start angle) per chain
         self.depth = cfg.lookahead_depth()
+        # The queue refills in batches: once `full` it takes more blocks only when it has fallen
+        # below depth (never shallower than configured), up to depth + batch. One backward pass
+        # then serves the whole batch instead of one per block.
+        self._batch = self.depth // 6
+        self._filling = True
+        # Backward pass owed (run lazily before a plan reads end speeds): pushes since the last
+        # pass, and how many blocks from the tail it must recompute at least.
+        self._pushed = 0
+        self._need = 0
         self.line = 0
         # operator controls
         self._feed_ovr = 1.0
@@ -124,7 +133,18 @@ class Planner:
             prev = self.blocks[-1]
             prev.vjunc = self.lim.junction(prev, b)
         self.blocks.append(b)
-        backward(self.blocks, 0, depth=blend.window(self.blocks) if blend is not None else 0)
+        self._pushed += 1
+        # Blocks pushed since the last pass never had one: the pass must reach past all of them.
+        need = max(self._need + 1, self._pushed)
+        if blend is not None:
+            need = max(need, blend.window(self.blocks))
+        self._need = need
+
+    def lookahead(self) -> None:
+        """Bring the queue's end speeds up to date (the backward pass the pushes owe)."""
+        if self._pushed:
+            backward(self.blocks, 0, depth=self._need)
+            self._pushed = self._need = 0
 
     @property
     def queue(self) -> deque[Block]:
@@ -136,7 +156,12 @@ class Planner:
 
     @property
     def full(self) -> bool:
-        return len(self.blocks) >= self.depth
+        n = len(self.blocks)
+        if n >= self.depth + self._batch:
+            self._filling = False
+        elif n < self.depth:
+            self._filling = True
+        return not self._filling
 
     @property
     def idle(self) -> bool:
@@ -348,6 +373,7 @@ class Planner:
         for b in self.blocks:
             self._update_cap(b)
         backward(self.blocks, 0, full=True)
+        self._pushed = self._need = 0
         self._replan()
 
     def _replan(self) -> None:
@@ -385,6 +411,7 @@ class Planner:
     def _flush(self) -> None:
         self._thread = None
         self.blocks.clear()
+        self._pushed = self._need = 0
         self.plan = None
         self._buf_pos = None
         self._started = False
@@ -472,9 +499,9 @@ class Planner:
             ve, de = (v - a * a / (2.0 * rj), dist - s - v * abs(a) / rj) if a < 0.0 else (v, dist - s)
             v1 = min(v1, reach(max(ve, 0.0), max(de, 0.0), MARGIN * ra, MARGIN * rj))
             pw = solve_position(s, v, a, dist, v1, vmax, ra, rj)
-            if pw is not None and pw.p.max() <= dist + 1e-7 and pw.v.min() >= -1e-7:
+            if pw is not None and pw.p_max <= dist + 1e-7 and pw.v_min() >= -1e-7:
                 break
-        if pw is None or pw.p.max() > dist + 1e-7 or pw.v.min() < -1e-7:
+        if pw is None or pw.p_max > dist + 1e-7 or pw.v_min() < -1e-7:
             # Cannot meet the target from this state (an override just cut the cap): ramp down
             # to the cap first, then plan the rest from there.
             target = min(cap, max(v1, 0.0))
@@ -497,6 +524,7 @@ class Planner:
         A junction past `cruise_from` (where the cap is reached) that may be crossed at the cap
         ends the run too: the profile cruises there, so nothing beyond it changes this solve.
         """
+        self.lookahead()
         blocks = self.blocks
         b = blocks[0]
         dist, ra, rj = b.length, b.a, b.j
