@@ -79,8 +79,9 @@ class Planner:
         self.depth = cfg.lookahead_depth()
         # The queue refills in batches: once `full` it takes more blocks only when it has fallen
         # below depth (never shallower than configured), up to depth + batch. One backward pass
-        # then serves the whole batch instead of one per block.
-        self._batch = self.depth // 6
+        # then serves the whole batch instead of one per block; the batch stays small (8 blocks
+        # at the default depth) so a refill costs a fraction of a 1 ms cycle, not a spike.
+        self._batch = self.depth // 12
         self._filling = True
         # Backward pass owed (run lazily before a plan reads end speeds): pushes since the last
         # pass, and how many blocks from the tail it must recompute at least.
