@@ -237,6 +237,6 @@ def test_lazy_backward_pass_equals_a_full_one(steps, feed, batch):
         if k % batch == 0:
             pl.lookahead()
     pl.lookahead()
-    lazy = [(b.vend, b.vjunc) for b in pl.blocks]
+    lazy = [x for b in pl.blocks for x in (b.vend, b.vjunc)]
     backward(pl.blocks, 0, full=True)
-    assert lazy == pytest.approx([(b.vend, b.vjunc) for b in pl.blocks], rel=1e-9, abs=1e-9)
+    assert lazy == pytest.approx([x for b in pl.blocks for x in (b.vend, b.vjunc)], rel=1e-9, abs=1e-9)
