@@ -88,6 +88,7 @@ class Bench:
     enable_timeout: float = 0.5  # s allowed for every drive to reach operation enabled
     settle_time: float = 0.3  # s the bench keeps cycling after the program to let axes settle
     max_time: float = 3600.0  # s of simulated time before the run is abandoned with an alarm
+    lookahead: int | None = None  # look-ahead depth in blocks; None: max(100, v/(2·a·T)) (issue 5)
     mlc: str = ""  # MLC logic: "" (by profile, see mlc_program), "basic", "lathe", "package.module" or a .py path
     checks: ChecksConfig = field(default_factory=ChecksConfig)
     realtime: RealtimeConfig = field(default_factory=RealtimeConfig)
@@ -112,7 +113,8 @@ class Bench:
         scurve = p.get("N1.037", FILTER_MS) / 1000.0
         dev = p.get("N1.053", PATH_DEVIATION)
         cfg = MotionConfig(cycle=self.cycle, axes=self.axis_names, limits={a.name: a.limits for a in self.axes},
-                           filter_time=filt, filter_scurve=scurve, path_tolerance=dev if dev > 0.0 else None)
+                           filter_time=filt, filter_scurve=scurve, path_tolerance=dev if dev > 0.0 else None,
+                           lookahead=self.lookahead)
         if cfg.filtered:
             # The filter spreads what several blocks in one cycle do; a block need not last a cycle.
             cfg.min_segment_cycles = 0.25

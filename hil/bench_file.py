@@ -185,6 +185,7 @@ def parse_bench(text: str, source: str = "bench.toml") -> Bench:
     b.enable_timeout = r.number(data, "enable_timeout", "enable_timeout", b.enable_timeout, positive=True) or 0.5
     b.settle_time = r.number(data, "settle_time", "settle_time", b.settle_time, minimum=0.0)
     b.max_time = r.number(data, "max_time", "max_time", b.max_time, positive=True) or b.max_time
+    b.lookahead = r.integer(data, "lookahead", "lookahead", None, positive=True)
 
     params = r.table(data, "params", "params")
     for k, v in params.items():
@@ -226,7 +227,7 @@ def parse_bench(text: str, source: str = "bench.toml") -> Bench:
     b.checks = _checks(r, r.table(data, "checks", "checks"), b.axis_names)
     b.io = _io_stations(r, data.pop("io", []), len(b.axes) + len(b.spindles))
     r.unknown(data, "", {"name", "profile", "cycle_ms", "bus", "mlc", "enable_timeout", "settle_time", "max_time",
-                         "params", "axes", "spindles", "realtime", "checks", "io"})
+                         "lookahead", "params", "axes", "spindles", "realtime", "checks", "io"})
 
     names = b.axis_names
     if b.axes and b.profile != "nc5-mill" and "X" not in names:
