@@ -43,6 +43,7 @@ class IoStationConfig:
     map: IoMap
     canopen_node: int = 64
     canopen_tpdo: str = "sync"  # "sync": inputs sent on every SYNC; "change": on change of state
+    modules: tuple[str, ...] = ()  # EtherCAT R1-EC module list (DI16, DO8, …); () = the default DI16 + DO16
 
 
 @dataclass

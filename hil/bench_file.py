@@ -364,7 +364,33 @@ def _checks(r: _Reader, d: dict, axes: tuple[str, ...]) -> ChecksConfig:
     return c
 
 
-_IO_KEYS = {"name", "inputs", "outputs", "x", "y", "canopen_node", "canopen_tpdo"}
+_IO_KEYS = {"name", "inputs", "outputs", "x", "y", "canopen_node", "canopen_tpdo", "modules"}
+
+
+def _io_modules(r: _Reader, d: dict, p: str, points_max: int) -> tuple[str, ...]:
+    """`modules`: an R1-EC station's modules in slot order (DI8/16/32, DO8/16/32); () when absent."""
+    from virtual_bus.ethercat.r1ec import MODULES, points
+
+    if "modules" not in d:
+        return ()
+    raw = d.pop("modules")
+    if not isinstance(raw, list) or not raw:
+        r.err(f"{p}.modules", f"must be a non-empty list of module names like [\"DI16\", \"DO16\"], got {_kind(raw)}")
+        return ()
+    mods = []
+    for i, m in enumerate(raw):
+        name = m.strip().upper() if isinstance(m, str) else None
+        if name not in MODULES:
+            r.err(f"{p}.modules[{i}]", f"unknown module {m!r} (R1-EC modules: {', '.join(MODULES)})")
+        else:
+            mods.append(name)
+    if len(mods) != len(raw):
+        return ()
+    n_in, n_out = points(mods)
+    if n_in > points_max or n_out > points_max:
+        r.err(f"{p}.modules", f"{n_in} inputs / {n_out} outputs: a station has at most {points_max} of each")
+        return ()
+    return tuple(mods)
 
 
 def _io_stations(r: _Reader, stations: Any, n_drives: int) -> list[IoStationConfig]:
@@ -385,6 +411,18 @@ def _io_stations(r: _Reader, stations: Any, n_drives: int) -> list[IoStationConf
         name = r.string(d, "name", f"{p}.name", f"EIO-{501 + k}") or f"EIO-{501 + k}"
         if any(o.map.name == name for o in out):
             r.err(f"{p}.name", f"duplicate station name {name!r}")
+        modules = _io_modules(r, d, p, POINTS_MAX)
+        if modules:  # the station's points are its modules' (inputs/outputs, if given too, must agree)
+            from virtual_bus.ethercat.r1ec import points
+
+            m_in, m_out = points(modules)
+            for key, have in (("inputs", m_in), ("outputs", m_out)):
+                given = d.get(key)
+                if key in d and given != have:
+                    r.err(f"{p}.{key}", f"{given!r}, but modules {' + '.join(modules)} have {have}")
+                    d.pop(key)
+            d.setdefault("inputs", m_in)
+            d.setdefault("outputs", m_out)
         n_in = r.integer(d, "inputs", f"{p}.inputs", 16, minimum=0, maximum=POINTS_MAX)
         n_out = r.integer(d, "outputs", f"{p}.outputs", 16, minimum=0, maximum=POINTS_MAX)
         n_in, n_out = 16 if n_in is None else n_in, 16 if n_out is None else n_out
@@ -400,7 +438,7 @@ def _io_stations(r: _Reader, stations: Any, n_drives: int) -> list[IoStationConf
             r.err(f"{p}.canopen_node", f"duplicate CANopen node {node}")
         tpdo = r.string(d, "canopen_tpdo", f"{p}.canopen_tpdo", "sync", ("sync", "change")) or "sync"
         r.unknown(d, f"{p}.", _IO_KEYS)
-        out.append(IoStationConfig(IoMap(name, n_in, n_out, x, y, k), node, tpdo))
+        out.append(IoStationConfig(IoMap(name, n_in, n_out, x, y, k), node, tpdo, modules))
         next_x, next_y = next_block(max(next_x, x + n_in)), next_block(max(next_y, y + n_out))
     for msg in overlaps([o.map for o in out]):
         r.err("io", msg)

@@ -24,7 +24,8 @@ def _add_ethercat(sims: argparse._SubParsersAction) -> None:
     p.add_argument("--iface", required=True, help="network interface (e.g. one end of a veth pair)")
     p.add_argument("--bench", help="bench file (TOML); default: the built-in 2-axis lathe")
     p.add_argument("--io", type=int, default=0, metavar="N",
-                   help="R1-EC class 16/16 digital I/O slaves after the drives (default: one per [[io]] station of the bench)")
+                   help="R1-EC class I/O slaves after the drives: one per [[io]] station of the bench (its `modules`), "
+                        "then DI16 + DO16 ones up to N")
     p.add_argument("--realtime", action="store_true",
                    help="advance drive models by wall-clock time between frames instead of one cycle per frame")
     p.add_argument("--fault", action="append", default=[], metavar="SPEC", help="inject a scripted fault (repeatable)")
@@ -55,21 +56,27 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def build_chain(bench, io: int = 0, realtime: bool = False, faults=()):
-    """Software ESCs for the bench's drives (ASDA-A3-E class) and `io` R1-EC class DIO modules."""
+    """Software ESCs for the bench's drives (ASDA-A3-E class) and R1-EC class I/O stations: one per
+    [[io]] station with its `modules`, and up to `io` in all (extra ones DI16 + DO16)."""
     from virtual_bus.ethercat.app import DioApp, DriveApp
     from virtual_bus.ethercat.device import load_device
     from virtual_bus.ethercat.esc import Esc
     from virtual_bus.ethercat.network import Chain
 
-    drive_dev, dio_dev = load_device("asda-a3-e"), load_device("r1-ec-dio")
+    from virtual_bus.ethercat.r1ec import DEFAULT_MODULES, r1ec_device
+
+    drive_dev = load_device("asda-a3-e")
     slaves = []
     for k, d in enumerate(sim_slaves(bench)):
         # Clocks start apart and run at slightly different rates, so DC has something to do.
         slaves.append(Esc(drive_dev, DriveApp(d), name=d.name, drift_ppm=(-1) ** k * 10.0 * k,
                           clock_base_ns=(k + 1) * 1_234_567_890, cycle_time=bench.cycle, lockstep=not realtime))
-    stations = [st.map.name for st in getattr(bench, "io", [])]  # the bench's [[io]] stations, then extra ones
+    # the bench's [[io]] stations (each with its R1-EC modules), then extra default 16/16 ones
+    stations = [(st.map.name, st.modules or DEFAULT_MODULES) for st in getattr(bench, "io", [])]
+    devices = {mods: r1ec_device(mods) for _, mods in stations} | {DEFAULT_MODULES: load_device("r1-ec-dio")}
     for k in range(max(io, len(stations))):
-        slaves.append(Esc(dio_dev, DioApp(), name=stations[k] if k < len(stations) else f"DIO{k + 1}",
+        name, mods = stations[k] if k < len(stations) else (f"DIO{k + 1}", DEFAULT_MODULES)
+        slaves.append(Esc(devices[mods], DioApp(), name=name,
                           clock_base_ns=(len(slaves) + 1) * 987_654_321, cycle_time=bench.cycle,
                           lockstep=not realtime))
     return Chain(slaves, list(faults))

@@ -105,25 +105,51 @@ class DriveApp(SlaveApp):
 
 @dataclass
 class DioApp(SlaveApp):
-    """16 digital inputs (0x6000:1) and 16 outputs (0x7000:1); inputs can be driven by a test."""
+    """An R1-EC station's digital modules (virtual_bus/ethercat/r1ec.py): `inputs` / `outputs` are the
+    station's points in module order; input module i is 0x6000+0x10·i:1, output module j 0x7000+0x10·j:1
+    (the default station: 16 inputs at 0x6000:1, 16 outputs at 0x7000:1). A test drives `inputs`."""
 
     inputs: int = 0
     outputs: int = 0
     od: ObjectDictionary | None = None
     history: list[int] = field(default_factory=list)
+    in_objs: list[tuple[int, int]] = field(default_factory=list)  # (index, bits) per input module
+    out_objs: list[tuple[int, int]] = field(default_factory=list)
 
     def attach(self, od: ObjectDictionary) -> None:
         self.od = od
+        self.in_objs = self._modules(od, 0x6000)
+        self.out_objs = self._modules(od, 0x7000)
+
+    @staticmethod
+    def _modules(od: ObjectDictionary, base: int) -> list[tuple[int, int]]:
+        out, index = [], base
+        while index in od.objects:
+            out.append((index, od.objects[index].entries[1].bits))
+            index += 0x10
+        return out
+
+    def _publish(self) -> None:
+        od = self.od
+        assert od is not None
+        shift = 0
+        for index, bits in self.in_objs:
+            od.set(index, 1, self.inputs >> shift & ((1 << bits) - 1))
+            shift += bits
 
     def refresh(self, index: int) -> None:
-        if self.od is not None and index == 0x6000:
-            self.od.set(0x6000, 1, self.inputs)
+        if self.od is not None and any(index == i for i, _ in self.in_objs):
+            self._publish()
 
     def cycle(self, outputs: bytes, rx_map, tx_map, step: bool, dt: float = 0.0) -> bytes:
         od = self.od
         assert od is not None
         if step:
             _unpack(outputs, rx_map, od)
-            self.outputs = od.value(0x7000, 1)
-        od.set(0x6000, 1, self.inputs)
+            value, shift = 0, 0
+            for index, bits in self.out_objs:
+                value |= (od.value(index, 1) & ((1 << bits) - 1)) << shift
+                shift += bits
+            self.outputs = value
+        self._publish()
         return _pack(tx_map, od)

@@ -393,7 +393,8 @@ class Esc:
             for lo, hi, p in writes:
                 self.mem[p:p + hi - lo] = data[lo - addr:hi - addr]
             inc += 2 if cmd == LRW else 1
-        if writes and state == OP:
+        # A slave without outputs (an R1-EC station of input modules only) cycles on its reads.
+        if state == OP and (writes or (reads and not self.rx_map)):
             now = time.monotonic_ns()
             dt = self.cycle_time
             if not self.lockstep and self.last_cycle_ns:
