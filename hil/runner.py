@@ -21,6 +21,7 @@ from mlc.basic import BasicMlc
 from nc.alarms import SERVO_ALARM, Alarm, NcAlarm, internal_error
 from nc.channel import Channel, RunState, skip_hook
 from nc.interp import Interpreter
+from nc.interrupt import m96_link
 from nc.motion import Planner
 from nc.motion.css import spindle_speed
 from nc.moves import Event
@@ -147,6 +148,7 @@ class BenchRunner:
         ch.soft_limits = SoftLimits.for_bench(self.bench, getattr(self, "profile", None))
         if getattr(self, "_interp", None) is not None:  # G31 skip (issue 5)
             ch.on_skip = skip_hook(self._interp)
+            ch.m96 = m96_link(self._interp)  # M2x019 program interruption
         for a in self.result.alarms:
             ch.alarms.append(a)
         ch.load(events)

@@ -34,9 +34,10 @@ from mlc.signals import d2, d3, m2, m3
 from nc.alarms import Alarm, NcAlarm
 from nc.channel import Channel
 from nc.interp import Interpreter
+from nc.interrupt import m96_link
 from nc.motion import Planner
 from nc.profiles import make_profile
-from nc.program import parse_program
+from nc.store import ProgramStore
 
 
 class ScriptError(Exception):
@@ -296,7 +297,9 @@ class Machine:
         self.mlc.mem.set_u16(d2(self.x, 0), 0)
         self.wait_until(lambda: self.mlc.link.mode == 0 and not self.mlc.manual.busy, 5.0, "AUTO mode")
         try:
-            program = parse_program(text, name=name)
+            store = ProgramStore()  # O programs after the main one are its subprograms (M98, M96 P_)
+            program = store.add_text(text, name)[0]
+            program.store = store
         except NcAlarm as exc:
             raise ScriptError(str(exc.alarm)) from None
         here = dict(zip(r.axes, r.channel.planner.position.tolist()))
@@ -304,6 +307,7 @@ class Machine:
         self.mlc.attach_variables(interp.vars)
         ch = Channel(Planner(self.bench.motion_config(), here, spindle_rpm=lambda: self.mlc.spindle.rpm))
         r.channel = ch
+        ch.m96 = m96_link(interp)  # the MLC's M2x019 interrupts it (machine.interrupt())
         ch.load(interp.run(program))
         self.pulse(m2(self.x, 0))
         return ch
@@ -340,6 +344,10 @@ class Machine:
     def estop(self, on: bool = True) -> None:
         self.mlc.mem.set_bit(m2(self.x, 13), on)
         self.cycle()
+
+    def interrupt(self) -> None:
+        """Raise M2x019 (M96 program interruption) for a few cycles; M3x031 shows it running."""
+        self.pulse(m2(self.x, 19))
 
     def feed_hold(self) -> None:
         self.pulse(m2(self.x, 1))

@@ -104,6 +104,8 @@ class ChannelLink:
         if self._rising(m2(x, 0)):
             self._cycle_start(ch)
         self._finish_input(ch)
+        if self._rising(m2(x, 19)) and callable(getattr(ch, "interrupt", None)):
+            ch.interrupt()  # M2x019: M96 program interruption (nc.interrupt)
         self._overrides(ch)
         self._spindle_alarm(ch)
         self._user_alarms(ch)
@@ -318,6 +320,7 @@ class ChannelLink:
             self._set3(19, True)
         elif not self._reset_pending:
             self._set3(19, False)
+        self._set3(31, bool(getattr(ch, "interrupt_active", False)))  # M3x031: M96 in execution
         self._set3(25, ch.state is RunState.ALARM or any(not isinstance(a.code, str) for a in self.alarms))
         self._set3(40, bool(mem.active_alarms()))
         block_stop = ch.state.name == "BLOCK_STOP"

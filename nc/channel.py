@@ -24,6 +24,7 @@ from dataclasses import dataclass, field
 from enum import Enum
 
 from nc.alarms import Alarm, NcAlarm, internal_error
+from nc.interrupt import M96Link, interrupt_stream
 from nc.motion.css import css_rpm
 from nc.motion.planner import Planner, Setpoint
 from nc.moves import Aux, Event, Move, ProgramEnd, Sync
@@ -68,6 +69,10 @@ class Channel:
     on_skip: Callable[[dict[str, float], dict[str, float]], None] | None = None
     skip_latched: dict[str, float] | None = None
     _skip_move: Move | None = None
+    # M96 (nc.interrupt): the MLC's M2x019 edge reaches interrupt(); m96 links the interpreter.
+    m96: M96Link | None = None
+    _interrupt: str | None = None  # "pending" (trigger taken) | "stopping" (braking along the path)
+    _m96_running: bool = False  # the interrupt program's motion is in progress (M3x031)
 
     def load(self, events: Iterator[Event]) -> None:
         self.events = events
@@ -166,6 +171,46 @@ class Channel:
         if self.on_skip is not None:
             self.on_skip(latched, stop)
 
+    # ---- M96 program interruption ---------------------------------------------------------
+    @property
+    def interrupt_active(self) -> bool:
+        """M3x031: the interrupt program runs (from the stop until its last move has ended)."""
+        return self._m96_running and self.state in (RunState.RUNNING, RunState.WAIT_AUX, RunState.HOLD,
+                                                    RunState.BLOCK_STOP)
+
+    def interrupt(self) -> None:
+        """The MLC's M2x019 (rising edge). With M96 P_ in force and the program running, the axes
+        stop along the path from this cycle on and the interrupt program runs from where they stand;
+        otherwise (no M96, M97, not running, an interrupt already running) it does nothing."""
+        if self.m96 is None or self._interrupt is not None or self._m96_running \
+                or self.state is not RunState.RUNNING or not self.m96.enabled():
+            return
+        self._interrupt = "pending"
+
+    def _interrupt_step(self) -> None:
+        pl = self.planner
+        if self.state is not RunState.RUNNING:  # a reset, an alarm or a hold came first
+            self._interrupt = None
+            return
+        if self._interrupt == "pending":
+            act = pl.active
+            if self._skip_move is not None or self._limit_alarm is not None \
+                    or (act is not None and act.kind == "thread"):
+                return  # G31 and spindle-locked threads cannot stop on their path: taken after them
+            pl.hold()
+            self._interrupt = "stopping"
+            return
+        if not pl.halted:
+            return
+        # At rest: the suspended block and what was read ahead leave the planner (look-ahead flushed)
+        self._interrupt = None
+        stop = dict(zip(pl.axes, pl.position.tolist()))
+        held: list[Event] = [b.move for b in pl.queue]
+        held += [e for e in (self._deferred, self.end) if e is not None]
+        self._deferred, self.end = None, None
+        pl.stop()
+        self.events = interrupt_stream(self, held, stop, self.events)
+
     # ---- faults -----------------------------------------------------------------------
     def raise_alarm(self, alarm: Alarm) -> None:
         """Any alarm, from the program, a drive or the bus: controlled stop, then ALARM."""
@@ -184,7 +229,9 @@ class Channel:
 
     # ---- per cycle --------------------------------------------------------------------
     def step(self) -> Setpoint:
-        if self.state is RunState.RUNNING:
+        if self._interrupt is not None:
+            self._interrupt_step()
+        if self.state is RunState.RUNNING and self._interrupt is None:
             self._feed_planner()
         try:
             sp = self.planner.step()

@@ -143,6 +143,47 @@ class Interpreter:
             self._interrupt_pending = True
             self._interrupt_stop = dict(stopped_at) if stopped_at is not None else None
 
+    def interrupt_events(self, stopped_at: dict[str, float]) -> Iterator[Event]:
+        """The M96 program run at once from `stopped_at`, up to its M99 (the channel's M2x019 while
+        the interpreter has read blocks ahead of the motion). Its moves start where the axes
+        stopped; afterwards the reading position (position, last point, block) is back where the
+        read-ahead left it, so the main program reads on unchanged. Modal changes it makes stay."""
+        st = self.state
+        if st.comp in (41, 42) or st.scaling:
+            raise NcAlarm(0x0005, "M96 interrupt while G41/G42 or G51 is active")
+        prog = self.store.find(self.interrupt_program or 0)
+        saved = dict(self.position), dict(self.last_target), self.block, self.program_name
+        base = len(self.stack)
+        self.stack.append(Frame(prog, 0, "m96", False, 1))
+        self.position.update({a: v for a, v in stopped_at.items() if a in self.position})
+        self.last_target = self.work_position()
+        limit = int(self.profile.param("max blocks", 1_000_000))
+        try:
+            while len(self.stack) > base:
+                fr = self.stack[-1]
+                if fr.pc >= len(fr.program.blocks):
+                    self._return(None)  # the end of the interrupt program returns like M99
+                    continue
+                block = fr.program.blocks[fr.pc]
+                fr.pc += 1
+                self._executed += 1
+                if self._executed > limit:
+                    raise NcAlarm(0x0000, f"more than {limit} blocks executed (endless loop?)",
+                                  line=block.line, block=block.text, program=fr.program.name)
+                if block.skip and self.block_skip:
+                    continue
+                self.program_name = fr.program.name
+                try:
+                    for ev in self._execute(block):
+                        yield ev
+                        if isinstance(ev, ProgramEnd):  # M02/M30 in the interrupt program ends it all
+                            return
+                except NcAlarm as alarm:
+                    raise alarm.at(block.line, block.text, fr.program.name) from None
+        finally:
+            del self.stack[base:]
+            self.position, self.last_target, self.block, self.program_name = saved
+
     def record_skip(self, machine: dict[str, float]) -> None:
         """Issue 5 reports where a G31 move stopped; #21048…/#21064… read it back."""
         self.skip_position = dict(machine)

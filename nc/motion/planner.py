@@ -169,6 +169,11 @@ class Planner:
         return not self.blocks and self.plan is None and self._buf_done and self._settled
 
     @property
+    def halted(self) -> bool:
+        """Held (feed hold / stop) and standing still, with the queue kept."""
+        return self.held and self.plan is None and self._buf_done and self.at_rest and self._settled
+
+    @property
     def _settled(self) -> bool:
         return self.filter is None or self.filter.settled
 

@@ -1,0 +1,150 @@
+"""M96 program interruption through the channel and the MLC relays (NC5 §3.11.4.6): M2x019 stops the
+running move on its path, the interrupt program runs from there with M3x031 ON, and its M99 goes on
+in a straight line to the suspended block's end. Positions are checked in simulated time."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from hil.bench_file import load_bench_file
+from hil.scripting import Machine
+from hil.session import make_link
+from mlc.machine import Mlc
+from nc.channel import RunState
+from nc.interp import Interpreter
+from nc.interrupt import m96_link
+from nc.motion.offline import run
+from nc.profiles import make_profile
+from nc.store import ProgramStore
+from tests.conftest import ROOT
+from tests.motion_helpers import mill_cfg, worst_ratio
+
+# line 3 cuts X0→X100 at 50 mm/s; O0050 lifts Z by 10 and lowers it again (incremental)
+PROGRAM = ("G90 G17 G21 G94\nM96 P50\nG01 X100. F3000\nY50.\nX0\nM30\n"
+           "O0050\nG91 G01 Z10. F2000\nZ-10.\nM99\n")
+TRIGGER = 1000  # cycle of the M2x019 edge: X ≈ 48.9, half way along line 3
+
+
+def stream(text: str = PROGRAM, trigger: int | None = TRIGGER, **cfg_kw):
+    store = ProgramStore()
+    prog = store.add_text(text)[0]
+    it = Interpreter(make_profile("nc5-mill"), store=store)
+    cfg = mill_cfg(**cfg_kw)
+    seen: dict[str, list] = {"active": [], "trigger_x": []}
+
+    def on_cycle(n, ch):
+        if n == 0:
+            ch.m96 = m96_link(it)
+        if n == trigger:
+            seen["trigger_x"].append(float(ch.planner.position[0]))
+            ch.interrupt()
+        seen["active"].append(ch.interrupt_active)
+
+    st = run(it.run(prog), cfg, {"X": 0.0, "Y": 0.0, "Z": 0.0}, on_cycle=on_cycle)
+    return st, cfg, np.array(seen["active"]), seen["trigger_x"]
+
+
+def test_m2x019_suspends_the_move_runs_o0050_and_returns_to_the_block_end():
+    st, cfg, active, trig = stream()
+    assert st.state is RunState.FINISHED and not st.alarms
+    p, lines = st.positions, st.lines
+    x_trig = trig[0]
+    assert 48.0 < x_trig < 50.0
+    # the cut stopped on its path a braking distance after the trigger, far from its end X100
+    o50 = np.flatnonzero(np.isin(lines, (8, 9)))
+    stop = p[o50[0] - 1]
+    assert x_trig < stop[0] < x_trig + 1.5 and stop[1] == 0.0 and stop[2] == 0.0
+    # braking began at once: no cycle after the trigger was faster than the one before it
+    v = np.abs(np.diff(p[TRIGGER:o50[0], 0]))
+    assert np.all(np.diff(v) <= 1e-12)
+    # O0050 ran from the stop point: Z up 10 and back, X/Y standing still
+    assert np.allclose(p[o50, 0], stop[0]) and np.allclose(p[o50, 1], 0.0)
+    assert abs(p[o50, 2].max() - 10.0) < 1e-4 and abs(p[o50[-1], 2]) < 1e-9
+    # M3x031 (interrupt_active) is ON exactly while O0050 moves, OFF before and after
+    on = np.flatnonzero(active)
+    assert on[0] <= o50[0] and on[-1] >= o50[-1] and not active[TRIGGER - 1]
+    assert not active[-1] and np.all(active[on[0]:on[-1] + 1])
+    # M99: line 3 goes on from the stop point to X100, then lines 4 and 5 as programmed
+    after = lines[o50[-1] + 1:]
+    rest = p[o50[-1] + 1:]
+    l3 = rest[after == 3]
+    assert np.allclose(l3[:, 1:], 0.0, atol=1e-3) and abs(l3[:, 0].max() - 100.0) < 1e-3 and l3[0, 0] >= stop[0]
+    assert abs(rest[after == 4][:, 1].max() - 50.0) < 1e-3
+    assert np.allclose(p[-1], (0.0, 50.0, 0.0), atol=1e-9)
+    # every cycle, also the stop and the restart, within the axis limits
+    worst = worst_ratio(st, cfg)
+    assert max(worst.values()) <= 1.0 + 1e-6, worst
+
+
+def test_interrupt_with_the_position_filter_on():
+    st, cfg, active, trig = stream(filter_time=0.016, filter_scurve=0.008)
+    assert st.state is RunState.FINISHED and not st.alarms
+    p = st.positions
+    assert 9.9 < p[:, 2].max() < 10.0 + 1e-9 and p[np.argmax(p[:, 2]), 0] < 51.0  # the filter rounds the reversal
+    assert np.allclose(p[-1], (0.0, 50.0, 0.0), atol=1e-9)
+    assert max(worst_ratio(st, cfg).values()) <= 1.0 + 1e-6
+
+
+def test_m97_or_no_m96_makes_the_trigger_do_nothing():
+    plain, _, _, _ = stream(trigger=None)
+    for text in (PROGRAM.replace("M96 P50\n", "M96 P50\nM97\n"), PROGRAM.replace("M96 P50\n", "")):
+        st, _, active, _ = stream(text)
+        assert st.state is RunState.FINISHED and not active.any()
+        assert st.positions[:, 2].max() == 0.0  # O0050 never ran
+        assert len(st.positions) == len(plain.positions) and np.allclose(st.positions, plain.positions)
+
+
+def test_interrupt_of_an_arc_returns_in_a_straight_line():
+    text = ("G90 G17 G21 G94\nM96 P50\nG02 X20. Y0 R10. F1200\nM30\n"
+            "O0050\nG91 G01 Z5. F2000\nZ-5.\nM99\n")
+    st, cfg, _, _ = stream(text, trigger=400)
+    assert st.state is RunState.FINISHED and not st.alarms
+    p, lines = st.positions, st.lines
+    o50 = np.flatnonzero(np.isin(lines, (6, 7)))
+    stop = p[o50[0] - 1]
+    assert abs(np.hypot(stop[0] - 10.0, stop[1]) - 10.0) < 1e-6 and 0.5 < stop[0] < 19.5  # on the arc
+    back = p[o50[-1] + 1:]
+    # straight from the stop point to X20 Y0 (N§3.11.4.6 note 2): every point on that chord
+    d = np.array([20.0, 0.0]) - stop[:2]
+    cross = (back[:, 0] - stop[0]) * d[1] - (back[:, 1] - stop[1]) * d[0]
+    assert np.abs(cross).max() < 1e-6 and np.allclose(p[-1], (20.0, 0.0, 0.0), atol=1e-9)
+    assert max(worst_ratio(st, cfg).values()) <= 1.0 + 1e-6
+
+
+def test_interrupt_with_g41_active_raises_0x0005():
+    text = ("G90 G17 G21 G94\nM96 P50\nG41 D1 G01 X20. F3000\nX100.\nG40 X110.\nG01 Y10.\nM30\n"
+            "O0050\nG91 G01 Z5. F2000\nM99\n")
+    st, _, _, _ = stream(text, trigger=600)
+    assert st.state is RunState.ALARM and [a.code for a in st.alarms] == [0x0005]
+
+
+@pytest.fixture
+def mill_machine():
+    bench = load_bench_file(ROOT / "benches" / "mill-3axis.toml")
+    mlc = Mlc(axes=bench.axis_names, cycle=bench.cycle, motion=bench.motion_config())
+    m = Machine(bench, mlc, make_link(bench))
+    m.power_up()
+    yield m
+    m.close()
+
+
+def test_m21019_relay_interrupts_on_the_bench_and_m31031_shows_it(mill_machine):
+    m = mill_machine
+    ch = m.start_program(PROGRAM.replace("G90 G17", "G90 G54 G17"), "m96")
+    m.wait_until(lambda: m.position("X") > 40.0, 5.0, "X past 40")
+    assert m.get("M31031") == 0
+    m.set("M21019", 1)
+    m.wait_until(lambda: m.get("M31031") == 1, 1.0, "M31031 ON")
+    stop_x = m.command("X")
+    assert 40.0 < stop_x < 60.0  # stopped on line 3, nowhere near X100
+    m.wait_until(lambda: m.command("Z") > 109.9, 2.0, "O0050 lifts Z")
+    assert abs(m.command("X") - stop_x) < 1e-9 and m.get("M31031") == 1
+    m.wait_until(lambda: m.get("M31031") == 0, 2.0, "M31031 OFF")
+    # M3x031 drops in the cycle the way back to X100 starts (the MLC sees it one scan later)
+    assert abs(m.command("Z") - 100.0) < 1e-9 and 0.0 < m.command("X") - stop_x < 1e-4
+    m.set("M21019", 0)
+    m.wait_until(lambda: not ch.busy or ch.state is RunState.WAIT_AUX, 10.0, "program end")
+    m.wait_until(lambda: not ch.busy, 2.0, "M30 finish")
+    assert [round(m.command(a), 6) for a in "XYZ"] == [0.0, 50.0, 100.0]  # the bench starts at Z100
+    assert m.get("M31031") == 0 and not ch.alarms
