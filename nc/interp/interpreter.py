@@ -462,9 +462,12 @@ class Interpreter:
                     yield self._resume_after_interrupt()
                 return
             if m == 96:
+                # a preview stop: M2x019 is honoured from this block's execution on, not from its reading
+                yield Sync(block.line, block.text, "M96")
                 self._m96(block)
                 continue
             if m == 97:
+                yield Sync(block.line, block.text, "M97")
                 self.interrupt_program = None
                 continue
             yield Aux("M", m, block.line, block.text, program=self.program_name)
