@@ -164,15 +164,9 @@ class Interpreter:
                 if fr.pc >= len(fr.program.blocks):
                     self._return(None)  # the end of the interrupt program returns like M99
                     continue
-                block = fr.program.blocks[fr.pc]
-                fr.pc += 1
-                self._executed += 1
-                if self._executed > limit:
-                    raise NcAlarm(0x0000, f"more than {limit} blocks executed (endless loop?)",
-                                  line=block.line, block=block.text, program=fr.program.name)
-                if block.skip and self.block_skip:
+                block = self._take_block(fr, limit)
+                if block is None:
                     continue
-                self.program_name = fr.program.name
                 try:
                     for ev in self._execute(block):
                         yield ev
@@ -246,16 +240,10 @@ class Interpreter:
                     break
                 self._return(None)  # end of a subprogram without M99 returns like M99
                 continue
-            block = fr.program.blocks[fr.pc]
-            fr.pc += 1
-            last = block
-            self._executed += 1
-            if self._executed > limit:
-                raise NcAlarm(0x0000, f"more than {limit} blocks executed (endless loop?)",
-                              line=block.line, block=block.text, program=fr.program.name)
-            if block.skip and self.block_skip:
+            last = fr.program.blocks[fr.pc]
+            block = self._take_block(fr, limit)
+            if block is None:
                 continue
-            self.program_name = fr.program.name
             try:
                 end = False
                 for ev in self._execute(block):
@@ -271,6 +259,19 @@ class Interpreter:
                               program=fr.program.name) from None
         self._check_no_pending_angle()
         yield ProgramEnd(last.line if last else 0, last.text if last else "", 0)
+
+    def _take_block(self, fr: Frame, limit: int) -> Block | None:
+        """Advance `fr` by one block and count it; None for a skipped '/' block."""
+        block = fr.program.blocks[fr.pc]
+        fr.pc += 1
+        self._executed += 1
+        if self._executed > limit:
+            raise NcAlarm(0x0000, f"more than {limit} blocks executed (endless loop?)",
+                          line=block.line, block=block.text, program=fr.program.name)
+        if block.skip and self.block_skip:
+            return None
+        self.program_name = fr.program.name
+        return block
 
     def _check_no_pending_angle(self) -> None:
         """A held two-block `,A` block never gets its partner at the end of the program."""
