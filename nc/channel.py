@@ -78,6 +78,7 @@ class Channel:
         self.events = events
         self.end = None
         self.state = RunState.IDLE
+        self._interrupt, self._m96_running = None, False
 
     def cycle_start(self) -> None:
         """Start the loaded program, resume after a feed hold, or run the next single block."""
@@ -134,6 +135,7 @@ class Channel:
         self._deferred = None
         self._limit_alarm = None
         self._skip_move = None
+        self._interrupt, self._m96_running = None, False  # a reset ends an interrupt program too
         self.events = None
         self.state = RunState.RESETTING if not self.planner.idle else RunState.IDLE
 

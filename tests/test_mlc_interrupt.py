@@ -148,3 +148,26 @@ def test_m21019_relay_interrupts_on_the_bench_and_m31031_shows_it(mill_machine):
     m.wait_until(lambda: not ch.busy, 2.0, "M30 finish")
     assert [round(m.command(a), 6) for a in "XYZ"] == [0.0, 50.0, 100.0]  # the bench starts at Z100
     assert m.get("M31031") == 0 and not ch.alarms
+
+
+def test_reset_during_the_interrupt_program_drops_m3x031():
+
+    seen: list[bool] = []
+    store = ProgramStore()
+    it = Interpreter(make_profile("nc5-mill"), store=store)
+    prog = store.add_text(PROGRAM)[0]
+    cfg = mill_cfg()
+
+    def hook(n, ch):
+        if n == 0:
+            ch.m96 = m96_link(it)
+        if n == TRIGGER:
+            ch.interrupt()
+        if n == 1100 and ch.interrupt_active:  # O0050 is lifting Z
+            ch.reset()
+            seen.append(ch.interrupt_active)
+
+    st = run(it.run(prog), cfg, {"X": 0.0, "Y": 0.0, "Z": 0.0}, on_cycle=hook)
+    assert seen == [False] and st.state is RunState.IDLE
+    assert 0.0 < st.positions[-1, 2] < 10.0  # stopped on O0050's Z move, never went back to line 3
+    assert max(worst_ratio(st, cfg).values()) <= 1.0 + 1e-6
