@@ -171,3 +171,15 @@ def test_reset_during_the_interrupt_program_drops_m3x031():
     assert seen == [False] and st.state is RunState.IDLE
     assert 0.0 < st.positions[-1, 2] < 10.0  # stopped on O0050's Z move, never went back to line 3
     assert max(worst_ratio(st, cfg).values()) <= 1.0 + 1e-6
+
+
+def test_hil_script_example_raises_m21019_mid_cut(capsys):
+    from hil.cli import main
+
+    code = main(["script", str(ROOT / "examples" / "scripts" / "m96_interrupt.py"),
+                 "--bench", str(ROOT / "benches" / "mill-3axis.toml")])
+    out = capsys.readouterr().out
+    assert code == 0, out
+    taken = next(line for line in out.splitlines() if "M21019 taken" in line)
+    assert 50.0 < float(taken.split("X stopped at ")[1].split()[0]) < 53.0
+    assert "end: X 0.0000 Y 50.0000 Z 100.0000" in out and "alarms  none" in out
