@@ -369,7 +369,7 @@ _IO_KEYS = {"name", "inputs", "outputs", "x", "y", "canopen_node", "canopen_tpdo
 
 def _io_modules(r: _Reader, d: dict, p: str, points_max: int) -> tuple[str, ...]:
     """`modules`: an R1-EC station's modules in slot order (DI8/16/32, DO8/16/32); () when absent."""
-    from virtual_bus.ethercat.r1ec import MODULES, points
+    from fieldbus.ethercat.r1ec_modules import MODULES, points
 
     if "modules" not in d:
         return ()
@@ -413,7 +413,7 @@ def _io_stations(r: _Reader, stations: Any, n_drives: int) -> list[IoStationConf
             r.err(f"{p}.name", f"duplicate station name {name!r}")
         modules = _io_modules(r, d, p, POINTS_MAX)
         if modules:  # the station's points are its modules' (inputs/outputs, if given too, must agree)
-            from virtual_bus.ethercat.r1ec import points
+            from fieldbus.ethercat.r1ec_modules import points
 
             m_in, m_out = points(modules)
             for key, have in (("inputs", m_in), ("outputs", m_out)):

@@ -21,7 +21,8 @@ def io_ports(bench: Bench, link: Any) -> list[Any]:
     if isinstance(link, EthercatLink):
         from fieldbus.ethercat.io import EthercatIoPort
 
-        return [EthercatIoPort(link, k, st.map.name, st.map.inputs, st.map.outputs) for k, st in enumerate(bench.io)]
+        return [EthercatIoPort(link, k, st.map.name, st.map.inputs, st.map.outputs, st.modules)
+                for k, st in enumerate(bench.io)]
     if isinstance(link, CanopenLink):
         from fieldbus.canopen.io import CanopenIoPort
 

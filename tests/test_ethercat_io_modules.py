@@ -11,6 +11,7 @@ from types import SimpleNamespace
 import pytest
 
 from fieldbus.ethercat.link import EthercatLink
+from fieldbus.link import BusError
 from hil.bench_file import BenchFileError, parse_bench
 from hil.commands.sim import build_chain
 from hil.scripting import Machine
@@ -164,3 +165,36 @@ def test_ethercat_module_stations_map_x_and_y_in_module_order_in_lock_step():
         m.cycle(2)
         assert line.outputs(0) == 0 and m.get("X31") == 0 and m.get("X71") == 1
         m.close()
+
+
+@pytest.mark.skipif(ROOT_REASON is not None, reason=ROOT_REASON or "")
+@pytest.mark.parametrize("modules, message", [
+    ('["DO16", "DI16"]', "EIO-501 (EIO node 501) is set up as DO16 + DI16; the slave reports DI16 + DO16"),
+    ('["DI32", "DO8"]', "EIO-501 (EIO node 501) needs 32 inputs / 8 outputs; EtherCAT has 16 inputs / 16 outputs"),
+])
+def test_a_station_built_otherwise_than_the_bench_says_raises_0x142e(modules, message):
+    """The line carries the default DI16 + DO16 station; the master's bench declares other modules:
+    the same size in another order (found by the slave's 0xF050 list), or other sizes."""
+    chain = build_chain(parse_bench(AXES + "[[io]]\n"))
+    bench = parse_bench(AXES + f"[[io]]\nmodules = {modules}\n")
+    with ForkedLine(chain, "iox") as line:
+        m = make_machine(bench, EthercatLink.for_bench(bench, line.iface), [])
+        with pytest.raises(BusError) as err:
+            m.power_up()
+            m.cycle(2)
+        m.close()
+    assert err.value.alarm.code == 0x142E and message in err.value.alarm.message, err.value.alarm.message
+
+
+@pytest.mark.skipif(ROOT_REASON is not None, reason=ROOT_REASON or "")
+def test_hil_sim_serves_the_bench_stations_and_hil_scan_names_their_modules(hil, tmp_path):
+    from virtual_bus.ethercat.veth import SimProcess
+
+    bench = tmp_path / "io.toml"
+    bench.write_text(AXES + STATIONS)
+    with SimProcess("--bench", str(bench), tag="ios") as sim:
+        r = hil("scan", "--bus", f"ethercat:{sim.iface}")
+    assert r.code == 0, r.err
+    rows = r.out.splitlines()[2:]  # after the two drives: each station's name and module list (0x1008, 0xF050)
+    assert [row.split("io", 1)[1].strip() for row in rows] == [
+        "R1-EC DI32+DO8  [DI32+DO8]", "R1-EC DO16+DI8+DI16  [DO16+DI8+DI16]", "R1-EC DI8  [DI8]"], r.out

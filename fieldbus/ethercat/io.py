@@ -1,6 +1,8 @@
 """A remote I/O station on EtherCAT as the MLC sees it (`mlc.remote_io.IoPort`): the k-th I/O
 slave in connection order (EIO node 501+k), its inputs from the last good frame, its outputs on
-the next frame. While the slave is not in OP its inputs read 0 (the safe state)."""
+the next frame. While the slave is not in OP its inputs read 0 (the safe state). A station the bench
+builds from `modules` is checked against the module list the slave reports (0xF050): another
+composition, even of the same size, is 0x142E."""
 
 from __future__ import annotations
 
@@ -18,6 +20,7 @@ class EthercatIoPort:
     name: str
     inputs: int  # points the bench declares
     outputs: int
+    modules: tuple[str, ...] = ()  # the bench's R1-EC modules in slot order; () = check the sizes only
     _checked: bool = False
 
     @property
@@ -35,6 +38,11 @@ class EthercatIoPort:
             have = f"{n_in} inputs / {n_out} outputs" if self.index < found else f"only {found} I/O slaves on the line"
             raise BusError(Alarm(A.EIO_MISMATCH, f"remote I/O station {self.name} (EIO node {501 + self.index}) needs "
                                          f"{self.inputs} inputs / {self.outputs} outputs; EtherCAT has {have}"))
+        found_mods = self.link.io_modules(self.index) if self.modules else None
+        if found_mods is not None and found_mods != list(self.modules):
+            raise BusError(Alarm(A.EIO_MISMATCH, f"remote I/O station {self.name} (EIO node {501 + self.index}) is set "
+                                                 f"up as {' + '.join(self.modules)}; the slave reports "
+                                                 f"{' + '.join(found_mods) or 'no modules'}"))
 
     def read_inputs(self, dt: float) -> tuple[int, list[int]]:
         self._check()

@@ -134,7 +134,11 @@ class EthercatLink:
             if n <= 0:
                 raise BusError(Alarm(A.NO_SLAVES, f"no EtherCAT slaves found on {self.iface}"))
             m.read_state()
-            return [SlaveInfo(i, s.name, self._kind(s), s.man, s.id, state_name(s.state)) for i, s in enumerate(m.slaves)]
+            infos = [SlaveInfo(i, s.name, self._kind(s), s.man, s.id, state_name(s.state)) for i, s in enumerate(m.slaves)]
+            for info, s in zip(infos, m.slaves):
+                if info.kind == "io":
+                    info.name, info.layout = self._io_identity(s)
+            return infos
         finally:
             m.close()
 
@@ -145,6 +149,28 @@ class EthercatLink:
         except Exception:
             return "io"
         return "drive" if device_type & 0xFFFF == 402 else "io"
+
+    @staticmethod
+    def _io_identity(s) -> tuple[str, str]:
+        """An I/O slave's own name (0x1008) and R1-EC module list (0xF050, "DI32+DO8"), over SDO: SOEM
+        copies SII data between slaves of one identity, so the SII name of the first R1-EC would stand
+        for every station whatever its modules (docs/decisions/ethercat.md, E10)."""
+        try:
+            name = s.sdo_read(0x1008, 0).decode("latin-1").strip() or s.name
+        except Exception:
+            name = s.name
+        return name, "+".join(EthercatLink._read_modules(s) or [])
+
+    @staticmethod
+    def _read_modules(s) -> list[str] | None:
+        """The R1-EC module list a slave reports in 0xF050; None if it keeps none."""
+        from fieldbus.ethercat.r1ec_modules import ident_name
+
+        try:
+            n = s.sdo_read(0xF050, 0, 1)[0]
+            return [ident_name(struct.unpack("<I", s.sdo_read(0xF050, k, 4)[:4])[0]) for k in range(1, n + 1)]
+        except Exception:  # no such object (or no mailbox): nothing to compare
+            return None
 
     def _bring_up(self, m) -> list[SlaveInfo]:
         n = m.config_init()
@@ -201,8 +227,9 @@ class EthercatLink:
         self._last = [layout.unpack_tx(s.input) for s, layout in zip(self.drives, layouts)]
         self.infos = [SlaveInfo(i, name, "drive", s.man, s.id, state_name(s.state), layout.name)
                       for i, (s, name, layout) in enumerate(zip(self.drives, self.names, layouts))]
-        self.infos += [SlaveInfo(len(self.infos) + k, s.name, "io", s.man, s.id, state_name(s.state))
-                       for k, s in enumerate(self.io)]
+        for s in self.io:
+            name, mods = self._io_identity(s)
+            self.infos.append(SlaveInfo(len(self.infos), name, "io", s.man, s.id, state_name(s.state), mods))
         self._states = [i.state for i in self.infos]
         self._failed = False
         self._io_out = [bytes(len(s.output)) for s in self.io]
@@ -306,6 +333,10 @@ class EthercatLink:
         if k >= len(self._io_in):
             return 0, 0
         return 8 * len(self._io_in[k]), 8 * len(self._io_out[k])
+
+    def io_modules(self, k: int) -> list[str] | None:
+        """The k-th I/O slave's R1-EC modules in slot order (0xF050 over SDO); None if it lists none."""
+        return self._read_modules(self.io[k]) if self.master is not None and k < len(self.io) else None
 
     def io_ok(self, k: int) -> bool:
         """The k-th I/O slave is in OP and the link stands (its inputs are current)."""

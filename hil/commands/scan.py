@@ -39,8 +39,8 @@ def cmd_scan(args: argparse.Namespace) -> int:
         if args.json:
             print(json.dumps({"position": s.position, "vendor": f"0x{s.vendor_id:08X}",
                               "product": f"0x{s.product_code:08X}", "name": s.name, "kind": s.kind,
-                              "state": s.state}))
+                              "state": s.state} | ({"modules": s.layout} if s.kind == "io" and s.layout else {})))
         else:
             print(f"{s.position:3d}  vendor 0x{s.vendor_id:08X}  product 0x{s.product_code:08X}  "
-                  f"{s.state:8s} {s.kind:5s}  {s.name}")
+                  f"{s.state:8s} {s.kind:5s}  {s.name}" + (f"  [{s.layout}]" if s.kind == "io" and s.layout else ""))
     return EXIT_OK

@@ -17,42 +17,14 @@ from __future__ import annotations
 
 import io
 from collections.abc import Sequence
-from dataclasses import dataclass
 
+from fieldbus.ethercat.r1ec_modules import DEFAULT_MODULES, MODULES, Module, points, split
 from virtual_bus.ethercat.device import Device, parse_device
 
+__all__ = ["DEFAULT_MODULES", "MODULES", "Module", "esi_xml", "points", "r1ec_device", "split", "title"]
 
-@dataclass(frozen=True)
-class Module:
-    name: str  # DI16 …
-    direction: str  # "in" / "out"
-    points: int
-    ident: int  # this project's module ident (0xF050), not a Delta part number
-
-    @property
-    def ctype(self) -> str:
-        return {8: "USINT", 16: "UINT", 32: "UDINT"}[self.points]
-
-
-MODULES: dict[str, Module] = {
-    f"D{d}{n}": Module(f"D{d}{n}", "in" if d == "I" else "out", n, 0x1DD0_0000 | (0x100 if d == "I" else 0x200) | n)
-    for d in ("I", "O") for n in (8, 16, 32)
-}
-DEFAULT_MODULES: tuple[str, ...] = ("DI16", "DO16")
 PRODUCT_CODE = 0x00005601
 _STATION_BYTES_MAX = 128  # the SM2/SM3 windows (0x1100 / 0x1180) hold 128 bytes each
-
-
-def split(modules: Sequence[str]) -> tuple[list[Module], list[Module]]:
-    """(input modules, output modules), each in station order; KeyError for an unknown name."""
-    mods = [MODULES[m] for m in modules]
-    return [m for m in mods if m.direction == "in"], [m for m in mods if m.direction == "out"]
-
-
-def points(modules: Sequence[str]) -> tuple[int, int]:
-    """(digital inputs, digital outputs) of a module list."""
-    ins, outs = split(modules)
-    return sum(m.points for m in ins), sum(m.points for m in outs)
 
 
 def title(modules: Sequence[str]) -> str:
