@@ -146,6 +146,7 @@ class BenchRunner:
                           spindle_command=lambda: self.mlc.spindle.signed_rpm)
         self.channel = ch = Channel(planner)
         ch.soft_limits = SoftLimits.for_bench(self.bench, getattr(self, "profile", None))
+        ch.css_diameter = "X" in getattr(getattr(self, "profile", None), "diameter_axes", ("X",))  # G96 D
         if getattr(self, "_interp", None) is not None:  # G31 skip (issue 5)
             ch.on_skip = skip_hook(self._interp)
             ch.m96 = m96_link(self._interp)  # M2x019 program interruption

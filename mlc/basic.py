@@ -28,6 +28,8 @@ class BasicMlc:
 
     def scan(self, channel: Channel) -> None:
         self.cycle += 1
+        if channel.css_rpm is not None:  # G96: the speed command is the surface speed's rpm (as D3x024)
+            self.spindle.rpm = min(channel.css_rpm, self.max_rpm)
         aux: Aux | None = channel.pending_aux
         if aux is None:
             return

@@ -311,6 +311,7 @@ class ChannelLink:
             self._set3(k, self.mode == k)
         self._set3(32, self._mode_switch_cycles > 0)
         self._handshake_output(ch)
+        self._css_output(ch)
         held = ch.state.name == "HOLD"
         running = ch.state in (RunState.RUNNING, RunState.WAIT_AUX) and self._system_hold is None
         self._set3(16, running)
@@ -370,6 +371,9 @@ class ChannelLink:
         if aux.kind == "T" and not (self.tool_range[0] <= int(aux.value) <= self.tool_range[1]):
             self._complete(ch, aux)
             return
+        if aux.kind == "S" and aux.args.get("max"):  # G50/G92 S: a speed limit the NC keeps, no S code
+            self._complete(ch, aux)
+            return
         if self._m2(16):
             return  # the previous finish is still ON: the next strobe waits for it to drop
         if aux.kind == "M":
@@ -387,6 +391,13 @@ class ChannelLink:
         self._handed = aux
         self._set3(self._strobe, True)
         self.handshake_log.append((self.cycle, aux.kind, aux.value))
+
+    def _css_output(self, ch: Channel) -> None:
+        """Under G96 the speed command D3x024 is the rpm the drive is given (the surface speed at the
+        current X, within G50/G92 S and the spindle maximum), from the S strobe on and every scan as
+        X moves; D3x050 keeps the S word in m/min (motion decisions 30)."""
+        if ch.css_rpm is not None:
+            self.mem.set_f32(d3(self.x, 24), min(ch.css_rpm, self.spindle_max_rpm))
 
     def _drive_outputs(self, drives: list[DriveStatus], ch: Channel | None = None) -> None:
         mem, x = self.mem, self.x

@@ -25,7 +25,7 @@ from enum import Enum
 
 from nc.alarms import Alarm, NcAlarm, internal_error
 from nc.interrupt import M96Link, interrupt_stream
-from nc.motion.css import css_rpm
+from nc.motion.css import css_rpm_at, x_origin
 from nc.motion.planner import Planner, Setpoint
 from nc.moves import Aux, Event, Move, ProgramEnd, Sync
 from nc.softlimits import SoftLimits
@@ -60,7 +60,8 @@ class Channel:
     css_rpm: float | None = None
     spindle_max: float | None = None
     _css_surface: float | None = None
-    _css_move: Move | None = None
+    _css_origin: float | None = None  # machine X of the work centre line (from the move or the S aux)
+    css_diameter: bool = True  # the profile programs X in diameter (N2.001 Bit10 = 0)
     _block_moves: int = 0  # moves pushed since the last single-block stop
     soft_limits: SoftLimits | None = None  # checked before a move reaches the planner (issue 8)
     _limit_alarm: Alarm | None = None  # raised once the moves before the offending one have run out
@@ -297,14 +298,6 @@ class Channel:
                 pl.push(ev)
                 self._block_moves += 1
             elif isinstance(ev, Aux):
-                if ev.kind == "S" and ev.args.get("max"):
-                    self.spindle_max = ev.value
-                elif ev.kind == "S" and ev.args.get("css"):
-                    self._css_surface = ev.value
-                elif ev.kind == "S":
-                    self._css_surface = None
-                if ev.kind == "S":
-                    self.spindle_rpm = ev.value
                 if pl.idle:
                     self._issue(ev)
                     return
@@ -319,23 +312,35 @@ class Channel:
 
     def _update_css(self, sp: Setpoint) -> None:
         """G96: the active move's surface speed at the current X diameter; between moves the last
-        S decides (an S under G96 is m/min, any other S ends it)."""
+        S decides (an S under G96 is m/min, any other S ends it). The S aux of `G96 S_` carries the
+        work centre, so the speed is right before the first move (motion decisions 30)."""
         mv = sp.move
         if mv is not None:
             self._css_surface = mv.css
             if mv.css is None:
                 self.css_rpm = None
                 return
-        if self._css_surface is None:
+            self._css_origin = x_origin(mv, "X", self.css_diameter)
+        axes = self.planner.axes
+        if self._css_surface is None or self._css_origin is None:
             self.css_rpm = None
-            return
-        ref = mv if mv is not None else self._css_move
-        if ref is None:
-            return
-        self._css_move = ref
-        self.css_rpm = css_rpm(ref, sp.positions, self.planner.axes, self._css_surface, self.spindle_max)
+        elif "X" not in axes:
+            self.css_rpm = 0.0
+        else:
+            self.css_rpm = css_rpm_at(float(sp.positions[axes.index("X")]), self._css_origin,
+                                      self._css_surface, self.spindle_max)
 
     def _issue(self, aux: Aux) -> None:
+        # S takes effect when it is issued (moves before it are done), not when it is read ahead
+        if aux.kind == "S" and aux.args.get("max"):
+            self.spindle_max = aux.value
+        elif aux.kind == "S" and aux.args.get("css"):
+            self._css_surface = aux.value
+            self._css_origin = aux.args.get("x0", self._css_origin)
+        elif aux.kind == "S":
+            self._css_surface = None
+        if aux.kind == "S" and not aux.args.get("max"):
+            self.spindle_rpm = aux.value
         self.pending_aux = aux
         if aux.wait:
             self.state = RunState.WAIT_AUX

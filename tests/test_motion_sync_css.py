@@ -11,8 +11,11 @@ import pytest
 from fieldbus.link import SimLink
 from hil.bench import default_lathe
 from hil.runner import BenchRunner
+from hil.scripting import build_mlc
 from hil.session import sim_slaves
 from nc.program import parse_program
+
+from conftest import ROOT
 
 FACING = """G21 G18 G99
 G50 S2000
@@ -85,3 +88,136 @@ def test_g50_clamp_also_holds_under_g97(hil, program, tmp_path):
     assert r.code == 0, r.out + r.err
     rpm = [float(row["S1_rpm_act"]) for row in csv.DictReader(open(trace))]
     assert max(rpm) == pytest.approx(800.0, rel=0.01)
+
+
+# ---- G96 from the S word on, before any move (session 3, motion decisions 30) -------------------
+# The default lathe starts at machine X60 (radius); `G00 X100.` puts the tool at diameter 100, where
+# 200 m/min is 1000·200/(π·100) = 636.6 rpm.
+
+AT_100 = 1000.0 * 200.0 / (math.pi * 100.0)
+
+
+def run_phases(text: str, params: dict[str, float] | None = None):
+    """Run on the default lathe with the Delta lathe MLC (M03 waits for speed reached); per cycle
+    (value of the pending aux or -1, X command, drive's commanded rpm)."""
+    bench = default_lathe()
+    bench.params.update(params or {})
+    runner = BenchRunner(bench, SimLink(sim_slaves(bench), bench.cycle), mlc=build_mlc(bench, "lathe"))
+    sc = bench.spindles[0].scaling
+    rows = []
+
+    def grab(r):
+        ch = r.channel
+        if ch is not None:
+            aux = ch.pending_aux
+            rows.append((aux.value if aux is not None else -1.0, r._commands[0],
+                         sc.counts_per_s_to_rpm(r.rx[2].target_velocity)))
+
+    runner.on_cycle = grab
+    result = runner.run_program(parse_program(text))
+    assert result.ok, result.alarms
+    return np.array(rows)
+
+
+def spinning(rows):
+    return rows[np.abs(rows[:, 2]) > 0.5]
+
+
+def test_g96_m03_starts_at_the_css_rpm_of_the_current_x_before_any_move():
+    rows = run_phases("G21 G18 G99\nG00 X100. Z5.\nG96 S200 M03\nG04 P100\nM05\nM30\n")
+    on = spinning(rows)
+    assert on[0, 1] == pytest.approx(50.0)  # X has not moved since the G00
+    # the very first command the drive gets is the CSS speed, never S200 read as rpm
+    assert on[0, 2] == pytest.approx(AT_100, abs=0.01)
+    assert np.allclose(on[:, 2], AT_100, atol=0.01)
+
+
+def test_g96_before_any_move_is_clamped_by_g50_s_and_by_the_spindle_maximum():
+    rows = run_phases("G21 G18 G99\nG00 X100. Z5.\nG50 S500\nG96 S200 M03\nG04 P50\nM30\n")
+    assert np.allclose(spinning(rows)[:, 2], 500.0, atol=0.01)
+    # no G50: the bench's spindle maximum (4000 rpm) caps 200 m/min at diameter 1 (63 662 rpm)
+    rows = run_phases("G21 G18 G99\nG00 X1. Z5.\nG96 S200 M03\nG04 P50\nM30\n")
+    assert np.allclose(spinning(rows)[:, 2], 4000.0, atol=0.01)
+
+
+def test_g97_s_is_exactly_rpm_and_g97_alone_keeps_the_speed_it_had():
+    rows = run_phases("G21 G18 G99\nG00 X100. Z5.\nG96 S200 M03\nG97 S800\nG04 P50\nM30\n")
+    assert spinning(rows)[-1, 2] == pytest.approx(800.0, abs=0.01)
+    # G97 without S: the spindle stays at the speed G96 had reached (Fanuc's rule), while X moves on
+    rows = run_phases("G21 G18 G99\nG00 X100. Z5.\nG96 S200 M03\nG97\nG00 X50.\nG04 P50\nM30\n")
+    on = spinning(rows)
+    assert on[-1, 1] == pytest.approx(25.0)
+    assert np.allclose(on[:, 2], AT_100, atol=0.01)
+
+
+def test_s_under_g96_changes_the_surface_speed_at_once_and_m05_m03_restarts_on_it():
+    text = "G21 G18 G99\nG00 X100. Z5.\nG96 S200 M03\nG04 P50\nS100\nM05\nG00 X50.\nM03\nG04 P50\nM30\n"
+    rows = run_phases(text)
+    s100 = np.flatnonzero(rows[:, 0] == 100.0)[0]
+    # the cycle S100 is issued the drive still has 200 m/min; from then on 100 m/min, X still at 50
+    assert rows[s100 + 1, 2] == pytest.approx(AT_100 / 2.0, abs=0.01)
+    m05 = np.flatnonzero(rows[:, 0] == 5.0)[0]
+    assert rows[m05 + 5, 2] == 0.0
+    # M03 again at X50 (diameter 50): 100 m/min is 636.6 rpm, from the first cycle the drive turns
+    m03 = np.flatnonzero(rows[:, 0] == 3.0)[-1]
+    after = spinning(rows[m03:])
+    assert after[0, 1] == pytest.approx(25.0) and np.allclose(after[:, 2], AT_100, atol=0.01)
+
+
+def test_g96_while_the_spindle_turns_switches_without_a_move():
+    rows = run_phases("G21 G18 G99\nG00 X100. Z5.\nG97 S300 M03\nG04 P50\nG96 S200\nG04 P50\nM30\n")
+    g96 = np.flatnonzero(rows[:, 0] == 200.0)[0]
+    assert rows[g96 - 1, 2] == pytest.approx(300.0, abs=0.01)
+    assert rows[g96 + 1, 2] == pytest.approx(AT_100, abs=0.01)
+    assert np.allclose(rows[g96 + 1:, 2][rows[g96 + 1:, 2] > 0], AT_100, atol=0.01)
+
+
+def test_g96_with_x_programmed_as_a_radius_uses_twice_x():
+    # N2.001 Bit10 = 1: X words are radii, so X50. is diameter 100 (636.6 rpm at 200 m/min)
+    text = "G21 G18 G99\nG00 X50. Z5.\nG96 S200 M03\nG01 X40. F0.1\nM30\n"
+    rows = run_phases(text, {"N2.001 Bit10": 1})
+    on = spinning(rows)
+    assert on[0, 2] == pytest.approx(AT_100, abs=0.01)
+    assert on[-1, 1] == pytest.approx(40.0)
+    assert on[-1, 2] == pytest.approx(1000.0 * 200.0 / (math.pi * 80.0), abs=0.01)
+
+
+def test_g96_m03_through_hil_run_with_the_lathe_mlc(hil, program, tmp_path):
+    """The lathe MLC reads D31024 = the CSS rpm from the S strobe on (D31050 keeps S200, m/min), the
+    drive is given it from the first cycle, and M03 finishes when the spindle reaches it."""
+    import csv
+
+    prog = program("G21 G18 G99\nG00 X100. Z5.\nG50 S3000\nG96 S200 M03\nG01 X50. F0.5\nM05\nM30\n")
+    trace = tmp_path / "t.csv"
+    r = hil("run", prog, "--bench", ROOT / "benches" / "lathe-2axis.toml", "--trace", trace,
+            "--trace-signals", "M31065,D31024,D31050,M31064,D31048,M21016")
+    assert r.code == 0, r.out + r.err
+    rows = list(csv.DictReader(trace.open()))
+    strobe = next(i for i, row in enumerate(rows) if row["M31065"] == "1")
+    assert float(rows[strobe]["D31024"]) == pytest.approx(AT_100, rel=1e-6)
+    assert float(rows[strobe]["D31050"]) == 200.0
+    cmd = [float(row["S1_rpm_cmd"]) for row in rows]
+    first = next(i for i, v in enumerate(cmd) if v > 0.5)
+    assert cmd[first] == pytest.approx(AT_100, abs=0.01)
+    m03 = next(i for i, row in enumerate(rows) if row["M31064"] == "1" and row["D31048"] == "3")
+    fin = next(i for i in range(m03, len(rows)) if rows[i]["M21016"] == "1")
+    assert float(rows[fin]["S1_rpm_act"]) == pytest.approx(AT_100, rel=0.02)
+    assert float(rows[fin]["X_cmd"]) == pytest.approx(50.0)  # the M03 waited before the first move
+    # while X faces in to diameter 50 the MLC's D31024 and the drive follow X
+    end = max(i for i, row in enumerate(rows) if abs(float(row["X_cmd"]) - 25.0) < 1e-9 and cmd[i] > 0.5)
+    assert cmd[end] == pytest.approx(2.0 * AT_100, abs=0.01)
+    assert float(rows[end]["D31024"]) == pytest.approx(2.0 * AT_100, rel=1e-5)
+
+
+def test_g50_s_is_a_limit_not_an_s_code_for_the_mlc(hil, program, tmp_path):
+    """G50 S2000 while the spindle turns at S500 leaves it at 500 (no S strobe, D31024 unchanged)."""
+    import csv
+
+    prog = program("G21 G18 G98\nG97 S500 M03\nG04 P100\nG50 S2000\nG04 P300\nM05\nM30\n")
+    trace = tmp_path / "t.csv"
+    r = hil("run", prog, "--trace", trace, "--trace-signals", "M31065,D31024")
+    assert r.code == 0, r.out + r.err
+    rows = list(csv.DictReader(trace.open()))
+    assert sum(1 for a, b in zip(rows, rows[1:]) if a["M31065"] == "0" and b["M31065"] == "1") == 1
+    assert max(float(row["S1_rpm_cmd"]) for row in rows) == pytest.approx(500.0, abs=0.01)
+    assert {float(row["D31024"]) for row in rows[-10:]} == {500.0}

@@ -410,6 +410,8 @@ class Interpreter:
             args = {"P": spindle.value} if spindle is not None and not funcs & {"G04", "G10", "G30", "G31", "G900", "G05"} and 98 not in mvals else {}
             if st.css:  # G96: S is a surface speed (m/min); the channel turns it into rpm (issue 5)
                 args = {**args, "css": 1.0}
+                if "X" in self.axes:  # machine X of the work centre: the diameter before any move
+                    args["x0"] = self.frames.origins(st.wcs, self.axes)["X"]
             yield Aux("S", s.value, block.line, block.text, args=args, program=self.program_name)
         t = block.get("T")
         if t is not None and not self._cycle_fn(funcs):

@@ -16,18 +16,30 @@ from nc.moves import Move
 MIN_DIAMETER = 1e-3  # mm: at the centre the speed is the clamp, never a division by zero
 
 
-def css_rpm(move: Move, positions: np.ndarray, axes: tuple[str, ...], surface: float,
-            limit: float | None, x_axis: str = "X") -> float:
-    """Spindle speed (rpm, ≥ 0) for surface speed `surface` (m/min) at the setpoint `positions`."""
-    if x_axis not in axes:
-        return 0.0
-    x = float(positions[axes.index(x_axis)])
-    offset = move.end.get(x_axis, 0.0) - move.work.get(x_axis, 0.0) / 2.0
-    d = max(abs(2.0 * (x - offset)), MIN_DIAMETER)
+def x_origin(move: Move, x_axis: str = "X", diameter: bool = True) -> float:
+    """Machine X (radius) of the work centre line the move is programmed from: its end less its
+    work X, which is a diameter when the profile programs X in diameter (N2.001 Bit10 = 0)."""
+    work = move.work.get(x_axis, 0.0)
+    return move.end.get(x_axis, 0.0) - (work / 2.0 if diameter else work)
+
+
+def css_rpm_at(x: float, origin: float, surface: float, limit: float | None) -> float:
+    """Spindle speed (rpm, ≥ 0) for `surface` m/min with the tool at machine X `x` (radius) and the
+    work centre at `origin`, clamped by the G50/G92 S `limit`."""
+    d = max(abs(2.0 * (x - origin)), MIN_DIAMETER)
     rpm = 1000.0 * surface / (math.pi * d)
     if limit is not None and limit > 0.0:
         rpm = min(rpm, limit)
     return rpm
+
+
+def css_rpm(move: Move, positions: np.ndarray, axes: tuple[str, ...], surface: float,
+            limit: float | None, x_axis: str = "X", diameter: bool = True) -> float:
+    """Spindle speed (rpm, ≥ 0) for surface speed `surface` (m/min) at the setpoint `positions`."""
+    if x_axis not in axes:
+        return 0.0
+    x = float(positions[axes.index(x_axis)])
+    return css_rpm_at(x, x_origin(move, x_axis, diameter), surface, limit)
 
 
 def spindle_speed(rpm: float, css: float | None, clamp: float | None, max_rpm: float) -> float:

@@ -50,6 +50,7 @@ class _Plan:
     base: float = 0.0  # plan position at the start of blocks[0] (ramps that cross blocks)
     target: float = 0.0  # ramp target speed
     rpm: float = 0.0  # spindle speed the feed-per-rev cap used
+    settled: bool = False  # that speed was the command the spindle had reached
     emitted: bool = False  # some of its samples went out (the planner state is the last of them)
 
 
@@ -399,8 +400,9 @@ class Planner:
             return
         rpm, settled = self._feed_rpm()
         # 2 % hides measurement noise; a spindle that reaches its command re-plans once more, so a feed
-        # planned during the run-up does not stay up to 2 % low (E-N11)
-        if abs(rpm - p.rpm) <= 0.02 * max(p.rpm, 1.0) and (not settled or rpm == p.rpm):
+        # planned during the run-up does not stay up to 2 % low (E-N11); only once: under G96 the
+        # command moves every cycle (motion decisions 30)
+        if abs(rpm - p.rpm) <= 0.02 * max(p.rpm, 1.0) and (not settled or p.settled):
             return
         self._update_cap(self.blocks[0], rpm)
         self._replan()
@@ -483,7 +485,7 @@ class Planner:
 
     def _plan_path(self, b: Block, t0: float) -> _Plan | None:
         s, v, a = self.s, self.v, self.a
-        rpm = self._feed_rpm()[0] if b.move.per_rev else 0.0
+        rpm, settled = self._feed_rpm() if b.move.per_rev else (0.0, False)
         cap = self._update_cap(b, rpm if b.move.per_rev else None)
         if b.move.per_rev and rpm <= 0.0 and not self.dry_run and not self._spindle_starting():
             raise NcAlarm(0x1001, "feed per revolution with the spindle stopped (S0)", line=b.move.line,
@@ -517,7 +519,7 @@ class Planner:
                 pw.duration = max(pw.duration, (dist - s) / target)
                 pw.t0[:, -1] = np.minimum(pw.t0[:, -1], pw.duration)
             return _Plan("ramp", pw, pw.duration, t0, 0.0, target)
-        return _Plan("path", pw, pw.duration, t0, target=dist, rpm=rpm)
+        return _Plan("path", pw, pw.duration, t0, target=dist, rpm=rpm, settled=settled)
 
     def _run_target(self, cap: float, extend: bool = False,
                     cruise_from: float = math.inf) -> tuple[float, float, float, float, float]:
