@@ -367,8 +367,9 @@ def _checks(r: _Reader, d: dict, axes: tuple[str, ...]) -> ChecksConfig:
 _IO_KEYS = {"name", "inputs", "outputs", "x", "y", "canopen_node", "canopen_tpdo", "modules"}
 
 
-def _io_modules(r: _Reader, d: dict, p: str, points_max: int) -> tuple[str, ...]:
-    """`modules`: an R1-EC station's modules in slot order (DI8/16/32, DO8/16/32); () when absent."""
+def _io_modules(r: _Reader, d: dict, p: str, points_max: int) -> tuple[str, ...] | None:
+    """`modules`: an R1-EC station's modules in slot order (DI8/16/32, DO8/16/32); () when absent,
+    None when the list is bad (errors recorded)."""
     from fieldbus.ethercat.r1ec_modules import MODULES, points
 
     if "modules" not in d:
@@ -376,7 +377,7 @@ def _io_modules(r: _Reader, d: dict, p: str, points_max: int) -> tuple[str, ...]
     raw = d.pop("modules")
     if not isinstance(raw, list) or not raw:
         r.err(f"{p}.modules", f"must be a non-empty list of module names like [\"DI16\", \"DO16\"], got {_kind(raw)}")
-        return ()
+        return None
     mods = []
     for i, m in enumerate(raw):
         name = m.strip().upper() if isinstance(m, str) else None
@@ -385,11 +386,11 @@ def _io_modules(r: _Reader, d: dict, p: str, points_max: int) -> tuple[str, ...]
         else:
             mods.append(name)
     if len(mods) != len(raw):
-        return ()
+        return None
     n_in, n_out = points(mods)
     if n_in > points_max or n_out > points_max:
         r.err(f"{p}.modules", f"{n_in} inputs / {n_out} outputs: a station has at most {points_max} of each")
-        return ()
+        return None
     return tuple(mods)
 
 
@@ -412,6 +413,7 @@ def _io_stations(r: _Reader, stations: Any, n_drives: int) -> list[IoStationConf
         if any(o.map.name == name for o in out):
             r.err(f"{p}.name", f"duplicate station name {name!r}")
         modules = _io_modules(r, d, p, POINTS_MAX)
+        bad_modules, modules = modules is None, modules or ()
         if modules:  # the station's points are its modules' (inputs/outputs, if given too, must agree)
             from fieldbus.ethercat.r1ec_modules import points
 
@@ -438,7 +440,8 @@ def _io_stations(r: _Reader, stations: Any, n_drives: int) -> list[IoStationConf
             r.err(f"{p}.canopen_node", f"duplicate CANopen node {node}")
         tpdo = r.string(d, "canopen_tpdo", f"{p}.canopen_tpdo", "sync", ("sync", "change")) or "sync"
         r.unknown(d, f"{p}.", _IO_KEYS)
-        out.append(IoStationConfig(IoMap(name, n_in, n_out, x, y, k), node, tpdo, modules))
+        if not bad_modules:  # a bad module list leaves the station's X/Y span unknown: no range errors for it
+            out.append(IoStationConfig(IoMap(name, n_in, n_out, x, y, k), node, tpdo, modules))
         next_x, next_y = next_block(max(next_x, x + n_in)), next_block(max(next_y, y + n_out))
     for msg in overlaps([o.map for o in out]):
         r.err("io", msg)

@@ -89,6 +89,10 @@ def test_bad_module_lists_are_reported_per_field():
     assert "io[2].inputs: 32, but modules DI16 + DO8 have 16" in msgs
     assert any(m.startswith("io[3].modules: must be a non-empty list") for m in msgs)
     assert "io: EIO-505: Y1000–Y1031 runs past Y1023" in msgs
+    with pytest.raises(BenchFileError) as err:  # a bad list leaves the span unknown: no range error on top
+        parse_bench(AXES + '[[io]]\nmodules = ["DI12", "DO16"]\nx = 1020\n')
+    assert err.value.errors == ["io[0].modules[0]: unknown module 'DI12' (R1-EC modules: DI8, DI16, DI32, DO8, "
+                                "DO16, DO32)"]
 
 
 def test_overlapping_module_station_exits_2_without_traceback(hil, program, tmp_path):
