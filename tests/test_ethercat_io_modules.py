@@ -202,3 +202,28 @@ def test_hil_sim_serves_the_bench_stations_and_hil_scan_names_their_modules(hil,
     rows = r.out.splitlines()[2:]  # after the two drives: each station's name and module list (0x1008, 0xF050)
     assert [row.split("io", 1)[1].strip() for row in rows] == [
         "R1-EC DI32+DO8  [DI32+DO8]", "R1-EC DO16+DI8+DI16  [DO16+DI8+DI16]", "R1-EC DI8  [DI8]"], r.out
+
+
+def test_module_idents_outside_the_catalogue_are_judged_by_size_only():
+    """A real R1-EC lists Delta's own module idents in 0xF050, which this project cannot name: the
+    station is then accepted if its image holds the declared points, refused (0x142E) if not."""
+    from fieldbus.ethercat.io import EthercatIoPort
+
+    class Line:  # the two EthercatLink calls the port makes after bring-up
+        master, io = object(), [object()]
+
+        def __init__(self, bits, modules):
+            self.bits, self.modules = bits, modules
+
+        def io_bits(self, k):
+            return self.bits
+
+        def io_modules(self, k):
+            return self.modules
+
+    declared = ("DI16", "DO16")
+    EthercatIoPort(Line((16, 16), ["0x00C80210", "0x00C80310"]), 0, "A", 16, 16, declared)._check()
+    for line in (Line((16, 16), ["DO16", "DI16"]), Line((8, 16), ["0x00C80210", "0x00C80310"])):
+        with pytest.raises(BusError) as err:
+            EthercatIoPort(line, 0, "A", 16, 16, declared)._check()
+        assert err.value.alarm.code == 0x142E

@@ -2,13 +2,14 @@
 slave in connection order (EIO node 501+k), its inputs from the last good frame, its outputs on
 the next frame. While the slave is not in OP its inputs read 0 (the safe state). A station the bench
 builds from `modules` is checked against the module list the slave reports (0xF050): another
-composition, even of the same size, is 0x142E."""
+composition, even of the same size, is 0x142E (when every ident it reports is one of ours)."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
 from fieldbus.ethercat import alarms as A
+from fieldbus.ethercat.r1ec_modules import MODULES
 from fieldbus.link import BusError
 from nc.alarms import Alarm
 
@@ -39,7 +40,8 @@ class EthercatIoPort:
             raise BusError(Alarm(A.EIO_MISMATCH, f"remote I/O station {self.name} (EIO node {501 + self.index}) needs "
                                          f"{self.inputs} inputs / {self.outputs} outputs; EtherCAT has {have}"))
         found_mods = self.link.io_modules(self.index) if self.modules else None
-        if found_mods is not None and found_mods != list(self.modules):
+        # Idents outside our catalogue (a real R1-EC's own codes) cannot be named: the sizes above decide.
+        if found_mods is not None and all(m in MODULES for m in found_mods) and found_mods != list(self.modules):
             raise BusError(Alarm(A.EIO_MISMATCH, f"remote I/O station {self.name} (EIO node {501 + self.index}) is set "
                                                  f"up as {' + '.join(self.modules)}; the slave reports "
                                                  f"{' + '.join(found_mods) or 'no modules'}"))
