@@ -20,6 +20,7 @@ class AxisConfig:
     units: str = "mm"  # "mm" (linear) or "deg" (rotary)
     soft_limits: tuple[float, float] | None = None  # machine-coordinate travel window, units
     drive_model: str = "asda-a3"
+    canopen_eds: str = ""  # the drive's EDS/DCF on a CANopen bus; "" = Bench.canopen_eds or the shipped ASDA-B3
 
 
 @dataclass
@@ -28,6 +29,7 @@ class SpindleConfig:
     scaling: AxisScaling = field(default_factory=lambda: AxisScaling(counts_per_rev=1_280_000, lead=360.0))
     max_rpm: float = 4000.0
     drive: DriveParams = field(default_factory=lambda: DriveParams(max_speed_rpm=6000.0, csv_accel=1.0e8))
+    canopen_eds: str = ""  # as AxisConfig.canopen_eds
 
 
 FILTER_MS = 16.0  # default N1.036 and N1.037 (ms)
@@ -44,6 +46,7 @@ class IoStationConfig:
     canopen_node: int = 64
     canopen_tpdo: str = "sync"  # "sync": inputs sent on every SYNC; "change": on change of state
     modules: tuple[str, ...] = ()  # EtherCAT R1-EC module list (DI16, DO8, …); () = the default DI16 + DO16
+    canopen_eds: str = ""  # the station's EDS/DCF; "" = the shipped CiA 401 DIO
 
 
 @dataclass
@@ -94,6 +97,8 @@ class Bench:
     checks: ChecksConfig = field(default_factory=ChecksConfig)
     realtime: RealtimeConfig = field(default_factory=RealtimeConfig)
     io: list[IoStationConfig] = field(default_factory=list)  # remote I/O stations, EIO 501, 502, …
+    canopen_bitrate: int = 1_000_000  # bit/s of a CANopen bus: the bus budget, and python-can where it sets it
+    canopen_eds: str = ""  # EDS/DCF of every CANopen drive without its own (AxisConfig.canopen_eds)
     source: str = ""  # the bench file this came from, for messages
 
     @property

@@ -14,6 +14,7 @@ from pathlib import Path
 from typing import Any
 
 from fieldbus.factory import parse_bus
+from fieldbus.pdo import ASDA_CSP, ASDA_CSP_CSV
 from fieldbus.units import AxisScaling
 from hil.bench import AxisConfig, Bench, ChecksConfig, IoStationConfig, RealtimeConfig, SpindleConfig
 from hil.session import InputError
@@ -22,6 +23,7 @@ from nc.profiles import PROFILE_NAMES
 from virtual_bus.drive import DriveParams
 
 AXIS_LETTERS = "XYZABCUVW"
+CIA301_BITRATES = (10_000, 20_000, 50_000, 125_000, 250_000, 500_000, 800_000, 1_000_000)  # CiA 301 bit timing table
 # DriveParams fields a bench may override, with whether they are integers (counts) or reals.
 _DRIVE_INT = {"following_error_window", "negative_limit", "positive_limit", "home_switch", "index_pulse_every",
               "substeps", "probe_position"}
@@ -53,6 +55,7 @@ class _Reader:
 
     def __init__(self) -> None:
         self.errors: list[str] = []
+        self.base = Path(".")  # relative paths in the file (canopen_eds) are relative to the file
 
     def err(self, path: str, msg: str) -> None:
         self.errors.append(f"{path}: {msg}")
@@ -136,6 +139,22 @@ class _Reader:
             return default
         return v
 
+    def eds(self, data: dict, path: str, layout: Any = None, io: tuple[int, int] = (0, 0)) -> str:
+        """`canopen_eds`: a device file resolved against the bench file's folder, parsed and checked
+        for the objects the CANopen master uses on a drive with this PDO `layout` or on an I/O station
+        with `io` = (inputs, outputs) points (fieldbus/canopen/eds_check.py); "" when absent."""
+        v = self.string(data, "canopen_eds", path, None)
+        if v is None:
+            return ""
+        from fieldbus.canopen.eds_check import drive_objects, eds_problem, io_objects
+
+        full = (self.base / Path(v).expanduser()).resolve()
+        problem = eds_problem(full, drive_objects(layout) if layout is not None else io_objects(*io))
+        if problem:
+            self.err(path, problem)
+            return ""
+        return str(full)
+
     def pair(self, data: dict, key: str, path: str, *, integers: bool, positive: bool) -> tuple | None:
         if key not in data:
             return None
@@ -169,6 +188,7 @@ def parse_bench(text: str, source: str = "bench.toml") -> Bench:
     except tomllib.TOMLDecodeError as exc:
         raise BenchFileError(source, [f"not valid TOML: {exc}"]) from None
     r = _Reader()
+    r.base = Path(source).parent
     b = Bench(source=source)
     b.name = r.string(data, "name", "name", Path(source).stem) or b.name
     b.profile = r.string(data, "profile", "profile", b.profile, PROFILE_NAMES) or b.profile
@@ -186,6 +206,8 @@ def parse_bench(text: str, source: str = "bench.toml") -> Bench:
     b.settle_time = r.number(data, "settle_time", "settle_time", b.settle_time, minimum=0.0)
     b.max_time = r.number(data, "max_time", "max_time", b.max_time, positive=True) or b.max_time
     b.lookahead = r.integer(data, "lookahead", "lookahead", None, positive=True)
+    b.canopen_bitrate = r.integer(data, "canopen_bitrate", "canopen_bitrate", b.canopen_bitrate,
+                                  choices=CIA301_BITRATES) or b.canopen_bitrate
 
     params = r.table(data, "params", "params")
     for k, v in params.items():
@@ -227,7 +249,7 @@ def parse_bench(text: str, source: str = "bench.toml") -> Bench:
     b.checks = _checks(r, r.table(data, "checks", "checks"), b.axis_names)
     b.io = _io_stations(r, data.pop("io", []), len(b.axes) + len(b.spindles))
     r.unknown(data, "", {"name", "profile", "cycle_ms", "bus", "mlc", "enable_timeout", "settle_time", "max_time",
-                         "lookahead", "params", "axes", "spindles", "realtime", "checks", "io"})
+                         "lookahead", "params", "axes", "spindles", "realtime", "checks", "io", "canopen_bitrate"})
 
     names = b.axis_names
     if b.axes and b.profile != "nc5-mill" and "X" not in names:
@@ -295,12 +317,14 @@ def _axis(r: _Reader, d: dict, p: str) -> AxisConfig | None:
                         r.number(lim, "jerk", f"{p}.limits.jerk", base.max_jerk, positive=True))
     r.unknown(lim, f"{p}.limits.", {"velocity", "acceleration", "jerk"})
     drive, model = _drive(r, d.pop("drive", {}), f"{p}.drive", DriveParams())
+    eds = r.eds(d, f"{p}.canopen_eds", ASDA_CSP)
     r.unknown(d, f"{p}.", {"name", "units", "counts_per_rev", "ratio", "lead", "direction", "start", "soft_limits",
-                           "limits", "drive"})
+                           "limits", "drive", "canopen_eds"})
     if name is None:
         return None
     return AxisConfig(name, scaling, limits, drive, start=start, units=units,
-                      soft_limits=(float(soft[0]), float(soft[1])) if soft else None, drive_model=model)
+                      soft_limits=(float(soft[0]), float(soft[1])) if soft else None, drive_model=model,
+                      canopen_eds=eds)
 
 
 def _spindle(r: _Reader, d: dict, p: str) -> SpindleConfig | None:
@@ -313,10 +337,11 @@ def _spindle(r: _Reader, d: dict, p: str) -> SpindleConfig | None:
     direction = r.integer(d, "direction", f"{p}.direction", 1, choices=(1, -1))
     max_rpm = r.number(d, "max_rpm", f"{p}.max_rpm", base.max_rpm, positive=True)
     drive, _model = _drive(r, d.pop("drive", {}), f"{p}.drive", base.drive)
-    r.unknown(d, f"{p}.", {"name", "counts_per_rev", "ratio", "direction", "max_rpm", "drive"})
+    eds = r.eds(d, f"{p}.canopen_eds", ASDA_CSP_CSV)
+    r.unknown(d, f"{p}.", {"name", "counts_per_rev", "ratio", "direction", "max_rpm", "drive", "canopen_eds"})
     scaling = AxisScaling(counts_per_rev=cpr or base.scaling.counts_per_rev, gear_motor=int(ratio[0]),
                           gear_load=int(ratio[1]), lead=360.0, direction=direction or 1)
-    return SpindleConfig(name, scaling, max_rpm or base.max_rpm, drive)
+    return SpindleConfig(name, scaling, max_rpm or base.max_rpm, drive, canopen_eds=eds)
 
 
 def _realtime(r: _Reader, d: dict) -> RealtimeConfig:
@@ -364,7 +389,7 @@ def _checks(r: _Reader, d: dict, axes: tuple[str, ...]) -> ChecksConfig:
     return c
 
 
-_IO_KEYS = {"name", "inputs", "outputs", "x", "y", "canopen_node", "canopen_tpdo", "modules"}
+_IO_KEYS = {"name", "inputs", "outputs", "x", "y", "canopen_node", "canopen_tpdo", "modules", "canopen_eds"}
 
 
 def _io_modules(r: _Reader, d: dict, p: str, points_max: int) -> tuple[str, ...] | None:
@@ -439,9 +464,10 @@ def _io_stations(r: _Reader, stations: Any, n_drives: int) -> list[IoStationConf
         elif any(o.canopen_node == node for o in out):
             r.err(f"{p}.canopen_node", f"duplicate CANopen node {node}")
         tpdo = r.string(d, "canopen_tpdo", f"{p}.canopen_tpdo", "sync", ("sync", "change")) or "sync"
+        eds = r.eds(d, f"{p}.canopen_eds", io=(n_in, n_out))
         r.unknown(d, f"{p}.", _IO_KEYS)
         if not bad_modules:  # a bad module list leaves the station's X/Y span unknown: no range errors for it
-            out.append(IoStationConfig(IoMap(name, n_in, n_out, x, y, k), node, tpdo, modules))
+            out.append(IoStationConfig(IoMap(name, n_in, n_out, x, y, k), node, tpdo, modules, canopen_eds=eds))
         next_x, next_y = next_block(max(next_x, x + n_in)), next_block(max(next_y, y + n_out))
     for msg in overlaps([o.map for o in out]):
         r.err("io", msg)

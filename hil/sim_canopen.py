@@ -45,13 +45,16 @@ def cmd_sim_canopen(args: argparse.Namespace) -> int:
     stop = threading.Event()
     signal.signal(signal.SIGTERM, lambda *_: stop.set())
     try:
-        bus = serve(sim_slaves(bench), args.interface, args.channel)
+        eds = [getattr(a, "canopen_eds", "") or bench.canopen_eds for a in [*bench.axes, *bench.spindles]]
+        bus = serve(sim_slaves(bench), args.interface, args.channel, eds=eds)
     except (OSError, ValueError, ImportError) as exc:
         print(f"hil sim canopen: cannot open {args.interface}:{args.channel}: {exc}", file=sys.stderr)
         return EXIT_USAGE
+    from fieldbus.canopen.objects import DIO_EDS
     from virtual_bus.canopen.dio import Cia401Slave
 
-    io = [Cia401Slave(st.canopen_node, st.map.inputs, st.map.outputs, st.map.name) for st in bench.io]
+    io = [Cia401Slave(st.canopen_node, st.map.inputs, st.map.outputs, st.map.name, st.canopen_eds or DIO_EDS)
+          for st in bench.io]
     for station in io:  # remote I/O stations on the same bus (mlc/remote_io.py)
         station.attach(bus.network)
     nodes = ", ".join([f"{s.node_id}={s.drive.name}" for s in bus.slaves] + [f"{s.node_id}={s.name}" for s in io])

@@ -53,15 +53,28 @@ class BusLoad:
                 f"{self.cycle * 1000:g} ms cycle + heartbeats")
 
 
+def io_frame_bytes(inputs: int, outputs: int) -> list[int]:
+    """Data bytes of a CiA 401 station's PDOs per cycle: RPDO1 = the output bytes (on every SYNC),
+    TPDO1 = the input bytes. A change-of-state TPDO is counted as one per cycle too: the master
+    reads inputs once a cycle, and the budget is for the worst case (inputs changing every cycle)."""
+    return [(n + 7) // 8 for n in (outputs, inputs) if n > 0]
+
+
 def bus_load(layouts: Sequence[PdoLayout], cycle: float, bitrate: int = DEFAULT_BITRATE,
-             heartbeat_period: float = 0.0) -> BusLoad:
+             heartbeat_period: float = 0.0, io: Sequence[tuple[int, int]] = ()) -> BusLoad:
+    """`io`: (input points, output points) of each remote I/O station on the same bus."""
     bits = frame_bits(0)  # SYNC without counter
     frames = 1
     for layout in layouts:
         for f in pdo_frames(layout.rx) + pdo_frames(layout.tx):
             bits += frame_bits(sum(e.bits for e in f) // 8)
             frames += 1
-    hb = len(layouts) * frame_bits(1) / heartbeat_period if heartbeat_period > 0 else 0.0
+    for inputs, outputs in io:
+        for n_bytes in io_frame_bytes(inputs, outputs):
+            bits += frame_bits(n_bytes)
+            frames += 1
+    producers = len(layouts) + len(io)  # every node, drive or I/O station, sends a heartbeat
+    hb = producers * frame_bits(1) / heartbeat_period if heartbeat_period > 0 else 0.0
     return BusLoad(bitrate, cycle, frames, bits, hb)
 
 
@@ -69,7 +82,7 @@ def check_budget(load: BusLoad, enforce: bool) -> str | None:
     """Refuse > 100 % when the wire has a bitrate (`enforce`); otherwise return a warning text or None."""
     if load.load > 1.0:
         advice = (f"; needs a cycle of at least {load.min_cycle() * 1000:.2f} ms "
-                  f"({load.min_cycle(WARN_LOAD) * 1000:.2f} ms for {WARN_LOAD:.0%}), fewer drives or a faster bus")
+                  f"({load.min_cycle(WARN_LOAD) * 1000:.2f} ms for {WARN_LOAD:.0%}), fewer drives or I/O stations, or a faster bus")
         if enforce:
             raise BusBudgetError(load.describe() + " exceeds the bus" + advice)
         return load.describe() + " -- a real bus at this bitrate could not carry it (virtual bus, no bit timing)" + advice

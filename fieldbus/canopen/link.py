@@ -136,7 +136,9 @@ class CanopenLink:
         self.ip_period = interpolation_period(cycle)
         for cfg in self.nodes_cfg:
             frame_layouts(cfg.layout)  # refuse layouts that don't fit the node's PDOs
-        self.budget: BusLoad = bus_load([c.layout for c in self.nodes_cfg], cycle, bitrate, self.heartbeat_period)
+        self.io_cfg = list(io_nodes)  # remote I/O stations, after the drives (CiA 401)
+        self.budget: BusLoad = bus_load([c.layout for c in self.nodes_cfg], cycle, bitrate, self.heartbeat_period,
+                                        [(c.inputs, c.outputs) for c in self.io_cfg])
         # Raises BusBudgetError above 100 % on a wire with a bitrate; the virtual bus only warns.
         self.budget_note = check_budget(self.budget, enforce=not self.lockstep)
         if self.budget_note:
@@ -149,7 +151,6 @@ class CanopenLink:
         self.infos: list[SlaveInfo] = []
         self.found: list[int] = []
         self._nodes: list[_Node] = []
-        self.io_cfg = list(io_nodes)  # remote I/O stations, after the drives (CiA 401)
         self._io: list[_IoNode] = []
         self._opened = False
         self._lock = threading.Condition()
@@ -161,9 +162,12 @@ class CanopenLink:
     def for_bench(cls, bench: Any, interface: str, channel: str = "") -> "CanopenLink":
         """Node IDs 1, 2, … in axis order, then the spindles; CSP set for axes, CSP+CSV for spindles."""
         eds = getattr(bench, "canopen_eds", None) or ASDA_B3_EDS
-        nodes = [NodeConfig(i + 1, a.name, ASDA_CSP, eds) for i, a in enumerate(bench.axes)]
-        nodes += [NodeConfig(len(nodes) + k + 1, s.name, ASDA_CSP_CSV, eds) for k, s in enumerate(bench.spindles)]
-        io = [IoNodeConfig(st.canopen_node, st.map.name, st.map.inputs, st.map.outputs, st.canopen_tpdo)
+        nodes = [NodeConfig(i + 1, a.name, ASDA_CSP, getattr(a, "canopen_eds", "") or eds)
+                 for i, a in enumerate(bench.axes)]
+        nodes += [NodeConfig(len(nodes) + k + 1, s.name, ASDA_CSP_CSV, getattr(s, "canopen_eds", "") or eds)
+                  for k, s in enumerate(bench.spindles)]
+        io = [IoNodeConfig(st.canopen_node, st.map.name, st.map.inputs, st.map.outputs, st.canopen_tpdo,
+                           getattr(st, "canopen_eds", ""))
               for st in getattr(bench, "io", [])]  # [[io]] stations (mlc/remote_io.py)
         return cls(nodes, interface, channel, bench.cycle,
                    bitrate=int(getattr(bench, "canopen_bitrate", None) or DEFAULT_BITRATE), io_nodes=io)
@@ -193,7 +197,7 @@ class CanopenLink:
             self.network = net
         else:
             self.network = canopen.Network()
-            self.network.connect(interface=self.interface, channel=self.channel)
+            self.network.connect(**connect_args(self.interface, self.channel, self.bitrate))
         net = self.network
         for cfg in self.nodes_cfg:
             remote = canopen.RemoteNode(cfg.node_id, canopen.import_od(str(cfg.eds), cfg.node_id))
@@ -529,6 +533,20 @@ class CanopenLink:
     @property
     def tpdo_misses(self) -> dict[str, int]:
         return {n.cfg.name: n.tpdo_misses for n in self._nodes}
+
+
+# python-can interfaces whose bit timing is not the process's to set: socketcan's is the kernel's
+# (`ip link set can0 type can bitrate …`), udp_multicast and virtual have none.
+_BITRATE_SET_ELSEWHERE = {"socketcan", "udp_multicast", "virtual"}
+
+
+def connect_args(interface: str, channel: str, bitrate: int) -> dict[str, Any]:
+    """python-can bus arguments: the bench's bitrate goes to the adapters that configure it themselves
+    (pcan, kvaser, ixxat, slcan, gs_usb …)."""
+    args: dict[str, Any] = {"interface": interface, "channel": channel}
+    if interface not in _BITRATE_SET_ELSEWHERE:
+        args["bitrate"] = bitrate
+    return args
 
 
 def _abort_text(exc: SdoAbortedError) -> str:

@@ -13,10 +13,12 @@ from __future__ import annotations
 import logging
 import threading
 from collections.abc import Sequence
+from pathlib import Path
 
 import canopen
 
 from fieldbus.canopen.lockstep import LockstepNetwork
+from fieldbus.canopen.objects import ASDA_B3_EDS
 from virtual_bus.canopen.node import Cia402Slave
 from virtual_bus.drive import Cia402Drive
 
@@ -24,9 +26,12 @@ log = logging.getLogger("virtual_bus.canopen")
 
 
 class SlaveBus:
-    def __init__(self, drives: Sequence[Cia402Drive], network: canopen.Network, first_id: int = 1) -> None:
+    def __init__(self, drives: Sequence[Cia402Drive], network: canopen.Network, first_id: int = 1,
+                 eds: Sequence[str | Path] = ()) -> None:
+        """`eds`: each drive's device file (bench `canopen_eds`), the shipped ASDA-B3 EDS where absent."""
         self.network = network
-        self.slaves = [Cia402Slave(first_id + i, d) for i, d in enumerate(drives)]
+        files = list(eds) + [""] * (len(drives) - len(eds))
+        self.slaves = [Cia402Slave(first_id + i, d, str(f or ASDA_B3_EDS)) for i, (d, f) in enumerate(zip(drives, files))]
         self.syncs = 0
         self._lock = threading.Lock()
         network.subscribe(0x80, self._on_sync)
@@ -57,18 +62,18 @@ class SlaveBus:
 
 def attach_lockstep(link, drives: Sequence[Cia402Drive]) -> SlaveBus:
     """Put the drives on the link's `virtual` channel and let the link pump them each frame."""
-    bus = SlaveBus(drives, LockstepNetwork(link.channel))
+    bus = SlaveBus(drives, LockstepNetwork(link.channel), eds=[c.eds for c in link.nodes_cfg])
     link.peers.append(bus.network.pump)
     link.on_close.append(bus.close)
     return bus
 
 
 def serve(drives: Sequence[Cia402Drive], interface: str, channel: str, stop: threading.Event | None = None,
-          ready: threading.Event | None = None) -> SlaveBus:
+          ready: threading.Event | None = None, eds: Sequence[str | Path] = ()) -> SlaveBus:
     """Run the nodes on a real python-can interface until `stop` is set (Ctrl-C in `hil sim`)."""
     network = canopen.Network()
     network.connect(interface=interface, channel=channel)
-    bus = SlaveBus(drives, network)
+    bus = SlaveBus(drives, network, eds=eds)
     log.info("CANopen nodes %s on %s:%s", [s.node_id for s in bus.slaves], interface, channel)
     if ready is not None:
         ready.set()
