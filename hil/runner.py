@@ -113,6 +113,8 @@ class BenchRunner:
             self.run_events(interp.run(program))
         except BusError as exc:
             self._alarm(exc.alarm)
+            # A bus alarm naming a drive (CANopen EMCY) is that drive's alarm: its fault bit is not raised again.
+            self._alarmed_drives.update(i for i in range(len(self.masters)) if self._name(i) == exc.alarm.axis)
         except NcAlarm as exc:
             self._alarm(exc.alarm)
         finally:

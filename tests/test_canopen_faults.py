@@ -118,3 +118,99 @@ def test_a_drive_that_cannot_map_an_object_aborts_the_mapping_write():
     finally:
         link.close()
     assert nodes["X"].nmt_state == "STOPPED"
+
+
+# ---- one alarm per drive fault (EMCY and statusword fault bit are two signs of one fault) ------------
+def _fault_run(prepare):
+    """The move with X faulting (ASDA AL013) at cycle 300; `prepare(nodes)` sets up the drive."""
+    def estop(r):
+        if r.cycle == 300:
+            nodes["X"].drive.external_fault = 0x13
+
+    bench = default_lathe()
+    link = CanopenLink.for_bench(bench, "virtual", "")
+    nodes = attach_lockstep(link, sim_slaves(bench))
+    prepare(nodes)
+    result = BenchRunner(bench, link, on_cycle=estop).run_program(parse_program(PROGRAM, name="move.nc"))
+    assert not result.ok and nodes["X"].drive.state is State.FAULT
+    return result, link, nodes
+
+
+def test_emcy_first_one_alarm_with_the_emcy_code():
+    result, link, nodes = _fault_run(lambda nodes: None)
+    assert [(a.code, a.axis, a.info) for a in result.alarms] == [(0xF002, "X", 0x13)]
+    assert "EMCY 0x5441" in result.alarms[0].message and "AL013" in result.alarms[0].message
+    (name, episode), = link.faults
+    assert (name, episode.reported_by, episode.fault_bit_seen) == ("X", "EMCY", True)
+    assert [e.code for e in episode.emcys] == [0x5441]
+
+
+def test_statusword_first_one_alarm_and_the_late_emcy_joins_it():
+    def late_emcy(nodes):
+        nodes["X"].emcy_delay = 3  # the TPDO with the fault bit arrives 3 cycles before the EMCY
+
+    result, link, nodes = _fault_run(late_emcy)
+    assert [(a.code, a.axis, a.info) for a in result.alarms] == [(0xF002, "X", 0x13)]
+    assert "drive error code 0x0013" in result.alarms[0].message  # from 0x603F in the TPDO
+    assert [(e.code, e.delta_alarm) for e in nodes["X"].emcys_sent] == [(0x5441, 0x13)]  # it did come
+    (name, episode), = link.faults
+    assert (name, episode.reported_by) == ("X", "statusword")
+    assert [e.code for e in episode.emcys] == [0x5441]  # received, raised nothing
+
+
+def test_emcy_disabled_the_statusword_still_raises_the_alarm():
+    def no_emcy(nodes):
+        # COB-ID EMCY (0x1014) bit 31: the drive has no valid EMCY (CiA 301); survives NMT reset
+        nodes["X"].node.object_dictionary[0x1014].default = 0x80000000 | (0x80 + 1)
+
+    result, link, nodes = _fault_run(no_emcy)
+    assert [(a.code, a.axis, a.info) for a in result.alarms] == [(0xF002, "X", 0x13)]
+    assert nodes["X"].emcys_sent == []
+    assert [(n, e.reported_by, e.emcys) for n, e in link.faults] == [("X", "statusword", [])]
+
+
+def test_an_episode_lasts_until_the_fault_reset_then_the_next_fault_is_raised_again():
+    """Link level, the drives disabled: a second EMCY (another alarm code) of the same fault raises
+    nothing; after fault reset (fault bit falls) the next fault is a new alarm."""
+    from fieldbus.cia402 import Cia402Master
+    from fieldbus.link import BusError
+    from fieldbus.pdo import RxPdo
+
+    bench = default_lathe()
+    link = CanopenLink.for_bench(bench, "virtual", "")
+    nodes = attach_lockstep(link, sim_slaves(bench))
+    masters = [Cia402Master() for _ in range(3)]
+    rx = [RxPdo(mode=8), RxPdo(mode=8), RxPdo(mode=9)]
+    raised = []
+
+    def cycles(n):
+        for _ in range(n):
+            try:
+                tx = link.exchange(rx)
+            except BusError as exc:
+                raised.append(exc.alarm)
+                continue
+            for m, r, t in zip(masters, rx, tx):
+                r.controlword = m.step(t.statusword)
+
+    link.open()
+    try:
+        cycles(5)
+        z = nodes["Z"].drive
+        z.external_fault = 0x09  # AL009 following error
+        cycles(5)
+        z.external_fault = 0x07  # the drive adds AL007 while still in fault: a second EMCY
+        z.error_code = 0x07
+        cycles(5)
+        assert [(a.axis, a.info) for a in raised] == [("Z", 0x09)]
+        assert [e.delta_alarm for e in link.faults[0][1].emcys] == [0x09, 0x07]
+        z.external_fault = 0
+        masters[1].fault_reset()
+        cycles(5)
+        assert z.state is State.SWITCH_ON_DISABLED and link._nodes[1].fault is None
+        z.external_fault = 0x13  # a new fault: emergency stop input
+        cycles(5)
+    finally:
+        link.close()
+    assert [(a.code, a.axis, a.info) for a in raised] == [(0xF002, "Z", 0x09), (0xF002, "Z", 0x13)]
+    assert [(n, e.reported_by) for n, e in link.faults] == [("Z", "EMCY"), ("Z", "EMCY")]

@@ -33,6 +33,7 @@ from fieldbus.canopen.emcy import ALARM_COMMUNICATION, ALARM_PDO_MAPPING, Emcy, 
 from fieldbus.canopen.lockstep import LockstepNetwork
 from fieldbus.canopen.netns import check_multicast_allowed
 from fieldbus.canopen.objects import ASDA_B3_EDS, DIO_EDS, MAX_PDOS, frame_layouts
+from fieldbus.cia402 import SW_FAULT
 from fieldbus.link import BusError, SlaveInfo
 from fieldbus.pdo import ASDA_CSP, ASDA_CSP_CSV, PdoLayout, RxPdo, TxPdo
 from nc.alarms import Alarm
@@ -99,6 +100,18 @@ class _Node:
     last_heartbeat: float = 0.0
     lost: bool = False
     tpdo_misses: int = 0
+    fault: "FaultEpisode | None" = None  # the fault being reported, until the drive is reset
+
+
+@dataclass
+class FaultEpisode:
+    """One drive fault from its first sign (EMCY or statusword fault bit) to its reset (the fault bit
+    falling): the NC raises one alarm for it. `reported_by` says which path raised it: "EMCY" (the
+    link, with the EMCY's code) or "statusword" (the CiA 402 master in the runner, with 0x603F)."""
+
+    reported_by: str
+    emcys: list[Emcy] = field(default_factory=list)  # every EMCY of the episode, the first one raised
+    fault_bit_seen: bool = False
 
 
 def interpolation_period(cycle: float) -> tuple[int, int]:
@@ -154,7 +167,8 @@ class CanopenLink:
         self._io: list[_IoNode] = []
         self._opened = False
         self._lock = threading.Condition()
-        self._emcys: list[Alarm] = []
+        self._emcys: list[tuple[_Node, Emcy]] = []
+        self.faults: list[tuple[str, FaultEpisode]] = []  # (drive, episode) in the order they began
         self._next_sync = 0.0
         self._opened_at = 0.0
 
@@ -381,10 +395,8 @@ class CanopenLink:
 
     def _emcy_cb(self, n: _Node) -> Callable[[int, bytes, float], None]:
         def cb(can_id: int, data: bytes, timestamp: float) -> None:
-            alarm = emcy_alarm(Emcy.decode(data), n.cfg.node_id, n.cfg.name)
-            if alarm is not None:
-                with self._lock:
-                    self._emcys.append(alarm)
+            with self._lock:
+                self._emcys.append((n, Emcy.decode(data)))
         return cb
 
     def _tpdo_cb(self, n: _Node) -> Callable[[int, bytes, float], None]:
@@ -450,7 +462,40 @@ class CanopenLink:
         self._supervise(emcys)
         return out
 
-    def _supervise(self, emcys: list[Alarm]) -> None:
+    def _fault_episodes(self, emcys: list[tuple[_Node, Emcy]]) -> Alarm | None:
+        """One alarm per drive fault, whichever of its two signs comes first. An EMCY opens an episode
+        and is the alarm (it carries the drive's error code and Delta alarm number); a statusword fault
+        bit without an EMCY before it opens one that the CiA 402 master raises from 0x603F. Later EMCYs
+        of the same episode are kept in `faults` but raise nothing; the episode ends when the fault
+        bit falls (fault reset), or at EMCY 0x0000 (error reset) if the fault bit never rose."""
+        alarm = None
+        for n, emcy in emcys:
+            if emcy.code == 0x0000:
+                if n.fault is not None and not n.fault.fault_bit_seen:
+                    n.fault = None
+                continue
+            if n.fault is not None:
+                n.fault.emcys.append(emcy)
+                log.info("EMCY 0x%04X from %s belongs to the fault already reported by %s", emcy.code,
+                         self._label(n), n.fault.reported_by)
+                continue
+            n.fault = FaultEpisode("EMCY", [emcy])
+            self.faults.append((n.cfg.name, n.fault))
+            alarm = alarm or emcy_alarm(emcy, n.cfg.node_id, n.cfg.name)
+        for n in self._nodes:
+            faulted = bool(n.tx.statusword & SW_FAULT) and not n.lost
+            if faulted and n.fault is None:
+                n.fault = FaultEpisode("statusword")
+                self.faults.append((n.cfg.name, n.fault))
+            if n.fault is not None:
+                if faulted:
+                    n.fault.fault_bit_seen = True
+                elif n.fault.fault_bit_seen:
+                    n.fault = None  # reset: the next fault is a new episode
+        return alarm
+
+    def _supervise(self, emcys: list[tuple[_Node, Emcy]]) -> None:
+        alarm = self._fault_episodes(emcys)
         now = self._now()
         for n in self._nodes:
             if n.lost:
@@ -479,8 +524,8 @@ class CanopenLink:
                 why = (f"no heartbeat for {(now - io.last_heartbeat) * 1000:.0f} ms" if silent else
                        f"heartbeat reports {NMT_NAMES.get(io.nmt_state, str(io.nmt_state))}")
                 raise BusError(Alarm(ALARM_EIO_FAILED, f"remote I/O station {self._label(io)} lost: {why}"))
-        if emcys:
-            raise BusError(emcys[0])
+        if alarm is not None:
+            raise BusError(alarm)
 
     def _lose(self, n: _Node) -> None:
         """A lost node reads 'not ready to switch on' and is no longer served or supervised."""

@@ -54,6 +54,10 @@ class Cia402Slave:
         self.network: canopen.Network | None = None
         self.syncs = 0
         self.emcys_sent: list[Emcy] = []
+        # SYNCs between a fault and its EMCY: 0 = the EMCY leaves before that SYNC's TPDOs (as a drive
+        # that reports at once); 1+ = the master sees the statusword fault bit first.
+        self.emcy_delay = 0
+        self._emcy_queue: list[tuple[int, Emcy]] = []  # (SYNC count it is due at, EMCY)
         self._rpdos: dict[int, PdoLayout] = {}
         self._tpdos: list[_Pdo] = []
         self._latched: dict[int, bytes] = {}
@@ -233,6 +237,10 @@ class Cia402Slave:
             self.drive.step(dt)
             tx = self.drive.feedback()
         self._emcy(tx.error_code)
+        due = [e for at, e in self._emcy_queue if at <= self.syncs]
+        self._emcy_queue = [(at, e) for at, e in self._emcy_queue if at > self.syncs]
+        for emcy in due:
+            self._send_emcy(emcy)
         if operational and self.network is not None:
             for pdo in self._tpdos:
                 self.network.send_message(pdo.cob_id, pdo.layout.pack_tx(tx))
@@ -240,13 +248,17 @@ class Cia402Slave:
     def _emcy(self, error_code: int) -> None:
         faulted = self.drive.state in (State.FAULT, State.FAULT_REACTION_ACTIVE)
         if faulted and error_code and error_code != self._fault_reported:
-            self._send_emcy(emcy_for_delta(error_code))
+            self._emcy_queue.append((self.syncs + self.emcy_delay, emcy_for_delta(error_code)))
             self._fault_reported = error_code
         elif not faulted and self._fault_reported:
-            self._send_emcy(Emcy(0x0000, 0x00, 0))  # error reset
+            self._emcy_queue.append((self.syncs + self.emcy_delay, Emcy(0x0000, 0x00, 0)))  # error reset
             self._fault_reported = 0
 
     def _send_emcy(self, emcy: Emcy) -> None:
+        """On the COB-ID of 0x1014; none when its bit 31 says the EMCY is not valid (CiA 301)."""
+        cob = self._value(0x1014, 0)
+        if cob & 0x80000000 or self.network is None:
+            return
         self.emcys_sent.append(emcy)
-        if self.network is not None:
-            self.node.emcy.send(emcy.code, emcy.register, emcy.encode()[3:])
+        self.node.emcy.cob_id = cob & 0x7FF
+        self.node.emcy.send(emcy.code, emcy.register, emcy.encode()[3:])
