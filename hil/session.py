@@ -70,6 +70,15 @@ def sim_slaves(bench: Bench) -> list[Cia402Drive]:
     return drives
 
 
+def sim_io_stations(bench: Bench) -> list:
+    """Virtual CiA 401 nodes for the bench's remote I/O stations, each with its own EDS."""
+    from fieldbus.canopen.objects import DIO_EDS
+    from virtual_bus.canopen.dio import Cia401Slave
+
+    return [Cia401Slave(st.canopen_node, st.map.inputs, st.map.outputs, st.map.name, st.canopen_eds or DIO_EDS)
+            for st in bench.io]
+
+
 def make_link(bench: Bench) -> BusLink:
     try:
         spec = parse_bus(bench.bus)
@@ -93,10 +102,9 @@ def make_link(bench: Bench) -> BusLink:
 
         attach_lockstep(link, sim_slaves(bench))
         if bench.io:  # the bench's remote I/O stations as simulated CiA 401 nodes (hil/remote_io.py)
-            from virtual_bus.canopen.dio import Cia401Slave, attach_lockstep_io
+            from virtual_bus.canopen.dio import attach_lockstep_io
 
-            link.io_devices = [Cia401Slave(st.canopen_node, st.map.inputs, st.map.outputs, st.map.name)
-                               for st in bench.io]
+            link.io_devices = sim_io_stations(bench)
             attach_lockstep_io(link, link.io_devices)
     return link
 

@@ -14,7 +14,7 @@ import sys
 import threading
 
 from hil.cli import EXIT_OK, EXIT_USAGE
-from hil.session import InputError, load_bench, sim_slaves
+from hil.session import InputError, load_bench, sim_io_stations, sim_slaves
 
 
 def add_canopen(sims: argparse._SubParsersAction) -> None:
@@ -50,11 +50,7 @@ def cmd_sim_canopen(args: argparse.Namespace) -> int:
     except (OSError, ValueError, ImportError) as exc:
         print(f"hil sim canopen: cannot open {args.interface}:{args.channel}: {exc}", file=sys.stderr)
         return EXIT_USAGE
-    from fieldbus.canopen.objects import DIO_EDS
-    from virtual_bus.canopen.dio import Cia401Slave
-
-    io = [Cia401Slave(st.canopen_node, st.map.inputs, st.map.outputs, st.map.name, st.canopen_eds or DIO_EDS)
-          for st in bench.io]
+    io = sim_io_stations(bench)
     for station in io:  # remote I/O stations on the same bus (mlc/remote_io.py)
         station.attach(bus.network)
     nodes = ", ".join([f"{s.node_id}={s.drive.name}" for s in bus.slaves] + [f"{s.node_id}={s.name}" for s in io])

@@ -11,7 +11,7 @@ import pytest
 
 from fieldbus.canopen.budget import BusBudgetError, frame_bits
 from fieldbus.canopen.link import CanopenLink, connect_args
-from fieldbus.canopen.objects import ASDA_B3_EDS
+from fieldbus.canopen.objects import ASDA_B3_EDS, DIO_EDS
 from hil.bench_file import BenchFileError, load_bench_file, parse_bench
 from hil.session import make_link
 from tests.conftest import ROOT
@@ -81,15 +81,15 @@ def test_bitrate_goes_to_python_can_adapters_that_set_it_and_not_to_socketcan():
 
 
 # ---- EDS per drive / per station ------------------------------------------------------------------
-def _custom_eds(folder: Path, product: int) -> Path:
-    """The shipped ASDA-B3 EDS with another product code (0x1018:2), as a vendor's variant would be."""
+def _custom_eds(folder: Path, product: int, source: Path = ASDA_B3_EDS, name: str = "asda_variant.eds") -> Path:
+    """A shipped EDS with another product code (0x1018:2), as a vendor's variant would be."""
     folder.mkdir(parents=True, exist_ok=True)
-    text = ASDA_B3_EDS.read_text(encoding="utf-8")
+    text = source.read_text(encoding="utf-8")
     head, sep, rest = text.partition("[1018sub2]")
     assert sep, "the shipped EDS has an identity object"
     block, nxt, tail = rest.partition("\n[")
     lines = [f"DefaultValue=0x{product:08X}" if ln.startswith("DefaultValue=") else ln for ln in block.split("\n")]
-    path = folder / "asda_variant.eds"
+    path = folder / name
     path.write_text(head + sep + "\n".join(lines) + nxt + tail, encoding="utf-8")
     return path
 
@@ -109,6 +109,18 @@ def test_drive_eds_is_resolved_next_to_the_bench_file_and_used_by_master_and_sim
     finally:
         link.close()
     assert [i.product_code for i in infos] == [0x6080, 0x6081, 0x6080]
+
+
+def test_station_eds_is_used_by_the_simulated_station_on_the_virtual_bus(tmp_path):
+    _custom_eds(tmp_path / "devices", 0x0401_0042, DIO_EDS, "dio_variant.eds")
+    bench_file = tmp_path / "bench.toml"
+    bench_file.write_text(lathe(io=station(64, 16, 16, 'canopen_eds = "devices/dio_variant.eds"')))
+    link = make_link(load_bench_file(bench_file))
+    try:
+        infos = link.open()  # the station's identity is read over SDO from the simulated node
+    finally:
+        link.close()
+    assert [i.product_code for i in infos if i.kind == "io"] == [0x0401_0042]
 
 
 @pytest.mark.parametrize("where, value, message", [
