@@ -96,12 +96,13 @@ class BenchRunner:
 
     # ---- public ---------------------------------------------------------------------------
     def run_program(self, program: Program) -> RunResult:
+        if isinstance(self.clock, RealTimeClock):
+            _preload()
         try:
-            if not self.power_up():
-                return self._finish()
+            # Everything the program needs is built before the drives are enabled: once cycles
+            # run (paced in real time), a cycle has no room for it.
             profile = make_profile(self.bench.profile, self.axes, self.bench.params)
-            start = dict(zip(self.axes, self.actual.tolist()))
-            interp = Interpreter(profile, start)
+            interp = Interpreter(profile)
             self._interp = interp  # G31 skip hands the latch back to it (issue 5)
             from hil.servo_link import BusServoAccess  # G10 L40-L46 → SDO / Modbus on this bench (issue 8)
 
@@ -110,6 +111,9 @@ class BenchRunner:
             self.profile = profile  # G10 L21 soft limits live in its params (issue 8)
             if hasattr(self.mlc, "attach_variables"):  # MLC ↔ #25000–#25511 exchange (issue 8)
                 self.mlc.attach_variables(interp.vars)
+            if not self.power_up():
+                return self._finish()
+            interp.take_position(dict(zip(self.axes, self.actual.tolist())))
             self.run_events(interp.run(program))
         except BusError as exc:
             self._alarm(exc.alarm)
@@ -369,3 +373,21 @@ class BenchRunner:
     def _name(self, i: int) -> str:
         n = len(self.axes)
         return self.axes[i] if i < n else self.bench.spindles[i - n].name
+
+
+def _preload() -> None:
+    """Import every module the NC and MLC may import on first use, before cycles are paced: a
+    first-use import inside a real-time cycle (the cutter compensation stream, the preview window,
+    G10 data setting …) costs milliseconds and overran the first program cycle."""
+    import importlib
+    import pkgutil
+
+    import mlc
+    import nc
+
+    for pkg in (nc, mlc):
+        for info in pkgutil.walk_packages(pkg.__path__, pkg.__name__ + "."):
+            try:
+                importlib.import_module(info.name)
+            except ImportError:  # an optional part this machine lacks is not used on this bench either
+                pass

@@ -96,8 +96,7 @@ class Interpreter:
         self.state = ModalState.power_on(profile)
         self.frames = Frames(self.axes)
         self.position: dict[str, float] = {a: 0.0 for a in self.axes}  # machine, as the axis travels
-        if start:
-            self.position.update({a: v for a, v in start.items() if a in self.position})
+        self.take_position(start or {})
         self.program_name = ""
         self.store = store or ProgramStore()
         self._own_store = store is not None  # else the program's own store (Program.store) is searched
@@ -130,6 +129,10 @@ class Interpreter:
         self._plain_axes = frozenset(self.axes) - {"G", "M", "T", "F", "S", "D"}  # `_axis_block` letters
 
     # ---- public ---------------------------------------------------------------------------
+
+    def take_position(self, start: dict[str, float]) -> None:
+        """Start from where the axes stand (machine coordinates), before the program runs."""
+        self.position.update({a: v for a, v in start.items() if a in self.position})
     def variable(self, number: int) -> float | None:
         return self.vars.get(number)
 
