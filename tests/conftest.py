@@ -46,3 +46,17 @@ def program(tmp_path):
         return p
 
     return make
+
+
+def run_counting_queue(bench, text: str):
+    """Run a program text on a bench (lock-step) and record the look-ahead queue length each cycle:
+    (runner, result, lengths)."""
+    from hil.runner import BenchRunner
+    from hil.session import make_link
+    from nc.program import parse_program
+
+    lengths: list[int] = []
+    runner = BenchRunner(bench, make_link(bench), None,
+                         on_cycle=lambda r: lengths.append(len(r.channel.planner.queue)) if r.channel else None)
+    result = runner.run_program(parse_program(text, name="p.nc"))
+    return runner, result, lengths

@@ -123,19 +123,13 @@ def test_cli_bad_bench_exits_2_naming_the_field(tmp_path, capsys):
 def test_lookahead_depth_from_the_bench_file_bounds_the_queue():
     """`lookahead = 6`: the planner never holds more than 6 blocks (the D3x320 count the MLC sees)
     and the program still ends where it must; by default the depth follows the limits (≥ 100)."""
-    from hil.runner import BenchRunner
-    from hil.session import make_link
-    from nc.program import parse_program
+    from tests.conftest import run_counting_queue
 
     assert parse_bench(GOOD, "b.toml").motion_config().lookahead_depth() >= 100
     bench = parse_bench(GOOD.replace('bus = "sim"', 'bus = "sim"\nlookahead = 6'), "b.toml")
     assert bench.motion_config().lookahead_depth() == 6
     zs = [f"G01 Z{-0.5 * k:.1f} F600." for k in range(1, 41)]
-    program = parse_program("G98\nG00 X20. Z0.\n" + "\n".join(zs) + "\nM30\n", name="p.nc")
-    seen: list[int] = []
-    runner = BenchRunner(bench, make_link(bench), None,
-                         on_cycle=lambda r: seen.append(len(r.channel.planner.queue)) if r.channel else None)
-    result = runner.run_program(program)
+    runner, result, seen = run_counting_queue(bench, "G98\nG00 X20. Z0.\n" + "\n".join(zs) + "\nM30\n")
     assert result.ok
     assert max(seen) == 6
     assert runner.channel.planner.position.tolist() == pytest.approx([10.0, -20.0])

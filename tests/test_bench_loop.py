@@ -182,17 +182,12 @@ def test_the_look_ahead_fills_a_few_blocks_per_cycle():
     once overran the first 1 ms real-time cycle of a CAM program (alarm 0x141F). The queue still
     reaches its depth within a few dozen cycles and the program ends where it must."""
     from hil.bench_file import load_bench_file
-    from hil.session import make_link
     from nc.channel import READS_PER_CYCLE
-    from tests.conftest import ROOT
+    from tests.conftest import ROOT, run_counting_queue
 
     bench = load_bench_file(ROOT / "benches" / "mill-3axis.toml")
     ys = [f"X{0.05 * k:.3f} Y{0.5 * np.sin(0.05 * k):.4f}" for k in range(1, 301)]
-    program = parse_program("G90 G01 F3000\n" + "\n".join(ys) + "\nM30\n", name="cam.nc")
-    queued: list[int] = []
-    runner = BenchRunner(bench, make_link(bench), None,
-                         on_cycle=lambda r: queued.append(len(r.channel.planner.queue)) if r.channel else None)
-    result = runner.run_program(program)
+    runner, result, queued = run_counting_queue(bench, "G90 G01 F3000\n" + "\n".join(ys) + "\nM30\n")
     assert result.ok
     growth = np.diff([0] + queued)
     assert growth.max() == READS_PER_CYCLE == 8
