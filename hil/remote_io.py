@@ -40,6 +40,25 @@ def sim_modules(bench: Bench, link: Any) -> list[Any]:
     return link.io_devices
 
 
+class IoNotSimulated(LookupError):
+    """The [[io]] station behind a point lives on a real bus, not in this process."""
+
+
+def io_terminal(bench: Bench, link: Any, kind: str, n: int) -> tuple[Any, int] | None:
+    """(simulated station, point) behind X<n> / Y<n> by the bench's [[io]] mapping; None when no station
+    maps the point; IoNotSimulated when its station is not simulated in this process."""
+    for i, st in enumerate(bench.io):
+        m = st.map
+        first, count = (m.x, m.inputs) if kind == "X" else (m.y, m.outputs)
+        if first <= n < first + count:
+            devices = getattr(link, "io_devices", None) or []
+            if i >= len(devices):
+                raise IoNotSimulated(f"station {m.name} is not simulated in this process (bus {bench.bus}); "
+                                     "drive its terminals on the slave side")
+            return devices[i], n - first
+    return None
+
+
 def attach_remote_io(bench: Bench, mlc: Any, link: Any) -> None:
     """Give the MLC the bench's stations (a no-op without [[io]] or for the foundation's BasicMlc)."""
     if not bench.io or not callable(getattr(mlc, "attach_io", None)):

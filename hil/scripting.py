@@ -25,7 +25,7 @@ from pathlib import Path
 from typing import Any, Callable
 
 from hil.bench import Bench
-from hil.remote_io import attach_remote_io
+from hil.remote_io import IoNotSimulated, attach_remote_io, io_terminal
 from hil.runner import BenchRunner
 from hil.session import make_link
 from mlc.machine import Mlc
@@ -38,6 +38,12 @@ from nc.interrupt import m96_link
 from nc.motion import Planner
 from nc.profiles import make_profile
 from nc.store import ProgramStore
+
+
+# The operator's buttons: relay M2x<index> of the channel, pressed as a pulse (rising edge). Shared by
+# the script API below and `hil run --at "t=…:feed-hold"` (hil/run_events.py).
+OPERATOR_BUTTONS = {"cycle-start": 0, "feed-hold": 1, "reset": 4, "interrupt": 19}
+ESTOP_RELAY = 13  # M2x013: emergency stop, a level (ON = stopped)
 
 
 class ScriptError(Exception):
@@ -189,16 +195,13 @@ class Machine:
             raise ScriptError(str(exc)) from None
         if k != kind:
             raise ScriptError(f"{device}: expected an {'input X' if kind == 'X' else 'output Y'}<n>")
-        for i, st in enumerate(self.bench.io):
-            m = st.map
-            first, count = (m.x, m.inputs) if kind == "X" else (m.y, m.outputs)
-            if first <= n < first + count:
-                devices = getattr(self.link, "io_devices", None) or []
-                if i >= len(devices):
-                    raise ScriptError(f"station {m.name} is not simulated in this process (bus {self.bench.bus}); "
-                                      "drive its terminals on the slave side")
-                return devices[i], n - first
-        raise ScriptError(f"{device} belongs to no [[io]] station of the bench")
+        try:
+            hit = io_terminal(self.bench, self.link, kind, n)
+        except IoNotSimulated as exc:
+            raise ScriptError(str(exc)) from None
+        if hit is None:
+            raise ScriptError(f"{device} belongs to no [[io]] station of the bench")
+        return hit
 
     def set_input(self, device: str, on: bool = True) -> None:
         """Switch the terminal behind remote input X<n> on its simulated station (seen from the next scan)."""
@@ -309,7 +312,7 @@ class Machine:
         r.channel = ch
         ch.m96 = m96_link(interp)  # the MLC's M2x019 interrupts it (machine.interrupt())
         ch.load(interp.run(program))
-        self.pulse(m2(self.x, 0))
+        self.pulse(m2(self.x, OPERATOR_BUTTONS["cycle-start"]))
         return ch
 
     def run_program(self, text: str, name: str = "program", timeout: float = 600.0) -> float:
@@ -342,18 +345,21 @@ class Machine:
         return self.runner.scales[i].counts_per_s_to_rpm(self.runner.tx[i].velocity_actual)
 
     def estop(self, on: bool = True) -> None:
-        self.mlc.mem.set_bit(m2(self.x, 13), on)
+        self.mlc.mem.set_bit(m2(self.x, ESTOP_RELAY), on)
         self.cycle()
 
     def interrupt(self) -> None:
         """Raise M2x019 (M96 program interruption) for a few cycles; M3x031 shows it running."""
-        self.pulse(m2(self.x, 19))
+        self.pulse(m2(self.x, OPERATOR_BUTTONS["interrupt"]))
 
     def feed_hold(self) -> None:
-        self.pulse(m2(self.x, 1))
+        self.pulse(m2(self.x, OPERATOR_BUTTONS["feed-hold"]))
+
+    def cycle_start(self) -> None:
+        self.pulse(m2(self.x, OPERATOR_BUTTONS["cycle-start"]))
 
     def reset(self) -> None:
-        self.pulse(m2(self.x, 4))
+        self.pulse(m2(self.x, OPERATOR_BUTTONS["reset"]))
 
     # ---- what the drives did -----------------------------------------------------------------------
     def summary(self) -> list[str]:
@@ -418,14 +424,16 @@ def load_mlc_program(spec: str) -> Any:
     return load_program(module_spec)
 
 
-def mlc_setup(bench: Bench, mlc_spec: str | None, signals: str | None, m00_resume: float | None):
-    """(mlc, on_cycle, trace sources) for `hil run`; raises InputError naming a bad module or device."""
+def mlc_setup(bench: Bench, mlc_spec: str | None, signals: str | None, m00_resume: float | None,
+              devices: bool = False):
+    """(mlc, on_cycle, trace sources) for `hil run`; raises InputError naming a bad module or device.
+    `devices`: the run writes M/D devices (`--at`), so it needs the Delta MLC like `signals` does."""
     from hil.session import InputError
     from mlc.machine import MlcLoadError
     from mlc.memory import DeviceError
     from mlc.tracing import SignalSource, parse_signal_list
 
-    if (signals or getattr(bench, "io", None)) and not mlc_spec and bench.mlc_program == "basic":
+    if (signals or devices or getattr(bench, "io", None)) and not mlc_spec and bench.mlc_program == "basic":
         mlc_spec = "lathe"  # device columns and remote I/O (X/Y) need the Delta MLC
     try:
         mlc = build_mlc(bench, mlc_spec)

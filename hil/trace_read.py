@@ -25,7 +25,7 @@ def _csv_types(path: Path) -> dict[str, pa.DataType]:
     for c in header:
         if c in INT_COLUMNS or c.endswith("_sw"):
             types[c] = pa.int64()
-        elif c == "alarm":
+        elif c in ("alarm", "event"):  # event: `hil run --at` actions (hil/run_events.py)
             types[c] = pa.string()
     return types
 

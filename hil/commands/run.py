@@ -13,6 +13,7 @@ from hil.cli import EXIT_ALARM, EXIT_OK, EXIT_USAGE
 from hil.clock import make_clock
 from hil.progress import Progress, wants_progress
 from hil.remote_io import attach_remote_io
+from hil.run_events import EventPlayer, EventSpecError, parse_events
 from hil.runner import BenchRunner, RunResult
 from hil.scripting import mlc_setup
 from hil.session import InputError, load_bench, load_program, make_link, print_alarm
@@ -41,6 +42,11 @@ def register(sub: argparse._SubParsersAction) -> None:
                         "mill) | module name | path.py (overrides the bench's mlc)")
     p.add_argument("--trace-signals", metavar="DEVICES",
                    help="extra trace columns, one per MLC device: M31064,M21016,D31048 or App. B names")
+    p.add_argument("--at", action="append", default=[], metavar="TRIGGER:ACTION",
+                   help="poke an MLC device during the run, e.g. \"t=1.1:pulse M21019\", \"line=12:set D21002=50\", "
+                        "\"Z<-10:set X5=1\", \"t=3:feed-hold\" (repeatable; grammar in docs/guide/mlc.md)")
+    p.add_argument("--events", action="append", default=[], metavar="FILE",
+                   help="events file: one TRIGGER:ACTION per line, # comments (after any --at)")
     p.add_argument("--m00-resume", metavar="SECONDS", type=float, default=0.5,
                    help="the simulated operator presses Cycle Start this long after an M00/M01 hold (default 0.5)")
     p.add_argument("--servo-modbus", metavar="DEVICE",
@@ -75,14 +81,24 @@ def cmd_run(args: argparse.Namespace) -> int:
     progress = None
     if wants_progress(args.progress):
         progress = Progress(max((b.line for b in program.blocks), default=1))
+    wants_events = bool(args.at or args.events)
     try:  # the MLC, its operator panel and --trace-signals columns (issue 8)
-        mlc, panel, signal_sources = mlc_setup(bench, args.mlc, args.trace_signals, args.m00_resume)
+        mlc, panel, signal_sources = mlc_setup(bench, args.mlc, args.trace_signals, args.m00_resume, wants_events)
     except InputError as exc:
         print(f"hil run: {exc}", file=sys.stderr)
         return EXIT_USAGE
     attach_remote_io(bench, mlc, link)  # [[io]] stations → X/Y devices (issue 8)
-    runner = BenchRunner(bench, link, None, mlc, panel, clock=clock, progress=progress)
+    player = None
+    if wants_events:  # --at / --events: timed pokes at MLC devices (hil/run_events.py)
+        try:
+            player = make_player(args, bench, mlc, link, panel, signal_sources)
+        except EventSpecError as exc:
+            print(f"hil run: {exc}", file=sys.stderr)
+            return EXIT_USAGE
+    runner = BenchRunner(bench, link, None, mlc, player or panel, clock=clock, progress=progress)
     runner.trace_sources += signal_sources
+    if player is not None:
+        runner.trace_sources.append(player)
     # Extra trace columns (e.g. the MLC's --trace-signals) are TraceSources appended here,
     # before the trace is opened with the runner's columns.
     trace_path = args.trace
@@ -110,6 +126,8 @@ def cmd_run(args: argparse.Namespace) -> int:
         if args.servo_modbus:
             runner.servo_modbus.close()
     print_summary(args.program, bench, result)
+    if player is not None:
+        print("\n".join(player.summary()), file=sys.stdout)
     print_timing(result)
     code = EXIT_OK if result.ok else EXIT_ALARM
     if trace_path and want_checks:
@@ -119,6 +137,15 @@ def cmd_run(args: argparse.Namespace) -> int:
     if trace_path and trace_path != args.trace:
         Path(trace_path).unlink(missing_ok=True)
     return code
+
+
+def make_player(args: argparse.Namespace, bench: Bench, mlc, link, panel, signal_sources) -> EventPlayer:
+    """The --at / --events player, wrapping the operator panel; EventSpecError for a bad event."""
+    if not hasattr(mlc, "mem"):
+        raise EventSpecError("--at/--events write MLC devices: they need a Delta MLC, not --mlc basic")
+    events = parse_events(args.at, args.events, bench.axis_names, mlc.link.x)
+    traced = [c for src in signal_sources for c in src.columns]
+    return EventPlayer(events, mlc, bench, link, panel, traced)
 
 
 def _temp_trace() -> str:
