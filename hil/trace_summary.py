@@ -62,6 +62,7 @@ class Summary:
     t1: float | None = None
     lines: set[int] = field(default_factory=set)
     alarms: list[tuple[int, float, int, str]] = field(default_factory=list)  # cycle, t, line, codes
+    events: list[tuple[int, float, int, str]] = field(default_factory=list)  # `hil run --at` actions, same
     ferr: dict[str, tuple[float, float, int]] = field(default_factory=dict)  # max |ferr|, t, line
     ranges: dict[str, tuple[float, float]] = field(default_factory=dict)  # actual min, max
     rpm: dict[str, float] = field(default_factory=dict)
@@ -85,10 +86,8 @@ def summarise(tf: TraceFile, lo: Bound | None = None, hi: Bound | None = None) -
         s.t0 = float(t[0]) if s.t0 is None else s.t0
         s.t1 = float(t[-1])
         s.lines.update(int(x) for x in np.unique(line) if x)
-        if "alarm" in cols:
-            al = cols["alarm"].to_pylist()
-            cyc = cols["cycle"].to_numpy() if "cycle" in cols else np.arange(len(al))
-            s.alarms += [(int(cyc[i]), float(t[i]), int(line[i]), a) for i, a in enumerate(al) if a]
+        s.alarms += _marked_rows(cols, "alarm", t, line)
+        s.events += _marked_rows(cols, "event", t, line)  # hil/run_events.py: what the MLC saw in that scan
         for a in axes:
             if f"{a}_ferr" not in cols or f"{a}_act" not in cols:
                 continue
@@ -107,6 +106,15 @@ def summarise(tf: TraceFile, lo: Bound | None = None, hi: Bound | None = None) -
                 s.period = round(float(np.median(per)), 7)
             s.jitter.add_many(per - s.period)
     return s
+
+
+def _marked_rows(cols: dict, name: str, t: np.ndarray, line: np.ndarray) -> list[tuple[int, float, int, str]]:
+    """(cycle, t, line, text) of the rows whose string column `name` is not empty (none without it)."""
+    if name not in cols:
+        return []
+    texts = cols[name].to_pylist()
+    cyc = cols["cycle"].to_numpy() if "cycle" in cols else np.arange(len(texts))
+    return [(int(cyc[i]), float(t[i]), int(line[i]), x) for i, x in enumerate(texts) if x]
 
 
 def format_summary(tf: TraceFile, s: Summary) -> str:
@@ -132,6 +140,10 @@ def format_summary(tf: TraceFile, s: Summary) -> str:
     out.append(f"alarms         {len(s.alarms) or 'none'}")
     for cyc, t, ln, codes in s.alarms[:20]:
         out.append(f"  {codes} at cycle {cyc} (t={t:.3f} s), line {ln}")
+    if "event" in tf.columns:
+        out.append(f"events         {len(s.events) or 'none'}")
+        for cyc, t, ln, text in s.events[:20]:
+            out.append(f"  {text} at cycle {cyc} (t={t:.3f} s), line {ln}")
     return "\n".join(out)
 
 

@@ -51,6 +51,9 @@ def test_pulse_m21019_at_1_1_s_runs_the_m96_interrupt_program(tmp_path, capsys):
     assert abs(z_up - 110.0) < 0.05 and np.allclose(c["X_cmd"][busy[1:-1]], x_stop, atol=1e-3)
     assert abs(c["Z_cmd"][: busy[0] - 1].max() - 100.0) < 1e-9  # no lift before M31031 (one scan late)
     assert np.allclose([c["X_cmd"][-1], c["Y_cmd"][-1], c["Z_cmd"][-1]], [0.0, 50.0, 100.0], atol=1e-6)
+    # `hil trace` lists the applied events from the trace
+    assert main(["trace", str(trace)]) == 0
+    assert "events         1\n  pulse M21019 at cycle 1100 (t=1.100 s), line 3" in capsys.readouterr().out
 
 
 def test_feed_override_set_mid_move_halves_the_path_speed_from_then_on(tmp_path, capsys):
