@@ -149,7 +149,7 @@ class BenchRunner:
         planner = Planner(self.bench.motion_config(), dict(zip(self.axes, self.actual.tolist())),
                           spindle_rpm=self.spindle_actual_rpm, spindle_angle=self.spindle_actual_angle,
                           spindle_index=self.spindle_index_angle,
-                          spindle_command=lambda: self.mlc.spindle.signed_rpm)
+                          spindle_command=self.spindle_command_rpm)
         self.channel = ch = Channel(planner)
         ch.soft_limits = SoftLimits.for_bench(self.bench, getattr(self, "profile", None))
         ch.css_diameter = "X" in getattr(getattr(self, "profile", None), "diameter_axes", ("X",))  # G96 D
@@ -172,11 +172,24 @@ class BenchRunner:
         self._settle()
 
     # ---- spindle feedback for the planner (issue 5: feed per rev, CSS, threading) -----------
+    def spindle_command_rpm(self) -> float:
+        """The first spindle drive's signed speed command: the MLC's direction and speed, the G96 rpm
+        under G96, times the spindle override (100 % in threads), within G50/G92 S and the spindle's
+        max_rpm (motion decisions 30, 32). Feed per rev and threads use the measured speed instead."""
+        ch = self.channel
+        rpm = self.mlc.spindle.signed_rpm
+        if ch is None:
+            return rpm
+        if ch.state is RunState.ALARM:
+            return 0.0
+        top = self.bench.spindles[0].max_rpm if self.bench.spindles else float("inf")
+        return spindle_speed(rpm, ch.css_rpm, ch.spindle_max, top, ch.spindle_factor)
+
     def spindle_actual_rpm(self) -> float:
         """The first spindle drive's measured speed (signed rpm); the MLC's command without a spindle."""
         n = len(self.axes)
         if len(self.scales) <= n:
-            return self.mlc.spindle.rpm
+            return abs(self.spindle_command_rpm())
         return self.scales[n].counts_per_s_to_rpm(self.tx[n].velocity_actual)
 
     def spindle_actual_angle(self) -> float:
@@ -267,8 +280,8 @@ class BenchRunner:
                 self.result.max_ferr[self.axes[i]] = ferr
         for k, sc in enumerate(self.scales[n_axes:]):
             rpm = self.mlc.spindle.signed_rpm if (ch is not None and ch.state is not RunState.ALARM) else 0.0
-            if k == 0 and ch is not None:  # G96 speed, G50/G92 S clamp (issue 5; decisions A39)
-                rpm = spindle_speed(rpm, ch.css_rpm, ch.spindle_max, self.bench.spindles[0].max_rpm)
+            if k == 0 and ch is not None:  # G96 speed, override, G50/G92 S clamp (issue 5; decisions A39, 32)
+                rpm = self.spindle_command_rpm()
             self.rx[n_axes + k].target_velocity = sc.rpm_to_counts_per_s(rpm)
             hook = getattr(self.mlc, "spindle_drive", None)  # spindle ↔ C axis, M19: CSV ↔ CSP (issue 8)
             if k == 0 and ch is not None and callable(hook):

@@ -339,6 +339,14 @@ class Machine:
             return self.mdi("M05")
         return self.mdi(f"{'M03' if direction > 0 else 'M04'} S{abs(rpm):g}")
 
+    def spindle_override(self, percent: int) -> None:
+        """The operator's spindle override D2x026 (%): the NC applies it under G97 and G96 alike,
+        within G50/G92 S and the spindle maximum, and holds 100 % during threads (motion decisions 32)."""
+        if not 0 <= int(percent) <= 65535:
+            raise ValueError(f"spindle override {percent} % is outside 0-65535")
+        self.mlc.mem.set_u16(d2(self.x, 26), int(percent))
+        self.cycle()
+
     def get_rpm(self, spindle: int = 0) -> float:
         """Actual speed of a spindle drive (0x606C), rpm."""
         i = len(self.runner.axes) + spindle

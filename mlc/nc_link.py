@@ -212,6 +212,7 @@ class ChannelLink:
         want = {
             "feed_override": min(self.mem.u16(d2(x, 2)), 150) / 100.0,  # 0–150 %
             "rapid_override": self.mem.u16(d2(x, 4)) / 100.0,
+            "spindle_override": self.mem.u16(d2(x, 26)) / 100.0,  # D2x026, applied by the NC (decisions 32)
             "dry_run": self._m2(5),
             "single_block": self._m2(8),
         }
@@ -424,8 +425,10 @@ class ChannelLink:
             mem.set_s16(d3(0, 432 + k), int(round(d.torque)))
             base = 704 + 16 * k
             cmd = self.commanded_rpm(k)
-            if k == 0 and ch is not None:  # what the drive is really given: G96, G50 clamp
-                cmd = spindle_speed(cmd, ch.css_rpm, ch.spindle_max, self.spindle_max_rpm)
+            if k == 0:  # what the drive is really given: G96, override, G50 clamp
+                css, clamp = (ch.css_rpm, ch.spindle_max) if ch is not None else (None, None)
+                ovr = ch.spindle_factor if ch is not None else self.mem.u16(d2(x, 26)) / 100.0
+                cmd = spindle_speed(cmd, css, clamp, self.spindle_max_rpm, ovr)
             mem.set_bit(m3(x, base + 1), abs(d.rpm) < 1.0)
             reached = abs(cmd) > 0 and abs(d.rpm - cmd) <= max(1.0, 0.02 * abs(cmd))
             mem.set_bit(m3(x, base), reached)
@@ -437,17 +440,14 @@ class ChannelLink:
 
     def commanded_rpm(self, k: int = 0) -> float:
         """Signed spindle speed the MLC relays ask for: direction M2x704/M2x705, speed from S (D3x024) or
-        from D2x024 when M2x710 is ON, times the spindle override D2x026."""
+        from D2x024 when M2x710 is ON. The spindle override D2x026 is not in it: the NC applies it
+        with the G96 speed and the clamps (`nc.motion.css.spindle_speed`, motion decisions 32)."""
         x, mem = self.x, self.mem
         base = 704 + 16 * k
         fwd, rev = mem.bit(m2(x, base)), mem.bit(m2(x, base + 1))
         if fwd == rev:
             return 0.0
-        if k == 0:
-            src = mem.u32(d2(x, 24)) if mem.bit(m2(x, base + 6)) else mem.f32(d3(x, 24))
-            pct = mem.u16(d2(x, 26))
-        else:
-            src, pct = 0.0, 100
-        rpm = min(abs(src) * pct / 100.0, self.spindle_max_rpm)
+        src = (mem.u32(d2(x, 24)) if mem.bit(m2(x, base + 6)) else mem.f32(d3(x, 24))) if k == 0 else 0.0
+        rpm = min(abs(src), self.spindle_max_rpm)
         return rpm if fwd else -rpm
 

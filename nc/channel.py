@@ -67,6 +67,9 @@ class Channel:
     _css_surface: float | None = None
     _css_origin: float | None = None  # machine X of the work centre line (from the move or the S aux)
     css_diameter: bool = True  # the profile programs X in diameter (N2.001 Bit10 = 0)
+    # D2x026 / 100, set by the MLC link: the NC applies it to the drive's speed, G97 and G96 alike,
+    # forced to 100 % while a thread runs or waits in the look-ahead (`spindle_factor`, decisions 32)
+    spindle_override: float = 1.0
     _block_moves: int = 0  # moves pushed since the last single-block stop
     soft_limits: SoftLimits | None = None  # checked before a move reaches the planner (issue 8)
     _limit_alarm: Alarm | None = None  # raised once the moves before the offending one have run out
@@ -339,8 +342,33 @@ class Channel:
             self.css_rpm = css_rpm_at(float(sp.positions[axes.index("X")]), self._css_origin,
                                       self._css_surface, self.spindle_max)
 
+    @property
+    def threading(self) -> bool:
+        """A spindle-locked thread runs or waits in the look-ahead (G32/G34/G92/G76)."""
+        pl = self.planner
+        return pl._thread is not None or any(b.kind == "thread" for b in pl.blocks)
+
+    @property
+    def spindle_factor(self) -> float:
+        """The spindle override the drive's speed gets: D2x026, but 100 % for threads, so every pass
+        runs at the programmed speed and meets the thread in phase (NC5 threading note (1))."""
+        return 1.0 if self.threading else self.spindle_override
+
+    def _css_now(self) -> float | None:
+        """The G96 rpm at the current X (the last setpoint's), None without a surface speed."""
+        axes = self.planner.axes
+        if self._css_surface is None or self._css_origin is None or "X" not in axes:
+            return self.css_rpm
+        x = float(self.planner.output[axes.index("X")])
+        return css_rpm_at(x, self._css_origin, self._css_surface, self.spindle_max)
+
     def _issue(self, aux: Aux) -> None:
         # S takes effect when it is issued (moves before it are done), not when it is read ahead
+        if aux.kind == "S" and aux.args.get("hold"):
+            # G97 alone: the rpm G96 has now becomes the G97 speed (Fanuc; motion decisions 31)
+            rpm = self._css_now()
+            if rpm is not None:
+                aux.value = rpm
         if aux.kind == "S" and aux.args.get("max"):
             self.spindle_max = aux.value
         elif aux.kind == "S" and aux.args.get("css"):

@@ -221,3 +221,133 @@ def test_g50_s_is_a_limit_not_an_s_code_for_the_mlc(hil, program, tmp_path):
     assert sum(1 for a, b in zip(rows, rows[1:]) if a["M31065"] == "0" and b["M31065"] == "1") == 1
     assert max(float(row["S1_rpm_cmd"]) for row in rows) == pytest.approx(500.0, abs=0.01)
     assert {float(row["D31024"]) for row in rows[-10:]} == {500.0}
+
+
+# ---- spindle override D2x026 and G96/G97 alone (session 3, motion decisions 31-32) ---------------
+
+def run_override(text: str, percent: int, params: dict[str, float] | None = None):
+    """As run_phases, with the operator's spindle override D21026 at `percent`; per cycle (aux value
+    or -1, X command, drive's commanded rpm, line, measured rpm, Z command, spindle angle)."""
+    bench = default_lathe()
+    bench.params.update(params or {})
+    mlc = build_mlc(bench, "lathe")
+    mlc.put("D21026", percent)
+    runner = BenchRunner(bench, SimLink(sim_slaves(bench), bench.cycle), mlc=mlc)
+    sc = bench.spindles[0].scaling
+    rows = []
+
+    def grab(r):
+        ch = r.channel
+        if ch is not None:
+            aux = ch.pending_aux
+            rows.append((aux.value if aux is not None else -1.0, r._commands[0],
+                         sc.counts_per_s_to_rpm(r.rx[2].target_velocity), r.line, r.spindle_actual_rpm(),
+                         r._commands[1], r.spindle_actual_angle()))
+
+    runner.on_cycle = grab
+    result = runner.run_program(parse_program(text))
+    assert result.ok, result.alarms  # M03 of the lathe MLC finishes only on "speed reached"
+    return np.array(rows), runner
+
+
+def test_spindle_override_scales_g97_and_g96_and_speed_reached_follows_it():
+    rows, _ = run_override("G21 G18 G99\nG00 X100. Z5.\nG97 S1000 M03\nG04 P200\nM30\n", 80)
+    on = spinning(rows)
+    assert np.allclose(on[:, 2], 800.0, atol=0.01)
+    # M03 finished (speed reached against 800, not 1000) and the drive really turns at 800
+    assert on[-1, 4] == pytest.approx(800.0, rel=0.01)
+    rows, _ = run_override("G21 G18 G99\nG00 X100. Z5.\nG96 S200 M03\nG04 P200\nM30\n", 80)
+    on = spinning(rows)
+    assert np.allclose(on[:, 2], 0.8 * AT_100, atol=0.01)
+    assert on[-1, 4] == pytest.approx(0.8 * AT_100, rel=0.01)
+
+
+def test_override_above_100_stays_within_g50_s_and_feed_per_rev_follows_the_actual_speed():
+    # 120 % of 636.6 = 763.9 rpm, capped by G50 S700; under G97 S1000 × 120 % likewise
+    rows, _ = run_override("G21 G18 G99\nG00 X100. Z5.\nG50 S700\nG96 S200 M03\nG04 P100\nM30\n", 120)
+    assert np.allclose(spinning(rows)[:, 2], 700.0, atol=0.01)
+    rows, _ = run_override("G21 G18 G99\nG00 X100. Z5.\nG50 S700\nG97 S1000 M03\nG04 P100\nM30\n", 120)
+    assert np.allclose(spinning(rows)[:, 2], 700.0, atol=0.01)
+    # G99 F0.2 at 80 % of S1000: Z moves 0.2 mm per revolution of the measured 800 rpm = 160 mm/min
+    rows, _ = run_override("G21 G18 G99\nG00 X100. Z5.\nG97 S1000 M03\nG01 Z-20. F0.2\nM30\n", 80)
+    cut = rows[rows[:, 3] == 4]
+    v = -np.diff(cut[:, 5]) / 0.001 * 60.0
+    cruise = v[np.abs(v - v.max()) < 1e-6 * v.max()]
+    assert len(cruise) > 1000 and cruise[0] == pytest.approx(0.2 * np.median(cut[:, 4]), rel=1e-3)
+    assert cruise[0] == pytest.approx(160.0, rel=1e-3)
+
+
+def test_threads_run_at_100_percent_whatever_the_override_and_stay_in_phase():
+    from test_motion_sync_thread import circ_spread, locked, passes_program, phase
+
+    xs = [19.4, 19.0, 18.6]
+    rows, runner = run_override(passes_program(xs), 80)
+    lines = [5 + 4 * i for i in range(len(xs))]
+    for ln in lines:
+        m = rows[rows[:, 3] == ln]
+        # S600, not 480 (the chain's last cycle already hands back to the override)
+        assert np.allclose(m[:-1, 2], 600.0, atol=0.01)
+        assert np.allclose(m[:, 4], 600.0, rtol=1e-3)  # the spindle has reached it before the pass
+    # between passes the next thread waits in the look-ahead: 600 throughout; after the last, 480
+    assert np.allclose(rows[(rows[:, 3] > 5) & (rows[:, 3] < 13), 2], 600.0, atol=0.01)
+    assert np.allclose(rows[rows[:, 3] == 14, 2], 480.0, atol=0.01)
+    log = runner.channel.planner.thread_log
+    assert circ_spread(np.array([sync % 360.0 for _, sync, _ in log])) < 0.5
+    thread = np.column_stack([rows[:, 3], rows[:, 1], rows[:, 5], rows[:, 5], rows[:, 6]])
+    cmd = np.concatenate([phase(locked(thread[thread[:, 0] == ln]), 2) for ln in lines])
+    assert circ_spread(cmd) < 0.5
+
+
+def test_g96_alone_switches_at_once_on_the_last_g96_surface_speed():
+    at_100_150 = 1000.0 * 150.0 / (math.pi * 100.0)
+    text = "G21 G18 G99\nG00 X100. Z5.\nG96 S150\nG97 S300 M03\nG04 P50\nG96\nG04 P50\nM30\n"
+    rows, _ = run_override(text, 100)
+    s300 = np.flatnonzero(rows[:, 0] == 300.0)[-1]
+    g96 = s300 + np.flatnonzero(rows[s300:, 0] == 150.0)[0]  # the S aux G96 alone gives
+    assert rows[g96 - 1, 2] == pytest.approx(300.0, abs=0.01)  # G97 S300 until G96 is read
+    assert rows[g96 + 1, 2] == pytest.approx(at_100_150, abs=0.01)  # S150 (m/min) from G96 on
+    assert np.allclose(rows[g96 + 1:, 2][rows[g96 + 1:, 2] > 0], at_100_150, atol=0.01)
+    # no S ever given under G96: 0 m/min (Fanuc), the spindle stops rather than read 300 rpm as m/min
+    rows, _ = run_override("G21 G18 G99\nG00 X100. Z5.\nG97 S300 M03\nG04 P50\nG96\nG04 P50\nM30\n", 100)
+    g96 = np.flatnonzero(rows[:, 0] == 0.0)[0]
+    assert rows[g96 - 1, 2] == pytest.approx(300.0, abs=0.01) and np.all(rows[g96 + 1:, 2] == 0.0)
+
+
+def test_g97_alone_hands_the_css_rpm_to_the_mlc_as_its_s():
+    text = "G21 G18 G99\nG00 X100. Z5.\nG96 S200 M03\nG04 P50\nG97\nG00 X50.\nG04 P50\nM30\n"
+    rows, runner = run_override(text, 80)
+    # the S strobe of G97 alone carries the rpm G96 had at X diameter 100, the new G97 speed
+    assert np.any(np.abs(rows[:, 0] - AT_100) < 1e-6 * AT_100)
+    from mlc.signals import d3
+
+    assert runner.mlc.mem.f32(d3(runner.mlc.link.x, 24)) == pytest.approx(AT_100, rel=1e-6)  # D31024
+    on = spinning(rows)
+    assert on[-1, 1] == pytest.approx(25.0)
+    assert on[-1, 2] == pytest.approx(0.8 * AT_100, abs=0.01)
+
+
+def test_g96_holds_through_a_turning_cycle():
+    # G90 (A system, outer diameter cycle): its cut moves carry the surface speed like G01 does
+    text = "G21 G18 G99\nG00 X100. Z5.\nG96 S200 M03\nG90 X80. Z-10. F0.2\nM30\n"
+    rows, _ = run_override(text, 100)
+    cyc = rows[(rows[:, 3] == 4) & (np.abs(rows[:, 2]) > 0.5)]
+    d = 2.0 * cyc[:, 1]
+    assert np.allclose(cyc[:, 2], 1000.0 * 200.0 / (math.pi * d), rtol=1e-3, atol=0.01)
+    assert cyc[:, 1].min() == pytest.approx(40.0)
+
+
+def test_spindle_override_from_the_command_line(hil, tmp_path):
+    r = hil("spindle", "1000", "--override", "80", "--seconds", "0.2")
+    assert r.code == 0, r.err
+    assert "800.0 rpm at speed" in r.out
+    assert hil("spindle", "1000", "--override", "-5").code == 2
+    script = tmp_path / "css.py"
+    script.write_text("def main(machine):\n"
+                      "    machine.spindle_override(80)\n"
+                      "    machine.mdi('G21 G18 G99 G00 X100. Z5.')\n"
+                      "    machine.mdi('G96 S200 M03')\n"
+                      "    machine.wait(0.2)\n"
+                      "    print(f'css at {machine.get_rpm():.1f} rpm')\n")
+    r = hil("script", str(script))
+    assert r.code == 0, r.err
+    assert f"css at {0.8 * AT_100:.1f} rpm" in r.out

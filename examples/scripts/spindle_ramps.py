@@ -9,10 +9,10 @@ def main(machine):
         took = machine.spindle(rpm)
         machine.wait(0.2)
         print(f"M03 S{rpm}: speed reached after {took:.3f} s, drive at {machine.get_rpm():.1f} rpm")
-    machine.mlc.put("D21026", 50)  # spindle override 50 %
+    machine.spindle_override(50)  # D21026
     machine.wait(0.3)
     print(f"override 50 %: drive at {machine.get_rpm():.1f} rpm")
-    machine.mlc.put("D21026", 100)
+    machine.spindle_override(100)
     took = machine.spindle(1000, direction=-1)
     print(f"M04 S1000: reversed in {took:.3f} s, drive at {machine.get_rpm():.1f} rpm")
     print(f"M05: stopped in {machine.spindle(0):.3f} s")

@@ -1,4 +1,4 @@
-"""`hil spindle RPM [--seconds S] [--ccw]`: start the spindle through M03/M04 S and the handshake
+"""`hil spindle RPM [--seconds S] [--ccw] [--override PCT]`: start the spindle through M03/M04 S and the handshake
 (the drive in CSV), hold it, stop it with M05, and report the ramps."""
 
 from __future__ import annotations
@@ -13,6 +13,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("rpm", type=float, help="speed (S word)")
     p.add_argument("--seconds", type=float, default=1.0, help="time at speed before M05 (default 1 s)")
     p.add_argument("--ccw", action="store_true", help="M04 instead of M03")
+    p.add_argument("--override", type=int, default=100, metavar="PCT",
+                   help="spindle override D2x026 in %% (default 100): the drive runs at RPM x PCT/100")
     add_bench_options(p)
     p.set_defaults(func=cmd_spindle)
 
@@ -25,10 +27,16 @@ def cmd_spindle(args: argparse.Namespace) -> int:
         print("hil spindle: the bench has no spindle", file=__import__("sys").stderr)
         machine.close()
         return 2
+    if not 0 <= args.override <= 65535:
+        print(f"hil spindle: --override {args.override} is outside 0-65535 %", file=__import__("sys").stderr)
+        machine.close()
+        return 2
+    machine.spindle_override(args.override)
     up = machine.spindle(args.rpm, -1 if args.ccw else 1)
     machine.wait(args.seconds)
     rpm = machine.get_rpm()
     down = machine.spindle(0)
-    print(f"spindle: M0{4 if args.ccw else 3} S{args.rpm:g} finished after {up:.3f} s (speed reached), "
+    ovr = f" at {args.override} % override" if args.override != 100 else ""
+    print(f"spindle: M0{4 if args.ccw else 3} S{args.rpm:g}{ovr} finished after {up:.3f} s (speed reached), "
           f"{rpm:.1f} rpm at speed; M05 finished after {down:.3f} s (zero speed)")
     return finish(machine)

@@ -56,7 +56,8 @@ def _is_diameter(host: Any, axis: str = "X") -> bool:
 
 def _builder(host: Any, block: Block, plane: tuple[str, str] = LATHE_PLANE) -> PathBuilder:
     return PathBuilder(dict(host.position), plane, block.line, block.text, host.to_work,
-                       getattr(host, "program_name", None), per_rev=bool(host.state.per_rev))
+                       getattr(host, "program_name", None), per_rev=bool(host.state.per_rev),
+                       css=host.state.surface_speed if host.state.css else None)  # G96 holds in cycles
 
 
 def _finish(host: Any, b: PathBuilder) -> list[Event]:

@@ -380,6 +380,7 @@ class Interpreter:
             yield Sync(block.line, block.text, f"M{halt_m}")
 
         # modal updates
+        was_css = st.css
         for grp, fn, w in gcodes:
             if grp:
                 self._set_modal(grp, fn, w, block)
@@ -409,6 +410,8 @@ class Interpreter:
             if s.value < 0 or s.value > 600000:
                 raise NcAlarm(0x0223, f"S{s.value:g} out of range 0-600000")
             st.spindle_speed = s.value
+            if st.css:
+                st.surface_speed = s.value
             spindle = block.get("P")
             args = {"P": spindle.value} if spindle is not None and not funcs & {"G04", "G10", "G30", "G31", "G900", "G05"} and 98 not in mvals else {}
             if st.css:  # G96: S is a surface speed (m/min); the channel turns it into rpm (issue 5)
@@ -416,6 +419,8 @@ class Interpreter:
                 if "X" in self.axes:  # machine X of the work centre: the diameter before any move
                     args["x0"] = self.frames.origins(st.wcs, self.axes)["X"]
             yield Aux("S", s.value, block.line, block.text, args=args, program=self.program_name)
+        elif st.css != was_css and s is None:
+            yield self._css_switch(block)  # G96 / G97 alone switch when read, not at the next move
         t = block.get("T")
         if t is not None and not self._cycle_fn(funcs):
             yield from self._tool(block, t)
@@ -743,6 +748,18 @@ class Interpreter:
         elif grp == 18:
             self._transform(fn, block)
 
+    def _css_switch(self, block: Block) -> Aux:
+        """The S aux of a `G96` or `G97` without S (motion decisions 31): G96 resumes the last
+        surface speed given under G96 (Fanuc; 0 m/min if none) with the work centre as `G96 S_` does;
+        G97 keeps the spindle at the rpm CSS had reached, which the channel fills in (`hold`)."""
+        st = self.state
+        if not st.css:
+            return Aux("S", st.spindle_speed, block.line, block.text, args={"hold": 1.0}, program=self.program_name)
+        args = {"css": 1.0}
+        if "X" in self.axes:
+            args["x0"] = self.frames.origins(st.wcs, self.axes)["X"]
+        return Aux("S", st.surface_speed, block.line, block.text, args=args, program=self.program_name)
+
     def _transform(self, fn: str, block: Block) -> None:
         """Scaling, mirror and rotation belong to `nc.transforms` (issue 4); without it they are
         refused rather than silently ignored."""
@@ -878,7 +895,7 @@ class Interpreter:
                 move.comp = tr.comp_code(self, move.plane, move.comp)
             move.comp_radius, move.tip = self._comp_radius()
         if st.css:
-            move.css = st.spindle_speed
+            move.css = st.surface_speed
         return move
 
     def _motion(self, block: Block, funcs: set[str]) -> Iterator[Event]:
@@ -1077,7 +1094,7 @@ class Interpreter:
         dwell = Move("dwell", block.line, block.text, here, dict(here), self.work_position(), duration=seconds,
                      program=self.program_name)
         if self.state.css:  # G96 holds during the dwell: rpm from the surface speed at the current X
-            dwell.css = self.state.spindle_speed
+            dwell.css = self.state.surface_speed
         yield dwell
 
     def _computed(self, w: Word) -> bool:

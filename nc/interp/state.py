@@ -39,6 +39,7 @@ class ModalState:
     spindle_speed: float = 0.0  # S, rpm (or m/min under G96)
     spindle_max: float | None = None  # G50 S / G92 S clamp
     css: bool = False  # G96
+    surface_speed: float = 0.0  # the last S under G96 (m/min): `G96` without S resumes it (Fanuc)
     spindle_dir: int = 0  # +1 M03, -1 M04, 0 M05
     tool: int = 0  # T as programmed
     tool_offset: int = 0  # lathe: offset number (last two digits of T)

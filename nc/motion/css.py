@@ -42,15 +42,17 @@ def css_rpm(move: Move, positions: np.ndarray, axes: tuple[str, ...], surface: f
     return css_rpm_at(x, x_origin(move, x_axis, diameter), surface, limit)
 
 
-def spindle_speed(rpm: float, css: float | None, clamp: float | None, max_rpm: float) -> float:
+def spindle_speed(rpm: float, css: float | None, clamp: float | None, max_rpm: float,
+                  override: float = 1.0) -> float:
     """The signed speed the first spindle's drive is given for the MLC's `rpm` (its sign is the
-    direction): the G96 speed `css` while constant surface speed is on (within `max_rpm`), else `rpm`
-    within the G50/G92 S `clamp`, which holds under G97 too (decisions A39). The runner commands it
-    and the NC's "speed reached" (M3x704) compares the drive with it."""
+    direction; its size the S or D2x024 speed before the override): the G96 speed `css` while
+    constant surface speed is on, else `rpm`, times the spindle `override` (D2x026; the caller
+    forces 1.0 in threads), then within the G50/G92 S `clamp`, which holds under G97 too (decisions
+    A39), and within `max_rpm` (motion decisions 30, 32). The runner commands it and the NC's
+    "speed reached" (M3x704) compares the drive with it."""
     if not rpm:
         return 0.0
-    if css is not None:
-        return min(css, max_rpm) * (1.0 if rpm > 0 else -1.0)
-    if clamp is not None:
-        return max(-clamp, min(clamp, rpm))
-    return rpm
+    out = (abs(rpm) if css is None else css) * max(override, 0.0)
+    if clamp is not None and (clamp > 0.0 or css is None):
+        out = min(out, clamp)
+    return min(out, max_rpm) * (1.0 if rpm > 0 else -1.0)
