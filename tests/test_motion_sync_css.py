@@ -351,3 +351,21 @@ def test_spindle_override_from_the_command_line(hil, tmp_path):
     r = hil("script", str(script))
     assert r.code == 0, r.err
     assert f"css at {0.8 * AT_100:.1f} rpm" in r.out
+
+
+def test_spindle_override_turned_during_hil_run_under_g96(hil, program, tmp_path):
+    """`--at` turns D21026 to 80 % mid-dwell: the drive drops to 80 % of the CSS rpm, D31024 keeps it."""
+    import csv
+
+    prog = program("G21 G18 G99\nG00 X100. Z5.\nG96 S200 M03\nG04 P500\nM05\nM30\n")
+    trace = tmp_path / "t.csv"
+    r = hil("run", prog, "--bench", ROOT / "benches" / "lathe-2axis.toml", "--trace", trace,
+            "--trace-signals", "D31024,D21026", "--at", "line=4:set SPINDLE1_OVERRIDE=80")
+    assert r.code == 0, r.out + r.err
+    rows = [row for row in csv.DictReader(trace.open()) if float(row["S1_rpm_cmd"]) > 0.5]
+    cmd = [float(row["S1_rpm_cmd"]) for row in rows]
+    assert cmd[0] == pytest.approx(AT_100, abs=0.01)
+    assert cmd[-1] == pytest.approx(0.8 * AT_100, abs=0.01)
+    assert float(rows[-1]["S1_rpm_act"]) == pytest.approx(0.8 * AT_100, rel=0.01)
+    assert all(float(row["D31024"]) == pytest.approx(AT_100, rel=1e-6) for row in rows)
+    assert float(rows[0]["D21026"]) == 100.0 and float(rows[-1]["D21026"]) == 80.0
