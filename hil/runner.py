@@ -128,6 +128,7 @@ class BenchRunner:
     def power_up(self) -> bool:
         """Bring every drive to operation enabled, one state-machine step per cycle."""
         self.link.open()
+        self._opened = True  # a link that failed to open is not cycled at shutdown (no 2nd alarm)
         self.clock.start(self.link)
         for m in self.masters:
             m.request(Target.ENABLED)
@@ -350,7 +351,7 @@ class BenchRunner:
         for m in self.masters:
             m.request(Target.DISABLED)
         try:
-            for _ in range(20):
+            for _ in range(20 if getattr(self, "_opened", False) else 0):
                 self._exchange()
                 if all(m.state in (State.SWITCH_ON_DISABLED, State.READY_TO_SWITCH_ON, State.FAULT) for m in self.masters):
                     break

@@ -19,6 +19,7 @@ Remote I/O (bench [[io]] stations): ``machine.set_input("X3")`` switches the sim
 
 from __future__ import annotations
 
+import math
 import runpy
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -237,6 +238,10 @@ class Machine:
     def mpg(self, axis: str, pulses: int, ratio: int = 1, rate: float = 100.0) -> None:
         """Turn the handwheel `pulses` detents (negative: backwards) at `rate` detents/s on `axis`."""
         i = self.axis_index(axis)
+        if not 0 <= ratio <= 0xFFFF:  # D2x009 is a word: the manual's 1/10/100 are usual, not the limit
+            raise ScriptError(f"MPG ratio {ratio}: D2x009 holds 0-65535 (usually 1, 10 or 100)")
+        if not 0.0 < rate < math.inf:  # no detents would ever come
+            raise ScriptError(f"MPG rate {rate:g}: detents per second must be > 0")
         mem = self.mlc.mem
         mem.set_u16(d2(self.x, 8), i)
         mem.set_u16(d2(self.x, 9), ratio)

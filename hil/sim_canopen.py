@@ -13,6 +13,8 @@ import signal
 import sys
 import threading
 
+import can
+
 from hil.cli import EXIT_OK, EXIT_USAGE
 from hil.session import InputError, load_bench, sim_io_stations, sim_slaves
 
@@ -47,7 +49,7 @@ def cmd_sim_canopen(args: argparse.Namespace) -> int:
     try:
         eds = [getattr(a, "canopen_eds", "") or bench.canopen_eds for a in [*bench.axes, *bench.spindles]]
         bus = serve(sim_slaves(bench), args.interface, args.channel, eds=eds)
-    except (OSError, ValueError, ImportError) as exc:
+    except (OSError, ValueError, ImportError, can.CanError) as exc:  # CanError: no such python-can interface
         print(f"hil sim canopen: cannot open {args.interface}:{args.channel}: {exc}", file=sys.stderr)
         return EXIT_USAGE
     io = sim_io_stations(bench)

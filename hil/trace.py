@@ -10,6 +10,8 @@ adds its signals of interest this way). `open_trace` picks the format from the f
 from __future__ import annotations
 
 import csv
+import errno
+import os
 from pathlib import Path
 from typing import IO, Any, Protocol, Sequence
 
@@ -79,7 +81,14 @@ def is_parquet(path: str | Path) -> bool:
     return Path(path).suffix.lower() in (".parquet", ".pq")
 
 
+def check_target(path: str | Path) -> None:
+    """Refuse an output path that is a folder now, not at the rename after the whole run."""
+    if Path(path).is_dir():
+        raise IsADirectoryError(errno.EISDIR, os.strerror(errno.EISDIR), str(path))
+
+
 def open_trace(path: str | Path, columns: list[str]) -> TraceWriter:
+    check_target(path)
     Path(path).parent.mkdir(parents=True, exist_ok=True)  # `--trace out/run.csv` on a fresh clone
     if is_parquet(path):
         from hil.trace_parquet import ParquetTrace

@@ -14,6 +14,10 @@ import pyarrow.parquet as pq
 from hil.trace import INT_COLUMNS, is_parquet
 
 
+FLOAT_COLUMNS = ("t", "period", "late")
+FLOAT_SUFFIXES = ("_cmd", "_act", "_vel", "_torque", "_ferr", "_angle")  # _rpm_cmd / _rpm_act included
+
+
 class TraceReadError(Exception):
     """A file that is not a trace this bench wrote (missing, unreadable, wrong columns)."""
 
@@ -27,6 +31,8 @@ def _csv_types(path: Path) -> dict[str, pa.DataType]:
             types[c] = pa.int64()
         elif c in ("alarm", "event"):  # event: `hil run --at` actions (hil/run_events.py)
             types[c] = pa.string()
+        elif c in FLOAT_COLUMNS or c.endswith(FLOAT_SUFFIXES):  # text there is damage, not data
+            types[c] = pa.float64()
     return types
 
 

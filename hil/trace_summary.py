@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -11,7 +12,7 @@ import pyarrow.csv as pacsv
 import pyarrow.parquet as pq
 
 from hil.clock import TimingStats
-from hil.trace import axes_of, is_parquet, spindles_of
+from hil.trace import axes_of, check_target, is_parquet, spindles_of
 from hil.trace_read import TraceFile
 
 
@@ -27,10 +28,14 @@ class Bound:
         t = text.strip()
         try:
             if t[:1] in "Ll" or t.lower().startswith("line:"):
-                return cls(line=int(t.split(":", 1)[1] if ":" in t else t[1:]))
-            return cls(time=float(t[:-1] if t.endswith("s") else t))
+                b = cls(line=int(t.split(":", 1)[1] if ":" in t else t[1:]))
+            else:
+                b = cls(time=float(t[:-1] if t.endswith("s") else t))
+            if (b.line is not None and b.line < 0) or (b.time is not None and not 0.0 <= b.time < math.inf):
+                raise ValueError
+            return b
         except ValueError:
-            raise ValueError(f"bad bound {text!r}: a time in seconds (1.5, 1.5s) or a line (L12, line:12)") from None
+            raise ValueError(f"bad bound {text!r}: a time in seconds >= 0 (1.5, 1.5s) or a line (L12, line:12)") from None
 
 
 def slice_mask(batch: pa.RecordBatch, lo: Bound | None, hi: Bound | None, state: dict) -> pa.Array:
@@ -164,6 +169,7 @@ def export(tf: TraceFile, out: str | Path, lo: Bound | None = None, hi: Bound | 
     state: dict = {}
     writer = None
     rows = 0
+    check_target(out)
     tmp = Path(str(out) + ".part")
     try:
         for batch in tf.batches(need):
@@ -177,11 +183,14 @@ def export(tf: TraceFile, out: str | Path, lo: Bound | None = None, hi: Bound | 
             if batch.num_rows:
                 writer.write_batch(batch) if is_parquet(out) else writer.write(batch)
                 rows += batch.num_rows
-    finally:
+    except BaseException:  # a damaged input leaves no half export behind
         if writer is not None:
             writer.close()
+        tmp.unlink(missing_ok=True)
+        raise
     if writer is None:
         raise ValueError(f"{tf.path}: empty trace")
+    writer.close()
     tmp.replace(out)
     return rows
 

@@ -15,6 +15,15 @@ from nc.alarm_table import ALARM_TABLE
 SERVO_ALARM = 0xF002
 
 
+BLOCK_SHOWN = 200  # characters of a block (and 2x of a message) an alarm shows: a 10 MB line is named, not echoed
+
+
+def clipped(block: str | None, limit: int = BLOCK_SHOWN) -> str | None:
+    if block is None or len(block) <= limit:
+        return block
+    return f"{block[:limit]}… ({len(block)} characters)"
+
+
 def alarm_name(code: int) -> str:
     entry = ALARM_TABLE.get(code)
     return entry[1] if entry else "Unlisted alarm."
@@ -38,7 +47,8 @@ class Alarm:
 
     def as_dict(self) -> dict[str, Any]:
         d: dict[str, Any] = {"kind": "alarm", "code": self.code_text, "line": self.line,
-                             "block": self.block, "message": self.message}
+                             "block": clipped(self.block),
+                             "message": clipped(self.message, 2 * BLOCK_SHOWN)}
         if self.program is not None:
             d["program"] = self.program
         if self.axis is not None:
@@ -56,8 +66,8 @@ class Alarm:
         extra = f" axis {self.axis}" if self.axis else ""
         if self.info is not None:
             extra += f" (servo alarm 0x{self.info:02X})"
-        blk = f": {self.block.strip()}" if self.block else ""
-        return f"ALARM {self.code_text}{extra}{where}{blk} -- {self.message}"
+        blk = f": {clipped(self.block.strip())}" if self.block else ""
+        return f"ALARM {self.code_text}{extra}{where}{blk} -- {clipped(self.message, 2 * BLOCK_SHOWN)}"
 
 
 class NcAlarm(Exception):

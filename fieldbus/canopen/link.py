@@ -211,7 +211,11 @@ class CanopenLink:
             self.network = net
         else:
             self.network = canopen.Network()
-            self.network.connect(**connect_args(self.interface, self.channel, self.bitrate))
+            try:
+                self.network.connect(**connect_args(self.interface, self.channel, self.bitrate))
+            except (can.CanError, OSError, ValueError, ImportError) as exc:  # no such interface / channel
+                raise BusError(Alarm(ALARM_ESTABLISH, f"cannot open CAN interface {self.interface}"
+                                                      f"{':' + self.channel if self.channel else ''}: {exc}")) from None
         net = self.network
         for cfg in self.nodes_cfg:
             remote = canopen.RemoteNode(cfg.node_id, canopen.import_od(str(cfg.eds), cfg.node_id))

@@ -35,6 +35,10 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def checks_from_args(args: argparse.Namespace, bench: Bench) -> ChecksConfig:
     c = bench.checks
+    for opt in ("max_ferr", "contour", "thread_phase", "jitter_p99", "jitter_max"):
+        v = getattr(args, opt)
+        if v is not None and not 0.0 <= v < float("inf"):  # a negative limit fails every trace
+            raise InputError(f"--{opt.replace('_', '-')} {v:g}: a limit must be >= 0")
     if args.max_ferr is not None:
         c.max_following_error = {a: args.max_ferr for a in bench.axis_names}
     if args.contour is not None:
@@ -86,7 +90,11 @@ def cmd_check(args: argparse.Namespace) -> int:
     if not checks.any:
         print("hil check: no checks to run: give a --bench with [checks] or limits such as --max-ferr", file=sys.stderr)
         return EXIT_USAGE
-    results = run_checks(tf, checks, bench if (args.bench or checks.limits) else None, moves)
+    try:  # the trace is read here: damage past its header shows now
+        results = run_checks(tf, checks, bench if (args.bench or checks.limits) else None, moves)
+    except TraceReadError as exc:
+        print(f"hil check: {exc}", file=sys.stderr)
+        return EXIT_USAGE
     for r in results:
         print(json.dumps(r.as_dict()) if args.json else str(r))
     failed = [r for r in results if not r.ok]

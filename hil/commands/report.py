@@ -8,6 +8,7 @@ import sys
 
 from hil.cli import EXIT_ALARM, EXIT_OK, EXIT_USAGE
 from hil.commands.check import add_check_options, prepared
+from hil.trace_read import TraceReadError
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -27,9 +28,12 @@ def cmd_report(args: argparse.Namespace) -> int:
     if isinstance(ready, int):
         return ready
     bench, checks, tf, moves = ready
-    results = run_checks(tf, checks, bench if (args.bench or checks.limits) else None, moves) if checks.any else None
-    try:
+    try:  # the trace is read here: damage past its header shows now
+        results = run_checks(tf, checks, bench if (args.bench or checks.limits) else None, moves) if checks.any else None
         rep = write_report(args.trace, args.out, bench if args.bench else None, moves, results, args.title)
+    except TraceReadError as exc:
+        print(f"hil report: {exc}", file=sys.stderr)
+        return EXIT_USAGE
     except OSError as exc:
         print(f"hil report: cannot write {args.out}: {exc.strerror}", file=sys.stderr)
         return EXIT_USAGE

@@ -57,6 +57,9 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def cmd_run(args: argparse.Namespace) -> int:
+    if not 0.0 <= args.m00_resume < float("inf"):
+        print(f"hil run: --m00-resume {args.m00_resume:g}: seconds must be >= 0", file=sys.stderr)
+        return EXIT_USAGE
     try:
         bench = load_bench(args.bench, args.profile, args.bus)
     except InputError as exc:

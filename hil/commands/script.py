@@ -26,8 +26,9 @@ def add_bench_options(p: argparse.ArgumentParser) -> None:
 
 def open_machine(args: argparse.Namespace):
     """Build and power up the bench for a script; returns (machine, exit code or None)."""
+    from fieldbus.link import BusError
     from hil.scripting import Machine, ScriptError, mlc_setup
-    from hil.session import InputError, load_bench, make_link
+    from hil.session import InputError, load_bench, make_link, print_alarm
 
     try:
         bench = load_bench(args.bench, None, args.bus)
@@ -41,6 +42,10 @@ def open_machine(args: argparse.Namespace):
         machine.power_up()
     except ScriptError as exc:
         print(f"hil {args.command}: {exc}", file=sys.stderr)
+        return None, EXIT_ALARM
+    except BusError as exc:  # a bus that does not answer (no such interface …): its alarm, exit 1
+        print_alarm(exc.alarm)
+        machine.close()
         return None, EXIT_ALARM
     return machine, None
 
@@ -72,4 +77,23 @@ def cmd_script(args: argparse.Namespace) -> int:
         machine.report()
         machine.close()
         return EXIT_ALARM
+    except (SyntaxError, ValueError) as exc:  # not a Python file (syntax, NUL bytes): a bad input file
+        if not isinstance(exc, SyntaxError) and "null bytes" not in str(exc):
+            return _script_failed(args, machine, exc)
+        print(f"hil script: {args.script} is not a Python script: {exc}", file=sys.stderr)
+        machine.close()
+        return EXIT_USAGE
+    except Exception as exc:  # the script's own error: where it raised, then the drives' report
+        return _script_failed(args, machine, exc)
     return finish(machine)
+
+
+def _script_failed(args: argparse.Namespace, machine, exc: Exception) -> int:
+    import traceback
+
+    frames = [f for f in traceback.extract_tb(exc.__traceback__) if f.filename.endswith(args.script.split("/")[-1])]
+    where = f" at line {frames[-1].lineno}" if frames else ""
+    print(f"hil script: {args.script} raised{where}: {type(exc).__name__}: {exc}", file=sys.stderr)
+    machine.report()
+    machine.close()
+    return EXIT_ALARM

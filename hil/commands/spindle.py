@@ -20,6 +20,10 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def cmd_spindle(args: argparse.Namespace) -> int:
+    if not (0.0 <= args.rpm < float("inf") and 0.0 <= args.seconds < float("inf")):
+        print(f"hil spindle: RPM {args.rpm:g} and --seconds {args.seconds:g} must be >= 0 (--ccw turns backwards)",
+              file=__import__("sys").stderr)
+        return 2
     machine, code = open_machine(args)
     if machine is None:
         return code

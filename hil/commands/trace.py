@@ -33,7 +33,10 @@ def cmd_trace(args: argparse.Namespace) -> int:
             print(f"wrote {rows} rows to {args.out}")
             return EXIT_OK
         print(format_summary(tf, summarise(tf, lo, hi)))
-    except (ValueError, TraceReadError, OSError) as exc:
+    except OSError as exc:
+        print(f"hil trace: {exc.filename or args.out}: {exc.strerror or exc}", file=sys.stderr)
+        return EXIT_USAGE
+    except (ValueError, TraceReadError) as exc:
         print(f"hil trace: {exc}", file=sys.stderr)
         return EXIT_USAGE
     return EXIT_OK

@@ -75,6 +75,12 @@ _WORD = re.compile(r"[A-Za-z]+")
 _SYM = ("||", "&&", "==", "!=", "<>", "<=", ">=", "<", ">", "=", "+", "-", "*", "/", "&", "|", "^", "!")
 
 
+# Bounds that keep parser and evaluator (both recursive) far from Python's recursion limit; a block
+# beyond them is an alarm, not a crash (docs/decisions/language.md "expression size").
+MAX_NESTING = 32  # brackets, function calls, #[...] and unary signs inside one another
+MAX_OPERATORS = 256  # binary operators in one expression
+
+
 class ExprParser:
     """Parses expressions out of a block's code text starting at ``pos``; shares the text with the
     block parser so statements and words can be mixed (``IF[...]GOTO#1``)."""
@@ -83,6 +89,13 @@ class ExprParser:
         self.s = text
         self.pos = pos
         self.eq_is_compare = eq_is_compare
+        self.depth = 0
+        self.ops = 0
+
+    def _nest(self, by: int) -> None:
+        self.depth += by
+        if self.depth > MAX_NESTING:
+            raise self.error(0x0209, f"expression nested deeper than {MAX_NESTING} levels")
 
     # -- scanning helpers
     def skip(self) -> None:
@@ -125,6 +138,9 @@ class ExprParser:
                 op = "=="
             if op == "<>":
                 op = "!="
+            self.ops += 1
+            if self.ops > MAX_OPERATORS:
+                raise self.error(0x0206, f"expression has more than {MAX_OPERATORS} operators")
             right = self.parse(level + 1)
             left = Binary(op.upper(), left, right)
 
@@ -148,12 +164,20 @@ class ExprParser:
         sym = self.peek_sym()
         if sym in ("-", "+", "!"):
             self.pos += 1
+            self._nest(1)
             arg = self.unary()
+            self._nest(-1)
             return arg if sym == "+" else Unary(sym, arg)
         if self.peek_word() == "NOT":
             self.pos += 3
-            return Unary("!", self.unary())
-        return self.primary()
+            self._nest(1)
+            arg = self.unary()
+            self._nest(-1)
+            return Unary("!", arg)
+        self._nest(1)
+        e = self.primary()
+        self._nest(-1)
+        return e
 
     def primary(self) -> Expr:
         self.skip()
