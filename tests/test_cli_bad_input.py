@@ -1,5 +1,5 @@
 """Bad input through every `hil` subcommand: an NC alarm code (App. A) or a usage message, exit 1 or 2,
-never a traceback or the internal-error alarm 0x0000, and no half-written output file.
+never a traceback or the internal error (0x0000 "NC internal error"), and no half-written output file.
 
 Decisions: docs/decisions/bench.md "bad input end to end" (an alarmed run's trace is a complete, closed
 file; a run refused before it starts writes none; exports and traces are renamed from *.part on success).
@@ -74,7 +74,7 @@ def hil(argv: list[str], capsys) -> tuple[int, str]:
     out, err = capsys.readouterr()
     text = out + err
     assert "Traceback" not in text
-    assert "0x0000" not in text, f"internal error (a bug) for {argv}: {text[-400:]}"
+    assert "NC internal error" not in text, f"internal error (a bug) for {argv}: {text[-400:]}"
     return rc, text
 
 
@@ -124,6 +124,10 @@ CASES: list[tuple[str, str, int, tuple[str, ...]]] = [
     ("run-mlc-raises", "run {d}/ok.nc --mlc {d}/syntax.py", 2, ("syntax.py",)),
     ("run-m00-negative", "run {d}/ok.nc --m00-resume -1", 2, ("--m00-resume",)),
     ("run-trace-folder", "run {d}/ok.nc --trace {d}/adir", 2, ("Is a directory",)),
+    ("run-at-junk", "run {d}/ok.nc --at junk", 2, ("--at", "TRIGGER:ACTION")),
+    ("run-at-negative", "run {d}/ok.nc --at t=-1:M31064=1", 2, ("--at", "≥ 0")),
+    ("run-events-binary", "run {d}/ok.nc --events {d}/garbage.nc", 2, ("events file",)),
+    ("run-events-folder", "run {d}/ok.nc --events {d}/adir", 2, ("events file",)),
     ("run-modbus-missing", "run {d}/ok.nc --servo-modbus /dev/nope-tty", 2, ("/dev/nope-tty",)),
     # traces: `hil trace`, `hil check`, `hil report`
     ("trace-missing", "trace {d}/nope.csv", 2, ("no such trace file",)),
@@ -168,6 +172,7 @@ CASES: list[tuple[str, str, int, tuple[str, ...]]] = [
     ("mpg-ethercat-nope0", "mpg X 10 --bus ethercat:nope0", 1, ("0x1429",)),
     ("spindle-negative-time", "spindle 500 --seconds -1", 2, ("--seconds",)),
     ("spindle-negative-rpm", "spindle -500", 2, ("RPM",)),
+    ("spindle-override", "spindle 500 --override -5", 2, ("--override",)),
     ("spindle-ethercat-nope0", "spindle 500 --bus ethercat:nope0", 1, ("0x1429",)),
     ("servo-param", "servo get X junk", 2, ("junk",)),
     ("servo-axis", "servo get Q P2-00", 2, ("'Q'",)),
