@@ -218,12 +218,15 @@ def test_alarmed_run_leaves_a_whole_trace(d, capsys):
 
 
 def test_bus_that_never_opened_leaves_an_empty_trace(d, capsys):
-    """No cycle ran: the trace is the header alone, and the run names one alarm (no follow-on
-    'link used before open')."""
+    """No cycle ran: the trace is the header alone, the run names one alarm (no follow-on
+    'link used before open'), and `hil check`/`report` refuse to judge it rather than pass it."""
     out = d / "nobus.parquet"
     rc, text = hil(["run", str(d / "ok.nc"), "--bus", "ethercat:nope0", "--trace", str(out), "--no-progress"], capsys)
     assert rc == 1 and "alarms         1" in text
     assert TraceFile(out).num_rows == 0
+    for cmd in (["check", str(out), "--max-ferr", "1"], ["report", str(out), "--out", str(d / "rep-nobus")]):
+        rc, text = hil(cmd, capsys)
+        assert rc == 2 and "has no rows" in text
 
 
 @pytest.mark.parametrize("bench", ["bad.toml", "adir", "types.toml"])

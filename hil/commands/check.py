@@ -73,6 +73,9 @@ def prepare(args: argparse.Namespace, cmd: str):
     bench = load_bench(args.bench)
     checks = checks_from_args(args, bench)
     tf = TraceFile(args.trace)
+    rows = tf.num_rows if tf.num_rows >= 0 else tf.table(["t"]).num_rows
+    if rows == 0:  # e.g. a run whose bus never opened: passing its checks would judge nothing as good
+        raise InputError(f"{args.trace} has no rows (its run stopped before the first cycle): nothing to check")
     missing = [a for a in bench.axis_names if f"{a}_cmd" not in tf.columns]
     if args.bench and missing:
         raise InputError(f"{args.trace} has no columns for axis {', '.join(missing)} of bench {bench.name}")
