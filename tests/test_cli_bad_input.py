@@ -261,3 +261,18 @@ def test_random_programs_never_crash(tmp_path, capsys, program):
                          .split("[checks]")[0])
     assert hil(["path", str(prog), "--json"], capsys)[0] in (0, 1, 2)
     assert hil(["run", str(prog), "--bench", str(bench), "--no-progress"], capsys)[0] in (0, 1, 2)
+
+
+def test_real_process_exit_codes(d):
+    """The installed entry point as a user runs it: exit codes and stderr, argparse's usage error included."""
+    import os
+    import subprocess
+    import sys
+
+    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    for argv, code, name in ((["path", str(d / "arc_r.nc")], 1, "0x0259"),
+                             (["run", str(d / "ok.nc"), "--bench", str(d / "bad.toml")], 2, "not valid TOML"),
+                             (["run", str(d / "ok.nc"), "--m00-resume", "soon"], 2, "invalid float value")):
+        p = subprocess.run([sys.executable, "-m", "hil.cli", *argv], capture_output=True, text=True, env=env,
+                           timeout=60)
+        assert p.returncode == code and name in p.stderr and "Traceback" not in p.stderr + p.stdout, p.stderr
