@@ -275,16 +275,25 @@ def signal_table(channels: tuple[int, ...] = (1,)) -> dict[str, Signal]:
     return out
 
 
+@lru_cache(maxsize=None)
+def _by_name(channel: int) -> dict[str, Signal]:
+    """Signal names of one channel (and the general ones), the first in table order winning."""
+    out: dict[str, Signal] = {}
+    for sig in signal_table(tuple(range(1, 5))).values():
+        if sig.channel in (0, channel):
+            out.setdefault(sig.name, sig)
+    return out
+
+
 def resolve(spec: str, channel: int = 1) -> Signal:
     """A device by address (``M21016``) or by name (``MST_FINISH``, ``JOG_FWD_X``; channel-relative)."""
     table = signal_table(tuple(range(1, 5)))
     try:
         kind, n = parse_address(spec)
     except DeviceError:
-        name = spec.strip().upper()
-        for sig in table.values():
-            if sig.name == name and sig.channel in (0, channel):
-                return sig
+        sig = _by_name(channel).get(spec.strip().upper())
+        if sig is not None:
+            return sig
         raise DeviceError(f"{spec!r} is neither a device address nor a signal name of App. B") from None
     sig = table.get(f"{kind}{n}")
     if sig is not None:

@@ -30,10 +30,11 @@ from nc.motion.planner import Planner, Setpoint
 from nc.moves import Aux, Event, Move, ProgramEnd, Sync
 from nc.softlimits import SoftLimits
 
-# Events read from the interpreter into the look-ahead per cycle. Filling a 100-block queue at
-# once takes ≈ 4 ms of interpretation and planning, which overruns a 1 ms real-time cycle at
-# program start; 8 (≈ 0.3 ms) still outpaces the fastest consumption (a block may last 1/4 cycle).
-READS_PER_CYCLE = 8
+# Moves read from the interpreter into the look-ahead per cycle (M/S/T codes and preview stops do
+# not count). Filling a 100-block queue at once takes ≈ 4 ms of interpretation and planning, which
+# overran the first 1 ms real-time cycle of a CAM program; 4 (≈ 0.2 ms) keep up with blocks as
+# short as 1/4 cycle. A first block that is long is planned with the 3 after it in view.
+READS_PER_CYCLE = 4
 
 
 class RunState(Enum):
@@ -288,7 +289,6 @@ class Channel:
                 return
             if reads == 0:
                 return  # the rest next cycle
-            reads -= 1
             try:
                 ev = next(self.events)  # type: ignore[arg-type]
             except StopIteration:
@@ -309,6 +309,7 @@ class Channel:
                     self.skip_latched = None
                 pl.push(ev)
                 self._block_moves += 1
+                reads -= 1
             elif isinstance(ev, Aux):
                 if pl.idle:
                     self._issue(ev)

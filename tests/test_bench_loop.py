@@ -190,7 +190,7 @@ def test_the_look_ahead_fills_a_few_blocks_per_cycle():
     runner, result, queued = run_counting_queue(bench, "G90 G01 F3000\n" + "\n".join(ys) + "\nM30\n")
     assert result.ok
     growth = np.diff([0] + queued)
-    assert growth.max() == READS_PER_CYCLE == 8
+    assert growth.max() == READS_PER_CYCLE == 4
     depth = runner.channel.planner.depth
     assert next(i for i, q in enumerate(queued) if q >= depth) < 2 * depth // READS_PER_CYCLE
     assert runner.channel.planner.position[:2].tolist() == pytest.approx([15.0, 0.5 * np.sin(15.0)], abs=1e-4)
