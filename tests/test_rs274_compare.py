@@ -4,40 +4,13 @@ programs that can be written in both dialects. Accepted differences: docs/decisi
 from __future__ import annotations
 
 import math
-import re
-import shutil
-import subprocess
 
 import pytest
 
 from cycles_helpers import run
+from rs274_helpers import dedupe, needs_rs274, rs274
 
-RS274 = shutil.which("rs274")
-pytestmark = pytest.mark.skipif(RS274 is None, reason="LinuxCNC rs274 is not installed "
-                                                      "(apt-get install linuxcnc-uspace)")
-CALL = re.compile(r"^\s*\d+\s+N\S*\s+(STRAIGHT_TRAVERSE|STRAIGHT_FEED|ARC_FEED)\((.*)\)")
-
-
-def rs274(tmp_path, text: str) -> list[tuple[str, list[float]]]:
-    f = tmp_path / "lc.ngc"
-    f.write_text(text)
-    out = subprocess.run([RS274, "-g", str(f)], capture_output=True, text=True, timeout=30).stdout
-    calls = []
-    for line in out.splitlines():
-        m = CALL.match(line)
-        if m:
-            calls.append((m.group(1), [float(v) for v in m.group(2).split(",")]))
-    assert calls, out
-    return calls
-
-
-def dedupe(points):
-    out = []
-    for p in points:
-        # zero-length moves (a return to the level the tool is already at) are dropped
-        if not out or any(abs(a - b) > 1e-6 for a, b in zip(p[1], out[-1][1])):
-            out.append(p)
-    return out
+pytestmark = needs_rs274
 
 
 def test_cutter_compensation_matches_linuxcnc(capsys, tmp_path):
