@@ -10,7 +10,7 @@ from __future__ import annotations
 import pytest
 
 from cycles_helpers import run
-from rs274_helpers import Canon, canon, needs_rs274
+from rs274_helpers import Canon, canon, needs_rs274, rs274_output
 
 pytestmark = needs_rs274
 TOL = 1e-6
@@ -230,3 +230,25 @@ G91 G28 X0. Y0. Z0.
     ours = compare(capsys, tmp_path, body)
     g28 = [m["end"] for m in ours if "G28" in m.get("tags", [])]
     assert g28[:2] == [{"X": 120.0, "Y": 45.0, "Z": 15.0}, {"X": 0.0, "Y": 0.0, "Z": 15.0}]
+
+
+def test_g28_cancels_tool_length_unlike_linuxcnc(capsys, tmp_path):
+    """NC5 N§3.5.1: G43/G44 hold up to the intermediate point, then G28 cancels them for good; LinuxCNC
+    keeps the offset. Compared up to the intermediate point, ours pinned to the manual after it."""
+    body = "G00 X10. Y0. Z0.\nG43 H1 Z5.\nG28 X20.\nG00 Z5.\n"
+    ours = ours_path(capsys, tmp_path, HEAD + "G10 L10 P1 R12.7\n" + body + "M30\n")
+    theirs = canon(tmp_path, HEAD + body + "M2\n", tools="T1 P1 Z0.5\n")
+    assert_same(ours[:-1], theirs[:-1])
+    assert ours[-1]["end"]["Z"] == pytest.approx(5.0, abs=TOL)
+    assert theirs[-1].end["Z"] == pytest.approx(17.7, abs=TOL)
+
+
+def test_r_full_circle_and_peck_retract_differences(capsys, tmp_path):
+    """R with the end on the start: NC5 does not move (A30), LinuxCNC stops with an error. G73 retract d:
+    N1.151 on NC5 (1.0 mm in our profile), a fixed 0.010 inch on LinuxCNC."""
+    p = run(capsys, tmp_path, HEAD + "G00 X10. Y0. Z0.\nG02 X10. Y0. R10. F100.\nG01 X20.\nM30\n", profile="nc5-mill")
+    assert p.code == 0 and [m["kind"] for m in p.moves] == ["rapid", "line"]
+    assert rs274_output(tmp_path, HEAD + "G00 X10. Y0. Z0.\nG02 X10. Y0. R10. F100.\nM2\n").count("ARC_FEED") == 0
+    ours = ours_path(capsys, tmp_path, HEAD + "G00 X0. Y0. Z20.\nG98 G73 X10. Y10. Z-7. R2. Q2.5 F100.\nG80\nM30\n")
+    ups = [m["end"]["Z"] for m in ours if m["kind"] == "rapid" and m["start"]["Z"] < 0]
+    assert ups == pytest.approx([-0.5 + 1.0, -3.0 + 1.0, -5.5 + 1.0, 20.0], abs=TOL)
