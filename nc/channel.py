@@ -350,6 +350,11 @@ class Channel:
         return pl._thread is not None or any(b.kind == "thread" for b in pl.blocks)
 
     @property
+    def spindle_wait(self) -> bool:
+        """A thread waits for the spindle's measured speed to settle at its command (decisions 33)."""
+        return self.planner.spindle_wait
+
+    @property
     def spindle_factor(self) -> float:
         """The spindle override the drive's speed gets: D2x026, but 100 % for threads, so every pass
         runs at the programmed speed and meets the thread in phase (NC5 threading note (1))."""

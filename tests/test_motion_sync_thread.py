@@ -4,6 +4,7 @@ speed, run in lock-step on the simulated bench (virtual CSP axes + CSV spindle d
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from fieldbus.link import SimLink
 from hil.bench import default_lathe
@@ -144,3 +145,98 @@ def test_g76_phase_check_from_the_command_line(hil, program, tmp_path):
     r = hil("check", trace, "--program", prog, "--thread-phase", "0.5", "--limits")
     assert r.code == 0, r.out
     assert "ok    thread phase" in r.out
+
+
+# ---- the spindle settles before a thread arms (motion decisions 33) --------------------------------
+
+def run_lathe_mlc(text: str, percent: int = 100, **drive):
+    """Run with the Delta lathe MLC (M03 ends on "speed reached", 2 %) and the spindle override D21026;
+    per cycle (time, line, X cmd, Z cmd, Z actual, spindle angle, measured rpm, waiting, drive's rpm command)."""
+    from hil.scripting import build_mlc
+
+    bench = default_lathe()
+    for key, v in drive.items():
+        setattr(bench.spindles[0].drive, key, v)
+    mlc = build_mlc(bench, "lathe")
+    mlc.put("D21026", percent)
+    runner = BenchRunner(bench, SimLink(sim_slaves(bench), bench.cycle), mlc=mlc)
+    rows = []
+
+    def grab(r):
+        if r.channel is not None:
+            rows.append((r.time, r.line, r._commands[0], r._commands[1], r.actual[1], r.spindle_actual_angle(),
+                         r.spindle_actual_rpm(), float(r.channel.spindle_wait), r.spindle_command_rpm()))
+
+    runner.on_cycle = grab
+    result = runner.run_program(parse_program(text))
+    assert result.ok, result.alarms
+    return np.array(rows), runner.channel.planner
+
+
+def check_settled_passes(rows: np.ndarray, planner, rpm: float = 600.0) -> None:
+    """Every pass: armed only after a wait-free or finished settle, at the commanded speed, and Z is
+    start − lead × revolutions since the sync angle on every locked cycle; one phase for all passes."""
+    from nc.motion.threading import SETTLE_BAND, SETTLE_CYCLES
+
+    moving_rpm, cmd_phase, act_phase = [], [], []
+    for line, sync, ramp_start in planner.thread_log:
+        m = rows[rows[:, 1] == line]
+        go = m[np.flatnonzero(np.abs(m[:, 3] - 5.0) > 1e-9)[0]:]  # Z has left the start point: the ramp runs
+        go = go[: int(np.argmin(go[:, 3])) + 1]  # up to the thread's end (not G92's return)
+        moving_rpm.append(go[:, 6])
+        lk = go[(go[:, 3] < 0.0) & (go[:, 3] > -15.0)]  # locked, before the pull-out
+        revs = (lk[:, 5] - sync) / 360.0
+        assert len(lk) > 500
+        assert np.allclose(lk[:, 3], 5.0 - LEAD * revs, atol=1e-6)  # lead × revolutions, exact
+        cmd_phase.append((lk[:, 5] - 360.0 * (5.0 - lk[:, 3]) / LEAD) % 360.0)
+        act_phase.append((lk[:, 5] - 360.0 * (5.0 - lk[:, 4]) / LEAD) % 360.0)
+    moving = np.concatenate(moving_rpm)
+    assert np.all(np.abs(moving - rpm) <= SETTLE_BAND * rpm)  # no pass ran on a spindle still speeding up
+    assert circ_spread(np.concatenate(cmd_phase)) < 0.5
+    assert circ_spread(np.concatenate(act_phase)) < 0.5
+    assert all(w == 0 or w >= SETTLE_CYCLES for _, w in planner.thread_waits)
+
+
+TWO_PASSES_AFTER_M03 = ("G21 G18 G99\nG00 X19.4 Z5.\nS600 M03\nG32 Z-20. F1.5\nG00 X30.\nZ5.\n"
+                        "X19.0\nG32 Z-20. F1.5\nG00 X30.\nZ5.\nM30\n")
+
+
+def test_thread_right_after_m03_waits_for_the_spindle_to_settle():
+    # A slow spindle (≈ 94 rpm/s): M03 ends at 2 % short of S600 ("speed reached"), 125 ms before
+    # the spindle really turns at 600; the first pass waits for that, the axes standing still.
+    rows, planner = run_lathe_mlc(TWO_PASSES_AFTER_M03, csv_accel=2.0e6)
+    waits = dict(planner.thread_waits)
+    assert [ln for ln, _, _ in planner.thread_log] == [4, 8]
+    assert waits[4] > 100 and waits[8] == 0
+    wait = rows[rows[:, 7] > 0]
+    assert len(wait) == waits[4] and np.all(wait[:, 1] == 4)  # the trace shows the thread's line waiting
+    assert np.ptp(wait[:, 2]) == 0.0 and np.ptp(wait[:, 3]) == 0.0  # no creeping
+    assert wait[0, 6] < 0.99 * 600.0 < 600.0 * (1 - 1e-3) < 1.0 * wait[-1, 6]
+    check_settled_passes(rows, planner)
+
+
+def test_g92_thread_waits_for_the_override_to_come_back_to_100_percent():
+    text = "G21 G18 G99\nS600 M03\nG00 X30. Z5.\nG04 P300\nG92 X19.4 Z-20. F1.5\nX19.0\nG00 X60.\nM30\n"
+    rows, planner = run_lathe_mlc(text, 80, csv_accel=2.0e6)
+    m03 = rows[(rows[:, 1] == 0) & (rows[:, 8] > 0.0)]  # S600 M03 before any move
+    assert np.allclose(m03[:, 8], 480.0) and m03[-1, 6] == pytest.approx(480.0, rel=0.02)  # at 80 %
+    assert np.allclose(rows[rows[:, 1] == 5, 8], 600.0)  # 100 % once the thread is in the look-ahead
+    waits = [w for _, w in planner.thread_waits]
+    assert len(waits) == 2 and waits[0] > 300 and waits[1] == 0  # 480 → 600 rpm at ≈ 94 rpm/s
+    wait = rows[rows[:, 7] > 0]
+    assert np.ptp(wait[:, 2]) == 0.0 and np.ptp(wait[:, 3]) == 0.0
+    check_settled_passes(rows, planner)
+
+
+# When the first pass's Z leaves the start point, measured on main before the settle check was added.
+START_AT_SPEED = 0.862
+
+
+def test_no_wait_when_the_spindle_is_already_at_speed():
+    rows, planner = run_lathe_mlc(passes_program([19.4, 19.0]))
+    assert planner.thread_waits == [(5, 0), (9, 0)]
+    assert not np.any(rows[:, 7])
+    m = rows[rows[:, 1] == 5]
+    start = m[np.flatnonzero(np.abs(m[:, 3] - 5.0) > 1e-9)[0], 0]
+    assert start == pytest.approx(START_AT_SPEED, abs=1e-9)  # the same cycle as before the settle check
+    check_settled_passes(rows, planner)

@@ -77,6 +77,12 @@ class Planner:
         self.spindle_command = spindle_command
         self._thread: thr.ThreadState | None = None
         self.thread_log: list[tuple[int, float, float]] = []  # (line, sync angle, ramp start angle) per chain
+        # A chain arms once the measured speed has settled at the command (decisions 33); while it
+        # waits the axes stand and spindle_wait is True. thread_waits: (line, cycles waited) per chain.
+        self._settle = thr.SpindleSettle()
+        self.spindle_wait = False
+        self._wait_cycles = 0
+        self.thread_waits: list[tuple[int, int]] = []
         self.depth = cfg.lookahead_depth()
         # The queue refills in batches: once `full` it takes more blocks only when it has fallen
         # below depth (never shallower than configured), up to depth + batch. One backward pass
@@ -279,6 +285,8 @@ class Planner:
         if self._integrate_angle:
             self._sim_angle += self.spindle_rpm() * 6.0 * self.cfg.cycle
         self._check_spindle()
+        if self.spindle_command is not None:
+            self._settle.update(float(self.spindle_rpm()), float(self.spindle_command()))
         if self._buf_done:
             self._refill()
         if self._buf_done and self.plan is None and self.blocks and self.blocks[0].kind == "thread" \
@@ -311,6 +319,14 @@ class Planner:
             if b.seg is not None and np.allclose(b.seg.start, self.position, atol=1e-6):
                 b.seg.start = self.position.copy()
             self.line = b.move.line
+            if self.spindle_command is not None and not self._settle.ready(float(self.spindle_command())):
+                self.spindle_wait = True  # the spindle still changes speed: stand still on the thread's line
+                self._wait_cycles += 1
+                self.v = self.a = 0.0
+                return Setpoint(self.position.copy(), self.line, 0.0, b.move)
+            self.spindle_wait = False
+            self.thread_waits.append((b.move.line, self._wait_cycles))
+            self._wait_cycles = 0
             st = self._thread = thr.arm(b, angle, float(self.spindle_rpm()), float(self.spindle_index()),
                                         b.move.line)
             self.thread_log.append((b.move.line, st.sync_angle, st.ramp_start))
@@ -418,6 +434,8 @@ class Planner:
 
     def _flush(self) -> None:
         self._thread = None
+        self.spindle_wait = False
+        self._wait_cycles = 0
         self.blocks.clear()
         self._pushed = self._need = 0
         self.plan = None

@@ -12,6 +12,8 @@ grows by K per revolution). The last move of the chain brakes to rest at its end
 jerk-limited profile, started when the remaining distance is what braking needs.
 
 Feed override, feed hold and dry run do not act on a thread (the override is forced to 100 %).
+A chain arms only once the spindle's measured speed has settled at its command (`SpindleSettle`,
+motion decisions 33): the ramp is planned on that speed, so it must not be still changing.
 """
 
 from __future__ import annotations
@@ -24,6 +26,29 @@ import numpy as np
 from nc.alarms import NcAlarm
 from nc.motion.lookahead import MARGIN, Block, change_distance
 from nc.motion.profile import Piecewise, solve_position, solve_velocity
+
+
+# A thread arms when the measured speed has stayed within SETTLE_BAND of the command (0.1 %, at least
+# SETTLE_MIN_RPM) for SETTLE_CYCLES cycles in a row. M3x704 "speed reached" (2 %) only ends M03;
+# a spindle 2 % short still accelerates through the ramp, which was planned on one speed.
+SETTLE_BAND = 1e-3
+SETTLE_MIN_RPM = 0.1
+SETTLE_CYCLES = 10
+
+
+@dataclass
+class SpindleSettle:
+    """Counts the cycles the spindle's measured speed has been at its commanded speed."""
+
+    cycles: int = 0
+
+    def update(self, rpm: float, command: float) -> None:
+        at = abs(command) >= 1.0 and abs(rpm - command) <= max(SETTLE_BAND * abs(command), SETTLE_MIN_RPM)
+        self.cycles = self.cycles + 1 if at else 0
+
+    def ready(self, command: float) -> bool:
+        """A stopped spindle never settles: arming then raises its own alarm (not rotating)."""
+        return abs(command) < 1.0 or self.cycles >= SETTLE_CYCLES
 
 
 def major_factor(b: Block) -> float:
