@@ -62,6 +62,17 @@ def test_e_n12_e_n13_g28_g29(capsys, tmp_path):
     assert r.machine("X", "Y", "Z")[1:] == [(50, 65, 50), (50, 65, 0)]
 
 
+def test_g28_ends_length_compensation_at_the_intermediate_point(capsys, tmp_path):
+    """N§3.5.1: the reference move runs without G43, so its work Z is the machine Z minus the work origin
+    only; the offset is cancelled also when the named axes already stand at the reference point."""
+    r = run_path(capsys, tmp_path, "G10 L10 P1 R12.7\nG00 X10. Y0. Z0.\nG43 H1 Z5.\nG28 X20.\nM30\n")
+    ref = r.moves[-1]
+    assert "reference" in ref["tags"] and ref["end"]["Z"] == 17.7 and ref["work"]["Z"] == 17.7
+    r = run_path(capsys, tmp_path, "G10 L10 P1 R12.7\nG00 X0. Y0. Z0.\nG43 H1 Z5.\nG91 G28 X0.\n"
+                 "G90 G00 Z5.\nM30\n", "--vars", "20308")
+    assert r.machine("Z")[-1] == (5.0,) and r.vars["20308"] == 49.0
+
+
 def test_g29_without_g28_is_0x0253(capsys, tmp_path):
     assert run_path(capsys, tmp_path, "G29 X10.\n").alarm["code"] == "0x0253"
 

@@ -252,3 +252,17 @@ def test_r_full_circle_and_peck_retract_differences(capsys, tmp_path):
     ours = ours_path(capsys, tmp_path, HEAD + "G00 X0. Y0. Z20.\nG98 G73 X10. Y10. Z-7. R2. Q2.5 F100.\nG80\nM30\n")
     ups = [m["end"]["Z"] for m in ours if m["kind"] == "rapid" and m["start"]["Z"] < 0]
     assert ups == pytest.approx([-0.5 + 1.0, -3.0 + 1.0, -5.5 + 1.0, 20.0], abs=TOL)
+
+
+def test_incremental_drilling_with_repeats_matches_linuxcnc(capsys, tmp_path):
+    """G91 hole cycles: R from the initial level, Z from R, X/Y spacing repeated K times (NC5 N§3.13.1
+    note (8)); LinuxCNC spells the repeat count L."""
+    body = """G00 X0. Y0. Z10.
+G91 G99 G73 X10. Y5. Z-6. R-8. Q2. {k}3 F100.
+G98 G83 X-4. Y0. Z-5. R-9. Q2. {k}2
+G90 G80
+G00 X0. Y0.
+"""
+    ours = compare(capsys, tmp_path, body.format(k="K"), body.format(k="L"), "--param", "N1.151=0.254")
+    holes = sorted({(m["end"]["X"], m["end"]["Y"]) for m in ours if m["kind"] == "line"})
+    assert holes == [(10.0, 5.0), (20.0, 10.0), (22.0, 15.0), (26.0, 15.0), (30.0, 15.0)]

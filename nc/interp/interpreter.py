@@ -1196,13 +1196,8 @@ class Interpreter:
         for a in words:
             end[a] = refpt[a]
         self.unit_locked = True
-        if end == self.position:
-            return
-        mv = Move("rapid", block.line, block.text, dict(self.position), end, self.to_work(end),
-                  program=self.program_name, plane=PLANES[self.state.plane], tags=(tag, "reference"),
-                  exact_stop=True)
-        self.position = end
-        self.unit_locked = True
+        # the offsets end at the intermediate point (N§3.5.1), also when the axes already stand at the
+        # reference point; the reference move's work point is therefore without them
         if self.profile.is_lathe:
             self.state.tool_offset = 0  # G28/G30 clear the tool offset number (N§3.10.1)
             self._apply_tool_offset()
@@ -1210,6 +1205,13 @@ class Interpreter:
             self.state.length_comp = 49
             self.state.groups[8] = 49
             self._apply_length_comp()
+        self.last_target = self.work_position()
+        if end == self.position:
+            return
+        mv = Move("rapid", block.line, block.text, dict(self.position), end, self.to_work(end),
+                  program=self.program_name, plane=PLANES[self.state.plane], tags=(tag, "reference"),
+                  exact_stop=True)
+        self.position = end
         self.last_target = self.work_position()
         yield mv
 
