@@ -8,6 +8,7 @@ import pytest
 @pytest.mark.parametrize("text, code, line", [
     ("G00 X10.\nG01 X10. Q\n", "0x0222", 2),  # address without a value
     ("G00 X10.\nG01 X10. $5\n", "0x0206", 2),  # character that is no address
+    ("G00 X10.\nG01 \u0386X10.\n", "0x0206", 2),  # a non-ASCII letter is no address either
     ("G00 X1.\nG01 O100.\n", "0x0201", 2),  # O inside a block (NC5 App. A example)
     ("G98\nG01 Z-10.\n", "0x1001", 2),  # no feed programmed
     ("G98 G00 X0 Z0\nG02 X100. Z0. R10. F100\n", "0x0259", 2),  # radius smaller than half the chord

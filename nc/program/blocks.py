@@ -358,7 +358,7 @@ class _BlockParser:
                     block.comma[letter] = v
                 first = False
                 continue
-            if not c.isalpha():
+            if not (c.isascii() and c.isalpha()):  # Ά, é are no addresses
                 raise self.alarm(0x0209 if c in "[]" else 0x0206,
                                  f"unexpected character {c!r}")
             kw = self.keyword()
