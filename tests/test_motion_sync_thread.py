@@ -240,3 +240,22 @@ def test_no_wait_when_the_spindle_is_already_at_speed():
     start = m[np.flatnonzero(np.abs(m[:, 3] - 5.0) > 1e-9)[0], 0]
     assert start == pytest.approx(START_AT_SPEED, abs=1e-9)  # the same cycle as before the settle check
     check_settled_passes(rows, planner)
+
+
+def test_spindle_settle_wait_from_the_command_line(hil, program, tmp_path):
+    """`hil run` with the lathe MLC: G32 right after S600 M03 waits for the spindle (M03 ends at 2 %
+    short), the summary says how long, the trace shows the axes standing on the thread's line."""
+    import csv
+
+    from conftest import ROOT
+
+    prog = program("G21 G18 G99\nG00 X19.4 Z5.\nS600 M03\nG32 Z-20. F1.5\nG00 X30.\nM30\n")
+    trace = tmp_path / "t.csv"
+    r = hil("run", prog, "--bench", ROOT / "benches" / "lathe-2axis.toml", "--trace", trace)
+    assert r.code == 0, r.out + r.err
+    assert "spindle settle line 4 " in r.out
+    rows = [row for row in csv.DictReader(trace.open()) if row["line"] == "4"]
+    moving = next(i for i, row in enumerate(rows) if abs(float(row["Z_cmd"]) - 5.0) > 1e-9)
+    assert moving > 10  # stood still on line 4 for the settle cycles at least
+    assert abs(float(rows[moving]["S1_rpm_act"]) - 600.0) <= 0.6
+    assert abs(float(rows[0]["S1_rpm_act"]) - 600.0) > 0.6  # line 4 began before the spindle settled

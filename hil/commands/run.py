@@ -129,6 +129,10 @@ def cmd_run(args: argparse.Namespace) -> int:
         if args.servo_modbus:
             runner.servo_modbus.close()
     print_summary(args.program, bench, result)
+    waits = [(ln, w) for ln, w in runner.channel.planner.thread_waits if w] if runner.channel is not None else []
+    if waits:  # threads armed only once the spindle settled at its command (motion decisions 33)
+        print("spindle settle " + "  ".join(f"line {ln} {w * bench.cycle * 1000:g} ms" for ln, w in waits)
+              + " before the thread", file=sys.stdout)
     if player is not None:
         print("\n".join(player.summary()), file=sys.stdout)
     print_timing(result)
