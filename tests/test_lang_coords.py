@@ -228,3 +228,48 @@ def test_chamfer_and_fillet_a32(capsys, tmp_path):
     # ,A linear angle: X from Z and the angle (lathe, angle from +Z)
     r = run_path(capsys, tmp_path, "G00 X0 Z0\nG01 Z-10. ,A135. F0.2\n", profile="nc5-lathe-a")
     assert r.ends("X", "Z")[-1] == (pytest.approx(20.0), -10.0)
+
+
+def test_g53_reaches_machine_point_past_g54_g92_and_g43(capsys, tmp_path):
+    """N§3.6.3: G53 X_ Z_ is a machine position whatever G54, G92 and G43 H say; G43 ends there for good
+    (note 4, N§3.9 note 2), so the G53 move's work point and every later Z are without the 12.7 mm;
+    G54 and the G92 shift stay. Hand-computed: work origin X = 100 + 10 (G92), Y = 50 + 10, Z = -200."""
+    prog = ("G10 L2 P1 X100. Y50. Z-200.\nG10 L10 P1 R12.7\nG90 G54 G00 X10. Y10. Z10.\nG92 X0 Y0\n"
+            "G43 H1 Z5.\nG53 X20. Z-50.\nG00 Y5.\nX0 Z0\n")
+    r = run_path(capsys, tmp_path, prog, "--vars", "20308,20312")
+    assert r.machine("X", "Y", "Z") == [(110, 60, -190), (110, 60, -182.3), (20, 60, -50), (20, 65, -50),
+                                        (110, 65, -200)]
+    g53 = r.moves[2]
+    assert g53["kind"] == "rapid" and g53["exact_stop"] and (g53["work"]["X"], g53["work"]["Z"]) == (-90.0, 150.0)
+    assert r.vars == {"20308": 49.0, "20312": 54.0}  # G49 afterwards, work system unchanged
+
+
+def test_g53_ends_lathe_tool_offset_and_keeps_g54(capsys, tmp_path):
+    """Lathe: the tool offset is the length compensation G53 cancels (decision: language.md, G53).
+    G54 X20. (diameter) = radius 10; T0101 geometry X10. (diameter) = 5, Z-5."""
+    prog = "G10 L2 P1 X20. Z-100.\nG10 L10 P1 X10. Z-5.\nG54 T0101\nG00 X20. Z10.\nG53 X80. Z-50.\nG00 X20.\n"
+    r = run_path(capsys, tmp_path, prog, profile="nc5-lathe-a")
+    assert r.machine("X", "Z") == [(25, -95), (40, -50), (20, -50)]
+    assert r.ends("X", "Z") == [(20, 10), (60, 50), (20, 50)]
+
+
+def test_g53_suspends_radius_compensation_for_its_move(capsys, tmp_path):
+    """N§3.6.3 note 4: radius compensation is cancelled in the G53 move (it reaches machine X60 Y40
+    exactly) and restored by the next motion block (start-up to Y35 = Y40 - R5 under G41)."""
+    prog = "G10 L12 P1 R5.\nG90 G00 X0 Y0\nG41 D1 G01 X20. F500\nY20.\nG53 X60. Y40.\nG01 X0. Y40.\nG40 X-20.\n"
+    r = run_path(capsys, tmp_path, prog)
+    assert r.code == 0, r.alarm
+    g53 = next(m for m in r.moves if "G53" in m.get("tags", ()))
+    assert (g53["start"]["X"], g53["start"]["Y"]) == (15.0, 20.0) and "cancel" in g53["tags"]
+    assert (g53["end"]["X"], g53["end"]["Y"]) == (60.0, 40.0)
+    after = r.moves[r.moves.index(g53) + 1]
+    assert "comp" in after["tags"] and (after["end"]["X"], after["end"]["Y"]) == (0.0, 35.0)
+
+
+def test_g53_in_g91_keeps_g43_and_g53_alone_ends_it(capsys, tmp_path):
+    """An ignored G91 G53 cancels nothing; a G90 G53 without axis words stands still but still ends G43
+    (decision: language.md, G53)."""
+    r = run_path(capsys, tmp_path, "G10 L10 P1 R12.7\nG43 H1 Z5.\nG91 G53 Z0.\nG90 G00 Z6.\n", "--vars", "20308")
+    assert r.machine("Z") == [(17.7,), (18.7,)] and r.vars == {"20308": 43.0}
+    r = run_path(capsys, tmp_path, "G10 L10 P1 R12.7\nG43 H1 Z5.\nG53\nG00 Z7.\n", "--vars", "20308")
+    assert r.machine("Z") == [(17.7,), (7.0,)] and r.vars == {"20308": 49.0}

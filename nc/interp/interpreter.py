@@ -1148,12 +1148,17 @@ class Interpreter:
         self.last_target = self.work_position()
 
     def _g_G53(self, block: Block) -> Iterator[Event]:
-        """Machine-coordinate rapid; ignored in incremental mode but its modal codes apply (7.3.7)."""
+        """Machine-coordinate rapid; ignored in incremental mode but its modal codes apply (7.3.7).
+
+        Executed (G90), it ends length compensation / the lathe tool offset for good, also without a move,
+        so its work point is without them; radius compensation sits out this move only (N§3.6.3 note 4)."""
         if not self.state.absolute:
             return
         words = self._axis_words(block)
         if any(inc for _, inc in words.values()):
             return
+        self._end_length_offsets()
+        self.last_target = self.work_position()
         end = dict(self.position)
         for a, (w, _inc) in words.items():
             v = self.distance(w, a)
@@ -1163,12 +1168,21 @@ class Interpreter:
         mv = Move("rapid", block.line, block.text, dict(self.position), end, self.to_work(end),
                   program=self.program_name, plane=PLANES[self.state.plane], tags=("G53",))
         self.position = end
+        self.last_target = self.work_position()
         self.unit_locked = True
-        if self.state.length_comp != 49:  # N: G53 cancels length compensation (D7)
+        mv = self._decorate(mv, exact=True)
+        mv.comp, mv.comp_radius, mv.tip = None, 0.0, 0  # state.comp stays: the next motion block restarts it
+        yield mv
+
+    def _end_length_offsets(self) -> None:
+        """G28/G30/G53: mill G43/G44 back to G49, lathe tool offset number cleared (tool number kept)."""
+        if self.profile.is_lathe:
+            self.state.tool_offset = 0  # N§3.10.1
+            self._apply_tool_offset()
+        elif self.state.length_comp != 49:
             self.state.length_comp = 49
             self.state.groups[8] = 49
             self._apply_length_comp()
-        yield self._decorate(mv, exact=True)
 
     def _reference(self, n: int) -> dict[str, float]:
         key = {1: "N2.060", 2: "N2.061", 3: "N2.062", 4: "N2.063"}[n]
@@ -1198,13 +1212,7 @@ class Interpreter:
         self.unit_locked = True
         # the offsets end at the intermediate point (N§3.5.1), also when the axes already stand at the
         # reference point; the reference move's work point is therefore without them
-        if self.profile.is_lathe:
-            self.state.tool_offset = 0  # G28/G30 clear the tool offset number (N§3.10.1)
-            self._apply_tool_offset()
-        elif self.state.length_comp != 49:
-            self.state.length_comp = 49
-            self.state.groups[8] = 49
-            self._apply_length_comp()
+        self._end_length_offsets()  # G28/G30 clear the tool offset number too (N§3.10.1)
         self.last_target = self.work_position()
         if end == self.position:
             return
