@@ -192,16 +192,24 @@ class Channel:
 
     def interrupt(self) -> None:
         """The MLC's M2x019 (rising edge). With M96 P_ in force and the program running, the axes
-        stop along the path from this cycle on and the interrupt program runs from where they stand;
-        otherwise (no M96, M97, not running, an interrupt already running) it does nothing."""
+        stop along the path from this cycle on and the interrupt program runs from where they stand.
+        In feed hold, an M/S/T wait or a single-block stop the trigger is latched and taken as soon
+        as the channel runs again (cycle start, the finish). Otherwise (no M96, M97, idle, M02/M30,
+        an interrupt already running) it does nothing."""
         if self.m96 is None or self._interrupt is not None or self._m96_running \
-                or self.state is not RunState.RUNNING or not self.m96.enabled():
+                or self.state not in _M96_LATCHED or not self.m96.enabled():
             return
-        self._interrupt = "pending"
+        aux = self.pending_aux
+        if aux is not None and aux.kind == "M" and aux.value in (2, 30):
+            return  # the program has ended: nothing to go back to
+        self._interrupt = "pending"  # kept through a hold, an M/S/T wait or a block stop
 
     def _interrupt_step(self) -> None:
         pl = self.planner
-        if self.state is not RunState.RUNNING:  # a reset, an alarm or a hold came first
+        if self.state in _M96_LATCHED and self.state is not RunState.RUNNING:
+            self._interrupt = "pending"  # latched; a stop begun is taken up again on resumption
+            return
+        if self.state is not RunState.RUNNING:  # a reset or an alarm came first
             self._interrupt = None
             return
         if self._interrupt == "pending":
@@ -210,6 +218,7 @@ class Channel:
                     or (act is not None and act.kind == "thread"):
                 return  # G31 and spindle-locked threads cannot stop on their path: taken after them
             pl.hold()
+            pl.end_dwell()  # a dwell is no motion to brake: the interrupt program starts at once
             self._interrupt = "stopping"
             return
         if not pl.halted:
@@ -387,6 +396,10 @@ class Channel:
         self.pending_aux = aux
         if aux.wait:
             self.state = RunState.WAIT_AUX
+
+
+# M96: where a trigger is taken (RUNNING) or kept until the channel runs again (docs/decisions/mlc.md)
+_M96_LATCHED = (RunState.RUNNING, RunState.WAIT_AUX, RunState.HOLD, RunState.BLOCK_STOP)
 
 
 def _on_path(mv: Move, latched: dict[str, float]) -> dict[str, float]:

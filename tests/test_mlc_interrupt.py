@@ -14,7 +14,7 @@ from mlc.machine import Mlc
 from nc.channel import RunState
 from nc.interp import Interpreter
 from nc.interrupt import m96_link
-from nc.motion.offline import run
+from nc.motion.offline import Stream, run
 from nc.profiles import make_profile
 from nc.store import ProgramStore
 from tests.conftest import ROOT
@@ -183,3 +183,146 @@ def test_hil_script_example_raises_m21019_mid_cut(capsys):
     taken = next(line for line in out.splitlines() if "M21019 taken" in line)
     assert 50.0 < float(taken.split("X stopped at ")[1].split()[0]) < 53.0
     assert "end: X 0.0000 Y 50.0000 Z 100.0000" in out and "alarms  none" in out
+
+
+# ---- a trigger while the channel is not moving the program (decision "latched trigger") -----------
+# line 3 cuts to X50, line 4 is an M-code / a dwell, line 5 cuts on to X100; O0050 lifts Z by 10 and back
+LATCH = ("G90 G17 G21 G94\nM96 P50\nG01 X50. F3000\n{mid}\nX100.\nM30\n"
+         "O0050\nG91 G01 Z10. F2000\nZ-10.\nM99\n")
+
+
+def drive(text: str, act, single_block: bool = False, cycles: int = 20_000, held: tuple[int, ...] = ()):
+    """Step a channel by hand: `act(n, ch)` is the MLC/operator of cycle n (hold, cycle start, trigger,
+    the finish of the M codes in `held`; every other M/S/T code is finished at once). Returns positions, lines, M3x031 per cycle, the channel and the motion config."""
+    from nc.channel import Channel
+    from nc.motion.planner import Planner
+
+    store = ProgramStore()
+    prog = store.add_text(text)[0]
+    it = Interpreter(make_profile("nc5-mill"), store=store)
+    cfg = mill_cfg()
+    ch = Channel(Planner(cfg, {"X": 0.0, "Y": 0.0, "Z": 0.0}), single_block=single_block)
+    ch.m96 = m96_link(it)
+    ch.load(it.run(prog))
+    ch.cycle_start()
+    rows, lines, active = [], [], []
+    for n in range(cycles):
+        if not ch.busy:
+            break
+        if ch.pending_aux is not None and ch.pending_aux.value not in held:
+            ch.finish_aux()
+        act(n, ch)
+        sp = ch.step()
+        rows.append(sp.positions.copy())
+        lines.append(sp.line)
+        active.append(ch.interrupt_active)
+    st = Stream(np.array(rows), np.array(lines), cfg.cycle, cfg.axes, ch.state, list(ch.alarms))
+    return st, np.array(active), ch, cfg
+
+
+def _o50_ran_from(st, active, x: float) -> np.ndarray:
+    p = st.positions
+    on = np.flatnonzero(active)
+    assert len(on) and np.allclose(p[on, 0], x, atol=1e-9) and np.allclose(p[on, 1], 0.0)
+    assert abs(p[on, 2].max() - 10.0) < 1e-4
+    assert np.allclose(p[-1], (100.0, 0.0, 0.0), atol=1e-9)  # then on to line 5's end
+    return on
+
+
+def test_trigger_while_an_m_code_waits_runs_right_after_its_finish():
+    seen: dict[str, int] = {}
+
+    def act(n, ch):
+        if ch.state is RunState.WAIT_AUX and "wait" not in seen:
+            seen["wait"] = n
+        if "wait" in seen and n == seen["wait"] + 50:
+            ch.interrupt()  # M08 still waiting for the MLC's finish
+        if "wait" in seen and n == seen["wait"] + 300:
+            seen["finish"] = n
+            ch.finish_aux()
+
+    st, active, ch, cfg = drive(LATCH.format(mid="M08"), act, held=(8,))
+    assert ch.state is RunState.FINISHED and not ch.alarms
+    on = _o50_ran_from(st, active, 50.0)
+    assert not active[:seen["finish"] + 1].any()  # nothing while the M-code waits
+    assert on[0] - seen["finish"] <= 3  # the interrupt program starts in the cycles after the finish
+    assert max(worst_ratio(st, cfg).values()) <= 1.0 + 1e-6
+
+
+def test_trigger_during_feed_hold_runs_when_cycle_start_resumes():
+    seen: dict[str, int] = {}
+
+    def act(n, ch):
+        if n == 600:
+            ch.feed_hold()  # on line 3, X ≈ 20
+        if n == 1200:
+            ch.interrupt()  # standing in feed hold
+        if n == 1500:
+            seen["x"] = float(ch.planner.position[0])
+            ch.cycle_start()
+
+    st, active, ch, cfg = drive(LATCH.format(mid="M08"), act)
+    assert ch.state is RunState.FINISHED and not ch.alarms
+    assert 10.0 < seen["x"] < 40.0 and not active[:1501].any()
+    on = _o50_ran_from(st, active, seen["x"])  # from where the hold left the axes, not further on
+    assert on[0] - 1500 <= 3
+    # M99: line 3 goes on from the hold point to X50, then M08 and line 5
+    after = st.lines[on[-1] + 1:]
+    assert abs(st.positions[on[-1] + 1:][after == 3][:, 0].max() - 50.0) < 1e-6
+    assert max(worst_ratio(st, cfg).values()) <= 1.0 + 1e-6
+
+
+def test_trigger_at_a_single_block_stop_runs_at_the_next_cycle_start():
+    seen: dict[str, int] = {}
+
+    def act(n, ch):
+        if ch.state is RunState.BLOCK_STOP:
+            if abs(ch.planner.position[0] - 50.0) < 1e-9 and "trigger" not in seen:
+                seen["trigger"] = n  # stopped after line 3 (X50)
+                ch.interrupt()
+            elif n >= seen.get("trigger", n) + 200:
+                seen.setdefault("start", n)
+                ch.cycle_start()
+
+    st, active, ch, cfg = drive(LATCH.format(mid="G04 X0.5"), act, single_block=True)
+    assert ch.state is RunState.FINISHED and not ch.alarms
+    on = _o50_ran_from(st, active, 50.0)
+    assert not active[:seen["start"] + 1].any() and on[0] - seen["start"] <= 3
+    assert max(worst_ratio(st, cfg).values()) <= 1.0 + 1e-6
+
+
+def test_trigger_during_a_dwell_runs_at_once_and_the_dwell_runs_again_whole():
+    seen: dict[str, int] = {}
+
+    def act(n, ch):
+        act_b = ch.planner.active
+        if act_b is not None and act_b.kind == "dwell" and "dwell" not in seen:
+            seen["dwell"] = n
+        if "dwell" in seen and n == seen["dwell"] + 200:  # 0.2 s into the 0.5 s dwell
+            ch.interrupt()
+
+    st, active, ch, cfg = drive(LATCH.format(mid="G04 X0.5"), act)
+    assert ch.state is RunState.FINISHED and not ch.alarms
+    on = _o50_ran_from(st, active, 50.0)
+    assert on[0] - (seen["dwell"] + 200) <= 3  # no waiting the dwell out
+    # after M99 the dwell runs its full 0.5 s at X50 before line 5 moves
+    rest = st.positions[on[-1] + 1:, 0]
+    still = np.flatnonzero(np.abs(rest - 50.0) > 1e-9)[0]
+    assert abs(still * st.cycle - 0.5) <= 3 * st.cycle
+    assert max(worst_ratio(st, cfg).values()) <= 1.0 + 1e-6
+
+
+def test_trigger_latched_after_m97_or_at_m30_does_nothing():
+    def act(n, ch):
+        if ch.state is RunState.WAIT_AUX:
+            ch.interrupt()  # every cycle an M-code (M08, then M30) waits
+            if n % 100 == 0:
+                ch.finish_aux()
+
+    for text in (LATCH.format(mid="M97\nM08"), LATCH.format(mid="M08")):
+        st, active, ch, _ = drive(text, act, held=(8, 30))  # the second: M08's wait latches, M30's ignores
+        assert ch.state is RunState.FINISHED and not ch.alarms
+        if "M97" in text:
+            assert not active.any() and st.positions[:, 2].max() == 0.0
+        else:
+            assert np.flatnonzero(np.diff(active.astype(int)) == 1).size == 1  # once, after M08 only

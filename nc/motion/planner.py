@@ -240,6 +240,12 @@ class Planner:
             self.held = False
             self._replan()
 
+    def end_dwell(self) -> None:
+        """Held: a dwell in progress ends now instead of running out (the M96 interrupt; the
+        dwell's block stays queued, so it can run again whole)."""
+        if self.held and self.plan is not None and self.plan.kind == "dwell":
+            self.plan, self._buf_pos, self._buf_i = None, None, 0
+
     def stop(self) -> None:
         """Reset: controlled stop along the path, then flush the queue once at rest."""
         self._stopping = True
