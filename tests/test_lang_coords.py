@@ -273,3 +273,18 @@ def test_g53_in_g91_keeps_g43_and_g53_alone_ends_it(capsys, tmp_path):
     assert r.machine("Z") == [(17.7,), (18.7,)] and r.vars == {"20308": 43.0}
     r = run_path(capsys, tmp_path, "G10 L10 P1 R12.7\nG43 H1 Z5.\nG53\nG00 Z7.\n", "--vars", "20308")
     assert r.machine("Z") == [(17.7,), (7.0,)] and r.vars == {"20308": 49.0}
+
+
+def test_g28_suspends_radius_compensation_and_the_next_motion_block_restores_it(capsys, tmp_path):
+    """N§3.5.1 and the G41/G42 note 4 (both manuals): under G41 a G28 goes to its intermediate point
+    and the reference point without compensation, and the next motion block starts it again (G01 to
+    X0 Y40 heads +Y from the reference point X0 Y0, so G41 puts it at X-5); it is not a G40."""
+    prog = "G10 L12 P1 R5.\nG90 G00 X0 Y0\nG41 D1 G01 X20. F500\nY20.\nG28 X60. Y40.\nG01 X0. Y40.\nG40 X-20.\n"
+    r = run_path(capsys, tmp_path, prog)
+    assert r.code == 0, r.alarm
+    ref = next(m for m in r.moves if "reference" in m.get("tags", ()))
+    mid = next(m for m in r.moves if "intermediate" in m.get("tags", ()))
+    assert (mid["end"]["X"], mid["end"]["Y"]) == (60.0, 40.0)  # the intermediate point itself, uncompensated
+    assert (ref["end"]["X"], ref["end"]["Y"]) == (0.0, 0.0)  # N2.060 reference point (0 on this profile)
+    after = r.moves[r.moves.index(ref) + 1]
+    assert "comp" in after["tags"] and (after["end"]["X"], after["end"]["Y"]) == (-5.0, 40.0)

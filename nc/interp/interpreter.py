@@ -1199,8 +1199,8 @@ class Interpreter:
         tag = "G28" if ref == 1 else f"G30P{ref}"
         mid = dict(self.position)
         mid.update(via)
-        if self.state.comp != 40:
-            self.state.comp = 40  # G28/G30 cancel radius compensation for this block (L)
+        # Radius compensation sits out the return (its moves carry none) and the next motion block
+        # restarts it (N§3.5.1, N§3.9 note 4; L§2.1 G28): state.comp stays.
         if mid != self.position:
             mv = Move("rapid", block.line, block.text, dict(self.position), dict(mid), self.to_work(mid),
                       program=self.program_name, plane=PLANES[self.state.plane], tags=(tag, "intermediate"))
