@@ -100,23 +100,8 @@ AT_100 = 1000.0 * 200.0 / (math.pi * 100.0)
 def run_phases(text: str, params: dict[str, float] | None = None):
     """Run on the default lathe with the Delta lathe MLC (M03 waits for speed reached); per cycle
     (value of the pending aux or -1, X command, drive's commanded rpm)."""
-    bench = default_lathe()
-    bench.params.update(params or {})
-    runner = BenchRunner(bench, SimLink(sim_slaves(bench), bench.cycle), mlc=build_mlc(bench, "lathe"))
-    sc = bench.spindles[0].scaling
-    rows = []
-
-    def grab(r):
-        ch = r.channel
-        if ch is not None:
-            aux = ch.pending_aux
-            rows.append((aux.value if aux is not None else -1.0, r._commands[0],
-                         sc.counts_per_s_to_rpm(r.rx[2].target_velocity)))
-
-    runner.on_cycle = grab
-    result = runner.run_program(parse_program(text))
-    assert result.ok, result.alarms
-    return np.array(rows)
+    rows, _ = run_override(text, 100, params)
+    return rows[:, :3]
 
 
 def spinning(rows):
