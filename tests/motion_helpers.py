@@ -7,7 +7,7 @@ import math
 import numpy as np
 
 from nc.motion import AxisLimits, MotionConfig
-from nc.motion.offline import Stream
+from nc.motion.offline import Stream, run
 from nc.moves import Move
 
 AX = ("X", "Y", "Z")
@@ -60,3 +60,16 @@ def jagged_polyline(n: int = 300, seed: int = 1) -> list[np.ndarray]:
         p = p + d * rng.uniform(0.01, 0.1)
         pts.append(p)
     return pts
+
+
+TOL = 1.0 + 1e-6
+
+
+def check(moves, cfg: MotionConfig, start=(0.0, 0.0, 0.0)) -> Stream:
+    """Run moves offline; the program must finish without an alarm and every cycle's finite-difference
+    velocity, acceleration and jerk stay within the axis limits."""
+    st = run(moves, cfg, dict(zip(AX, start)))
+    assert st.state.value == "finished" and not st.alarms
+    r = worst_ratio(st, cfg)
+    assert r["v"] <= TOL and r["a"] <= TOL and r["j"] <= TOL, r
+    return st

@@ -14,26 +14,16 @@ from hypothesis import given, settings
 from hypothesis import strategies as hst
 
 from nc.motion.lookahead import backward
-from nc.motion.offline import run
 from nc.motion.planner import Planner
 from nc.motion.smoothing import PositionFilter
-from tests.motion_helpers import AX, arc, circle_chords, jagged_polyline, lines, mill_cfg, worst_ratio
+from tests.motion_helpers import AX, arc, check, circle_chords, jagged_polyline, lines, mill_cfg
 
-TOL = 1.0 + 1e-6
 SQUARE = [(0, 0, 0), (10, 0, 0), (10, 10, 0), (0, 10, 0), (0, 0, 0)]
 
 
 def filtered(ms: float = 16.0, tol: float | None = None, **kw):
     return mill_cfg(filter_time=ms / 1000.0, filter_scurve=ms / 1000.0, path_tolerance=tol,
                     min_segment_cycles=0.25, **kw)
-
-
-def check(moves, cfg, start=(0.0, 0.0, 0.0)):
-    st = run(moves, cfg, dict(zip(AX, start)))
-    assert st.state.value == "finished" and not st.alarms
-    r = worst_ratio(st, cfg)
-    assert r["v"] <= TOL and r["a"] <= TOL and r["j"] <= TOL, r
-    return st
 
 
 def cam_curve(n: int = 1500) -> list[tuple[float, float, float]]:

@@ -10,18 +10,7 @@ import pytest
 
 from nc.motion.offline import run
 from nc.motion.profile import solve_position
-from tests.motion_helpers import AX, arc, circle_chords, jagged_polyline, lines, mill_cfg, worst_ratio
-
-TOL = 1.0 + 1e-6
-
-
-def check(moves, cfg, start=(0.0, 0.0, 0.0)):
-    st = run(moves, cfg, dict(zip(AX, start)))
-    assert st.state.value == "finished" and not st.alarms
-    r = worst_ratio(st, cfg)
-    assert r["v"] <= TOL and r["a"] <= TOL and r["j"] <= TOL, r
-    return st
-
+from tests.motion_helpers import arc, check, circle_chords, jagged_polyline, lines, mill_cfg, worst_ratio
 
 def test_corners_and_reversals_end_exactly():
     pts = [(0, 0, 0), (10, 0, 0), (10, 10, 0), (0, 10, 0), (0, 0, 0), (20, 5, 0), (0, 0, 0), (10, 0, 0), (0, 0, 0)]

@@ -110,11 +110,11 @@ def _phases(pr) -> tuple[list, list, list, list, list]:
     return t0, p, v, a, j
 
 
-def solve_position(p0: float, v0: float, a0: float, p1: float, v1: float, v_max: float, a_max: float,
-                   j_max: float) -> Piecewise | None:
-    """Time-optimal 1-DoF profile (p0, v0, a0) → (p1, v1, 0); None when ruckig cannot solve it."""
+def _one_dof(interface: ControlInterface, p0: float, v0: float, a0: float, p1: float, v1: float,
+             v_max: float, a_max: float, j_max: float) -> tuple[Ruckig, InputParameter]:
+    """The pooled 1-DoF calculator with its input set: (p0, v0, a0) → (p1, v1, 0) within the limits."""
     otg, inp = _calc(1)
-    inp.control_interface = ControlInterface.Position
+    inp.control_interface = interface
     inp.synchronization = Synchronization.Time
     inp.current_position = [p0]
     inp.current_velocity = [v0]
@@ -122,9 +122,16 @@ def solve_position(p0: float, v0: float, a0: float, p1: float, v1: float, v_max:
     inp.target_position = [p1]
     inp.target_velocity = [v1]
     inp.target_acceleration = [0.0]
-    inp.max_velocity = [max(v_max, 1e-9)]
+    inp.max_velocity = [v_max]
     inp.max_acceleration = [a_max]
     inp.max_jerk = [j_max]
+    return otg, inp
+
+
+def solve_position(p0: float, v0: float, a0: float, p1: float, v1: float, v_max: float, a_max: float,
+                   j_max: float) -> Piecewise | None:
+    """Time-optimal 1-DoF profile (p0, v0, a0) → (p1, v1, 0); None when ruckig cannot solve it."""
+    otg, inp = _one_dof(ControlInterface.Position, p0, v0, a0, p1, v1, max(v_max, 1e-9), a_max, j_max)
     traj = Trajectory(1)
     try:
         ok = otg.calculate(inp, traj) in _OK
@@ -144,18 +151,7 @@ def solve_position(p0: float, v0: float, a0: float, p1: float, v1: float, v_max:
 
 def solve_velocity(p0: float, v0: float, a0: float, v1: float, a_max: float, j_max: float) -> Piecewise:
     """Jerk-limited change of velocity to v1 (ends with a = 0), e.g. a feed hold or override ramp."""
-    otg, inp = _calc(1)
-    inp.control_interface = ControlInterface.Velocity
-    inp.synchronization = Synchronization.Time
-    inp.current_position = [p0]
-    inp.current_velocity = [v0]
-    inp.current_acceleration = [a0]
-    inp.target_position = [p0]
-    inp.target_velocity = [v1]
-    inp.target_acceleration = [0.0]
-    inp.max_velocity = [max(abs(v0), abs(v1), 1e-9)]
-    inp.max_acceleration = [a_max]
-    inp.max_jerk = [j_max]
+    otg, inp = _one_dof(ControlInterface.Velocity, p0, v0, a0, p0, v1, max(abs(v0), abs(v1), 1e-9), a_max, j_max)
     traj = Trajectory(1)
     if otg.calculate(inp, traj) not in _OK:
         raise NcAlarm(0x0000, f"velocity ramp {v0:g} → {v1:g} mm/s cannot be planned")
