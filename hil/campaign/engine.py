@@ -1,0 +1,121 @@
+"""Running a campaign's cases: serially in this process, or on Dask — a local cluster of one
+worker process per core by default, or an existing cluster given by its scheduler address.
+
+Dask does the distribution: a worker that dies has its case rescheduled on another one, and a
+case that has lost `retries` workers comes back as `KilledWorker`, which becomes a `worker_lost`
+row. A case never aborts the campaign: every outcome is a row.
+"""
+
+from __future__ import annotations
+
+import socket
+import sys
+import time
+from collections.abc import Callable, Iterator, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+from hil.campaign.inputs import CaseInputs
+from hil.campaign.worker import lost_row, run_case
+
+
+@dataclass
+class Engine:
+    scheduler: str | None = None  # tcp://HOST:PORT of an existing cluster; None = a local cluster
+    workers: int | None = None  # local cluster size (default: one per core); 0 = serially, in process
+    retries: int = 3
+
+
+def run_cases(cases: Sequence[CaseInputs], engine: Engine) -> Iterator[dict[str, Any]]:
+    """Rows as cases finish, in completion order."""
+    if not cases:
+        return iter(())
+    if engine.workers == 0 and engine.scheduler is None:
+        return (run_case(c) for c in cases)
+    return _dask(cases, engine)
+
+
+def _dask(cases: Sequence[CaseInputs], engine: Engine) -> Iterator[dict[str, Any]]:
+    import dask
+    from distributed import Client, LocalCluster, as_completed
+    from distributed.client import FutureCancelledError
+
+    with dask.config.set({"distributed.scheduler.allowed-failures": engine.retries - 1,
+                          "distributed.worker.daemon": False,  # a worker may start its own processes
+                          "distributed.admin.system-monitor.gil.enabled": False}):
+        cluster = None
+        if engine.scheduler is None:
+            import os
+
+            n = engine.workers or os.cpu_count() or 1
+            cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
+                                   host="127.0.0.1", silence_logs=50)
+        client = Client(cluster if cluster is not None else engine.scheduler, timeout="30s")
+        try:
+            # The scheduler decides when a case has lost too many workers; on a cluster that is not
+            # ours it has its own setting, so the campaign's `retries` is set there too.
+            client.run_on_scheduler(_allow_failures, engine.retries - 1)
+            by_key = {}
+            futures = []
+            for c in cases:
+                # pure=False: a rerun is a new computation, never a cached result
+                f = client.submit(run_case, c, key=f"case-{c.input_hash}-{time.monotonic_ns()}", pure=False)
+                by_key[f.key] = c
+                futures.append(f)
+            for f in as_completed(futures):
+                case = by_key[f.key]
+                try:
+                    yield f.result()
+                except (FutureCancelledError, Exception) as exc:  # KilledWorker after `retries` lost workers
+                    yield lost_row(case, f"{type(exc).__name__}: {exc}", engine.retries)
+                finally:
+                    f.release()
+        finally:
+            client.close()
+            if cluster is not None:
+                cluster.close()
+
+
+def _allow_failures(n: int, dask_scheduler=None) -> None:
+    dask_scheduler.allowed_failures = n
+
+
+class Progress:
+    """`cases 12/40  failed 2  ETA 0:45` on stderr: redrawn in place on a terminal, a line at most
+    every `every` seconds otherwise (CI logs), nothing when quiet."""
+
+    def __init__(self, total: int, quiet: bool = False, every: float = 10.0,
+                 clock: Callable[[], float] = time.monotonic) -> None:
+        self.total, self.quiet, self.every, self.clock = total, quiet, every, clock
+        self.done = self.failed = 0
+        self.t0 = self.clock()
+        self.last = -1e9
+        self.tty = sys.stderr.isatty()
+
+    def line(self) -> str:
+        elapsed = self.clock() - self.t0
+        eta = "--"
+        if self.done:
+            left = elapsed / self.done * (self.total - self.done)
+            eta = f"{int(left // 60)}:{int(left % 60):02d}"
+        return f"cases {self.done}/{self.total}  failed {self.failed}  ETA {eta}"
+
+    def update(self, row: dict[str, Any]) -> None:
+        self.done += 1
+        self.failed += row.get("status") != "completed"
+        if self.quiet:
+            return
+        now = self.clock()
+        if self.tty:
+            print("\r" + self.line() + "   ", end="", file=sys.stderr, flush=True)
+        elif now - self.last >= self.every or self.done == self.total:
+            print(self.line(), file=sys.stderr, flush=True)
+            self.last = now
+
+    def close(self) -> None:
+        if self.tty and not self.quiet:
+            print(file=sys.stderr)
+
+
+def host() -> str:
+    return socket.gethostname()

@@ -1,0 +1,103 @@
+"""One campaign from file to results: expand the cases, skip those already done (by input hash),
+run the rest, journal each row as it lands, then write results.parquet, the per-run traces and
+reports, and summary.html."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from hil.campaign.engine import Engine, Progress, run_cases
+from hil.campaign.inputs import gather
+from hil.campaign.matrix_html import matrix_page
+from hil.campaign.results import RESULTS, Journal, report_dir, to_table, trace_dir, write_atomic
+from hil.campaign.spec import load_campaign
+
+
+@dataclass
+class CampaignOutcome:
+    rows: list[dict[str, Any]] = field(default_factory=list)
+    skipped: int = 0  # cases whose result was already there (resume)
+    interrupted: bool = False
+    results: Path | None = None
+
+    @property
+    def ok(self) -> bool:
+        return not self.interrupted and all(r["status"] == "completed" for r in self.rows)
+
+    def counts(self) -> dict[str, int]:
+        out: dict[str, int] = {}
+        for r in self.rows:
+            out[r["status"]] = out.get(r["status"], 0) + 1
+        return out
+
+
+def run_campaign(path: str | Path, out: str | Path, engine: Engine | None = None, *, rerun: bool = False,
+                 quiet: bool = True, reports: bool = True) -> CampaignOutcome:
+    """Raises CampaignFileError (an InputError) for a bad campaign file, naming the field."""
+    campaign = load_campaign(path)
+    engine = engine or Engine()
+    engine.retries = campaign.retries
+    cases = gather(campaign)
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    journal = Journal(out)
+    previous = {} if rerun else journal.previous()
+    wanted = {c.input_hash for c in cases}
+    outcome = CampaignOutcome()
+    kept = [previous[h] for h in wanted if h in previous and previous[h]["status"] != "worker_lost"]
+    todo = [c for c in cases if c.input_hash not in {r["input_hash"] for r in kept}]
+    outcome.skipped = len(kept)
+    outcome.rows = list(kept)
+    progress = Progress(len(todo), quiet)
+    try:
+        for row in run_cases(todo, engine):
+            trace_bytes = row.pop("_trace_bytes", None)
+            if trace_bytes is not None:
+                folder = trace_dir(out, row)
+                folder.mkdir(parents=True, exist_ok=True)
+                (folder / "trace.parquet").write_bytes(trace_bytes)
+                row["trace"] = (folder / "trace.parquet").relative_to(out).as_posix()
+            journal.append(row)
+            outcome.rows.append(row)
+            progress.update(row)
+    except KeyboardInterrupt:
+        outcome.interrupted = True
+    finally:
+        progress.close()
+    outcome.rows = [r for r in outcome.rows if r["input_hash"] in wanted]
+    outcome.results = out / RESULTS
+    write_atomic(to_table(outcome.rows), outcome.results)
+    journal.close(remove=not outcome.interrupted)
+    if reports:
+        _reports(out, outcome.rows)
+    page = matrix_page(f"campaign {campaign.name}", outcome.rows, out)
+    _write_text(out / "summary.html", page)
+    return outcome
+
+
+def _reports(out: Path, rows: list[dict[str, Any]]) -> None:
+    """A report for each kept trace, in DIR/reports/<input hash>/ (not beside the trace: the traces
+    folder is a Parquet dataset and must hold nothing else), for the matrix to link to."""
+    from hil.report import write_report
+
+    for r in rows:
+        if not r.get("trace"):
+            continue
+        trace = out / r["trace"]
+        target = out / report_dir(r)
+        if trace.exists() and not (target / "index.html").exists():
+            try:
+                write_report(trace, target, title=f"{r['program']} on {r['bench']}")
+            except Exception as exc:  # a report is a convenience: the row and trace stand without it
+                _write_text(target / "index.html", f"<p>report failed: {exc}</p>")
+
+
+def _write_text(path: Path, text: str) -> None:
+    import os
+
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(f".{path.name}.tmp")
+    tmp.write_text(text, encoding="utf-8")
+    os.replace(tmp, path)

@@ -1,0 +1,39 @@
+"""A case's bench: the bench file as written, with the case's variant applied — the campaign's
+[params] sweep values, its [checks] in place of the bench's own, its max_time and the bus."""
+
+from __future__ import annotations
+
+import json
+from typing import Any
+
+from hil.bench import Bench
+from hil.bench_file import BenchFileError, _checks, _Reader, parse_bench
+from hil.campaign.spec import Case
+
+
+def apply_variant(text: str, source: str, case: Case | Any, checks: dict[str, Any] | str | None,
+                  max_time: float | None) -> Bench:
+    """`case` is a Case or CaseInputs (both carry bus, params, events); raises BenchFileError."""
+    bench = parse_bench(text, source)
+    bench.bus = case.bus
+    for name, value in case.params:
+        bench.params[name] = value
+    if max_time is not None:
+        bench.max_time = max_time
+    if isinstance(checks, str):
+        checks = json.loads(checks) if checks else None
+    if checks is not None:
+        r = _Reader()
+        bench.checks = _checks(r, checks, tuple(bench.axis_names))
+        if r.errors:
+            raise BenchFileError(f"{source} with the campaign's [checks]", r.errors)
+    if case.events:
+        from hil.run_events import EventSpecError, parse_event
+
+        for e in case.events:
+            try:
+                parse_event(e, bench.axis_names)
+            except EventSpecError as exc:
+                raise BenchFileError(f"{source}, fault {case.fault!r}" if hasattr(case, "fault") else source,
+                                     [str(exc)]) from None
+    return bench

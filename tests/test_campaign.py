@@ -1,0 +1,239 @@
+"""`hil campaign`: a matrix of lock-step runs on Dask (issue 21).
+
+The test campaign (tests/data/campaign/campaign.toml) is 2 programs × 3 feed overrides × 2 fault
+variants on one lathe bench, plus a listed case whose program calls a subprogram beside it: 13
+cases, among them a program alarm (unknown G code on line 4) and an injected E-stop.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import signal
+import socket
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pyarrow.parquet as pq
+import pytest
+
+pytest.importorskip("distributed")
+
+DATA = Path(__file__).parent / "data" / "campaign"
+ROOT = Path(__file__).resolve().parents[1]
+NONDETERMINISTIC = ("wall_s", "worker", "attempts", "trace")
+ENV = {**os.environ, "PYTHONPATH": os.pathsep.join(p for p in (str(ROOT), os.environ.get("PYTHONPATH")) if p)}
+
+
+def hil(*argv: str, cwd: Path | None = None, timeout: float = 240) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "hil.cli", *argv], capture_output=True, text=True, env=ENV,
+                          cwd=cwd, timeout=timeout)
+
+
+def rows(out: Path) -> list[dict]:
+    return pq.read_table(out / "results.parquet").drop(list(NONDETERMINISTIC)).to_pylist()
+
+
+@pytest.fixture(scope="module")
+def serial(tmp_path_factory) -> Path:
+    out = tmp_path_factory.mktemp("serial")
+    p = hil("campaign", str(DATA / "campaign.toml"), "--out", str(out), "--workers", "0", "--quiet")
+    assert p.returncode == 1, p.stdout + p.stderr  # alarms in the matrix: the campaign is not all green
+    return out
+
+
+def by_case(rs: list[dict]) -> dict[tuple, dict]:
+    return {(r["program"], r["override"], r["fault"]): r for r in rs}
+
+
+def test_serial_results_are_one_row_per_case_with_what_each_run_did(serial):
+    rs = rows(serial)
+    assert len(rs) == 13
+    cases = by_case(rs)
+    for ov in (50.0, 100.0, 150.0):
+        ok = cases[("short_turn.nc", ov, "none")]
+        assert ok["status"] == "completed" and ok["alarm"] is None
+        assert ok["max_ferr_X"] < 0.2 and 0 < ok["peak_v_share_X"] <= 1.0 and ok["peak_j_share_Z"] <= 1.0
+        bad = cases[("bad_code.nc", ov, "none")]
+        assert (bad["status"], bad["alarm"], bad["alarm_line"]) == ("alarm", "0x021D", 4)
+        stop = cases[("short_turn.nc", ov, "estop")]
+        assert (stop["status"], stop["alarm"]) == ("alarm", "0x0401")  # E-stop relay M2x013, App. A
+        assert stop["program_time_s"] < cases[("short_turn.nc", ov, "none")]["program_time_s"]
+    # feed override stretches the feed moves: 50 % is slower than 100 %, which is slower than 150 %
+    t = [cases[("short_turn.nc", ov, "none")]["program_time_s"] for ov in (50.0, 100.0, 150.0)]
+    assert t[0] > t[1] > t[2]
+    sub = cases[("with_sub.nc", 100.0, "none")]
+    assert sub["status"] == "completed" and sub["program_time_s"] > 0.3  # O0104 was found and run
+    assert {r["deltahil_version"] for r in rs} and all(len(r["input_hash"]) == 20 for r in rs)
+
+
+def test_local_cluster_gives_the_serial_results_bit_for_bit(serial, tmp_path):
+    p = hil("campaign", str(DATA / "campaign.toml"), "--out", str(tmp_path), "--workers", "2")
+    assert p.returncode == 1, p.stderr
+    assert rows(tmp_path) == rows(serial)
+    assert "cases 13/13" in p.stderr and "completed 4" in p.stdout
+
+
+def test_resume_skips_finished_cases_and_rerun_runs_them_again(serial, tmp_path):
+    out = tmp_path / "c"
+    shutil.copytree(serial, out)
+    t_before = pq.read_table(out / "results.parquet").column("wall_s").to_pylist()
+    p = hil("campaign", str(DATA / "campaign.toml"), "--out", str(out), "--workers", "0", "--quiet")
+    assert "13 already done, 0 run" in p.stdout
+    assert pq.read_table(out / "results.parquet").column("wall_s").to_pylist() == t_before
+    p = hil("campaign", str(DATA / "campaign.toml"), "--out", str(out), "--workers", "0", "--quiet", "--rerun")
+    assert "0 already done, 13 run" in p.stdout
+    assert rows(out) == rows(serial)
+
+
+def test_diff_flags_a_changed_bench_limit(serial, tmp_path):
+    data = tmp_path / "data"
+    shutil.copytree(DATA, data)
+    bench = data / "bench.toml"
+    # a slower Z axis: the same cases take longer
+    bench.write_text(bench.read_text().replace("velocity = 400.0, acceleration = 4000.0",
+                                               "velocity = 40.0, acceleration = 400.0"))
+    p = hil("campaign", str(data / "campaign.toml"), "--out", str(tmp_path / "new"), "--workers", "0", "--quiet")
+    assert p.returncode == 1
+    d = hil("campaign", "diff", str(serial), str(tmp_path / "new"), "--html", str(tmp_path / "diff.html"))
+    assert d.returncode == 1, d.stdout + d.stderr
+    assert "REGRESSION  short_turn.nc on bench.toml: program time (s)" in d.stdout
+    assert "regressions" in d.stdout and "compared       13 cases" in d.stdout
+    assert "border:3px solid" in (tmp_path / "diff.html").read_text()
+    same = hil("campaign", "diff", str(serial), str(serial))
+    assert same.returncode == 0 and "regressions    0" in same.stdout
+
+
+@pytest.mark.parametrize("text, field", [
+    ("[campaign]\nprograms = ['nope*.nc']\nbenches = ['bench.toml']\n", "campaign.programs[0]"),
+    ("[campaign]\nprograms = ['short_turn.nc']\nbenches = ['bench.toml']\noverrides = [100, 'fast']\n",
+     "campaign.overrides[1]"),
+    ("[campaign]\nprograms = ['short_turn.nc']\nbenches = ['bench.toml']\nbuses = ['ethercat:eth0']\n",
+     "campaign.buses[0]"),
+    ("[campaign]\nprograms = ['short_turn.nc']\nbenches = ['bench.toml']\nfeeds = [1]\n", "campaign.feeds"),
+    ("[campaign]\nprograms = ['short_turn.nc']\nbenches = ['bench.toml']\n[faults]\nx = ['t=0.1:explode']\n",
+     "benches (bench.toml)"),
+    ("[campaign]\nprograms = ['short_turn.nc']\nbenches = ['bench.toml']\n[checks]\nmax_following_error = {Q = 1}\n",
+     "checks.max_following_error.Q"),
+    ("[[case]]\nprogram = 'short_turn.nc'\n", "case[0].bench"),
+    ("[campaign\n", "not valid TOML"),
+])
+def test_a_bad_campaign_file_names_the_field(tmp_path, text, field):
+    for f in DATA.iterdir():
+        shutil.copy(f, tmp_path)
+    (tmp_path / "bad.toml").write_text(text)
+    p = hil("campaign", str(tmp_path / "bad.toml"), "--out", str(tmp_path / "o"), "--workers", "0")
+    assert p.returncode == 2, p.stdout + p.stderr
+    assert field in p.stderr and "Traceback" not in p.stderr
+    assert not (tmp_path / "o" / "results.parquet").exists()
+
+
+# ---- a cluster of separate processes on loopback -------------------------------------------------------
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def _dask(*argv: str) -> subprocess.Popen:
+    return subprocess.Popen([sys.executable, "-m", "distributed.cli.dask_" + argv[0], *argv[1:]], env=ENV,
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
+
+
+@pytest.fixture
+def cluster():
+    """A scheduler and three single-threaded workers (no nanny, so a killed worker stays dead)."""
+    from distributed import Client
+
+    port = _free_port()
+    address = f"tcp://127.0.0.1:{port}"
+    procs = [_dask("scheduler", "--host", "127.0.0.1", "--port", str(port), "--no-dashboard")]
+    workers = {}
+    try:
+        time.sleep(1.0)
+        for name in ("wa", "wb", "wc"):
+            workers[name] = _dask("worker", address, "--nthreads", "1", "--no-nanny", "--no-dashboard",
+                                  "--name", name, "--host", "127.0.0.1")
+        with Client(address, timeout="30s") as client:
+            client.wait_for_workers(3, timeout=60)
+            yield address, client, workers
+    finally:
+        for p in [*workers.values(), *procs]:
+            if p.poll() is None:
+                os.killpg(p.pid, signal.SIGKILL)
+            p.wait()
+
+
+def _kill_while_busy(client, workers: dict, name: str, deadline: float = 60.0) -> bool:
+    """SIGKILL worker `name` as soon as it is running a case."""
+    end = time.monotonic() + deadline
+    while time.monotonic() < end:
+        busy = {client.scheduler_info()["workers"][w]["name"]: tasks for w, tasks in client.processing().items()
+                if w in client.scheduler_info()["workers"]}
+        if busy.get(name):
+            os.kill(workers[name].pid, signal.SIGKILL)
+            return True
+        time.sleep(0.02)
+    return False
+
+
+def test_scheduler_and_workers_as_processes_run_the_campaign_and_survive_a_killed_worker(serial, cluster,
+                                                                                       tmp_path):
+    address, client, workers = cluster
+    run = subprocess.Popen([sys.executable, "-m", "hil.cli", "campaign", str(DATA / "campaign.toml"),
+                            "--out", str(tmp_path / "r"), "--scheduler", address, "--quiet"],
+                           env=ENV, stdout=subprocess.PIPE,
+                           stderr=subprocess.PIPE, text=True)
+    assert _kill_while_busy(client, workers, "wa")
+    out, err = run.communicate(timeout=240)
+    assert run.returncode == 1, out + err
+    assert rows(tmp_path / "r") == rows(serial)  # every case completed, the killed one elsewhere
+    assert "worker_lost" not in out
+
+
+def test_a_case_that_keeps_losing_its_worker_is_marked_worker_lost(cluster, tmp_path):
+    address, client, workers = cluster
+    for f in DATA.iterdir():
+        shutil.copy(f, tmp_path)
+    text = (DATA / "campaign.toml").read_text().replace('name = "test"', 'name = "test"\nretries = 1')
+    (tmp_path / "campaign.toml").write_text(text)
+    run = subprocess.Popen([sys.executable, "-m", "hil.cli", "campaign", str(tmp_path / "campaign.toml"),
+                            "--out", str(tmp_path / "r"), "--scheduler", address, "--quiet"],
+                           env=ENV, stdout=subprocess.PIPE,
+                           stderr=subprocess.PIPE, text=True)
+    assert _kill_while_busy(client, workers, "wb")
+    out, err = run.communicate(timeout=240)
+    assert run.returncode == 1
+    rs = pq.read_table(tmp_path / "r" / "results.parquet").to_pylist()
+    assert len(rs) == 13
+    lost = [r for r in rs if r["status"] == "worker_lost"]
+    # Dask counts a lost worker against every case it held: the one running and, with the
+    # scheduler's default worker saturation (1.1 tasks a thread), possibly one queued behind it.
+    assert 1 <= len(lost) <= 2 and all("KilledWorker" in r["message"] for r in lost)
+    assert sum(r["status"] in ("completed", "alarm") for r in rs) == 13 - len(lost)
+    assert "worker_lost" in out
+
+
+def test_kept_traces_form_a_partitioned_dataset_and_canopen_runs_like_sim(tmp_path):
+    for f in DATA.iterdir():
+        shutil.copy(f, tmp_path)
+    (tmp_path / "traced.toml").write_text(
+        "[campaign]\nprograms = ['short_turn.nc']\nbenches = ['bench.toml']\nbuses = ['sim', 'canopen:virtual']\n"
+        "trace = true\n")
+    p = hil("campaign", str(tmp_path / "traced.toml"), "--out", str(tmp_path / "o"), "--workers", "0", "--quiet")
+    assert p.returncode == 0, p.stdout + p.stderr
+    rs = {r["bus"]: r for r in pq.read_table(tmp_path / "o" / "results.parquet").to_pylist()}
+    assert set(rs) == {"sim", "canopen:virtual"} and all(r["status"] == "completed" for r in rs.values())
+    # the same program on the two buses takes the same simulated time, to the cycle
+    assert rs["sim"]["program_time_s"] == pytest.approx(rs["canopen:virtual"]["program_time_s"], abs=0.005)
+    dataset = pq.read_table(tmp_path / "o" / "traces")  # Hive partitions become columns
+    assert {"program", "bench", "case"} <= set(dataset.column_names)
+    assert set(dataset.column("case").to_pylist()) == {r["input_hash"] for r in rs.values()}
+    assert set(dataset.column("program").to_pylist()) == {"short_turn.nc"}
+    for r in rs.values():
+        assert (tmp_path / "o" / r["trace"]).exists()
+        assert (tmp_path / "o" / "reports" / r["input_hash"] / "index.html").exists()
+    summary = (tmp_path / "o" / "summary.html").read_text()
+    assert "reports/" in summary and "canopen:virtual" in summary
