@@ -166,6 +166,12 @@ def cluster():
             p.wait()
 
 
+def campaign_on(address: str, campaign: Path, out: Path) -> subprocess.Popen:
+    return subprocess.Popen([sys.executable, "-m", "hil.cli", "campaign", str(campaign), "--out", str(out),
+                             "--scheduler", address, "--quiet"], env=ENV, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+
+
 def _kill_while_busy(client, workers: dict, name: str, deadline: float = 60.0) -> bool:
     """SIGKILL worker `name` as soon as it is running a case."""
     end = time.monotonic() + deadline
@@ -182,10 +188,7 @@ def _kill_while_busy(client, workers: dict, name: str, deadline: float = 60.0) -
 def test_scheduler_and_workers_as_processes_run_the_campaign_and_survive_a_killed_worker(serial, cluster,
                                                                                        tmp_path):
     address, client, workers = cluster
-    run = subprocess.Popen([sys.executable, "-m", "hil.cli", "campaign", str(DATA / "campaign.toml"),
-                            "--out", str(tmp_path / "r"), "--scheduler", address, "--quiet"],
-                           env=ENV, stdout=subprocess.PIPE,
-                           stderr=subprocess.PIPE, text=True)
+    run = campaign_on(address, DATA / "campaign.toml", tmp_path / "r")
     assert _kill_while_busy(client, workers, "wa")
     out, err = run.communicate(timeout=240)
     assert run.returncode == 1, out + err
@@ -199,10 +202,7 @@ def test_a_case_that_keeps_losing_its_worker_is_marked_worker_lost(cluster, tmp_
         shutil.copy(f, tmp_path)
     text = (DATA / "campaign.toml").read_text().replace('name = "test"', 'name = "test"\nretries = 1')
     (tmp_path / "campaign.toml").write_text(text)
-    run = subprocess.Popen([sys.executable, "-m", "hil.cli", "campaign", str(tmp_path / "campaign.toml"),
-                            "--out", str(tmp_path / "r"), "--scheduler", address, "--quiet"],
-                           env=ENV, stdout=subprocess.PIPE,
-                           stderr=subprocess.PIPE, text=True)
+    run = campaign_on(address, tmp_path / "campaign.toml", tmp_path / "r")
     assert _kill_while_busy(client, workers, "wb")
     out, err = run.communicate(timeout=240)
     assert run.returncode == 1
