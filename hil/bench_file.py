@@ -171,15 +171,18 @@ class _Reader:
         return tuple(v)
 
 
-def load_bench_file(path: str | Path) -> Bench:
-    source = str(path)
+def read_text_file(path: str | Path, error: type[BenchFileError] = BenchFileError) -> str:
+    """A TOML input's text, or `error` naming the file: unreadable, not UTF-8."""
     try:
-        text = Path(path).read_text(encoding="utf-8")
+        return Path(path).read_text(encoding="utf-8")
     except OSError as exc:
-        raise BenchFileError(source, [f"cannot be read: {exc.strerror}"]) from None
+        raise error(str(path), [f"cannot be read: {exc.strerror}"]) from None
     except UnicodeDecodeError:
-        raise BenchFileError(source, ["is not UTF-8 text"]) from None
-    return parse_bench(text, source)
+        raise error(str(path), ["is not UTF-8 text"]) from None
+
+
+def load_bench_file(path: str | Path) -> Bench:
+    return parse_bench(read_text_file(path), str(path))
 
 
 def parse_bench(text: str, source: str = "bench.toml") -> Bench:

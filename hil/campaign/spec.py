@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from hil.bench_file import BenchFileError, _Reader  # one field reader for every TOML input we take
+from hil.bench_file import BenchFileError, _Reader, read_text_file  # one field reader for every TOML input we take
 from hil.session import InputError
 
 BUSES = ("sim", "canopen:virtual")  # lock-step, in-process: what a worker can run with no hardware
@@ -79,17 +79,11 @@ def _rel(p: Path, root: Path) -> str:
 
 
 def load_campaign(path: str | Path) -> Campaign:
-    source = str(path)
-    try:
-        text = Path(path).read_text(encoding="utf-8")
-    except OSError as exc:
-        raise CampaignFileError(source, [f"cannot be read: {exc.strerror}"]) from None
-    except UnicodeDecodeError:
-        raise CampaignFileError(source, ["is not UTF-8 text"]) from None
+    text = read_text_file(path, CampaignFileError)
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
-        raise CampaignFileError(source, [f"not valid TOML: {exc}"]) from None
+        raise CampaignFileError(str(path), [f"not valid TOML: {exc}"]) from None
     return parse_campaign(data, Path(path).resolve())
 
 
