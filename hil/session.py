@@ -46,6 +46,11 @@ def load_bench(path: str | None, profile: str | None = None, bus: str | None = N
         bench = load_bench_file(path)
     else:
         bench = default_lathe()
+    return override_bench(bench, profile, bus)
+
+
+def override_bench(bench: Bench, profile: str | None = None, bus: str | None = None) -> Bench:
+    """`--profile` and `--bus` over what the bench says."""
     if profile:
         if profile not in PROFILE_NAMES:
             raise InputError(f"unknown profile {profile!r}; choose one of {', '.join(PROFILE_NAMES)}")

@@ -25,9 +25,14 @@ class BasicMlc:
     max_rpm: float = 6000.0
     log: list[tuple[int, str, float]] = field(default_factory=list)  # (cycle, code, value) handled
     cycle: int = 0
+    # Feed, rapid and spindle override (fractions): the basic MLC has no panel, so these stay as set
+    # (hil.run's feed_override … options), where the Delta MLC takes them from D2x002/D2x004/D2x026.
+    overrides: tuple[float, float, float] = (1.0, 1.0, 1.0)
 
     def scan(self, channel: Channel) -> None:
         self.cycle += 1
+        if self.overrides != (1.0, 1.0, 1.0):
+            channel.feed_override, channel.rapid_override, channel.spindle_override = self.overrides
         if channel.css_rpm is not None:  # G96: the speed command is the surface speed's rpm (as D3x024)
             self.spindle.rpm = min(channel.css_rpm, self.max_rpm)
         aux: Aux | None = channel.pending_aux

@@ -73,7 +73,11 @@ def load_rows(path: str | Path) -> list[dict[str, Any]]:
     p = Path(path)
     if p.is_dir():
         p = p / "results.parquet"
-    return pq.read_table(p).to_pylist()
+    table = pq.read_table(p)
+    missing = [c for c in (*KEY_COLUMNS, "status") if c not in table.column_names]
+    if missing:
+        raise ValueError(f"no {', '.join(missing)} column{'s' if len(missing) > 1 else ''}")
+    return table.to_pylist()
 
 
 def diff(base: list[dict[str, Any]], new: list[dict[str, Any]], tol: Tolerances) -> Diff:

@@ -14,7 +14,7 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
-from hil.campaign.spec import Campaign, Case
+from hil.campaign.spec import Campaign
 
 # An O-numbered program file as NC5 names it (nc/store.py): O1, O0001, O0001.NC …
 _O_FILE = re.compile(r"^O\d{1,5}(\.(nc|txt|ngc))?$", re.IGNORECASE)

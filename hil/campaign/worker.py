@@ -70,8 +70,10 @@ def _execute(case: CaseInputs, scratch: Path) -> dict[str, Any]:
     mlc = where.get(case.mlc, case.mlc) if case.mlc else None
     result = hil_run(where[case.program], bench=bench, trace=str(trace), mlc=mlc, events=case.events,
                      libs=[where[x] for x in case.libs], feed_override=case.override,
-                     rapid_override=case.rapid_override, spindle_override=case.spindle_override,
-                     allow_unfired=True)
+                     rapid_override=case.rapid_override, spindle_override=case.spindle_override)
+    if result.runner is None:  # the program could not be read or parsed
+        a = result.alarms[0]
+        return {"status": "alarm", "alarm": f"0x{a.code:04X}", "alarm_line": a.line, "message": a.message[:500]}
     out: dict[str, Any] = {"program_time_s": result.program_time, "sim_time_s": result.sim_time,
                            "cycles": result.cycles}
     for axis, v in result.max_following_error.items():

@@ -3,22 +3,14 @@
 from __future__ import annotations
 
 import argparse
-import os
 import sys
-import tempfile
-from pathlib import Path
 
 from hil.bench import Bench
 from hil.cli import EXIT_ALARM, EXIT_OK, EXIT_USAGE
-from hil.clock import make_clock
-from hil.progress import Progress, wants_progress
-from hil.remote_io import attach_remote_io
-from hil.run_events import EventPlayer, EventSpecError, parse_events
-from hil.runner import BenchRunner, RunResult
-from hil.scripting import mlc_setup
-from hil.session import InputError, load_bench, load_program, make_link, print_alarm
-from hil.trace import open_trace
-from nc.alarms import NcAlarm
+from hil.progress import wants_progress
+from hil.run_events import EventPlayer
+from hil.runner import RunResult
+from hil.session import InputError, print_alarm
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -53,128 +45,50 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="G10 L40/L41 servo parameters go over this RS-485 port (Modbus RTU, station = I) "
                         "instead of SDO on the bench's bus")
     p.add_argument("--servo-baud", type=int, default=38400, help="baud rate of --servo-modbus (default 38400)")
+    p.add_argument("--feed-override", type=float, default=100.0, metavar="PERCENT",
+                   help="feed override switch at power-on, 0–150 %% (D2x002; default 100)")
+    p.add_argument("--rapid-override", type=float, default=100.0, metavar="PERCENT",
+                   help="rapid override switch at power-on, 0–100 %% (D2x004; default 100)")
+    p.add_argument("--spindle-override", type=float, default=100.0, metavar="PERCENT",
+                   help="spindle override switch at power-on, 50–120 %% (D2x026; default 100)")
     p.set_defaults(func=cmd_run)
 
 
 def cmd_run(args: argparse.Namespace) -> int:
-    if not 0.0 <= args.m00_resume < float("inf"):
-        print(f"hil run: --m00-resume {args.m00_resume:g}: seconds must be >= 0", file=sys.stderr)
-        return EXIT_USAGE
-    try:
-        bench = load_bench(args.bench, args.profile, args.bus)
-    except InputError as exc:
-        print(f"hil run: {exc}", file=sys.stderr)
-        return EXIT_USAGE
-    try:
-        program = load_program(args.program, args.lib)
-    except NcAlarm as exc:
-        print_alarm(exc.alarm)
-        return EXIT_ALARM
-    except InputError as exc:  # a --lib that is neither file nor folder
-        print(f"hil run: {exc}", file=sys.stderr)
-        return EXIT_USAGE
-    try:
-        link = make_link(bench)
-    except InputError as exc:
-        print(f"hil run: {exc}", file=sys.stderr)
-        return EXIT_USAGE
-    if args.overrun:
-        bench.realtime.overrun = args.overrun
-    clock = make_clock(bench.cycle, args.realtime, bench.realtime)
-    progress = None
-    if wants_progress(args.progress):
-        progress = Progress(max((b.line for b in program.blocks), default=1))
-    wants_events = bool(args.at or args.events)
-    try:  # the MLC, its operator panel and --trace-signals columns (issue 8)
-        mlc, panel, signal_sources = mlc_setup(bench, args.mlc, args.trace_signals, args.m00_resume, wants_events)
-    except InputError as exc:
-        print(f"hil run: {exc}", file=sys.stderr)
-        return EXIT_USAGE
-    attach_remote_io(bench, mlc, link)  # [[io]] stations → X/Y devices (issue 8)
-    player = None
-    if wants_events:  # --at / --events: timed pokes at MLC devices (hil/run_events.py)
-        try:
-            player = make_player(args, bench, mlc, link, panel, signal_sources)
-        except EventSpecError as exc:
-            print(f"hil run: {exc}", file=sys.stderr)
-            return EXIT_USAGE
-    runner = BenchRunner(bench, link, None, mlc, player or panel, clock=clock, progress=progress)
-    runner.trace_sources += signal_sources
-    if player is not None:
-        runner.trace_sources.append(player)
-    # Extra trace columns (e.g. the MLC's --trace-signals) are TraceSources appended here,
-    # before the trace is opened with the runner's columns.
-    trace_path = args.trace
-    want_checks = bench.checks.any and args.check is not False
-    if want_checks and not trace_path:
-        trace_path = _temp_trace()  # checks read a trace; keep it only if asked for
-    if trace_path:
-        try:
-            runner.trace = open_trace(trace_path, runner.trace_columns())
-        except OSError as exc:
-            print(f"hil run: cannot write trace {trace_path}: {exc.strerror}", file=sys.stderr)
-            return EXIT_USAGE
-    if args.servo_modbus:  # G10 L40/L41 over the drives' RS-485 port (issue 8)
-        import serial
+    """`hil run` prints what `hil.run` returns; the run itself is the library's (hil/api.py)."""
+    from hil.api import run
 
-        from fieldbus.modbus import ModbusRtuMaster
-        try:
-            runner.servo_modbus = ModbusRtuMaster.open(args.servo_modbus, baudrate=args.servo_baud)
-        except (serial.SerialException, OSError) as exc:
-            print(f"hil run: cannot open {args.servo_modbus}: {exc}", file=sys.stderr)
-            return EXIT_USAGE
     try:
-        result = runner.run_program(program)
-    finally:
-        if args.servo_modbus:
-            runner.servo_modbus.close()
-    print_summary(args.program, bench, result)
+        r = run(args.program, args.bench, bus=args.bus, profile=args.profile, libs=args.lib, trace=args.trace,
+                mlc=args.mlc, events=args.at, event_files=args.events, feed_override=args.feed_override,
+                rapid_override=args.rapid_override, spindle_override=args.spindle_override, check=args.check,
+                trace_signals=args.trace_signals, m00_resume=args.m00_resume, realtime=args.realtime,
+                overrun=args.overrun, progress=True if wants_progress(args.progress) else None,
+                servo_modbus=args.servo_modbus, servo_baud=args.servo_baud)
+    except InputError as exc:
+        if exc.alarm is not None:
+            print_alarm(exc.alarm)
+            return EXIT_ALARM
+        print(f"hil run: {exc}", file=sys.stderr)
+        return EXIT_USAGE
+    if r.runner is None:  # the program could not be read or parsed: its alarm, no run
+        print_alarm(r.alarms[0])
+        return EXIT_ALARM
+    print_summary(args.program, r.bench, r.run)
+    runner = r.runner
     waits = [(ln, w) for ln, w in runner.channel.planner.thread_waits if w] if runner.channel is not None else []
     if waits:  # threads armed only once the spindle settled at its command (motion decisions 33)
-        print("spindle settle " + "  ".join(f"line {ln} {w * bench.cycle * 1000:g} ms" for ln, w in waits)
+        print("spindle settle " + "  ".join(f"line {ln} {w * r.bench.cycle * 1000:g} ms" for ln, w in waits)
               + " before the thread", file=sys.stdout)
+    player = runner.on_cycle if isinstance(runner.on_cycle, EventPlayer) else None
     if player is not None:
         print("\n".join(player.summary()), file=sys.stdout)
-    print_timing(result)
-    code = EXIT_OK if result.ok else EXIT_ALARM
-    if trace_path and want_checks:
-        checks_ok = run_bench_checks(trace_path, bench, program)
-        if not checks_ok:
-            code = EXIT_ALARM
-    if trace_path and trace_path != args.trace:
-        Path(trace_path).unlink(missing_ok=True)
-    return code
-
-
-def make_player(args: argparse.Namespace, bench: Bench, mlc, link, panel, signal_sources) -> EventPlayer:
-    """The --at / --events player, wrapping the operator panel; EventSpecError for a bad event."""
-    if not hasattr(mlc, "mem"):
-        raise EventSpecError("--at/--events write MLC devices: they need a Delta MLC, not --mlc basic")
-    events = parse_events(args.at, args.events, bench.axis_names, mlc.link.x)
-    traced = [c for src in signal_sources for c in src.columns]
-    return EventPlayer(events, mlc, bench, link, panel, traced)
-
-
-def _temp_trace() -> str:
-    fd, name = tempfile.mkstemp(prefix="hil-run-", suffix=".parquet")
-    os.close(fd)
-    return name
-
-
-def run_bench_checks(trace_path: str, bench: Bench, program) -> bool:
-    """Judge the run's trace by the bench's [checks]; print one line per check."""
-    from hil.checks import program_moves, run_checks
-    from hil.trace_read import TraceFile
-
-    try:
-        moves = program_moves(program, bench)
-    except NcAlarm:
-        moves = None
-    results = run_checks(TraceFile(trace_path), bench.checks, bench, moves)
-    print("checks", file=sys.stdout)
-    for r in results:
-        print(f"  {r}", file=sys.stdout)
-    return all(r.ok for r in results)
+    print_timing(r.run)
+    if r.checks:
+        print("checks", file=sys.stdout)
+        for c in r.checks:
+            print(f"  {c}", file=sys.stdout)
+    return EXIT_OK if r.ok else EXIT_ALARM
 
 
 def print_timing(r: RunResult) -> None:

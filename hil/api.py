@@ -1,0 +1,254 @@
+"""deltahil as a library: `hil.run`, `hil.path`, `hil.load_trace`.
+
+The `hil run` command is a thin printer over `run`, so a user's script, the pytest plugin and
+a campaign worker wire a bench exactly as the command line does (the same MLC, remote I/O,
+events, trace and checks):
+
+    import hil
+    r = hil.run("examples/lathe_demo.nc", bench="benches/lathe-2axis.toml", trace="out/demo.parquet")
+    assert r.ok, r.alarms
+    print(r.program_time, r.max_following_error, r.final_position)
+    table = r.trace.load()          # a pyarrow Table; .to_pandas() is one call away
+
+Bad input (a bench file, an option, an event) raises `hil.session.InputError` naming what is
+wrong; a program that cannot be read or parsed is a result with its Delta alarm, as on the NC.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from hil.bench import Bench
+
+
+@dataclass
+class TraceRef:
+    path: Path
+
+    def load(self, columns: Sequence[str] | None = None):
+        """The trace as a pyarrow Table (Parquet or CSV alike)."""
+        from hil.trace_read import TraceFile
+
+        return TraceFile(self.path).table(columns)
+
+
+@dataclass
+class Result:
+    """What one run did. `ok`: it completed, raised no alarm and passed every check it ran."""
+
+    program: str
+    bench: Bench
+    run: Any  # hil.runner.RunResult
+    checks: list[Any] = field(default_factory=list)  # hil.checks.CheckResult, empty when none ran
+    events: list[Any] = field(default_factory=list)  # hil.run_events.RunEvent, with fired_* filled in
+    trace: TraceRef | None = None
+    runner: Any = None  # the BenchRunner, for a caller that wants more than the summary
+
+    @property
+    def alarms(self) -> list[Any]:
+        return list(self.run.alarms)
+
+    @property
+    def completed(self) -> bool:
+        return bool(self.run.ok)
+
+    @property
+    def checks_ok(self) -> bool:
+        return all(c.ok for c in self.checks)
+
+    @property
+    def ok(self) -> bool:
+        return self.completed and self.checks_ok
+
+    @property
+    def program_time(self) -> float:
+        return self.run.program_time
+
+    @property
+    def sim_time(self) -> float:
+        return self.run.sim_time
+
+    @property
+    def cycles(self) -> int:
+        return self.run.cycles
+
+    @property
+    def max_following_error(self) -> dict[str, float]:
+        return dict(self.run.max_ferr)
+
+    @property
+    def final_position(self) -> dict[str, float]:
+        return dict(self.run.final)
+
+    @property
+    def unfired(self) -> list[Any]:
+        return [e for e in self.events if e.fired_cycle is None]
+
+
+def _bench(bench: str | Path | Bench | None, profile: str | None, bus: str | None) -> Bench:
+    from hil.session import load_bench, override_bench
+
+    if isinstance(bench, Bench):
+        return override_bench(bench, profile, bus)
+    return load_bench(str(bench) if bench is not None else None, profile, bus)
+
+
+def _percent(name: str, value: float, high: float) -> float:
+    from hil.session import InputError
+
+    if not (isinstance(value, (int, float)) and 0 <= value <= high):
+        raise InputError(f"{name} {value!r}: a percentage from 0 to {high:g}")
+    return float(value)
+
+
+def run(program: str | Path, bench: str | Path | Bench | None = None, *, bus: str | None = None,
+        profile: str | None = None, libs: Sequence[str] = (), trace: str | Path | None = None,
+        mlc: str | None = None, events: Sequence[str] = (), event_files: Sequence[str] = (),
+        feed_override: float = 100.0, rapid_override: float = 100.0, spindle_override: float = 100.0,
+        check: bool | None = None, trace_signals: str | None = None, m00_resume: float = 0.5,
+        realtime: bool = False, overrun: str | None = None, progress: Any = None,
+        servo_modbus: str | None = None, servo_baud: int = 38400) -> Result:
+    """Run `program` on a bench in lock-step virtual time (or `realtime`); see the module doc.
+
+    `bench`: a bench file, a `Bench`, or None for the built-in 2-axis lathe. `events`: `--at`
+    strings; `event_files`: `--events` files. Overrides are the panel's switch positions at power-on
+    (D2x002 feed 0–150 %, D2x004 rapid 0–100 %, D2x026 spindle 50–120 %); the MLC may change them.
+    `check`: judge the run by the bench's [checks] (default: when it has any)."""
+    from hil.clock import make_clock
+    from hil.progress import Progress
+    from hil.remote_io import attach_remote_io
+    from hil.run_events import EventPlayer, EventSpecError, parse_events
+    from hil.runner import BenchRunner, RunResult
+    from hil.scripting import mlc_setup
+    from hil.session import InputError, load_program, make_link
+    from hil.trace import open_trace
+    from nc.alarms import NcAlarm
+
+    if not 0.0 <= m00_resume < float("inf"):
+        raise InputError(f"--m00-resume {m00_resume:g}: seconds must be >= 0")
+    feed = _percent("feed override", feed_override, 150.0)
+    rapid = _percent("rapid override", rapid_override, 100.0)
+    spindle = _percent("spindle override", spindle_override, 120.0)
+    if spindle < 50.0:
+        raise InputError(f"spindle override {spindle_override!r}: a percentage from 50 to 120")
+    b = _bench(bench, profile, bus)
+    try:
+        prog = load_program(str(program), list(libs))
+    except NcAlarm as exc:
+        return Result(str(program), b, RunResult(alarms=[exc.alarm]))
+    if overrun:
+        b.realtime.overrun = overrun
+    link = make_link(b)
+    clock = make_clock(b.cycle, realtime, b.realtime)
+    if progress is True:
+        progress = Progress(max((blk.line for blk in prog.blocks), default=1))
+    wants_events = bool(events or event_files)
+    overridden = (feed, rapid, spindle) != (100.0, 100.0, 100.0)
+    m, panel, signal_sources = mlc_setup(b, mlc, trace_signals, m00_resume, wants_events)
+    _set_overrides(m, feed, rapid, spindle)
+    attach_remote_io(b, m, link)
+    player = None
+    if wants_events:
+        if not hasattr(m, "mem"):
+            raise InputError("--at/--events write MLC devices: they need a Delta MLC, not --mlc basic")
+        try:
+            parsed = parse_events(list(events), list(event_files), b.axis_names, m.link.x)
+        except EventSpecError as exc:
+            raise InputError(str(exc)) from None
+        traced = [c for src in signal_sources for c in src.columns]
+        player = EventPlayer(parsed, m, b, link, panel, traced)
+    runner = BenchRunner(b, link, None, m, player or panel, clock=clock, progress=progress)
+    runner.trace_sources += signal_sources
+    if player is not None:
+        runner.trace_sources.append(player)
+    del overridden
+    trace_path = str(trace) if trace else None
+    want_checks = b.checks.any and check is not False
+    temporary = want_checks and not trace_path
+    if temporary:  # checks read a trace; keep it only if asked for
+        fd, trace_path = tempfile.mkstemp(prefix="hil-run-", suffix=".parquet")
+        os.close(fd)
+    try:
+        if trace_path:
+            try:
+                runner.trace = open_trace(trace_path, runner.trace_columns())
+            except OSError as exc:
+                raise InputError(f"cannot write trace {trace_path}: {exc.strerror}") from None
+        if servo_modbus:  # G10 L40/L41 over the drives' RS-485 port (issue 8)
+            import serial
+
+            from fieldbus.modbus import ModbusRtuMaster
+
+            try:
+                runner.servo_modbus = ModbusRtuMaster.open(servo_modbus, baudrate=servo_baud)
+            except (serial.SerialException, OSError) as exc:
+                raise InputError(f"cannot open {servo_modbus}: {exc}") from None
+        try:
+            result = runner.run_program(prog)
+        finally:
+            if servo_modbus:
+                runner.servo_modbus.close()
+        checks = _checks(trace_path, b, prog) if trace_path and want_checks else []
+    finally:
+        if temporary and trace_path:
+            Path(trace_path).unlink(missing_ok=True)
+    return Result(str(program), b, result, checks, list(player.events) if player is not None else [],
+                  TraceRef(Path(trace_path)) if trace_path and not temporary else None, runner)
+
+
+def _set_overrides(mlc: Any, feed: float, rapid: float, spindle: float) -> None:
+    """The panel's override switches at power-on: the Delta MLC's D2x002/D2x004/D2x026, or the
+    basic MLC's fixed values (it has no panel)."""
+    if hasattr(mlc, "mem"):
+        from mlc.signals import d2
+
+        x = mlc.link.x
+        for reg, value in ((2, feed), (4, rapid), (26, spindle)):
+            mlc.mem.set_u16(d2(x, reg), int(round(value)))
+    else:
+        mlc.overrides = (feed / 100.0, rapid / 100.0, spindle / 100.0)
+
+
+def _checks(trace_path: str, bench: Bench, program: Any) -> list[Any]:
+    from hil.checks import program_moves, run_checks
+    from hil.trace_read import TraceFile
+    from nc.alarms import NcAlarm
+
+    try:
+        moves = program_moves(program, bench)
+    except NcAlarm:
+        moves = None
+    return run_checks(TraceFile(trace_path), bench.checks, bench, moves)
+
+
+def path(program: str | Path, bench: str | Path | Bench | None = None, *, profile: str | None = None,
+         libs: Sequence[str] = (), params: dict[str, float] | None = None) -> list[Any]:
+    """The canonical moves and aux events of a program in machine coordinates, without motion —
+    what `hil path --json` prints; with a bench, from its axes' power-on positions. Raises nc.alarms.NcAlarm where the NC would alarm, InputError for
+    a bad bench or library."""
+    from hil.session import InputError
+    from nc.interp import Interpreter
+    from nc.profiles import make_profile
+    from nc.store import ProgramStore
+
+    b = _bench(bench, profile, None)
+    rotary = tuple(a.name for a in b.axes if a.units == "deg") if bench is not None else ()
+    prof = make_profile(b.profile, b.axis_names if bench is not None else None, {**b.params, **(params or {})},
+                        rotary)
+    store = ProgramStore(usb_first=bool(prof.param("N8.22 Bit5")))
+    try:
+        store.add_libs(list(libs))
+    except ValueError as exc:
+        raise InputError(str(exc)) from None
+    start = {a.name: a.start for a in b.axes} if bench is not None else None  # the bench's power-on position
+    return list(Interpreter(prof, start, store=store).run(store.load_main(str(program))))
+
+
+def load_trace(path_: str | Path):
+    """A trace file (Parquet or CSV) as a pyarrow Table."""
+    return TraceRef(Path(path_)).load()
