@@ -12,7 +12,7 @@ from pathlib import Path
 
 DOCS = Path(__file__).resolve().parent
 
-ORDER = ["foundation", "language", "cycles", "motion", "ethercat", "canopen", "mlc", "bench"]
+ORDER = ["foundation", "language", "cycles", "motion", "ethercat", "canopen", "mlc", "bench", "campaign"]
 
 HEADERS = {
     "decisions": """# Decisions where the Delta manuals are ambiguous

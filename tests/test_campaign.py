@@ -237,3 +237,18 @@ def test_kept_traces_form_a_partitioned_dataset_and_canopen_runs_like_sim(tmp_pa
         assert (tmp_path / "o" / "reports" / r["input_hash"] / "index.html").exists()
     summary = (tmp_path / "o" / "summary.html").read_text()
     assert "reports/" in summary and "canopen:virtual" in summary
+
+
+def test_a_run_past_max_time_is_a_timeout_and_params_sweep_is_a_variant(tmp_path):
+    for f in DATA.iterdir():
+        shutil.copy(f, tmp_path)
+    (tmp_path / "t.toml").write_text(
+        "[campaign]\nprograms = ['short_turn.nc']\nbenches = ['bench.toml']\nmax_time = 0.4\n"
+        "[params]\n'N1.040' = [0.01, 0.02]\n")
+    p = hil("campaign", str(tmp_path / "t.toml"), "--out", str(tmp_path / "o"), "--workers", "0", "--quiet")
+    assert p.returncode == 1
+    rs = pq.read_table(tmp_path / "o" / "results.parquet").to_pylist()
+    assert sorted(r["params"] for r in rs) == ["N1.040=0.01", "N1.040=0.02"]
+    # motion ends at max_time, then the axes stop under control before the run ends
+    assert {r["status"] for r in rs} == {"timeout"} and all(0.39 <= r["program_time_s"] <= 0.41 for r in rs)
+    assert all(r["program_time_s"] < r["sim_time_s"] < 0.7 for r in rs)

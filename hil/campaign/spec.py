@@ -98,7 +98,7 @@ def parse_campaign(data: dict[str, Any], source: Path) -> Campaign:
     programs = _paths(r, top, "programs", "campaign.programs", root, required=False)
     benches = _paths(r, top, "benches", "campaign.benches", root, required=False)
     buses = _strings(r, top, "buses", "campaign.buses", ["sim"], BUSES)
-    overrides = _percents(r, top, "overrides", "campaign.overrides", 0, 200)
+    overrides = _percents(r, top, "overrides", "campaign.overrides", 0, 150)
     rapid = _percents(r, top, "rapid_overrides", "campaign.rapid_overrides", 0, 100)
     spindle = _percents(r, top, "spindle_overrides", "campaign.spindle_overrides", 50, 120)
     c.lib = _paths(r, top, "lib", "campaign.lib", root, required=False, dirs=True)
@@ -240,7 +240,7 @@ def _case(r: _Reader, item: dict, path: str, root: Path, faults: dict[str, tuple
     prog = _one_path(r, item, "program", f"{path}.program", root)
     bench = _one_path(r, item, "bench", f"{path}.bench", root)
     bus = r.string(item, "bus", f"{path}.bus", "sim", BUSES) or "sim"
-    ov = r.number(item, "override", f"{path}.override", 100.0, minimum=0.0, maximum=200.0)
+    ov = r.number(item, "override", f"{path}.override", 100.0, minimum=0.0, maximum=150.0)
     ro = r.number(item, "rapid_override", f"{path}.rapid_override", 100.0, minimum=0.0, maximum=100.0)
     so = r.number(item, "spindle_override", f"{path}.spindle_override", 100.0, minimum=50.0, maximum=120.0)
     fault = r.string(item, "fault", f"{path}.fault", NO_FAULT, (NO_FAULT, *faults)) or NO_FAULT
