@@ -1,8 +1,8 @@
 """The `hil` command line. Each subcommand lives in `hil.commands.<name>` and registers itself,
 so capabilities can be added without touching this file.
 
-Exit codes: 0 success, 1 the run or program raised an alarm or a check failed, 2 bad usage or
-a bad input file. No Python traceback reaches the user: an unexpected error is reported as
+Exit codes (README): 0 success, 1 the run or program raised an alarm, 2 bad usage or a bad input
+file, 3 a run that completed but failed a check (hil run), 130 interrupted. No Python traceback reaches the user: an unexpected error is reported as
 NC internal alarm 0x0000.
 """
 

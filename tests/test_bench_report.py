@@ -42,11 +42,12 @@ def test_run_trace_report(tmp_path, prog, capsys):
     assert "Checks: <span class='ok'>PASS</span>" in html
 
 
-def test_failed_bench_check_exits_1(tmp_path, prog, capsys):
+def test_failed_bench_check_exits_3(tmp_path, prog, capsys):
+    """A completed run whose check fails exits 3, apart from an alarm's 1 (issue 22: distinct codes)."""
     bench = tmp_path / "tight.toml"
     bench.write_text((BENCHES / "lathe-2axis.toml").read_text().replace(
         "max_following_error = { X = 0.1, Z = 0.1 }", "max_following_error = { X = 0.001, Z = 0.1 }"))
-    assert main(["run", str(prog), "--bench", str(bench)]) == 1
+    assert main(["run", str(prog), "--bench", str(bench)]) == 3
     out = capsys.readouterr().out
     assert "FAIL  following error X" in out and "at cycle" in out and ", line " in out
 

@@ -49,7 +49,7 @@ def run_case(case: CaseInputs) -> dict[str, Any]:
             from nc.alarms import internal_error
 
             alarm = internal_error(exc)
-            row.update(status="alarm", alarm=f"0x{alarm.code:04X}", message=alarm.message[:500])
+            row.update(status="alarm", alarm=alarm.code_text, message=alarm.message[:500])
     row["wall_s"] = time.perf_counter() - t0
     return {k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in row.items()}
 
@@ -73,7 +73,7 @@ def _execute(case: CaseInputs, scratch: Path) -> dict[str, Any]:
                      rapid_override=case.rapid_override, spindle_override=case.spindle_override)
     if result.runner is None:  # the program could not be read or parsed
         a = result.alarms[0]
-        return {"status": "alarm", "alarm": f"0x{a.code:04X}", "alarm_line": a.line, "message": a.message[:500]}
+        return {"status": "alarm", "alarm": a.code_text, "alarm_line": a.line, "message": a.message[:500]}
     out: dict[str, Any] = {"program_time_s": result.program_time, "sim_time_s": result.sim_time,
                            "cycles": result.cycles}
     for axis, v in result.max_following_error.items():
@@ -81,7 +81,7 @@ def _execute(case: CaseInputs, scratch: Path) -> dict[str, Any]:
     failed = [c for c in result.checks if not c.ok and not c.skipped]
     if result.alarms:
         a = result.alarms[0]
-        out.update(status="timeout" if _is_timeout(a) else "alarm", alarm=f"0x{a.code:04X}", alarm_line=a.line,
+        out.update(status="timeout" if _is_timeout(a) else "alarm", alarm=a.code_text, alarm_line=a.line,
                    message=a.message[:500])
     elif failed:
         out.update(status="check_failed", checks_failed="; ".join(c.name for c in failed))

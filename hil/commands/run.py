@@ -6,7 +6,7 @@ import argparse
 import sys
 
 from hil.bench import Bench
-from hil.cli import EXIT_ALARM, EXIT_OK, EXIT_USAGE
+from hil.cli import EXIT_ALARM, EXIT_USAGE
 from hil.progress import wants_progress
 from hil.run_events import EventPlayer
 from hil.runner import RunResult
@@ -51,6 +51,12 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="rapid override switch at power-on, 0–100 %% (D2x004; default 100)")
     p.add_argument("--spindle-override", type=float, default=100.0, metavar="PERCENT",
                    help="spindle override switch at power-on, 50–120 %% (D2x026; default 100)")
+    p.add_argument("--json", action="store_true",
+                   help="print one JSON object (result, alarms, checks, events, times, errors, trace) on stdout; "
+                        "the text summary goes to stderr")
+    p.add_argument("--junit", metavar="FILE", help="write JUnit XML: a test case for the run and one per check")
+    p.add_argument("--allow-unfired", action="store_true",
+                   help="an --at/--events event that never fired does not fail the run")
     p.set_defaults(func=cmd_run)
 
 
@@ -71,28 +77,48 @@ def cmd_run(args: argparse.Namespace) -> int:
             return EXIT_ALARM
         print(f"hil run: {exc}", file=sys.stderr)
         return EXIT_USAGE
+    from hil.run_output import junit_xml, to_json, verdict, write_atomic
+
+    text = sys.stderr if args.json else sys.stdout
     if r.runner is None:  # the program could not be read or parsed: its alarm, no run
         print_alarm(r.alarms[0])
-        return EXIT_ALARM
-    print_summary(args.program, r.bench, r.run)
+    else:
+        print_run(args.program, r, text)
+    _, code = verdict(r, args.allow_unfired)
+    if r.unfired and not args.allow_unfired:
+        print(f"hil run: {len(r.unfired)} event(s) never fired (--allow-unfired to accept): "
+              + "; ".join(e.spec for e in r.unfired), file=sys.stderr)
+    if args.junit:
+        try:
+            write_atomic(args.junit, junit_xml(r, args.allow_unfired))
+        except OSError as exc:
+            print(f"hil run: cannot write {args.junit}: {exc.strerror}", file=sys.stderr)
+            return EXIT_USAGE
+    if args.json:
+        print(to_json(r, args.allow_unfired), file=sys.stdout)
+    return code
+
+
+def print_run(program: str, r, out) -> None:
+    """The text summary of a run, as `hil run` prints it."""
+    print_summary(program, r.bench, r.run, out)
     runner = r.runner
     waits = [(ln, w) for ln, w in runner.channel.planner.thread_waits if w] if runner.channel is not None else []
     if waits:  # threads armed only once the spindle settled at its command (motion decisions 33)
         print("spindle settle " + "  ".join(f"line {ln} {w * r.bench.cycle * 1000:g} ms" for ln, w in waits)
-              + " before the thread", file=sys.stdout)
+              + " before the thread", file=out)
     player = runner.on_cycle if isinstance(runner.on_cycle, EventPlayer) else None
     if player is not None:
-        print("\n".join(player.summary()), file=sys.stdout)
-    print_timing(r.run)
+        print("\n".join(player.summary()), file=out)
+    print_timing(r.run, out)
     if r.checks:
-        print("checks", file=sys.stdout)
+        print("checks", file=out)
         for c in r.checks:
-            print(f"  {c}", file=sys.stdout)
-    return EXIT_OK if r.ok else EXIT_ALARM
+            print(f"  {c}", file=out)
 
 
-def print_timing(r: RunResult) -> None:
-    out = sys.stdout
+def print_timing(r: RunResult, out=None) -> None:
+    out = out or sys.stdout
     if r.realtime:
         j = r.timing.get("jitter", {})
         print(f"real time      {r.granted}", file=out)
@@ -110,8 +136,8 @@ def print_timing(r: RunResult) -> None:
         print(f"overruns       {r.overruns} cycles ran past their deadline", file=sys.stderr if not r.alarms else out)
 
 
-def print_summary(program: str, bench: Bench, r: RunResult) -> None:
-    out = sys.stdout
+def print_summary(program: str, bench: Bench, r: RunResult, out=None) -> None:
+    out = out or sys.stdout
     print(f"program        {program}  (profile {bench.profile}, bench {bench.name}, bus {bench.bus})", file=out)
     print(f"cycles         {r.cycles}  ({bench.cycle * 1000:g} ms cycle, {r.sim_time:.3f} s simulated)", file=out)
     print(f"drives enabled after {r.enable_cycles} cycles", file=out)

@@ -1,0 +1,104 @@
+"""Machine-readable results of a run: the `hil run --json` object and JUnit XML (`--junit FILE`),
+both built from the library's `hil.api.Result`, so the CLI, the pytest plugin and scripts agree.
+
+Exit codes (README): 0 completed and every check passed; 1 ended by an alarm; 3 completed but a
+check failed (an `--at` event that never fired counts as a failed check unless allowed).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import xml.etree.ElementTree as ET
+from pathlib import Path
+from typing import Any
+
+EXIT_OK, EXIT_ALARM, EXIT_CHECKS = 0, 1, 3
+
+
+def verdict(result: Any, allow_unfired: bool = False) -> tuple[str, int]:
+    """("completed" | "alarm" | "checks_failed", exit code)."""
+    if not result.completed:
+        return "alarm", EXIT_ALARM
+    if not result.checks_ok or (result.unfired and not allow_unfired):
+        return "checks_failed", EXIT_CHECKS
+    return "completed", EXIT_OK
+
+
+def _finite(v: Any) -> Any:
+    """Strict JSON: NaN and ±inf have no JSON spelling, they become null."""
+    if isinstance(v, float) and not math.isfinite(v):
+        return None
+    if isinstance(v, dict):
+        return {k: _finite(x) for k, x in v.items()}
+    if isinstance(v, list):
+        return [_finite(x) for x in v]
+    return v
+
+
+def as_dict(result: Any, allow_unfired: bool = False) -> dict[str, Any]:
+    status, code = verdict(result, allow_unfired)
+    bench = result.bench
+    applied = sorted((e for e in result.events if e.fired_cycle is not None), key=lambda e: e.fired_cycle)
+    return _finite({
+        "result": status, "exit_code": code, "program": result.program,
+        "bench": {"name": bench.name, "source": bench.source, "profile": bench.profile, "bus": bench.bus,
+                  "cycle_s": bench.cycle},
+        "alarms": [a.as_dict() for a in result.alarms],
+        "checks": [c.as_dict() for c in result.checks],
+        "events": {"applied": [{"spec": e.spec, "t": e.fired_time, "cycle": e.fired_cycle, "line": e.fired_line,
+                                "action": str(e.action)} for e in applied],
+                   "never_fired": [e.spec for e in result.unfired]},
+        "program_time_s": result.program_time, "sim_time_s": result.sim_time, "cycles": result.cycles,
+        "max_following_error": result.max_following_error, "final_position": result.final_position,
+        "trace": str(result.trace.path) if result.trace is not None else None,
+    })
+
+
+def to_json(result: Any, allow_unfired: bool = False) -> str:
+    return json.dumps(as_dict(result, allow_unfired), allow_nan=False)
+
+
+def junit_xml(result: Any, allow_unfired: bool = False) -> bytes:
+    """One test suite per run: a test case "run" (fails on an alarm), one per check (skipped checks
+    are <skipped/>), and one "events" case when the run had --at events."""
+    name = f"hil run {Path(result.program).name}"
+    suite = ET.Element("testsuite", name=name, time=f"{result.sim_time:.6f}")
+    cases = []
+    run = ET.Element("testcase", classname=name, name="run", time=f"{result.program_time:.6f}")
+    if result.alarms:
+        a = result.alarms[0]
+        f = ET.SubElement(run, "failure", type=a.code_text, message=a.message)
+        f.text = "\n".join(str(x) for x in result.alarms)
+    cases.append(run)
+    for c in result.checks:
+        tc = ET.Element("testcase", classname=name, name=c.name, time="0")
+        if c.skipped:
+            ET.SubElement(tc, "skipped", message=c.detail)
+        elif not c.ok:
+            ET.SubElement(tc, "failure", type="check", message=str(c))
+        cases.append(tc)
+    if result.events:
+        tc = ET.Element("testcase", classname=name, name="events", time="0")
+        if result.unfired and not allow_unfired:
+            ET.SubElement(tc, "failure", type="never fired",
+                          message="; ".join(e.spec for e in result.unfired))
+        cases.append(tc)
+    suite.extend(cases)
+    suite.set("tests", str(len(cases)))
+    suite.set("failures", str(sum(tc.find("failure") is not None for tc in cases)))
+    suite.set("skipped", str(sum(tc.find("skipped") is not None for tc in cases)))
+    suite.set("errors", "0")
+    return ET.tostring(ET.ElementTree(suite).getroot(), encoding="utf-8", xml_declaration=True)
+
+
+def write_atomic(path: str | Path, data: bytes) -> None:
+    """The previous complete file or the new one, never half of one; no temporary file left."""
+    path = Path(path)
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    try:
+        tmp.write_bytes(data)
+        os.replace(tmp, path)
+    finally:
+        tmp.unlink(missing_ok=True)
