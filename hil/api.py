@@ -175,8 +175,11 @@ def run(program: str | Path, bench: str | Path | Bench | None = None, *, bus: st
         os.close(fd)
     try:
         if trace_path:
+            from hil.trace_meta import column_units, run_meta
+
+            columns = runner.trace_columns()
             try:
-                runner.trace = open_trace(trace_path, runner.trace_columns())
+                runner.trace = open_trace(trace_path, columns, run_meta(b, str(program)), column_units(columns, b))
             except OSError as exc:
                 raise InputError(f"cannot write trace {trace_path}: {exc.strerror}") from None
         if servo_modbus:  # G10 L40/L41 over the drives' RS-485 port (issue 8)
@@ -187,6 +190,8 @@ def run(program: str | Path, bench: str | Path | Bench | None = None, *, bus: st
             try:
                 runner.servo_modbus = ModbusRtuMaster.open(servo_modbus, baudrate=servo_baud)
             except (serial.SerialException, OSError) as exc:
+                if runner.trace is not None:
+                    runner.trace.discard()
                 raise InputError(f"cannot open {servo_modbus}: {exc}") from None
         try:
             result = runner.run_program(prog)

@@ -126,6 +126,9 @@ class BenchRunner:
             self._alarmed_drives.update(i for i in range(len(self.masters)) if self._name(i) == exc.alarm.axis)
         except NcAlarm as exc:
             self._alarm(exc.alarm)
+        except BaseException as exc:  # Ctrl-C or an unexpected error: the trace's end record says so
+            self._end_reason = "interrupted" if isinstance(exc, KeyboardInterrupt) else "internal error"
+            raise
         finally:
             self._shutdown()
             if paced:
@@ -377,9 +380,17 @@ class BenchRunner:
         finally:
             self.clock.stop()
             if self.trace is not None:
-                self.trace.close()
+                self.trace.close(end=self._end_record())
             if self.progress is not None:
                 self.progress.close()
+
+    def _end_record(self) -> dict:
+        """How the run ended, for the trace's metadata: reason, first alarm, last cycle."""
+        pool = self.result.alarms + (self.channel.alarms if self.channel is not None else [])
+        reason = getattr(self, "_end_reason", None) or ("alarm" if pool else "completed")
+        return {"reason": reason, "alarm": pool[0].code_text if pool else None,
+                "alarm_line": pool[0].line if pool else None, "cycle": self.cycle, "t": round(self.time, 9),
+                "complete": reason in ("completed", "alarm")}
 
     def _finish(self) -> RunResult:
         r = self.result

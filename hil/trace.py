@@ -23,7 +23,9 @@ class TraceWriter(Protocol):
 
     def write(self, row: Sequence[float | int | str]) -> None: ...
 
-    def close(self) -> None: ...
+    def close(self, end: dict[str, Any] | None = None) -> None: ...
+
+    def discard(self) -> None: ...
 
 
 class TraceSource(Protocol):
@@ -71,10 +73,17 @@ class CsvTrace:
     def write(self, row: Sequence[float | int | str]) -> None:
         self._w.writerow([_csv_value(v) for v in row])
 
-    def close(self) -> None:
+    def close(self, end: dict[str, Any] | None = None) -> None:
+        """CSV has no place for the end-of-run record; a Parquet trace keeps it."""
         if not self._fh.closed:
             self._fh.close()
             self._tmp.replace(self.path)
+
+    def discard(self) -> None:
+        """A run refused after its trace was opened leaves nothing."""
+        if not self._fh.closed:
+            self._fh.close()
+        self._tmp.unlink(missing_ok=True)
 
 
 def is_parquet(path: str | Path) -> bool:
@@ -87,11 +96,14 @@ def check_target(path: str | Path) -> None:
         raise IsADirectoryError(errno.EISDIR, os.strerror(errno.EISDIR), str(path))
 
 
-def open_trace(path: str | Path, columns: list[str]) -> TraceWriter:
+def open_trace(path: str | Path, columns: list[str], meta: dict[str, Any] | None = None,
+               units: dict[str, str] | None = None) -> TraceWriter:
+    """`meta` (run provenance) and `units` (per column) go into a Parquet trace's metadata; a CSV
+    trace is plain CSV."""
     check_target(path)
     Path(path).parent.mkdir(parents=True, exist_ok=True)  # `--trace out/run.csv` on a fresh clone
     if is_parquet(path):
         from hil.trace_parquet import ParquetTrace
 
-        return ParquetTrace(path, columns)
+        return ParquetTrace(path, columns, meta=meta, units=units)
     return CsvTrace(path, columns)

@@ -1,10 +1,24 @@
-"""Parquet traces through pyarrow: rows are buffered and written one row group at a time, so a
-run of hours keeps at most one row group in memory and a crash loses at most that much."""
+"""Parquet traces through pyarrow, safe against a hard kill.
+
+While the run goes, rows are buffered and each row group is written as a complete Parquet file of
+its own in `<trace>.part/` (written aside and renamed, so every file there is whole). A run killed
+with SIGKILL or a power loss leaves that folder: a Parquet dataset that pyarrow, pandas, polars,
+duckdb and `hil trace` read up to the last flush. At the end the parts are joined into the trace
+file (one row group each), its end-of-run record is stored in the metadata, and the folder goes.
+
+Types read the same in every tool: "no alarm" is null (not ""), statuswords are uint16, cycle and
+line int64, quantities float64. Every column carries its unit in its field metadata (`unit`), and
+the schema metadata `deltahil` holds the run's provenance (hil/trace_meta.py).
+"""
 
 from __future__ import annotations
 
+import json
+import os
+import shutil
+import time
 from pathlib import Path
-from typing import Sequence
+from typing import Any, Sequence
 
 import pyarrow as pa
 import pyarrow.parquet as pq
@@ -12,12 +26,16 @@ import pyarrow.parquet as pq
 from hil.trace import INT_COLUMNS
 
 ROW_GROUP = 50_000  # rows per row group: ~50 s at 1 ms, a few MB in memory
+FLUSH_S = 2.0  # …or sooner, once this much wall time has passed (real-time runs lose at most this)
+META_KEY = b"deltahil"
 
 
-def _type_of(name: str, value: float | int | str) -> pa.DataType:
-    if name in INT_COLUMNS or name.endswith("_sw"):
+def _type_of(name: str, value: float | int | str | None) -> pa.DataType:
+    if name.endswith("_sw"):
+        return pa.uint16()  # CiA 402 statusword 0x6041 is UNSIGNED16
+    if name in INT_COLUMNS:
         return pa.int64()
-    if isinstance(value, str):
+    if isinstance(value, str) or value is None:
         return pa.string()
     if isinstance(value, (bool, int)):
         return pa.int64()
@@ -25,42 +43,92 @@ def _type_of(name: str, value: float | int | str) -> pa.DataType:
 
 
 class ParquetTrace:
-    def __init__(self, path: str | Path, columns: list[str], row_group: int = ROW_GROUP) -> None:
+    def __init__(self, path: str | Path, columns: list[str], row_group: int = ROW_GROUP,
+                 meta: dict[str, Any] | None = None, units: dict[str, str] | None = None) -> None:
         self.path = Path(path)
         self.columns = columns
         self.row_group = row_group
-        self._tmp = self.path.with_name(self.path.name + ".part")
-        self._tmp.touch()  # fail now, not at the first flush, if the place is not writable
+        self.meta = dict(meta or {})
+        self.units = units or {}
+        self.parts = self.path.with_name(self.path.name + ".part")
+        if self.parts.is_file():  # an old single-file partial trace
+            self.parts.unlink()
+        shutil.rmtree(self.parts, ignore_errors=True)  # a killed earlier run's parts
+        self.parts.mkdir()  # fail now, not at the first flush, if the place is not writable
         self._rows: list[Sequence[float | int | str]] = []
         self._schema: pa.Schema | None = None
-        self._writer: pq.ParquetWriter | None = None
+        self._n_parts = 0
+        self._last_flush = time.monotonic()
         self._closed = False
 
     def write(self, row: Sequence[float | int | str]) -> None:
         self._rows.append(tuple(row))
-        if len(self._rows) >= self.row_group:
+        n = len(self._rows)
+        if n >= self.row_group or (n & 1023 == 0 and time.monotonic() - self._last_flush >= FLUSH_S):
             self._flush()
 
+    def _make_schema(self, first: Sequence[Any]) -> pa.Schema:
+        fields = []
+        for c, v in zip(self.columns, first):
+            unit = self.units.get(c)
+            fields.append(pa.field(c, _type_of(c, v), metadata={"unit": unit} if unit else None))
+        return pa.schema(fields, metadata=self._metadata())
+
+    def _metadata(self) -> dict[bytes, bytes]:
+        return {META_KEY: json.dumps(self.meta, allow_nan=False, default=str).encode()}
+
     def _flush(self) -> None:
+        self._last_flush = time.monotonic()
         if not self._rows:
             return
         if self._schema is None:
-            first = self._rows[0]
-            self._schema = pa.schema([(c, _type_of(c, v)) for c, v in zip(self.columns, first)])
-            self._writer = pq.ParquetWriter(self._tmp, self._schema, compression="zstd")
+            self._schema = self._make_schema(self._rows[0])
         cols = list(zip(*self._rows))
-        arrays = [pa.array(col, type=f.type) for col, f in zip(cols, self._schema)]
-        assert self._writer is not None
-        self._writer.write_table(pa.Table.from_arrays(arrays, schema=self._schema))
+        arrays = []
+        for col, f in zip(cols, self._schema):
+            if pa.types.is_string(f.type):
+                col = [v or None for v in col]  # "" = nothing happened: null, as every reader means it
+            arrays.append(pa.array(col, type=f.type))
+        part = self.parts / f"{self._n_parts:06d}.parquet"
+        tmp = self.parts / f".{part.name}.tmp"
+        pq.write_table(pa.Table.from_arrays(arrays, schema=self._schema), tmp, compression="zstd")
+        os.replace(tmp, part)
+        self._n_parts += 1
         self._rows.clear()
 
-    def close(self) -> None:
+    def close(self, end: dict[str, Any] | None = None) -> None:
+        """Join the parts into the trace, with the end-of-run record (reason, alarm, cycle)."""
         if self._closed:
             return
         self._closed = True
         self._flush()
-        if self._writer is None:  # no rows at all: still a valid file with the columns
+        if end is not None:
+            self.meta["end"] = end
+        if self._schema is None:  # no rows at all: still a valid file with the columns
             self._schema = pa.schema([(c, pa.float64()) for c in self.columns])
-            self._writer = pq.ParquetWriter(self._tmp, self._schema)
-        self._writer.close()
-        self._tmp.replace(self.path)
+        schema = self._schema.with_metadata(self._metadata())
+        tmp = self.path.with_name(f".{self.path.name}.{os.getpid()}.tmp")
+        try:
+            with pq.ParquetWriter(tmp, schema, compression="zstd") as writer:
+                for part in sorted(self.parts.glob("*.parquet")):
+                    writer.write_table(pq.read_table(part).replace_schema_metadata(schema.metadata))
+            os.replace(tmp, self.path)
+        finally:
+            tmp.unlink(missing_ok=True)
+        shutil.rmtree(self.parts, ignore_errors=True)
+
+    def discard(self) -> None:
+        """A run refused after its trace was opened leaves nothing."""
+        self._closed = True
+        shutil.rmtree(self.parts, ignore_errors=True)
+
+
+def read_meta(schema: pa.Schema) -> dict[str, Any]:
+    """The `deltahil` run metadata of a trace's schema ({} for a trace without it)."""
+    raw = (schema.metadata or {}).get(META_KEY)
+    if not raw:
+        return {}
+    try:
+        return json.loads(raw)
+    except ValueError:
+        return {}

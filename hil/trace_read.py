@@ -23,8 +23,7 @@ class TraceReadError(Exception):
 
 
 def _csv_types(path: Path) -> dict[str, pa.DataType]:
-    with open(path, newline="") as fh:
-        header = fh.readline().strip().split(",")
+    header = _header(path)
     types: dict[str, pa.DataType] = {}
     for c in header:
         if c in INT_COLUMNS or c.endswith("_sw"):
@@ -36,14 +35,31 @@ def _csv_types(path: Path) -> dict[str, pa.DataType]:
     return types
 
 
+def _header(path: Path) -> list[str]:
+    """A CSV trace's column names (quoted or not: pyarrow's CSV writer quotes them)."""
+    import csv
+
+    with open(path, newline="") as fh:
+        return next(csv.reader([fh.readline()]), [])
+
+
 class TraceFile:
     def __init__(self, path: str | Path) -> None:
         self.path = Path(path)
-        if not self.path.is_file():
+        # A `<trace>.part` folder is what a run killed hard (SIGKILL, power loss) leaves: complete
+        # row-group files up to its last flush, read here as one partial trace.
+        self.partial = self.path.is_dir() and any(self.path.glob("*.parquet"))
+        if not self.path.is_file() and not self.partial:
             raise TraceReadError(f"{path}: no such trace file")
-        self.parquet = is_parquet(self.path)
+        self.parquet = self.partial or is_parquet(self.path)
         try:
-            if self.parquet:
+            if self.partial:
+                import pyarrow.dataset as ds
+
+                self._pf = _Parts(ds.dataset(sorted(str(p) for p in self.path.glob("*.parquet")), format="parquet"))
+                self.columns = list(self._pf.schema_arrow.names)
+                self.num_rows = self._pf.num_rows
+            elif self.parquet:
                 self._pf = pq.ParquetFile(self.path)
                 self.columns = list(self._pf.schema_arrow.names)
                 self.num_rows = self._pf.metadata.num_rows
@@ -56,13 +72,25 @@ class TraceFile:
         if "t" not in self.columns or "line" not in self.columns:
             raise TraceReadError(f"{path}: not a bench trace (no 't' and 'line' columns)")
 
+    @property
+    def meta(self) -> dict:
+        """The run's provenance and end record (Parquet traces; {} for CSV)."""
+        from hil.trace_parquet import read_meta
+
+        return read_meta(self._pf.schema_arrow) if self.parquet else {}
+
+    def units(self) -> dict[str, str]:
+        if not self.parquet:
+            return {}
+        return {f.name: f.metadata[b"unit"].decode() for f in self._pf.schema_arrow
+                if f.metadata and b"unit" in f.metadata}
+
     def _types_header(self) -> list[str]:
-        with open(self.path, newline="") as fh:
-            return fh.readline().strip().split(",")
+        return _header(self.path)
 
     def _convert(self, columns: Sequence[str] | None) -> pacsv.ConvertOptions:
         return pacsv.ConvertOptions(column_types=self._types, include_columns=list(columns) if columns else None,
-                                    strings_can_be_null=False)
+                                    strings_can_be_null=True)  # "" in a CSV alarm column = null, as in Parquet
 
     def batches(self, columns: Sequence[str] | None = None, batch_rows: int = 65_536) -> Iterator[pa.RecordBatch]:
         try:
@@ -94,6 +122,21 @@ class TraceFile:
             else:
                 out[name] = col.to_numpy()
         return out
+
+
+class _Parts:
+    """The few ParquetFile calls TraceFile makes, over the row-group files of a partial trace."""
+
+    def __init__(self, dataset) -> None:
+        self._ds = dataset
+        self.schema_arrow = dataset.schema
+        self.num_rows = dataset.count_rows()
+
+    def iter_batches(self, batch_size: int, columns: list[str] | None) -> Iterator[pa.RecordBatch]:
+        yield from self._ds.to_batches(columns=columns, batch_size=batch_size)
+
+    def read(self, columns: list[str] | None = None) -> pa.Table:
+        return self._ds.to_table(columns=columns)
 
 
 def write_table(tab: pa.Table, path: str | Path) -> None:

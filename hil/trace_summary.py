@@ -158,9 +158,19 @@ def _standard(columns: list[str]) -> set[str]:
     return set(trace_columns(axes_of(columns), spindles_of(columns)))
 
 
+EXPORT_SUFFIXES = (".parquet", ".pq", ".csv", ".feather", ".arrow", ".mf4")
+
+
 def export(tf: TraceFile, out: str | Path, lo: Bound | None = None, hi: Bound | None = None,
            columns: list[str] | None = None) -> int:
-    """Write the slice (and columns) to CSV or Parquet by the output's extension; returns rows."""
+    """Write the slice (and columns) in the format the output's suffix names — Parquet (.parquet,
+    .pq), CSV, Arrow IPC (.feather, .arrow) or MDF4 (.mf4, through asammdf, with each column's
+    unit) — and return its rows; ValueError for any other suffix, before anything is written."""
+    check_target(out)
+    suffix = Path(out).suffix.lower()
+    if suffix not in EXPORT_SUFFIXES:
+        raise ValueError(f"{out}: cannot write {suffix or 'a file without a suffix'}; "
+                         f"choose {', '.join(EXPORT_SUFFIXES)}")
     if columns:
         missing = [c for c in columns if c not in tf.columns]
         if missing:
@@ -169,8 +179,9 @@ def export(tf: TraceFile, out: str | Path, lo: Bound | None = None, hi: Bound | 
     state: dict = {}
     writer = None
     rows = 0
-    check_target(out)
     tmp = Path(str(out) + ".part")
+    if suffix == ".mf4":
+        return _export_mdf(tf, out, tmp, lo, hi, columns, need)
     try:
         for batch in tf.batches(need):
             if lo is not None or hi is not None:
@@ -178,10 +189,9 @@ def export(tf: TraceFile, out: str | Path, lo: Bound | None = None, hi: Bound | 
             if columns:
                 batch = batch.select(columns)
             if writer is None:
-                writer = pq.ParquetWriter(tmp, batch.schema, compression="zstd") if is_parquet(out) else \
-                    pacsv.CSVWriter(tmp, batch.schema)
+                writer = _writer(suffix, tmp, batch.schema)
             if batch.num_rows:
-                writer.write_batch(batch) if is_parquet(out) else writer.write(batch)
+                writer.write_batch(batch) if hasattr(writer, "write_batch") else writer.write(batch)
                 rows += batch.num_rows
     except BaseException:  # a damaged input leaves no half export behind
         if writer is not None:
@@ -193,6 +203,59 @@ def export(tf: TraceFile, out: str | Path, lo: Bound | None = None, hi: Bound | 
     writer.close()
     tmp.replace(out)
     return rows
+
+
+def _writer(suffix: str, tmp: Path, schema):
+    if suffix in (".parquet", ".pq"):
+        return pq.ParquetWriter(tmp, schema, compression="zstd")
+    if suffix in (".feather", ".arrow"):  # Feather v2 is the Arrow IPC file format
+        import pyarrow as pa
+
+        return pa.ipc.new_file(str(tmp), schema)
+    return pacsv.CSVWriter(tmp, schema)
+
+
+def _export_mdf(tf: TraceFile, out: str | Path, tmp: Path, lo, hi, columns, need) -> int:
+    """MDF4 for CANape and asammdf users: one channel per column against the trace's time, with
+    its unit; the alarm column as text."""
+    try:
+        from asammdf import MDF, Signal
+    except ImportError:
+        raise ValueError("writing .mf4 needs asammdf: pip install 'deltahil[mdf]'") from None
+    import numpy as np
+    import pyarrow as pa
+
+    table = tf.table(need)
+    if lo is not None or hi is not None:
+        table = table.filter(slice_mask(table, lo, hi, {}))
+    if table.num_rows == 0:
+        raise ValueError(f"{tf.path}: empty trace")
+    units = tf.units()
+    t = table.column("t").to_numpy()
+    signals = []
+    for name in (columns or table.column_names):
+        if name == "t":
+            continue
+        col = table.column(name)
+        extra = {}
+        if pa.types.is_string(col.type):
+            samples = np.array([(v or "").encode() for v in col.to_pylist()], dtype="S32")
+            extra["encoding"] = "utf-8"
+        else:
+            samples = col.to_numpy()
+        signals.append(Signal(samples=samples, timestamps=t, name=name, unit=units.get(name, ""), **extra))
+    mdf = MDF(version="4.10")
+    meta = tf.meta
+    mdf.append(signals, comment=f"deltahil trace of {meta.get('program', tf.path.name)}"
+               + (f" on bench {meta['bench']['name']}" if "bench" in meta else ""))
+    tmp = Path(out).with_name(f".{Path(out).stem}.part.mf4")  # asammdf adds .mf4 to any other suffix
+    try:
+        saved = Path(mdf.save(str(tmp), overwrite=True))
+        mdf.close()
+        saved.replace(out)
+    finally:
+        tmp.unlink(missing_ok=True)
+    return table.num_rows
 
 
 __all__ = ["Bound", "Summary", "export", "format_summary", "summarise"]

@@ -16,7 +16,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--from", dest="lo", metavar="T|Ln", help="start: time in s (1.5) or program line (L12)")
     p.add_argument("--to", dest="hi", metavar="T|Ln", help="end: time in s or program line (inclusive)")
     p.add_argument("--columns", help="comma-separated columns to export (t and line are always kept first)")
-    p.add_argument("--out", metavar="FILE", help="export the slice: .parquet/.pq → Parquet, else CSV")
+    p.add_argument("--out", metavar="FILE", help="export the slice by its suffix: .parquet/.pq, .csv, "
+                   ".feather/.arrow (Arrow IPC), .mf4 (MDF4 with units, needs deltahil[mdf])")
     p.set_defaults(func=cmd_trace)
 
 
