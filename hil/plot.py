@@ -10,12 +10,8 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-
-from nc.moves import Move  # noqa: E402
+from hil.figures import subplots
+from nc.moves import Move
 
 STYLE = {
     "rapid": dict(color="tab:red", linestyle="--", linewidth=0.8),
@@ -55,7 +51,7 @@ def active_plane(moves: Sequence[Move], default: tuple[str, str]) -> tuple[str, 
 def plot_path(moves: Sequence[Move], path: str, plane: tuple[str, str], programmed: Sequence[Move] | None = None,
               title: str = "", radius_axis: str | None = None) -> None:
     """Write a PNG of the path. `programmed` (optional) is the uncompensated path."""
-    fig, ax = plt.subplots(figsize=(10, 6.5), dpi=110)
+    fig, ax = subplots(figsize=(10, 6.5), dpi=110)
     seen: set[str] = set()
     compensated = any("comp" in m.tags for m in moves)
     if programmed is not None and compensated:
@@ -93,7 +89,6 @@ def plot_path(moves: Sequence[Move], path: str, plane: tuple[str, str], programm
     ax.legend(loc="best", fontsize=8)
     fig.tight_layout()
     fig.savefig(path)
-    plt.close(fig)
 
 
 def plot_program(moves: Sequence[Move], out: str, profile, make_interpreter, program) -> None:

@@ -1,7 +1,8 @@
 """HTML report with PNG plots of a trace: the path commanded against actual, following error,
 velocity and torque, the cycle-jitter histogram and the MLC signal timeline.
 
-Plots are drawn with matplotlib's Agg backend (no display needed). Long traces are decimated
+Plots are matplotlib Figures with their own canvas (no display, no pyplot: importing this never
+changes a notebook's backend). Long traces are decimated
 for drawing (every k-th row, keeping each plotted series' extremes visible through min/max
 envelopes on the time plots), never for the numbers in the summary.
 """
@@ -12,18 +13,15 @@ import html
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import matplotlib
+import numpy as np
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-
-from hil.bench import Bench  # noqa: E402
-from hil.checks import CheckResult, _polyline  # noqa: E402
-from hil.trace import axes_of, spindles_of, trace_columns  # noqa: E402
-from hil.trace_read import TraceFile  # noqa: E402
-from hil.trace_summary import format_summary, summarise  # noqa: E402
-from nc.moves import Move  # noqa: E402
+from hil.bench import Bench
+from hil.checks import CheckResult, _polyline
+from hil.figures import subplots
+from hil.trace import axes_of, spindles_of, trace_columns
+from hil.trace_read import TraceFile
+from hil.trace_summary import format_summary, summarise
+from nc.moves import Move
 
 MAX_POINTS = 20_000  # points per plotted series
 
@@ -83,7 +81,7 @@ def write_report(trace_path: str | Path, out: str | Path, bench: Bench | None = 
     plane = path_axes(axes, bench.profile if bench else None)
     if plane is not None:
         h, v = plane
-        fig, ax = plt.subplots(figsize=(8, 6), dpi=110)
+        fig, ax = subplots(figsize=(8, 6), dpi=110)
         if moves:
             names = [a for a in axes if any(a in m.end for m in moves)]
             if h in names and v in names:
@@ -103,7 +101,7 @@ def write_report(trace_path: str | Path, out: str | Path, bench: Bench | None = 
         ax.legend(loc="best", fontsize=8)
         figs.append(_save(fig, out / "path.png", rep, f"Path in the {h}{v} plane, commanded against actual"))
 
-    fig, ax = plt.subplots(figsize=(10, 4), dpi=110)
+    fig, ax = subplots(figsize=(10, 4), dpi=110)
     for a in axes:
         _plot_series(ax, t, cols[f"{a}_ferr"] * 1000.0, a)
     ax.set_xlabel("time (s)")
@@ -113,7 +111,7 @@ def write_report(trace_path: str | Path, out: str | Path, bench: Bench | None = 
     ax.legend(loc="best", fontsize=8)
     figs.append(_save(fig, out / "following_error.png", rep, "Following error over time"))
 
-    fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(10, 6), dpi=110, sharex=True)
+    fig, (ax1, ax2) = subplots(2, 1, figsize=(10, 6), dpi=110, sharex=True)
     for a in axes:
         _plot_series(ax1, t, cols[f"{a}_vel"], a)
         _plot_series(ax2, t, cols[f"{a}_torque"], a)
@@ -129,7 +127,7 @@ def write_report(trace_path: str | Path, out: str | Path, bench: Bench | None = 
     figs.append(_save(fig, out / "velocity_torque.png", rep, "Velocity and torque"))
 
     period = cols.get("period")
-    fig, ax = plt.subplots(figsize=(8, 4), dpi=110)
+    fig, ax = subplots(figsize=(8, 4), dpi=110)
     if period is not None and len(period):
         nominal = bench.cycle if bench else round(float(np.median(period)), 7)
         jit = (period - nominal) * 1e6
@@ -144,7 +142,7 @@ def write_report(trace_path: str | Path, out: str | Path, bench: Bench | None = 
     standard = set(trace_columns(axes, spindles))
     signals = [c for c in tf.columns if c not in standard and np.issubdtype(cols[c].dtype, np.number)]
     rows = ["line"] + [f"{s}_rpm_cmd" for s in spindles] + signals
-    fig, axs = plt.subplots(len(rows), 1, figsize=(10, 1.0 + 0.9 * len(rows)), dpi=110, sharex=True, squeeze=False)
+    fig, axs = subplots(len(rows), 1, figsize=(10, 1.0 + 0.9 * len(rows)), dpi=110, sharex=True, squeeze=False)
     for ax, name in zip(axs[:, 0], rows):
         tt, y = _decimate(t, cols[name].astype(float))
         ax.step(tt, y, where="post", lw=1.0)
@@ -167,7 +165,6 @@ def write_report(trace_path: str | Path, out: str | Path, bench: Bench | None = 
 def _save(fig, path: Path, rep: Report, caption: str) -> tuple[str, str]:
     fig.tight_layout()
     fig.savefig(path)
-    plt.close(fig)
     rep.images.append(path)
     return path.name, caption
 

@@ -79,3 +79,10 @@ def test_import_hil_stays_light():
     code = "import sys, hil; print(any(m.startswith(('nc.', 'matplotlib', 'pyarrow', 'fieldbus')) for m in sys.modules))"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT)
     assert out.stdout.strip() == "False"
+
+
+def test_importing_the_report_leaves_matplotlibs_backend_alone(tmp_path):
+    code = ("import matplotlib; matplotlib.use('svg'); import hil.report, hil.plot; "
+            "print(matplotlib.get_backend())")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT)
+    assert out.stdout.strip() == "svg", out.stderr
