@@ -126,6 +126,7 @@ CASES: list[tuple[str, str, int, tuple[str, ...]]] = [
     ("run-trace-folder", "run {d}/ok.nc --trace {d}/adir", 2, ("Is a directory",)),
     ("run-feed-override", "run {d}/ok.nc --feed-override 151", 2, ("feed override",)),
     ("run-spindle-override", "run {d}/ok.nc --spindle-override 20", 2, ("spindle override",)),
+    ("examples-file", "examples {d}/ok.nc", 2, ("is not a folder",)),
     ("campaign-missing", "campaign {d}/nope.toml --out {d}/co", 2, ("nope.toml", "cannot be read")),
     ("campaign-toml", "campaign {d}/bad.toml --out {d}/co", 2, ("not valid TOML",)),
     ("campaign-binary", "campaign {d}/garbage.toml --out {d}/co", 2, ("UTF-8",)),
