@@ -85,6 +85,25 @@ class Result:
     def final_position(self) -> dict[str, float]:
         return dict(self.run.final)
 
+    def figures(self) -> dict[str, Any]:
+        """The report's plots of this run's trace as matplotlib Figures, by name ("path",
+        "following_error", "velocity_torque", "jitter", "signals"): a notebook shows them inline."""
+        if self.trace is None:
+            raise ValueError("this run kept no trace: give trace=… to hil.run")
+        from hil.report import trace_figures
+
+        moves = None
+        if self.runner is not None:
+            from hil.checks import program_moves
+            from hil.session import load_program
+            from nc.alarms import NcAlarm
+
+            try:
+                moves = program_moves(load_program(self.program), self.bench)
+            except NcAlarm:
+                moves = None
+        return {name.removesuffix(".png"): fig for name, _, fig in trace_figures(self.trace.path, self.bench, moves)}
+
     @property
     def unfired(self) -> list[Any]:
         return [e for e in self.events if e.fired_cycle is None]

@@ -12,6 +12,7 @@ from __future__ import annotations
 import html
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -73,10 +74,21 @@ def write_report(trace_path: str | Path, out: str | Path, bench: Bench | None = 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     rep = Report(out, out / "index.html")
+    figs = [_save(fig, out / name, rep, caption) for name, caption, fig in trace_figures(tf, bench, moves)]
+    summary = format_summary(tf, summarise(tf))
+    rep.html.write_text(_html(title or f"Bench report: {tf.path.name}", summary, checks, figs), encoding="utf-8")
+    return rep
+
+
+def trace_figures(trace: str | Path | TraceFile, bench: Bench | None = None,
+                  moves: list[Move] | None = None) -> list[tuple[str, str, Any]]:
+    """The report's plots as matplotlib Figures, (file name, caption, figure) each: a notebook shows
+    them, `write_report` saves them."""
+    tf = trace if isinstance(trace, TraceFile) else TraceFile(trace)
     cols = tf.arrays()
     axes, spindles = axes_of(tf.columns), spindles_of(tf.columns)
     t = cols["t"]
-    figs: list[tuple[str, str]] = []  # (file, caption)
+    figs: list[tuple[str, str, Any]] = []
 
     plane = path_axes(axes, bench.profile if bench else None)
     if plane is not None:
@@ -99,7 +111,7 @@ def write_report(trace_path: str | Path, out: str | Path, bench: Bench | None = 
         ax.set_aspect("equal", adjustable="datalim")
         ax.grid(True, alpha=0.3)
         ax.legend(loc="best", fontsize=8)
-        figs.append(_save(fig, out / "path.png", rep, f"Path in the {h}{v} plane, commanded against actual"))
+        figs.append(("path.png", f"Path in the {h}{v} plane, commanded against actual", fig))
 
     fig, ax = subplots(figsize=(10, 4), dpi=110)
     for a in axes:
@@ -109,7 +121,7 @@ def write_report(trace_path: str | Path, out: str | Path, bench: Bench | None = 
     ax.set_title("Following error per axis")
     ax.grid(True, alpha=0.3)
     ax.legend(loc="best", fontsize=8)
-    figs.append(_save(fig, out / "following_error.png", rep, "Following error over time"))
+    figs.append(("following_error.png", "Following error over time", fig))
 
     fig, (ax1, ax2) = subplots(2, 1, figsize=(10, 6), dpi=110, sharex=True)
     for a in axes:
@@ -124,7 +136,7 @@ def write_report(trace_path: str | Path, out: str | Path, bench: Bench | None = 
     for ax in (ax1, ax2):
         ax.grid(True, alpha=0.3)
         ax.legend(loc="best", fontsize=8)
-    figs.append(_save(fig, out / "velocity_torque.png", rep, "Velocity and torque"))
+    figs.append(("velocity_torque.png", "Velocity and torque", fig))
 
     period = cols.get("period")
     fig, ax = subplots(figsize=(8, 4), dpi=110)
@@ -137,7 +149,7 @@ def write_report(trace_path: str | Path, out: str | Path, bench: Bench | None = 
     ax.set_xlabel("period deviation (µs)")
     ax.set_ylabel("cycles (log)")
     ax.grid(True, alpha=0.3)
-    figs.append(_save(fig, out / "jitter.png", rep, "Cycle jitter histogram"))
+    figs.append(("jitter.png", "Cycle jitter histogram", fig))
 
     standard = set(trace_columns(axes, spindles))
     signals = [c for c in tf.columns if c not in standard and np.issubdtype(cols[c].dtype, np.number)]
@@ -155,11 +167,9 @@ def write_report(trace_path: str | Path, out: str | Path, bench: Bench | None = 
             ax.axvline(at, color="red", lw=1.0)
     axs[0, 0].set_title("Program line, spindle command and MLC signals" + (" (red: alarms)" if alarm_t else ""))
     axs[-1, 0].set_xlabel("time (s)")
-    figs.append(_save(fig, out / "signals.png", rep, "MLC signal timeline"))
+    figs.append(("signals.png", "MLC signal timeline", fig))
 
-    summary = format_summary(tf, summarise(tf))
-    rep.html.write_text(_html(title or f"Bench report: {tf.path.name}", summary, checks, figs), encoding="utf-8")
-    return rep
+    return figs
 
 
 def _save(fig, path: Path, rep: Report, caption: str) -> tuple[str, str]:

@@ -86,3 +86,14 @@ def test_importing_the_report_leaves_matplotlibs_backend_alone(tmp_path):
             "print(matplotlib.get_backend())")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT)
     assert out.stdout.strip() == "svg", out.stderr
+
+
+def test_the_api_returns_the_reports_figures(square, tmp_path):
+    from matplotlib.figure import Figure
+
+    r = hil.run(square, bench=MILL, trace=tmp_path / "t.parquet")
+    figs = r.figures()
+    assert set(figs) == {"path", "following_error", "velocity_torque", "jitter", "signals"}
+    assert all(isinstance(f, Figure) for f in figs.values())
+    ax = figs["path"].axes[0]
+    assert [l.get_label() for l in ax.get_lines()][:3] == ["programmed", "commanded", "actual (feedback)"]

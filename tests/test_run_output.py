@@ -60,6 +60,11 @@ def test_failed_check_exits_3_and_junit_has_a_failure_per_failed_check(capsys, t
     assert cases["following error X"].find("failure") is not None
     assert cases["following error Z"].find("failure") is None
     assert not list(tmp_path.glob(".*tmp"))  # written atomically, no temporary left
+    junitparser = pytest.importorskip("junitparser")  # as CI servers read it
+    xml = junitparser.JUnitXml.fromfile(str(junit))
+    suites = list(xml) if isinstance(xml, junitparser.JUnitXml) else [xml]
+    results = {case.name: [type(r).__name__ for r in case.result] for s in suites for case in s}
+    assert results["following error X"] == ["Failure"] and results["run"] == []
 
 
 def test_an_event_that_never_fires_fails_the_run_unless_allowed(capsys):
