@@ -212,8 +212,11 @@ def run(program: str | Path, bench: str | Path | Bench | None = None, *, bus: st
                 if runner.trace is not None:
                     runner.trace.discard()
                 raise InputError(f"cannot open {servo_modbus}: {exc}") from None
+        from hil.stop_signals import stop_on_signals
+
         try:
-            result = runner.run_program(prog)
+            with stop_on_signals(runner):
+                result = runner.run_program(prog)
         finally:
             if servo_modbus:
                 runner.servo_modbus.close()

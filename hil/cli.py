@@ -2,7 +2,8 @@
 so capabilities can be added without touching this file.
 
 Exit codes (README): 0 success, 1 the run or program raised an alarm, 2 bad usage or a bad input
-file, 3 a run that completed but failed a check (hil run), 130 interrupted. No Python traceback reaches the user: an unexpected error is reported as
+file, 3 a run that completed but failed a check (hil run), 128 + n for a run stopped by signal n
+(hil/stop_signals.py), 130 interrupted. No Python traceback reaches the user: an unexpected error is reported as
 NC internal alarm 0x0000.
 """
 

@@ -2,7 +2,8 @@
 both built from the library's `hil.api.Result`, so the CLI, the pytest plugin and scripts agree.
 
 Exit codes (README): 0 completed and every check passed; 1 ended by an alarm; 3 completed but a
-check failed (an `--at` event that never fired counts as a failed check unless allowed).
+check failed (an `--at` event that never fired counts as a failed check unless allowed);
+128 + n when signal n stopped the run under control (130 SIGINT, 143 SIGTERM, 129 SIGHUP).
 """
 
 from __future__ import annotations
@@ -18,7 +19,12 @@ EXIT_OK, EXIT_ALARM, EXIT_CHECKS = 0, 1, 3
 
 
 def verdict(result: Any, allow_unfired: bool = False) -> tuple[str, int]:
-    """("completed" | "alarm" | "checks_failed", exit code)."""
+    """("completed" | "alarm" | "checks_failed" | "stopped", exit code)."""
+    stopped_by = getattr(result.run, "stopped_by", None)
+    if stopped_by:  # a signal's controlled stop: 128 + the signal's number (130 SIGINT, 143 SIGTERM)
+        from hil.stop_signals import exit_code
+
+        return "stopped", exit_code(stopped_by)
     if not result.completed:
         return "alarm", EXIT_ALARM
     if not result.checks_ok or (result.unfired and not allow_unfired):
@@ -42,7 +48,8 @@ def as_dict(result: Any, allow_unfired: bool = False) -> dict[str, Any]:
     bench = result.bench
     applied = sorted((e for e in result.events if e.fired_cycle is not None), key=lambda e: e.fired_cycle)
     return _finite({
-        "result": status, "exit_code": code, "program": result.program,
+        "result": status, "exit_code": code, "stopped_by": getattr(result.run, "stopped_by", None),
+        "program": result.program,
         "bench": {"name": bench.name, "source": bench.source, "profile": bench.profile, "bus": bench.bus,
                   "cycle_s": bench.cycle},
         "alarms": [a.as_dict() for a in result.alarms],

@@ -48,6 +48,7 @@ class RunResult:
     timing: dict[str, dict[str, float]] = field(default_factory=dict)  # jitter/latency/exec percentiles, s
     overruns: int = 0
     granted: str = ""  # what the system granted the real-time loop
+    stopped_by: str | None = None  # the signal (SIGINT, SIGTERM, SIGHUP) whose stop ended the run
 
     @property
     def ok(self) -> bool:
@@ -89,6 +90,7 @@ class BenchRunner:
         # the trace with `trace_columns()`.
         self.trace_sources: list[TraceSource] = []
         self._seen_alarms: set[int] = set()
+        self.stop_request: str | None = None  # a signal's name (hil/stop_signals.py): stop, then end
         self._overrun_alarmed = False
 
     def trace_columns(self) -> list[str]:
@@ -181,7 +183,11 @@ class BenchRunner:
         ch.cycle_start()
         t0 = self.time
         max_cycles = int(self.bench.max_time / self.bench.cycle)
+        stopping = False
         while ch.busy:
+            if self.stop_request is not None and not stopping:
+                stopping = True  # along the path, jerk-limited, then flush: the NC's reset
+                ch.reset()
             self._exchange()
             if self.cycle >= max_cycles:
                 ch.raise_alarm(Alarm(0x0000, f"run exceeded the bench's max_time of {self.bench.max_time:g} s"))
@@ -384,13 +390,19 @@ class BenchRunner:
             if self.progress is not None:
                 self.progress.close()
 
+    def request_stop(self, reason: str) -> None:
+        """Stop the run under control at the next cycle (a signal, or a caller's own reason)."""
+        if self.stop_request is None:
+            self.stop_request = reason
+            self.result.stopped_by = reason
+
     def _end_record(self) -> dict:
         """How the run ended, for the trace's metadata: reason, first alarm, last cycle."""
         pool = self.result.alarms + (self.channel.alarms if self.channel is not None else [])
-        reason = getattr(self, "_end_reason", None) or ("alarm" if pool else "completed")
+        reason = getattr(self, "_end_reason", None) or self.stop_request or ("alarm" if pool else "completed")
         return {"reason": reason, "alarm": pool[0].code_text if pool else None,
                 "alarm_line": pool[0].line if pool else None, "cycle": self.cycle, "t": round(self.time, 9),
-                "complete": reason in ("completed", "alarm")}
+                "complete": reason not in ("interrupted", "internal error")}
 
     def _finish(self) -> RunResult:
         r = self.result

@@ -153,4 +153,5 @@ def print_summary(program: str, bench: Bench, r: RunResult, out=None) -> None:
             print(f"  {a}", file=out)
     else:
         print("alarms         none", file=out)
-    print(f"result         {'completed' if r.ok else 'STOPPED'}", file=out)
+    why = f" by {r.stopped_by}: axes stopped along the path, drives disabled at standstill" if r.stopped_by else ""
+    print(f"result         {'completed' if r.ok else 'STOPPED'}{why}", file=out)

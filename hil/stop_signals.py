@@ -1,0 +1,46 @@
+"""Signals end a run through the stop path, as an operator's reset would on the NC.
+
+While a run is in progress, SIGINT (Ctrl-C), SIGTERM and SIGHUP only *request* a stop: the runner
+sees the request at the next cycle, stops the axes along the path under control (jerk-limited, the
+planner's reset), lets them settle, disables the drives at standstill, closes the bus and finishes
+the trace with the signal as its end reason; `hil run` prints its summary and exits 128 + signal
+number (130, 143, 129). A second signal during that stop does not wait: it raises KeyboardInterrupt
+at once, and the drives are disabled where they are (their own quick-stop ramp brakes them).
+"""
+
+from __future__ import annotations
+
+import signal
+import threading
+from collections.abc import Iterator
+from contextlib import contextmanager
+from typing import Any
+
+STOP_SIGNALS = tuple(s for s in (getattr(signal, "SIGINT", None), getattr(signal, "SIGTERM", None),
+                                 getattr(signal, "SIGHUP", None)) if s is not None)
+
+
+@contextmanager
+def stop_on_signals(runner: Any) -> Iterator[None]:
+    """Route the stop signals to `runner.request_stop(name)` for the duration (main thread only:
+    elsewhere Python cannot take signals, and the caller's own handling stays)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def handler(signum: int, frame: Any) -> None:
+        name = signal.Signals(signum).name
+        if runner.stop_request is not None:
+            raise KeyboardInterrupt(f"second {name} during the stop")
+        runner.request_stop(name)
+
+    previous = {s: signal.signal(s, handler) for s in STOP_SIGNALS}
+    try:
+        yield
+    finally:
+        for s, h in previous.items():
+            signal.signal(s, h)
+
+
+def exit_code(name: str) -> int:
+    return 128 + int(signal.Signals[name])

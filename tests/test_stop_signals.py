@@ -1,0 +1,94 @@
+"""Signals end `hil run` through the stop path (issue 15): SIGINT, SIGTERM and SIGHUP on the sim bus
+and on canopen:virtual. Each cell asserts what a controller engineer checks at a bench: the axes
+decelerate within their limits, the drives leave Operation Enabled only at standstill and nothing
+moves after, the trace is complete and names the signal, the summary is printed, and the exit code
+is 128 + the signal's number."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from hil.bench_file import load_bench_file
+from hil.trace_read import TraceFile
+
+ROOT = Path(__file__).resolve().parents[1]
+LATHE = ROOT / "benches" / "lathe-2axis.toml"
+LONG = "G98\nG00 X58. Z98.\nG01 Z-300. F6000\nG01 Z98.\nG01 Z-300.\nM30\n"  # ~10 s of Z at 100 mm/s
+OP_ENABLED = 0x27  # statusword & 0x6F (CiA 402)
+
+
+def start(tmp_path: Path, bus: str) -> tuple[subprocess.Popen, Path]:
+    prog = tmp_path / "long.nc"
+    prog.write_text(LONG)
+    trace = tmp_path / "run.parquet"
+    p = subprocess.Popen([sys.executable, "-m", "hil.cli", "run", str(prog), "--bench", str(LATHE), "--bus", bus,
+                          "--trace", str(trace), "--no-check", "--no-progress"],
+                         env={**os.environ, "PYTHONPATH": str(ROOT)}, stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE, text=True)
+    parts = trace.with_name(trace.name + ".part")
+    deadline = time.monotonic() + 60
+    while not list(parts.glob("*.parquet")) and time.monotonic() < deadline and p.poll() is None:
+        time.sleep(0.02)  # the run is under way (its first row group is on disk)
+    return p, trace
+
+
+@pytest.mark.parametrize("bus", ["sim", "canopen:virtual"])
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM, signal.SIGHUP], ids=lambda s: s.name)
+def test_a_signal_stops_the_axes_under_control(tmp_path, bus, sig):
+    p, trace = start(tmp_path, bus)
+    p.send_signal(sig)
+    out, err = p.communicate(timeout=120)
+    assert p.returncode == 128 + sig, out + err
+    assert f"STOPPED by {sig.name}" in out and "program time" in out and "Traceback" not in err
+    tf = TraceFile(trace)
+    assert tf.meta["end"]["reason"] == sig.name and tf.meta["end"]["complete"]
+    assert tf.meta["end"]["cycle"] == tf.num_rows
+    c = tf.arrays(["t", "Z_cmd", "Z_act", "Z_vel", "Z_sw"])
+    z = load_bench_file(LATHE).axes[1].limits
+    v = np.diff(c["Z_cmd"]) / 0.001
+    a, j = np.diff(v) / 0.001, np.diff(v, 2) / 0.001 ** 2
+    assert np.abs(v).max() <= z.max_velocity * 1.001 and np.abs(a).max() <= z.max_acceleration * 1.001
+    assert np.abs(j).max() <= z.max_jerk * 1.001
+    assert 1.0 < c["t"][-1] < 9.0  # stopped mid-program, not at its end
+    enabled = (c["Z_sw"] & 0x6F) == OP_ENABLED
+    off = int(np.flatnonzero(enabled)[-1]) + 1  # first row with the drive out of Operation Enabled
+    assert off < len(enabled) and not enabled[off:].any()
+    assert abs(c["Z_vel"][off - 1]) < 0.01  # disabled only at standstill
+    assert np.ptp(c["Z_act"][off - 1:]) < 1e-3  # and nothing moves after
+    assert not trace.with_name(trace.name + ".part").exists()
+
+
+def test_a_second_signal_during_the_stop_disables_at_once(tmp_path):
+    """In process, so the two signals land on known cycles: the first at cycle 1500 (Z at full
+    speed) starts the controlled stop, the second 5 cycles later disables the drives at once."""
+    from hil.runner import BenchRunner
+    from hil.session import load_bench, make_link
+    from hil.stop_signals import stop_on_signals
+    from hil.trace import open_trace
+    from nc.program import parse_program
+
+    bench = load_bench(str(LATHE))
+    bench.mlc = "basic"
+
+    def kill(runner):
+        if runner.cycle in (1500, 1505):
+            os.kill(os.getpid(), signal.SIGINT)
+
+    runner = BenchRunner(bench, make_link(bench), None, on_cycle=kill)
+    runner.trace = open_trace(tmp_path / "t.parquet", runner.trace_columns())
+    with pytest.raises(KeyboardInterrupt), stop_on_signals(runner):
+        runner.run_program(parse_program(LONG, name="long.nc"))
+    tf = TraceFile(tmp_path / "t.parquet")  # the trace is still whole, and says the run was cut
+    assert tf.meta["end"]["reason"] == "interrupted" and not tf.meta["end"]["complete"]
+    c = tf.arrays(["Z_sw", "Z_vel"])
+    enabled = (c["Z_sw"] & 0x6F) == OP_ENABLED
+    off = int(np.flatnonzero(enabled)[-1]) + 1
+    assert 1505 <= off <= 1530 and abs(c["Z_vel"][off - 1]) > 10  # disabled while still moving
