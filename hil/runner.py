@@ -90,6 +90,7 @@ class BenchRunner:
         # the trace with `trace_columns()`.
         self.trace_sources: list[TraceSource] = []
         self._seen_alarms: set[int] = set()
+        self._planner_failed = False
         self.stop_request: str | None = None  # a signal's name (hil/stop_signals.py): stop, then end
         self._overrun_alarmed = False
 
@@ -128,8 +129,12 @@ class BenchRunner:
             self._alarmed_drives.update(i for i in range(len(self.masters)) if self._name(i) == exc.alarm.axis)
         except NcAlarm as exc:
             self._alarm(exc.alarm)
-        except BaseException as exc:  # Ctrl-C or an unexpected error: the trace's end record says so
-            self._end_reason = "interrupted" if isinstance(exc, KeyboardInterrupt) else "internal error"
+        except Exception as exc:  # a bug in the NC or the planner: it must not take the stop with it
+            self._end_reason = "internal error"
+            self._alarm(internal_error(exc))
+            self._quick_stop()
+        except BaseException:  # a second Ctrl-C: the trace's end record says the run was cut
+            self._end_reason = "interrupted"
             raise
         finally:
             self._shutdown()
@@ -279,7 +284,7 @@ class BenchRunner:
                                   axis=self._name(i)))
         for i in range(n_axes):
             self.actual[i] = self.scales[i].to_units(self.tx[i].position_actual) + self.origin[i]
-        ch = self.channel
+        ch = self.channel if not self._planner_failed else None  # a failed NC is not stepped again
         if ch is not None:
             if hasattr(self.mlc, "bus_feedback"):  # drive status for the MLC's special M/D (issue 8)
                 from hil.mlc_bridge import drive_status
@@ -296,6 +301,10 @@ class BenchRunner:
             m, rx = self.masters[i], self.rx[i]
             if m.enabled and ch is not None:
                 rx.target_position = self.scales[i].to_counts(self._commands[i] - self.origin[i])
+            elif self._planner_failed and self.tx[i].statusword & 0x6F == 0x27:
+                # Until the drive takes its quick stop, the setpoint goes on at the speed it had:
+                # a setpoint that stopped dead would brake harder than the drive's own ramp.
+                rx.target_position += self._coast[i]
             else:
                 # Not enabled: follow the actual position so enabling never jumps.
                 rx.target_position = self.tx[i].position_actual
@@ -362,6 +371,26 @@ class BenchRunner:
             self.channel.raise_alarm(alarm)
         self.result.alarms.append(alarm)
 
+    def _quick_stop(self, limit_s: float = 5.0) -> None:
+        """The planner itself failed: leave it alone, command every drive's quick stop (CiA 402: the
+        drive brakes on its own ramp, 0x6085) and cycle until the axes stand; _shutdown then disables."""
+        if not getattr(self, "_opened", False):
+            return
+        self._coast = [int(round(tx.velocity_actual * self.bench.cycle)) for tx in self.tx]
+        for rx, step in zip(self.rx[: len(self.axes)], self._coast):
+            rx.target_position += step  # the update the failed cycle did not make
+        self._planner_failed = True
+        for m in self.masters:
+            if m.enabled:
+                m.request(Target.QUICK_STOP)
+        try:
+            for _ in range(int(limit_s / self.bench.cycle)):
+                self._exchange()
+                if all(abs(tx.velocity_actual) < 1 for tx in self.tx):
+                    break
+        except BusError as exc:
+            self.result.alarms.append(exc.alarm)
+
     def _settle(self) -> None:
         """Keep cycling on the final setpoints until the axes stand still (or the settle time ends)."""
         for _ in range(int(self.bench.settle_time / self.bench.cycle)):
@@ -402,7 +431,7 @@ class BenchRunner:
         reason = getattr(self, "_end_reason", None) or self.stop_request or ("alarm" if pool else "completed")
         return {"reason": reason, "alarm": pool[0].code_text if pool else None,
                 "alarm_line": pool[0].line if pool else None, "cycle": self.cycle, "t": round(self.time, 9),
-                "complete": reason not in ("interrupted", "internal error")}
+                "complete": reason != "interrupted"}
 
     def _finish(self) -> RunResult:
         r = self.result

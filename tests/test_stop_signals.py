@@ -92,3 +92,42 @@ def test_a_second_signal_during_the_stop_disables_at_once(tmp_path):
     enabled = (c["Z_sw"] & 0x6F) == OP_ENABLED
     off = int(np.flatnonzero(enabled)[-1]) + 1
     assert 1505 <= off <= 1530 and abs(c["Z_vel"][off - 1]) > 10  # disabled while still moving
+
+
+def test_an_internal_error_in_the_cycle_loop_still_stops_under_control(tmp_path):
+    """The planner raising mid-move (an injected bug at cycle 1500, Z at full speed) must not take
+    the stop with it: the NC internal alarm 0x0000 is raised, every drive does its quick stop (CiA
+    402, ramp 0x6085), and is disabled at standstill; the trace is finished and names the cause."""
+    from hil.runner import BenchRunner
+    from hil.session import load_bench, make_link
+    from hil.trace import open_trace
+    from nc.program import parse_program
+
+    bench = load_bench(str(LATHE))
+    bench.mlc = "basic"
+
+    def inject(runner):
+        if runner.cycle == 1500:
+            def broken():
+                raise ZeroDivisionError("injected planner bug")
+            runner.channel.step = broken
+
+    runner = BenchRunner(bench, make_link(bench), None, on_cycle=inject)
+    runner.trace = open_trace(tmp_path / "t.parquet", runner.trace_columns())
+    result = runner.run_program(parse_program(LONG, name="long.nc"))
+    assert not result.ok and result.alarms[0].code == 0x0000
+    assert "injected planner bug" in result.alarms[0].message
+    tf = TraceFile(tmp_path / "t.parquet")
+    assert tf.meta["end"]["reason"] == "internal error" and tf.meta["end"]["alarm"] == "0x0000"
+    c = tf.arrays(["Z_sw", "Z_vel", "Z_act"])
+    assert abs(c["Z_vel"][1498]) > 99  # it was moving at full speed when the bug hit
+    sw = c["Z_sw"] & 0x6F
+    assert (sw[1500:1510] == 0x07).any()  # Quick Stop Active
+    energised = np.isin(sw, (OP_ENABLED, 0x07))
+    off = int(np.flatnonzero(energised)[-1]) + 1
+    moving = np.flatnonzero(np.abs(c["Z_vel"]) > 0.01)
+    assert moving[-1] < off  # the drive stood still before it was disabled
+    assert np.ptp(c["Z_act"][off:]) < 1e-3  # and nothing moved after
+    v = c["Z_vel"][1498:off]
+    assert np.all(np.abs(np.diff(v)) <= 2.0)  # the drive's ramp (0x6085 = 1.56 m/s² on Z): no jump
+    assert np.all(v * np.sign(v[0]) >= -0.01)  # braking only, no reversal
