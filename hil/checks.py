@@ -118,6 +118,20 @@ def run_checks(trace: TraceFile, checks: ChecksConfig, bench: Bench | None = Non
                                                     ("max", "jitter_max")) if getattr(checks, k) is not None]
     if jitter:
         out += check_jitter(cols, bench.cycle if bench else None, jitter)
+    return check_finite(cols) + out
+
+
+def check_finite(cols: _Cols) -> list[CheckResult]:
+    """A NaN (or ±inf) in a column a check read makes every comparison on it false, so the check
+    would pass on missing data: each such column fails here instead, naming its first bad cycle."""
+    out = []
+    for name, col in sorted(cols._c.items()):
+        if col.dtype.kind != "f":
+            continue
+        bad = np.flatnonzero(~np.isfinite(col))
+        if bad.size:
+            out.append(CheckResult(f"trace data {name}", False, detail=f"{bad.size} cycles hold no number "
+                                   f"(NaN/inf), first at cycle {cols.where(int(bad[0]))['cycle']}"))
     return out
 
 

@@ -26,7 +26,10 @@ class UsageError(Exception):
 
 
 def build_parser() -> argparse.ArgumentParser:
+    from hil.version import version
+
     parser = argparse.ArgumentParser(prog="hil", description="Delta NC5 hardware-in-the-loop bench driver")
+    parser.add_argument("--version", action="version", version=f"hil (deltahil) {version()}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     sub.required = True
     for mod in sorted(pkgutil.iter_modules(hil.commands.__path__), key=lambda m: m.name):

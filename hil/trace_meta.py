@@ -9,22 +9,13 @@ from collections.abc import Sequence
 from typing import Any
 
 from hil.bench import Bench
+from hil.version import version
 
 # column suffix → unit (a rotary axis's positions are degrees: see column_units)
 _SUFFIX_UNITS = (("_rpm_cmd", "rpm"), ("_rpm_act", "rpm"), ("_angle", "deg"), ("_cmd", "mm"), ("_act", "mm"),
                  ("_vel", "mm/s"), ("_torque", "% rated torque"), ("_ferr", "mm"), ("_sw", "CiA 402 statusword"))
 _FIXED = {"t": "s", "period": "s", "late": "s", "line": "program line", "cycle": "bench cycle",
           "alarm": "Delta alarm code", "event": "--at action"}
-
-
-def version() -> str:
-    from importlib.metadata import PackageNotFoundError
-    from importlib.metadata import version as v
-
-    try:
-        return v("deltahil")
-    except PackageNotFoundError:
-        return "unknown"
 
 
 def column_units(columns: Sequence[str], bench: Bench | None = None) -> dict[str, str]:

@@ -97,3 +97,8 @@ def test_the_api_returns_the_reports_figures(square, tmp_path):
     assert all(isinstance(f, Figure) for f in figs.values())
     ax = figs["path"].axes[0]
     assert [l.get_label() for l in ax.get_lines()][:3] == ["programmed", "commanded", "actual (feedback)"]
+
+
+def test_hil_version():
+    out = subprocess.run([sys.executable, "-m", "hil.cli", "--version"], capture_output=True, text=True, cwd=ROOT)
+    assert out.returncode == 0 and out.stdout.startswith("hil (deltahil) ")

@@ -209,3 +209,24 @@ def test_contour_error_of_a_filtered_cam_program_is_measured_against_the_right_b
     assert line.strip().startswith("ok")
     value = float(line.split("contour error:")[1].split("mm")[0])
     assert 0.0005 < value < 0.03
+
+
+def test_nan_in_a_checked_column_fails_and_a_skipped_check_is_no_pass(tmp_path, capsys):
+    """issue 15 item 6 / issue 20: `hil check` passed a following-error column of NaN ("ok … nan mm")
+    and counted a SKIP as a pass."""
+    from hil.cli import main
+
+    cols = trace_columns(["X", "Z"], [])
+    w = CsvTrace(tmp_path / "n.csv", cols)
+    for k in range(50):
+        row = {c: 0.0 for c in cols}
+        row.update(t=(k + 1) * 0.001, line=1, cycle=k + 1, alarm="", X_sw=0x1237, Z_sw=0x1237,
+                   X_ferr=float("nan") if k >= 20 else 0.001)
+        w.write([row[c] for c in cols])
+    w.close()
+    assert main(["check", str(tmp_path / "n.csv"), "--max-ferr", "0.1"]) == 1
+    out = capsys.readouterr().out
+    assert "FAIL  trace data X_ferr" in out and "first at cycle 21" in out
+    assert main(["check", str(tmp_path / "n.csv"), "--max-ferr", "0.1", "--contour", "0.05"]) == 1
+    out = capsys.readouterr()
+    assert "skipped" in out.out and "nothing was judged" in out.err

@@ -15,16 +15,7 @@ from typing import Any
 import numpy as np
 
 from hil.campaign.inputs import CaseInputs, materialise
-
-
-def version() -> str:
-    from importlib.metadata import PackageNotFoundError
-    from importlib.metadata import version as v
-
-    try:
-        return v("deltahil")
-    except PackageNotFoundError:
-        return "unknown"
+from hil.version import version
 
 
 def base_row(case: CaseInputs) -> dict[str, Any]:

@@ -100,7 +100,15 @@ def cmd_check(args: argparse.Namespace) -> int:
         return EXIT_USAGE
     for r in results:
         print(json.dumps(r.as_dict()) if args.json else str(r))
-    failed = [r for r in results if not r.ok]
+    failed = [r for r in results if not r.ok and not r.skipped]
+    skipped = [r for r in results if r.skipped]
+    passed = len(results) - len(failed) - len(skipped)
     if not args.json:
-        print(f"{len(results) - len(failed)} passed, {len(failed)} failed")
-    return EXIT_ALARM if failed else EXIT_OK
+        print(f"{passed} passed, {len(failed)} failed" + (f", {len(skipped)} skipped" if skipped else ""))
+    # A check that could not run for want of input (the program, the bench) is not a pass; one with
+    # nothing to judge in this run (no thread in the program) is only reported.
+    unjudged = [r for r in skipped if r.detail.startswith("needs")]
+    if unjudged:
+        print(f"hil check: {len(unjudged)} check(s) skipped ({'; '.join(r.detail for r in unjudged)}): "
+              "nothing was judged there", file=sys.stderr)
+    return EXIT_ALARM if failed or unjudged else EXIT_OK
