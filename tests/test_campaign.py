@@ -176,8 +176,8 @@ def _kill_while_busy(client, workers: dict, name: str, deadline: float = 60.0) -
     """SIGKILL worker `name` as soon as it is running a case."""
     end = time.monotonic() + deadline
     while time.monotonic() < end:
-        busy = {client.scheduler_info()["workers"][w]["name"]: tasks for w, tasks in client.processing().items()
-                if w in client.scheduler_info()["workers"]}
+        info = client.scheduler_info()["workers"]  # one snapshot: workers come and go under load
+        busy = {info[w]["name"]: tasks for w, tasks in client.processing().items() if w in info}
         if busy.get(name):
             os.kill(workers[name].pid, signal.SIGKILL)
             return True
