@@ -32,6 +32,19 @@ def hil(*argv: str, cwd: Path | None = None, timeout: float = 240) -> subprocess
                           cwd=cwd, timeout=timeout)
 
 
+def with_data(folder: Path, name: str | None = None, text: str = "") -> Path:
+    """The test campaign's files copied into `folder`, plus a campaign file `name` holding `text`."""
+    for f in DATA.iterdir():
+        shutil.copy(f, folder)
+    if name:
+        (folder / name).write_text(text)
+    return folder / (name or "campaign.toml")
+
+
+def run_quiet(campaign: Path, out: Path) -> subprocess.CompletedProcess:
+    return hil("campaign", str(campaign), "--out", str(out), "--workers", "0", "--quiet")
+
+
 def rows(out: Path) -> list[dict]:
     return pq.read_table(out / "results.parquet").drop(list(NONDETERMINISTIC)).to_pylist()
 
@@ -121,10 +134,7 @@ def test_diff_flags_a_changed_bench_limit(serial, tmp_path):
     ("[campaign\n", "not valid TOML"),
 ])
 def test_a_bad_campaign_file_names_the_field(tmp_path, text, field):
-    for f in DATA.iterdir():
-        shutil.copy(f, tmp_path)
-    (tmp_path / "bad.toml").write_text(text)
-    p = hil("campaign", str(tmp_path / "bad.toml"), "--out", str(tmp_path / "o"), "--workers", "0")
+    p = run_quiet(with_data(tmp_path, "bad.toml", text), tmp_path / "o")
     assert p.returncode == 2, p.stdout + p.stderr
     assert field in p.stderr and "Traceback" not in p.stderr
     assert not (tmp_path / "o" / "results.parquet").exists()
@@ -198,10 +208,8 @@ def test_scheduler_and_workers_as_processes_run_the_campaign_and_survive_a_kille
 
 def test_a_case_that_keeps_losing_its_worker_is_marked_worker_lost(cluster, tmp_path):
     address, client, workers = cluster
-    for f in DATA.iterdir():
-        shutil.copy(f, tmp_path)
-    text = (DATA / "campaign.toml").read_text().replace('name = "test"', 'name = "test"\nretries = 1')
-    (tmp_path / "campaign.toml").write_text(text)
+    with_data(tmp_path, "campaign.toml",
+              (DATA / "campaign.toml").read_text().replace('name = "test"', 'name = "test"\nretries = 1'))
     run = campaign_on(address, tmp_path / "campaign.toml", tmp_path / "r")
     assert _kill_while_busy(client, workers, "wb")
     out, err = run.communicate(timeout=240)
@@ -217,12 +225,9 @@ def test_a_case_that_keeps_losing_its_worker_is_marked_worker_lost(cluster, tmp_
 
 
 def test_kept_traces_form_a_partitioned_dataset_and_canopen_runs_like_sim(tmp_path):
-    for f in DATA.iterdir():
-        shutil.copy(f, tmp_path)
-    (tmp_path / "traced.toml").write_text(
-        "[campaign]\nprograms = ['short_turn.nc']\nbenches = ['bench.toml']\nbuses = ['sim', 'canopen:virtual']\n"
-        "trace = true\n")
-    p = hil("campaign", str(tmp_path / "traced.toml"), "--out", str(tmp_path / "o"), "--workers", "0", "--quiet")
+    campaign = with_data(tmp_path, "traced.toml", "[campaign]\nprograms = ['short_turn.nc']\nbenches = ['bench.toml']\n"
+                         "buses = ['sim', 'canopen:virtual']\ntrace = true\n")
+    p = run_quiet(campaign, tmp_path / "o")
     assert p.returncode == 0, p.stdout + p.stderr
     rs = {r["bus"]: r for r in pq.read_table(tmp_path / "o" / "results.parquet").to_pylist()}
     assert set(rs) == {"sim", "canopen:virtual"} and all(r["status"] == "completed" for r in rs.values())
@@ -240,12 +245,9 @@ def test_kept_traces_form_a_partitioned_dataset_and_canopen_runs_like_sim(tmp_pa
 
 
 def test_a_run_past_max_time_is_a_timeout_and_params_sweep_is_a_variant(tmp_path):
-    for f in DATA.iterdir():
-        shutil.copy(f, tmp_path)
-    (tmp_path / "t.toml").write_text(
-        "[campaign]\nprograms = ['short_turn.nc']\nbenches = ['bench.toml']\nmax_time = 0.4\n"
-        "[params]\n'N1.040' = [0.01, 0.02]\n")
-    p = hil("campaign", str(tmp_path / "t.toml"), "--out", str(tmp_path / "o"), "--workers", "0", "--quiet")
+    campaign = with_data(tmp_path, "t.toml", "[campaign]\nprograms = ['short_turn.nc']\nbenches = ['bench.toml']\n"
+                         "max_time = 0.4\n[params]\n'N1.040' = [0.01, 0.02]\n")
+    p = run_quiet(campaign, tmp_path / "o")
     assert p.returncode == 1
     rs = pq.read_table(tmp_path / "o" / "results.parquet").to_pylist()
     assert sorted(r["params"] for r in rs) == ["N1.040=0.01", "N1.040=0.02"]
