@@ -12,7 +12,8 @@ from pathlib import Path
 
 DOCS = Path(__file__).resolve().parent
 
-ORDER = ["foundation", "language", "cycles", "motion", "ethercat", "canopen", "mlc", "bench", "campaign"]
+ORDER = ["foundation", "language", "cycles", "motion", "ethercat", "canopen", "mlc", "bench", "campaign",
+         "bench-tools"]
 
 HEADERS = {
     "decisions": """# Decisions where the Delta manuals are ambiguous

@@ -52,10 +52,22 @@ def main(argv: Sequence[str] | None = None) -> int:
         print("hil: interrupted", file=sys.stderr)
         return 130
     except BrokenPipeError:
-        return EXIT_OK
+        return _reader_left()
     except Exception as exc:  # never a traceback: report as the NC's internal alarm
         print(str(internal_error(exc)), file=sys.stderr)
         return EXIT_ALARM
+
+
+def _reader_left() -> int:
+    """stdout's reader closed (`hil path … | head`): end quietly, exit 0 as README says. Python would
+    flush stdout again at exit and print 'Exception ignored … BrokenPipeError', so point it at devnull."""
+    import os
+
+    try:
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+    except (OSError, ValueError):  # stdout is not a real file (pytest capture): nothing to flush
+        pass
+    return EXIT_OK
 
 
 if __name__ == "__main__":

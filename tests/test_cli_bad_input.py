@@ -193,7 +193,7 @@ CASES: list[tuple[str, str, int, tuple[str, ...]]] = [
     ("servo-set-no-value", "servo set X P2-00", 2, ("VALUE",)),
     ("servo-ethercat-nope0", "servo get X P2-00 --bus ethercat:nope0", 1, ("0x1429",)),
     ("servo-canopen-nosuch", "servo get X P2-00 --bench {d}/slow.toml --bus canopen:nosuchiface", 1, ("0x1420",)),
-    ("servo-modbus-missing", "servo get X P2-00 --modbus /dev/nope-tty", 2, ("/dev/nope-tty",)),
+    ("servo-modbus-missing", "servo get X P2-00 --servo-modbus /dev/nope-tty", 2, ("/dev/nope-tty",)),
     ("scan-ethercat-nope0", "scan --bus ethercat:nope0", 1, ("0x1429",)),
     ("scan-canopen", "scan --bus canopen:virtual", 2, ("not supported",)),
     ("scan-junk", "scan --bus junk", 2, ("unknown bus",)),

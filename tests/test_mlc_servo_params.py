@@ -69,7 +69,7 @@ def test_the_drive_refuses_bad_parameters_with_delta_answers(drive_on_pty):
 def test_hil_servo_set_over_modbus_then_get_over_sdo_of_the_same_drive(hil, drive_on_pty):
     drive, srv, master = drive_on_pty
     master.close()  # hil servo opens its own serial port on the pty
-    r = hil("servo", "set", "X", "P2-00", "220", "--modbus", srv.device)
+    r = hil("servo", "set", "X", "P2-00", "220", "--servo-modbus", srv.device)
     assert r.code == 0, r.err
     assert "P2-00 set 220 → 220" in r.out and "register 0x0200" in r.out
     assert struct.unpack("<i", SimLink([drive]).sdo_read(0, 0x2200))[0] == 220

@@ -162,6 +162,8 @@ def cmd_path(args: argparse.Namespace) -> int:
         _print_preview(interp, args)
         print_alarm(exc.alarm, as_json=args.json)
         return EXIT_ALARM
+    except BrokenPipeError:  # `hil path … | head`: the reader left; hil.cli ends quietly
+        raise
     except Exception as exc:  # a bug, reported as the NC internal alarm, never a traceback
         print_alarm(internal_error(exc), as_json=args.json)
         return EXIT_ALARM

@@ -1,7 +1,7 @@
 """`hil servo get|set AXIS PARAM [VALUE]`: Delta ASDA servo parameters Pn-xx of one drive.
 
 Over the bench's bus by SDO (object 0x2000 + n*0x100 + xx; SimLink's simulated drives and
-EtherCAT), or with ``--modbus DEVICE`` over the drive's RS-485 port (Modbus RTU, pyserial).
+EtherCAT), or with ``--servo-modbus DEVICE`` over the drive's RS-485 port (Modbus RTU, pyserial).
 A `set` reads the value back and prints both.  Exit 1 when the drive refuses (SDO abort code or
 Modbus exception), 2 for usage errors.
 """
@@ -21,9 +21,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("value", nargs="?", type=int, help="value to write (set)")
     p.add_argument("--bench", help="bench file (TOML); default: the built-in 2-axis lathe")
     p.add_argument("--bus", help="sim | ethercat:IFACE (overrides the bench)")
-    p.add_argument("--modbus", metavar="DEVICE", help="serial device of the drive's RS-485 port (Modbus RTU)")
+    p.add_argument("--servo-modbus", dest="modbus", metavar="DEVICE",
+                   help="serial device of the drive's RS-485 port (Modbus RTU); the same flag as hil run's")
+    p.add_argument("--modbus", dest="modbus", help=argparse.SUPPRESS)  # old spelling
     p.add_argument("--unit", type=lambda s: int(s, 0), default=0x7F, help="Modbus station address (P3-00), default 0x7F")
-    p.add_argument("--baud", type=int, default=38400, help="RS-485 baud rate (default 38400)")
+    p.add_argument("--servo-baud", dest="baud", type=int, default=38400, help="RS-485 baud rate (default 38400)")
+    p.add_argument("--baud", dest="baud", type=int, help=argparse.SUPPRESS)  # old spelling
     p.set_defaults(func=cmd_servo)
 
 
@@ -64,7 +67,7 @@ def _over_sdo(args, bench, position: int, group: int, number: int, label: str, i
         print(f"hil servo: {exc}", file=sys.stderr)
         return 2
     if not hasattr(link, "sdo_read"):
-        print(f"hil servo: bus {bench.bus} has no SDO access here; use --modbus DEVICE", file=sys.stderr)
+        print(f"hil servo: bus {bench.bus} has no SDO access here; use --servo-modbus DEVICE", file=sys.stderr)
         return 2
     where = f"{args.axis} (slave {position}) object 0x{index:04X}:0 over SDO ({bench.bus})"
     try:

@@ -21,7 +21,8 @@ def _add_ethercat(sims: argparse._SubParsersAction) -> None:
                         formatter_class=argparse.RawDescriptionHelpFormatter,
                         description="Serve the bench's drives (axes, then spindles) as EtherCAT slaves on IFACE.",
                         epilog=_fault_help())
-    p.add_argument("--iface", required=True, help="network interface (e.g. one end of a veth pair)")
+    p.add_argument("--iface", help="network interface (e.g. one end of a veth pair); required")
+    p.add_argument("--interface", dest="iface", help=argparse.SUPPRESS)  # CANopen's word, accepted here too
     p.add_argument("--bench", help="bench file (TOML); default: the built-in 2-axis lathe")
     p.add_argument("--io", type=int, default=0, metavar="N",
                    help="R1-EC class I/O slaves after the drives: one per [[io]] station of the bench (its `modules`), "
@@ -87,6 +88,8 @@ def cmd_sim_ethercat(args: argparse.Namespace) -> int:
     from virtual_bus.ethercat.network import RawSocketLine
 
     try:
+        if not args.iface:  # not argparse's required=: the hidden --interface alias fills it too
+            raise InputError("give the network interface: --iface IFACE")
         bench = load_bench(args.bench)
         faults = [parse_fault(f) for f in args.fault]
     except (InputError, ValueError) as exc:
