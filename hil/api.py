@@ -131,13 +131,14 @@ def run(program: str | Path, bench: str | Path | Bench | None = None, *, bus: st
         feed_override: float = 100.0, rapid_override: float = 100.0, spindle_override: float = 100.0,
         check: bool | None = None, trace_signals: str | None = None, m00_resume: float = 0.5,
         realtime: bool = False, overrun: str | None = None, progress: Any = None,
-        servo_modbus: str | None = None, servo_baud: int = 38400) -> Result:
+        servo_modbus: str | None = None, servo_baud: int = 38400, capture: str | Path | None = None) -> Result:
     """Run `program` on a bench in lock-step virtual time (or `realtime`); see the module doc.
 
     `bench`: a bench file, a `Bench`, or None for the built-in 2-axis lathe. `events`: `--at`
     strings; `event_files`: `--events` files. Overrides are the panel's switch positions at power-on
     (D2x002 feed 0–150 %, D2x004 rapid 0–100 %, D2x026 spindle 50–120 %); the MLC may change them.
-    `check`: judge the run by the bench's [checks] (default: when it has any)."""
+    `check`: judge the run by the bench's [checks] (default: when it has any). `capture`: record the
+    bus's frames (EtherCAT .pcapng, CAN .asc/.blf/.log; fieldbus/capture.py)."""
     from hil.clock import make_clock
     from hil.progress import Progress
     from hil.remote_io import attach_remote_io
@@ -162,6 +163,8 @@ def run(program: str | Path, bench: str | Path | Bench | None = None, *, bus: st
         return Result(str(program), b, RunResult(alarms=[exc.alarm]))
     if overrun:
         b.realtime.overrun = overrun
+    if capture:  # refuse a sim bus or a wrong suffix before anything starts
+        _capture_suffix(str(capture), b)
     link = make_link(b)
     clock = make_clock(b.cycle, realtime, b.realtime)
     if progress is True:
@@ -192,7 +195,10 @@ def run(program: str | Path, bench: str | Path | Bench | None = None, *, bus: st
     if temporary:  # checks read a trace; keep it only if asked for
         fd, trace_path = tempfile.mkstemp(prefix="hil-run-", suffix=".parquet")
         os.close(fd)
+    cap = None
     try:
+        if capture:
+            cap = _open_capture(str(capture), link, b)
         if trace_path:
             from hil.trace_meta import column_units, run_meta
 
@@ -224,8 +230,33 @@ def run(program: str | Path, bench: str | Path | Bench | None = None, *, bus: st
     finally:
         if temporary and trace_path:
             Path(trace_path).unlink(missing_ok=True)
+        if cap is not None:
+            cap.close()
     return Result(str(program), b, result, checks, list(player.events) if player is not None else [],
                   TraceRef(Path(trace_path)) if trace_path and not temporary else None, runner)
+
+
+def _capture_suffix(path: str, b: Bench) -> None:
+    from fieldbus.capture import check_suffix
+    from fieldbus.factory import parse_bus
+    from hil.session import InputError
+
+    try:
+        check_suffix(path, parse_bus(b.bus).kind)
+    except ValueError as exc:
+        raise InputError(str(exc)) from None
+
+
+def _open_capture(path: str, link: Any, b: Bench) -> Any:
+    from fieldbus.capture import open_capture
+    from fieldbus.factory import parse_bus
+    from hil.session import InputError
+
+    spec = parse_bus(b.bus)
+    try:
+        return open_capture(path, link, spec.kind, spec.interface)
+    except (ValueError, OSError) as exc:
+        raise InputError(f"cannot capture to {path}: {exc}") from None
 
 
 def _set_overrides(mlc: Any, feed: float, rapid: float, spindle: float) -> None:

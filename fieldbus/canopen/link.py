@@ -171,6 +171,7 @@ class CanopenLink:
         self.faults: list[tuple[str, FaultEpisode]] = []  # (drive, episode) in the order they began
         self._next_sync = 0.0
         self._opened_at = 0.0
+        self.capture: Any = None  # fieldbus.capture.CanCapture: `hil run --capture FILE.asc`
 
     @classmethod
     def for_bench(cls, bench: Any, interface: str, channel: str = "") -> "CanopenLink":
@@ -217,6 +218,10 @@ class CanopenLink:
                 raise BusError(Alarm(ALARM_ESTABLISH, f"cannot open CAN interface {self.interface}"
                                                       f"{':' + self.channel if self.channel else ''}: {exc}")) from None
         net = self.network
+        if self.capture is not None:  # every frame from NMT reset on; lock-step frames carry simulated time
+            t0 = time.time()
+            self.capture.tap(net.bus, (lambda: t0 + self.time) if self.lockstep else time.time,
+                             self.channel if not self.lockstep else "virtual")
         for cfg in self.nodes_cfg:
             remote = canopen.RemoteNode(cfg.node_id, canopen.import_od(str(cfg.eds), cfg.node_id))
             net.add_node(remote)

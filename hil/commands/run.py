@@ -55,6 +55,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="print one JSON object (result, alarms, checks, events, times, errors, trace) on stdout; "
                         "the text summary goes to stderr")
     p.add_argument("--junit", metavar="FILE", help="write JUnit XML: a test case for the run and one per check")
+    p.add_argument("--capture", metavar="FILE",
+                   help="record the bus's frames: EtherCAT as .pcapng (Wireshark/tshark), CAN as .asc/.blf/.log")
     p.add_argument("--allow-unfired", action="store_true",
                    help="an --at/--events event that never fired does not fail the run")
     p.set_defaults(func=cmd_run)
@@ -70,7 +72,8 @@ def cmd_run(args: argparse.Namespace) -> int:
                 rapid_override=args.rapid_override, spindle_override=args.spindle_override, check=args.check,
                 trace_signals=args.trace_signals, m00_resume=args.m00_resume, realtime=args.realtime,
                 overrun=args.overrun, progress=True if wants_progress(args.progress) else None,
-                servo_modbus=args.servo_modbus, servo_baud=args.servo_baud)
+                servo_modbus=args.servo_modbus, servo_baud=args.servo_baud,
+                capture=args.capture)
     except InputError as exc:
         if exc.alarm is not None:
             print_alarm(exc.alarm)
