@@ -9,7 +9,7 @@ the pure geometry modules and return the events; they leave `host.position` at t
 from __future__ import annotations
 
 import weakref
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator
 from typing import Any
 
 from nc.alarms import NcAlarm
@@ -63,6 +63,19 @@ def _builder(host: Any, block: Block, plane: tuple[str, str] = LATHE_PLANE) -> P
 def _finish(host: Any, b: PathBuilder) -> list[Event]:
     host.position = dict(b.position)
     return b.events
+
+
+def _stream(host: Any, b: PathBuilder, steps: Iterable[object]) -> Iterator[Event]:
+    """Hand the builder's events on as the cycle makes them, one step (hole, peck, pass) at a time:
+    K999999999 or P1 Q1 pecks keep memory flat and the run can be stopped meanwhile (decisions B1).
+    `host.position` moves to the cycle's end once it is done, as `_finish` does."""
+    for _ in steps:
+        if b.events:
+            yield from b.events
+            b.events.clear()
+    host.position = dict(b.position)
+    yield from b.events
+    b.events.clear()
 
 
 def _has_any(block: Block, letters: str) -> bool:
@@ -151,11 +164,11 @@ def _g71_g72(host: Any, code: str, block: Block) -> list[Event]:
     return _finish(host, b)
 
 
-def _g73(host: Any, block: Block) -> list[Event]:
+def _g73(host: Any, block: Block) -> Iterator[Event]:
     mem = _mem(host)
     if not (block.has("P") and block.has("Q")):
         mem["G73_first"] = {"i": _d(host, block, "U"), "k": _d(host, block, "W"), "d": _raw(block, "R")}
-        return []
+        return
     first = mem.pop("G73_first", {})
     prm = host.profile.param
     i = first.get("i")
@@ -171,8 +184,7 @@ def _g73(host: Any, block: Block) -> list[Event]:
     moves = _contour(host, block)
     b = _builder(host, block)
     b.feed = host.feed(block)
-    turning.pattern(b, segs_from_moves(moves, LATHE_PLANE), i, k, d, u, w)
-    return _finish(host, b)
+    yield from _stream(host, b, turning.pattern(b, segs_from_moves(moves, LATHE_PLANE), i, k, d, u, w))
 
 
 def _g70(host: Any, block: Block) -> list[Event]:
@@ -186,11 +198,11 @@ def _g70(host: Any, block: Block) -> list[Event]:
 
 
 # ---- grooving -------------------------------------------------------------------------------
-def _g74_g75(host: Any, code: str, block: Block) -> list[Event]:
+def _g74_g75(host: Any, code: str, block: Block) -> Iterator[Event]:
     mem = _mem(host)
     if not _has_any(block, "XZUWPQF"):
         mem[f"{code}_first"] = _d(host, block, "R", 0.0)
-        return []
+        return
     e = mem.pop(f"{code}_first", None)
     if e is None:
         e = host.profile.param("P348", 0.0)
@@ -202,10 +214,10 @@ def _g74_g75(host: Any, code: str, block: Block) -> list[Event]:
     b.feed = host.feed(block)
     end = (tgt["Z"], tgt["X"])
     if code == "G74":  # peck in Z by Q, shift in X by P
-        lathe_single.peck_groove(b, end, p_amt, q_amt, escape, e, True, code)
+        steps = lathe_single.peck_groove(b, end, p_amt, q_amt, escape, e, True, code)
     else:  # peck in X by P, shift in Z by Q
-        lathe_single.peck_groove(b, end, q_amt, p_amt, escape, e, False, code)
-    return _finish(host, b)
+        steps = lathe_single.peck_groove(b, end, q_amt, p_amt, escape, e, False, code)
+    yield from _stream(host, b, steps)
 
 
 # ---- threading ------------------------------------------------------------------------------
@@ -312,7 +324,7 @@ def _hole_state(host: Any, block: Block, code: str, axis: str) -> dict:
     return st
 
 
-def _mill_hole(host: Any, code: str, block: Block) -> list[Event]:
+def _mill_hole(host: Any, code: str, block: Block) -> Iterator[Event]:
     plane = int(host.state.plane)
     axis = MILL_DRILL_AXIS.get(plane, "Z")
     pos_axes = PLANE_AXES.get(plane, ("X", "Y"))
@@ -340,7 +352,8 @@ def _mill_hole(host: Any, code: str, block: Block) -> list[Event]:
         # K0: the cycle is set, nothing is drilled; the tool only positions
         b = _builder(host, block, pos_axes)
         b.rapid_axes({a: host.to_machine(work_tgt)[a] for a in pos_axes})
-        return _finish(host, b)
+        yield from _finish(host, b)
+        return
     initial = st["initial"]
 
     def level(work_value: float) -> float:
@@ -369,20 +382,24 @@ def _mill_hole(host: Any, code: str, block: Block) -> list[Event]:
     b.per_rev = bool(host.state.per_rev)
     dwell = st.get("P", 0.0) if code in ("MG82", "MG88", "MG89", "MG76", "MG87", "MG84", "MG74") else 0.0
     here_work = dict(start_work)
-    for n in range(repeats):
-        for a in delta:
-            here_work[a] = start_work[a] + delta[a] * (n + 1) if not absolute else work_tgt[a]
-        pos_m = host.to_machine({**host.work_position(), **{a: here_work[a] for a in delta}})
-        hole = holes.Hole(kind, code[1:], axis, {a: pos_m[a] for a in pos_axes}, r_level, bottom, initial,
-                          return_r, peck=abs(st.get("Q", 0.0)) if code in ("MG73", "MG83", "MG84", "MG74") else 0.0,
-                          clearance=host.profile.param("N1.151", 1.0), dwell=dwell, shift=shift,
-                          spindle_dir=int(host.state.spindle_dir), reverse_tap=code == "MG74")
-        holes.drill_hole(b, hole)
-    st["last_level"] = b.position[axis]
-    return _finish(host, b)
+    here_machine = host.work_position()  # read once: `host.position` stays put until the cycle ends
+
+    def each_hole() -> Iterator[None]:
+        for n in range(repeats):  # lazy: K999999999 holes one at a time (decisions B1)
+            for a in delta:
+                here_work[a] = start_work[a] + delta[a] * (n + 1) if not absolute else work_tgt[a]
+            pos_m = host.to_machine({**here_machine, **{a: here_work[a] for a in delta}})
+            hole = holes.Hole(kind, code[1:], axis, {a: pos_m[a] for a in pos_axes}, r_level, bottom, initial,
+                              return_r, peck=abs(st.get("Q", 0.0)) if code in ("MG73", "MG83", "MG84", "MG74") else 0.0,
+                              clearance=host.profile.param("N1.151", 1.0), dwell=dwell, shift=shift,
+                              spindle_dir=int(host.state.spindle_dir), reverse_tap=code == "MG74")
+            yield from holes.drill_hole(b, hole)
+            yield
+        st["last_level"] = b.position[axis]
+    yield from _stream(host, b, each_hole())
 
 
-def _lathe_hole(host: Any, code: str, block: Block) -> list[Event]:
+def _lathe_hole(host: Any, code: str, block: Block) -> Iterator[Event]:
     face = code in ("G83", "G84", "G85")
     axis = "Z" if face else "X"
     st = _hole_state(host, block, code, axis)
@@ -431,13 +448,15 @@ def _lathe_hole(host: Any, code: str, block: Block) -> list[Event]:
         kind = "bore_feed"
     b = _builder(host, block)
     b.feed = feed
-    for _ in range(max(repeats, 0)):
-        hole = holes.Hole(kind, code, axis, {a: tgt[a] for a in pos_axes}, r_level, bottom, initial, return_r,
-                          peck=peck, clearance=host.profile.param("N1.151", 1.0), dwell=st.get("P", 0.0),
-                          spindle_dir=int(host.state.spindle_dir))
-        holes.drill_hole(b, hole)
-    st["last_level"] = b.position[axis]
-    return _finish(host, b)
+    def each_hole() -> Iterator[None]:
+        for _ in range(max(repeats, 0)):  # lazy, as `_mill_hole`
+            hole = holes.Hole(kind, code, axis, {a: tgt[a] for a in pos_axes}, r_level, bottom, initial, return_r,
+                              peck=peck, clearance=host.profile.param("N1.151", 1.0), dwell=st.get("P", 0.0),
+                              spindle_dir=int(host.state.spindle_dir))
+            yield from holes.drill_hole(b, hole)
+            yield
+        st["last_level"] = b.position[axis]
+    yield from _stream(host, b, each_hole())
 
 
 # ---- entry ----------------------------------------------------------------------------------
@@ -464,4 +483,4 @@ def run_cycle(host: Any, code: str, block: Block) -> Iterator[Event]:
         events = _mill_hole(host, code, block)
     else:
         events = _lathe_hole(host, code, block)
-    return iter(events)
+    return iter(events)  # the hole, G73 and G74/G75 cycles are generators: lazy for any K, R, P or Q

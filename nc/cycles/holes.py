@@ -7,12 +7,12 @@ sees them in order with the motion (decisions A50/A51).
 
 from __future__ import annotations
 
+import math
+from collections.abc import Iterator
 from dataclasses import dataclass
 
 from nc.alarms import NcAlarm
 from nc.cycles.builder import PathBuilder
-
-MAX_PECKS = 100000
 
 
 @dataclass
@@ -33,20 +33,17 @@ class Hole:
     reverse_tap: bool = False  # G74 left-hand tapping
 
 
-def _levels(start: float, end: float, step: float) -> list[float]:
+def _levels(start: float, end: float, step: float) -> Iterator[float]:
+    """Peck bottoms from `start` to `end` every `step`, the last one `end`; lazy, so a 1 µm peck on a
+    long stroke (legal, N§3.13.1) costs no memory (decisions B1)."""
     if step <= 0:
-        return [end]
+        yield end
+        return
     sgn = 1.0 if end > start else -1.0
-    total = abs(end - start)
-    out = []
-    k = 1
-    while k * step < total - 1e-9:
-        out.append(start + sgn * k * step)
-        k += 1
-        if k > MAX_PECKS:
-            raise NcAlarm(0x0246, "too many pecks in the drilling cycle")
-    out.append(end)
-    return out
+    n = max(1, math.ceil((abs(end - start) - 1e-9) / step))  # pecks, the last one clamped to `end`
+    for k in range(1, n):
+        yield start + sgn * k * step
+    yield end
 
 
 def _not_past(level: float, r_level: float, sgn: float) -> float:
@@ -58,7 +55,8 @@ def _spindle_code(direction: int) -> int:
     return {1: 3, -1: 4}.get(direction, 5)
 
 
-def drill_hole(b: PathBuilder, h: Hole) -> None:
+def drill_hole(b: PathBuilder, h: Hole) -> Iterator[None]:
+    """Add one hole's moves to `b`; yields after each peck so the caller can hand them on (lazy)."""
     ax = h.axis
     tag = (h.code,)
     b.rapid_axes(h.position, tag + ("position",))
@@ -89,36 +87,36 @@ def drill_hole(b: PathBuilder, h: Hole) -> None:
             b.dwell(h.dwell, tag + ("dwell",))
         b.rapid_axes({ax: ret_level}, tag + ("return",))
     elif h.kind in ("peck_full", "peck_chip"):
-        depths = _levels(h.r_level, h.bottom, h.peck)
         prev = h.r_level
-        for i, d in enumerate(depths, start=1):
+        for i, d in enumerate(_levels(h.r_level, h.bottom, h.peck), start=1):
             if h.kind == "peck_full" and i > 1:
                 # re-approach rapidly to just above the previous bottom, never above R (a peck
                 # shallower than d, e.g. `Q4` = 4 µm, would otherwise cut air from above R)
                 b.rapid_axes({ax: _not_past(prev + sgn * h.clearance, h.r_level, sgn)}, tag + ("reapproach",))
             b.line_axes({ax: d}, tag + ("peck", str(i)))
-            if d != depths[-1]:
+            if d != h.bottom:
                 if h.kind == "peck_full":
                     b.rapid_axes({ax: h.r_level}, tag + ("retract",))
                 else:
                     b.rapid_axes({ax: _not_past(d + sgn * h.clearance, h.r_level, sgn)}, tag + ("retract",))
             prev = d
+            yield
         if h.dwell > 0:
             b.dwell(h.dwell, tag + ("dwell",))
         b.rapid_axes({ax: ret_level}, tag + ("return",))
     elif h.kind == "tap":
         into = -1 if h.reverse_tap else 1
-        depths = _levels(h.r_level, h.bottom, h.peck) if h.peck > 0 else [h.bottom]
         if h.spindle_dir != into:
             b.aux("M", _spindle_code(into))
-        for i, d in enumerate(depths, start=1):
+        for i, d in enumerate(_levels(h.r_level, h.bottom, h.peck), start=1):
             if i > 1:
                 b.aux("M", _spindle_code(into))
             b.line_axes({ax: d}, tag + ("tap", str(i)))
-            if h.dwell > 0 and d == depths[-1]:
+            if h.dwell > 0 and d == h.bottom:
                 b.dwell(h.dwell, tag + ("dwell",))
             b.aux("M", _spindle_code(-into))  # spindle reversal at the bottom of each peck
             b.line_axes({ax: h.r_level}, tag + ("tap_out", str(i)))
+            yield
         b.aux("M", _spindle_code(h.spindle_dir if h.spindle_dir else into))
         if not h.return_r:
             b.rapid_axes({ax: h.initial}, tag + ("return",))

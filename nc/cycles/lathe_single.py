@@ -7,12 +7,11 @@ R is the taper (start − end, radius) at the start side; G74/G75 end at their s
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator
 
 from nc.alarms import NcAlarm
 from nc.cycles.builder import PathBuilder
 from nc.cycles.geometry import Pt
-
-MAX_PECKS = 100000
 
 
 def g90(b: PathBuilder, end: Pt, taper: float, code: str = "G90") -> None:
@@ -33,25 +32,28 @@ def g94(b: PathBuilder, end: Pt, taper: float, code: str = "G94") -> None:
     b.rapid((za, xa), (code, "return"))
 
 
-def _steps(a: float, b: float, step: float) -> list[float]:
-    """Positions from a to b (inclusive) every `step`, the last one clamped to b."""
+def _steps(a: float, b: float, step: float) -> Iterator[float]:
+    """Positions from a to b (inclusive) every `step`, the last one clamped to b; lazy, so P1 Q1
+    (1 µm) on a long stroke, legal if huge, costs no memory (decisions B1)."""
     if abs(b - a) < 1e-9:
-        return [a]
+        yield a
+        return
     if step <= 0:
         raise NcAlarm(0x0246, "peck/shift amount must be positive")
     n = math.ceil(abs(b - a) / step - 1e-9)
-    if n > MAX_PECKS:
-        raise NcAlarm(0x0246, "too many pecks")
     sgn = 1.0 if b > a else -1.0
-    return [a + sgn * min(i * step, abs(b - a)) for i in range(n + 1)]
+    for i in range(n):
+        yield a + sgn * i * step
+    yield b  # exactly: callers recognise the last position by it
 
 
 def peck_groove(b: PathBuilder, end: Pt, shift: float, peck: float, escape: float, retract: float,
-                face: bool, code: str) -> None:
+                face: bool, code: str) -> Iterator[None]:
     """G74 (face = True: peck in Z, shift in X) and G75 (peck in X, shift in Z).
 
     Per position: feed one peck, rapid back `retract`, feed on, to the bottom; escape `escape` at the
     bottom away from the shift direction, rapid back to the start level, shift to the next position.
+    Yields after each peck so the caller hands the moves on as they are made.
     """
     za, xa = b.here
     ze, xe = end
@@ -71,12 +73,15 @@ def peck_groove(b: PathBuilder, end: Pt, shift: float, peck: float, escape: floa
     sdir = 1.0 if s_end > s_start else -1.0
     for j, s in enumerate(positions, start=1):
         b.rapid(pt(p_start, s), (code, "shift"))
-        depths = _steps(p_start, p_end, peck)[1:] if abs(p_end - p_start) > 1e-9 else []
-        for i, d in enumerate(depths):
-            b.feed_to(pt(d, s), (code, "peck", str(j)))
-            if i < len(depths) - 1 and retract > 0:
-                back = d - pdir * min(retract, abs(d - p_start))
-                b.rapid(pt(back, s), (code, "retract"))
+        if abs(p_end - p_start) > 1e-9:
+            depths = _steps(p_start, p_end, peck)
+            next(depths)  # the start level itself
+            for d in depths:
+                b.feed_to(pt(d, s), (code, "peck", str(j)))
+                if d != p_end and retract > 0:
+                    back = d - pdir * min(retract, abs(d - p_start))
+                    b.rapid(pt(back, s), (code, "retract"))
+                yield
         if escape > 1e-12 and j > 1:
             b.feed_to(pt(p_end, s - sdir * escape), (code, "escape"))
         b.rapid(pt(p_start, b.here[1] if face else b.here[0]), (code, "return"))

@@ -9,6 +9,7 @@ start point, ,C/,R inside P–Q arrive already expanded, G41/G42 is ignored in r
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from dataclasses import dataclass
 
 from nc.alarms import NcAlarm
@@ -154,8 +155,9 @@ def rough(b: PathBuilder, contour_segs: list[Seg], spec: RoughSpec) -> None:
 
 
 def pattern(b: PathBuilder, contour_segs: list[Seg], total_x: float, total_z: float, count: int,
-            u: float, w: float, code: str = "G73") -> None:
-    """G73: the whole contour repeated `count` times, stepping from (i+u, k+w) to (u, w)."""
+            u: float, w: float, code: str = "G73") -> Iterator[None]:
+    """G73: the whole contour repeated `count` times, stepping from (i+u, k+w) to (u, w); yields
+    after each pass so a huge R streams instead of filling memory (decisions B1)."""
     if count < 2 or count != int(count):
         raise NcAlarm(0x0246, f"{code} needs an integer number of cuts R ≥ 2 (got {count:g})")
     start = b.here
@@ -177,6 +179,7 @@ def pattern(b: PathBuilder, contour_segs: list[Seg], total_x: float, total_z: fl
                 b.rapid(s.p0, tags)
             b.seg(s, tags)
         b.rapid(start, (code, "return"))
+        yield
 
 
 def finish(b: PathBuilder, moves: list, code: str = "G70") -> None:

@@ -1,0 +1,88 @@
+"""Issue 15 budgets: canned cycles and repeats expand lazily (memory flat for any K, P, Q, R) and
+the run can be stopped while they run (decisions B1)."""
+
+from __future__ import annotations
+
+import itertools
+import tracemalloc
+from pathlib import Path
+
+import pytest
+
+from hil import api
+from nc.interp import Interpreter
+from nc.moves import Move
+from nc.profiles import make_profile
+from nc.program.blocks import parse_program
+
+ROOT = Path(__file__).resolve().parents[1]
+
+HUGE = {
+    # milling G81 with K999999999 incremental holes, 1 mm apart
+    "g81_k": ("nc5-mill", "G90 G00 X0 Y0 Z10.\nG91 G81 X1. Y0 Z-5. R-2. F500 K999999999\nG80\nM30\n"),
+    # milling G83, a 1 µm peck (legal) on a 50 mm hole, repeated K99999999 times
+    "g83_k": ("nc5-mill", "G90 G00 X0 Y0 Z10.\nG91 G83 X1. Z-50. R-2. Q1 F500 K99999999\nM30\n"),
+    # lathe G74 face grooving, P1 Q1 (1 µm shift and peck) over 20 mm x 205 mm
+    "g74_p1q1": ("nc5-lathe-a", "G00 X0 Z5. M03 S1000\nG74 R0.5\nG74 X20. Z-200. P1 Q1 F0.1\nM30\n"),
+    "g75_p1q1": ("nc5-lathe-a", "G00 X60. Z5. M03 S1000\nG75 R0.5\nG75 X10. Z-200. P1 Q1 F0.1\nM30\n"),
+    # lathe G73 pattern repeat with R99999999 passes
+    "g73_r": ("nc5-lathe-a", "G00 X60. Z5. M03 S1000\nG73 U5. W0. R99999999\nG73 P10 Q20 U0.2 W0.1 F0.2\n"
+                             "N10 G00 X20.\nG01 Z-20.\nN20 X50.\nM30\n"),
+    # lathe G83 with a large K
+    "g83_lathe_k": ("nc5-lathe-a", "G00 X0 Z5. M03 S1000\nG83 Z-300. R-1. Q1 F0.1 K999999999\nM30\n"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(HUGE))
+def test_huge_repeat_streams_with_flat_memory(case: str) -> None:
+    """The first 20,000 moves of a cycle with ~1e8-1e13 of them come out at once, in a few MB."""
+    profile, text = HUGE[case]
+    interp = Interpreter(make_profile(profile))
+    events = interp.run(parse_program(text, f"{case}.nc"))
+    tracemalloc.start()
+    try:
+        moves = [e for e in itertools.islice(events, 20_000) if isinstance(e, Move)]
+        _, peak = tracemalloc.get_traced_memory()
+    finally:
+        tracemalloc.stop()
+    assert len(moves) > 10_000
+    assert peak < 30e6, f"{case}: {peak / 1e6:.0f} MB for 20,000 events"
+
+
+def test_first_holes_of_k_cycle_are_where_programmed() -> None:
+    """Lazy does not change the path: G91 G81 K holes step 1 mm in X, drill 2+5 mm below Z10."""
+    interp = Interpreter(make_profile("nc5-mill"))
+    events = interp.run(parse_program(HUGE["g81_k"][1], "k.nc"))
+    cuts = [e for e in itertools.islice(events, 400) if isinstance(e, Move) and "cut" in e.tags]
+    assert [round(c.end["X"], 6) for c in cuts[:5]] == [1.0, 2.0, 3.0, 4.0, 5.0]
+    assert all(abs(c.start["Z"] - 8.0) < 1e-9 and abs(c.end["Z"] - 3.0) < 1e-9 for c in cuts)
+
+
+def test_finite_k_still_ends_where_the_last_hole_is() -> None:
+    """`host.position` moves to the cycle's end once the lazy cycle is done: the next block starts there."""
+    text = "G90 G00 X0 Y0 Z10.\nG91 G83 X2. Z-5. R-2. Q2. F500 K3\nG80\nG90 G01 Y5. F100\nM30\n"
+    moves = [e for e in Interpreter(make_profile("nc5-mill")).run(parse_program(text, "k3.nc"))
+             if isinstance(e, Move)]
+    pecks = [m for m in moves if "peck" in m.tags]
+    assert len(pecks) == 3 * 3  # R8 to the bottom at Z3 by Q2: pecks to 6, 4 and 3
+    last = moves[-1]
+    assert last.start["X"] == pytest.approx(6.0) and last.end["Y"] == pytest.approx(5.0)
+
+
+def _bench(tmp_path: Path, name: str, max_time: float) -> Path:
+    text = (ROOT / "benches" / name).read_text()
+    text = text.split("[checks]")[0].replace("cycle_ms", f"max_time = {max_time}\ncycle_ms", 1)
+    out = tmp_path / name
+    out.write_text(text)
+    return out
+
+
+@pytest.mark.parametrize("case,bench", [("g81_k", "mill-3axis.toml"), ("g74_p1q1", "lathe-2axis.toml")])
+def test_huge_cycle_is_stopped_by_max_time(tmp_path: Path, case: str, bench: str) -> None:
+    """The run does not first expand the cycle: it moves, and the bench's max_time stops it."""
+    prog = tmp_path / f"{case}.nc"
+    prog.write_text(HUGE[case][1])
+    r = api.run(prog, _bench(tmp_path, bench, 0.5), mlc="basic")
+    assert not r.completed
+    assert [a.code for a in r.alarms] and "max_time" in r.alarms[0].message
+    assert r.run.cycles <= 0.5 / r.bench.cycle + 2000  # stopped, not run to the end
