@@ -20,6 +20,7 @@ from hil.clock import CycleTiming, LockStepClock, RealTimeClock
 from hil.trace import TraceSource, TraceWriter, trace_columns
 from mlc.basic import BasicMlc
 from nc.alarms import SERVO_ALARM, Alarm, NcAlarm, internal_error
+from nc.budget import StatementBudget
 from nc.channel import Channel, RunState, skip_hook
 from nc.interp import Interpreter
 from nc.interrupt import m96_link
@@ -108,6 +109,7 @@ class BenchRunner:
             # run (paced in real time), a cycle has no room for it.
             profile = make_profile(self.bench.profile, self.axes, self.bench.params)
             interp = Interpreter(profile)
+            interp.budget = StatementBudget.for_profile(profile)  # macro statements per cycle (decisions B2)
             self._interp = interp  # G31 skip hands the latch back to it (issue 5)
             from hil.servo_link import BusServoAccess  # G10 L40-L46 → SDO / Modbus on this bench (issue 8)
 
@@ -182,6 +184,7 @@ class BenchRunner:
         if getattr(self, "_interp", None) is not None:  # G31 skip (issue 5)
             ch.on_skip = skip_hook(self._interp)
             ch.m96 = m96_link(self._interp)  # M2x019 program interruption
+            ch.statement_budget = self._interp.budget
         for a in self.result.alarms:
             ch.alarms.append(a)
         ch.load(events)

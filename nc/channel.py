@@ -27,7 +27,8 @@ from nc.alarms import Alarm, NcAlarm, internal_error
 from nc.interrupt import M96Link, interrupt_stream
 from nc.motion.css import css_rpm_at, x_origin
 from nc.motion.planner import Planner, Setpoint
-from nc.moves import Aux, Event, Move, ProgramEnd, Sync
+from nc.budget import StatementBudget
+from nc.moves import Aux, Busy, Event, Move, ProgramEnd, Sync
 from nc.softlimits import SoftLimits
 
 # Moves read from the interpreter into the look-ahead per cycle (M/S/T codes and preview stops do
@@ -83,6 +84,8 @@ class Channel:
     m96: M96Link | None = None
     _interrupt: str | None = None  # "pending" (trigger taken) | "stopping" (braking along the path)
     _m96_running: bool = False  # the interrupt program's motion is in progress (M3x031)
+    # the interpreter's macro statement budget, opened anew every cycle (nc.budget, decisions B2)
+    statement_budget: StatementBudget | None = None
 
     def load(self, events: Iterator[Event]) -> None:
         self.events = events
@@ -278,6 +281,11 @@ class Channel:
         """
         pl = self.planner
         reads = READS_PER_CYCLE
+        budget = self.statement_budget
+        if budget is not None:
+            if budget.spent:
+                budget.held_cycles += 1  # the last cycle ended with macro statements still to run
+            budget.new_cycle()
         while self.state is RunState.RUNNING and self.end is None and not pl.full:
             if self._limit_alarm is not None:
                 if pl.idle:  # the legal moves before it have run out: the offending one never starts
@@ -309,6 +317,8 @@ class Channel:
             except Exception as exc:  # a bug must still stop the machine with an alarm
                 self.raise_alarm(internal_error(exc))
                 return
+            if isinstance(ev, Busy):
+                return  # the statement budget is spent: the interpreter reads on next cycle
             if isinstance(ev, Move):
                 if self.soft_limits is not None and (crossing := self.soft_limits.check(ev)) is not None:
                     self._limit_alarm = crossing

@@ -98,4 +98,15 @@ class ProgramEnd:
         return {"kind": "end", "line": self.line, "block": self.block, "code": self.code}
 
 
-Event = Union[Move, Aux, Sync, ProgramEnd]
+@dataclass(slots=True)
+class Busy:
+    """Not part of the program: the interpreter has spent this cycle's macro statement budget
+    (`nc.budget`, decisions B2) and reads on next cycle. Stream stages pass it on at once."""
+
+    def as_dict(self) -> dict:
+        return {"kind": "busy"}
+
+
+BUSY = Busy()
+
+Event = Union[Move, Aux, Sync, ProgramEnd, Busy]

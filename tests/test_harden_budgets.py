@@ -86,3 +86,52 @@ def test_huge_cycle_is_stopped_by_max_time(tmp_path: Path, case: str, bench: str
     assert not r.completed
     assert [a.code for a in r.alarms] and "max_time" in r.alarms[0].message
     assert r.run.cycles <= 0.5 / r.bench.cycle + 2000  # stopped, not run to the end
+
+
+WHILE_100K = "#1=0\n#2=0\nWHILE[#1LT100000]DO1\n#1=#1+1\n#2=#2+2\nEND1\nG01 X[#1/10000] F1000\nM30\n"
+
+
+def test_100k_while_is_spread_over_cycles_with_right_values(tmp_path: Path) -> None:
+    """400,003 statements at 40 per cycle: no cycle runs more than its budget, the loop takes
+    10,000 cycles (10 s) of simulated time, and the variables and the move after it are right."""
+    prog = tmp_path / "while.nc"
+    prog.write_text(WHILE_100K)
+    r = api.run(prog, ROOT / "benches" / "mill-3axis.toml", check=False)
+    assert r.completed and not r.alarms
+    interp = r.runner._interp
+    assert interp.vars.get(1) == 100000 and interp.vars.get(2) == 200000
+    budget = interp.budget
+    assert budget.limit == 40 and budget.peak == 40  # the budget was used, never exceeded
+    statements = 2 + 100000 * 4 + 1  # #1=, #2=, (WHILE, #1=, #2=, END) per pass, the last WHILE
+    assert budget.held_cycles >= statements // 40 - 1
+    assert r.run.program_time >= statements / 40 * r.bench.cycle
+    assert r.run.final["X"] == pytest.approx(10.0, abs=1e-6)
+
+
+def test_statement_budget_is_a_profile_parameter(tmp_path: Path) -> None:
+    """[params] "macro statements per cycle" = 400: the same loop takes a tenth of the cycles."""
+    text = WHILE_100K.replace("100000", "4000").replace("#1/10000", "#1/400")
+    times = []
+    for per_cycle in (40, 400):
+        bench = tmp_path / f"b{per_cycle}.toml"
+        bench.write_text((ROOT / "benches" / "mill-3axis.toml").read_text().split("[checks]")[0]
+                         + f'\n[params]\n"macro statements per cycle" = {per_cycle}\n')
+        prog = tmp_path / "w.nc"
+        prog.write_text(text)
+        r = api.run(prog, bench, check=False)
+        assert r.completed and r.runner._interp.budget.peak == per_cycle
+        assert r.runner._interp.vars.get(2) == 8000
+        times.append(r.run.program_time)
+    statements = 2 + 4000 * 4 + 1
+    assert times[0] - times[1] == pytest.approx(statements * 0.001 * (1 / 40 - 1 / 400), abs=0.01)
+
+
+def test_preview_log_keeps_the_last_statements_only() -> None:
+    """The preview log is bounded ("preview log" = 1000 records), keeping the newest."""
+    interp = Interpreter(make_profile("nc5-mill"))
+    list(interp.run(parse_program(WHILE_100K.replace("100000", "5000"), "w.nc")))
+    log = interp.preview_log
+    assert len(log) == 1000
+    assert log[-1].block == "WHILE[#1LT5000]DO1"  # the newest: the test that ends the loop
+    assert [r.block for r in log].count("END1") == 250  # 4 statements a pass: the last 250 passes
+    assert interp.vars.get(1) == 5000

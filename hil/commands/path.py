@@ -9,6 +9,7 @@ import argparse
 import dataclasses
 import json
 import sys
+from collections import deque
 
 from hil.cli import EXIT_ALARM, EXIT_OK, EXIT_USAGE
 from hil.session import InputError, load_bench, print_alarm
@@ -130,6 +131,8 @@ def cmd_path(args: argparse.Namespace) -> int:
         return EXIT_USAGE
     store = ProgramStore(usb_first=bool(profile.param("N8.22 Bit5")))
     interp = Interpreter(profile, store=store)
+    if args.preview_log:  # asked for: the whole log, not only the last statements (decisions B3)
+        interp.preview_log = deque()
     out = sys.stdout
     try:
         store.add_libs(args.lib)

@@ -25,7 +25,7 @@ from nc.alarms import NcAlarm
 from nc.compensation import offset as geo
 from nc.compensation.nose import tip_vector
 from nc.cycles.geometry import Pt, Seg, dist
-from nc.moves import Event, Move, ProgramEnd
+from nc.moves import Busy, Event, Move, ProgramEnd
 
 PLANE_MOVES = ("rapid", "line", "arc", "thread")
 
@@ -146,7 +146,7 @@ class Compensator:
         if not isinstance(ev, Move):
             if isinstance(ev, ProgramEnd):
                 return self.finish() + [ev]
-            if self.pending is not None:
+            if self.pending is not None and not isinstance(ev, Busy):  # a Busy mark passes at once
                 self.pending.held.append(ev)
                 return []
             return [ev]

@@ -15,7 +15,7 @@ from collections.abc import Iterator
 from typing import TYPE_CHECKING
 
 from nc.alarms import NcAlarm
-from nc.moves import Event, Move, ProgramEnd
+from nc.moves import Busy, Event, Move, ProgramEnd
 
 if TYPE_CHECKING:  # pragma: no cover
     from nc.interp.interpreter import Interpreter
@@ -38,7 +38,7 @@ def expand_corners(interp: "Interpreter", events: Iterator[Event]) -> Iterator[E
                 continue
             yield ev
             continue
-        if pending is not None:
+        if pending is not None and not isinstance(ev, Busy):  # a Busy mark passes at once
             if isinstance(ev, ProgramEnd):
                 _fail(pending)
             held.append(ev)

@@ -10,10 +10,12 @@ from __future__ import annotations
 
 import copy
 import math
+from collections import deque
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 
 from nc.alarms import NcAlarm
+from nc.budget import StatementBudget
 from nc.interp import context
 from nc.interp.arcs import center_from_radius, check_center, sweep
 from nc.interp.corners import expand_corners
@@ -23,7 +25,7 @@ from nc.interp.state import N_EXT_WCS, PLANES, Frames, ModalState
 from nc.interp.sysvars import SystemVariables
 from nc.interp.tools import ToolTable
 from nc.interp.variables import Variables
-from nc.moves import Aux, Event, Move, ProgramEnd, Sync
+from nc.moves import BUSY, Aux, Event, Move, ProgramEnd, Sync
 from nc.profiles import Profile
 from nc.program.blocks import (Assign, Block, Else, ElseIf, End, EndIf, ExitW, Goto, IfGoto, IfThen,
                                Program, While, Word)
@@ -119,9 +121,11 @@ class Interpreter:
         self.last_arc_ijk: tuple[float, float, float] = (0.0, 0.0, 0.0)
         self.unit_locked = False
         self.block_skip = bool(profile.param("M2x010"))
-        self.preview_log: list[PreviewRecord] = []
+        # the last statements only: a long run would otherwise grow ~2 MB/min (decisions B3)
+        self.preview_log: deque[PreviewRecord] = deque(maxlen=_log_length(profile))
         self.servo = ServoPort(alarm_on_error=bool(profile.param("servo param alarm", 1.0)))  # G10 L40-L46
         self.on_statement = None  # callable(block, program) set by the preview window
+        self.budget: StatementBudget | None = None  # per-cycle statements; set by a channel (decisions B2)
         self.p_scale = 1.0
         self._executed = 0
         self._gcall_depth = 0
@@ -232,7 +236,11 @@ class Interpreter:
             self.store.loaded.setdefault(program.number, program)
         limit = int(self.profile.param("max blocks", 1_000_000))
         last: Block | None = None
+        budget = self.budget
         while self.stack:
+            if budget is not None and budget.spent:
+                yield BUSY  # the rest of the macro next cycle; the cycle never stalls (decisions B2)
+                continue
             fr = self.stack[-1]
             if self._interrupt_pending:
                 self._interrupt_pending = False
@@ -506,6 +514,8 @@ class Interpreter:
         fr = self.frame
         if self.on_statement is not None:
             self.on_statement(block, fr.program.name)
+        if self.budget is not None:
+            self.budget.spend()
         if isinstance(s, Assign):
             n = var_index(s.target, self.vars.get)
             v = self.eval(s.value)
@@ -1635,6 +1645,16 @@ class Interpreter:
     def emit_aux(self, kind: str, value: float) -> Event:
         b = self.block
         return Aux(kind, value, b.line if b else 0, b.text if b else "", program=self.program_name)  # type: ignore[arg-type]
+
+
+def _log_length(profile: Profile) -> int | None:
+    """Profile parameter "preview log": how many statements the preview log keeps (< 0: all)."""
+    v = profile.param("preview log", 1000)
+    try:
+        n = int(v)
+    except (TypeError, ValueError, OverflowError):
+        return 1000
+    return None if n < 0 else n
 
 
 def _transforms(host: "Interpreter"):

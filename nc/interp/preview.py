@@ -14,7 +14,7 @@ from collections import deque
 from collections.abc import Iterator
 from typing import TYPE_CHECKING
 
-from nc.moves import Event, Move, Sync
+from nc.moves import Busy, Event, Move, Sync
 
 if TYPE_CHECKING:  # pragma: no cover
     from nc.interp.interpreter import Interpreter
@@ -56,6 +56,9 @@ class PreviewWindow:
                     failure = exc
                     done = True
                     break
+                if isinstance(ev, Busy):  # the statement budget is spent: the channel reads on next cycle
+                    yield ev
+                    continue
                 buf.append(ev)
                 if isinstance(ev, Move):
                     moves += 1
