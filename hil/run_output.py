@@ -9,11 +9,12 @@ check failed (an `--at` event that never fired counts as a failed check unless a
 from __future__ import annotations
 
 import json
-import math
 import os
 import xml.etree.ElementTree as ET
 from pathlib import Path
 from typing import Any
+
+from hil.strict_json import finite
 
 EXIT_OK, EXIT_ALARM, EXIT_CHECKS = 0, 1, 3
 
@@ -32,22 +33,11 @@ def verdict(result: Any, allow_unfired: bool = False) -> tuple[str, int]:
     return "completed", EXIT_OK
 
 
-def _finite(v: Any) -> Any:
-    """Strict JSON: NaN and ±inf have no JSON spelling, they become null."""
-    if isinstance(v, float) and not math.isfinite(v):
-        return None
-    if isinstance(v, dict):
-        return {k: _finite(x) for k, x in v.items()}
-    if isinstance(v, list):
-        return [_finite(x) for x in v]
-    return v
-
-
 def as_dict(result: Any, allow_unfired: bool = False) -> dict[str, Any]:
     status, code = verdict(result, allow_unfired)
     bench = result.bench
     applied = sorted((e for e in result.events if e.fired_cycle is not None), key=lambda e: e.fired_cycle)
-    return _finite({
+    return finite({
         "result": status, "exit_code": code, "stopped_by": getattr(result.run, "stopped_by", None),
         "program": result.program,
         "bench": {"name": bench.name, "source": bench.source, "profile": bench.profile, "bus": bench.bus,

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 import sys
 from dataclasses import replace
 from pathlib import Path
@@ -11,6 +10,7 @@ from typing import Sequence
 from fieldbus.factory import parse_bus
 from fieldbus.link import BusLink, SimLink
 from fieldbus.pdo import RxPdo
+from hil import strict_json
 from hil.bench import Bench, default_lathe
 from nc.alarms import Alarm, NcAlarm
 from nc.profiles import PROFILE_NAMES
@@ -117,6 +117,6 @@ def make_link(bench: Bench) -> BusLink:
 def print_alarm(alarm: Alarm, as_json: bool = False, stream=None) -> None:
     stream = stream or (sys.stdout if as_json else sys.stderr)
     if as_json:
-        print(json.dumps(alarm.as_dict()), file=stream)
+        print(strict_json.dumps(alarm.as_dict()), file=stream)
     else:
         print(str(alarm), file=stream)

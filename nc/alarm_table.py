@@ -5,6 +5,9 @@ Generated once from shared/research/seed-mlc-interface.md §1.4–1.5; edit by h
 
 from __future__ import annotations
 
+DELTAHIL_CODES = range(0xDE00, 0xDF00)  # codes of deltahil's own guards, not in the NC5 manual
+ENDLESS_LOOP = 0xDE01
+
 # code -> (category, name as the manual prints it, cause / correction condensed)
 ALARM_TABLE: dict[int, tuple[str, str, str]] = {
     0x0000: ('instruction', 'NC internal error.', 'An internal error occurred in the control system, please contact Delta or supplier.'),
@@ -191,5 +194,9 @@ ALARM_TABLE: dict[int, tuple[str, str, str]] = {
     0x1605: ('axis', 'The axis is set as non-rotary axis in home mode 6.', 'Please confirm the parameter settings of N2.01 axis configuration.'),
     0xB01D: ('instruction', 'Spindle speed is over speed', '[NC5] threading notes (lines 3899, 3960, 4030, 4088); [LATHE] "B01D Spindle overspeed"'),
     0xB6A5: ('instruction', 'Lathe drilling or tapping instructions are incorrect', '[NC5] lathe drilling/tapping cycles (lines 3402, 3487)'),
+    # deltahil's own codes, 0xDE00-0xDEFF: guards the emulator needs and App. A has no code for
+    # (docs/decisions/program-input.md P5). NC5 never raises them; a bench that compares alarms
+    # with a real controller sees them only where the NC5 would run on.
+    0xDE01: ('instruction', 'Endless-loop guard: too many blocks executed.', "deltahil: more blocks than the parameter 'max blocks' (1,000,000) were executed; a WHILE or GOTO loop that never ends. Raise 'max blocks' in [params] if the program is meant to run that long."),
     0xF002: ('axis', 'The alarm codes of Delta servo.', "The alarm of 0xF002 needs to be interpreted in conjunction with the alarm codes of the Delta servo. For example, if the Delta servo displays an alarm code 0x09 (following error), the controller will display 0xF002 and indicate the servo's alarm code as 0x09."),
 }

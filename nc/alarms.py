@@ -79,6 +79,7 @@ class NcAlarm(Exception):
         if message is None:
             message = alarm_name(code) if isinstance(code, int) else str(code)
         self.alarm = Alarm(code, message, line, block, program, axis, info)
+        self.caller_missing = False  # set by the program store: the next `at` adds the calling block
         super().__init__(str(self.alarm))
 
     def at(self, line: int | None, block: str | None, program: str | None = None) -> "NcAlarm":
@@ -86,7 +87,15 @@ class NcAlarm(Exception):
         a = self.alarm
         if a.line is None:
             self.alarm = Alarm(a.code, a.message, line, block, program or a.program, a.axis, a.info)
-            self.args = (str(self.alarm),)
+        elif self.caller_missing and line is not None:
+            # raised while loading a subprogram file: it names that file and line; add the call site
+            where = f"called from line {line}" + (f" of {program}" if program else "")
+            self.alarm = Alarm(a.code, f"{a.message} ({where}: {clipped((block or '').strip(), 80)})",
+                               a.line, a.block, a.program, a.axis, a.info)
+        elif a.program is None and program is not None:
+            self.alarm = Alarm(a.code, a.message, a.line, a.block, program, a.axis, a.info)
+        self.caller_missing = False
+        self.args = (str(self.alarm),)
         return self
 
 

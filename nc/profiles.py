@@ -60,7 +60,7 @@ def default_params() -> dict[str, float]:
         "M2x010": 0,  # block skip switch ('/')
         "preview depth": 8,  # blocks the interpreter reads ahead of motion (decisions A27)
         "M99 main restarts": 1,  # how often M99 in a main program restarts it before `hil path` stops (A22)
-        "max blocks": 1_000_000,  # executed blocks before the emulator stops an endless loop (0x0000)
+        "max blocks": 1_000_000,  # executed blocks before the emulator stops an endless loop (0xDE01)
         "preview log": 1000,  # last macro statements `Interpreter.preview_log` keeps (memory flat, B3)
         "macro statements per cycle": 40,  # macro statements read per cycle before motion goes on (B2)
     }

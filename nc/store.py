@@ -15,11 +15,11 @@ O program of the main file and of files given with ``--lib FILE`` is registered 
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from nc.alarms import NcAlarm
-from nc.program.blocks import Program, parse_programs
+from nc.program.blocks import MAX_DIGITS, Program, parse_programs
 
 SUFFIXES = ("", ".NC", ".nc", ".txt", ".TXT", ".ngc")
 
@@ -42,7 +42,15 @@ class ProgramStore:
         return progs
 
     def add_file(self, path: Path) -> list[Program]:
-        return self.add_text(path.read_text(errors="replace"), path.name)
+        """Register a subprogram file found by `find`; an alarm in it names the file and its line
+        (the interpreter adds the calling block)."""
+        text = read_program(path, 0x0263)
+        try:
+            return self.add_text(text, path.name)
+        except NcAlarm as exc:
+            exc.alarm = replace(exc.alarm, program=str(path))
+            exc.caller_missing = True
+            raise
 
     def add_libs(self, libs: list[str] | tuple[str, ...]) -> None:
         """``--lib DIR|FILE``: a file's O programs are registered now, a folder is a (DISK) root
@@ -60,10 +68,7 @@ class ProgramStore:
         """The main program of a file; every further O program of the file is registered (A23).
         The program keeps this store, so any interpreter that runs it finds its subprograms."""
         p = Path(path)
-        try:
-            text = p.read_text(encoding="utf-8", errors="replace")
-        except OSError as exc:
-            raise NcAlarm(0x0002, f"program file {path} cannot be read: {exc.strerror}", program=p.name) from None
+        text = read_program(p, 0x0002)
         self.main_dir = p.parent
         try:
             progs = self.add_text(text, p.name)
@@ -85,10 +90,24 @@ class ProgramStore:
             order = [self.usb] + order
         return order
 
+    def program_roots(self) -> list[Path]:
+        """Folders a subprogram file may resolve into (symlinks included): the main program's
+        folder, the --lib / bench (DISK) roots and the USB root (decisions P4)."""
+        roots = [r for r in (self.main_dir, self.usb, *self.roots) if r is not None]
+        return [r.resolve() for r in roots]
+
+    def _inside_roots(self, cand: Path) -> bool:
+        real = cand.resolve()
+        return any(real.is_relative_to(r) for r in self.program_roots())
+
     def find(self, number: int, macro_call: bool = False, code: int = 0x0263) -> Program:
-        """The program O<number>; raises NcAlarm(code) if no folder holds it."""
+        """The program O<number>; raises NcAlarm(code) if no folder holds it, or if the file found
+        resolves (through a symlink) outside every program root."""
         if number in self.loaded:
             return self.loaded[number]
+        if not 0 <= number < 10 ** MAX_DIGITS:
+            shown = str(number) if len(str(number)) <= 12 else f"{str(number)[:12]}… ({len(str(number))} digits)"
+            raise NcAlarm(code, f"P{shown} is not a program number (O0001-O9999; at most {MAX_DIGITS} digits)")
         names = {f"O{number:04d}", f"O{number}", f"O{number:05d}"}
         for folder in self.folders(macro_call):
             if not folder.is_dir():
@@ -97,6 +116,8 @@ class ProgramStore:
                 for suf in SUFFIXES:
                     for cand in (folder / (base + suf), folder / (base.lower() + suf)):
                         if cand.is_file():
+                            if not self._inside_roots(cand):
+                                raise NcAlarm(code, f"{cand} resolves outside the program folders: refused")
                             progs = self.add_file(cand)
                             hit = next((p for p in progs if p.number == number), progs[0])
                             hit.number = number
@@ -106,3 +127,19 @@ class ProgramStore:
         raise NcAlarm(code, f"program O{number:04d} not found"
                       + (f" (searched {', '.join(str(f) for f in self.folders(macro_call) if f.is_dir())})"
                          if self.roots or self.main_dir else ""))
+
+
+BINARY_SNIFF = 8192  # bytes looked at to tell a text program from a binary file
+
+
+def read_program(path: Path, code: int) -> str:
+    """The text of a program file, or NcAlarm(code) naming the file -- never its contents when it
+    is not a program (a binary file, or one that cannot be read)."""
+    try:
+        data = path.read_bytes()
+    except OSError as exc:
+        raise NcAlarm(code, f"program file {path} cannot be read: {exc.strerror or exc}",
+                      program=path.name) from None
+    if b"\0" in data[:BINARY_SNIFF]:
+        raise NcAlarm(code, f"{path} is not a program (binary data)", program=path.name)
+    return data.decode("utf-8", errors="replace")

@@ -4,9 +4,9 @@ Exit 0 when every check passes, 1 when one fails (naming its cycle and line), 2 
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 
+from hil import strict_json
 from hil.bench import Bench, ChecksConfig
 from hil.cli import EXIT_ALARM, EXIT_OK, EXIT_USAGE
 from hil.session import InputError, load_bench, load_program, print_alarm
@@ -99,7 +99,7 @@ def cmd_check(args: argparse.Namespace) -> int:
         print(f"hil check: {exc}", file=sys.stderr)
         return EXIT_USAGE
     for r in results:
-        print(json.dumps(r.as_dict()) if args.json else str(r))
+        print(strict_json.dumps(r.as_dict()) if args.json else str(r))
     failed = [r for r in results if not r.ok and not r.skipped]
     skipped = [r for r in results if r.skipped]
     passed = len(results) - len(failed) - len(skipped)

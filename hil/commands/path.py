@@ -7,10 +7,10 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
-import json
 import sys
 from collections import deque
 
+from hil import strict_json
 from hil.cli import EXIT_ALARM, EXIT_OK, EXIT_USAGE
 from hil.session import InputError, load_bench, print_alarm
 from nc.alarms import NcAlarm, internal_error
@@ -155,11 +155,11 @@ def cmd_path(args: argparse.Namespace) -> int:
                 if getattr(args, "plot", None):
                     plotted.append(ev)
                 if args.json:
-                    print(json.dumps(move_dict(ev)), file=out)
+                    print(strict_json.dumps(move_dict(ev)), file=out)
                 else:
                     print(_human(ev), file=out)
             elif args.preview_log and isinstance(ev, Sync):
-                print(json.dumps(ev.as_dict()) if args.json else f"{ev.line:5d} sync   {ev.reason}", file=out)
+                print(strict_json.dumps(ev.as_dict()) if args.json else f"{ev.line:5d} sync   {ev.reason}", file=out)
     except NcAlarm as exc:
         _print_servo(interp, args, listed)
         _print_preview(interp, args)
@@ -184,7 +184,7 @@ def cmd_path(args: argparse.Namespace) -> int:
             return EXIT_USAGE
     if var_ids:
         values = {str(i): interp.variable(i) for i in var_ids}
-        print(json.dumps({"kind": "vars", "values": values}) if args.json else
+        print(strict_json.dumps({"kind": "vars", "values": values}) if args.json else
               "vars " + " ".join(f"#{k}={'vacant' if v is None else v}" for k, v in values.items()), file=out)
     return EXIT_OK
 
@@ -195,7 +195,7 @@ def _print_servo(interp: Interpreter, args: argparse.Namespace, listed: int) -> 
     log = interp.servo.log
     for req, reply in log[listed:]:
         if args.json:
-            print(json.dumps({"kind": "servo", "line": req.line, "block": req.block, "station": req.station,
+            print(strict_json.dumps({"kind": "servo", "line": req.line, "block": req.block, "station": req.station,
                               "object": req.label, "write": req.value, "value": reply.value,
                               "result": reply.result}))
         else:
@@ -209,7 +209,7 @@ def _print_preview(interp: Interpreter, args: argparse.Namespace) -> None:
         return
     for r in interp.preview_log:
         if args.json:
-            print(json.dumps({"kind": "preview", "line": r.line, "block": r.block, "program": r.program,
+            print(strict_json.dumps({"kind": "preview", "line": r.line, "block": r.block, "program": r.program,
                               "ahead_of_line": r.ahead_of_line, "ahead_of_block": r.ahead_of_block,
                               "blocks_ahead": r.blocks_ahead}))
         else:

@@ -3,11 +3,11 @@
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 
 from fieldbus.factory import parse_bus
 from fieldbus.link import BusError
+from hil import strict_json
 from hil.cli import EXIT_ALARM, EXIT_OK, EXIT_USAGE
 from hil.session import print_alarm
 
@@ -37,7 +37,7 @@ def cmd_scan(args: argparse.Namespace) -> int:
         return EXIT_ALARM
     for s in slaves:
         if args.json:
-            print(json.dumps({"position": s.position, "vendor": f"0x{s.vendor_id:08X}",
+            print(strict_json.dumps({"position": s.position, "vendor": f"0x{s.vendor_id:08X}",
                               "product": f"0x{s.product_code:08X}", "name": s.name, "kind": s.kind,
                               "state": s.state} | ({"modules": s.layout} if s.kind == "io" and s.layout else {})))
         else:

@@ -14,6 +14,7 @@ from collections import deque
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 
+from nc.alarm_table import ENDLESS_LOOP
 from nc.alarms import NcAlarm
 from nc.budget import StatementBudget
 from nc.interp import context
@@ -277,7 +278,7 @@ class Interpreter:
         fr.pc += 1
         self._executed += 1
         if self._executed > limit:
-            raise NcAlarm(0x0000, f"more than {limit} blocks executed (endless loop?)",
+            raise NcAlarm(ENDLESS_LOOP, f"more than {limit} blocks executed (endless loop?; parameter 'max blocks')",
                           line=block.line, block=block.text, program=fr.program.name)
         if block.skip and self.block_skip:
             return None

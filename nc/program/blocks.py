@@ -13,6 +13,7 @@ ENDIF / IF…EXITW, WHILE…DOm / ENDm / EXITW (nc5) or WHILE / ENDW (lathe-2018
 from __future__ import annotations
 
 import re
+import unicodedata
 from dataclasses import dataclass, field, replace
 from typing import Any, Union
 
@@ -143,7 +144,7 @@ class Program:
                     self.labels.setdefault(b.n, []).append(i)
 
 
-_NUMBER = re.compile(r"[+-]?\s*(\d+\.?\d*|\.\d+)")
+_NUMBER = re.compile(r"[+-]?\s*([0-9]+\.?[0-9]*|\.[0-9]+)")
 _KEYWORDS = ("ELSEIF", "ENDIF", "EXITW", "WHILE", "GOTO", "THEN", "ELSE", "ENDW", "END", "IF", "DO")
 MAX_DIGITS = 9
 _COMMENT_START = re.compile(r"[(;%/]")  # a line without these has no comment and no block skip
@@ -438,6 +439,8 @@ def parse_block(line: int, text: str) -> Block:
 def _parse_general(line: int, text: str) -> Block:
     code, comment = strip_comments(text)
     block = Block(line=line, text=text.rstrip("\r\n"), comment=comment)
+    if not code.isascii():
+        raise non_ascii_alarm(code, line, block.text)
     s = code.strip()
     if s.startswith("/"):
         block.skip = True
@@ -449,7 +452,26 @@ def _parse_general(line: int, text: str) -> Block:
     return block
 
 
-_O_LINE = re.compile(r"\s*[Oo](\d+)")
+def non_ascii_alarm(code: str, line: int | None, block: str | None) -> NcAlarm:
+    """0x020A for the first non-ASCII character outside a comment (decisions P1): NC words take
+    ASCII only, so `X١٠.` (Arabic-Indic) or `X１０.` (fullwidth) is never read as X10."""
+    c = next(ch for ch in code if not ch.isascii())
+    kind = "digit" if c.isdigit() else "character"
+    name = unicodedata.name(c, f"U+{ord(c):04X}")
+    return NcAlarm(0x020A, f"non-ASCII {kind} {c!r} ({name}): NC words take ASCII letters, digits 0-9 "
+                           "and signs only", line=line, block=block)
+
+
+def o_number(digits: str, line: int | None, block: str | None) -> int:
+    """The number of an ``O`` line; more than MAX_DIGITS significant digits is 0x0223 (the NC5
+    names O0001-O9999 and O50000/O60000, a file name cannot hold 5,000 digits)."""
+    if len(digits.lstrip("0")) > MAX_DIGITS:
+        raise NcAlarm(0x0223, f"O number with {len(digits)} digits (at most {MAX_DIGITS})",
+                      line=line, block=block)
+    return int(digits)
+
+
+_O_LINE = re.compile(r"\s*[Oo]([0-9]+)")
 
 
 def parse_program(text: str, name: str = "program", number: int | None = None) -> Program:
@@ -462,7 +484,7 @@ def parse_program(text: str, name: str = "program", number: int | None = None) -
             continue
         m = _O_LINE.match(stripped)
         if m and not blocks and number is None:
-            number = int(m.group(1))
+            number = o_number(m.group(1), idx, raw)
             continue
         if m and not blocks:
             continue
@@ -480,7 +502,7 @@ def parse_programs(text: str, name: str = "program") -> list[Program]:
     for i, raw in enumerate(lines):
         m = _O_LINE.match(raw)
         if m and not raw.strip().startswith("("):
-            starts.append((i, int(m.group(1))))
+            starts.append((i, o_number(m.group(1), i + 1, raw)))
     out: list[Program] = []
     first = starts[0][0] if starts else len(lines)
     head = "\n".join(lines[:first])

@@ -70,8 +70,9 @@ LEVELS: list[set[str]] = [
     {"+", "-", "OR", "|", "XOR", "^"},
     {"*", "/", "MOD", "AND", "&"},
 ]
-_NUM = re.compile(r"\d+\.?\d*|\.\d+")
+_NUM = re.compile(r"[0-9]+\.?[0-9]*|\.[0-9]+")  # ASCII digits only (decisions P1)
 _WORD = re.compile(r"[A-Za-z]+")
+_INDEX = re.compile(r"[0-9]+")
 _SYM = ("||", "&&", "==", "!=", "<>", "<=", ">=", "<", ">", "=", "+", "-", "*", "/", "&", "|", "^", "!")
 
 
@@ -226,7 +227,7 @@ class ExprParser:
             e = self.parse()
             self.expect("]")
             return Var(e)
-        m = re.compile(r"\d+").match(self.s, self.pos)
+        m = _INDEX.match(self.s, self.pos)
         if not m:
             raise self.error(0x0206, "# must be followed by a number or [expression]")
         self.pos = m.end()
