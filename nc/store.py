@@ -41,10 +41,11 @@ class ProgramStore:
                 self.loaded.setdefault(p.number, p)
         return progs
 
-    def add_file(self, path: Path) -> list[Program]:
+    def add_file(self, path: Path, named: bool = False) -> list[Program]:
         """Register a subprogram file found by `find`; an alarm in it names the file and its line
-        (the interpreter adds the calling block)."""
-        text = read_program(path, 0x0263)
+        (the interpreter adds the calling block). `named`: a file the user gave (--lib FILE) is
+        parsed as given, binary or not."""
+        text = read_program(path, 0x0263, refuse_binary=not named)
         try:
             return self.add_text(text, path.name)
         except NcAlarm as exc:
@@ -58,7 +59,7 @@ class ProgramStore:
         for lib in libs:
             lp = Path(lib)
             if lp.is_file():
-                self.add_file(lp)
+                self.add_file(lp, named=True)
             elif lp.is_dir():
                 self.roots.append(lp)
             else:
@@ -68,7 +69,7 @@ class ProgramStore:
         """The main program of a file; every further O program of the file is registered (A23).
         The program keeps this store, so any interpreter that runs it finds its subprograms."""
         p = Path(path)
-        text = read_program(p, 0x0002)
+        text = read_program(p, 0x0002, refuse_binary=False)  # the file the user named: parsed as given
         self.main_dir = p.parent
         try:
             progs = self.add_text(text, p.name)
@@ -132,14 +133,14 @@ class ProgramStore:
 BINARY_SNIFF = 8192  # bytes looked at to tell a text program from a binary file
 
 
-def read_program(path: Path, code: int) -> str:
+def read_program(path: Path, code: int, refuse_binary: bool = True) -> str:
     """The text of a program file, or NcAlarm(code) naming the file -- never its contents when it
-    is not a program (a binary file, or one that cannot be read)."""
+    is not a program (a binary file found by the subprogram search, or one that cannot be read)."""
     try:
         data = path.read_bytes()
     except OSError as exc:
         raise NcAlarm(code, f"program file {path} cannot be read: {exc.strerror or exc}",
                       program=path.name) from None
-    if b"\0" in data[:BINARY_SNIFF]:
+    if refuse_binary and b"\0" in data[:BINARY_SNIFF]:
         raise NcAlarm(code, f"{path} is not a program (binary data)", program=path.name)
     return data.decode("utf-8", errors="replace")

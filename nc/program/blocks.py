@@ -453,12 +453,14 @@ def _parse_general(line: int, text: str) -> Block:
 
 
 def non_ascii_alarm(code: str, line: int | None, block: str | None) -> NcAlarm:
-    """0x020A for the first non-ASCII character outside a comment (decisions P1): NC words take
-    ASCII only, so `X١٠.` (Arabic-Indic) or `X１０.` (fullwidth) is never read as X10."""
+    """The alarm for the first non-ASCII character outside a comment (decisions P1): NC words take
+    ASCII only, so `X١٠.` (Arabic-Indic) or `X１０.` (fullwidth) is never read as X10.  A digit is
+    0x020A (wrong command characters), any other character 0x0206 as before (Ά, é: language.md)."""
     c = next(ch for ch in code if not ch.isascii())
-    kind = "digit" if c.isdigit() else "character"
+    digit = c.isdigit() or unicodedata.category(c) == "Nd"
+    kind = "digit" if digit else "character"
     name = unicodedata.name(c, f"U+{ord(c):04X}")
-    return NcAlarm(0x020A, f"non-ASCII {kind} {c!r} ({name}): NC words take ASCII letters, digits 0-9 "
+    return NcAlarm(0x020A if digit else 0x0206, f"non-ASCII {kind} {c!r} ({name}): NC words take ASCII letters, digits 0-9 "
                            "and signs only", line=line, block=block)
 
 
