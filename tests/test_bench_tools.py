@@ -23,14 +23,23 @@ def _hil(*args: str, **kw) -> subprocess.CompletedProcess:
     return subprocess.run([sys.executable, "-m", "hil.cli", *args], capture_output=True, text=True, timeout=120, **kw)
 
 
-@pytest.mark.parametrize("args", [("path", PART), ("path", "--json", PART)])
-def test_closed_stdout_ends_quietly(args):
+@pytest.mark.parametrize("what", ["path", "path --json", "trace"])
+def test_closed_stdout_ends_quietly(what, tmp_path):
     """`hil path … | head -1`: the first line arrives, exit 0 (README), nothing on stderr."""
+    args: tuple[str, ...] = (*what.split(), PART)
+    if what == "trace":
+        prog = tmp_path / "short.nc"
+        prog.write_text(SHORT)
+        assert _hil("run", str(prog), "--trace", str(tmp_path / "t.csv")).returncode == 0
+        args = ("trace", str(tmp_path / "t.csv"))
     cmd = f"{sys.executable} -m hil.cli {' '.join(args)} | head -1; exit ${{PIPESTATUS[0]}}"
     r = subprocess.run(["bash", "-c", cmd], capture_output=True, text=True, timeout=60, cwd=ROOT)
     assert r.returncode == 0, r.stderr
     assert r.stderr == ""
-    assert r.stdout.count("\n") == 1 and ("X45" in r.stdout or '"x"' in r.stdout.lower())
+    assert r.stdout.count("\n") == 1 and ("X45" in r.stdout or '"x"' in r.stdout.lower() or "trace" in r.stdout)
+
+
+SHORT = "G98\nG00 X10. Z10.\nG01 X12. Z8. F1000.\nM30\n"  # feed per minute: no spindle needed
 
 
 def _help(*path: str) -> str:
@@ -62,9 +71,6 @@ def test_one_spelling_per_flag_old_ones_hidden():
 def test_sim_ethercat_without_iface_is_usage():
     r = _hil("sim", "ethercat")
     assert r.returncode == 2 and "--iface" in r.stderr and "Traceback" not in r.stderr
-
-
-SHORT = "G98\nG00 X10. Z10.\nG01 X12. Z8. F1000.\nM30\n"  # feed per minute: no spindle needed
 
 
 def _cycles(stdout: str) -> int:

@@ -34,6 +34,8 @@ def cmd_trace(args: argparse.Namespace) -> int:
             print(f"wrote {rows} rows to {args.out}")
             return EXIT_OK
         print(format_summary(tf, summarise(tf, lo, hi)))
+    except BrokenPipeError:  # `hil trace … | head`: hil.cli ends quietly
+        raise
     except OSError as exc:
         print(f"hil trace: {exc.filename or args.out}: {exc.strerror or exc}", file=sys.stderr)
         return EXIT_USAGE
