@@ -205,3 +205,13 @@ def test_fuzzed_programs_give_no_internal_error_and_strict_json(capsys, tmp_path
     for o in objs:
         if o["kind"] == "alarm":
             assert o["code"] != "0x0000", o
+
+
+def test_campaign_journal_writes_a_nan_figure_as_null(tmp_path) -> None:
+    from hil.campaign.results import Journal
+    j = Journal(tmp_path)
+    j.append({"input_hash": "h1", "status": "completed", "max_ferr_mm": float("nan"), "time_s": 1.5})
+    j.close(remove=False)
+    rows = j.previous()
+    assert rows["h1"]["max_ferr_mm"] is None and rows["h1"]["time_s"] == 1.5
+    assert "NaN" not in j.path.read_text()

@@ -14,6 +14,8 @@ from typing import Any, Iterable
 import pyarrow as pa
 import pyarrow.parquet as pq
 
+from hil import strict_json
+
 STATUSES = ("completed", "alarm", "check_failed", "worker_lost", "timeout")
 KEY_COLUMNS = ("program", "bench", "bus", "override", "rapid_override", "spindle_override", "params", "fault")
 # Fixed columns and their types; per-axis metrics (max_ferr_X, peak_v_share_X …) are float64 and
@@ -76,7 +78,7 @@ class Journal:
     def append(self, row: dict[str, Any]) -> None:
         if self._f is None:
             self._f = self.path.open("a", encoding="utf-8")
-        self._f.write(json.dumps(row, allow_nan=False) + "\n")
+        self._f.write(strict_json.dumps(row) + "\n")  # a NaN figure is null, never a crash
         self._f.flush()
         os.fsync(self._f.fileno())
 
