@@ -8,6 +8,7 @@ See docs/guide/bench-file.md for the format.
 
 from __future__ import annotations
 
+import math
 import tomllib
 from dataclasses import fields
 from pathlib import Path
@@ -16,6 +17,7 @@ from typing import Any
 from fieldbus.factory import parse_bus
 from fieldbus.pdo import ASDA_CSP, ASDA_CSP_CSV
 from fieldbus.units import AxisScaling
+from hil.bench_params import check_param
 from hil.bench import AxisConfig, Bench, ChecksConfig, IoStationConfig, RealtimeConfig, SpindleConfig
 from hil.session import InputError
 from nc.motion.limits import AxisLimits
@@ -27,6 +29,8 @@ CIA301_BITRATES = (10_000, 20_000, 50_000, 125_000, 250_000, 500_000, 800_000, 1
 # DriveParams fields a bench may override, with whether they are integers (counts) or reals.
 _DRIVE_INT = {"following_error_window", "negative_limit", "positive_limit", "home_switch", "index_pulse_every",
               "substeps", "probe_position"}
+# Axis limit bounds (mm or deg per s, s², s³): a 100 m/s axis or a jerk of 1e10 is no machine tool.
+LIMIT_BOUNDS = {"velocity": (1e-3, 1e5), "acceleration": (1e-3, 1e7), "jerk": (1e-3, 1e10)}
 _DRIVE_KEYS = {f.name for f in fields(DriveParams)} - {"counts_per_rev"}
 
 
@@ -165,6 +169,9 @@ class _Reader:
         if not isinstance(v, list) or len(v) != 2 or not all(ok_type(x) for x in v):
             self.err(path, f"must be an array of two {what}, got {_kind(v)}")
             return None
+        if not all(math.isfinite(x) for x in v):
+            self.err(path, f"must be finite numbers, got {v}")
+            return None
         if positive and any(x <= 0 for x in v):
             self.err(path, f"must be an array of two {what}, got {v}")
             return None
@@ -214,8 +221,11 @@ def parse_bench(text: str, source: str = "bench.toml") -> Bench:
 
     params = r.table(data, "params", "params")
     for k, v in params.items():
+        where = f"params.{k!r}" if " " in k else f"params.{k}"
         if isinstance(v, bool) or not isinstance(v, (int, float)):
-            r.err(f"params.{k!r}" if " " in k else f"params.{k}", f"must be a number, got {_kind(v)}")
+            r.err(where, f"must be a number, got {_kind(v)}")
+        elif (problem := check_param(k, v)) is not None:
+            r.err(where, problem)
         else:
             b.params[k] = float(v)
 
@@ -314,10 +324,11 @@ def _axis(r: _Reader, d: dict, p: str) -> AxisConfig | None:
             r.err(f"{p}.start", f"{start:g} lies outside soft_limits [{soft[0]:g}, {soft[1]:g}]")
     lim = r.table(d, "limits", f"{p}.limits")
     base = AxisLimits()
-    limits = AxisLimits(r.number(lim, "velocity", f"{p}.limits.velocity", base.max_velocity, positive=True),
-                        r.number(lim, "acceleration", f"{p}.limits.acceleration", base.max_acceleration,
-                                 positive=True),
-                        r.number(lim, "jerk", f"{p}.limits.jerk", base.max_jerk, positive=True))
+    # Physically plausible bounds (decisions inputs.md I4): 1e-50 or 1e200 is a typo, not a machine.
+    limits = AxisLimits(*(r.number(lim, k, f"{p}.limits.{k}", dflt, positive=True, minimum=LIMIT_BOUNDS[k][0],
+                                   maximum=LIMIT_BOUNDS[k][1])
+                          for k, dflt in (("velocity", base.max_velocity), ("acceleration", base.max_acceleration),
+                                          ("jerk", base.max_jerk))))
     r.unknown(lim, f"{p}.limits.", {"velocity", "acceleration", "jerk"})
     drive, model = _drive(r, d.pop("drive", {}), f"{p}.drive", DriveParams())
     eds = r.eds(d, f"{p}.canopen_eds", ASDA_CSP)
