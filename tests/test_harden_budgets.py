@@ -135,3 +135,20 @@ def test_preview_log_keeps_the_last_statements_only() -> None:
     assert log[-1].block == "WHILE[#1LT5000]DO1"  # the newest: the test that ends the loop
     assert [r.block for r in log].count("END1") == 250  # 4 statements a pass: the last 250 passes
     assert interp.vars.get(1) == 5000
+
+
+def test_absurd_acceleration_alarms_at_once_instead_of_spinning(tmp_path: Path) -> None:
+    """acceleration 1e-50: every plan ends before its first sample. The planner stops after a bounded
+    number of solves with an alarm naming the limits, long before the bench's max_time (decisions B4)."""
+    text = _bench(tmp_path, "mill-3axis.toml", 600.0).read_text()
+    text = text.replace("acceleration = 5000.0", "acceleration = 1e-50")
+    bench = tmp_path / "absurd.toml"
+    bench.write_text(text)
+    prog = tmp_path / "mv.nc"
+    prog.write_text("G90 G01 X10. Y5. F1000\nX20.\nM30\n")
+    r = api.run(prog, bench, check=False)
+    assert not r.completed
+    alarm = r.alarms[0]
+    assert "no progress" in alarm.message and "acceleration" in alarm.message and alarm.line == 1
+    assert r.run.cycles < 100  # not the 600,000 cycles of max_time
+    assert r.run.final["X"] == pytest.approx(0.0, abs=1e-6)  # nothing moved

@@ -31,6 +31,7 @@ from nc.motion import threading as thr
 from nc.moves import Move
 
 CHUNK = 64  # cycles sampled per vectorised step
+MAX_SOLVES_PER_CYCLE = 1000  # plans one cycle may start and end before a sample is due (decisions B4)
 
 
 @dataclass
@@ -453,7 +454,7 @@ class Planner:
 
     def _refill(self) -> None:
         T = self.cfg.cycle
-        for _ in range(1000):
+        for _ in range(MAX_SOLVES_PER_CYCLE):
             if self.plan is None and not self._settled and self.at_rest:
                 return  # exact stop: the filtered setpoint reaches the point before anything starts
             if self.plan is None:
@@ -469,6 +470,20 @@ class Planner:
                 if self.plan is None:
                     continue  # re-solve at a block boundary
             self._end_plan(p)
+        self._no_progress()
+
+    def _no_progress(self) -> None:
+        """Every solve of this cycle ended before its first sample: with absurd limits (acceleration
+        1e-50, jerk 1e200) planning would spin here cycle after cycle, each taking most of a second
+        of wall clock, and never reach the bench's max_time. Alarm instead (decisions B4)."""
+        self.plan = None
+        b = self.blocks[0] if self.blocks else None
+        mv = b.move if b is not None else None
+        limits = f" (acceleration {b.a:g}, jerk {b.j:g})" if b is not None else ""
+        raise NcAlarm(0x0000, f"motion planning made no progress in {MAX_SOLVES_PER_CYCLE} solves in one cycle"
+                      f"{limits}: check the axis limits",
+                      line=mv.line if mv else None, block=mv.block if mv else None,
+                      program=mv.program if mv else None)
 
     def _start_plan(self) -> _Plan | None:
         """Plan from the current state; None when there is nothing to do (idle or held at rest)."""
