@@ -149,6 +149,6 @@ def test_absurd_acceleration_alarms_at_once_instead_of_spinning(tmp_path: Path) 
     r = api.run(prog, bench, check=False)
     assert not r.completed
     alarm = r.alarms[0]
-    assert "no progress" in alarm.message and "acceleration" in alarm.message and alarm.line == 1
+    assert alarm.code == 0xDE10 and "no progress" in alarm.message and "acceleration" in alarm.message and alarm.line == 1
     assert r.run.cycles < 100  # not the 600,000 cycles of max_time
     assert r.run.final["X"] == pytest.approx(0.0, abs=1e-6)  # nothing moved

@@ -21,6 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from nc.alarm_table import PLANNING_STALL
 from nc.alarms import NcAlarm
 from nc.motion.limits import MotionConfig
 from nc.motion.lookahead import MARGIN, Block, Limits, backward, change_distance, reach
@@ -480,7 +481,7 @@ class Planner:
         b = self.blocks[0] if self.blocks else None
         mv = b.move if b is not None else None
         limits = f" (acceleration {b.a:g}, jerk {b.j:g})" if b is not None else ""
-        raise NcAlarm(0x0000, f"motion planning made no progress in {MAX_SOLVES_PER_CYCLE} solves in one cycle"
+        raise NcAlarm(PLANNING_STALL, f"motion planning made no progress in {MAX_SOLVES_PER_CYCLE} solves in one cycle"
                       f"{limits}: check the axis limits",
                       line=mv.line if mv else None, block=mv.block if mv else None,
                       program=mv.program if mv else None)
