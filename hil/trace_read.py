@@ -43,6 +43,21 @@ def _header(path: Path) -> list[str]:
         return next(csv.reader([fh.readline()]), [])
 
 
+def _check_types(path: str | Path, schema: pa.Schema) -> None:
+    """Numbers where the bench writes numbers: a string `t` would otherwise surface as an internal error
+    deep inside a check (decisions inputs.md I5)."""
+    for f in schema:
+        c = f.name
+        if c in INT_COLUMNS or c.endswith("_sw"):
+            ok, what = pa.types.is_integer(f.type), "integers"
+        elif c in FLOAT_COLUMNS or c.endswith(FLOAT_SUFFIXES):
+            ok, what = pa.types.is_floating(f.type) or pa.types.is_integer(f.type), "numbers"
+        else:
+            continue
+        if not ok:
+            raise TraceReadError(f"{path}: column {c!r} must hold {what}, got {f.type}")
+
+
 class TraceFile:
     def __init__(self, path: str | Path) -> None:
         self.path = Path(path)
@@ -71,6 +86,8 @@ class TraceFile:
             raise TraceReadError(f"{path}: not a readable trace ({exc})") from None
         if "t" not in self.columns or "line" not in self.columns:
             raise TraceReadError(f"{path}: not a bench trace (no 't' and 'line' columns)")
+        if self.parquet:
+            _check_types(path, self._pf.schema_arrow)
 
     @property
     def meta(self) -> dict:
@@ -100,7 +117,7 @@ class TraceFile:
                 reader = pacsv.open_csv(self.path, read_options=pacsv.ReadOptions(block_size=1 << 22),
                                         convert_options=self._convert(columns))
                 yield from reader
-        except pa.ArrowInvalid as exc:
+        except (pa.ArrowInvalid, OSError) as exc:  # OSError: a corrupt page (decompression, checksum)
             raise TraceReadError(f"{self.path}: damaged trace ({exc})") from None
 
     def table(self, columns: Sequence[str] | None = None) -> pa.Table:
@@ -108,7 +125,7 @@ class TraceFile:
             if self.parquet:
                 return self._pf.read(columns=list(columns) if columns else None)
             return pacsv.read_csv(self.path, convert_options=self._convert(columns))
-        except pa.ArrowInvalid as exc:
+        except (pa.ArrowInvalid, OSError) as exc:  # OSError: a corrupt page (decompression, checksum)
             raise TraceReadError(f"{self.path}: damaged trace ({exc})") from None
 
     def arrays(self, columns: Sequence[str] | None = None) -> dict[str, np.ndarray]:

@@ -147,3 +147,76 @@ def test_mutated_bench_never_crashes(mutations, typo):
     for a in b.axes:
         for v in (a.limits.max_velocity, a.limits.max_acceleration, a.limits.max_jerk, a.scaling.lead, a.start):
             assert math.isfinite(v) and abs(v) < 1e12
+
+
+# --- item 3: bad traces ----------------------------------------------------------------------------------
+
+@pytest.fixture(scope="module")
+def good_trace(tmp_path_factory) -> Path:
+    """A real trace: 0.3 s of the demo program (max_time ends it: exit 1, the trace is complete)."""
+    d = tmp_path_factory.mktemp("trace")
+    bench = d / "bench.toml"
+    bench.write_text(BENCH.read_text().replace("cycle_ms = 1.0", "cycle_ms = 1.0\nmax_time = 0.3"))
+    p = hil("run", str(PROGRAM), "--bench", str(bench), "--trace", str(d / "good.parquet"))
+    assert p.returncode in (0, 1), p.stderr
+    return d / "good.parquet"
+
+
+def _bad_traces(good: Path) -> dict[str, tuple[Path, str]]:
+    import numpy as np
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    d, t = good.parent, pq.read_table(good)
+    out: dict[str, tuple[Path, str]] = {}
+
+    def put(name: str, table: pa.Table, says: str) -> None:
+        pq.write_table(table, d / name)
+        out[name] = (d / name, says)
+    put("strt.parquet", t.set_column(0, "t", t["t"].cast(pa.string())), "column 't' must hold numbers")
+    put("strsw.parquet", t.set_column(t.column_names.index("X_sw"), "X_sw", t["X_sw"].cast(pa.string())),
+        "column 'X_sw' must hold integers")
+    put("noline.parquet", t.drop(["line"]), "no 't' and 'line' columns")
+    raw = bytearray(good.read_bytes())
+    for i in range(200, len(raw) // 2, 97):
+        raw[i] ^= 0x5A
+    (d / "corrupt.parquet").write_bytes(bytes(raw))
+    out["corrupt.parquet"] = (d / "corrupt.parquet", "trace")
+    (d / "empty.parquet").write_bytes(b"")
+    out["empty.parquet"] = (d / "empty.parquet", "not a readable trace")
+    (d / "garbage.csv").write_text("t,line,X_cmd\n0.001,1,abc\n\x00zz,,\n")
+    out["garbage.csv"] = (d / "garbage.csv", "damaged trace")
+    return out
+
+
+@pytest.mark.parametrize("command", ["check", "report", "trace"])
+def test_bad_traces_exit_2_naming_file(good_trace, tmp_path, command):
+    bad = _bad_traces(good_trace)
+    names = list(bad) if command == "check" else ["strt.parquet", "corrupt.parquet"]  # same reader: keep CI short
+    for name in names:
+        path, says = bad[name]
+        args = {"check": ("check", str(path), "--bench", str(BENCH), "--max-ferr", "1"),
+                "report": ("report", str(path), "--out", str(tmp_path / f"rep_{name}")),
+                "trace": ("trace", str(path), "--out", str(tmp_path / f"{name}.csv"))}[command]
+        p = hil(*args)
+        assert_clean(p, 2, name, says)
+        assert "0x0000" not in p.stdout + p.stderr
+
+
+@settings(max_examples=25, deadline=None)
+@given(st.dictionaries(st.sampled_from(["t", "line", "cycle", "X_cmd", "X_act", "X_sw", "alarm", "junk"]),
+                       st.sampled_from(["int", "float", "str", "nan"]), max_size=6))
+def test_random_trace_tables_never_internal_error(tmp_path_factory, cols):
+    """Random column sets and types: a TraceReadError with the file name, or a readable table."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    from hil.trace_read import TraceFile, TraceReadError
+    make = {"int": pa.array([1, 2, 3]), "float": pa.array([0.0, 0.001, 0.002]), "str": pa.array(["a", "b", "c"]),
+            "nan": pa.array([float("nan")] * 3)}
+    path = tmp_path_factory.mktemp("rnd") / "rnd.parquet"
+    pq.write_table(pa.table({c: make[k] for c, k in cols.items()}) if cols else pa.table({}), path)
+    try:
+        TraceFile(path).arrays()
+    except TraceReadError as exc:
+        assert "rnd.parquet" in str(exc)
