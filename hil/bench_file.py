@@ -276,9 +276,10 @@ def parse_bench(text: str, source: str = "bench.toml") -> Bench:
 
 def _scaling(r: _Reader, d: dict, p: str, default_lead: float) -> AxisScaling:
     base = AxisScaling()
-    cpr = r.integer(d, "counts_per_rev", f"{p}.counts_per_rev", base.counts_per_rev, positive=True)
+    cpr = r.integer(d, "counts_per_rev", f"{p}.counts_per_rev", base.counts_per_rev, positive=True,
+                    maximum=2**31 - 1)  # CiA 402 position is a signed 32-bit count
     ratio = r.pair(d, "ratio", f"{p}.ratio", integers=True, positive=True) or (1, 1)
-    lead = r.number(d, "lead", f"{p}.lead", default_lead, positive=True)
+    lead = r.number(d, "lead", f"{p}.lead", default_lead, positive=True, minimum=1e-6, maximum=1e4)
     direction = r.integer(d, "direction", f"{p}.direction", 1, choices=(1, -1))
     return AxisScaling(counts_per_rev=cpr or base.counts_per_rev, gear_motor=int(ratio[0]), gear_load=int(ratio[1]),
                        lead=lead or default_lead, direction=direction or 1)
@@ -314,7 +315,7 @@ def _axis(r: _Reader, d: dict, p: str) -> AxisConfig | None:
         name = None
     units = r.string(d, "units", f"{p}.units", "mm", ("mm", "deg")) or "mm"
     scaling = _scaling(r, d, p, 360.0 if units == "deg" else 10.0)
-    start = r.number(d, "start", f"{p}.start", 0.0) or 0.0
+    start = r.number(d, "start", f"{p}.start", 0.0, minimum=-1e6, maximum=1e6) or 0.0
     soft = r.pair(d, "soft_limits", f"{p}.soft_limits", integers=False, positive=False)
     if soft is not None:
         if soft[0] >= soft[1]:

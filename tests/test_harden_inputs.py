@@ -175,7 +175,7 @@ def _bad_traces(good: Path) -> dict[str, tuple[Path, str]]:
         out[name] = (d / name, says)
     put("strt.parquet", t.set_column(0, "t", t["t"].cast(pa.string())), "column 't' must hold numbers")
     put("strsw.parquet", t.set_column(t.column_names.index("X_sw"), "X_sw", t["X_sw"].cast(pa.string())),
-        "column 'X_sw' must hold integers")
+        "column 'X_sw' must hold numbers")
     put("noline.parquet", t.drop(["line"]), "no 't' and 'line' columns")
     raw = bytearray(good.read_bytes())
     for i in range(200, len(raw) // 2, 97):
