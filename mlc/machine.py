@@ -28,6 +28,7 @@ from mlc.nc_link import ChannelLink, DriveStatus
 from mlc.program import ScanContext
 from mlc.spindle_axis import SpindleAxisSwitch
 from mlc.signals import d2, m2
+from nc.alarms import NcAlarm
 from nc.channel import Channel
 from nc.manual import ManualMotion
 from nc.motion.limits import MotionConfig
@@ -137,7 +138,18 @@ class Mlc:
         self._bus_relays()
         ctx = self.ctx
         ctx.time, ctx.scan_count = self.time, ctx.scan_count + 1
-        self.program.scan(ctx)
+        if not getattr(self, "program_failed", False):
+            try:
+                self.program.scan(ctx)
+            except NcAlarm:
+                raise
+            except Exception as exc:  # the user's MLC code, not the NC: its own alarm, file, line, traceback
+                from mlc.user_error import mlc_program_alarm
+
+                # like a PLC whose program faulted: it goes to STOP, the NC stops the channel under control
+                self.program_failed = True
+                alarm = mlc_program_alarm(exc, getattr(self.program, "__file__", None))
+                raise NcAlarm(alarm.code, alarm.message) from None
         self._write_io()
         rpm = self.link.commanded_rpm(0)
         self.spindle.rpm, self.spindle.direction = abs(rpm), (1 if rpm > 0 else -1 if rpm < 0 else 0)

@@ -141,3 +141,20 @@ def test_ethercat_capture_decodes_in_tshark(tmp_path):
         by_src[r_[1]] = by_src.get(r_[1], 0) + 1
     cycles = _cycles(r.stdout)
     assert len(by_src) == 2 and all(abs(n - cycles) <= 5 for n in by_src.values()), (by_src, cycles)
+
+
+def test_user_mlc_error_names_file_line_and_traceback(tmp_path):
+    """A bug in the user's MLC: alarm 0xDE02 (not 0x0000) with the file, the line and the user's
+    frames; the run stops under control with its summary, exit 1."""
+    mlc = tmp_path / "bad_mlc.py"
+    mlc.write_text('def helper(mlc):\n    return 1 / mlc.state.get("zero", 0)\n\n\n'
+                   'def scan(mlc):\n    mlc.state["n"] = mlc.state.get("n", 0) + 1\n'
+                   '    if mlc.state["n"] > 50:\n        helper(mlc)\n')
+    prog = tmp_path / "short.nc"
+    prog.write_text(SHORT)
+    r = _hil("run", str(prog), "--mlc", str(mlc))
+    assert r.returncode == 1, r.stdout + r.stderr
+    assert f"ALARM 0xDE02 -- MLC program error in {mlc} line 2: ZeroDivisionError" in r.stdout
+    assert f'File "{mlc}", line 8, in scan' in r.stdout and f'File "{mlc}", line 2, in helper' in r.stdout
+    assert "0x0000" not in r.stdout + r.stderr and "machine.py" not in r.stdout
+    assert "result         STOPPED" in r.stdout
