@@ -13,7 +13,7 @@ from pathlib import Path
 DOCS = Path(__file__).resolve().parent
 
 ORDER = ["foundation", "language", "cycles", "motion", "ethercat", "canopen", "mlc", "bench", "campaign",
-         "bench-tools", "budgets", "program-input", "inputs", "reliability"]
+         "bench-tools", "budgets", "program-input", "inputs", "reliability", "report"]
 
 HEADERS = {
     "decisions": """# Decisions where the Delta manuals are ambiguous

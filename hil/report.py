@@ -32,6 +32,7 @@ class Report:
     out: Path
     html: Path
     images: list[Path] = field(default_factory=list)
+    interactive: Path | None = None  # report.html: Plotly, self-contained
 
 
 def _env(t: np.ndarray, y: np.ndarray, n: int = MAX_POINTS // 2) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -77,6 +78,10 @@ def write_report(trace_path: str | Path, out: str | Path, bench: Bench | None = 
     figs = [_save(fig, out / name, rep, caption) for name, caption, fig in trace_figures(tf, bench, moves)]
     summary = format_summary(tf, summarise(tf))
     rep.html.write_text(_html(title or f"Bench report: {tf.path.name}", summary, checks, figs), encoding="utf-8")
+    from hil.report_html import write_html_report
+
+    rep.interactive = write_html_report(tf, out / "report.html", path_axes(axes_of(tf.columns),
+                                        bench.profile if bench else None), title, summary)
     return rep
 
 
@@ -198,6 +203,7 @@ def _html(title: str, summary: str, checks: list[CheckResult] | None, figs: list
                          f"<td>{'' if c.t is None else f'{c.t:.3f}'}</td><td>{c.line or ''}</td>"
                          f"<td>{e(c.detail)}</td></tr>")
         parts.append("</table>")
+    parts.append("<p><a href='report.html'>Interactive report</a> (zoomable, linked time axes)</p>")
     for name, caption in figs:
         parts.append(f"<h2>{e(caption)}</h2><img src='{e(name)}' alt='{e(caption)}'>")
     parts.append("</body></html>")

@@ -38,6 +38,8 @@ def cmd_report(args: argparse.Namespace) -> int:
         print(f"hil report: cannot write {args.out}: {exc.strerror}", file=sys.stderr)
         return EXIT_USAGE
     print(f"wrote {rep.html}")
+    if rep.interactive:
+        print(f"  {rep.interactive} (interactive, opens offline)")
     for img in rep.images:
         print(f"  {img}")
     if results and not all(r.ok for r in results):
