@@ -16,6 +16,7 @@ from typing import Any
 
 import numpy as np
 
+from hil.atomic_dir import atomic_dir
 from hil.bench import Bench
 from hil.checks import CheckResult, _polyline
 from hil.figures import subplots
@@ -73,16 +74,20 @@ def write_report(trace_path: str | Path, out: str | Path, bench: Bench | None = 
                  title: str | None = None) -> Report:
     tf = TraceFile(trace_path)
     out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
-    rep = Report(out, out / "index.html")
-    figs = [_save(fig, out / name, rep, caption) for name, caption, fig in trace_figures(tf, bench, moves)]
-    summary = format_summary(tf, summarise(tf))
-    rep.html.write_text(_html(title or f"Bench report: {tf.path.name}", summary, checks, figs), encoding="utf-8")
+    if out.exists() and not out.is_dir():
+        raise NotADirectoryError(20, "not a directory", str(out))
     from hil.report_html import write_html_report
 
-    rep.interactive = write_html_report(tf, out / "report.html", path_axes(axes_of(tf.columns),
-                                        bench.profile if bench else None), title, summary)
-    return rep
+    with atomic_dir(out) as tmp:  # an existing report stays whole until the new one is complete
+        rep = Report(tmp, tmp / "index.html")
+        figs = [_save(fig, tmp / name, rep, caption) for name, caption, fig in trace_figures(tf, bench, moves)]
+        summary = format_summary(tf, summarise(tf))
+        rep.html.write_text(_html(title or f"Bench report: {tf.path.name}", summary, checks, figs), encoding="utf-8")
+        write_html_report(tf, tmp / "report.html", path_axes(axes_of(tf.columns), bench.profile if bench else None),
+                          title, summary)
+    done = Report(out, out / "index.html", [out / p.name for p in rep.images])
+    done.interactive = out / "report.html"
+    return done
 
 
 def trace_figures(trace: str | Path | TraceFile, bench: Bench | None = None,

@@ -220,3 +220,31 @@ def test_random_trace_tables_never_internal_error(tmp_path_factory, cols):
         TraceFile(path).arrays()
     except TraceReadError as exc:
         assert "rnd.parquet" in str(exc)
+
+
+# --- item 5: hil report is all or nothing -------------------------------------------------------------------
+
+def test_failing_report_leaves_the_earlier_one_untouched(good_trace, tmp_path, monkeypatch):
+    import hil.report as report
+    from hil.trace_read import TraceReadError
+
+    out = tmp_path / "rep"
+    assert_clean(hil("report", str(good_trace), "--out", str(out)), 0, "index.html")
+    before = {p.name: p.read_bytes() for p in out.iterdir()}
+    (out / "notes.txt").write_text("mine")
+    real = report.trace_figures
+
+    def dies_midway(*a, **k):  # the trace's damage shows after the first figure was drawn
+        it = iter(real(*a, **k))
+        yield next(it)
+        raise TraceReadError(f"{good_trace}: damaged trace (page 3)")
+    monkeypatch.setattr(report, "trace_figures", dies_midway)
+    import pyarrow.parquet as pq
+    half = tmp_path / "half.parquet"  # another trace, so its first figure differs from the old one
+    t = pq.read_table(good_trace)
+    pq.write_table(t.slice(0, t.num_rows // 2), half)
+    with pytest.raises(TraceReadError):
+        report.write_report(half, out)
+    after = {p.name: p.read_bytes() for p in out.iterdir() if p.name != "notes.txt"}
+    assert after == before  # same files, same bytes; no temporary folder left
+    assert (out / "notes.txt").read_text() == "mine"
