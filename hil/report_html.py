@@ -117,7 +117,12 @@ def path_figure(tf: TraceFile, plane: tuple[str, str]) -> Any:
 def write_html_report(tf: TraceFile, path: Path, plane: tuple[str, str] | None, title: str | None = None,
                       summary: str = "") -> Path:
     """One file, Plotly JS embedded (include_plotlyjs=True): it opens without a network."""
+    from hil.circular_test import format_circular, full_circles
+
     head = title_of(tf, title)
+    if plane is not None:
+        circles = format_circular(full_circles(tf.arrays(), plane))
+        summary = f"{summary}\n{circles}" if circles else summary
     parts = [time_figure(tf).to_html(full_html=False, include_plotlyjs=True, div_id="time")]
     if plane is not None:
         parts.append(path_figure(tf, plane).to_html(full_html=False, include_plotlyjs=False, div_id="path"))

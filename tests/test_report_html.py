@@ -7,6 +7,7 @@ import re
 import shutil
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from hil.cli import main
@@ -71,3 +72,28 @@ def test_report_html_in_browser_zoom_links_axes(report):
             d.save_screenshot(str(ROOT / "docs" / "guide" / "img" / "report-html.png"))
     finally:
         d.quit()
+
+
+def test_circular_test_on_known_deviation():
+    """An actual path 2 µm oval (cos 2θ) about a 10 mm circle: G = 4 µm, F = ±2 µm; not for a line."""
+    from hil.circular_test import full_circles
+
+    th = np.linspace(0, 2 * np.pi, 2000)
+    r_act = 10.0 + 0.002 * np.cos(2 * th)
+    cols = {"line": np.full(th.size, 7), "X_cmd": 5 + 10 * np.cos(th), "Y_cmd": 10 * np.sin(th),
+            "X_act": 5 + r_act * np.cos(th), "Y_act": r_act * np.sin(th)}
+    (c,) = full_circles(cols, ("X", "Y"))
+    assert c.line == 7 and c.radius == pytest.approx(10.0) and c.centre == pytest.approx((5.0, 0.0), abs=1e-9)
+    assert c.G == pytest.approx(0.004, rel=1e-3) and (c.F_min, c.F_max) == pytest.approx((-0.002, 0.002), rel=1e-3)
+    cols["Y_cmd"] = cols["Y_act"] = np.zeros(th.size)
+    assert full_circles(cols, ("X", "Y")) == []
+
+
+def test_report_html_full_circle_gets_iso_230_4(tmp_path):
+    (tmp_path / "c.nc").write_text("G90 G17\nG00 X10. Y0.\nG01 X20. F3000.\nG02 I-10. J0. F3000.\nG00 X0. Y0.\nM30\n")
+    mill = ROOT / "benches" / "mill-3axis.toml"
+    assert main(["run", str(tmp_path / "c.nc"), "--bench", str(mill), "--trace", str(tmp_path / "c.parquet")]) == 0
+    assert main(["report", str(tmp_path / "c.parquet"), "--out", str(tmp_path / "r"), "--bench", str(mill)]) == 0
+    m = re.search(r"ISO 230-4 circular test, line 4: R ([\d.]+) mm .*circular deviation G ([\d.]+) µm",
+                  (tmp_path / "r" / "report.html").read_text())
+    assert m and float(m.group(1)) == pytest.approx(10.0, abs=0.01) and 0 < float(m.group(2)) < 20
