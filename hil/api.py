@@ -277,11 +277,14 @@ def _checks(trace_path: str, bench: Bench, program: Any) -> list[Any]:
     from hil.trace_read import TraceFile
     from nc.alarms import NcAlarm
 
+    tf = TraceFile(trace_path)
+    if (tf.num_rows if tf.num_rows >= 0 else tf.table(["t"]).num_rows) == 0:
+        return []  # no cycle ran (a bus that never opened): the run's alarm is the result; nothing to judge
     try:
         moves = program_moves(program, bench)
     except NcAlarm:
         moves = None
-    return run_checks(TraceFile(trace_path), bench.checks, bench, moves)
+    return run_checks(tf, bench.checks, bench, moves)
 
 
 def path(program: str | Path, bench: str | Path | Bench | None = None, *, profile: str | None = None,

@@ -248,3 +248,14 @@ def test_failing_report_leaves_the_earlier_one_untouched(good_trace, tmp_path, m
     after = {p.name: p.read_bytes() for p in out.iterdir() if p.name != "notes.txt"}
     assert after == before  # same files, same bytes; no temporary folder left
     assert (out / "notes.txt").read_text() == "mine"
+
+
+# --- item 4: a bench with [checks] whose bus never opens -----------------------------------------------------
+
+def test_checks_bench_whose_bus_never_opens(tmp_path):
+    """The shipped bench has [checks]; on a bus that cannot open, the bus alarm is the result (exit 1),
+    not an internal error from judging an empty trace."""
+    b = bench_with(tmp_path, ('bus = "sim"', 'bus = "ethercat:nope0"'))
+    p = hil("run", str(PROGRAM), "--bench", str(b), "--no-progress")
+    assert_clean(p, 1, "ALARM")
+    assert "0x0000" not in p.stdout + p.stderr
