@@ -12,6 +12,7 @@ from collections import defaultdict
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.lib.stride_tricks import sliding_window_view
 
 from hil.bench import FILTER_MS, Bench, ChecksConfig
 from hil.trace import axes_of, spindles_of
@@ -235,10 +236,13 @@ def check_limits(cols: _Cols, bench: Bench, tolerance: float) -> list[CheckResul
             continue
         x = cols[name]
         unit = "deg" if ax.units == "deg" else "mm"
+        commanded = _commanded_rows(cols, ax.name, len(x))
         for order, (label, lim) in enumerate((("velocity", ax.limits.max_velocity),
                                               ("acceleration", ax.limits.max_acceleration),
                                               ("jerk", ax.limits.max_jerk)), start=1):
             d = np.abs(np.diff(x, n=order)) / dt ** order
+            if commanded is not None and d.size:  # only differences wholly inside the NC's command
+                d = np.where(sliding_window_view(commanded, order + 1).all(axis=1), d, 0.0)
             u = f"{unit}/s" + ("" if order == 1 else f"^{order}")
             if d.size == 0:
                 out.append(CheckResult(f"{label} {ax.name}", True, 0.0, lim, u))
@@ -249,7 +253,38 @@ def check_limits(cols: _Cols, bench: Bench, tolerance: float) -> list[CheckResul
                 if bad.size else ""
             out.append(CheckResult(f"{label} {ax.name}", not bad.size, float(d[i]), lim, u, detail=detail,
                                    **cols.where(i + order)))
+        braking = _braking_check(cols, ax.name, ax.limits.max_acceleration, tolerance, dt, unit)
+        if braking is not None:
+            out.append(braking)
     return out
+
+
+def _commanded_rows(cols: _Cols, axis: str, n: int) -> np.ndarray | None:
+    """Rows where the axis's drive was in Operation Enabled, i.e. followed the NC's setpoint. In quick
+    stop (E-stop, a failed planner) the drive brakes on its own ramp: that is judged by
+    _braking_check, not as a setpoint (decision B12)."""
+    name = f"{axis}_sw"
+    if name not in cols.trace.columns:
+        return None
+    return (cols[name].astype(np.int64) & 0x6F) == 0x27
+
+
+def _braking_check(cols: _Cols, axis: str, limit: float, tolerance: float, dt: float,
+                   unit: str) -> CheckResult | None:
+    """The drive's own quick stop (CiA 402 state 0x07) must brake within the axis's acceleration."""
+    sw, vel = f"{axis}_sw", f"{axis}_vel"
+    if sw not in cols.trace.columns or vel not in cols.trace.columns:
+        return None
+    quick = (cols[sw].astype(np.int64) & 0x6F) == 0x07
+    if not quick.any():
+        return None
+    a = np.abs(np.diff(cols[vel])) / dt
+    a = np.where(quick[1:] | quick[:-1], a, 0.0)
+    i = int(np.argmax(a))
+    bad = np.flatnonzero(a > limit * (1 + tolerance))
+    detail = f"{bad.size} cycles over, first at cycle {cols.where(int(bad[0]) + 1)['cycle']}" if bad.size else ""
+    return CheckResult(f"quick stop deceleration {axis}", not bad.size, float(a[i]), limit, f"{unit}/s^2",
+                       detail=detail, **cols.where(i + 1))
 
 
 def check_thread_phase(cols: _Cols, axes: list[str], spindles: list[str], moves: list[Move] | None,

@@ -19,6 +19,7 @@ from hil.bench import Bench
 from hil.clock import CycleTiming, LockStepClock, RealTimeClock
 from hil.trace import TraceSource, TraceWriter, trace_columns
 from mlc.basic import BasicMlc
+from nc.alarm_table import MAX_TIME
 from nc.alarms import SERVO_ALARM, Alarm, NcAlarm, internal_error
 from nc.budget import StatementBudget
 from nc.channel import Channel, RunState, skip_hook
@@ -33,6 +34,8 @@ from nc.softlimits import SoftLimits
 
 MODE_CSP = 8
 MODE_CSV = 9
+MAX_TIME_ALARM = MAX_TIME  # deltahil's own range 0xDE00-0xDEFF (nc/alarm_table.py)
+STANDSTILL_TIMEOUT = 10.0  # s the stop path waits for the axes to stand before it disables anyway
 
 
 @dataclass
@@ -92,6 +95,8 @@ class BenchRunner:
         self.trace_sources: list[TraceSource] = []
         self._seen_alarms: set[int] = set()
         self._planner_failed = False
+        self._braking = False  # every drive was told its quick stop (E-stop, failed planner)
+        self._bus_closed = False
         self.stop_request: str | None = None  # a signal's name (hil/stop_signals.py): stop, then end
         self._overrun_alarmed = False
 
@@ -191,15 +196,17 @@ class BenchRunner:
         ch.cycle_start()
         t0 = self.time
         max_cycles = int(self.bench.max_time / self.bench.cycle)
+        give_up = max_cycles + int(STANDSTILL_TIMEOUT / self.bench.cycle)
         stopping = False
-        while ch.busy:
+        while ch.busy and self.cycle < give_up:
             if self.stop_request is not None and not stopping:
                 stopping = True  # along the path, jerk-limited, then flush: the NC's reset
                 ch.reset()
             self._exchange()
-            if self.cycle >= max_cycles:
-                ch.raise_alarm(Alarm(0x0000, f"run exceeded the bench's max_time of {self.bench.max_time:g} s"))
-                break
+            if self.cycle == max_cycles:  # an alarm like any other: the channel stops along the path
+                self._end_reason = "max_time"
+                ch.raise_alarm(Alarm(MAX_TIME_ALARM, f"run exceeded the bench's max_time of {self.bench.max_time:g} s",
+                                     line=self.line or None))
         self.result.program_time = self.time - t0
         self.result.finished = ch.state is RunState.FINISHED
         self._settle()
@@ -300,14 +307,19 @@ class BenchRunner:
             sp = ch.step()
             self._commands[:] = sp.positions
             self.line = sp.line or self.line
+            if ch.emergency and not self._braking:
+                self._begin_quick_stop()  # E-stop: stop category 1, the drives brake on their own ramp
+            elif self._braking and not ch.emergency and not self._planner_failed:
+                self._reenable(ch)  # E-stop released and reset: servo on again where the axes stand
         for i in range(n_axes):
             m, rx = self.masters[i], self.rx[i]
-            if m.enabled and ch is not None:
+            if m.enabled and ch is not None and not self._braking:
                 rx.target_position = self.scales[i].to_counts(self._commands[i] - self.origin[i])
-            elif self._planner_failed and self.tx[i].statusword & 0x6F == 0x27:
+            elif self._braking and self.tx[i].statusword & 0x6F == 0x27:
                 # Until the drive takes its quick stop, the setpoint goes on at the speed it had:
                 # a setpoint that stopped dead would brake harder than the drive's own ramp.
                 rx.target_position += self._coast[i]
+                self._commands[i] = self.scales[i].to_units(rx.target_position) + self.origin[i]
             else:
                 # Not enabled: follow the actual position so enabling never jumps.
                 rx.target_position = self.tx[i].position_actual
@@ -330,6 +342,7 @@ class BenchRunner:
                     rx.target_velocity = sc.rpm_to_counts_per_s(vel)
         if self.trace is not None:
             self.trace.write(self._row())
+            self._row_cycle = self.cycle
         if self.on_cycle is not None:
             self.on_cycle(self)
         if self.progress is not None:
@@ -374,25 +387,38 @@ class BenchRunner:
             self.channel.raise_alarm(alarm)
         self.result.alarms.append(alarm)
 
-    def _quick_stop(self, limit_s: float = 5.0) -> None:
-        """The planner itself failed: leave it alone, command every drive's quick stop (CiA 402: the
-        drive brakes on its own ramp, 0x6085) and cycle until the axes stand; _shutdown then disables."""
-        if not getattr(self, "_opened", False):
-            return
+    def _begin_quick_stop(self) -> None:
+        """Command every enabled drive's quick stop (CiA 402: it brakes on its own ramp, 0x6085). Until a
+        drive takes it, its setpoint goes on at the speed it had (see _exchange)."""
         self._coast = [int(round(tx.velocity_actual * self.bench.cycle)) for tx in self.tx]
-        for rx, step in zip(self.rx[: len(self.axes)], self._coast):
-            rx.target_position += step  # the update the failed cycle did not make
-        self._planner_failed = True
+        self._braking = True
         for m in self.masters:
             if m.enabled:
                 m.request(Target.QUICK_STOP)
-        try:
-            for _ in range(int(limit_s / self.bench.cycle)):
-                self._exchange()
-                if all(abs(tx.velocity_actual) < 1 for tx in self.tx):
-                    break
-        except BusError as exc:
-            self.result.alarms.append(exc.alarm)
+
+    def _reenable(self, ch: Channel) -> None:
+        """After an E-stop is released and reset: once the axes stand, enable the drives again and
+        let the NC take over the actual position (the axes braked past the frozen setpoint)."""
+        if any(abs(tx.velocity_actual) >= 1 for tx in self.tx):
+            return
+        ch.planner.reset_position(dict(zip(self.axes, self.actual.tolist())))
+        self._braking = False
+        for m in self.masters:
+            m.request(Target.ENABLED)
+
+    def _quick_stop(self) -> None:
+        """The planner itself failed: leave it alone and command every drive's quick stop; _shutdown
+        waits for standstill, then disables."""
+        if not getattr(self, "_opened", False):
+            return
+        self._planner_failed = True
+        self._begin_quick_stop()
+        for i, (rx, step) in enumerate(zip(self.rx[: len(self.axes)], self._coast)):
+            rx.target_position += step  # the update the failed cycle did not make
+            self._commands[i] = self.scales[i].to_units(rx.target_position) + self.origin[i]
+        if self.trace is not None and getattr(self, "_row_cycle", None) != self.cycle:
+            self.trace.write(self._row())  # the failed cycle's row: one row per cycle, alarm included
+            self._row_cycle = self.cycle
 
     def _settle(self) -> None:
         """Keep cycling on the final setpoints until the axes stand still (or the settle time ends)."""
@@ -402,11 +428,23 @@ class BenchRunner:
             if still:
                 break
 
+    def _standstill(self) -> None:
+        """Cycle until every axis stands (the channel's stop along the path, or the drives' quick
+        stop, runs meanwhile), at most STANDSTILL_TIMEOUT: drives are disabled only at standstill."""
+        for _ in range(int(STANDSTILL_TIMEOUT / self.bench.cycle)):
+            if all(abs(tx.velocity_actual) < 1 for tx in self.tx):
+                return
+            self._exchange()
+
     def _shutdown(self) -> None:
-        """Disable every drive in order (operation enabled → ready → switch on disabled)."""
-        for m in self.masters:
-            m.request(Target.DISABLED)
+        """Wait for standstill, then disable every drive in order (operation enabled → ready →
+        switch on disabled), close the bus and finish the trace. A second signal (the run was
+        interrupted) disables at once."""
         try:
+            if getattr(self, "_opened", False) and getattr(self, "_end_reason", None) != "interrupted":
+                self._standstill()
+            for m in self.masters:
+                m.request(Target.DISABLED)
             for _ in range(20 if getattr(self, "_opened", False) else 0):
                 self._exchange()
                 if all(m.state in (State.SWITCH_ON_DISABLED, State.READY_TO_SWITCH_ON, State.FAULT) for m in self.masters):
@@ -415,6 +453,7 @@ class BenchRunner:
             self.result.alarms.append(exc.alarm)
         try:
             self.link.close()
+            self._bus_closed = True
         finally:
             self.clock.stop()
             if self.trace is not None:
@@ -434,7 +473,7 @@ class BenchRunner:
         reason = getattr(self, "_end_reason", None) or self.stop_request or ("alarm" if pool else "completed")
         return {"reason": reason, "alarm": pool[0].code_text if pool else None,
                 "alarm_line": pool[0].line if pool else None, "cycle": self.cycle, "t": round(self.time, 9),
-                "complete": reason != "interrupted"}
+                "complete": reason != "interrupted", "bus": "closed" if self._bus_closed else "open"}
 
     def _finish(self) -> RunResult:
         r = self.result

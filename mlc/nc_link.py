@@ -155,6 +155,8 @@ class ChannelLink:
             ch.end = None
             ch.alarms.clear()
             ch.state = RunState.IDLE
+        if not self._estop and hasattr(ch, "emergency"):
+            ch.emergency = False  # E-stop released, then reset: the bench enables the drives again
         self.alarms.clear()
         self._alarms_seen.clear()
         self._reset_pending = True

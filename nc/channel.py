@@ -86,6 +86,7 @@ class Channel:
     _m96_running: bool = False  # the interrupt program's motion is in progress (M3x031)
     # the interpreter's macro statement budget, opened anew every cycle (nc.budget, decisions B2)
     statement_budget: StatementBudget | None = None
+    emergency: bool = False  # an E-stop froze the setpoints: the bench must brake with the drives
 
     def load(self, events: Iterator[Event]) -> None:
         self.events = events
@@ -245,7 +246,9 @@ class Channel:
             self.pending_aux = None
 
     def emergency_stop(self, alarm: Alarm) -> None:
-        """E-stop: setpoints freeze this cycle (the drives' own quick stop does the braking)."""
+        """E-stop: setpoints freeze this cycle; the bench commands the drives' own quick stop, which
+        does the braking (stop category 1)."""
+        self.emergency = True
         self.alarms.append(alarm)
         self.planner.abort()
         self.state = RunState.ALARM

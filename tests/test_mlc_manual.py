@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 import pytest
 
 from hil.bench import default_lathe
@@ -98,20 +99,36 @@ def test_feed_hold_stops_within_the_jerk_limited_distance_and_resumes(machine):
     assert machine.command("Z") == pytest.approx(100.0 - 80.0, abs=1e-6)
 
 
-def test_estop_freezes_every_setpoint_within_one_cycle_with_alarm_0401(machine):
+def test_estop_brakes_on_the_drives_quick_stop_and_reset_enables_again(machine):
+    """E-stop (M2x013) is a stop category 1 (decision B12): the NC stops interpolating and zeroes the
+    spindle command within one cycle, every drive brakes on its own quick-stop ramp (CiA 402
+    state 0x07, 0x6085) within the axis's acceleration, and is disabled at standstill. Released and
+    reset, the drives are enabled again and the NC takes over where the axes stand."""
     machine.mdi("M03 S800")
     ch = machine.start_program("G98 G01 U-40. W-80. F6000\nM30\n")
     machine.wait(0.3)
     rows = []
-    machine.watchers.append(lambda m: rows.append((m.command("X"), m.command("Z"),
-                                                   m.runner.rx[2].target_velocity)))
+    machine.watchers.append(lambda m: rows.append((m.position("Z"), m.runner.rx[2].target_velocity,
+                                                   [tx.statusword & 0x6F for tx in m.runner.tx])))
     machine.estop()  # M21013 set, then one cycle
-    machine.wait(0.05)
+    machine.wait(0.3)
     assert machine.get("M31018") == 1
     assert [a.code for a in ch.alarms] == [0x0401]
-    # the first cycle after the relay already holds the setpoints and the spindle command at zero
-    assert rows[0][2] == 0 and all(r == rows[0] for r in rows)
+    assert rows[0][1] == 0  # the spindle command is zero the first cycle after the relay
+    assert all(sw == 0x07 for sw in rows[2][2])  # every drive in Quick Stop Active two cycles on
+    z = np.array([r[0] for r in rows])
+    a = np.abs(np.diff(z, 2)) / machine.bench.cycle ** 2
+    assert a.max() <= machine.bench.axes[1].limits.max_acceleration * 1.01  # braked, not frozen dead
+    assert abs(z[-1] - z[-2]) < 1e-9  # standing
+    assert not any(m.enabled for m in machine.runner.masters)  # disabled at standstill
     machine.estop(False)
     machine.reset()
     machine.wait(0.05)
     assert machine.get("M31019") == 1 and machine.get("M31025") == 0 and not ch.busy
+    assert all(m.enabled for m in machine.runner.masters)
+    z0 = machine.position("Z")
+    assert machine.command("Z") == pytest.approx(z0, abs=1e-6)  # the NC took over the braked position
+    machine.mdi("G98 G01 W5. F3000")
+    assert machine.command("Z") == pytest.approx(z0 + 5.0, abs=1e-6)  # no jump: 5 mm on from there
+
+

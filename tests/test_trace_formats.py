@@ -45,7 +45,8 @@ def test_types_nulls_units_and_provenance(trace):
     assert meta["program"].endswith("short_turn.nc") and meta["deltahil_version"]
     end = meta["end"]
     assert end == {"reason": "alarm", "alarm": "0x0401", "alarm_line": end["alarm_line"],
-                   "cycle": tf.num_rows, "t": pytest.approx(tf.num_rows * 0.001), "complete": True}
+                   "cycle": tf.num_rows, "t": pytest.approx(tf.num_rows * 0.001), "complete": True,
+                   "bus": "closed"}
     alarm = pq.read_table(trace, columns=["alarm"]).column("alarm")
     assert alarm.null_count == alarm.length() - 1  # one row names the E-stop, the rest are null
 

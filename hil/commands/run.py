@@ -157,4 +157,6 @@ def print_summary(program: str, bench: Bench, r: RunResult, out=None) -> None:
     else:
         print("alarms         none", file=out)
     why = f" by {r.stopped_by}: axes stopped along the path, drives disabled at standstill" if r.stopped_by else ""
+    if r.stopped_by and r.ok:
+        why = f" ({r.stopped_by} came after the program's end)"
     print(f"result         {'completed' if r.ok else 'STOPPED'}{why}", file=out)
