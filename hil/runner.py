@@ -36,6 +36,7 @@ MODE_CSP = 8
 MODE_CSV = 9
 MAX_TIME_ALARM = MAX_TIME  # deltahil's own range 0xDE00-0xDEFF (nc/alarm_table.py)
 STANDSTILL_TIMEOUT = 10.0  # s the stop path waits for the axes to stand before it disables anyway
+FROZEN_S = 0.2  # s of unchanged feedback from a moving drive that mean it left the bus
 
 
 @dataclass
@@ -431,10 +432,20 @@ class BenchRunner:
     def _standstill(self) -> None:
         """Cycle until every axis stands (the channel's stop along the path, or the drives' quick
         stop, runs meanwhile), at most STANDSTILL_TIMEOUT: drives are disabled only at standstill."""
+        # A drive whose feedback froze for FROZEN_S (it left the bus: same position, same non-zero
+        # speed) is not waited for: it brakes on its own fault reaction, unseen.
+        frozen = {i: 0 for i in range(len(self.tx))}
+        gone = max(1, int(FROZEN_S / self.bench.cycle))
+        last = [(tx.position_actual, tx.velocity_actual) for tx in self.tx]
         for _ in range(int(STANDSTILL_TIMEOUT / self.bench.cycle)):
-            if all(abs(tx.velocity_actual) < 1 for tx in self.tx):
+            if all(abs(tx.velocity_actual) < 1 or frozen[i] >= gone
+                   for i, tx in enumerate(self.tx)):
                 return
             self._exchange()
+            for i, tx in enumerate(self.tx):
+                now = (tx.position_actual, tx.velocity_actual)
+                frozen[i] = frozen[i] + 1 if now == last[i] else 0
+                last[i] = now
 
     def _shutdown(self) -> None:
         """Wait for standstill, then disable every drive in order (operation enabled → ready →

@@ -10,6 +10,7 @@ from hil.session import make_link
 from hil.trace import open_trace
 from hil.trace_read import TraceFile
 from nc.program import parse_program
+from tests.fault_helpers import Recorder, assert_stopped_after_alarm
 
 PROGRAM = "G98\nM03 S600\nG00 X24. Z2.\nG01 Z-3. F600.\nX30.\nM30\n"
 
@@ -133,8 +134,10 @@ def test_overrun_detected_and_alarm_policy(tmp_path):
             return type(t)(t.period, t.late, overrun=self._n == 50)
 
     runner.clock = Overrunning(bench.cycle)
+    runner.on_cycle = rec = Recorder()
     r = runner.run_program(parse_program(PROGRAM, name="p.nc"))
     assert [a.code for a in r.alarms] == [0x141F]
+    assert_stopped_after_alarm(rec, r)
     assert "cycle overrun: cycle 49" in r.alarms[0].message
 
 

@@ -12,6 +12,7 @@ from hil.bench import default_lathe
 from hil.runner import BenchRunner
 from hil.session import sim_slaves
 from nc.program import parse_program
+from tests.fault_helpers import Recorder, assert_stopped_after_alarm
 from virtual_bus.canopen import attach_lockstep
 
 # 0.8 s of motion on both axes (Z 200 mm at 1000 mm/min ... plenty of time to fault mid-move)
@@ -42,8 +43,10 @@ def test_node_loss_is_found_by_heartbeat_timeout_and_stops_the_rest():
     nodes = attach_lockstep(link, sim_slaves(bench))
     runner = BenchRunner(bench, link, on_cycle=pull_cable)
     seen = []
-    runner.on_cycle = lambda r: (pull_cable(r), seen.append((r.cycle, len(r.result.alarms))))
+    rec = Recorder(chain=lambda r: (pull_cable(r), seen.append((r.cycle, len(r.result.alarms)))))
+    runner.on_cycle = rec
     result = runner.run_program(parse_program(PROGRAM, name="move.nc"))
+    assert_stopped_after_alarm(rec, result, lost=("Z",))  # X brakes along the path; Z's feedback is gone
 
     assert not result.ok and lost_at == [300]
     alarm = result.alarms[0]
@@ -68,7 +71,9 @@ def test_emcy_from_a_faulted_drive_raises_the_delta_servo_alarm():
     bench = default_lathe()
     link = CanopenLink.for_bench(bench, "virtual", "")
     nodes = attach_lockstep(link, sim_slaves(bench))
-    result = BenchRunner(bench, link, on_cycle=estop).run_program(parse_program(PROGRAM, name="move.nc"))
+    rec = Recorder(chain=estop)
+    result = BenchRunner(bench, link, on_cycle=rec).run_program(parse_program(PROGRAM, name="move.nc"))
+    assert_stopped_after_alarm(rec, result)  # X on its fault reaction, Z along the path
 
     assert not result.ok
     first = result.alarms[0]

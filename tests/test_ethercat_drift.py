@@ -10,6 +10,7 @@ from fieldbus.ethercat.link import EthercatLink
 from hil.bench import default_lathe
 from hil.runner import BenchRunner
 from nc.program import parse_program
+from tests.fault_helpers import Recorder, assert_stopped_after_alarm
 from virtual_bus.ethercat.faults import parse_fault
 from virtual_bus.ethercat.veth import SimProcess, can_create
 
@@ -24,7 +25,9 @@ def run(*faults: str, limit: float = 50_000):
     bench.params.update(ethercat_drift_limit_ns=limit, ethercat_drift_check_every=10)
     with SimProcess(*(f"--fault={f}" for f in faults), tag="d") as sim:
         link = EthercatLink.for_bench(bench, sim.iface)
-        result = BenchRunner(bench, link).run_program(parse_program(PROGRAM, name="drift.nc"))
+        rec = Recorder()
+        result = BenchRunner(bench, link, on_cycle=rec).run_program(parse_program(PROGRAM, name="drift.nc"))
+    run.recorder = rec  # type: ignore[attr-defined]
     return result, link
 
 
@@ -50,6 +53,7 @@ def test_runaway_clock_on_z_raises_0x141f_on_z_before_the_program_ends():
     assert not result.finished
     assert a.code == 0x141F and a.axis == "Z" and a.info > 50_000
     assert "DC drift" in a.message and link.stats.max_drift_ns > 50_000
+    assert_stopped_after_alarm(run.recorder, result)
 
 
 @needs_veth

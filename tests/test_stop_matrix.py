@@ -119,3 +119,20 @@ def test_every_end_stops_the_axes_under_control(tmp_path, request, bus, reason):
     assert_stopped_under_control(tf, moving_at_stop=reason != "end")
     if reason == "internal":
         assert "injected planner bug" in out and "0x0000" in out
+
+
+def test_max_time_is_alarm_0xfe01_and_the_axes_stop_along_the_path():
+    """The bench's max_time runs out with Z at full speed: alarm 0xFE01, a stop along the path
+    within the braking distance, drives disabled at standstill (decision B13)."""
+    from hil.runner import MAX_TIME_ALARM, BenchRunner
+    from hil.session import load_bench, make_link
+    from nc.program import parse_program
+    from tests.fault_helpers import Recorder, assert_stopped_after_alarm
+
+    bench = load_bench(str(LATHE))
+    bench.mlc, bench.max_time = "basic", 2.0
+    rec = Recorder()
+    result = BenchRunner(bench, make_link(bench), on_cycle=rec).run_program(parse_program(LONG, name="long.nc"))
+    assert [a.code for a in result.alarms] == [MAX_TIME_ALARM] and result.alarms[0].line == 3
+    assert abs(rec.vel[1999][1]) > 99  # Z at 100 mm/s when the time ran out
+    assert_stopped_after_alarm(rec, result)

@@ -283,7 +283,7 @@ class EthercatLink:
                 self._states = ["OP"] * len(self.infos)
             self._last = [layout.unpack_tx(s.input, tx) for s, layout, tx in zip(self.drives, self._structs, self._last)]
             self._io_in = [bytes(s.input) for s in self.io]
-            if self.dc and self.drift_check_every and self.stats.cycles % self.drift_check_every == 0:
+            if self.dc and self.drift_check_every and not self._failed and self.stats.cycles % self.drift_check_every == 0:
                 self._check_drift()
             return list(self._last)
         return self._bad_cycle(m, wkc)
@@ -295,11 +295,23 @@ class EthercatLink:
             self.stats.lost_frames += 1
         m.read_state()
         self._states = [state_name(s.state) for s in self.drives + self.io]
+        if self._failed:
+            return self._ride_on(wkc)
         try:
             return self._judge_bad_cycle(m, wkc)
         except BusError:
             self._failed = True
             raise
+
+    def _ride_on(self, wkc: int) -> list[TxPdo]:
+        """The alarm is already raised: keep the line cycling so the NC can stop the drives still on
+        it under control (the stop must not depend on the slave that failed). A slave in SAFE-OP or OP
+        still returns its inputs in the frame; a lost frame or a slave further down keeps its last."""
+        if wkc >= 0:
+            live = (pysoem.SAFEOP_STATE, pysoem.OP_STATE)
+            self._last = [layout.unpack_tx(s.input, tx) if s.state & 0x0F in live else tx
+                          for s, layout, tx in zip(self.drives, self._structs, self._last)]
+        return list(self._last)
 
     def _judge_bad_cycle(self, m, wkc: int) -> list[TxPdo]:
         io = {id(s) for s in self.io}

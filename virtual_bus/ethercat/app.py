@@ -9,6 +9,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from fieldbus.pdo import ASDA_CSP_CSV, RxPdo
+from fieldbus.cia402 import State
 from virtual_bus.drive import Cia402Drive
 from virtual_bus.ethercat.coe import ObjectDictionary, SdoAbort
 from virtual_bus.ethercat.device import OBJ_VAR, TYPES, OdEntry, OdObject
@@ -18,6 +19,7 @@ from virtual_bus.servo_params import ServoParamError, ServoParams, coe_objects
 # object index -> RxPdo / TxPdo attribute, from the ASDA preset's entries
 RX_ATTR = {e.index: e.attr for e in ASDA_CSP_CSV.rx} | {0x60FE: "digital_outputs"}
 TX_ATTR = {e.index: e.attr for e in ASDA_CSP_CSV.tx}
+COMM_FAULT = 0x7500  # CiA 402 error code class "communication"
 
 
 def _unpack(data: bytes, mapping, od: ObjectDictionary) -> None:
@@ -81,10 +83,17 @@ class DriveApp(SlaveApp):
         elif 0x2000 <= index <= 0x26FF and self.od is not None and index in self.od.objects:
             self.od.set(index, 0, self.drive.servo_params.read(ServoParams.from_index(index, 0)))
 
-    def cycle(self, outputs: bytes, rx_map, tx_map, step: bool, dt: float = 0.0) -> bytes:
+    def cycle(self, outputs: bytes, rx_map, tx_map, step: bool, dt: float = 0.0, lost: bool = False) -> bytes:
         od = self.od
         assert od is not None
-        if step:
+        if step and lost:
+            # Out of OP by an error (SM watchdog, sync, AL error): the outputs are not valid any more.
+            # The drive takes its communication fault reaction (CiA 402 0x6007 = 2: fault, braking on
+            # the quick-stop ramp) and its time runs on, so the master still sees it brake.
+            if self.drive.state is not State.FAULT:
+                self.drive.fault(COMM_FAULT)
+            self.drive.step(dt)
+        elif step:
             _unpack(outputs, rx_map, od)
             rx = RxPdo(mode=self.drive.mode)
             for index, attr in RX_ATTR.items():
@@ -141,10 +150,10 @@ class DioApp(SlaveApp):
         if self.od is not None and any(index == i for i, _ in self.in_objs):
             self._publish()
 
-    def cycle(self, outputs: bytes, rx_map, tx_map, step: bool, dt: float = 0.0) -> bytes:
+    def cycle(self, outputs: bytes, rx_map, tx_map, step: bool, dt: float = 0.0, lost: bool = False) -> bytes:
         od = self.od
         assert od is not None
-        if step:
+        if step and not lost:
             _unpack(outputs, rx_map, od)
             value, shift = 0, 0
             for index, bits in self.out_objs:

@@ -84,7 +84,8 @@ class SlaveApp:
 
     def attach(self, od: ObjectDictionary) -> None: ...
 
-    def cycle(self, outputs: bytes, rx_map, tx_map, step: bool, dt: float = 0.0) -> bytes:
+    def cycle(self, outputs: bytes, rx_map, tx_map, step: bool, dt: float = 0.0, lost: bool = False) -> bytes:
+        """`lost`: the slave fell out of OP by an error; its outputs are stale, its time runs on."""
         return b""
 
     def refresh(self, index: int) -> None: ...
@@ -407,8 +408,9 @@ class Esc:
                                               step=True, dt=dt))
         elif reads and state == SAFEOP:
             s2 = self.sm(2)
+            lost = bool(self.mem[R_AL_STATUS] & AL_ERROR) and self.outputs_written > 0  # dropped out of OP
             self._write_inputs(self.app.cycle(bytes(self.mem[s2.start:s2.end]), self.rx_map, self.tx_map,
-                                              step=False))
+                                              step=lost, dt=self.cycle_time, lost=lost))
         if reads:
             for lo, hi, p in reads:
                 data[lo - addr:hi - addr] = self.mem[p:p + hi - lo]
