@@ -7,7 +7,7 @@ from __future__ import annotations
 
 DELTAHIL_CODES = range(0xDE00, 0xDF00)  # codes of deltahil's own guards, not in the NC5 manual
 ENDLESS_LOOP = 0xDE01
-MAX_TIME = 0xDE02  # the bench's max_time ran out (decisions B13)
+MAX_TIME = 0xDE03  # the bench's max_time ran out (decisions B13)
 PLANNING_STALL = 0xDE10  # the planner's solves of one cycle all ended before a sample (decisions B4)
 MLC_PROGRAM_ERROR = 0xDE02
 
@@ -201,7 +201,7 @@ ALARM_TABLE: dict[int, tuple[str, str, str]] = {
     # (docs/decisions/program-input.md P5). NC5 never raises them; a bench that compares alarms
     # with a real controller sees them only where the NC5 would run on.
     0xDE01: ('instruction', 'Endless-loop guard: too many blocks executed.', "deltahil: more blocks than the parameter 'max blocks' (1,000,000) were executed; a WHILE or GOTO loop that never ends. Raise 'max blocks' in [params] if the program is meant to run that long."),
-    0xDE02: ('bench', "The run exceeded the bench's max_time.", 'deltahil: the bench (or campaign) max_time ran out before the program ended; the channel stopped along the path as for any alarm (decisions B13). Raise max_time, or find why the program did not end.'),
+    0xDE03: ('bench', "The run exceeded the bench's max_time.", 'deltahil: the bench (or campaign) max_time ran out before the program ended; the channel stopped along the path as for any alarm (decisions B13). Raise max_time, or find why the program did not end.'),
     0xDE10: ('axis', 'Motion planning guard: no progress within one cycle.', "deltahil: every one of the planner's 1000 solves in one cycle ended before a setpoint was due, as with absurd axis limits (acceleration 1e-50 mm/s^2); check the bench's limits (docs/decisions/budgets.md B4)."),
     0xDE02: ('mlc', 'MLC program error: the user MLC program raised an exception.', "deltahil: the MLC program's scan (a user's --mlc FILE.py) raised; the alarm names the file, the line and the program's traceback. The NC stops the channel as for an MLC alarm; fix the program."),
     0xF002: ('axis', 'The alarm codes of Delta servo.', "The alarm of 0xF002 needs to be interpreted in conjunction with the alarm codes of the Delta servo. For example, if the Delta servo displays an alarm code 0x09 (following error), the controller will display 0xF002 and indicate the servo's alarm code as 0x09."),

@@ -251,6 +251,6 @@ def test_a_run_past_max_time_is_a_timeout_and_params_sweep_is_a_variant(tmp_path
     assert p.returncode == 1
     rs = pq.read_table(tmp_path / "o" / "results.parquet").to_pylist()
     assert sorted(r["params"] for r in rs) == ["N1.040=0.01", "N1.040=0.02"]
-    # alarm 0xDE02 at max_time, then the channel stops along the path before the run ends
+    # alarm 0xDE03 at max_time, then the channel stops along the path before the run ends
     assert {r["status"] for r in rs} == {"timeout"} and all(0.4 <= r["program_time_s"] <= 0.6 for r in rs)
     assert all(r["program_time_s"] < r["sim_time_s"] < 0.9 for r in rs)
