@@ -97,6 +97,7 @@ class BenchRunner:
         self._seen_alarms: set[int] = set()
         self._planner_failed = False
         self._braking = False  # every drive was told its quick stop (E-stop, failed planner)
+        self._winding_down = False  # the run is over; the stop path brings everything to rest
         self._bus_closed = False
         self.stop_request: str | None = None  # a signal's name (hil/stop_signals.py): stop, then end
         self._overrun_alarmed = False
@@ -332,9 +333,11 @@ class BenchRunner:
             rpm = self.mlc.spindle.signed_rpm if (ch is not None and ch.state is not RunState.ALARM) else 0.0
             if k == 0 and ch is not None:  # G96 speed, override, G50/G92 S clamp (issue 5; decisions A39, 32)
                 rpm = self.spindle_command_rpm()
+            if self._winding_down:
+                rpm = 0.0  # the run is over: spindles ramp down before their drives are disabled
             self.rx[n_axes + k].target_velocity = sc.rpm_to_counts_per_s(rpm)
             hook = getattr(self.mlc, "spindle_drive", None)  # spindle ↔ C axis, M19: CSV ↔ CSP (issue 8)
-            if k == 0 and ch is not None and callable(hook):
+            if k == 0 and ch is not None and callable(hook) and not self._winding_down:
                 rx = self.rx[n_axes]
                 rx.mode, deg, vel = hook(self)
                 if deg is not None:
@@ -434,6 +437,7 @@ class BenchRunner:
         stop, runs meanwhile), at most STANDSTILL_TIMEOUT: drives are disabled only at standstill."""
         # A drive whose feedback froze for FROZEN_S (it left the bus: same position, same non-zero
         # speed) is not waited for: it brakes on its own fault reaction, unseen.
+        self._winding_down = True
         frozen = {i: 0 for i in range(len(self.tx))}
         gone = max(1, int(FROZEN_S / self.bench.cycle))
         last = [(tx.position_actual, tx.velocity_actual) for tx in self.tx]

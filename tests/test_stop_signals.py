@@ -132,3 +132,24 @@ def test_an_internal_error_in_the_cycle_loop_still_stops_under_control(tmp_path)
     v = c["Z_vel"][1498:off]
     assert np.all(np.abs(np.diff(v)) <= 2.0)  # the drive's ramp (0x6085 = 1.56 m/s² on Z): no jump
     assert np.all(v * np.sign(v[0]) >= -0.01)  # braking only, no reversal
+
+
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM], ids=lambda s: s.name)
+def test_a_signal_leaves_no_temporary_check_trace(tmp_path, sig):
+    """Without --trace, `hil run` judges the bench's checks on a temporary trace: a signal mid-run
+    still judges them on what ran and removes it (nothing left in the temporary folder)."""
+    prog = tmp_path / "long.nc"
+    prog.write_text(LONG)
+    tmp = tmp_path / "tmp"
+    tmp.mkdir()
+    p = subprocess.Popen([sys.executable, "-m", "hil.cli", "run", str(prog), "--bench", str(LATHE), "--no-progress"],
+                         env={**os.environ, "PYTHONPATH": str(ROOT), "TMPDIR": str(tmp)}, stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 60
+    while not any(tmp.glob("hil-run-*")) and time.monotonic() < deadline and p.poll() is None:
+        time.sleep(0.02)  # the run is under way: its temporary trace exists
+    time.sleep(1.0)
+    p.send_signal(sig)
+    out, err = p.communicate(timeout=120)
+    assert p.returncode == 128 + sig and "checks" in out and "Traceback" not in err, out + err
+    assert not list(tmp.iterdir())
