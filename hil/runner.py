@@ -308,7 +308,8 @@ class BenchRunner:
             self._skip_probe(ch)
             sp = ch.step()
             self._commands[:] = sp.positions
-            self.line = sp.line or self.line
+            if not self._winding_down:
+                self.line = sp.line or self.line
             if ch.emergency and not self._braking:
                 self._begin_quick_stop()  # E-stop: stop category 1, the drives brake on their own ramp
             elif self._braking and not ch.emergency and not self._planner_failed:
@@ -438,6 +439,7 @@ class BenchRunner:
         # A drive whose feedback froze for FROZEN_S (it left the bus: same position, same non-zero
         # speed) is not waited for: it brakes on its own fault reaction, unseen.
         self._winding_down = True
+        self.line = 0  # the rows after the program name no line: the bench is bringing things to rest
         frozen = {i: 0 for i in range(len(self.tx))}
         gone = max(1, int(FROZEN_S / self.bench.cycle))
         last = [(tx.position_actual, tx.velocity_actual) for tx in self.tx]

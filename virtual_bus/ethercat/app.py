@@ -90,8 +90,8 @@ class DriveApp(SlaveApp):
             # Out of OP by an error (SM watchdog, sync, AL error): the outputs are not valid any more.
             # The drive takes its communication fault reaction (CiA 402 0x6007 = 2: fault, braking on
             # the quick-stop ramp) and its time runs on, so the master still sees it brake.
-            if self.drive.state is not State.FAULT:
-                self.drive.fault(COMM_FAULT)
+            if self.drive.state in (State.OPERATION_ENABLED, State.QUICK_STOP_ACTIVE):
+                self.drive.fault(COMM_FAULT)  # a drive that was not powering its motor has nothing to stop
             self.drive.step(dt)
         elif step:
             _unpack(outputs, rx_map, od)
