@@ -162,27 +162,26 @@ def test_symlink_out_of_the_program_folders_is_refused_and_not_echoed(capsys, tm
     assert "TOPSECRET" not in json.dumps(objs) and "root:x" not in json.dumps(objs)
 
 
-def test_symlink_to_another_program_root_is_allowed(capsys, tmp_path) -> None:
-    lib = tmp_path / "lib"
-    lib.mkdir()
-    (lib / "O0005.nc").write_text("G01 X5. F100\nM99\n")
+def linked_program(tmp_path, folder: str, n: int, link_to) -> Path:
+    """O000n in tmp_path/folder, reached from tmp_path/progs through a symlink; returns main.nc."""
+    (tmp_path / folder).mkdir()
+    (tmp_path / folder / f"O000{n}.nc").write_text(f"G01 X{n}. F100\nM99\n")
     progs = tmp_path / "progs"
     progs.mkdir()
-    os.symlink(lib / "O0005.nc", progs / "O0005.nc")
-    (progs / "main.nc").write_text("M98 P5\nM30\n")
-    code, objs = path_json(capsys, progs / "main.nc", "--lib", str(lib))
+    os.symlink(link_to, progs / f"O000{n}.nc")
+    (progs / "main.nc").write_text(f"M98 P{n}\nM30\n")
+    return progs / "main.nc"
+
+
+def test_symlink_to_another_program_root_is_allowed(capsys, tmp_path) -> None:
+    main = linked_program(tmp_path, "lib", 5, tmp_path / "lib" / "O0005.nc")
+    code, objs = path_json(capsys, main, "--lib", str(tmp_path / "lib"))
     assert code == 0 and [o["work"]["X"] for o in objs if o["kind"] == "line"] == [5.0]
 
 
 def test_dotdot_folder_symlink_out_of_the_root_is_refused(capsys, tmp_path) -> None:
-    other = tmp_path / "other"
-    other.mkdir()
-    (other / "O0006.nc").write_text("G01 X6. F100\nM99\n")
-    progs = tmp_path / "progs"
-    progs.mkdir()
-    os.symlink("../other/O0006.nc", progs / "O0006.nc")
-    (progs / "main.nc").write_text("M98 P6\nM30\n")
-    code, objs = path_json(capsys, progs / "main.nc")
+    main = linked_program(tmp_path, "other", 6, "../other/O0006.nc")
+    code, objs = path_json(capsys, main)
     assert (code, alarm_of(objs)["code"]) == (1, "0x0263")
 
 
