@@ -95,7 +95,8 @@ def program_moves(program: Program, bench: Bench) -> list[Move]:
 
 
 def run_checks(trace: TraceFile, checks: ChecksConfig, bench: Bench | None = None,
-               moves: list[Move] | None = None) -> list[CheckResult]:
+               moves: list[Move] | None = None, no_moves: str = "needs the program (--program)") -> list[CheckResult]:
+    """`no_moves` says why `moves` is None (the skipped path checks print it)."""
     cols = _Cols(trace)
     axes = axes_of(trace.columns)
     out: list[CheckResult] = []
@@ -104,17 +105,20 @@ def run_checks(trace: TraceFile, checks: ChecksConfig, bench: Bench | None = Non
                    CheckResult(f"following error {axis}", False, detail=f"no column {axis}_ferr in the trace"))
     if checks.contour_error is not None:
         if moves is None:
-            out.append(CheckResult("contour error", True, skipped=True, detail="needs the program (--program)"))
+            out.append(CheckResult("contour error", True, skipped=True, detail=no_moves))
         else:
-            lag = LAG_CYCLES if bench is None else sum(bench.motion_config().filter_cycles()) + SERVO_LAG_CYCLES
-            out.append(check_contour(cols, axes, moves, checks.contour_error, lag))
+            lag, independent = LAG_CYCLES, False
+            if bench is not None:
+                cfg = bench.motion_config()
+                lag, independent = sum(cfg.filter_cycles()) + SERVO_LAG_CYCLES, cfg.rapid_independent
+            out.append(check_contour(cols, axes, moves, checks.contour_error, lag, independent))
     if checks.limits:
         if bench is None:
             out.append(CheckResult("setpoint limits", True, skipped=True, detail="needs the bench (--bench)"))
         else:
             out += check_limits(cols, bench, checks.limit_tolerance)
     if checks.thread_phase is not None:
-        out.append(check_thread_phase(cols, axes, spindles_of(trace.columns), moves, checks.thread_phase))
+        out.append(check_thread_phase(cols, axes, spindles_of(trace.columns), moves, checks.thread_phase, no_moves))
     jitter = [(n, getattr(checks, k)) for n, k in (("p99", "jitter_p99"), ("p99.9", "jitter_p999"),
                                                     ("max", "jitter_max")) if getattr(checks, k) is not None]
     if jitter:
@@ -188,8 +192,20 @@ def distance_to_polyline(p: np.ndarray, a: np.ndarray, b: np.ndarray, chunk: int
     return out
 
 
+def _distance_to_boxes(p: np.ndarray, rapids: list[Move], axes: list[str]) -> np.ndarray:
+    """Distance to the nearest axis-aligned box spanned by a rapid's start and end: with
+    independent rapids each axis runs on its own, so the path is somewhere inside that box."""
+    out = np.full(len(p), np.inf)
+    for m in rapids:
+        seg = Segment.of(m, tuple(axes))
+        lo, hi = np.minimum(seg.start, seg.end), np.maximum(seg.start, seg.end)
+        gap = np.maximum(np.maximum(lo - p, p - hi), 0.0)
+        out = np.minimum(out, np.sqrt(np.einsum("ij,ij->i", gap, gap)))
+    return out
+
+
 def check_contour(cols: _Cols, axes: list[str], moves: list[Move], limit: float,
-                  lag_cycles: int = LAG_CYCLES) -> CheckResult:
+                  lag_cycles: int = LAG_CYCLES, independent_rapids: bool = False) -> CheckResult:
     """Distance of the actual position from the programmed path, on cycles executing a feed move.
 
     A cycle's line is the block the interpolator is in; the position the drives were given trails
@@ -199,11 +215,13 @@ def check_contour(cols: _Cols, axes: list[str], moves: list[Move], limit: float,
     run (on 0.05 mm CAM blocks that is a dozen blocks back), and their neighbours, because a
     move's corner may be blended."""
     mv_axes = [a for a in axes if any(a in m.end for m in moves)]
+    # A canned cycle's one line holds rapids as well as feeds (G71 retracts, G76 returns): every
+    # move of a line is a candidate, but only lines holding a feed move are judged.
     by_line: dict[int, set[int]] = defaultdict(set)
     for i, m in enumerate(moves):
-        if m.kind in FEED_KINDS:
-            by_line[m.line].update(j for j in (i - 1, i, i + 1) if 0 <= j < len(moves))
-    if not by_line:
+        by_line[m.line].update(j for j in (i - 1, i, i + 1) if 0 <= j < len(moves))
+    judged = {m.line for m in moves if m.kind in FEED_KINDS}
+    if not judged:
         return CheckResult("contour error", True, 0.0, limit, "mm", detail="no feed moves in the program")
     line = cols["line"]
     act = np.column_stack([cols[f"{a}_act"] for a in mv_axes]) if mv_axes else np.zeros((len(line), 0))
@@ -212,13 +230,18 @@ def check_contour(cols: _Cols, axes: list[str], moves: list[Move], limit: float,
     starts = np.flatnonzero(np.diff(line, prepend=np.nan) != 0) if len(line) else np.zeros(0, int)
     ends = np.append(starts[1:], len(line))
     for r0, r1 in zip(starts.tolist(), ends.tolist()):
-        if int(line[r0]) not in by_line:
+        if int(line[r0]) not in judged:
             continue
         idx: set[int] = set()
         for ln in np.unique(line[max(0, r0 - lag_cycles):r1]).tolist():
             idx |= by_line.get(int(ln), set())
-        a, b = _polyline([moves[j] for j in sorted(idx)], mv_axes)
-        dist[r0:r1] = distance_to_polyline(act[r0:r1], a, b)
+        cand = [moves[j] for j in sorted(idx)]
+        boxes = [m for m in cand if independent_rapids and m.kind == "rapid"]
+        a, b = _polyline([m for m in cand if not (independent_rapids and m.kind == "rapid")], mv_axes)
+        d = distance_to_polyline(act[r0:r1], a, b) if len(a) else np.full(r1 - r0, np.inf)
+        if boxes:
+            d = np.minimum(d, _distance_to_boxes(act[r0:r1], boxes, mv_axes))
+        dist[r0:r1] = d
     i = int(np.argmax(dist))
     over = np.flatnonzero(dist > limit)
     detail = f"{over.size} cycles over, first at cycle {cols.where(int(over[0]))['cycle']}" if over.size else ""
@@ -288,7 +311,7 @@ def _braking_check(cols: _Cols, axis: str, limit: float, tolerance: float, dt: f
 
 
 def check_thread_phase(cols: _Cols, axes: list[str], spindles: list[str], moves: list[Move] | None,
-                       limit: float) -> CheckResult:
+                       limit: float, no_moves: str = "needs the program (--program)") -> CheckResult:
     """Each pass of a thread must meet the spindle at the same phase.
 
     For every threading line, a reference point on the thread axis common to all passes is chosen
@@ -297,7 +320,7 @@ def check_thread_phase(cols: _Cols, axes: list[str], spindles: list[str], moves:
     the start on purpose), must agree across passes within `limit` degrees."""
     name = "thread phase"
     if moves is None:
-        return CheckResult(name, True, skipped=True, detail="needs the program (--program)")
+        return CheckResult(name, True, skipped=True, detail=no_moves)
     if not spindles or f"{spindles[0]}_angle" not in cols.trace.columns:
         return CheckResult(name, True, skipped=True, detail="the trace has no spindle angle column")
     threads: dict[int, list[Move]] = defaultdict(list)

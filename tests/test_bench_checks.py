@@ -230,3 +230,52 @@ def test_nan_in_a_checked_column_fails_and_a_skipped_check_is_no_pass(tmp_path, 
     assert main(["check", str(tmp_path / "n.csv"), "--max-ferr", "0.1", "--contour", "0.05"]) == 1
     out = capsys.readouterr()
     assert "skipped" in out.out and "nothing was judged" in out.err
+
+
+def cycle_moves():
+    """One canned-cycle line (like a G76 pass): thread in, rapid out in X, rapid back in Z."""
+    kw = dict(plane=("Z", "X"))
+    return [Move("thread", 5, "G76 ...", {"X": 10.0, "Z": 0.0}, {"X": 10.0, "Z": -20.0}, {}, feed=2.0, **kw),
+            Move("rapid", 5, "G76 ...", {"X": 10.0, "Z": -20.0}, {"X": 14.0, "Z": -20.0}, {}, **kw),
+            Move("rapid", 5, "G76 ...", {"X": 14.0, "Z": -20.0}, {"X": 14.0, "Z": 0.0}, {}, **kw),
+            Move("rapid", 5, "G76 ...", {"X": 14.0, "Z": 0.0}, {"X": 10.0, "Z": 0.0}, {}, **kw),
+            Move("rapid", 6, "G00 X20. Z10.", {"X": 10.0, "Z": 0.0}, {"X": 20.0, "Z": 10.0}, {}, **kw)]
+
+
+def cycle_trace(dogleg: bool):
+    """The actual path along cycle_moves(); with `dogleg`, the last rapid runs X then Z."""
+    pts = [(10.0, 0.0), (10.0, -20.0), (14.0, -20.0), (14.0, 0.0), (10.0, 0.0)]
+    pts += [(20.0, 0.0), (20.0, 10.0)] if dogleg else [(20.0, 10.0)]
+    seg = np.array(pts)
+    k = np.linspace(0, len(seg) - 1, N)
+    i = np.minimum(k.astype(int), len(seg) - 2)
+    p = seg[i] + (seg[i + 1] - seg[i]) * (k - i)[:, None]
+    d = base()
+    d["X_act"], d["Z_act"] = p[:, 0].copy(), p[:, 1].copy()
+    d["X_cmd"], d["Z_cmd"] = p[:, 0].copy(), p[:, 1].copy()
+    d["line"][:] = np.where(k < 4, 5, 6)
+    return d
+
+
+def test_contour_of_a_canned_cycle_includes_its_own_rapids(tmp_path):
+    """A G71/G76 line holds feeds and rapids; its rapid return is programmed path too (the
+    example lathe part reported a 2.4 mm contour error on the G76 return)."""
+    r = only(run_checks(write(tmp_path, cycle_trace(False)), ChecksConfig(contour_error=0.01), moves=cycle_moves()),
+             "contour error")
+    assert r.ok and r.value < 1e-9, r
+
+
+def test_contour_of_independent_rapids_is_judged_against_their_box(tmp_path):
+    """N1.20 bit 18 (independent rapids): each axis runs on its own, so a rapid on a judged line
+    may leave the straight line but not the box its start and end span."""
+    from hil.checks import _Cols, check_contour
+
+    d = cycle_trace(True)
+    d["line"][:] = 5  # the dogleg rapid is part of the cycle's own line
+    tf = write(tmp_path, d)
+    moves = cycle_moves()
+    moves[4] = Move("rapid", 5, "G76 ...", {"X": 10.0, "Z": 0.0}, {"X": 20.0, "Z": 10.0}, {}, plane=("Z", "X"))
+    linear = check_contour(_Cols(tf), ["X", "Z"], moves, 0.01, independent_rapids=False)
+    boxed = check_contour(_Cols(tf), ["X", "Z"], moves, 0.01, independent_rapids=True)
+    assert not linear.ok and linear.value > 5.0  # the dogleg corner (X20 Z0) is far off the straight line
+    assert boxed.ok and boxed.value < 1e-9

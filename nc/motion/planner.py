@@ -28,6 +28,7 @@ from nc.motion.lookahead import MARGIN, Block, Limits, backward, change_distance
 from nc.motion.path import Segment
 from nc.motion.profile import Piecewise, solve_axes, solve_position, solve_velocity
 from nc.motion.smoothing import PositionFilter
+from nc.motion.thread_corners import corner_offset
 from nc.motion import threading as thr
 from nc.moves import Move
 
@@ -346,6 +347,8 @@ class Planner:
             thr.stop(st, b)
         while True:
             last = not (len(self.blocks) > 1 and self.blocks[1].kind == "thread") or st.stopping
+            if not last:
+                thr.add_corner(st, b, self.blocks[1], self.lim.acc, self.lim.jerk)
             s = thr.advance(st, b, angle, T, last)
             if s is not None:
                 break
@@ -360,6 +363,10 @@ class Planner:
             thr.next_block(st, b, nb)
             b = nb
         self.position = b.seg.points(np.array([s]))[0]
+        if st.corners:  # the chain's corners are rounded within the axes' limits (nc.motion.thread_corners)
+            off = corner_offset(st.corners, st.u_block + s / thr.major_factor(b))
+            if off is not None:
+                self.position = self.position + off
         self.line = b.move.line
         self.s, self.v, self.a = s, st.v, 0.0
         if st.halted:

@@ -19,13 +19,14 @@ motion decisions 33): the ramp is planned on that speed, so it must not be still
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from nc.alarms import NcAlarm
 from nc.motion.lookahead import MARGIN, Block, change_distance
 from nc.motion.profile import Piecewise, solve_position, solve_velocity
+from nc.motion.thread_corners import ThreadCorner, make_corner
 
 
 # A thread arms when the measured speed has stayed within SETTLE_BAND of the command (0.1 %, at least
@@ -77,6 +78,9 @@ class ThreadState:
     v: float = 0.0  # path speed (finite difference)
     stopping: bool = False  # a reset brakes the thread where it is
     halted: bool = False
+    corners: list[ThreadCorner] = field(default_factory=list)  # rounded corners inside the chain
+    cornered: int = -1  # the chain block index whose corner to the next block is known
+    block_no: int = 0  # index of the current block within the chain
 
 
 def arm(b: Block, angle: float, rpm: float, index: float, line: int) -> ThreadState:
@@ -158,8 +162,30 @@ def _set(st: ThreadState, s: float, T: float, done: bool, b: Block) -> float | N
     return None if done else s
 
 
+def slope(b: Block) -> np.ndarray:
+    """dP/du of a thread block: the axes' travel per unit of major-axis travel."""
+    assert b.seg is not None
+    return (b.seg.end - b.seg.start) * (major_factor(b) / b.length) if b.length > 0 else np.zeros(len(b.seg.end))
+
+
+def add_corner(st: ThreadState, b: Block, nb: Block, acc: np.ndarray, jerk: np.ndarray) -> None:
+    """Register the rounded corner from b into the chain's next block nb (once per junction)."""
+    if st.cornered >= st.block_no or st.stopping or b.seg is None or nb.seg is None \
+            or b.seg.kind != "line" or nb.seg.kind != "line":
+        return
+    st.cornered = st.block_no
+    du_b, du_n = b.length / major_factor(b), nb.length / major_factor(nb)
+    u_c = st.u_block + du_b
+    v = float(b.move.lead or 0.0) * st.omega / 360.0
+    room = min(0.5 * du_b, 0.5 * du_n, u_c - st.u)  # never reach back past where the chain already is
+    c = make_corner(u_c, slope(b), slope(nb), v, acc, jerk, room)
+    if c is not None:
+        st.corners = [k for k in st.corners if k.u + k.w > st.u] + [c]
+
+
 def next_block(st: ThreadState, b: Block, nb: Block) -> None:
     """The chain runs on from b into the next thread block nb: carry the travel over."""
+    st.block_no += 1
     st.u_block += b.length / major_factor(b)
     st.u = max(st.u, st.u_block)
     st.n_block = st.direction * (st.last_angle - st.sync_angle) / 360.0
