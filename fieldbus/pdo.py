@@ -1,9 +1,8 @@
 """Process data: the per-cycle images exchanged with a CiA 402 drive, and PDO layouts that say
 which objects travel and how they pack on the wire.
 
-The Delta ASDA preset follows the objects a Delta ASDA-A2-E/A3-E drive maps for CSP
-(the same set lcec's `deasda` driver uses). Values are in drive units: positions in counts,
-velocities in counts/s, torque in 0.1 % of rated.
+Values are in the drive's units (`fieldbus.units.DriveUnits`): positions in counts, velocities in
+0.1 rpm of the motor on Delta drives, torque in 0.1 % of rated.
 """
 
 from __future__ import annotations
@@ -19,7 +18,7 @@ class RxPdo:
     controlword: int = 0  # 0x6040
     target_position: int = 0  # 0x607A, counts
     mode: int = 8  # 0x6060 (8 = CSP, 9 = CSV, 6 = homing)
-    target_velocity: int = 0  # 0x60FF, counts/s (CSV)
+    target_velocity: int = 0  # 0x60FF, drive units (Delta: 0.1 rpm)
     touch_probe_function: int = 0  # 0x60B8
     digital_outputs: int = 0  # 0x60FE:1
 
@@ -30,7 +29,7 @@ class TxPdo:
 
     statusword: int = 0  # 0x6041
     position_actual: int = 0  # 0x6064, counts
-    velocity_actual: int = 0  # 0x606C, counts/s
+    velocity_actual: int = 0  # 0x606C, drive units (Delta: 0.1 rpm)
     torque_actual: int = 0  # 0x6077, 0.1 % of rated
     following_error: int = 0  # 0x60F4, counts
     error_code: int = 0  # 0x603F

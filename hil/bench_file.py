@@ -31,7 +31,7 @@ _DRIVE_INT = {"following_error_window", "negative_limit", "positive_limit", "hom
               "substeps", "probe_position"}
 # Axis limit bounds (mm or deg per s, s², s³): a 100 m/s axis or a jerk of 1e10 is no machine tool.
 LIMIT_BOUNDS = {"velocity": (1e-3, 1e5), "acceleration": (1e-3, 1e7), "jerk": (1e-3, 1e10)}
-_DRIVE_KEYS = {f.name for f in fields(DriveParams)} - {"counts_per_rev"}
+_DRIVE_KEYS = {f.name for f in fields(DriveParams)} - {"counts_per_rev", "units"}
 
 
 class BenchFileError(InputError):

@@ -232,7 +232,7 @@ class BenchRunner:
         n = len(self.axes)
         if len(self.scales) <= n:
             return abs(self.spindle_command_rpm())
-        return self.scales[n].counts_per_s_to_rpm(self.tx[n].velocity_actual)
+        return self.scales[n].drive_to_rpm(self.tx[n].velocity_actual)
 
     def spindle_actual_angle(self) -> float:
         """The first spindle's measured angle, cumulative degrees (position_actual, not wrapped)."""
@@ -336,7 +336,7 @@ class BenchRunner:
                 rpm = self.spindle_command_rpm()
             if self._winding_down:
                 rpm = 0.0  # the run is over: spindles ramp down before their drives are disabled
-            self.rx[n_axes + k].target_velocity = sc.rpm_to_counts_per_s(rpm)
+            self.rx[n_axes + k].target_velocity = sc.rpm_to_drive(rpm)
             hook = getattr(self.mlc, "spindle_drive", None)  # spindle ↔ C axis, M19: CSV ↔ CSP (issue 8)
             if k == 0 and ch is not None and callable(hook) and not self._winding_down:
                 rx = self.rx[n_axes]
@@ -344,7 +344,7 @@ class BenchRunner:
                 if deg is not None:
                     rx.target_position = sc.to_counts(deg)
                 if vel is not None:
-                    rx.target_velocity = sc.rpm_to_counts_per_s(vel)
+                    rx.target_velocity = sc.rpm_to_drive(vel)
         if self.trace is not None:
             self.trace.write(self._row())
             self._row_cycle = self.cycle
@@ -375,13 +375,13 @@ class BenchRunner:
         n_axes = len(self.axes)
         for i in range(n_axes):
             tx, sc = self.tx[i], self.scales[i]
-            row += [float(self._commands[i]), float(self.actual[i]), sc.to_units(tx.velocity_actual),
-                    tx.torque_actual / 10.0, sc.to_units(tx.following_error), tx.statusword]
+            row += [float(self._commands[i]), float(self.actual[i]), sc.drive_to_velocity(tx.velocity_actual),
+                    sc.torque_percent(tx.torque_actual), sc.to_units(tx.following_error), tx.statusword]
         for k, sc in enumerate(self.scales[n_axes:]):
             tx = self.tx[n_axes + k]
-            row += [sc.counts_per_s_to_rpm(self.rx[n_axes + k].target_velocity),
-                    sc.counts_per_s_to_rpm(tx.velocity_actual), sc.to_units(tx.position_actual) % 360.0,
-                    tx.torque_actual / 10.0, tx.statusword]
+            row += [sc.drive_to_rpm(self.rx[n_axes + k].target_velocity),
+                    sc.drive_to_rpm(tx.velocity_actual), sc.to_units(tx.position_actual) % 360.0,
+                    sc.torque_percent(tx.torque_actual), tx.statusword]
         for src in self.trace_sources:
             row += list(src.values(self))
         return row
@@ -395,7 +395,8 @@ class BenchRunner:
     def _begin_quick_stop(self) -> None:
         """Command every enabled drive's quick stop (CiA 402: it brakes on its own ramp, 0x6085). Until a
         drive takes it, its setpoint goes on at the speed it had (see _exchange)."""
-        self._coast = [int(round(tx.velocity_actual * self.bench.cycle)) for tx in self.tx]
+        self._coast = [int(round(sc.drive_to_counts_per_s(tx.velocity_actual) * self.bench.cycle))
+                       for tx, sc in zip(self.tx, self.scales)]
         self._braking = True
         for m in self.masters:
             if m.enabled:

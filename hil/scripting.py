@@ -142,9 +142,9 @@ class Machine:
                 rec.start = pos
             rec.end = pos
             rec.min, rec.max = min(rec.min, pos), max(rec.max, pos)
-            rec.peak_velocity = max(rec.peak_velocity, abs(sc.to_units(tx.velocity_actual)))
+            rec.peak_velocity = max(rec.peak_velocity, abs(sc.drive_to_velocity(tx.velocity_actual)))
             if i >= n:
-                rec.peak_rpm = max(rec.peak_rpm, abs(sc.counts_per_s_to_rpm(tx.velocity_actual)))
+                rec.peak_rpm = max(rec.peak_rpm, abs(sc.drive_to_rpm(tx.velocity_actual)))
             mode = getattr(tx, "mode_display", 0)
             if not rec.modes or rec.modes[-1] != mode:
                 rec.modes.append(mode)
@@ -355,7 +355,7 @@ class Machine:
     def get_rpm(self, spindle: int = 0) -> float:
         """Actual speed of a spindle drive (0x606C), rpm."""
         i = len(self.runner.axes) + spindle
-        return self.runner.scales[i].counts_per_s_to_rpm(self.runner.tx[i].velocity_actual)
+        return self.runner.scales[i].drive_to_rpm(self.runner.tx[i].velocity_actual)
 
     def estop(self, on: bool = True) -> None:
         self.mlc.mem.set_bit(m2(self.x, ESTOP_RELAY), on)
@@ -385,7 +385,7 @@ class Machine:
                              f"modes {'/'.join(_mode_name(m) for m in rec.modes)}")
             else:
                 lines.append(f"{name:<4} peak {rec.peak_rpm:8.1f} rpm, now "
-                             f"{self.runner.scales[i].counts_per_s_to_rpm(self.runner.tx[i].velocity_actual):8.1f} rpm  "
+                             f"{self.runner.scales[i].drive_to_rpm(self.runner.tx[i].velocity_actual):8.1f} rpm  "
                              f"modes {'/'.join(_mode_name(m) for m in rec.modes)}")
         alarms = self.alarms + [a for a in (self.runner.channel.alarms if self.runner.channel else [])
                                 if a not in self.alarms]

@@ -64,12 +64,12 @@ def sim_slaves(bench: Bench) -> list[Cia402Drive]:
     """Virtual drives for every axis and spindle, at the bench's power-on positions."""
     drives = []
     for a in bench.axes:
-        d = Cia402Drive(params=replace(a.drive, counts_per_rev=a.scaling.counts_per_rev), name=a.name)
+        d = Cia402Drive(params=replace(a.drive, counts_per_rev=a.scaling.counts_per_rev, units=a.scaling.units), name=a.name)
         d.position = float(a.scaling.to_counts(a.start))
         d.command = d.position
         drives.append(d)
     for s in bench.spindles:
-        d = Cia402Drive(params=replace(s.drive, counts_per_rev=s.scaling.counts_per_rev), name=s.name, mode=9)
+        d = Cia402Drive(params=replace(s.drive, counts_per_rev=s.scaling.counts_per_rev, units=s.scaling.units), name=s.name, mode=9)
         d.apply(RxPdo(mode=9))
         drives.append(d)
     return drives

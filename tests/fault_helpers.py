@@ -31,7 +31,7 @@ class Recorder:
         self.runner = r
         n = len(r.axes)
         self.pos.append(r.actual.tolist())
-        self.vel.append([r.scales[i].to_units(r.tx[i].velocity_actual) for i in range(n)])
+        self.vel.append([r.scales[i].drive_to_velocity(r.tx[i].velocity_actual) for i in range(n)])
         self.alarms.append(len(r.result.alarms) + (len(r.channel.alarms) if r.channel is not None else 0))
 
 

@@ -28,6 +28,9 @@ G00 Z5.
 M30
 """
 
+# The drive is given 0x60FF in 0.1 rpm (Delta ASDA), so a commanded speed is within half a unit.
+RPM_RES = 0.05
+
 
 def run(text: str):
     bench = default_lathe()
@@ -37,7 +40,7 @@ def run(text: str):
 
     def grab(r):
         if r.channel is not None:
-            rows.append((r.line, r._commands[0], sc.counts_per_s_to_rpm(r.rx[2].target_velocity),
+            rows.append((r.line, r._commands[0], sc.drive_to_rpm(r.rx[2].target_velocity),
                          r.spindle_actual_rpm()))
 
     runner.on_cycle = grab
@@ -53,12 +56,12 @@ def test_facing_under_g96_raises_the_spindle_speed_clamped_by_g50():
     d = 2.0 * x  # no offsets: machine X radius = half the work diameter
     want = np.minimum(1000.0 * 150.0 / (math.pi * d), 2000.0)
     # the command tracks the surface-speed law at every cycle (1 count/s of rounding)
-    assert np.allclose(cmd, want, rtol=1e-3, atol=0.01)
+    assert np.allclose(cmd, want, rtol=1e-3, atol=RPM_RES)
     # it rises as X falls and stops at the G50 limit
     assert np.all(np.diff(cmd) >= -1e-6)
     assert cmd[0] < 600.0 and cmd.max() == np.float64(cmd.max()) and abs(cmd.max() - 2000.0) < 0.01
     clamped = d < 1000.0 * 150.0 / (math.pi * 2000.0)
-    assert clamped.any() and np.allclose(cmd[clamped], 2000.0, atol=0.01)
+    assert clamped.any() and np.allclose(cmd[clamped], 2000.0, atol=RPM_RES)
     # the drive really speeds up, and feed per rev follows its measured speed
     assert face[-1, 3] > 2.0 * face[0, 3]
 
@@ -113,26 +116,26 @@ def test_g96_m03_starts_at_the_css_rpm_of_the_current_x_before_any_move():
     on = spinning(rows)
     assert on[0, 1] == pytest.approx(50.0)  # X has not moved since the G00
     # the very first command the drive gets is the CSS speed, never S200 read as rpm
-    assert on[0, 2] == pytest.approx(AT_100, abs=0.01)
-    assert np.allclose(on[:, 2], AT_100, atol=0.01)
+    assert on[0, 2] == pytest.approx(AT_100, abs=RPM_RES)
+    assert np.allclose(on[:, 2], AT_100, atol=RPM_RES)
 
 
 def test_g96_before_any_move_is_clamped_by_g50_s_and_by_the_spindle_maximum():
     rows = run_phases("G21 G18 G99\nG00 X100. Z5.\nG50 S500\nG96 S200 M03\nG04 P50\nM30\n")
-    assert np.allclose(spinning(rows)[:, 2], 500.0, atol=0.01)
+    assert np.allclose(spinning(rows)[:, 2], 500.0, atol=RPM_RES)
     # no G50: the bench's spindle maximum (4000 rpm) caps 200 m/min at diameter 1 (63 662 rpm)
     rows = run_phases("G21 G18 G99\nG00 X1. Z5.\nG96 S200 M03\nG04 P50\nM30\n")
-    assert np.allclose(spinning(rows)[:, 2], 4000.0, atol=0.01)
+    assert np.allclose(spinning(rows)[:, 2], 4000.0, atol=RPM_RES)
 
 
 def test_g97_s_is_exactly_rpm_and_g97_alone_keeps_the_speed_it_had():
     rows = run_phases("G21 G18 G99\nG00 X100. Z5.\nG96 S200 M03\nG97 S800\nG04 P50\nM30\n")
-    assert spinning(rows)[-1, 2] == pytest.approx(800.0, abs=0.01)
+    assert spinning(rows)[-1, 2] == pytest.approx(800.0, abs=RPM_RES)
     # G97 without S: the spindle stays at the speed G96 had reached (Fanuc's rule), while X moves on
     rows = run_phases("G21 G18 G99\nG00 X100. Z5.\nG96 S200 M03\nG97\nG00 X50.\nG04 P50\nM30\n")
     on = spinning(rows)
     assert on[-1, 1] == pytest.approx(25.0)
-    assert np.allclose(on[:, 2], AT_100, atol=0.01)
+    assert np.allclose(on[:, 2], AT_100, atol=RPM_RES)
 
 
 def test_s_under_g96_changes_the_surface_speed_at_once_and_m05_m03_restarts_on_it():
@@ -140,21 +143,21 @@ def test_s_under_g96_changes_the_surface_speed_at_once_and_m05_m03_restarts_on_i
     rows = run_phases(text)
     s100 = np.flatnonzero(rows[:, 0] == 100.0)[0]
     # the cycle S100 is issued the drive still has 200 m/min; from then on 100 m/min, X still at 50
-    assert rows[s100 + 1, 2] == pytest.approx(AT_100 / 2.0, abs=0.01)
+    assert rows[s100 + 1, 2] == pytest.approx(AT_100 / 2.0, abs=RPM_RES)
     m05 = np.flatnonzero(rows[:, 0] == 5.0)[0]
     assert rows[m05 + 5, 2] == 0.0
     # M03 again at X50 (diameter 50): 100 m/min is 636.6 rpm, from the first cycle the drive turns
     m03 = np.flatnonzero(rows[:, 0] == 3.0)[-1]
     after = spinning(rows[m03:])
-    assert after[0, 1] == pytest.approx(25.0) and np.allclose(after[:, 2], AT_100, atol=0.01)
+    assert after[0, 1] == pytest.approx(25.0) and np.allclose(after[:, 2], AT_100, atol=RPM_RES)
 
 
 def test_g96_while_the_spindle_turns_switches_without_a_move():
     rows = run_phases("G21 G18 G99\nG00 X100. Z5.\nG97 S300 M03\nG04 P50\nG96 S200\nG04 P50\nM30\n")
     g96 = np.flatnonzero(rows[:, 0] == 200.0)[0]
-    assert rows[g96 - 1, 2] == pytest.approx(300.0, abs=0.01)
-    assert rows[g96 + 1, 2] == pytest.approx(AT_100, abs=0.01)
-    assert np.allclose(rows[g96 + 1:, 2][rows[g96 + 1:, 2] > 0], AT_100, atol=0.01)
+    assert rows[g96 - 1, 2] == pytest.approx(300.0, abs=RPM_RES)
+    assert rows[g96 + 1, 2] == pytest.approx(AT_100, abs=RPM_RES)
+    assert np.allclose(rows[g96 + 1:, 2][rows[g96 + 1:, 2] > 0], AT_100, atol=RPM_RES)
 
 
 def test_g96_with_x_programmed_as_a_radius_uses_twice_x():
@@ -162,9 +165,9 @@ def test_g96_with_x_programmed_as_a_radius_uses_twice_x():
     text = "G21 G18 G99\nG00 X50. Z5.\nG96 S200 M03\nG01 X40. F0.1\nM30\n"
     rows = run_phases(text, {"N2.001 Bit10": 1})
     on = spinning(rows)
-    assert on[0, 2] == pytest.approx(AT_100, abs=0.01)
+    assert on[0, 2] == pytest.approx(AT_100, abs=RPM_RES)
     assert on[-1, 1] == pytest.approx(40.0)
-    assert on[-1, 2] == pytest.approx(1000.0 * 200.0 / (math.pi * 80.0), abs=0.01)
+    assert on[-1, 2] == pytest.approx(1000.0 * 200.0 / (math.pi * 80.0), abs=RPM_RES)
 
 
 def test_g96_m03_through_hil_run_with_the_lathe_mlc(hil, program, tmp_path):
@@ -183,14 +186,14 @@ def test_g96_m03_through_hil_run_with_the_lathe_mlc(hil, program, tmp_path):
     assert float(rows[strobe]["D31050"]) == 200.0
     cmd = [float(row["S1_rpm_cmd"]) for row in rows]
     first = next(i for i, v in enumerate(cmd) if v > 0.5)
-    assert cmd[first] == pytest.approx(AT_100, abs=0.01)
+    assert cmd[first] == pytest.approx(AT_100, abs=RPM_RES)
     m03 = next(i for i, row in enumerate(rows) if row["M31064"] == "1" and row["D31048"] == "3")
     fin = next(i for i in range(m03, len(rows)) if rows[i]["M21016"] == "1")
     assert float(rows[fin]["S1_rpm_act"]) == pytest.approx(AT_100, rel=0.02)
     assert float(rows[fin]["X_cmd"]) == pytest.approx(50.0)  # the M03 waited before the first move
     # while X faces in to diameter 50 the MLC's D31024 and the drive follow X
     end = max(i for i, row in enumerate(rows) if abs(float(row["X_cmd"]) - 25.0) < 1e-9 and cmd[i] > 0.5)
-    assert cmd[end] == pytest.approx(2.0 * AT_100, abs=0.01)
+    assert cmd[end] == pytest.approx(2.0 * AT_100, abs=RPM_RES)
     assert float(rows[end]["D31024"]) == pytest.approx(2.0 * AT_100, rel=1e-5)
 
 
@@ -204,7 +207,7 @@ def test_g50_s_is_a_limit_not_an_s_code_for_the_mlc(hil, program, tmp_path):
     assert r.code == 0, r.out + r.err
     rows = list(csv.DictReader(trace.open()))
     assert sum(1 for a, b in zip(rows, rows[1:]) if a["M31065"] == "0" and b["M31065"] == "1") == 1
-    assert max(float(row["S1_rpm_cmd"]) for row in rows) == pytest.approx(500.0, abs=0.01)
+    assert max(float(row["S1_rpm_cmd"]) for row in rows) == pytest.approx(500.0, abs=RPM_RES)
     assert {float(row["D31024"]) for row in rows[-10:]} == {500.0}
 
 
@@ -226,7 +229,7 @@ def run_override(text: str, percent: int, params: dict[str, float] | None = None
         if ch is not None:
             aux = ch.pending_aux
             rows.append((aux.value if aux is not None else -1.0, r._commands[0],
-                         sc.counts_per_s_to_rpm(r.rx[2].target_velocity), r.line, r.spindle_actual_rpm(),
+                         sc.drive_to_rpm(r.rx[2].target_velocity), r.line, r.spindle_actual_rpm(),
                          r._commands[1], r.spindle_actual_angle()))
 
     runner.on_cycle = grab
@@ -238,21 +241,21 @@ def run_override(text: str, percent: int, params: dict[str, float] | None = None
 def test_spindle_override_scales_g97_and_g96_and_speed_reached_follows_it():
     rows, _ = run_override("G21 G18 G99\nG00 X100. Z5.\nG97 S1000 M03\nG04 P200\nM30\n", 80)
     on = spinning(rows)
-    assert np.allclose(on[:, 2], 800.0, atol=0.01)
+    assert np.allclose(on[:, 2], 800.0, atol=RPM_RES)
     # M03 finished (speed reached against 800, not 1000) and the drive really turns at 800
     assert on[-1, 4] == pytest.approx(800.0, rel=0.01)
     rows, _ = run_override("G21 G18 G99\nG00 X100. Z5.\nG96 S200 M03\nG04 P200\nM30\n", 80)
     on = spinning(rows)
-    assert np.allclose(on[:, 2], 0.8 * AT_100, atol=0.01)
+    assert np.allclose(on[:, 2], 0.8 * AT_100, atol=RPM_RES)
     assert on[-1, 4] == pytest.approx(0.8 * AT_100, rel=0.01)
 
 
 def test_override_above_100_stays_within_g50_s_and_feed_per_rev_follows_the_actual_speed():
     # 120 % of 636.6 = 763.9 rpm, capped by G50 S700; under G97 S1000 × 120 % likewise
     rows, _ = run_override("G21 G18 G99\nG00 X100. Z5.\nG50 S700\nG96 S200 M03\nG04 P100\nM30\n", 120)
-    assert np.allclose(spinning(rows)[:, 2], 700.0, atol=0.01)
+    assert np.allclose(spinning(rows)[:, 2], 700.0, atol=RPM_RES)
     rows, _ = run_override("G21 G18 G99\nG00 X100. Z5.\nG50 S700\nG97 S1000 M03\nG04 P100\nM30\n", 120)
-    assert np.allclose(spinning(rows)[:, 2], 700.0, atol=0.01)
+    assert np.allclose(spinning(rows)[:, 2], 700.0, atol=RPM_RES)
     # G99 F0.2 at 80 % of S1000: Z moves 0.2 mm per revolution of the measured 800 rpm = 160 mm/min
     rows, _ = run_override("G21 G18 G99\nG00 X100. Z5.\nG97 S1000 M03\nG01 Z-20. F0.2\nM30\n", 80)
     cut = rows[rows[:, 3] == 4]
@@ -271,11 +274,11 @@ def test_threads_run_at_100_percent_whatever_the_override_and_stay_in_phase():
     for ln in lines:
         m = rows[rows[:, 3] == ln]
         # S600, not 480 (the chain's last cycle already hands back to the override)
-        assert np.allclose(m[:-1, 2], 600.0, atol=0.01)
+        assert np.allclose(m[:-1, 2], 600.0, atol=RPM_RES)
         assert np.allclose(m[:, 4], 600.0, rtol=1e-3)  # the spindle has reached it before the pass
     # between passes the next thread waits in the look-ahead: 600 throughout; after the last, 480
-    assert np.allclose(rows[(rows[:, 3] > 5) & (rows[:, 3] < 13), 2], 600.0, atol=0.01)
-    assert np.allclose(rows[rows[:, 3] == 14, 2], 480.0, atol=0.01)
+    assert np.allclose(rows[(rows[:, 3] > 5) & (rows[:, 3] < 13), 2], 600.0, atol=RPM_RES)
+    assert np.allclose(rows[rows[:, 3] == 14, 2], 480.0, atol=RPM_RES)
     log = runner.channel.planner.thread_log
     assert circ_spread(np.array([sync % 360.0 for _, sync, _ in log])) < 0.5
     thread = np.column_stack([rows[:, 3], rows[:, 1], rows[:, 5], rows[:, 5], rows[:, 6]])
@@ -289,13 +292,13 @@ def test_g96_alone_switches_at_once_on_the_last_g96_surface_speed():
     rows, _ = run_override(text, 100)
     s300 = np.flatnonzero(rows[:, 0] == 300.0)[-1]
     g96 = s300 + np.flatnonzero(rows[s300:, 0] == 150.0)[0]  # the S aux G96 alone gives
-    assert rows[g96 - 1, 2] == pytest.approx(300.0, abs=0.01)  # G97 S300 until G96 is read
-    assert rows[g96 + 1, 2] == pytest.approx(at_100_150, abs=0.01)  # S150 (m/min) from G96 on
-    assert np.allclose(rows[g96 + 1:, 2][rows[g96 + 1:, 2] > 0], at_100_150, atol=0.01)
+    assert rows[g96 - 1, 2] == pytest.approx(300.0, abs=RPM_RES)  # G97 S300 until G96 is read
+    assert rows[g96 + 1, 2] == pytest.approx(at_100_150, abs=RPM_RES)  # S150 (m/min) from G96 on
+    assert np.allclose(rows[g96 + 1:, 2][rows[g96 + 1:, 2] > 0], at_100_150, atol=RPM_RES)
     # no S ever given under G96: 0 m/min (Fanuc), the spindle stops rather than read 300 rpm as m/min
     rows, _ = run_override("G21 G18 G99\nG00 X100. Z5.\nG97 S300 M03\nG04 P50\nG96\nG04 P50\nM30\n", 100)
     g96 = np.flatnonzero(rows[:, 0] == 0.0)[0]
-    assert rows[g96 - 1, 2] == pytest.approx(300.0, abs=0.01) and np.all(rows[g96 + 1:, 2] == 0.0)
+    assert rows[g96 - 1, 2] == pytest.approx(300.0, abs=RPM_RES) and np.all(rows[g96 + 1:, 2] == 0.0)
 
 
 def test_g97_alone_hands_the_css_rpm_to_the_mlc_as_its_s():
@@ -308,7 +311,7 @@ def test_g97_alone_hands_the_css_rpm_to_the_mlc_as_its_s():
     assert runner.mlc.mem.f32(d3(runner.mlc.link.x, 24)) == pytest.approx(AT_100, rel=1e-6)  # D31024
     on = spinning(rows)
     assert on[-1, 1] == pytest.approx(25.0)
-    assert on[-1, 2] == pytest.approx(0.8 * AT_100, abs=0.01)
+    assert on[-1, 2] == pytest.approx(0.8 * AT_100, abs=RPM_RES)
 
 
 def test_g96_holds_through_a_turning_cycle():
@@ -317,7 +320,7 @@ def test_g96_holds_through_a_turning_cycle():
     rows, _ = run_override(text, 100)
     cyc = rows[(rows[:, 3] == 4) & (np.abs(rows[:, 2]) > 0.5)]
     d = 2.0 * cyc[:, 1]
-    assert np.allclose(cyc[:, 2], 1000.0 * 200.0 / (math.pi * d), rtol=1e-3, atol=0.01)
+    assert np.allclose(cyc[:, 2], 1000.0 * 200.0 / (math.pi * d), rtol=1e-3, atol=RPM_RES)
     assert cyc[:, 1].min() == pytest.approx(40.0)
 
 
@@ -349,8 +352,8 @@ def test_spindle_override_turned_during_hil_run_under_g96(hil, program, tmp_path
     assert r.code == 0, r.out + r.err
     rows = [row for row in csv.DictReader(trace.open()) if float(row["S1_rpm_cmd"]) > 0.5]
     cmd = [float(row["S1_rpm_cmd"]) for row in rows]
-    assert cmd[0] == pytest.approx(AT_100, abs=0.01)
-    assert cmd[-1] == pytest.approx(0.8 * AT_100, abs=0.01)
+    assert cmd[0] == pytest.approx(AT_100, abs=RPM_RES)
+    assert cmd[-1] == pytest.approx(0.8 * AT_100, abs=RPM_RES)
     assert float(rows[-1]["S1_rpm_act"]) == pytest.approx(0.8 * AT_100, rel=0.01)
     assert all(float(row["D31024"]) == pytest.approx(AT_100, rel=1e-6) for row in rows)
     assert float(rows[0]["D21026"]) == 100.0 and float(rows[-1]["D21026"]) == 80.0

@@ -1,8 +1,10 @@
 """A CiA 402 servo drive model: the slave-side state machine, CSP and CSV modes, a cascaded
 position/velocity loop with second-order dynamics, feedback objects, travel limits and faults.
 
-Units are the drive's: counts, counts/s, torque in 0.1 % of rated. The physics is stepped in
-substeps per bus cycle so the velocity loop stays stable at any cycle time.
+The numeric core works in counts and counts/s; the objects it exchanges carry the drive's declared
+units (`DriveParams.units`: Delta's 0.1 rpm for 0x606C/0x60FF, 0.1 % of rated torque for 0x6077),
+converted only in `apply` and `feedback`. The physics is stepped in substeps per bus cycle so the
+velocity loop stays stable at any cycle time.
 """
 
 from __future__ import annotations
@@ -13,6 +15,7 @@ from dataclasses import dataclass, field
 from fieldbus.cia402 import (STATE_BITS, SW_FOLLOWING, SW_FOLLOWING_ERROR, SW_INTERNAL_LIMIT, SW_REMOTE,
                              SW_TARGET_REACHED, SW_VOLTAGE, SW_QUICK_STOP, State, command_of)
 from fieldbus.pdo import RxPdo, TxPdo
+from fieldbus.units import DELTA_UNITS, DriveUnits
 from virtual_bus.servo_params import ServoParams
 
 # Delta ASDA alarm numbers as the drive reports them in 0x603F (the NC shows 0xF002 + this code)
@@ -43,6 +46,7 @@ class DriveParams:
     index_pulse_every: int | None = None  # counts between encoder index pulses; None = counts_per_rev
     probe_position: int | None = None  # counts where a touch-probe input (G31 skip) switches; None = no probe
     substeps: int = 4
+    units: DriveUnits = DELTA_UNITS  # what 0x606C/0x60FF and 0x6077 carry (the device model's)
 
 
 @dataclass
@@ -54,7 +58,7 @@ class Cia402Drive:
     velocity: float = 0.0  # counts/s
     acceleration: float = 0.0
     command: float = 0.0  # interpolated position command, counts
-    target_velocity: float = 0.0
+    target_velocity: float = 0.0  # counts/s, the CSV ramp's current value
     mode: int = 8
     error_code: int = 0
     torque: float = 0.0  # 0.1 % of rated
@@ -66,12 +70,14 @@ class Cia402Drive:
     _probe_latched: bool = False
     _probe_pos: int = 0
     _limit_flags: int = 0
+    _want_cps: float = 0.0  # 0x60FF converted to counts/s
     servo_params: ServoParams = field(default_factory=ServoParams)  # P0-xx…P6-xx over SDO / Modbus (issue 8)
 
     # ---- process data -----------------------------------------------------------------
     def apply(self, rx: RxPdo) -> None:
         """Latch the master's outputs (what a SYNC event does on a real drive)."""
         self._rx = rx
+        self._want_cps = self.params.units.raw_to_velocity(rx.target_velocity, self.params.counts_per_rev)
         self._state_machine(rx.controlword)
         if rx.mode != self.mode:
             self.mode = rx.mode
@@ -97,8 +103,8 @@ class Cia402Drive:
         return TxPdo(
             statusword=sw,
             position_actual=int(round(self.position)),
-            velocity_actual=int(round(self.velocity)),
-            torque_actual=int(round(self.torque)),
+            velocity_actual=self.params.units.velocity_to_raw(self.velocity, self.params.counts_per_rev),
+            torque_actual=int(round(self.torque * 0.1 / self.params.units.torque_percent)),
             following_error=int(round(self.command - self.position)) if self.mode == 8 else 0,
             error_code=self.error_code,
             mode_display=self.mode,
@@ -193,7 +199,7 @@ class Cia402Drive:
                 self.command = prev + (target - prev) * k / n
                 v_cmd = p.kff * ff_vel + p.kp * (self.command - self.position)
             elif self.state is State.OPERATION_ENABLED and self.mode == 9:
-                want = float(self._rx.target_velocity)
+                want = self._want_cps
                 step = p.csv_accel * h
                 self.target_velocity += max(-step, min(step, want - self.target_velocity))
                 v_cmd = self.target_velocity
