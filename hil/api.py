@@ -94,14 +94,10 @@ class Result:
 
         moves = None
         if self.runner is not None:
-            from hil.checks import program_moves
+            from hil.checks import offline_moves
             from hil.session import load_program
-            from nc.alarms import NcAlarm
 
-            try:
-                moves = program_moves(load_program(self.program), self.bench)
-            except NcAlarm:
-                moves = None
+            moves, _ = offline_moves(load_program(self.program), self.bench)
         return {name.removesuffix(".png"): fig for name, _, fig in trace_figures(self.trace.path, self.bench, moves)}
 
     @property
@@ -273,19 +269,14 @@ def _set_overrides(mlc: Any, feed: float, rapid: float, spindle: float) -> None:
 
 
 def _checks(trace_path: str, bench: Bench, program: Any) -> list[Any]:
-    from hil.checks import program_moves, run_checks
+    from hil.checks import offline_moves, run_checks
     from hil.trace_read import TraceFile
-    from nc.alarms import NcAlarm
 
     tf = TraceFile(trace_path)
     if (tf.num_rows if tf.num_rows >= 0 else tf.table(["t"]).num_rows) == 0:
         return []  # no cycle ran (a bus that never opened): the run's alarm is the result; nothing to judge
-    try:
-        moves = program_moves(program, bench)
-    except NcAlarm as e:  # e.g. it reads servo parameters or MLC registers only a run can answer
-        return run_checks(tf, bench.checks, bench, None,
-                          f"the program does not run offline, so its path is unknown here: alarm {e}")
-    return run_checks(tf, bench.checks, bench, moves)
+    moves, why = offline_moves(program, bench)
+    return run_checks(tf, bench.checks, bench, moves, why)
 
 
 def path(program: str | Path, bench: str | Path | Bench | None = None, *, profile: str | None = None,

@@ -17,6 +17,7 @@ from numpy.lib.stride_tricks import sliding_window_view
 from hil.bench import FILTER_MS, Bench, ChecksConfig
 from hil.trace import axes_of, spindles_of
 from hil.trace_read import TraceFile
+from nc.alarms import NcAlarm
 from nc.interp import Interpreter
 from nc.motion.path import Segment
 from nc.moves import Move
@@ -87,6 +88,9 @@ class _Cols:
                 "line": int(self["line"][i]), "t": float(self["t"][i])}
 
 
+NO_PROGRAM = "needs the program (--program)"
+
+
 def program_moves(program: Program, bench: Bench) -> list[Move]:
     """The programmed path in machine coordinates, from the axes' power-on positions."""
     profile = make_profile(bench.profile, bench.axis_names, bench.params)
@@ -94,8 +98,17 @@ def program_moves(program: Program, bench: Bench) -> list[Move]:
     return [ev for ev in interp.run(program) if isinstance(ev, Move)]
 
 
+def offline_moves(program: Program, bench: Bench) -> tuple[list[Move] | None, str]:
+    """`program_moves`, or None and why: a program that reads what only a run answers (servo
+    parameters, MLC registers) alarms offline, and its path checks are skipped saying so."""
+    try:
+        return program_moves(program, bench), NO_PROGRAM
+    except NcAlarm as e:
+        return None, f"the program does not run offline, so its path is unknown here: alarm {e}"
+
+
 def run_checks(trace: TraceFile, checks: ChecksConfig, bench: Bench | None = None,
-               moves: list[Move] | None = None, no_moves: str = "needs the program (--program)") -> list[CheckResult]:
+               moves: list[Move] | None = None, no_moves: str = NO_PROGRAM) -> list[CheckResult]:
     """`no_moves` says why `moves` is None (the skipped path checks print it)."""
     cols = _Cols(trace)
     axes = axes_of(trace.columns)
@@ -311,7 +324,7 @@ def _braking_check(cols: _Cols, axis: str, limit: float, tolerance: float, dt: f
 
 
 def check_thread_phase(cols: _Cols, axes: list[str], spindles: list[str], moves: list[Move] | None,
-                       limit: float, no_moves: str = "needs the program (--program)") -> CheckResult:
+                       limit: float, no_moves: str = NO_PROGRAM) -> CheckResult:
     """Each pass of a thread must meet the spindle at the same phase.
 
     For every threading line, a reference point on the thread axis common to all passes is chosen

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import csv
 import errno
+import json
 import os
 from pathlib import Path
 from typing import IO, Any, Protocol, Sequence
@@ -59,10 +60,19 @@ def _csv_value(v: float | int | str) -> float | int | str:
     return repr(v) if isinstance(v, float) else v
 
 
+def csv_meta_path(path: str | Path) -> Path:
+    """A CSV trace's provenance and end record live beside it: CSV has no place for them."""
+    p = Path(path)
+    return p.with_name(p.name + ".meta.json")
+
+
 class CsvTrace:
-    def __init__(self, path: str | Path, columns: list[str]) -> None:
+    def __init__(self, path: str | Path, columns: list[str], meta: dict[str, Any] | None = None,
+                 units: dict[str, str] | None = None) -> None:
         self.path = Path(path)
         self.columns = columns
+        self._meta = {**(meta or {}), **({"units": units} if units else {})}
+        csv_meta_path(self.path).unlink(missing_ok=True)  # never leave an older run's record beside this trace
         # Written to a side file and renamed on close, so a failed run never leaves half a trace
         # that looks complete.
         self._tmp = self.path.with_name(self.path.name + ".part")
@@ -74,10 +84,16 @@ class CsvTrace:
         self._w.writerow([_csv_value(v) for v in row])
 
     def close(self, end: dict[str, Any] | None = None) -> None:
-        """CSV has no place for the end-of-run record; a Parquet trace keeps it."""
+        """The trace, then its side file with the provenance and the end-of-run record (a Parquet
+        trace keeps both in its metadata)."""
         if not self._fh.closed:
             self._fh.close()
             self._tmp.replace(self.path)
+            if self._meta:
+                side = csv_meta_path(self.path)
+                tmp = side.with_name(side.name + ".part")
+                tmp.write_text(json.dumps({**self._meta, **({"end": end} if end else {})}, default=str))
+                tmp.replace(side)
 
     def discard(self) -> None:
         """A run refused after its trace was opened leaves nothing."""
@@ -106,4 +122,4 @@ def open_trace(path: str | Path, columns: list[str], meta: dict[str, Any] | None
         from hil.trace_parquet import ParquetTrace
 
         return ParquetTrace(path, columns, meta=meta, units=units)
-    return CsvTrace(path, columns)
+    return CsvTrace(path, columns, meta=meta, units=units)

@@ -6,9 +6,11 @@ from __future__ import annotations
 
 import datetime as _dt
 from collections.abc import Sequence
+from dataclasses import asdict, fields
 from typing import Any
 
-from hil.bench import Bench
+from hil.bench import AxisConfig, Bench, ChecksConfig, SpindleConfig
+from nc.motion.limits import AxisLimits
 from hil.version import version
 
 # column suffix → unit (a rotary axis's positions are degrees: see column_units)
@@ -42,7 +44,35 @@ def run_meta(bench: Bench, program: str) -> dict[str, Any]:
         "bench": {"name": bench.name, "source": bench.source, "profile": bench.profile, "bus": bench.bus,
                   "cycle_s": bench.cycle,
                   "axes": {a.name: {"units": a.units, "velocity": a.limits.max_velocity,
-                                    "acceleration": a.limits.max_acceleration, "jerk": a.limits.max_jerk}
+                                    "acceleration": a.limits.max_acceleration, "jerk": a.limits.max_jerk,
+                                    "start": a.start}
                            for a in bench.axes},
-                  "spindles": {s.name: {"max_rpm": s.max_rpm} for s in bench.spindles}},
+                  "spindles": {s.name: {"max_rpm": s.max_rpm} for s in bench.spindles},
+                  # what `hil check TRACE` needs to judge it as the run did: the NC parameters (the
+                  # position filter sets the contour check's lag) and the bench's [checks]
+                  "params": dict(bench.params), "checks": asdict(bench.checks)},
     }
+
+
+def bench_from_meta(meta: dict[str, Any]) -> Bench | None:
+    """The bench a trace was recorded on, as far as checks and reports need it (axes, limits,
+    power-on positions, profile, cycle, NC parameters, [checks]); None when the trace does not
+    say (a CSV trace, or one written before the metadata existed)."""
+    b = meta.get("bench")
+    if not isinstance(b, dict) or not isinstance(b.get("axes"), dict):
+        return None
+    try:
+        axes = [AxisConfig(name, limits=AxisLimits(float(a["velocity"]), float(a["acceleration"]), float(a["jerk"])),
+                           start=float(a.get("start", 0.0)), units=str(a.get("units", "mm")))
+                for name, a in b["axes"].items()]
+        spindles = [SpindleConfig(name, max_rpm=float(sp.get("max_rpm", 4000.0)))
+                    for name, sp in (b.get("spindles") or {}).items()]
+        raw = b.get("checks") or {}
+        known = {f.name for f in fields(ChecksConfig)}
+        checks = ChecksConfig(**{k: v for k, v in raw.items() if k in known})
+        return Bench(name=str(b.get("name", "")), profile=str(b.get("profile", "nc5-lathe-a")), axes=axes,
+                     spindles=spindles, cycle=float(b.get("cycle_s", 0.001)), bus=str(b.get("bus", "sim")),
+                     params={k: float(v) for k, v in (b.get("params") or {}).items()}, checks=checks,
+                     source=str(b.get("source", "")))
+    except (KeyError, TypeError, ValueError):
+        return None  # metadata from another tool or damaged: as if there were none

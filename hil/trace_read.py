@@ -3,6 +3,8 @@ trace is too long to hold."""
 
 from __future__ import annotations
 
+import json
+
 from collections.abc import Iterator, Sequence
 from pathlib import Path
 
@@ -89,7 +91,16 @@ class TraceFile:
         """The run's provenance and end record (Parquet traces; {} for CSV)."""
         from hil.trace_parquet import read_meta
 
-        return read_meta(self._pf.schema_arrow) if self.parquet else {}
+        if self.parquet:
+            return read_meta(self._pf.schema_arrow)
+        from hil.trace import csv_meta_path
+
+        side = csv_meta_path(self.path)
+        try:  # a CSV trace's provenance is its side file, if it still has one
+            meta = json.loads(side.read_text()) if side.is_file() else {}
+        except (OSError, ValueError):
+            return {}
+        return meta if isinstance(meta, dict) else {}
 
     def units(self) -> dict[str, str]:
         if not self.parquet:

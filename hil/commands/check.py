@@ -33,14 +33,22 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=cmd_check)
 
 
-def checks_from_args(args: argparse.Namespace, bench: Bench) -> ChecksConfig:
-    c = bench.checks
+CHECK_FLAGS = ("max_ferr", "contour", "limits", "thread_phase", "jitter_p99", "jitter_max")
+
+
+def checks_from_args(args: argparse.Namespace, bench: Bench | None, axes: list[str],
+                     recorded: bool = False) -> ChecksConfig:
+    """The bench's [checks] with the command line's limits over them. A bench only recorded in
+    the trace lends its [checks] when no check is asked for: then the trace is judged as its run
+    was; with flags, only what they ask."""
+    asked = any(getattr(args, k) not in (None, False) for k in CHECK_FLAGS)
+    c = bench.checks if bench is not None and not (recorded and asked) else ChecksConfig()
     for opt in ("max_ferr", "contour", "thread_phase", "jitter_p99", "jitter_max"):
         v = getattr(args, opt)
         if v is not None and not 0.0 <= v < float("inf"):  # a negative limit fails every trace
             raise InputError(f"--{opt.replace('_', '-')} {v:g}: a limit must be >= 0")
     if args.max_ferr is not None:
-        c.max_following_error = {a: args.max_ferr for a in bench.axis_names}
+        c.max_following_error = {a: args.max_ferr for a in (bench.axis_names if bench is not None else axes)}
     if args.contour is not None:
         c.contour_error = args.contour
     if args.limits:
@@ -52,6 +60,51 @@ def checks_from_args(args: argparse.Namespace, bench: Bench) -> ChecksConfig:
     if args.jitter_max is not None:
         c.jitter_max = args.jitter_max / 1e6
     return c
+
+
+def trace_bench(args: argparse.Namespace, tf: TraceFile) -> tuple[Bench | None, str]:
+    """The bench to judge the trace against, and how it was found: --bench, else the bench the
+    trace's metadata records (Parquet traces from `hil run`), else none (decision R4)."""
+    from hil.trace_meta import bench_from_meta
+
+    recorded = bench_from_meta(tf.meta)
+    if args.bench:
+        bench = load_bench(args.bench)
+        if recorded is not None and recorded.name != bench.name:
+            print(f"hil: note: {args.trace} was recorded on bench {recorded.name}; checking against "
+                  f"{bench.name} ({args.bench}) as asked", file=sys.stderr)
+        return bench, f"{bench.name} ({args.bench})"
+    if recorded is not None:
+        src = f", {recorded.source}" if recorded.source else ""
+        return recorded, f"{recorded.name} (recorded in the trace{src})"
+    return None, ""
+
+
+def prepare(args: argparse.Namespace, cmd: str):
+    """Bench, checks, trace, the programmed moves and where the bench came from; bad input raises
+    InputError / TraceReadError / NcAlarm."""
+    from hil.checks import NO_PROGRAM, offline_moves
+    from hil.trace import axes_of, csv_meta_path
+
+    tf = TraceFile(args.trace)
+    bench, origin = trace_bench(args, tf)
+    checks = checks_from_args(args, bench, axes_of(tf.columns), recorded=bench is not None and not args.bench)
+    rows = tf.num_rows if tf.num_rows >= 0 else tf.table(["t"]).num_rows
+    if rows == 0:  # e.g. a run whose bus never opened: passing its checks would judge nothing as good
+        raise InputError(f"{args.trace} has no rows (its run stopped before the first cycle): nothing to check")
+    if bench is None:
+        needs = [n for n, on in (("--limits", checks.limits), ("--program", bool(args.program))) if on]
+        if needs:  # never judge against limits or a path the trace did not run with
+            raise InputError(f"{args.trace} does not say which bench it ran on (hil run records it in a Parquet "
+                             f"trace, and beside a CSV trace as {csv_meta_path(args.trace).name}): "
+                             f"give --bench FILE for {' and '.join(needs)}")
+    else:
+        missing = [a for a in bench.axis_names if f"{a}_cmd" not in tf.columns]
+        if missing:
+            raise InputError(f"{args.trace} has no columns for axis {', '.join(missing)} of bench {bench.name}")
+    moves, why = offline_moves(load_program(args.program), bench) if args.program and bench is not None \
+        else (None, NO_PROGRAM)
+    return bench, checks, tf, moves, origin, why
 
 
 def prepared(args: argparse.Namespace, cmd: str):
@@ -66,38 +119,23 @@ def prepared(args: argparse.Namespace, cmd: str):
         return EXIT_ALARM
 
 
-def prepare(args: argparse.Namespace, cmd: str):
-    """Bench, checks, trace and the programmed moves; bad input raises InputError / TraceReadError / NcAlarm."""
-    from hil.checks import program_moves
-
-    bench = load_bench(args.bench)
-    checks = checks_from_args(args, bench)
-    tf = TraceFile(args.trace)
-    rows = tf.num_rows if tf.num_rows >= 0 else tf.table(["t"]).num_rows
-    if rows == 0:  # e.g. a run whose bus never opened: passing its checks would judge nothing as good
-        raise InputError(f"{args.trace} has no rows (its run stopped before the first cycle): nothing to check")
-    missing = [a for a in bench.axis_names if f"{a}_cmd" not in tf.columns]
-    if args.bench and missing:
-        raise InputError(f"{args.trace} has no columns for axis {', '.join(missing)} of bench {bench.name}")
-    moves = program_moves(load_program(args.program), bench) if args.program else None
-    return bench, checks, tf, moves
-
-
 def cmd_check(args: argparse.Namespace) -> int:
     from hil.checks import run_checks
 
     ready = prepared(args, "check")
     if isinstance(ready, int):
         return ready
-    bench, checks, tf, moves = ready
+    bench, checks, tf, moves, origin, why = ready
     if not checks.any:
         print("hil check: no checks to run: give a --bench with [checks] or limits such as --max-ferr", file=sys.stderr)
         return EXIT_USAGE
     try:  # the trace is read here: damage past its header shows now
-        results = run_checks(tf, checks, bench if (args.bench or checks.limits) else None, moves)
+        results = run_checks(tf, checks, bench, moves, why)
     except TraceReadError as exc:
         print(f"hil check: {exc}", file=sys.stderr)
         return EXIT_USAGE
+    if origin and not args.json:
+        print(f"bench {origin}")
     for r in results:
         print(strict_json.dumps(r.as_dict()) if args.json else str(r))
     failed = [r for r in results if not r.ok and not r.skipped]

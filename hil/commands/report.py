@@ -27,16 +27,18 @@ def cmd_report(args: argparse.Namespace) -> int:
     ready = prepared(args, "report")
     if isinstance(ready, int):
         return ready
-    bench, checks, tf, moves = ready
+    bench, checks, tf, moves, origin, why = ready
     try:  # the trace is read here: damage past its header shows now
-        results = run_checks(tf, checks, bench if (args.bench or checks.limits) else None, moves) if checks.any else None
-        rep = write_report(args.trace, args.out, bench if args.bench else None, moves, results, args.title)
+        results = run_checks(tf, checks, bench, moves, why) if checks.any else None
+        rep = write_report(args.trace, args.out, bench, moves, results, args.title)
     except TraceReadError as exc:
         print(f"hil report: {exc}", file=sys.stderr)
         return EXIT_USAGE
     except OSError as exc:
         print(f"hil report: cannot write {args.out}: {exc.strerror}", file=sys.stderr)
         return EXIT_USAGE
+    if origin:
+        print(f"bench {origin}")
     print(f"wrote {rep.html}")
     if rep.interactive:
         print(f"  {rep.interactive} (interactive, opens offline)")
