@@ -61,7 +61,7 @@ def test_no_flags_judges_the_trace_as_its_run_was(hil, tmp_path):
     """With no check asked for, the recorded bench's [checks] apply (the run's own verdict)."""
     trace = tmp_path / "t.parquet"
     assert hil("run", PROGRAM, "--bench", fast_z_bench(tmp_path), "--trace", trace).code == 0
-    r = hil("check", trace, "--program", PROGRAM)
+    r = hil("check", trace)
     assert "following error X" in r.out and "velocity Z: 414.2 mm/s <= 800" in r.out and "jitter p99" in r.out
-    # servo_params reads servo parameters only a run answers: its contour check says why it is skipped
-    assert r.code == 0 and "SKIP  contour error: the program does not run offline" in r.out
+    # the bench's contour check needs the program: not given, so nothing passes on it
+    assert r.code == 1 and "SKIP  contour error: needs the program" in r.out

@@ -83,7 +83,7 @@ def trace_bench(args: argparse.Namespace, tf: TraceFile) -> tuple[Bench | None, 
 def prepare(args: argparse.Namespace, cmd: str):
     """Bench, checks, trace, the programmed moves and where the bench came from; bad input raises
     InputError / TraceReadError / NcAlarm."""
-    from hil.checks import NO_PROGRAM, offline_moves
+    from hil.checks import program_moves
     from hil.trace import axes_of, csv_meta_path
 
     tf = TraceFile(args.trace)
@@ -102,9 +102,9 @@ def prepare(args: argparse.Namespace, cmd: str):
         missing = [a for a in bench.axis_names if f"{a}_cmd" not in tf.columns]
         if missing:
             raise InputError(f"{args.trace} has no columns for axis {', '.join(missing)} of bench {bench.name}")
-    moves, why = offline_moves(load_program(args.program), bench) if args.program and bench is not None \
-        else (None, NO_PROGRAM)
-    return bench, checks, tf, moves, origin, why
+    # The program given here is the user's: an alarm offline is reported as the NC would (exit 1).
+    moves = program_moves(load_program(args.program), bench) if args.program and bench is not None else None
+    return bench, checks, tf, moves, origin
 
 
 def prepared(args: argparse.Namespace, cmd: str):
@@ -125,12 +125,12 @@ def cmd_check(args: argparse.Namespace) -> int:
     ready = prepared(args, "check")
     if isinstance(ready, int):
         return ready
-    bench, checks, tf, moves, origin, why = ready
+    bench, checks, tf, moves, origin = ready
     if not checks.any:
         print("hil check: no checks to run: give a --bench with [checks] or limits such as --max-ferr", file=sys.stderr)
         return EXIT_USAGE
     try:  # the trace is read here: damage past its header shows now
-        results = run_checks(tf, checks, bench, moves, why)
+        results = run_checks(tf, checks, bench, moves)
     except TraceReadError as exc:
         print(f"hil check: {exc}", file=sys.stderr)
         return EXIT_USAGE
