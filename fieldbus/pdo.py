@@ -19,6 +19,7 @@ class RxPdo:
     target_position: int = 0  # 0x607A, counts
     mode: int = 8  # 0x6060 (8 = CSP, 9 = CSV, 6 = homing)
     target_velocity: int = 0  # 0x60FF, drive units (Delta: 0.1 rpm)
+    target_torque: int = 0  # 0x6071, 0.1 % of rated (in Delta's 0x1602 set; CST is not used)
     touch_probe_function: int = 0  # 0x60B8
     digital_outputs: int = 0  # 0x60FE:1
 
@@ -31,7 +32,7 @@ class TxPdo:
     position_actual: int = 0  # 0x6064, counts
     velocity_actual: int = 0  # 0x606C, drive units (Delta: 0.1 rpm)
     torque_actual: int = 0  # 0x6077, 0.1 % of rated
-    following_error: int = 0  # 0x60F4, counts
+    following_error: int = 0  # 0x60F4, counts (derived by the master where no PDO carries it)
     error_code: int = 0  # 0x603F
     mode_display: int = 0  # 0x6061
     touch_probe_status: int = 0  # 0x60B9
@@ -56,17 +57,23 @@ class PdoEntry:
 
 @dataclass(frozen=True)
 class PdoLayout:
-    """An ordered RxPDO and TxPDO mapping, packed little-endian as EtherCAT and CANopen do."""
+    """An ordered RxPDO and TxPDO mapping, packed little-endian as EtherCAT and CANopen do.
+    On EtherCAT it is written into the PDO objects `rx_index` / `tx_index` and assigned alone."""
 
     name: str
     rx: tuple[PdoEntry, ...]
     tx: tuple[PdoEntry, ...]
+    rx_index: int = 0x1600
+    tx_index: int = 0x1A00
     rx_struct: struct.Struct = field(init=False, repr=False, compare=False)
     tx_struct: struct.Struct = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "rx_struct", struct.Struct("<" + "".join(e.struct_code for e in self.rx)))
         object.__setattr__(self, "tx_struct", struct.Struct("<" + "".join(e.struct_code for e in self.tx)))
+
+    def carries(self, index: int) -> bool:
+        return any(e.index == index for e in self.rx + self.tx)
 
     @property
     def rx_bytes(self) -> int:
@@ -117,6 +124,8 @@ _TX_CSP = (
     PdoEntry(0x603F, 0, 16, "error_code"),
 )
 
+# CANopen presets (our EDS, split into 8-byte frames, fieldbus/canopen/objects.py); on EtherCAT a
+# bench may still name them (`ethercat_pdo`), but a real Delta drive refuses 0x60F4 in a PDO.
 # The preset named in the foundation issue: CSP objects only.
 ASDA_CSP = PdoLayout("asda-csp", _RX_CSP, _TX_CSP)
 
@@ -129,4 +138,21 @@ ASDA_CSP_CSV = PdoLayout(
                PdoEntry(0x60BA, 0, 32, "touch_probe_pos1", True), PdoEntry(0x60FD, 0, 32, "digital_inputs")),
 )
 
-LAYOUTS: dict[str, PdoLayout] = {l.name: l for l in (ASDA_CSP, ASDA_CSP_CSV)}
+# EtherCAT default: the third Rx/Tx sets of a Delta ASDA-A3-E / B3-E with their ESI contents
+# (linuxcnc-ethercat esi-data, "ASDA-A3-E CoE Drive" r3: 0x1602 = 6040 607A 60FF 6071 6060 60B8,
+# 0x1A02 = 6041 6064 606C 6077 6061 60B9 60BA 60FD: 8 entries, the sets' limit). Every object the
+# bench needs travels except the error code 0x603F (read over SDO when the fault bit rises) and
+# the following error 0x60F4 (no Delta set maps it; the master derives it in CSP).
+ASDA_E = PdoLayout(
+    "asda-e",
+    (PdoEntry(0x6040, 0, 16, "controlword"), PdoEntry(0x607A, 0, 32, "target_position", True),
+     PdoEntry(0x60FF, 0, 32, "target_velocity", True), PdoEntry(0x6071, 0, 16, "target_torque", True),
+     PdoEntry(0x6060, 0, 8, "mode", True), PdoEntry(0x60B8, 0, 16, "touch_probe_function")),
+    (PdoEntry(0x6041, 0, 16, "statusword"), PdoEntry(0x6064, 0, 32, "position_actual", True),
+     PdoEntry(0x606C, 0, 32, "velocity_actual", True), PdoEntry(0x6077, 0, 16, "torque_actual", True),
+     PdoEntry(0x6061, 0, 8, "mode_display", True), PdoEntry(0x60B9, 0, 16, "touch_probe_status"),
+     PdoEntry(0x60BA, 0, 32, "touch_probe_pos1", True), PdoEntry(0x60FD, 0, 32, "digital_inputs")),
+    rx_index=0x1602, tx_index=0x1A02,
+)
+
+LAYOUTS: dict[str, PdoLayout] = {l.name: l for l in (ASDA_E, ASDA_CSP, ASDA_CSP_CSV)}

@@ -19,7 +19,8 @@ class AxisConfig:
     start: float = 0.0  # machine position of the simulated axis at power-on, mm
     units: str = "mm"  # "mm" (linear) or "deg" (rotary)
     soft_limits: tuple[float, float] | None = None  # machine-coordinate travel window, units
-    drive_model: str = "asda-a3"
+    drive_model: str = "asda-a3-e"  # fieldbus.devices.MODELS: the identity its virtual EtherCAT slave presents
+    drive_esi: str = ""  # a vendor ESI file the virtual EtherCAT slave is built from ("" = the packaged one)
     canopen_eds: str = ""  # the drive's EDS/DCF on a CANopen bus; "" = Bench.canopen_eds or the shipped ASDA-B3
 
 
@@ -30,6 +31,8 @@ class SpindleConfig:
     max_rpm: float = 4000.0
     drive: DriveParams = field(default_factory=lambda: DriveParams(max_speed_rpm=6000.0, csv_accel=1.0e8))
     canopen_eds: str = ""  # as AxisConfig.canopen_eds
+    drive_model: str = "asda-a3-e"  # as AxisConfig.drive_model
+    drive_esi: str = ""  # as AxisConfig.drive_esi
 
 
 FILTER_MS = 16.0  # default N1.036 and N1.037 (ms)

@@ -16,6 +16,7 @@ from typing import Any
 
 from fieldbus.factory import parse_bus
 from fieldbus.pdo import ASDA_CSP, ASDA_CSP_CSV
+from fieldbus.devices import DEFAULT_MODEL, MODELS
 from fieldbus.units import AxisScaling
 from hil.bench_params import check_param
 from hil.bench import AxisConfig, Bench, ChecksConfig, IoStationConfig, RealtimeConfig, SpindleConfig
@@ -26,6 +27,7 @@ from virtual_bus.drive import DriveParams
 
 AXIS_LETTERS = "XYZABCUVW"
 CIA301_BITRATES = (10_000, 20_000, 50_000, 125_000, 250_000, 500_000, 800_000, 1_000_000)  # CiA 301 bit timing table
+MODEL_ALIASES = {"asda-a3": "asda-a3-e"}  # the name benches used before the models were real (issue 23)
 # DriveParams fields a bench may override, with whether they are integers (counts) or reals.
 _DRIVE_INT = {"following_error_window", "negative_limit", "positive_limit", "home_switch", "index_pulse_every",
               "substeps", "probe_position"}
@@ -285,12 +287,29 @@ def _scaling(r: _Reader, d: dict, p: str, default_lead: float) -> AxisScaling:
                        lead=lead or default_lead, direction=direction or 1)
 
 
-def _drive(r: _Reader, d: Any, p: str, base: DriveParams) -> tuple[DriveParams, str]:
+def _drive(r: _Reader, d: Any, p: str, base: DriveParams) -> tuple[DriveParams, str, str]:
+    """The drive table: tuning, `model` (fieldbus.devices.MODELS) and `esi` (a vendor ESI file the
+    virtual EtherCAT slave is built from instead of the packaged one; the model's product code picks
+    the device in it)."""
     if not isinstance(d, dict):
         r.err(p, f"must be a table, got {_kind(d)}")
-        return base, "asda-a3"
+        return base, DEFAULT_MODEL, ""
     d = dict(d)
-    model = r.string(d, "model", f"{p}.model", "asda-a3") or "asda-a3"
+    model = r.string(d, "model", f"{p}.model", DEFAULT_MODEL) or DEFAULT_MODEL
+    model = MODEL_ALIASES.get(model, model)
+    if model not in MODELS:
+        r.err(f"{p}.model", f"unknown drive model {model!r}; choose one of {', '.join(MODELS)}")
+        model = DEFAULT_MODEL
+    esi = r.string(d, "esi", f"{p}.esi", None) or ""
+    if esi:
+        from virtual_bus.ethercat.device import parse_device
+
+        esi = str((r.base / Path(esi).expanduser()).resolve())
+        try:
+            parse_device(esi, MODELS[model].product_code)
+        except (OSError, ValueError, KeyError, SyntaxError) as exc:  # ET.ParseError is a SyntaxError
+            r.err(f"{p}.esi", f"cannot use {esi}: {exc}")
+            esi = ""
     values: dict[str, Any] = {}
     for key in sorted(_DRIVE_KEYS & set(d)):
         if key in _DRIVE_INT:
@@ -300,10 +319,10 @@ def _drive(r: _Reader, d: Any, p: str, base: DriveParams) -> tuple[DriveParams, 
             v = r.number(d, key, f"{p}.{key}", None, positive=True)
         if v is not None:
             values[key] = v
-    r.unknown(d, f"{p}.", _DRIVE_KEYS | {"model"})
+    r.unknown(d, f"{p}.", _DRIVE_KEYS | {"model", "esi"})
     kw = {f.name: getattr(base, f.name) for f in fields(DriveParams)}
     kw.update(values)
-    return DriveParams(**kw), model
+    return DriveParams(**kw), model, esi
 
 
 def _axis(r: _Reader, d: dict, p: str) -> AxisConfig | None:
@@ -331,7 +350,7 @@ def _axis(r: _Reader, d: dict, p: str) -> AxisConfig | None:
                           for k, dflt in (("velocity", base.max_velocity), ("acceleration", base.max_acceleration),
                                           ("jerk", base.max_jerk))))
     r.unknown(lim, f"{p}.limits.", {"velocity", "acceleration", "jerk"})
-    drive, model = _drive(r, d.pop("drive", {}), f"{p}.drive", DriveParams())
+    drive, model, esi = _drive(r, d.pop("drive", {}), f"{p}.drive", DriveParams())
     eds = r.eds(d, f"{p}.canopen_eds", ASDA_CSP)
     r.unknown(d, f"{p}.", {"name", "units", "counts_per_rev", "ratio", "lead", "direction", "start", "soft_limits",
                            "limits", "drive", "canopen_eds"})
@@ -339,7 +358,7 @@ def _axis(r: _Reader, d: dict, p: str) -> AxisConfig | None:
         return None
     return AxisConfig(name, scaling, limits, drive, start=start, units=units,
                       soft_limits=(float(soft[0]), float(soft[1])) if soft else None, drive_model=model,
-                      canopen_eds=eds)
+                      canopen_eds=eds, drive_esi=esi)
 
 
 def _spindle(r: _Reader, d: dict, p: str) -> SpindleConfig | None:
@@ -351,12 +370,13 @@ def _spindle(r: _Reader, d: dict, p: str) -> SpindleConfig | None:
     ratio = r.pair(d, "ratio", f"{p}.ratio", integers=True, positive=True) or (1, 1)
     direction = r.integer(d, "direction", f"{p}.direction", 1, choices=(1, -1))
     max_rpm = r.number(d, "max_rpm", f"{p}.max_rpm", base.max_rpm, positive=True)
-    drive, _model = _drive(r, d.pop("drive", {}), f"{p}.drive", base.drive)
+    drive, model, esi = _drive(r, d.pop("drive", {}), f"{p}.drive", base.drive)
     eds = r.eds(d, f"{p}.canopen_eds", ASDA_CSP_CSV)
     r.unknown(d, f"{p}.", {"name", "counts_per_rev", "ratio", "direction", "max_rpm", "drive", "canopen_eds"})
     scaling = AxisScaling(counts_per_rev=cpr or base.scaling.counts_per_rev, gear_motor=int(ratio[0]),
                           gear_load=int(ratio[1]), lead=360.0, direction=direction or 1)
-    return SpindleConfig(name, scaling, max_rpm or base.max_rpm, drive, canopen_eds=eds)
+    return SpindleConfig(name, scaling, max_rpm or base.max_rpm, drive, canopen_eds=eds, drive_model=model,
+                         drive_esi=esi)
 
 
 def _realtime(r: _Reader, d: dict) -> RealtimeConfig:

@@ -42,6 +42,10 @@ PARAMS: dict[str, ParamSpec] = {
     "preview depth": ParamSpec(1, 1000, True), "preview log": ParamSpec(-1, 1_000_000, True, "-1: all"),
     "macro statements per cycle": ParamSpec(1, 100_000, True, "endless-loop guard"),
     "servo param alarm": _BIT,
+    # EtherCAT master (docs/decisions ethercat.md E8, E12)
+    "ethercat_drift_limit_ns": ParamSpec(0, 1e9, True, "ns, 0: record only"),
+    "ethercat_drift_check_every": ParamSpec(0, 1e6, True, "cycles"),
+    "ethercat_complete_access": ParamSpec(0, 1, True, "1: map with complete access first"),
 }
 # Call tables: N1.200-N1.249 (G -> O9100+), N1.250-N1.299 (M -> O9150+), legacy O9010-O9029.
 PARAMS.update({f"N1.{n}": _CODE for n in range(200, 300)})

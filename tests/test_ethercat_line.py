@@ -117,9 +117,10 @@ def test_kickcat_master_brings_the_virtual_slaves_to_op(line):
     slaves = bus.slaves()
     assert len(slaves) == 4
     bus.create_mapping()
-    # the drives keep the last mapping a master wrote over SDO: the ESI default or the CSP/CSV preset
+    # the drives keep the last mapping a master wrote over SDO: the ESI default (0x1600/0x1A01, 12/22
+    # bytes, issue 23) or hil's ASDA_E (0x1602/0x1A02, 15/23 bytes)
     sizes = [(s.output_size, s.input_size) for s in slaves]
-    assert sizes[3] == (2, 2) and all(sz in {(7, 18), (13, 29)} for sz in sizes[:3])
+    assert sizes[3] == (2, 2) and all(sz in {(12, 22), (15, 23)} for sz in sizes[:3])
     bus.request_state(kickcat.State.SAFE_OP)
     bus.wait_for_state(kickcat.State.SAFE_OP, 2.0)
     bus.process_data()

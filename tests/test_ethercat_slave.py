@@ -132,7 +132,7 @@ def test_al_state_machine_refuses_invalid_changes(chain):
     assert chain.slaves[0].al_code == 0x0016
     send(chain, (E.FPWR, 0x1001, E.R_AL_CONTROL, struct.pack("<H", E.INIT | 0x10)))
     to_preop(chain)
-    # SAFE-OP with an output SM that does not match the mapping (7 bytes): 0x001D
+    # SAFE-OP with an output SM that does not match the mapping (12 bytes): 0x001D
     send(chain, (E.FPWR, 0x1001, E.R_SM + 16, struct.pack("<HHBBBB", 0x1400, 5, 0x64, 0, 1, 0)))
     send(chain, (E.FPWR, 0x1001, E.R_AL_CONTROL, struct.pack("<H", E.SAFEOP)))
     assert chain.slaves[0].al_state == E.PREOP and chain.slaves[0].al_code == 0x001D
@@ -151,7 +151,8 @@ def test_coe_sdo_expedited_segmented_complete_access_and_aborts(chain):
     assert r[2] & 0x03 == 0x01 and struct.unpack_from("<I", r, 6)[0] == 19 and r[10:29] == b"ASDA-A3-E CoE Drive"
     (r,) = upload(0x1600, 0, ca=True)  # complete access: SI0 padded to 16 bits, then 32-bit entries
     n = struct.unpack_from("<I", r, 6)[0]
-    assert n == 2 + 4 * 3 and r[10] == 3 and struct.unpack_from("<I", r, 12)[0] == 0x60400010
+    # the A3-E ESI's 1st RxPDO: 6040 607A 60FF 60B8 (12 bytes out, the drive's default image)
+    assert n == 2 + 4 * 4 and r[10] == 4 and struct.unpack_from("<I", r, 12)[0] == 0x60400010
     (r,) = upload(0x2345, 0)
     assert r[2] == 0x80 and struct.unpack_from("<I", r, 6)[0] == ABORT_NO_OBJECT
     # download to a read-only object aborts; mapping changes only in PRE-OP
@@ -161,10 +162,10 @@ def test_coe_sdo_expedited_segmented_complete_access_and_aborts(chain):
     data = struct.pack("<BxIII", 3, 0x60400010, 0x607A0020, 0x60FF0020)
     (r,) = mailbox(chain, 0x1001, struct.pack("<HBHBI", 0x2000, 0x31, 0x1601, 0, len(data)) + data)
     assert r[2] == 0x60
-    assert chain.slaves[0].od.mapping(0x1C12) == [(0x6040, 0, 16), (0x607A, 0, 32), (0x6060, 0, 8)]
+    assert chain.slaves[0].od.mapping(0x1C12) == [(0x6040, 0, 16), (0x607A, 0, 32), (0x60FF, 0, 32), (0x60B8, 0, 16)]
     assert chain.slaves[0].od.value(0x1601, 3) == 0x60FF0020
     chain.slaves[0].mem[E.R_AL_STATUS] = E.SAFEOP
-    (r,) = mailbox(chain, 0x1001, struct.pack("<HBHBI", 0x2000, 0x23, 0x1600, 0, 0))
+    (r,) = mailbox(chain, 0x1001, struct.pack("<HBHBI", 0x2000, 0x2F, 0x1600, 0, 0))  # 1 byte to SI0
     assert struct.unpack_from("<I", r, 6)[0] == ABORT_STATE
 
 

@@ -19,7 +19,8 @@ import pysoem
 
 from fieldbus.ethercat import alarms as A
 from fieldbus.link import BusError, LinkStatus, SlaveInfo
-from fieldbus.pdo import ASDA_CSP_CSV, LAYOUTS, PdoLayout, RxPdo, TxPdo
+from fieldbus.cia402 import SW_FAULT
+from fieldbus.pdo import ASDA_E, LAYOUTS, PdoLayout, RxPdo, TxPdo
 from nc.alarms import Alarm
 
 DELTA_VENDOR = 0x000001DD
@@ -41,10 +42,25 @@ def state_name(state: int) -> str:
 
 
 def mapping_sdos(layout: PdoLayout) -> list[tuple[int, int, bytes]]:
-    """The SDO writes (index, subindex, data; complete access) that configure `layout`:
-    assignment off, mapping object written whole, assignment on."""
+    """The SDO writes (index, subindex, data) that configure `layout` entry by entry, as LinuxCNC
+    (IgH) does and every CoE slave takes (ETG.1000.6 5.6.7.4.9): assignment off, mapping count 0,
+    each entry, the count, then the PDO assigned and the assignment on."""
     out = []
-    for assign, pdo, entries in ((0x1C12, 0x1600, layout.rx), (0x1C13, 0x1A00, layout.tx)):
+    for assign, pdo, entries in ((0x1C12, layout.rx_index, layout.rx), (0x1C13, layout.tx_index, layout.tx)):
+        out.append((assign, 0, b"\x00"))
+        out.append((pdo, 0, b"\x00"))
+        out += [(pdo, k, struct.pack("<I", e.index << 16 | e.subindex << 8 | e.bits)) for k, e in enumerate(entries, 1)]
+        out.append((pdo, 0, bytes([len(entries)])))
+        out.append((assign, 1, struct.pack("<H", pdo)))
+        out.append((assign, 0, b"\x01"))
+    return out
+
+
+def mapping_sdos_complete(layout: PdoLayout) -> list[tuple[int, int, bytes]]:
+    """The same configuration in three complete-access writes per direction (faster on a line of many
+    drives); a drive that refuses complete access gets `mapping_sdos` instead."""
+    out = []
+    for assign, pdo, entries in ((0x1C12, layout.rx_index, layout.rx), (0x1C13, layout.tx_index, layout.tx)):
         words = [e.index << 16 | e.subindex << 8 | e.bits for e in entries]
         out.append((assign, 0, struct.pack("<BxH", 0, 0)))
         out.append((pdo, 0, struct.pack("<Bx" + "I" * len(words), len(words), *words)))
@@ -67,7 +83,8 @@ class EthercatLink:
     iface: str
     cycle_time: float = 0.001
     names: Sequence[str] = ()  # one per drive, in bus order (axes, then spindles)
-    layouts: Sequence[PdoLayout] = ()  # per drive; default the ASDA CSP/CSV preset
+    layouts: Sequence[PdoLayout] = ()  # per drive; default ASDA_E (Delta's 0x1602/0x1A02 sets)
+    complete_access: bool = False  # map with complete access first (falls back to subindex writes)
     dc: bool = True
     receive_timeout_us: int = 100_000  # Python slaves on a loaded CI host: SOEM's 2 ms is far too short
     max_bad_cycles: int = 3  # consecutive bad cycles ridden through before the alarm
@@ -93,10 +110,10 @@ class EthercatLink:
     @classmethod
     def for_bench(cls, bench, iface: str) -> "EthercatLink":
         names = list(bench.axis_names) + [s.name for s in bench.spindles]
-        layout = LAYOUTS.get(str(bench.params.get("ethercat_pdo", "")), ASDA_CSP_CSV) \
-            if hasattr(bench, "params") else ASDA_CSP_CSV
         params = getattr(bench, "params", {}) or {}
-        link = cls(iface, bench.cycle, names, [layout] * len(names))
+        layout = LAYOUTS.get(str(params.get("ethercat_pdo", "")), ASDA_E)
+        link = cls(iface, bench.cycle, names, [layout] * len(names),
+                   complete_access=bool(params.get("ethercat_complete_access", False)))
         link.io_names = [st.map.name for st in getattr(bench, "io", [])]
         # bench [params]: ethercat_drift_limit_ns, ethercat_drift_check_every (docs/decisions E8)
         link.drift_limit_ns = int(params.get("ethercat_drift_limit_ns", link.drift_limit_ns))
@@ -184,7 +201,7 @@ class EthercatLink:
             raise BusError(Alarm(A.NO_SLAVES, f"{len(self.drives)} CiA 402 drives found on {self.iface}, "
                                               f"the bench needs {len(self.names)} ({', '.join(self.names)})"))
         self.drives = self.drives[: len(self.names)]
-        layouts = list(self.layouts) or [ASDA_CSP_CSV] * len(self.names)
+        layouts = list(self.layouts) or [ASDA_E] * len(self.names)
         self._structs = layouts
         errors: list[Alarm] = []
         for s, layout, name in zip(self.drives, layouts, self.names):
@@ -237,13 +254,24 @@ class EthercatLink:
         return self.infos
 
     def _mapper(self, s, layout: PdoLayout, name: str, errors: list[Alarm]):
+        def write_all(sdos, complete: bool) -> None:
+            for index, sub, data in sdos:
+                s.sdo_write(index, sub, data, complete)
+
         def configure(_pos: int) -> None:
+            if self.complete_access:
+                try:
+                    write_all(mapping_sdos_complete(layout), True)
+                    return
+                except pysoem.SdoError as exc:  # no complete access on this drive: entry by entry
+                    self.stats.events.append(f"{name}: complete access refused (0x{exc.abort_code:08X}), "
+                                             f"mapping entry by entry")
             for index, sub, data in mapping_sdos(layout):
                 try:
-                    s.sdo_write(index, sub, data, True)
+                    s.sdo_write(index, sub, data, False)
                 except pysoem.SdoError as exc:
                     errors.append(Alarm(A.PDO_MISMATCH, f"{name}: PDO mapping {layout.name} refused at "
-                                                        f"0x{index:04X}: SDO abort 0x{exc.abort_code:08X} "
+                                                        f"0x{index:04X}:{sub:02X}: SDO abort 0x{exc.abort_code:08X} "
                                                         f"({exc.desc})"))
                     return
         return configure
@@ -282,11 +310,28 @@ class EthercatLink:
             if not self._failed:  # the full working counter: every slave exchanged, so every slave is in OP
                 self._states = ["OP"] * len(self.infos)
             self._last = [layout.unpack_tx(s.input, tx) for s, layout, tx in zip(self.drives, self._structs, self._last)]
+            self._derive(outputs)
             self._io_in = [bytes(s.input) for s in self.io]
             if self.dc and self.drift_check_every and not self._failed and self.stats.cycles % self.drift_check_every == 0:
                 self._check_drift()
             return list(self._last)
         return self._bad_cycle(m, wkc)
+
+    def _derive(self, outputs: Sequence[RxPdo]) -> None:
+        """What the layout does not carry (no Delta PDO set maps 0x60F4; ASDA_E leaves 0x603F out):
+        the following error in CSP is the target just sent less the position reached (the drive's own
+        0x60F4 in lock-step), and the error code is read over SDO once when the fault bit rises."""
+        for i, (s, layout, rx, tx) in enumerate(zip(self.drives, self._structs, outputs, self._last)):
+            if not layout.carries(0x60F4):
+                tx.following_error = rx.target_position - tx.position_actual if tx.mode_display == 8 else 0
+            if not layout.carries(0x603F):
+                if not tx.statusword & SW_FAULT:
+                    tx.error_code = 0
+                elif not tx.error_code:
+                    try:
+                        tx.error_code = int.from_bytes(s.sdo_read(0x603F, 0, 2), "little") or 0xFF00
+                    except Exception:  # unreadable: still a fault; 0xFF00 is CiA 402's "device specific"
+                        tx.error_code = 0xFF00
 
     def _bad_cycle(self, m, wkc: int) -> list[TxPdo]:
         self.stats.bad_cycles += 1

@@ -57,7 +57,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def build_chain(bench, io: int = 0, realtime: bool = False, faults=()):
-    """Software ESCs for the bench's drives (ASDA-A3-E class) and R1-EC class I/O stations: one per
+    """Software ESCs for the bench's drives (each its `drive.model`: ASDA-A3-E, B3-E or A2-E) and R1-EC class I/O stations: one per
     [[io]] station with its `modules`, and up to `io` in all (extra ones DI16 + DO16)."""
     from virtual_bus.ethercat.app import DioApp, DriveApp
     from virtual_bus.ethercat.device import load_device
@@ -66,18 +66,22 @@ def build_chain(bench, io: int = 0, realtime: bool = False, faults=()):
 
     from virtual_bus.ethercat.r1ec import DEFAULT_MODULES, r1ec_device
 
-    drive_dev = load_device("asda-a3-e")
+    from fieldbus.devices import MODELS
+
+    # each drive presents its model's identity and PDO sets, from the packaged file or the bench's ESI
+    models = [(c.drive_model, c.drive_esi) for c in list(bench.axes) + list(bench.spindles)]
+    devices = {(m, esi): load_device(esi, MODELS[m].product_code) if esi else load_device(m) for m, esi in set(models)}
     slaves = []
-    for k, d in enumerate(sim_slaves(bench)):
+    for k, (d, model) in enumerate(zip(sim_slaves(bench), models)):
         # Clocks start apart and run at slightly different rates, so DC has something to do.
-        slaves.append(Esc(drive_dev, DriveApp(d), name=d.name, drift_ppm=(-1) ** k * 10.0 * k,
+        slaves.append(Esc(devices[model], DriveApp(d), name=d.name, drift_ppm=(-1) ** k * 10.0 * k,
                           clock_base_ns=(k + 1) * 1_234_567_890, cycle_time=bench.cycle, lockstep=not realtime))
     # the bench's [[io]] stations (each with its R1-EC modules), then extra default 16/16 ones
     stations = [(st.map.name, st.modules or DEFAULT_MODULES) for st in getattr(bench, "io", [])]
-    devices = {mods: r1ec_device(mods) for _, mods in stations} | {DEFAULT_MODULES: load_device("r1-ec-dio")}
+    io_devices = {mods: r1ec_device(mods) for _, mods in stations} | {DEFAULT_MODULES: load_device("r1-ec-dio")}
     for k in range(max(io, len(stations))):
         name, mods = stations[k] if k < len(stations) else (f"DIO{k + 1}", DEFAULT_MODULES)
-        slaves.append(Esc(devices[mods], DioApp(), name=name,
+        slaves.append(Esc(io_devices[mods], DioApp(), name=name,
                           clock_base_ns=(len(slaves) + 1) * 987_654_321, cycle_time=bench.cycle,
                           lockstep=not realtime))
     return Chain(slaves, list(faults))

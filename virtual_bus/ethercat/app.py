@@ -8,17 +8,17 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from fieldbus.pdo import ASDA_CSP_CSV, RxPdo
+from fieldbus.pdo import ASDA_CSP_CSV, ASDA_E, RxPdo
 from fieldbus.cia402 import State
 from virtual_bus.drive import Cia402Drive
-from virtual_bus.ethercat.coe import ObjectDictionary, SdoAbort
+from virtual_bus.ethercat.coe import ABORT_VALUE_RANGE, ObjectDictionary, SdoAbort
 from virtual_bus.ethercat.device import OBJ_VAR, TYPES, OdEntry, OdObject
 from virtual_bus.ethercat.esc import SlaveApp
 from virtual_bus.servo_params import ServoParamError, ServoParams, coe_objects
 
-# object index -> RxPdo / TxPdo attribute, from the ASDA preset's entries
-RX_ATTR = {e.index: e.attr for e in ASDA_CSP_CSV.rx} | {0x60FE: "digital_outputs"}
-TX_ATTR = {e.index: e.attr for e in ASDA_CSP_CSV.tx}
+# (index, subindex) -> RxPdo / TxPdo attribute, from the layouts' entries
+RX_ATTR = {(e.index, e.subindex): e.attr for e in ASDA_CSP_CSV.rx + ASDA_E.rx} | {(0x60FE, 1): "digital_outputs"}
+TX_ATTR = {(e.index, e.subindex): e.attr for e in ASDA_CSP_CSV.tx + ASDA_E.tx}
 COMM_FAULT = 0x7500  # CiA 402 error code class "communication"
 
 
@@ -45,23 +45,34 @@ class DriveApp(SlaveApp):
     drive: Cia402Drive
     od: ObjectDictionary | None = None
     _last_error: int = 0
+    _params: set[int] = field(default_factory=set)  # object indices of the Delta Pn-xx parameters
 
     def attach(self, od: ObjectDictionary) -> None:
         self.od = od
         # Delta parameters Pn-xx as objects 0x2000 + n*0x100 + xx (DINT), served from the drive's
         # `ServoParams` so SDO, Modbus and the drive see one table (issue 8).
         dtype, bits, signed = TYPES["DINT"]
+        self._params = {index for index, _ in coe_objects()}
         for index, p in coe_objects():
             od.objects[index] = OdObject(index, p.label, OBJ_VAR, {0: OdEntry(
                 0, p.label, dtype, bits, signed, "rw" if p.writable else "ro", value=p.default)})
         od.after_write = self._after_write
+        od.before_write = self._before_write
         self._publish()
+
+    def _before_write(self, index: int, sub: int, value) -> None:
+        """0x6060 takes only the modes 0x6502 advertises (0: no mode); CiA 402 / Delta: abort 0x06090030."""
+        od = self.od
+        if index == 0x6060 and od is not None and 0x6502 in od.objects:
+            supported = od.value(0x6502)
+            if value != 0 and not (1 <= value <= 32 and supported >> (value - 1) & 1):
+                raise SdoAbort(ABORT_VALUE_RANGE)
 
     def _after_write(self, index: int, sub: int) -> None:
         """A servo parameter written over SDO goes through the drive's checks; a refusal restores
         the old value and aborts the transfer with the drive's code."""
         od, params = self.od, self.drive.servo_params
-        if od is None or not 0x2000 <= index <= 0x26FF:
+        if od is None or index not in self._params:  # 0x2511 (P5-17, auxiliary encoder) is the device's own
             return
         try:
             params.write(ServoParams.from_index(index, sub), od.value(index, sub))
@@ -73,14 +84,14 @@ class DriveApp(SlaveApp):
         od = self.od
         assert od is not None
         fb = self.drive.feedback()
-        for index, attr in TX_ATTR.items():
+        for (index, sub), attr in TX_ATTR.items():
             if index in od.objects:
-                od.set(index, 0, int(getattr(fb, attr)))
+                od.set(index, sub, int(getattr(fb, attr)))
 
     def refresh(self, index: int) -> None:
-        if index in TX_ATTR:
+        if any(index == i for i, _ in TX_ATTR):
             self._publish()
-        elif 0x2000 <= index <= 0x26FF and self.od is not None and index in self.od.objects:
+        elif index in self._params and self.od is not None:
             self.od.set(index, 0, self.drive.servo_params.read(ServoParams.from_index(index, 0)))
 
     def cycle(self, outputs: bytes, rx_map, tx_map, step: bool, dt: float = 0.0, lost: bool = False) -> bytes:
@@ -96,9 +107,9 @@ class DriveApp(SlaveApp):
         elif step:
             _unpack(outputs, rx_map, od)
             rx = RxPdo(mode=self.drive.mode)
-            for index, attr in RX_ATTR.items():
+            for (index, sub), attr in RX_ATTR.items():
                 if index in od.objects:
-                    setattr(rx, attr, od.value(index))
+                    setattr(rx, attr, od.value(index, sub))
             self.drive.apply(rx)
             self.drive.step(dt)
         self._publish()

@@ -14,6 +14,7 @@ from virtual_bus.ethercat.device import OBJ_VAR, VISIBLE_STRING, Device, OdEntry
 COE_EMERGENCY, COE_SDO_REQ, COE_SDO_RESP, COE_SDO_INFO = 1, 2, 3, 8
 
 ABORT_TOGGLE = 0x05030000
+ABORT_UNSUPPORTED_ACCESS = 0x06010000
 ABORT_COMMAND = 0x05040001
 ABORT_WRITE_ONLY = 0x06010001
 ABORT_READ_ONLY = 0x06010002
@@ -24,6 +25,7 @@ ABORT_PDO_LENGTH = 0x06040042
 ABORT_TYPE_LENGTH = 0x06070010
 ABORT_NO_SUBINDEX = 0x06090011
 ABORT_VALUE_RANGE = 0x06090030
+ABORT_VALUE_TOO_LOW = 0x06090032
 ABORT_GENERAL = 0x08000000
 ABORT_STATE = 0x08000022
 
@@ -54,8 +56,11 @@ class ObjectDictionary:
 
     def __init__(self, device: Device, state: Callable[[], int] = lambda: PREOP) -> None:
         self.objects: dict[int, OdObject] = copy.deepcopy(device.objects)
+        self.complete_access = device.coe_complete_access  # the ESI's <CoE CompleteAccess="1">
         self.state = state
         self.before_read: Callable[[int], None] = lambda index: None
+        # the application's check of a value before it is stored (raises SdoAbort to refuse it)
+        self.before_write: Callable[[int, int, int | bytes], None] = lambda index, sub, value: None
         self.after_write: Callable[[int, int], None] = lambda index, sub: None
 
     def entry(self, index: int, sub: int) -> OdEntry:
@@ -77,6 +82,8 @@ class ObjectDictionary:
 
     # ---- SDO semantics ------------------------------------------------------------------
     def read(self, index: int, sub: int, complete: bool = False) -> bytes:
+        if complete and not self.complete_access:
+            raise SdoAbort(ABORT_UNSUPPORTED_ACCESS)
         self.before_read(index)
         e = self.entry(index, sub)
         if not complete:
@@ -91,7 +98,11 @@ class ObjectDictionary:
             out += obj.entries[s].encode()
         return out
 
-    def write(self, index: int, sub: int, data: bytes, complete: bool = False) -> None:
+    def write(self, index: int, sub: int, data: bytes, complete: bool = False, exact: bool = True) -> None:
+        """`exact`: the request gave its data size (expedited with the size indicator, normal,
+        segmented); a size other than the entry's is then refused (0x06070010), as CiA 301 says."""
+        if complete and not self.complete_access:
+            raise SdoAbort(ABORT_UNSUPPORTED_ACCESS)
         obj = self.objects.get(index)
         if obj is None:
             raise SdoAbort(ABORT_NO_OBJECT)
@@ -114,18 +125,22 @@ class ObjectDictionary:
             if count is not None:
                 self._write_entry(index, 0, bytes([count]))
             return
-        self._write_entry(index, sub, data)
+        self._write_entry(index, sub, data, exact)
 
-    def _write_entry(self, index: int, sub: int, data: bytes) -> None:
+    def _write_entry(self, index: int, sub: int, data: bytes, exact: bool = True) -> None:
         e = self.entry(index, sub)
         if not e.writable:
             raise SdoAbort(ABORT_READ_ONLY)
         n = max(1, (e.bits + 7) // 8)
-        if e.dtype != VISIBLE_STRING and len(data) < n:
+        if e.dtype != VISIBLE_STRING and (len(data) < n or (exact and len(data) != n)):
             raise SdoAbort(ABORT_TYPE_LENGTH)
         value = e.decode(data)
         if 0x1600 <= index <= 0x1BFF or index in (0x1C12, 0x1C13):
             self._check_mapping(index, sub, value)
+        if index in (0x1C32, 0x1C33) and sub == 2 and value and 5 in self.objects[index].entries \
+                and value < self.value(index, 5):
+            raise SdoAbort(ABORT_VALUE_TOO_LOW)  # below the minimum cycle time the device gives in :05
+        self.before_write(index, sub, value)
         e.value = value
         self.after_write(index, sub)
 
@@ -154,7 +169,8 @@ class ObjectDictionary:
                 raise SdoAbort(ABORT_TYPE_LENGTH)
             return
         if value > obj.max_sub:
-            raise SdoAbort(ABORT_VALUE_RANGE)
+            # more entries than the PDO holds: CiA 301 / ETG.1000.6 "exceeds PDO length"
+            raise SdoAbort(ABORT_PDO_LENGTH if 0x1600 <= index <= 0x1BFF else ABORT_VALUE_RANGE)
         if 0x1600 <= index <= 0x1BFF:
             total = sum(obj.entries[s].value & 0xFF for s in range(1, value + 1))
             if total > 8 * 64:
@@ -263,7 +279,7 @@ class CoeServer:
         complete = bool(cmd & 0x10)
         if cmd & 0x02:  # expedited
             n = 4 - ((cmd >> 2) & 3) if cmd & 0x01 else 4
-            self.od.write(index, sub, p[6:6 + n], complete)
+            self.od.write(index, sub, p[6:6 + n], complete, exact=bool(cmd & 0x01))
             return self._resp(0x60, index, sub, b"\x00" * 4)
         size = struct.unpack_from("<I", p, 6)[0]
         data = p[10:10 + size]

@@ -10,6 +10,8 @@ from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
 
+from fieldbus.devices import MODELS
+
 # CoE basic data types: name -> (CoE data type code, bits, signed)
 TYPES: dict[str, tuple[int, int, bool]] = {
     "BOOL": (0x0001, 1, False), "SINT": (0x0002, 8, True), "INT": (0x0003, 16, True),
@@ -155,8 +157,10 @@ def _object(el: ET.Element, pdos: dict[int, PdoDef]) -> OdObject:
     if tname == "RECORD":
         obj = OdObject(index, name, OBJ_RECORD)
         subs = el.findall("SubItem")
-        obj.entries[0] = OdEntry(0, "Number of entries", 0x0005, 8, False, "ro", "", len(subs))
-        for i, s in enumerate(subs, start=1):
+        # <SubIdx> numbers a record with gaps (0x1C32: 1-6, 9, 11, 12, 32); without it, 1, 2, 3, ...
+        numbers = [_int(_text(s, "SubIdx"), i) for i, s in enumerate(subs, start=1)]
+        obj.entries[0] = OdEntry(0, "Number of entries", 0x0005, 8, False, "ro", "", max(numbers, default=0))
+        for i, s in zip(numbers, subs):
             obj.entries[i] = _entry(i, _text(s, "Name"), _text(s, "Type"), _text(s, "Access", "ro"),
                                     _text(s, "PdoMapping"), _text(s, "Default"))
         return obj
@@ -182,15 +186,33 @@ def _object(el: ET.Element, pdos: dict[int, PdoDef]) -> OdObject:
 def _pdo(el: ET.Element) -> PdoDef:
     entries = tuple(PdoEntryDef(_int(_text(e, "Index")), _int(_text(e, "SubIndex")), _int(_text(e, "BitLen")))
                     for e in el.findall("Entry"))
-    return PdoDef(_int(_text(el, "Index")), _int(el.get("Sm")), _text(el, "Name"), entries)
+    # A PDO without Sm="n" is not assigned at power-on (ESI); the SII marks it 0xFF.
+    return PdoDef(_int(_text(el, "Index")), _int(el.get("Sm"), 0xFF), _text(el, "Name"), entries)
 
 
-def parse_device(source: str | Path) -> Device:
+def parse_devices(source: str | Path) -> list[Device]:
+    """Every device of an ESI-like file (a vendor's file describes several)."""
     root = ET.parse(source).getroot()
     vendor = root.find("Vendor")
-    dev = root.find("Descriptions/Devices/Device")
-    if vendor is None or dev is None:
+    devs = root.findall("Descriptions/Devices/Device")
+    if vendor is None or not devs:
         raise ValueError(f"{source}: not an ESI-like description (no Vendor or Device)")
+    return [_device(vendor, dev) for dev in devs]
+
+
+def parse_device(source: str | Path, product_code: int | None = None) -> Device:
+    """The device of `product_code` in the file, or its first device."""
+    devices = parse_devices(source)
+    if product_code is None:
+        return devices[0]
+    for d in devices:
+        if d.product_code == product_code:
+            return d
+    raise ValueError(f"{source}: no device with product code 0x{product_code:08X} "
+                     f"(it has {', '.join(f'0x{d.product_code:08X}' for d in devices)})")
+
+
+def _device(vendor: ET.Element, dev: ET.Element) -> Device:
     t = dev.find("Type")
     assert t is not None
     rx = [_pdo(e) for e in dev.findall("RxPdo")]
@@ -223,12 +245,18 @@ def parse_device(source: str | Path) -> Device:
     return device
 
 
-DEVICE_FILES = {"asda-a3-e": "asda_a3_e.xml", "r1-ec-dio": "r1_ec_dio.xml"}
+# short name -> (packaged file, product code or None for the file's first device)
+DEVICE_FILES: dict[str, tuple[str, int | None]] = {
+    **{key: ("delta_asda_e.xml", m.product_code) for key, m in MODELS.items()},
+    "r1-ec-dio": ("r1_ec_dio.xml", None),
+}
 
 
-def load_device(name: str) -> Device:
-    """A packaged description by short name (asda-a3-e, r1-ec-dio) or a path to an XML file."""
+def load_device(name: str, product_code: int | None = None) -> Device:
+    """A packaged description by short name (asda-a3-e, asda-b3-e, asda-a2-e, r1-ec-dio), or an ESI(-like)
+    file by path, then the device of `product_code` in it (default: its first)."""
     if name in DEVICE_FILES:
-        with resources.as_file(resources.files("virtual_bus.ethercat") / "devices" / DEVICE_FILES[name]) as p:
-            return parse_device(p)
-    return parse_device(name)
+        fname, code = DEVICE_FILES[name]
+        with resources.as_file(resources.files("virtual_bus.ethercat") / "devices" / fname) as p:
+            return parse_device(p, code)
+    return parse_device(name, product_code)

@@ -311,7 +311,10 @@ class Esc:
         if req not in allowed.get(cur, ()):
             self.al_error(AL_INVALID_STATE_CHANGE, cur)
             return
-        check = {PREOP: self._check_mailbox, SAFEOP: self._check_process_data, OP: self._check_sync}[req]
+        # The SYNC0 cycle is judged on the way into SAFE-OP when the master programmed DC before (TwinCAT,
+        # ETG.1020 order), and again into OP for masters that start SYNC0 in SAFE-OP (SOEM).
+        check = {PREOP: self._check_mailbox, SAFEOP: lambda: self._check_sync() or self._check_process_data(),
+                 OP: self._check_sync}[req]
         code = check()
         if code:
             self.al_error(code, cur)

@@ -7,7 +7,7 @@ import struct
 
 from virtual_bus.ethercat.device import FMMU_TYPES, SM_TYPES, TYPES, Device
 
-CAT_STRINGS, CAT_GENERAL, CAT_FMMU, CAT_SM, CAT_TXPDO, CAT_RXPDO, CAT_END = 10, 30, 40, 41, 50, 51, 0xFFFF
+CAT_STRINGS, CAT_GENERAL, CAT_FMMU, CAT_SM, CAT_TXPDO, CAT_RXPDO, CAT_DC, CAT_END = 10, 30, 40, 41, 50, 51, 60, 0xFFFF
 MBX_COE = 0x0004
 COE_SDO, COE_SDO_INFO, COE_PDO_ASSIGN, COE_PDO_CONFIG, COE_COMPLETE_ACCESS = 0x01, 0x02, 0x04, 0x08, 0x20
 
@@ -66,6 +66,9 @@ def build_sii(dev: Device) -> bytes:
         return out
 
     tx, rx = pdo_cat(dev.tx_pdos), pdo_cat(dev.rx_pdos)
+    # ETG.2010 DC category: one op mode (cycle time 0 = the master's, shifts 0, AssignActivate, names)
+    dc = struct.pack("<IIIhHhBB4x", 0, 0, 0, 0, dev.assign_activate, 0, strings.index("DC"),
+                     strings.index("DC synchron (SYNC0)")) if dev.assign_activate else b""
     text = bytes([len(strings.items)]) + b"".join(bytes([len(s)]) + s for s in strings.items)
 
     head = bytearray(128)
@@ -78,7 +81,7 @@ def build_sii(dev: Device) -> bytes:
     struct.pack_into("<HH", head, 0x3E * 2, dev.eeprom_bytes * 8 // 1024 - 1, 1)
     body = (_category(CAT_STRINGS, text) + _category(CAT_GENERAL, general) + _category(CAT_FMMU, fmmu)
             + _category(CAT_SM, sm) + _category(CAT_TXPDO, tx) + _category(CAT_RXPDO, rx)
-            + struct.pack("<H", CAT_END))
+            + (_category(CAT_DC, dc) if dc else b"") + struct.pack("<H", CAT_END))
     image = bytes(head) + body
     if len(image) > dev.eeprom_bytes:
         raise ValueError(f"{dev.name}: SII image of {len(image)} bytes exceeds the {dev.eeprom_bytes}-byte EEPROM")

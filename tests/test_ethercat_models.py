@@ -1,0 +1,121 @@
+"""Delta drive models on the EtherCAT bench (issue 23): the packaged multi-device ESI-like file agrees with
+fieldbus.devices, a bench picks A3-E / B3-E / A2-E per axis or points a drive at a vendor ESI file, and
+hil's master maps Delta's 0x1602/0x1A02 entry by entry (complete access only on request, with a
+fallback when the drive refuses it)."""
+
+from __future__ import annotations
+
+import re
+import subprocess
+import sys
+from importlib import resources
+from pathlib import Path
+
+import pytest
+
+from fieldbus.devices import MODELS
+from fieldbus.ethercat.link import EthercatLink, mapping_sdos
+from fieldbus.pdo import ASDA_E
+from virtual_bus.ethercat.device import load_device, parse_devices
+from virtual_bus.ethercat.veth import SimProcess, can_create
+
+ROOT = Path(__file__).resolve().parents[1]
+PACKAGED = Path(str(resources.files("virtual_bus.ethercat") / "devices" / "delta_asda_e.xml"))
+
+
+def test_packaged_file_holds_three_devices_equal_to_the_catalogue():
+    devices = parse_devices(PACKAGED)
+    assert [(d.vendor_id, d.product_code, d.revision) for d in devices] == \
+        [(m.vendor_id, m.product_code, m.revision) for m in MODELS.values()]
+    for key, m in MODELS.items():
+        d = load_device(key)
+        assert d.product_code == m.product_code and d.name == m.type_name
+        for index, entries in m.rx_sets.items() | m.tx_sets.items():
+            obj = d.objects[index]
+            assert obj.max_sub == m.max_entries
+            words = [obj.entries[k].value for k in range(1, obj.entries[0].value + 1)]
+            assert words == [i << 16 | s << 8 | b for i, s, b in entries]
+        for direction in "RT":
+            flagged = {(i, e.sub) for i, o in d.objects.items() for e in o.entries.values() if e.pdo == direction}
+            assert flagged == m.mappable(direction)
+        assert d.objects[0x1C12].entries[1].value == m.default_rx and d.objects[0x1C13].entries[1].value == m.default_tx
+
+
+def test_asda_e_fits_every_model():
+    """hil's default layout stays within each model's limits: 8 entries, mappable objects only."""
+    for m in MODELS.values():
+        assert len(ASDA_E.rx) <= m.max_entries and len(ASDA_E.tx) <= m.max_entries
+        assert {(e.index, e.subindex) for e in ASDA_E.rx} <= m.mappable("R")
+        assert {(e.index, e.subindex) for e in ASDA_E.tx} <= m.mappable("T")
+
+
+def test_master_maps_entry_by_entry():
+    """As LinuxCNC (IgH) does: assignment off, count 0, entries, count, PDO assigned, assignment on."""
+    sdos = mapping_sdos(ASDA_E)
+    rx = [(i, s) for i, s, _ in sdos if i in (0x1C12, 0x1602)]
+    assert rx[:2] == [(0x1C12, 0), (0x1602, 0)]
+    assert rx[2:8] == [(0x1602, k) for k in range(1, 7)]
+    assert rx[8:] == [(0x1602, 0), (0x1C12, 1), (0x1C12, 0)]
+    assert all(len(d) in (1, 2, 4) for _, _, d in sdos)  # no complete-access blocks
+
+
+def hil(*args: str) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "hil.cli", *args], capture_output=True, text=True, cwd=ROOT,
+                          timeout=180)
+
+
+def test_bench_refuses_an_unknown_model_and_a_missing_esi(tmp_path):
+    bench = tmp_path / "b.toml"
+    bench.write_text('[[axes]]\nname = "X"\ndrive = { model = "asda-z9" }\n'
+                     '[[axes]]\nname = "Z"\ndrive = { model = "asda-b3-e", esi = "nowhere.xml" }\n')
+    r = hil("check", str(ROOT / "examples" / "lathe_demo.nc"), "--bench", str(bench))
+    assert r.returncode == 2
+    assert "axes[0].drive.model" in r.stderr and "asda-a3-e, asda-b3-e, asda-a2-e" in r.stderr
+    assert "axes[1].drive.esi" in r.stderr and "Traceback" not in r.stderr
+
+
+@pytest.mark.skipif(can_create() is not None, reason=can_create() or "")
+def test_mixed_models_and_a_vendor_esi_without_complete_access(tmp_path):
+    """X an A3-E, Z a B3-E built from a copy of the ESI that says CompleteAccess="0", S1 an A2-E. The
+    bench asks for complete access; the B3-E refuses it (0x06010000) and is mapped entry by entry; the
+    demo program completes and `hil scan` names each model."""
+    esi = tmp_path / "vendor.xml"
+    esi.write_text(PACKAGED.read_text().replace('CompleteAccess="1"', 'CompleteAccess="0"'))
+    bench = tmp_path / "mixed.toml"
+    bench.write_text(f'''
+bus = "sim"
+[params]
+ethercat_complete_access = 1
+[[axes]]
+name = "X"
+lead = 5.0
+start = 60.0
+drive = {{ model = "asda-a3-e" }}
+[[axes]]
+name = "Z"
+lead = 10.0
+start = 100.0
+drive = {{ model = "asda-b3-e", esi = "{esi}" }}
+[[spindles]]
+name = "S1"
+drive = {{ model = "asda-a2-e" }}
+''')
+    with SimProcess("--bench", str(bench), tag="m") as sim:
+        scan = hil("scan", "--bus", f"ethercat:{sim.iface}")
+        assert scan.returncode == 0, scan.stderr
+        rows = scan.stdout.splitlines()
+        assert [re.search(r"product 0x([0-9A-F]{8})", row).group(1) for row in rows] == \
+            ["00006010", "00006080", "10305070"]
+        assert "ASDA-B3-E CoE Drive" in rows[1] and "ASDA-A2-E CoE Drive" in rows[2]
+        link = EthercatLink(sim.iface, names=["X", "Z", "S1"], complete_access=True)
+        link.open()
+        try:
+            refused = [e for e in link.stats.events if "complete access refused" in e]
+            assert len(refused) == 1 and refused[0].startswith("Z:") and "0x06010000" in refused[0]
+            assert [i.state for i in link.infos] == ["OP"] * 3
+        finally:
+            link.close()
+        r = hil("run", str(ROOT / "examples" / "lathe_demo.nc"), "--bench", str(bench),
+                "--bus", f"ethercat:{sim.iface}")
+        assert r.returncode == 0, r.stdout + r.stderr
+        assert "result         completed" in r.stdout
