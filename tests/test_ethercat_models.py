@@ -68,7 +68,7 @@ def test_bench_refuses_an_unknown_model_and_a_missing_esi(tmp_path):
     bench = tmp_path / "b.toml"
     bench.write_text('[[axes]]\nname = "X"\ndrive = { model = "asda-z9" }\n'
                      '[[axes]]\nname = "Z"\ndrive = { model = "asda-b3-e", esi = "nowhere.xml" }\n')
-    r = hil("check", str(ROOT / "examples" / "lathe_demo.nc"), "--bench", str(bench))
+    r = hil("run", str(ROOT / "examples" / "lathe_demo.nc"), "--bench", str(bench))
     assert r.returncode == 2
     assert "axes[0].drive.model" in r.stderr and "asda-a3-e, asda-b3-e, asda-a2-e" in r.stderr
     assert "axes[1].drive.esi" in r.stderr and "Traceback" not in r.stderr

@@ -322,8 +322,9 @@ class EthercatLink:
         the following error in CSP is the target just sent less the position reached (the drive's own
         0x60F4 in lock-step), and the error code is read over SDO once when the fault bit rises."""
         for i, (s, layout, rx, tx) in enumerate(zip(self.drives, self._structs, outputs, self._last)):
-            if not layout.carries(0x60F4):
-                tx.following_error = rx.target_position - tx.position_actual if tx.mode_display == 8 else 0
+            if not layout.carries(0x60F4):  # the drive's command follows the actual position until enabled
+                live = tx.mode_display == 8 and tx.statusword & 0x6F == 0x27
+                tx.following_error = rx.target_position - tx.position_actual if live else 0
             if not layout.carries(0x603F):
                 if not tx.statusword & SW_FAULT:
                     tx.error_code = 0
