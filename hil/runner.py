@@ -36,6 +36,10 @@ MODE_CSP = 8
 MODE_CSV = 9
 MAX_TIME_ALARM = MAX_TIME  # deltahil's own range 0xDE00-0xDEFF (nc/alarm_table.py)
 STANDSTILL_TIMEOUT = 10.0  # s the stop path waits for the axes to stand before it disables anyway
+# An axis stands when its position feedback (0x6064) has not changed for REST_CYCLES cycles and its
+# velocity feedback reads 0. Velocity alone cannot say it: Delta drives report 0x606C in 0.1 rpm of
+# the motor, which reads 0 below 1 rpm (2,133 counts/s at 1,280,000 counts/rev).
+REST_CYCLES = 3
 FROZEN_S = 0.2  # s of unchanged feedback from a moving drive that mean it left the bus
 
 
@@ -76,6 +80,8 @@ class BenchRunner:
         for rx in self.rx[n_axes:]:
             rx.touch_probe_function = 0x0001  # latch the spindle encoder index (thread sync)
         self.tx: list[TxPdo] = [TxPdo() for _ in self.rx]
+        self._rest = [0] * len(self.rx)  # cycles each drive's feedback has stood still (see REST_CYCLES)
+        self._last_position: list[int | None] = [None] * len(self.rx)
         self.scales = [a.scaling for a in bench.axes] + [s.scaling for s in bench.spindles]
         self.result = RunResult(max_ferr={a: 0.0 for a in self.axes})
         self.channel: Channel | None = None
@@ -284,8 +290,12 @@ class BenchRunner:
         self.cycle += 1
         self.time += self.bench.cycle
         n_axes = len(self.axes)
+        rest, last = self._rest, self._last_position
         for i, (m, tx) in enumerate(zip(self.masters, self.tx)):
             self.rx[i].controlword = m.step(tx.statusword)
+            p = tx.position_actual
+            rest[i] = rest[i] + 1 if p == last[i] and tx.velocity_actual == 0 else 0
+            last[i] = p
             if m.faulted and i not in self._alarmed_drives:
                 self._alarmed_drives.add(i)
                 self._alarm(Alarm(SERVO_ALARM, f"servo alarm on {self._name(i)}: drive error code 0x{tx.error_code:04X}",
@@ -405,7 +415,7 @@ class BenchRunner:
     def _reenable(self, ch: Channel) -> None:
         """After an E-stop is released and reset: once the axes stand, enable the drives again and
         let the NC take over the actual position (the axes braked past the frozen setpoint)."""
-        if any(abs(tx.velocity_actual) >= 1 for tx in self.tx):
+        if not all(self._at_rest(i) for i in range(len(self.tx))):
             return
         ch.planner.reset_position(dict(zip(self.axes, self.actual.tolist())))
         self._braking = False
@@ -426,11 +436,16 @@ class BenchRunner:
             self.trace.write(self._row())  # the failed cycle's row: one row per cycle, alarm included
             self._row_cycle = self.cycle
 
+    def _at_rest(self, i: int) -> bool:
+        """Drive i stands: feedback unchanged for REST_CYCLES and, while it follows the NC's
+        setpoint, no following error left (a drive braking on its own quick stop has none to meet)."""
+        return self._rest[i] >= REST_CYCLES and (self.tx[i].following_error == 0 or not self.masters[i].enabled)
+
     def _settle(self) -> None:
         """Keep cycling on the final setpoints until the axes stand still (or the settle time ends)."""
         for _ in range(int(self.bench.settle_time / self.bench.cycle)):
             self._exchange()
-            still = all(abs(tx.velocity_actual) < 1 and abs(tx.following_error) <= 1 for tx in self.tx[: len(self.axes)])
+            still = all(self._at_rest(i) for i in range(len(self.axes)))
             if still:
                 break
 
@@ -445,8 +460,7 @@ class BenchRunner:
         gone = max(1, int(FROZEN_S / self.bench.cycle))
         last = [(tx.position_actual, tx.velocity_actual) for tx in self.tx]
         for _ in range(int(STANDSTILL_TIMEOUT / self.bench.cycle)):
-            if all(abs(tx.velocity_actual) < 1 or frozen[i] >= gone
-                   for i, tx in enumerate(self.tx)):
+            if all(self._at_rest(i) or frozen[i] >= gone for i in range(len(self.tx))):
                 return
             self._exchange()
             for i, tx in enumerate(self.tx):
