@@ -62,6 +62,20 @@ def jagged_polyline(n: int = 300, seed: int = 1) -> list[np.ndarray]:
     return pts
 
 
+def polyline_deviation(positions: np.ndarray, pts) -> float:
+    """Largest distance of any setpoint from the programmed polyline `pts` (mm)."""
+    P = np.asarray(positions, float)
+    pts = np.asarray(pts, float)
+    A, D = pts[:-1], np.diff(pts, axis=0)
+    L2 = np.maximum((D * D).sum(1), 1e-30)
+    out = 0.0
+    for k in range(0, len(P), 500):
+        Q = P[k:k + 500][:, None, :]
+        t = np.clip(((Q - A) * D).sum(2) / L2, 0.0, 1.0)
+        out = max(out, float(np.sqrt((((A + t[..., None] * D) - Q) ** 2).sum(2)).min(1).max()))
+    return out
+
+
 TOL = 1.0 + 1e-6
 
 

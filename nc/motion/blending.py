@@ -1,13 +1,13 @@
 """Corner speeds under the post-interpolation filter (nc.motion.smoothing).
 
-With the filter, a tangent jump Δu crossed at speed v is a velocity step v·Δu_i on each axis,
-which the two moving averages (T1, T2) turn into an acceleration ≤ v·Δu_i/T1 and a jerk
-≤ v·Δu_i/(T1·T2). Junctions that follow each other closely add up inside the filter windows, so
-the limit is on sums: over any stretch the path covers in T1 (acceleration) or T1+T2 (jerk),
-    max speed there · Σ|Δu_i| ≤ share_corner · a_i · T1     and     ≤ share_corner · j_i · T1 · T2.
-The filter also rounds the corner: the output passes the corner point at a distance of
-about v·|Σ Δu|·(T1+T2)/8 (the kernel's mean |t| is at most (T1+T2)/4), which must stay within the
-G64 path tolerance.
+With the filter, a tangent jump Δu crossed at speed v is a velocity step v·Δu_i on each axis. The
+two moving averages (T1 ≥ T2 window lengths) turn the steps into an acceleration
+v·S_i(T1 window)/T1 and a jerk v·(S_i(T1 window) − S_i(the T1 window T2 earlier))/(T1·T2), S_i the
+*signed* sum of the steps inside (issue 18): zig-zags from rounded coordinates cancel there, and on
+a curve consecutive windows hold nearly the same sum. The caps are found first from the unsigned
+sums (safe, cheap: the search for the stretch below), then raised to what the signed window sums
+allow at the speed the windows are crossed (`_refine`). The deviation from the path is the kernel
+model of nc.motion.deviation, evaluated per junction (`_tolerance`).
 
 Every new junction J caps the junctions within one window behind it (J included) by
 budget / (sum over that stretch). For any time window W, the fastest junction m of W lies within
@@ -22,6 +22,9 @@ from collections import deque
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
+import numpy as np
+
+from nc.motion.deviation import KernelDeviation
 from nc.motion.limits import MotionConfig
 
 if TYPE_CHECKING:
@@ -56,7 +59,7 @@ class FilterCorners:
         self.budget_a = tuple(sc * a * t1 for a in acc)
         self.budget_j = tuple(sc * j * t1 * t2 for j in jerk)
         self.tol = cfg.path_tolerance
-        self.dev = (t1 + t2) / 8.0  # corner deviation per unit of v·|ΣΔu|
+        self.kd = KernelDeviation(n1, n2, cfg.cycle)
         self.t2sum = t1 * t1 + t2 * t2
         # One window of T1+T2 for both sums: a T1 window lies inside it.
         self.budget = tuple(min(ba, bj) for ba, bj in zip(self.budget_a, self.budget_j))
@@ -82,28 +85,22 @@ class FilterCorners:
 
     def corner(self, du: Sequence[float], acc: float) -> float:
         """Speed cap of one isolated tangent jump (|Δu| per axis) between blocks whose path
-        acceleration reaches `acc`."""
+        acceleration reaches `acc`: the acceleration and jerk budgets. The path tolerance is the
+        deviation model's (`_tolerance`), except that a corner whose braking alone cuts it by
+        more than the tolerance is an exact stop."""
         v = math.inf
         for d, ba, bj in zip(du, self.budget_a, self.budget_j):
             if d > 1e-12:
                 v = min(v, ba / d, bj / d)
-        if self.tol is not None:
-            n = math.sqrt(sum(d * d for d in du))
-            if n > 1e-12:
-                v = min(v, self.tolerance_cap(n, n, acc))
+        if self.tol is not None and self.braking(math.sqrt(sum(d * d for d in du)), acc) >= self.tol:
+            return 0.0
         return v
 
-    def tolerance_cap(self, du_n: float, sum_n: float, acc: float) -> float:
-        """Highest corner speed whose rounding stays within the tolerance. Braking into and
-        speeding out of the corner inside the filter window cuts it too, by about
-        |Δu|·a·(T1²+T2²)/192 (measured on 90° corners: 1/240); when that alone exceeds the
+    def braking(self, du_n: float, acc: float) -> float:
+        """How far braking into and speeding out of a corner inside the filter window cuts it:
+        about |Δu|·a·(T1²+T2²)/192 (measured on 90° corners: 1/240). When that alone exceeds the
         tolerance the corner is an exact stop (0), which the filter then passes exactly."""
-        floor = du_n * acc * self.t2sum / 192.0
-        if floor >= self.tol:
-            return 0.0
-        if sum_n <= 1e-12:
-            return math.inf
-        return (self.tol - floor) / (self.dev * sum_n)
+        return du_n * acc * self.t2sum / 192.0
 
     def arc_speed(self, radius: float) -> float:
         """Highest speed on an arc whose filtered radius shrinks by no more than the tolerance.
@@ -137,6 +134,7 @@ class FilterCorners:
         if len(blocks) < 2:
             return 0
         j_new = blocks[-2]
+        j_new.vbase = j_new.vjunc
         hist = self._hist
         if j_new.du is None:
             # A stop: the planner waits there for the filter to settle, so no window holds
@@ -152,6 +150,8 @@ class FilterCorners:
         else:
             cum_j = tuple(p + d for p, d in zip(prev, du + (j_new.du_n,)))
         j_new.cum = cum_j
+        sprev = hist[-1].scum if last > h0 else self._zero
+        j_new.scum = sj = tuple(p + d for p, d in zip(sprev, j_new.dv))
         hist.append(j_new)
         s_j = j_new.s_end
         span_max = self.span_max
@@ -161,6 +161,7 @@ class FilterCorners:
             del hist[:h0]
             self._seq0 += h0
             self._m -= h0
+            last -= h0  # J's index, and its sequence number seq0 + last, stay the same
             h0 = 0
         self._h0 = h0
         # The search starts where the previous junction's ended; the maxima of tangential
@@ -182,35 +183,41 @@ class FilterCorners:
         pad = 0.5 * acc_q[0][1] * t_w2
         two_al = 2.0 * acc_q[0][1] * len_q[0][1]
         v_hi = top_q[0][1]
-        budget = self.budget
+        budget_a, budget_j = self.budget_a, self.budget_j
         axes = self._axes
-        tol = self.tol
         zero = self._zero
-        if tol is not None:
-            acc = tail.a if tail.a > j_new.a else j_new.a
-            room = tol - j_new.du_n * acc * self.t2sum / 192.0  # after J's own braking term
-            dev = self.dev
+        rng = range(axes)
 
         def cap(m: int) -> float:
-            """Cap from the junctions hist[m..last] (inf when there are none)."""
+            """Cap from the junctions hist[m..last] (inf when there are none): per axis, the
+            acceleration budget over the largest signed sum of any run of them that ends at J,
+            the jerk budget over the smaller of their unsigned sum and twice that."""
             if m > last:
                 return math.inf
             base = hist[m - 1].cum if m > h0 else zero
+            smax = [0.0] * axes
+            for k in range(m - 1, last):
+                pk = hist[k].scum if k >= h0 and k >= m - 1 and (k > m - 1 or m > h0) else zero
+                for i in rng:
+                    d = sj[i] - pk[i]
+                    if d < 0.0:
+                        d = -d
+                    if d > smax[i]:
+                        smax[i] = d
             c = math.inf
-            for i in range(axes):
+            for i in rng:
                 si = cum_j[i] - base[i]
                 if si > 1e-12:
-                    x = budget[i] / si
-                    if x < c:
-                        c = x
-            if tol is not None:
-                if room <= 0.0:
-                    return 0.0
-                sn = cum_j[axes] - base[axes]
-                if sn > 1e-12:
-                    x = room / (dev * sn)
-                    if x < c:
-                        c = x
+                    sg = smax[i]
+                    ja = si if si < 2.0 * sg else 2.0 * sg
+                    if ja > 1e-12:
+                        x = budget_j[i] / ja
+                        if x < c:
+                            c = x
+                    if sg > 1e-12:
+                        x = budget_a[i] / sg
+                        if x < c:
+                            c = x
             return c
 
         def taken(k: int) -> bool:
@@ -249,9 +256,18 @@ class FilterCorners:
                 _drop_before(q, self._seq0 + m)
         self._m = m
         c = cap(m)
+        if c < top:
+            # The sums over the whole stretch bound the filter's acceleration and jerk from
+            # above; the windows themselves (at the speed they are crossed) are far less on a
+            # curve, where consecutive windows hold nearly the same signed sum.
+            c2 = self._refine(hist, h0, last, sj, c, top)
+            if c2 > c:
+                c = c2
+                while m > h0 and s_j - hist[m - 1].s_end <= c * t_w + pad:
+                    m -= 1
+        depth = self._tolerance(blocks) if self.tol is not None else 0
         if c >= top_q[0][1]:
-            return 0  # no junction of the stretch can run as fast as this cap
-        depth = 0
+            return depth  # no junction of the stretch can run as fast as this cap
         k = 2
         idx = last
         it = reversed(blocks)
@@ -259,12 +275,116 @@ class FilterCorners:
         for b in it:
             if idx < m:
                 break
-            if b.vjunc > c:
-                b.vjunc = c
-                # Lowering a junction below its planned speed needs a new backward pass down to
-                # it; above it nothing changes (float noise included).
-                if c < b.vend * (1.0 - 1e-9):
-                    depth = k
+            if b.vbase > c:
+                b.vbase = c
+                if b.vjunc > c:
+                    b.vjunc = c
+                    # Lowering a junction below its planned speed needs a new backward pass down
+                    # to it; above it nothing changes (float noise included).
+                    if c < b.vend * (1.0 - 1e-9) and k > depth:
+                        depth = k
             k += 1
             idx -= 1
+        return depth
+
+    def _refine(self, hist: list["Block"], h0: int, last: int, sj: tuple[float, ...], c: float,
+                top: float) -> float:
+        """The highest speed ≤ top (above the safe cap c, else c) at which every filter window
+        whose last junction is J meets the budgets, the windows taken at that speed: per axis
+        the acceleration c·|S(T1 window)|/T1 and the jerk c·|S(T1) − S(T1 one T2 earlier)|/(T1·T2),
+        S the signed sum of Δu (the two moving averages' derivatives, exactly, at constant speed)."""
+        t1, t2 = self.t_a, self.t_j - self.t_a
+        s_j = hist[last].s_end
+        lo = last
+        reach = top * self.t_j * 2.0
+        while lo > h0 and s_j - hist[lo - 1].s_end <= reach:
+            lo -= 1
+        seg = hist[lo:last + 1]
+        s = np.fromiter((b.s_end for b in seg), float, len(seg))
+        p0 = hist[lo - 1].scum if lo > h0 else self._zero[:self._axes]
+        pre = np.vstack([np.array(p0[:self._axes], float)[None, :], np.array([b.scum for b in seg], float)])
+        ba = np.array(self.budget_a)
+        bj = np.array(self.budget_j)
+
+        def sums(v: float) -> tuple[np.ndarray, np.ndarray]:
+            w1, w2 = v * t1, v * t2
+            ev = np.concatenate(([s_j], s + w1, s + w1 - 1e-9, s + w1 + w2, s + w1 + w2 - 1e-9))
+            ev = ev[(ev >= s_j) & (ev <= s_j + w1 + w2)]
+
+            def at(x: np.ndarray) -> np.ndarray:
+                return pre[np.searchsorted(s, x, side="right")]
+            mid = at(ev - w1)
+            a = at(ev) - mid
+            b = mid - at(ev - w1 - w2)
+            return np.abs(a).max(axis=0), np.abs(a - b).max(axis=0)
+
+        def cap_at(v: float) -> float:
+            sa, sd = sums(v)
+            with np.errstate(divide="ignore"):
+                x = min(float(np.min(np.where(sa > 1e-12, ba / sa, math.inf))),
+                        float(np.min(np.where(sd > 1e-12, bj / sd, math.inf))))
+            return x
+
+        best = c
+        v = min(cap_at(c), top)
+        for _ in range(3):
+            if v <= best * (1.0 + 1e-6):
+                break
+            nxt = cap_at(v)
+            if nxt >= v * (1.0 - 1e-9):  # v meets the budgets with its own windows
+                best = v
+                v = min(nxt, top)
+            else:
+                v = 0.5 * (best + v)
+        return best
+
+    def _tolerance(self, blocks: Sequence["Block"]) -> int:
+        """Evaluate the deviation model (nc.motion.deviation) at the junctions within half a
+        window (at the fastest speed nearby) behind the newest one J, with every junction known
+        around them, and give each junction the least speed evaluated at any junction whose
+        window holds it. Junctions further back keep what they had: their windows were complete
+        before J came. Returns how many blocks from the tail need a new backward pass."""
+        hist, h0 = self._hist, self._h0
+        last = len(hist) - 1
+        s_j = hist[last].s_end
+        half = self.kd.half
+        vt = blocks[-1].vtop
+        lo = last
+        while lo > h0:
+            b = hist[lo - 1]
+            if b.vtop > vt:
+                vt = b.vtop
+            if s_j - b.s_end > 3.0 * vt * half:
+                break
+            lo -= 1
+        h = vt * half
+        seg = hist[lo:]
+        s = np.fromiter((b.s_end for b in seg), float, len(seg))
+        du = np.array([b.dv for b in seg], dtype=float)
+        ev = np.nonzero(s >= s_j - h - 1e-12)[0]
+        room = np.empty(len(ev))
+        for r, i in enumerate(ev):
+            b = seg[i]
+            nx = seg[i + 1] if i + 1 < len(seg) else blocks[-1]
+            room[r] = self.tol - self.braking(b.du_n, b.a if b.a > nx.a else nx.a)
+        near = s >= s_j - 2.0 * h - 1e-12
+        caps = self.kd.caps(s[ev], room, vt, s[near], du[near])
+        for r, i in enumerate(ev):
+            seg[i].ctol = float(caps[r])
+        ctol = np.fromiter((b.ctol for b in seg), float, len(seg))
+        reach = np.minimum(ctol, vt) * half + 1e-12
+        upd = np.nonzero(near)[0]
+        held = np.abs(s[upd][:, None] - s[None, :]) <= reach[None, :]
+        vtol = np.where(held, ctol[None, :], math.inf).min(axis=1)
+        depth = 0
+        n = len(blocks)
+        for r, i in enumerate(upd):
+            b = seg[i]
+            b.vtol = float(vtol[r])
+            k = len(seg) - i + 1  # seg[-1] is blocks[-2]
+            v = b.vbase if b.vbase < b.vtol else b.vtol
+            if k <= n and abs(v - b.vjunc) > 1e-9 * max(v, 1.0):
+                b.vjunc = v
+                if k > depth:
+                    depth = k
         return depth

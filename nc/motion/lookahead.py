@@ -56,6 +56,16 @@ class Block:
     du_n: float = 0.0
     cum: tuple[float, ...] = ()  # running Σ|Δu| per axis and Σ|Δu| norms up to this junction
     vtop: float = 0.0  # the fastest this block can ever run (feed × the top override, or its geometric cap)
+    # Path tolerance under the filter (nc.motion.deviation): the signed tangent step at the end
+    # junction, the junction speed without the tolerance, the speed the deviation model allows
+    # when evaluated at this junction, and the least of those of the junctions whose window
+    # holds this one (vjunc = min(vbase, vtol); vtol is replaced, not only lowered, as the
+    # windows fill).
+    dv: tuple[float, ...] = ()
+    scum: tuple[float, ...] = ()  # running signed Σ Δu per axis up to this junction
+    vbase: float = math.inf
+    ctol: float = math.inf
+    vtol: float = math.inf
 
 
 def change_distance(v0: float, v1: float, a: float, j: float) -> float:
@@ -150,9 +160,11 @@ class Limits:
         s1, s2 = b1.seg, b2.seg
         assert s1 is not None and s2 is not None
         v = min(b1.cap_hard, b2.cap_hard)
-        du = [abs(p - q) for p, q in zip(s2.tangent(False), s1.tangent(True))]
+        dv = [p - q for p, q in zip(s2.tangent(False), s1.tangent(True))]
+        du = [abs(d) for d in dv]
         cfg = self.cfg
         if self.blend is not None:
+            b1.dv = tuple(dv)
             b1.du = tuple(du)
             b1.du_n = math.sqrt(sum(d * d for d in du))
             if b1.du_n > 1e-9:

@@ -1,0 +1,56 @@
+"""Issue 18: dense CAM paths at programmed feed on benches/mill-3axis.toml (N1.036 = N1.037 = 16 ms,
+N1.053 = 0.02 mm), in simulated time: program time against the feed-limited bound (LinuxCNC's
+times for the same programs are in benchmarks/bench_vs_linuxcnc.py and docs/performance/motion.md),
+deviation from the programmed polyline within N1.053, every cycle within the axis limits."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from benchmarks.bench_vs_linuxcnc import START, Program, cam_polyline, chord_circle
+from hil.bench_file import load_bench_file
+from nc.motion.offline import Stream, run
+from nc.moves import Move
+from tests.motion_helpers import TOL, polyline_deviation, worst_ratio
+
+BENCH = Path(__file__).resolve().parent.parent / "benches" / "mill-3axis.toml"
+
+
+def moves(prog: Program) -> list[Move]:
+    pts = [START] + prog.points
+    return [Move("line", k, "", dict(zip("XYZ", pts[k - 1])), dict(zip("XYZ", pts[k])), dict(zip("XYZ", pts[k])),
+                 feed=prog.feed, plane=("X", "Y")) for k in range(1, len(pts))]
+
+
+def cut(prog: Program) -> tuple[Stream, float]:
+    """Run offline with the bench's motion settings; returns the stream and its time over the
+    feed-limited bound, after asserting the limits and the tolerance."""
+    cfg = load_bench_file(BENCH).motion_config()
+    st = run(moves(prog), cfg, dict(zip("XYZ", START)))
+    assert st.state.value == "finished" and not st.alarms
+    r = worst_ratio(st, cfg)
+    assert r["v"] <= TOL and r["a"] <= TOL and r["j"] <= TOL, r
+    assert polyline_deviation(st.positions, [START] + prog.points) <= cfg.path_tolerance + 1e-9
+    return st, st.time / prog.feed_limited()
+
+
+@pytest.mark.parametrize("radius, bound", [(10.0, 1.17), (2.0, 2.2)])
+def test_chord_circle_keeps_its_feed_within_the_tolerance(radius, bound):
+    """0.05 mm chords at F3000 with a lead-in. LinuxCNC 2.9 (G64 P0.02, no jerk limit): r10 1.483 s
+    = 1.018× the bound. Before issue 18: 3.98 s (2.73×) on r10, 1.63 s (5.6×) on r2."""
+    st, ratio = cut(chord_circle(radius))
+    assert ratio <= bound, ratio
+    # on the circle itself (the second half: past the lead-in's corner) the feed holds
+    v = np.linalg.norm(np.diff(st.positions, axis=0), axis=1) / st.cycle
+    half = v[len(v) // 2: -len(v) // 8]
+    if radius >= 5.0:
+        assert np.median(half) >= 0.98 * 50.0
+
+
+def test_cam_polyline_with_15_degree_corners():
+    """A 3-D polyline of 400 segments of about 0.78 mm turning about 15° at each (F2500)."""
+    _, ratio = cut(cam_polyline(400))
+    assert ratio <= 1.55, ratio
