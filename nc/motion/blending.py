@@ -17,6 +17,7 @@ one window behind W's last junction, whose cap was computed over a sum that hold
 
 from __future__ import annotations
 
+import bisect
 import math
 from collections import deque
 from collections.abc import Sequence
@@ -29,6 +30,10 @@ from nc.motion.limits import MotionConfig
 
 if TYPE_CHECKING:
     from nc.motion.lookahead import Block
+
+
+def _s_end(b: "Block") -> float:
+    return b.s_end
 
 
 def _push_max(q: deque[tuple[int, float]], seq: int, value: float) -> None:
@@ -73,12 +78,14 @@ class FilterCorners:
         vmax = math.sqrt(sum(cfg.limit(a).max_velocity ** 2 for a in cfg.axes))
         amax = math.sqrt(sum(cfg.limit(a).max_acceleration ** 2 for a in cfg.axes))
         self.span_max = vmax * self.t_j + amax * self.t_j ** 2
+        self.amax = amax
 
     def _clear(self) -> None:
         self._hist.clear()
         self._h0 = 0  # first entry of _hist still within reach of a window
         self._m = 0  # where the last search for the first junction taken ended
         self._seq0 = 0  # junctions dropped from the front of _hist so far
+        self._lim_s = -math.inf  # path position of the newest junction the tolerance limits
         # Sliding maxima over _hist[_m:] as (sequence number, value) of the blocks' tangential
         # acceleration, vtop and length.
         self._maxima: tuple[deque[tuple[int, float]], ...] = (deque(), deque(), deque())
@@ -195,6 +202,15 @@ class FilterCorners:
             if m > last:
                 return math.inf
             base = hist[m - 1].cum if m > h0 else zero
+            c = math.inf  # first from the unsigned sums: a lower bound of the signed cap
+            for i in rng:
+                si = cum_j[i] - base[i]
+                if si > 1e-12:
+                    x = (budget_a[i] if budget_a[i] < budget_j[i] else budget_j[i]) / si
+                    if x < c:
+                        c = x
+            if c >= v_hi:
+                return c  # no junction of the stretch runs as fast: the signed sums change nothing
             smax = [0.0] * axes
             for k in range(m - 1, last):
                 pk = hist[k].scum if k >= h0 and k >= m - 1 and (k > m - 1 or m > h0) else zero
@@ -260,12 +276,12 @@ class FilterCorners:
             # The sums over the whole stretch bound the filter's acceleration and jerk from
             # above; the windows themselves (at the speed they are crossed) are far less on a
             # curve, where consecutive windows hold nearly the same signed sum.
-            c2 = self._refine(hist, h0, last, sj, c, top)
+            c2 = self._refine(hist, h0, last, c, top)
             if c2 > c:
                 c = c2
                 while m > h0 and s_j - hist[m - 1].s_end <= c * t_w + pad:
                     m -= 1
-        depth = self._tolerance(blocks) if self.tol is not None else 0
+        depth = self._tolerance(blocks, v_hi) if self.tol is not None else 0
         if c >= top_q[0][1]:
             return depth  # no junction of the stretch can run as fast as this cap
         k = 2
@@ -287,12 +303,12 @@ class FilterCorners:
             idx -= 1
         return depth
 
-    def _refine(self, hist: list["Block"], h0: int, last: int, sj: tuple[float, ...], c: float,
-                top: float) -> float:
+    def _refine(self, hist: list["Block"], h0: int, last: int, c: float, top: float) -> float:
         """The highest speed ≤ top (above the safe cap c, else c) at which every filter window
         whose last junction is J meets the budgets, the windows taken at that speed: per axis
-        the acceleration c·|S(T1 window)|/T1 and the jerk c·|S(T1) − S(T1 one T2 earlier)|/(T1·T2),
-        S the signed sum of Δu (the two moving averages' derivatives, exactly, at constant speed)."""
+        the acceleration |Σ v_i·Δu_i|/T1 over a T1 window and the jerk over the difference of two
+        such windows T2 apart, divided by T1·T2 (the two moving averages' derivatives, exactly, at
+        constant speed), v_i the least of v and the junction's cap so far (vbase only ever falls)."""
         t1, t2 = self.t_a, self.t_j - self.t_a
         s_j = hist[last].s_end
         lo = last
@@ -301,12 +317,16 @@ class FilterCorners:
             lo -= 1
         seg = hist[lo:last + 1]
         s = np.fromiter((b.s_end for b in seg), float, len(seg))
-        p0 = hist[lo - 1].scum if lo > h0 else self._zero[:self._axes]
-        pre = np.vstack([np.array(p0[:self._axes], float)[None, :], np.array([b.scum for b in seg], float)])
+        du = np.array([b.dv for b in seg], dtype=float)
+        # A junction's velocity step is its own speed times Δu: no more than the cap it already
+        # has (vbase only ever falls), nor than the speed the windows are taken at.
+        vb = np.fromiter((b.vbase for b in seg), float, len(seg))
         ba = np.array(self.budget_a)
         bj = np.array(self.budget_j)
 
         def sums(v: float) -> tuple[np.ndarray, np.ndarray]:
+            """Largest |Σ v_i·Δu_i| per axis over T1 windows, and over their differences."""
+            pre = np.vstack([np.zeros((1, du.shape[1])), np.cumsum(np.minimum(vb, v)[:, None] * du, axis=0)])
             w1, w2 = v * t1, v * t2
             ev = np.concatenate(([s_j], s + w1, s + w1 - 1e-9, s + w1 + w2, s + w1 + w2 - 1e-9))
             ev = ev[(ev >= s_j) & (ev <= s_j + w1 + w2)]
@@ -319,11 +339,11 @@ class FilterCorners:
             return np.abs(a).max(axis=0), np.abs(a - b).max(axis=0)
 
         def cap_at(v: float) -> float:
+            """v scaled to the budgets (≥ v: v meets them with its own windows)."""
             sa, sd = sums(v)
             with np.errstate(divide="ignore"):
-                x = min(float(np.min(np.where(sa > 1e-12, ba / sa, math.inf))),
-                        float(np.min(np.where(sd > 1e-12, bj / sd, math.inf))))
-            return x
+                return v * min(float(np.min(np.where(sa > 1e-12, ba / sa, math.inf))),
+                               float(np.min(np.where(sd > 1e-12, bj / sd, math.inf))))
 
         best = c
         v = min(cap_at(c), top)
@@ -338,7 +358,7 @@ class FilterCorners:
                 v = 0.5 * (best + v)
         return best
 
-    def _tolerance(self, blocks: Sequence["Block"]) -> int:
+    def _tolerance(self, blocks: Sequence["Block"], v_hi: float) -> int:
         """Evaluate the deviation model (nc.motion.deviation) at the junctions within half a
         window (at the fastest speed nearby) behind the newest one J, with every junction known
         around them, and give each junction the least speed evaluated at any junction whose
@@ -348,7 +368,18 @@ class FilterCorners:
         last = len(hist) - 1
         s_j = hist[last].s_end
         half = self.kd.half
-        vt = blocks[-1].vtop
+        vt = v_hi if v_hi > blocks[-1].vtop else blocks[-1].vtop
+        h = vt * half
+        # Cheap first: with G ≤ G(0) and unsigned steps, the deviation anywhere near J is at most
+        # vt·G(0)·Σ|Δu| plus a braking term; within the tolerance and with no junction limited
+        # within reach (whose caps would have to be lifted), nothing near J changes: the common
+        # case on gentle curves, O(log n).
+        if self._lim_s < s_j - 3.0 * h:
+            k = bisect.bisect_left(hist, s_j - 2.0 * h - 1e-12, h0, last + 1, key=_s_end)
+            axes = self._axes
+            sum_n = hist[last].cum[axes] - (hist[k - 1].cum[axes] if k > h0 else 0.0)
+            if vt * self.kd.g0 * sum_n + self.braking(sum_n, self.amax) <= self.tol:
+                return 0
         lo = last
         while lo > h0:
             b = hist[lo - 1]
@@ -371,6 +402,8 @@ class FilterCorners:
         caps = self.kd.caps(s[ev], room, vt, s[near], du[near])
         for r, i in enumerate(ev):
             seg[i].ctol = float(caps[r])
+            if caps[r] < vt * (1.0 - 1e-9) and seg[i].s_end > self._lim_s:
+                self._lim_s = seg[i].s_end
         ctol = np.fromiter((b.ctol for b in seg), float, len(seg))
         reach = np.minimum(ctol, vt) * half + 1e-12
         upd = np.nonzero(near)[0]
