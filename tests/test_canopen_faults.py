@@ -118,6 +118,11 @@ def test_a_drive_that_cannot_map_an_object_aborts_the_mapping_write():
         from canopen.sdo.exceptions import SdoAbortedError
 
         with pytest.raises(SdoAbortedError) as exc:
+            sdo[0x1600][1].raw = 0x60400010  # the PDO is valid: its mapping cannot change (CiA 301)
+        assert exc.value.code == 0x06010000
+        sdo[0x1400][1].raw = sdo[0x1400][1].raw | 0x80000000  # invalidate the RPDO, then clear sub 0
+        sdo[0x1600][0].raw = 0
+        with pytest.raises(SdoAbortedError) as exc:
             sdo[0x1600][1].raw = 0x60650020  # 0x6065 following error window: not mappable
         assert exc.value.code == 0x06040041
     finally:

@@ -28,6 +28,8 @@ from virtual_bus.servo_params import ServoParamError, ServoParams, coe_objects
 
 log = logging.getLogger("virtual_bus.canopen")
 
+ABORT_COMMAND = 0x05040001  # client command specifier not valid or unknown (block transfers)
+ABORT_UNSUPPORTED_ACCESS = 0x06010000
 ABORT_NOT_MAPPABLE = 0x06040041
 ABORT_PDO_LENGTH = 0x06040042
 ABORT_VALUE_RANGE = 0x06090030
@@ -48,6 +50,7 @@ class Cia402Slave:
         self.node = canopen.LocalNode(node_id, canopen.import_od(eds, node_id))
         self.drive = drive
         self.rx = RxPdo(mode=drive.mode)
+        self._power_on_mode = drive.mode
         # Fault injection: (index, subindex) → SDO abort code the firmware answers a write with.
         self.reject_writes = dict(reject_writes or {})
         self.alive = True
@@ -76,6 +79,9 @@ class Cia402Slave:
         """Join the bus and power up: boot-up message, then PRE-OPERATIONAL (CiA 301)."""
         self.network = network
         network.add_node(self.node)
+        # SDO requests pass our gate first: none in STOPPED, block transfers aborted (CiA 301)
+        network.unsubscribe(self.node.sdo.rx_cobid, self.node.sdo.on_request)
+        network.subscribe(self.node.sdo.rx_cobid, self._on_sdo)
         network.subscribe(0, self._after_nmt)  # after the NmtSlave's own handler
         self.node.nmt.send_command(0x82)  # INITIALISING: sends the boot-up
         self.node.nmt.send_command(0x80)  # PRE-OPERATIONAL: starts the heartbeat from 0x1017
@@ -86,6 +92,8 @@ class Cia402Slave:
         self.node.nmt.stop_heartbeat()
         if self.network is not None:
             self.network.unsubscribe(0, self._after_nmt)
+            self.network.unsubscribe(self.node.sdo.rx_cobid, self._on_sdo)
+            self.network.subscribe(self.node.sdo.rx_cobid, self.node.sdo.on_request)  # remove_network takes it off
             for cob in self._rpdos:
                 self.network.unsubscribe(cob, self._on_rpdo)
             self.node.remove_network()
@@ -93,6 +101,32 @@ class Cia402Slave:
     @property
     def nmt_state(self) -> str:
         return self.node.nmt.state
+
+    def _on_sdo(self, can_id: int, data: bytes, timestamp: float) -> None:
+        """CiA 301: the SDO server is not available in STOPPED (no answer at all); this node does
+        not do block transfers, so their initiate requests abort with 0x05040001."""
+        if not self.alive or self.node.nmt.state == "STOPPED" or not data:
+            return
+        if data[0] >> 5 in (5, 6) and len(data) >= 4 and self.network is not None:
+            index, sub = struct.unpack_from("<HB", data, 1)
+            self.network.send_message(self.node.sdo.tx_cobid, struct.pack("<BHBI", 0x80, index, sub, ABORT_COMMAND))
+            return
+        self.node.sdo.on_request(can_id, data, timestamp)
+
+    def _power_on_profile(self) -> None:
+        """NMT Reset Node: the application restarts with its power-on values: the CiA 402 objects
+        from the EDS, the drive out of any fault (a persisting cause faults it again), no RPDO data."""
+        for index in [i for i in self.node.data_store if 0x6000 <= i <= 0x9FFF]:
+            del self.node.data_store[index]
+        d = self.drive
+        d.external_fault = 0
+        d.error_code = 0
+        d.state = State.SWITCH_ON_DISABLED
+        d.mode = self._power_on_mode
+        self.rx = RxPdo(mode=d.mode)
+        d.apply(copy.copy(self.rx))
+        self._emcy_queue.clear()
+        self._fault_reported = 0
 
     def _after_nmt(self, can_id: int, data: bytes, timestamp: float) -> None:
         cmd, target = struct.unpack_from("BB", data)
@@ -103,7 +137,7 @@ class Cia402Slave:
             for index in [i for i in self.node.data_store if 0x1000 <= i <= 0x1FFF]:
                 del self.node.data_store[index]
             if cmd == 0x81:
-                self.drive.external_fault = 0
+                self._power_on_profile()
             self.node.nmt.stop_heartbeat()
             self._dirty = True
             self.node.nmt.send_command(0x82)  # boot-up
@@ -147,6 +181,10 @@ class Cia402Slave:
             self._check_mapping_write(index, subindex, od.decode_raw(data))
             self._dirty = True
             return
+        if index == 0x6060:  # CiA 402: only the modes 0x6502 advertises (0 = no mode)
+            mode, supported = od.decode_raw(data), self._value(0x6502, 0)
+            if mode != 0 and not (1 <= mode <= 32 and supported >> (mode - 1) & 1):
+                raise SdoAbortedError(ABORT_VALUE_RANGE)
         attr = OBJECT_ATTRS.get((index, subindex))
         if attr is not None and index in _RX_OBJECTS:
             setattr(self.rx, attr, od.decode_raw(data))
@@ -154,6 +192,14 @@ class Cia402Slave:
                 self.drive.apply(copy.copy(self.rx))  # acyclic (SDO) device control acts at once
 
     def _check_mapping_write(self, index: int, subindex: int, value: int) -> None:
+        if index & 0xFF00 in (0x1600, 0x1A00):
+            # CiA 301 7.5.2.36/38: a mapping changes only while its PDO is invalid (COB-ID bit 31 set)
+            # and, for the entries, while sub 0 is 0; sub 0 never above the entries the object has.
+            com = (0x1400 if index & 0xFF00 == 0x1600 else 0x1800) + (index & 0xFF)
+            if not self._value(com, 1) & 0x80000000 or (subindex >= 1 and self._value(index, 0)):
+                raise SdoAbortedError(ABORT_UNSUPPORTED_ACCESS)
+            if subindex == 0 and value > max(self.node.object_dictionary[index].subindices):
+                raise SdoAbortedError(ABORT_PDO_LENGTH)
         if index & 0xFF00 in (0x1600, 0x1A00) and subindex >= 1 and value:
             obj, sub, bits = value >> 16, (value >> 8) & 0xFF, value & 0xFF
             rx = index & 0xFF00 == 0x1600

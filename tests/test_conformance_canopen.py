@@ -1,0 +1,133 @@
+"""Conformance of the simulated CANopen CiA 402 node (issue 23), checked by plain python-canopen clients
+(none of hil's master code) on python-can's in-process `virtual` bus; SIGTERM across processes inside a
+network namespace. Expectations cite CiA 301 (NMT, SDO, PDO mapping), CiA 402 (0x6060/0x6502) and
+python-canopen's BaseNode402, never our implementation."""
+
+from __future__ import annotations
+
+import struct
+import subprocess
+import uuid
+
+import canopen
+import pytest
+from canopen.sdo.exceptions import SdoAbortedError, SdoCommunicationError
+
+from fieldbus.canopen.objects import ASDA_B3_EDS
+from hil.bench import default_lathe
+from hil.session import sim_slaves
+from tests.test_canopen_process import _in_ns, netns  # noqa: F401  (fixture)
+from tests.conftest import ROOT
+from virtual_bus.canopen.nodes import serve
+
+
+@pytest.fixture
+def bus():
+    """The built-in lathe's drives as nodes 1-3, and a python-canopen client on the same virtual channel."""
+    channel = f"conf-{uuid.uuid4().hex[:8]}"
+    slaves = serve(sim_slaves(default_lathe()), "virtual", channel)
+    net = canopen.Network()
+    net.connect(interface="virtual", channel=channel, receive_own_messages=False)
+    node = canopen.BaseNode402(1, str(ASDA_B3_EDS))
+    net.add_node(node)
+    node.sdo.RESPONSE_TIMEOUT = 0.3
+    node.sdo.MAX_RETRIES = 1  # one try (0 would retry for ever in python-canopen 2.4)
+    try:
+        yield slaves, net, node
+    finally:
+        net.disconnect()
+        slaves.close()
+
+
+def abort_of(fn) -> int:
+    with pytest.raises(SdoAbortedError) as exc:
+        fn()
+    return exc.value.code
+
+
+def test_no_sdo_in_stopped(bus):
+    """CiA 301 7.3.2.2.3: in STOPPED only NMT (and heartbeat) is served; the SDO gets no answer."""
+    slaves, net, node = bus
+    assert node.sdo[0x1000].raw & 0xFFFF == 402
+    node.nmt.send_command(0x02)  # stop
+    with pytest.raises(SdoCommunicationError):
+        node.sdo[0x1000].raw
+    node.nmt.send_command(0x80)  # enter pre-operational
+    assert node.sdo[0x1000].raw & 0xFFFF == 402
+
+
+def test_block_upload_is_aborted(bus):
+    """CiA 301 7.2.4.3.17: a server without block transfer aborts with 0x05040001 (command specifier)."""
+    _, _, node = bus
+    assert abort_of(lambda: node.sdo.open(0x1008, 0, "rb", block_transfer=True).read()) == 0x05040001
+    assert isinstance(node.sdo.upload(0x1008, 0), bytes)  # a segmented upload still works
+
+
+def test_reset_node_restores_the_power_on_profile_area(bus):
+    """CiA 301 NMT Reset Node: the application restarts with its power-on values — a drive fault of the
+    previous run is gone (CiA 402: switch on disabled), a profile object written before is back at its
+    default."""
+    slaves, _, node = bus
+    drive = slaves[1].drive
+    drive.fault(0x0009)
+    for _ in range(50):
+        drive.step(0.001)
+    assert node.sdo[0x6041].raw & 0x4F == 0x08  # fault
+    default = node.sdo[0x6065].raw
+    node.sdo[0x6065].raw = default + 1000
+    node.nmt.send_command(0x81)  # reset node
+    node.nmt.wait_for_bootup(2)
+    assert node.sdo[0x6041].raw & 0x4F == 0x40  # switch on disabled
+    assert node.sdo[0x603F].raw == 0
+    assert node.sdo[0x6065].raw == default
+
+
+def test_pdo_mapping_changes_only_while_the_pdo_is_invalid(bus):
+    """CiA 301 7.5.2.36/7.5.2.38: mapping entries change only with the PDO invalid (COB-ID bit 31) and
+    sub 0 = 0, else the access is refused (0x06010000); more entries than the object holds abort with
+    0x06040042 (number and length of the objects would exceed the PDO length)."""
+    _, _, node = bus
+    tpdo = node.sdo[0x1A00]
+    assert abort_of(lambda: setattr(tpdo[1], "raw", 0x60410010)) == 0x06010000
+    cob = node.sdo[0x1800][1]
+    cob.raw = cob.raw | 0x80000000
+    assert abort_of(lambda: setattr(tpdo[1], "raw", 0x60410010)) == 0x06010000  # sub 0 still > 0
+    tpdo[0].raw = 0
+    tpdo[1].raw = 0x60410010
+    assert abort_of(lambda: setattr(tpdo[0], "raw", 9)) == 0x06040042  # 8 entries in this object
+    tpdo[0].raw = 1
+
+
+def test_modes_of_operation_and_basenode402(bus):
+    """CiA 402: 0x6060 refuses unsupported values with 0x06090030; 0x6502 lists what runs, the same
+    value as on EtherCAT (CSP and CSV); python-canopen's BaseNode402 reads it so."""
+    _, _, node = bus
+    assert node.sdo[0x6502].raw == 0x00000180
+    for bad in (0x55, 2, 1, 6, 10):
+        assert abort_of(lambda: setattr(node.sdo[0x6060], "raw", bad)) == 0x06090030
+    node.sdo[0x6060].raw = 9
+    assert node.sdo[0x6061].raw == 9
+    assert node.is_op_mode_supported("CYCLIC SYNCHRONOUS POSITION")
+    assert node.is_op_mode_supported("CYCLIC SYNCHRONOUS VELOCITY")
+    assert not node.is_op_mode_supported("HOMING") and not node.is_op_mode_supported("PROFILED POSITION")
+
+
+def test_sdo_size_must_match_the_object(bus):
+    """CiA 301: a 4-byte download to the 2-byte controlword aborts with 0x06070010."""
+    _, _, node = bus
+    assert abort_of(lambda: node.sdo.download(0x6040, 0, struct.pack("<I", 6))) == 0x06070010
+
+
+def test_hil_sim_canopen_stops_cleanly_on_sigterm(netns):  # noqa: F811
+    proc = subprocess.Popen(_in_ns(netns, "-m", "hil.cli", "sim", "canopen", "--interface", "udp_multicast",
+                                   "--channel", "239.74.163.9"),
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=ROOT)
+    try:
+        assert "nodes 1=X" in proc.stdout.readline()
+        proc.terminate()
+        _, err = proc.communicate(timeout=5)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+    assert proc.returncode == 0 and "hil sim canopen: stopped" in err and "Traceback" not in err
