@@ -1,0 +1,78 @@
+"""NC5 Appendix A.2, one program per alarm: the code comes back with the line that caused it.
+
+Each case cites the App. A row (and the chapter that states the rule) and is written from the manual's
+"wrong example" where the table gives one. docs/alarms.md (python docs/build_alarms.py) lists these
+cases as the tests that raise their codes.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import pytest
+
+from lang_helpers import run_path
+
+
+@dataclass(frozen=True)
+class Case:
+    code: str
+    program: str
+    line: int
+    cite: str
+    profile: str = "nc5-mill"
+    files: tuple[tuple[str, str], ...] = ()
+
+
+SUB = "O2000\nG01 X1. F100\nM99\n"
+ALARM_CASES = [
+    Case("0x0203", "G01 IF [#1 EQ 0] GOTO 5\nM30\n", 1, "App. A 0x0203 wrong example 'G01 IF'"),
+    Case("0x0204", "DO 1\nM30\n", 1, "App. A 0x0204 'Ex: DO, THEN' at the beginning of the line"),
+    Case("0x0205", "#1=1\nWHILE [#1 LT 3] DO 1\n#1=#1+1\nEND 1 X100.\nM30\n", 4, "App. A 0x0205 wrong example 'END 1 X100.'"),
+    Case("0x020E", "IF GOTO 5\nM30\n", 1, "App. A 0x020E 'no condition after the IF judgement'"),
+    Case("0x020F", "WHILE DO 1\nEND 1\nM30\n", 1, "App. A 0x020F 'no condition after the WHILE statement'"),
+    Case("0x0211", "#1\nM30\n", 1, "App. A 0x0211 incorrect '=' syntax (a # variable with no assignment)"),
+    Case("0x0213", "#1=0\nWHILE [#1 LT 3]\n#1=#1+1\nM30\n", 2, "App. A 0x0213 'WHILE statement lacks the END instruction' "
+         "(lathe guide WHILE ... ENDW form)", profile="lathe-2018"),
+    Case("0x0216", "G90 G00 X0 Y0\nG42 X100.\nM30\n", 2, "App. A 0x0216 wrong example 'G42 X100.'"),
+    Case("0x0217", "G42 D1234567 X10.\nM30\n", 1, "App. A 0x0217 wrong example 'G42 D1234567.'"),
+    Case("0x0218", "G43 Z100.\nM30\n", 1, "App. A 0x0218 wrong example 'G43 X100.' (tool length on the mill's Z)"),
+    Case("0x0219", "G43 H1234567 Z100.\nM30\n", 1, "App. A 0x0219 wrong example 'G43 H1234567.'"),
+    Case("0x021C", "M06 T123456789\nM30\n", 1, "App. A 0x021C wrong example 'M06 T1234567.' (beyond the T range)"),
+    Case("0x0225", "#1=0\nWHILE [#1 LT 3] DO 1\n#1=#1+1\nEND\nM30\n", 4, "App. A 0x0225 'No value specified after END'"),
+    Case("0x0226", "WHILE [#1 LT 3] DO\nEND 1\nM30\n", 1, "App. A 0x0226 'WHILE DO No value specified after DO'"),
+    Case("0x0229", "M98 Q10\nM30\n", 1, "App. A 0x0229 wrong example 'M98 Q10' beyond the program's lines"),
+    Case("0x0231", "G00 X0 Z10.\nG83 R-2. F100\nM30\n", 2, "App. A 0x0231 drilling cycle axis (hole bottom Z/W) missing; "
+         "N§3.7 lathe G83 format", profile="nc5-lathe-a"),
+    Case("0x0233", "G00 X50. Z5.\nG70\nM30\n", 2, "App. A 0x0233 G70 cannot find the P/Q blocks; N§3.7 G70 format", profile="nc5-lathe-a"),
+    Case("0x0238", "IF [#1 EQ 0] X10.\nM30\n", 1, "App. A 0x0238 IF command error (IF without GOTO/THEN)"),
+    Case("0x023A", "ELSEIF [#1 EQ 0]\nM30\n", 1, "App. A 0x023A ELSEIF command error (no THEN)"),
+    Case("0x023B", "ELSE\nENDIF\nM30\n", 1, "App. A 0x023B ELSE command error (ELSE with no IF...THEN)"),
+    Case("0x0241", "G65 A1.\nM30\n", 1, "App. A 0x0241 'The P command is not marked' (N§3.11.4.4 G65 P_ L_ format)"),
+    Case("0x0242", "G65 P123456 A1.\nM30\n", 1, "App. A 0x0242 'value of P exceeds the maximum value'"),
+    Case("0x0249", "M70000\nM30\n", 1, "App. A 0x0249 M code usage error (M out of range)"),
+    Case("0x024B", "G65 P2000 M98 P2000\nM30\n" + SUB, 1, "App. A 0x024B 'Call instruction usage error' (two calls in a block)"),
+    Case("0x024E", "G31 P300 X10. F100\nM30\n", 1, "App. A 0x024E HSI value usage error (G31 P mask 0-255; N§3.5.4)"),
+    Case("0x0256", "#1=POW[2]\nM30\n", 1, "App. A 0x0256 arithmetic command usage error (POW takes two arguments)"),
+    Case("0x025D", "G19\nG02 Z10. R5. F100\nM30\n", 2, "App. A 0x025D working plane setting error (G19 needs Y and Z)",
+         profile="nc5-lathe-a"),
+    Case("0x120E", "G91 G00 X900000000.\nX900000000.\nM30\n", 2, "App. A 0x120E interpolation distance exceeds the maximum travel"),
+    Case("0x021A", "T0170\nM30\n", 1, "App. A 0x021A lathe tool compensation T value above the limit (lathe guide: offsets 1-64)",
+         profile="lathe-2018"),
+    Case("0x022E", "M98 L2\nM30\n", 1, "App. A 0x022E 'Missing P command in M98' (lathe guide M98 P_ L_ format)",
+         profile="lathe-2018"),
+    Case("0x0232", "G00 X30. Z5.\nG76 P010060 Q100 R0.1\nG76 X20. Z-20. F1.5\nM30\n", 3,
+         "App. A 0x0232 'Missing P_ or Q_' in the cycle's second block (N§3.7 G76 two-block format)", profile="nc5-lathe-a"),
+    Case("0x1203", "G10 L12 P1 R4.\nG00 X0 Y0\nG41 D1 G01 X10. F100\nG18 X20.\nM30\n", 4,
+         "App. A 0x1203 'Plane changing after enabling tool compensation' (N§3.6.2)"),
+    Case("0x1206", "G10 L12 P1 R4.\nG10 L12 P2 R2.\nG00 X0 Y0\nG41 D1 G01 X10. F100\nG02 X30. R10. D2\nM30\n", 5,
+         "App. A 0x1206 'Changing tool diameter during arc command performing'"),
+]
+
+
+@pytest.mark.parametrize("case", ALARM_CASES, ids=[c.code for c in ALARM_CASES])
+def test_appendix_a_alarm_is_raised_at_its_line(capsys, tmp_path, case: Case):
+    r = run_path(capsys, tmp_path, case.program, profile=case.profile, files=dict(case.files))
+    assert r.code == 1, (case.cite, r.moves[-1:] if r.moves else None)
+    assert r.alarm["code"] == case.code, (case.cite, r.alarm)
+    assert r.alarm["line"] == case.line, (case.cite, r.alarm)
