@@ -30,7 +30,7 @@ def bus():
     net.connect(interface="virtual", channel=channel, receive_own_messages=False)
     node = canopen.BaseNode402(1, str(ASDA_B3_EDS))
     net.add_node(node)
-    node.sdo.RESPONSE_TIMEOUT = 0.3
+    node.sdo.RESPONSE_TIMEOUT = 2.0  # generous: 2 shared cores under load; only the STOPPED test waits it out
     node.sdo.MAX_RETRIES = 1  # one try (0 would retry for ever in python-canopen 2.4)
     try:
         yield slaves, net, node
