@@ -25,11 +25,24 @@ class UsageError(Exception):
     """Bad arguments or a bad input file: exit 2 with a message naming what is wrong."""
 
 
-def build_parser() -> argparse.ArgumentParser:
-    from hil.version import version
+class _Version(argparse.Action):
+    """`--version`: the package metadata is read only when asked (importlib.metadata costs start-up)."""
 
+    def __init__(self, option_strings, dest=argparse.SUPPRESS, default=argparse.SUPPRESS, help=None):
+        super().__init__(option_strings, dest=dest, default=default, nargs=0, help=help)
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        from hil.version import version
+
+        parser.exit(message=f"hil (deltahil) {version()}\n")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """Every subcommand registers itself; command modules import only argparse at the top and load
+    what they run (the bench, pyarrow, python-can, the runner) inside their command function, so
+    `hil path` does not pay for `hil run`'s imports (issue 16)."""
     parser = argparse.ArgumentParser(prog="hil", description="Delta NC5 hardware-in-the-loop bench driver")
-    parser.add_argument("--version", action="version", version=f"hil (deltahil) {version()}")
+    parser.add_argument("--version", action=_Version, help="show program's version number and exit")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     sub.required = True
     for mod in sorted(pkgutil.iter_modules(hil.commands.__path__), key=lambda m: m.name):

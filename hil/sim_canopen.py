@@ -13,10 +13,7 @@ import signal
 import sys
 import threading
 
-import can
-
 from hil.cli import EXIT_OK, EXIT_USAGE
-from hil.session import InputError, load_bench, sim_io_stations, sim_slaves
 
 
 def add_canopen(sims: argparse._SubParsersAction) -> None:
@@ -32,7 +29,10 @@ def add_canopen(sims: argparse._SubParsersAction) -> None:
 
 
 def cmd_sim_canopen(args: argparse.Namespace) -> int:
+    import can  # python-can (and its MDF4 support) only when the simulator runs
+
     from fieldbus.canopen.netns import check_multicast_allowed
+    from hil.session import InputError, load_bench, sim_io_stations, sim_slaves
     from virtual_bus.canopen import serve
 
     try:

@@ -6,12 +6,13 @@ from __future__ import annotations
 import argparse
 import sys
 
-from hil import strict_json
-from hil.bench import Bench, ChecksConfig
+from typing import TYPE_CHECKING
+
 from hil.cli import EXIT_ALARM, EXIT_OK, EXIT_USAGE
-from hil.session import InputError, load_bench, load_program, print_alarm
-from hil.trace_read import TraceFile, TraceReadError
-from nc.alarms import NcAlarm
+
+if TYPE_CHECKING:  # the bench, traces and pyarrow load when the command runs, not at start-up
+    from hil.bench import Bench, ChecksConfig
+    from hil.trace_read import TraceFile
 
 
 def add_check_options(p: argparse.ArgumentParser) -> None:
@@ -41,6 +42,9 @@ def checks_from_args(args: argparse.Namespace, bench: Bench | None, axes: list[s
     """The bench's [checks] with the command line's limits over them. A bench only recorded in
     the trace lends its [checks] when no check is asked for: then the trace is judged as its run
     was; with flags, only what they ask."""
+    from hil.bench import ChecksConfig
+    from hil.session import InputError
+
     asked = any(getattr(args, k) not in (None, False) for k in CHECK_FLAGS)
     c = bench.checks if bench is not None and not (recorded and asked) else ChecksConfig()
     for opt in ("max_ferr", "contour", "thread_phase", "jitter_p99", "jitter_max"):
@@ -65,6 +69,7 @@ def checks_from_args(args: argparse.Namespace, bench: Bench | None, axes: list[s
 def trace_bench(args: argparse.Namespace, tf: TraceFile) -> tuple[Bench | None, str]:
     """The bench to judge the trace against, and how it was found: --bench, else the bench the
     trace's metadata records (Parquet traces from `hil run`), else none (decision R4)."""
+    from hil.session import load_bench
     from hil.trace_meta import bench_from_meta
 
     recorded = bench_from_meta(tf.meta)
@@ -84,7 +89,9 @@ def prepare(args: argparse.Namespace, cmd: str):
     """Bench, checks, trace, the programmed moves and where the bench came from; bad input raises
     InputError / TraceReadError / NcAlarm."""
     from hil.checks import program_moves
+    from hil.session import InputError, load_program
     from hil.trace import axes_of, csv_meta_path
+    from hil.trace_read import TraceFile
 
     tf = TraceFile(args.trace)
     bench, origin = trace_bench(args, tf)
@@ -109,6 +116,10 @@ def prepare(args: argparse.Namespace, cmd: str):
 
 def prepared(args: argparse.Namespace, cmd: str):
     """`prepare`, with a bad input reported for `hil CMD`: returns the tuple, or the exit code."""
+    from hil.session import InputError, print_alarm
+    from hil.trace_read import TraceReadError
+    from nc.alarms import NcAlarm
+
     try:
         return prepare(args, cmd)
     except (InputError, TraceReadError) as exc:
@@ -120,7 +131,9 @@ def prepared(args: argparse.Namespace, cmd: str):
 
 
 def cmd_check(args: argparse.Namespace) -> int:
+    from hil import strict_json
     from hil.checks import run_checks
+    from hil.trace_read import TraceReadError
 
     ready = prepared(args, "check")
     if isinstance(ready, int):

@@ -10,14 +10,15 @@ import dataclasses
 import sys
 from collections import deque
 
+from typing import TYPE_CHECKING
+
 from hil import strict_json
 from hil.cli import EXIT_ALARM, EXIT_OK, EXIT_USAGE
-from hil.session import InputError, load_bench, print_alarm
 from nc.alarms import NcAlarm, internal_error
-from nc.interp import Interpreter
-from nc.moves import Move, Sync
-from nc.profiles import make_profile
-from nc.store import ProgramStore
+
+if TYPE_CHECKING:  # the interpreter and the bench load when the command runs, not at `hil` start-up
+    from nc.interp import Interpreter
+    from nc.moves import Move
 
 
 def parse_ranges(text: str) -> list[int]:
@@ -35,6 +36,8 @@ def parse_ranges(text: str) -> list[int]:
             else:
                 out.append(int(part))
         except ValueError:
+            from hil.session import InputError
+
             raise InputError(f"bad --vars range {part!r}: use e.g. 100-199,500") from None
     return out
 
@@ -66,6 +69,8 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def parse_interrupt(text: str) -> tuple[int, float]:
+    from hil.session import InputError
+
     line, _, frac = text.partition("@")
     try:
         at = (int(line), float(frac) if frac else 0.5)
@@ -112,6 +117,12 @@ def move_dict(m: Move) -> dict:
 
 
 def cmd_path(args: argparse.Namespace) -> int:
+    from hil.session import InputError, load_bench, print_alarm
+    from nc.interp import Interpreter
+    from nc.moves import Move, Sync
+    from nc.profiles import make_profile
+    from nc.store import ProgramStore
+
     try:
         bench = load_bench(args.bench, args.profile)
         var_ids = parse_ranges(args.vars) if args.vars else []

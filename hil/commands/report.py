@@ -8,7 +8,6 @@ import sys
 
 from hil.cli import EXIT_ALARM, EXIT_OK, EXIT_USAGE
 from hil.commands.check import add_check_options, prepared
-from hil.trace_read import TraceReadError
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -23,6 +22,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 def cmd_report(args: argparse.Namespace) -> int:
     from hil.checks import run_checks
     from hil.report import write_report
+    from hil.trace_read import TraceReadError
 
     ready = prepared(args, "report")
     if isinstance(ready, int):

@@ -5,12 +5,13 @@ from __future__ import annotations
 import argparse
 import sys
 
-from hil.bench import Bench
+from typing import TYPE_CHECKING
+
 from hil.cli import EXIT_ALARM, EXIT_USAGE
-from hil.progress import wants_progress
-from hil.run_events import EventPlayer
-from hil.runner import RunResult
-from hil.session import InputError, print_alarm
+
+if TYPE_CHECKING:  # the runner and the bench load when a run starts, not at `hil` start-up
+    from hil.bench import Bench
+    from hil.runner import RunResult
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -65,6 +66,8 @@ def register(sub: argparse._SubParsersAction) -> None:
 def cmd_run(args: argparse.Namespace) -> int:
     """`hil run` prints what `hil.run` returns; the run itself is the library's (hil/api.py)."""
     from hil.api import run
+    from hil.progress import wants_progress
+    from hil.session import InputError, print_alarm
 
     try:
         r = run(args.program, args.bench, bus=args.bus, profile=args.profile, libs=args.lib, trace=args.trace,
@@ -104,6 +107,8 @@ def cmd_run(args: argparse.Namespace) -> int:
 
 def print_run(program: str, r, out) -> None:
     """The text summary of a run, as `hil run` prints it."""
+    from hil.run_events import EventPlayer
+
     print_summary(program, r.bench, r.run, out)
     runner = r.runner
     waits = [(ln, w) for ln, w in runner.channel.planner.thread_waits if w] if runner.channel is not None else []

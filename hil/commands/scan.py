@@ -5,11 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from fieldbus.factory import parse_bus
-from fieldbus.link import BusError
-from hil import strict_json
 from hil.cli import EXIT_ALARM, EXIT_OK, EXIT_USAGE
-from hil.session import print_alarm
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -20,6 +16,11 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def cmd_scan(args: argparse.Namespace) -> int:
+    from fieldbus.factory import parse_bus
+    from fieldbus.link import BusError
+    from hil import strict_json
+    from hil.session import print_alarm
+
     try:
         spec = parse_bus(args.bus)
     except ValueError as exc:

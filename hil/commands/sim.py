@@ -12,7 +12,6 @@ import sys
 from collections.abc import Callable
 
 from hil.cli import EXIT_OK, EXIT_USAGE
-from hil.session import InputError, load_bench, sim_slaves
 from hil.sim_canopen import add_canopen
 
 
@@ -59,6 +58,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 def build_chain(bench, io: int = 0, realtime: bool = False, faults=()):
     """Software ESCs for the bench's drives (each its `drive.model`: ASDA-A3-E, B3-E or A2-E) and R1-EC class I/O stations: one per
     [[io]] station with its `modules`, and up to `io` in all (extra ones DI16 + DO16)."""
+    from hil.session import sim_slaves
     from virtual_bus.ethercat.app import DioApp, DriveApp
     from virtual_bus.ethercat.device import load_device
     from virtual_bus.ethercat.esc import Esc
@@ -90,6 +90,7 @@ def build_chain(bench, io: int = 0, realtime: bool = False, faults=()):
 def cmd_sim_ethercat(args: argparse.Namespace) -> int:
     from virtual_bus.ethercat.faults import parse_fault
     from virtual_bus.ethercat.network import RawSocketLine
+    from hil.session import InputError, load_bench
 
     try:
         if not args.iface:  # not argparse's required=: the hidden --interface alias fills it too

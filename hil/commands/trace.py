@@ -6,8 +6,6 @@ import argparse
 import sys
 
 from hil.cli import EXIT_OK, EXIT_USAGE
-from hil.trace_read import TraceFile, TraceReadError
-from hil.trace_summary import Bound, export, format_summary, summarise
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -22,6 +20,9 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def cmd_trace(args: argparse.Namespace) -> int:
+    from hil.trace_read import TraceFile, TraceReadError  # pyarrow: only when a trace is read
+    from hil.trace_summary import Bound, export, format_summary, summarise
+
     try:
         lo = Bound.parse(args.lo) if args.lo else None
         hi = Bound.parse(args.hi) if args.hi else None
