@@ -127,14 +127,16 @@ def run(program: str | Path, bench: str | Path | Bench | None = None, *, bus: st
         feed_override: float = 100.0, rapid_override: float = 100.0, spindle_override: float = 100.0,
         check: bool | None = None, trace_signals: str | None = None, m00_resume: float = 0.5,
         realtime: bool = False, overrun: str | None = None, progress: Any = None,
-        servo_modbus: str | None = None, servo_baud: int = 38400, capture: str | Path | None = None) -> Result:
+        servo_modbus: str | None = None, servo_baud: int = 38400, capture: str | Path | None = None,
+        scope: Any = None) -> Result:
     """Run `program` on a bench in lock-step virtual time (or `realtime`); see the module doc.
 
     `bench`: a bench file, a `Bench`, or None for the built-in 2-axis lathe. `events`: `--at`
     strings; `event_files`: `--events` files. Overrides are the panel's switch positions at power-on
     (D2x002 feed 0–150 %, D2x004 rapid 0–100 %, D2x026 spindle 50–120 %); the MLC may change them.
     `check`: judge the run by the bench's [checks] (default: when it has any). `capture`: record the
-    bus's frames (EtherCAT .pcapng, CAN .asc/.blf/.log; fieldbus/capture.py)."""
+    bus's frames (EtherCAT .pcapng, CAN .asc/.blf/.log; fieldbus/capture.py). `scope`: a started
+    `hil.scope.Scope` that streams this run's rows to its page."""
     from hil.clock import make_clock
     from hil.progress import Progress
     from hil.remote_io import attach_remote_io
@@ -203,6 +205,13 @@ def run(program: str | Path, bench: str | Path | Bench | None = None, *, bus: st
                 runner.trace = open_trace(trace_path, columns, run_meta(b, str(program)), column_units(columns, b))
             except OSError as exc:
                 raise InputError(f"cannot write trace {trace_path}: {exc.strerror}") from None
+        if scope is not None:  # the live scope reads the rows the trace is written from
+            try:
+                runner.trace = scope.attach(runner.trace, runner.trace_columns())
+            except ValueError as exc:
+                if runner.trace is not None:
+                    runner.trace.discard()
+                raise InputError(str(exc)) from None
         if servo_modbus:  # G10 L40/L41 over the drives' RS-485 port (issue 8)
             import serial
 

@@ -4,13 +4,13 @@ a zoom on one plot moves the x range of the linked time axes."""
 
 import os
 import re
-import shutil
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from hil.cli import main
+from tests.browser_helpers import chromium_driver, console_errors
 
 ROOT = Path(__file__).resolve().parent.parent
 BENCH = ROOT / "benches" / "lathe-2axis.toml"
@@ -40,28 +40,12 @@ def test_report_html_is_self_contained_and_titled(report):
     assert "Interactive report" in (report.parent / "index.html").read_text()
 
 
-def _driver():
-    webdriver = pytest.importorskip("selenium.webdriver", reason="selenium not installed")
-    chrome, drv = shutil.which("chromium"), shutil.which("chromedriver")
-    if not chrome or not drv:
-        pytest.skip("chromium / chromedriver not installed (apt-get install chromium chromium-driver)")
-    from selenium.webdriver.chrome.service import Service
-
-    opts = webdriver.ChromeOptions()
-    opts.binary_location = chrome
-    for a in ("--headless=new", "--no-sandbox", "--disable-dev-shm-usage", "--window-size=1400,1000"):
-        opts.add_argument(a)
-    opts.set_capability("goog:loggingPrefs", {"browser": "ALL"})
-    return webdriver.Chrome(service=Service(drv), options=opts)
-
-
 def test_report_html_in_browser_zoom_links_axes(report):
-    d = _driver()
+    d = chromium_driver()
     try:
         d.get(report.as_uri())
         assert d.execute_script("return document.querySelectorAll('.js-plotly-plot').length") == 2
-        errors = [e for e in d.get_log("browser") if e["level"] == "SEVERE"]
-        assert errors == []
+        assert console_errors(d) == []
         d.save_screenshot(str(report.parent / "report.png"))
         d.execute_script("Plotly.relayout('time', {'xaxis.range': [0.1, 0.3]})")
         ranges = d.execute_script("var l=document.getElementById('time').layout;"

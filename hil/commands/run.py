@@ -58,6 +58,18 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--junit", metavar="FILE", help="write JUnit XML: a test case for the run and one per check")
     p.add_argument("--capture", metavar="FILE",
                    help="record the bus's frames: EtherCAT as .pcapng (Wireshark/tshark), CAN as .asc/.blf/.log")
+    p.add_argument("--scope", action="store_true",
+                   help="live scope: serve a page on 127.0.0.1 (free port, printed) that streams trace columns "
+                        "while the run goes")
+    p.add_argument("--scope-columns", metavar="COLS",
+                   help="columns for --scope, e.g. X_cmd,X_act,Z_ferr,S1_rpm_act "
+                        "(default: every axis's cmd/act/ferr and every spindle's rpm_cmd/rpm_act)")
+    p.add_argument("--scope-linger", metavar="SECONDS", type=float, default=30.0,
+                   help="after the run, keep the scope page up this long unless the browser already "
+                        "has the last rows (default 30)")
+    p.add_argument("--scope-wait", action="store_true",
+                   help="hold the run until a browser has the scope page open")
+    p.add_argument("--scope-port", metavar="PORT", type=int, default=0, help=argparse.SUPPRESS)
     p.add_argument("--allow-unfired", action="store_true",
                    help="an --at/--events event that never fired does not fail the run")
     p.set_defaults(func=cmd_run)
@@ -65,6 +77,34 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def cmd_run(args: argparse.Namespace) -> int:
     """`hil run` prints what `hil.run` returns; the run itself is the library's (hil/api.py)."""
+    if (args.scope_columns or args.scope_wait) and not args.scope:
+        print("hil run: --scope-columns and --scope-wait need --scope", file=sys.stderr)
+        return EXIT_USAGE
+    try:
+        scope = _start_scope(args)
+    except OSError as exc:
+        print(f"hil run: --scope cannot listen on 127.0.0.1:{args.scope_port}: {exc.strerror}", file=sys.stderr)
+        return EXIT_USAGE
+    try:
+        return _run_and_print(args, scope)
+    finally:
+        if scope is not None:
+            scope.close()
+
+
+def _start_scope(args: argparse.Namespace):
+    if not args.scope:
+        return None
+    from hil.scope import Scope
+
+    scope = Scope(args.scope_columns, linger_s=max(0.0, args.scope_linger), port=args.scope_port)
+    print(f"scope: {scope.start()} (127.0.0.1 only)", file=sys.stderr, flush=True)
+    if args.scope_wait:
+        scope.wait_for_browser(sys.stderr)
+    return scope
+
+
+def _run_and_print(args: argparse.Namespace, scope) -> int:
     from hil.api import run
     from hil.progress import wants_progress
     from hil.session import InputError, print_alarm
@@ -76,7 +116,7 @@ def cmd_run(args: argparse.Namespace) -> int:
                 trace_signals=args.trace_signals, m00_resume=args.m00_resume, realtime=args.realtime,
                 overrun=args.overrun, progress=True if wants_progress(args.progress) else None,
                 servo_modbus=args.servo_modbus, servo_baud=args.servo_baud,
-                capture=args.capture)
+                capture=args.capture, scope=scope)
     except InputError as exc:
         if exc.alarm is not None:
             print_alarm(exc.alarm)
@@ -102,6 +142,8 @@ def cmd_run(args: argparse.Namespace) -> int:
             return EXIT_USAGE
     if args.json:
         print(to_json(r, args.allow_unfired), file=sys.stdout)
+    if scope is not None:
+        scope.linger(sys.stderr)
     return code
 
 
