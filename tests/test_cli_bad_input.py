@@ -195,7 +195,7 @@ CASES: list[tuple[str, str, int, tuple[str, ...]]] = [
     ("servo-canopen-nosuch", "servo get X P2-00 --bench {d}/slow.toml --bus canopen:nosuchiface", 1, ("0x1420",)),
     ("servo-modbus-missing", "servo get X P2-00 --servo-modbus /dev/nope-tty", 2, ("/dev/nope-tty",)),
     ("scan-ethercat-nope0", "scan --bus ethercat:nope0", 1, ("0x1429",)),
-    ("scan-canopen", "scan --bus canopen:virtual", 2, ("not supported",)),
+    ("scan-sim", "scan --bus sim", 2, ("nothing to scan",)),
     ("scan-junk", "scan --bus junk", 2, ("unknown bus",)),
     ("sim-ethercat-nope0", "sim ethercat --iface nope0 --duration 0.1", 2, ("nope0",)),
     ("sim-ethercat-fault", "sim ethercat --iface nope0 --fault junk", 2, ("fault spec",)),

@@ -131,3 +131,13 @@ def test_hil_sim_canopen_stops_cleanly_on_sigterm(netns):  # noqa: F811
             proc.kill()
             proc.wait()
     assert proc.returncode == 0 and "hil sim canopen: stopped" in err and "Traceback" not in err
+
+
+def test_hil_scan_lists_the_canopen_nodes(hil):
+    """`hil scan` on CANopen: node IDs, vendor and product from 0x1018, name from 0x1008, CiA 402 drives."""
+    r = hil("scan", "--bus", "canopen:virtual")
+    assert r.code == 0, r.err
+    rows = r.out.splitlines()
+    assert len(rows) == 3
+    assert all("vendor 0x000001DD" in row and "product 0x00006080" in row and " drive " in row for row in rows)
+    assert [int(row.split()[0]) for row in rows] == [1, 2, 3]

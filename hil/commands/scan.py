@@ -1,4 +1,5 @@
-"""`hil scan --bus ethercat:IFACE`: list the slaves on a line (position, vendor, product, name, state)."""
+"""`hil scan --bus ethercat:IFACE | canopen:INTERFACE:CHANNEL`: list the slaves on a line or the nodes
+on a CAN bus (position or node ID, vendor, product, name, state)."""
 
 from __future__ import annotations
 
@@ -9,8 +10,10 @@ from hil.cli import EXIT_ALARM, EXIT_OK, EXIT_USAGE
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser("scan", help="list the slaves on a bus (EtherCAT: vendor, product, name, AL state)")
-    p.add_argument("--bus", required=True, help="ethercat:IFACE")
+    p = sub.add_parser("scan", help="list the slaves on a bus (vendor, product, name, AL or NMT state)")
+    p.add_argument("--bus", required=True, help="ethercat:IFACE, or canopen:INTERFACE:CHANNEL (canopen:virtual: "
+                                                "the bench's simulated nodes in this process)")
+    p.add_argument("--bench", help="with canopen:virtual: whose drives to simulate (default: the built-in lathe)")
     p.add_argument("--json", action="store_true", help="one JSON object per slave")
     p.set_defaults(func=cmd_scan)
 
@@ -19,20 +22,22 @@ def cmd_scan(args: argparse.Namespace) -> int:
     from fieldbus.factory import parse_bus
     from fieldbus.link import BusError
     from hil import strict_json
-    from hil.session import print_alarm
+    from hil.session import InputError, print_alarm
 
     try:
         spec = parse_bus(args.bus)
     except ValueError as exc:
         print(f"hil scan: {exc}", file=sys.stderr)
         return EXIT_USAGE
-    if spec.kind != "ethercat":
-        print(f"hil scan: scanning {spec.kind} buses is not supported here; use ethercat:IFACE", file=sys.stderr)
+    if spec.kind not in ("ethercat", "canopen"):
+        print(f"hil scan: the {spec.kind} bus has nothing to scan; use ethercat:IFACE or canopen:INTERFACE:CHANNEL",
+              file=sys.stderr)
         return EXIT_USAGE
-    from fieldbus.ethercat.link import EthercatLink
-
     try:
-        slaves = EthercatLink(spec.interface).scan()
+        slaves = _scan_ethercat(spec) if spec.kind == "ethercat" else _scan_canopen(spec, args.bench)
+    except InputError as exc:
+        print(f"hil scan: {exc}", file=sys.stderr)
+        return EXIT_USAGE
     except BusError as exc:
         print_alarm(exc.alarm, args.json)
         return EXIT_ALARM
@@ -45,3 +50,38 @@ def cmd_scan(args: argparse.Namespace) -> int:
             print(f"{s.position:3d}  vendor 0x{s.vendor_id:08X}  product 0x{s.product_code:08X}  "
                   f"{s.state:8s} {s.kind:5s}  {s.name}" + (f"  [{s.layout}]" if s.kind == "io" and s.layout else ""))
     return EXIT_OK
+
+
+def _scan_ethercat(spec) -> list:
+    from fieldbus.ethercat.link import EthercatLink
+
+    return EthercatLink(spec.interface).scan()
+
+
+def _scan_canopen(spec, bench_path: str | None) -> list:
+    """A CAN bus by node ID; `canopen:virtual` has no nodes of its own, so the bench's simulated drives
+    (as `hil run --bus canopen:virtual` builds them) answer on a private virtual channel."""
+    import uuid
+
+    from fieldbus.canopen.budget import DEFAULT_BITRATE
+    from fieldbus.canopen.netns import check_multicast_allowed
+    from fieldbus.canopen.scan import scan
+    from hil.session import InputError, load_bench, sim_slaves
+
+    try:
+        check_multicast_allowed(spec.interface)
+    except ValueError as exc:
+        raise InputError(str(exc)) from None
+    bench = load_bench(bench_path)
+    bitrate = int(getattr(bench, "canopen_bitrate", None) or DEFAULT_BITRATE)
+    if spec.interface != "virtual":
+        return scan(spec.interface, spec.channel, bitrate)
+    from virtual_bus.canopen.nodes import serve
+
+    channel = f"scan-{uuid.uuid4().hex[:8]}"
+    nodes = serve(sim_slaves(bench), "virtual", channel,
+                  eds=[c.canopen_eds or bench.canopen_eds for c in [*bench.axes, *bench.spindles]])
+    try:
+        return scan("virtual", channel, bitrate)
+    finally:
+        nodes.close()
