@@ -81,7 +81,8 @@ M99 P30
     assert r.vars == {"100": 10.0, "101": None, "102": 1.0}
     assert run_path(capsys, tmp_path, "M98\n").alarm["code"] == "0x0261"
     assert run_path(capsys, tmp_path, "M98 P77\n").alarm["code"] == "0x0263"
-    assert run_path(capsys, tmp_path, "M98 P2000 L2\n" + prog[prog.index("O2000"):]).alarm["code"] == "0x0251"
+    # App. A 0x0251 "Only P_, H(Q)_, L_ can be used": L is legal, a non-integer repeat count is not (A21)
+    assert run_path(capsys, tmp_path, "M98 P2000 L2.5\n" + prog[prog.index("O2000"):]).alarm["code"] == "0x0251"
 
 
 def test_m98_h_wins_over_q(capsys, tmp_path):

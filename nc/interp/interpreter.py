@@ -42,6 +42,8 @@ M_BEFORE_MOTION = {3, 4, 8, 19, 29}  # issued to the MLC before the block's moti
 M_END = {2, 30}
 # Codes whose axis words name a centre or the axes concerned, never a target: no motion in their block.
 TRANSFORM_ARG_FUNCS = frozenset({"scale", "mirror", "mirror_off", "G68"})
+# App. A 0x025F, N§3.12.5: refused while G68 rotation is on, until G69
+REFUSED_UNDER_G68 = frozenset({"G54", "G55", "G56", "G57", "G58", "G59", "G28", "G29", "G30", "G2.4", "G3.4"})
 # Non-modal codes whose block runs no motion of the current motion mode (the code itself moves or not).
 NO_MOTION_FUNCS = frozenset({"G04", "G10", "G11", "G28", "G29", "G30", "G31", "G52", "G53", "set", "G05",
                              "G70", "G71", "G72", "G73", "G74", "G75", "G76", "G900"})
@@ -77,6 +79,8 @@ class Frame:
     ifs: list[int] = field(default_factory=list)  # ENDIF pcs of the open IF-THEN blocks
     call_code: str | None = None  # "G100" / "M100" / "T" while executing a code-called macro
     restarts: int = 0
+    args: dict[int, float] | None = None  # the call's arguments: every L repetition starts from them
+    entry: int = 0  # where each repetition starts (M98 H/Q enter mid-program)
 
 
 @dataclass
@@ -366,6 +370,9 @@ class Interpreter:
         gcodes = self._gcodes(block)
         funcs = {fn for _, fn, _ in gcodes}
         self._check_letters(block, funcs)
+        if (self.state.rotation or "G68" in funcs) and "G69" not in funcs and funcs & REFUSED_UNDER_G68:
+            raise NcAlarm(0x025F, f"{' '.join(sorted(funcs & REFUSED_UNDER_G68))} while G68 rotation is on: "
+                                  "cancel it with G69 first")
         mcodes = block.all("M")
         for w in mcodes:
             if w.value != int(w.value) or not 0 <= w.value <= 65534:
@@ -1383,7 +1390,7 @@ class Interpreter:
         if count < 1:
             return
         self.vars.push_locals(args)
-        self.stack.append(Frame(prog, 0, kind, True, count, call_code=code))
+        self.stack.append(Frame(prog, 0, kind, True, count, call_code=code, args=dict(args)))
 
     def _macro_call(self, block: Block, modal: bool) -> None:
         p = block.get("P")
@@ -1468,10 +1475,14 @@ class Interpreter:
             return
         if p is None and h is None and q is None:
             raise NcAlarm(0x0261, "M98 needs P, H or Q")
-        if lw is not None:
-            raise NcAlarm(0x0251, "M98 on NC5 takes P, H or Q (no L)")
+        # App. A 0x0251 lists L among M98's words: the repeat count (A21, revisited in issue 19)
+        count = 1 if lw is None else int(lw.value)
+        if lw is not None and (lw.value != count or not 0 <= count <= 9999):
+            raise NcAlarm(0x0251, f"M98 L{lw.value:g}: the repeat count is 0-9999")
         prog = self.store.find(int(p.value)) if p is not None else self.frame.program
-        fr = Frame(prog, 0, "m98", False, 1)
+        if count < 1:
+            return
+        fr = Frame(prog, 0, "m98", False, count)
         if h is not None:  # H has priority over Q
             hits = prog.labels.get(int(h.value))
             if not hits:
@@ -1483,6 +1494,7 @@ class Interpreter:
                 raise NcAlarm(0x0229, f"M98 Q{int(q.value)}: line not found")
             fr.pc = idx
         fr.call_code = None
+        fr.entry = fr.pc
         self.stack.append(fr)
 
     def _m99(self, block: Block) -> None:
@@ -1506,10 +1518,12 @@ class Interpreter:
         fr = self.frame
         fr.repeat -= 1
         if fr.repeat > 0:
-            fr.pc = 0
+            # each repetition is the whole call again (N§3.11.4.4 Example 1 (3)): fresh arguments
+            fr.pc = fr.entry
             fr.loops, fr.ifs = [], []
-            if fr.locals_pushed and fr.kind != "g65":
-                pass
+            if fr.locals_pushed and fr.args is not None:
+                self.vars.pop_locals()
+                self.vars.push_locals(dict(fr.args))
             return
         self.stack.pop()
         if fr.locals_pushed:

@@ -1,0 +1,55 @@
+"""Manual conformance round 2 (issue 19): behaviours held against the NC5 G command guide (N§ = NC5 guide,
+App. A = its alarm table). Each test failed on main before its fix."""
+
+from __future__ import annotations
+
+import pytest
+
+from lang_helpers import run_path
+
+MACRO = "O9000\n#100=#100+#1\n#101=#101+1\n#1=#1+10.\nM99\n"
+
+
+def test_g65_l_repeats_the_whole_call_with_fresh_arguments_n3_11_4_4_example_1(capsys, tmp_path):
+    """N§3.11.4.4 format 'G65 P_ L_ <argument>', Example 1 (3): L is the number of repetitions; each one is
+    the call again, so the macro's change of its own #1 does not reach the next repetition."""
+    r = run_path(capsys, tmp_path, "#100=0\n#101=0\nG65 P9000 L3 A1.\nM30\n" + MACRO, "--vars", "100-101")
+    assert r.code == 0, r.alarm
+    assert (r.vars["101"], r.vars["100"]) == (3.0, 3.0)  # three passes, each with A=1 (not 1+11+21)
+
+
+def test_g66_l_runs_the_macro_l_times_per_moving_block_n3_11_4_5(capsys, tmp_path):
+    """N§3.11.4.5 'G66 P_ L_ <argument>': the macro runs L times after each block that moves an axis,
+    with the arguments of the G66 block every time."""
+    r = run_path(capsys, tmp_path, "#100=0\n#101=0\nG66 P9000 L2 A1.\nG00 X10.\nX20.\nG67\nM30\n" + MACRO,
+                 "--vars", "100-101")
+    assert r.code == 0, r.alarm
+    assert (r.vars["101"], r.vars["100"]) == (4.0, 4.0)  # 2 blocks x L2, each pass with A=1
+
+
+def test_m98_p_l_repeats_the_subprogram_app_a_0x0251(capsys, tmp_path):
+    """App. A 0x0251: 'Only P_, H(Q)_, L_ can be used' with M98, so L is legal; it is the repeat count
+    (decision A21 revisited)."""
+    r = run_path(capsys, tmp_path, "G90 G00 X0 Y0\nM98 P2000 L3\nM30\nO2000\nG91 G01 X1. F100\nG90\nM99\n")
+    assert r.code == 0, r.alarm
+    assert [e[0] for e in r.ends("X")][-3:] == [1.0, 2.0, 3.0]
+
+
+def test_m98_l0_does_not_call(capsys, tmp_path):
+    """A repeat count of 0 runs the subprogram no time (as G65 L0)."""
+    r = run_path(capsys, tmp_path, "G90 G00 X0 Y0\nM98 P2000 L0\nM30\nO2000\nG91 G01 X1. F100\nG90\nM99\n")
+    assert r.code == 0, r.alarm
+    assert r.ends("X")[-1] == (0.0,)
+
+
+@pytest.mark.parametrize("block", ["G54 X0 Y0", "G55", "G28 X0", "G30 X0", "G29 X10."])
+def test_g68_active_refuses_wcs_and_reference_returns_app_a_0x025f(capsys, tmp_path, block):
+    """App. A 0x025F and N§3.12.5: with G68 rotation on, G54–G59, G28/G29/G30 (and 3-D arcs) are
+    refused until G69."""
+    r = run_path(capsys, tmp_path, f"G90 G00 X0 Y0\nG28 X0\nG68 X0 Y0 R30.\n{block}\nG69\nM30\n")
+    assert r.code == 1 and r.alarm["code"] == "0x025F" and r.alarm["line"] == 4, r.alarm
+
+
+def test_after_g69_the_same_blocks_run(capsys, tmp_path):
+    r = run_path(capsys, tmp_path, "G90 G00 X0 Y0\nG68 X0 Y0 R30.\nG01 X10. F100\nG69\nG54 X0 Y0\nG28 X0\nM30\n")
+    assert r.code == 0, r.alarm
