@@ -67,6 +67,8 @@ ALARM_CASES = [
          "App. A 0x1203 'Plane changing after enabling tool compensation' (N§3.6.2)"),
     Case("0x1206", "G10 L12 P1 R4.\nG10 L12 P2 R2.\nG00 X0 Y0\nG41 D1 G01 X10. F100\nG02 X30. R10. D2\nM30\n", 5,
          "App. A 0x1206 'Changing tool diameter during arc command performing'"),
+    Case("0x025B", "G90 G00 X0 Y0 Z0\nG2.4 X10. Y0 Z0 F300\nG2.4 X20. Y0 Z0\nM30\n", 3,
+         "App. A 0x025B 3-dimension arc command error: three points on one line make no circle (N§3.3.4)"),
 ]
 
 

@@ -53,3 +53,51 @@ def test_g68_active_refuses_wcs_and_reference_returns_app_a_0x025f(capsys, tmp_p
 def test_after_g69_the_same_blocks_run(capsys, tmp_path):
     r = run_path(capsys, tmp_path, "G90 G00 X0 Y0\nG68 X0 Y0 R30.\nG01 X10. F100\nG69\nG54 X0 Y0\nG28 X0\nM30\n")
     assert r.code == 0, r.alarm
+
+
+def _circle_through(a, b, c):
+    import numpy as np
+    a, b, c = map(np.array, (a, b, c))
+    u, v = b - a, c - a
+    w = np.cross(u, v)
+    centre = a + (np.cross(w, u) * v.dot(v) + np.cross(v, w) * u.dot(u)) / (2 * w.dot(w))
+    return centre, float(np.linalg.norm(a - centre)), w / np.linalg.norm(w)
+
+
+@pytest.mark.parametrize("code, body", [
+    ("G2.4", "G90 G2.4 X10. Y10. Z5. F300\nG2.4 X20. Y0 Z10.\n"),
+    ("G3.4", "G90 G3.4 X10. Y10. Z5. F300\nG3.4 X20. Y0 Z10.\n"),
+    # N§3.3.4 note (1): under G91 the middle point is relative to the start, the end to the middle point
+    ("G2.4", "G91 G2.4 X10. Y10. Z5. F300\nG2.4 X10. Y-10. Z5.\nG90\n"),
+])
+def test_three_point_arc_in_the_manuals_two_block_format_n3_3_4(capsys, tmp_path, code, body):
+    """N§3.3.4 format table: 'G2.4 X1 Y1 Z1 (Middle-point position)' then 'G2.4 X2 Y2 Z2 (End-point position)':
+    the 3-D arc from the current point through the middle point to the end point."""
+    import numpy as np
+    r = run_path(capsys, tmp_path, "G90 G00 X0 Y0 Z0\n" + body + "M30\n")
+    assert r.code == 0, r.alarm
+    arc = [m for m in r.moves if m["line"] == 3]
+    assert arc and all(code in m["tags"] for m in arc)
+    assert not [m for m in r.moves if m["line"] == 2]  # the middle-point block does not move by itself
+    centre, radius, normal = _circle_through((0, 0, 0), (10, 10, 5), (20, 0, 10))
+    pts = [np.array([m["end"][a] for a in "XYZ"]) for m in arc]
+    assert tuple(pts[-1]) == (20.0, 0.0, 10.0)
+    for p in pts:  # every vertex on the circle: on its sphere and in its plane
+        assert np.linalg.norm(p - centre) == pytest.approx(radius, abs=2e-6)
+        assert float((p - centre).dot(normal)) == pytest.approx(0.0, abs=2e-6)
+    # the path passes through the middle point (within the chord tolerance, 0.5 µm)
+    mid = np.array([10.0, 10.0, 5.0])
+    seg = min(np.linalg.norm(np.cross(q - p, p - mid)) / np.linalg.norm(q - p) for p, q in zip(pts, pts[1:])
+              if (mid - p).dot(q - p) >= 0 and (mid - q).dot(p - q) >= 0)
+    assert seg < 0.5e-3
+
+
+def test_three_point_middle_without_end_point_is_0x0260(capsys, tmp_path):
+    """App. A 0x0260 'Insufficient information for circle command by three points method'."""
+    r = run_path(capsys, tmp_path, "G90 G00 X0 Y0 Z0\nG2.4 X10. Y10. Z5. F300\nG01 X20.\nM30\n")
+    assert r.code == 1 and r.alarm["code"] == "0x0260" and r.alarm["line"] == 3, r.alarm
+
+
+def test_three_point_arc_is_refused_under_g68_app_a_0x025f(capsys, tmp_path):
+    r = run_path(capsys, tmp_path, "G90 G00 X0 Y0 Z0\nG68 X0 Y0 R30.\nG2.4 X10. Y10. Z5. F300\nG2.4 X20. Y0 Z10.\nM30\n")
+    assert r.code == 1 and r.alarm["code"] == "0x025F" and r.alarm["line"] == 3, r.alarm

@@ -42,6 +42,7 @@ M_BEFORE_MOTION = {3, 4, 8, 19, 29}  # issued to the MLC before the block's moti
 M_END = {2, 30}
 # Codes whose axis words name a centre or the axes concerned, never a target: no motion in their block.
 TRANSFORM_ARG_FUNCS = frozenset({"scale", "mirror", "mirror_off", "G68"})
+CHORD_TOL_3D = 0.0005  # mm: G2.4/G3.4 chords deviate from the arc by at most 0.5 µm
 # App. A 0x025F, N§3.12.5: refused while G68 rotation is on, until G69
 REFUSED_UNDER_G68 = frozenset({"G54", "G55", "G56", "G57", "G58", "G59", "G28", "G29", "G30", "G2.4", "G3.4"})
 # Non-modal codes whose block runs no motion of the current motion mode (the code itself moves or not).
@@ -698,7 +699,9 @@ class Interpreter:
             if st.cycle is not None:  # a group-01 code cancels the cycle as G80 does
                 self.cycle_memory.pop("hole", None)
             st.cycle = None
-            self._three_point = None
+            if self._three_point is not None and fn not in ("G2.4", "G3.4"):
+                # N§3.3.4: the middle-point block is followed by the end-point block
+                raise NcAlarm(0x0260, f"{fn} after a G2.4/G3.4 middle point: the end point block is missing")
         elif grp == 2:
             if st.comp != 40 and int(w.value) != st.plane:
                 raise NcAlarm(0x1203, "plane change while tool radius compensation is active")
@@ -921,7 +924,9 @@ class Interpreter:
         if "G04" in funcs:
             return
         cyc = st.cycle
-        geo = self._geometry(block)
+        # N§3.3.4 note (1): under G91 the end point of G2.4/G3.4 counts from the middle point
+        mid = self._three_point
+        geo = self._geometry(block, base=None if mid is None else self.to_work(mid))
         if cyc is not None and not (funcs & {"G00", "G01", "G02", "G03"}):
             if geo.moved or self._cycle_fn(funcs):
                 self.unit_locked = True
@@ -1080,7 +1085,9 @@ class Interpreter:
         e1 = (a - centre) / radius
         e2 = np.cross(n, e1)
         ang_end = math.atan2(float(np.dot(c - centre, e2)), float(np.dot(c - centre, e1))) % (2 * math.pi)
-        segs = max(4, int(math.ceil(ang_end / math.radians(2.0))))
+        # chords whose sagitta stays within CHORD_TOL_3D of the true arc (every vertex is on the circle)
+        step = 2.0 * math.acos(max(-1.0, 1.0 - CHORD_TOL_3D / radius)) if radius > CHORD_TOL_3D else math.pi / 2
+        segs = max(4, int(math.ceil(ang_end / min(step, math.radians(2.0)))))
         feed = self.feed()
         for i in range(1, segs + 1):
             t = ang_end * i / segs
