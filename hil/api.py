@@ -54,6 +54,11 @@ class Result:
         return list(self.run.alarms)
 
     @property
+    def warnings(self) -> list[Any]:
+        """hil.aux_watch.AuxWarning: M/S/T codes the MLC did not answer in time."""
+        return list(getattr(self.runner, "warnings", ()))
+
+    @property
     def completed(self) -> bool:
         return bool(self.run.ok)
 
@@ -128,7 +133,7 @@ def run(program: str | Path, bench: str | Path | Bench | None = None, *, bus: st
         check: bool | None = None, trace_signals: str | None = None, m00_resume: float = 0.5,
         realtime: bool = False, overrun: str | None = None, progress: Any = None,
         servo_modbus: str | None = None, servo_baud: int = 38400, capture: str | Path | None = None,
-        scope: Any = None) -> Result:
+        scope: Any = None, aux_timeout: float = 5.0) -> Result:
     """Run `program` on a bench in lock-step virtual time (or `realtime`); see the module doc.
 
     `bench`: a bench file, a `Bench`, or None for the built-in 2-axis lathe. `events`: `--at`
@@ -136,7 +141,8 @@ def run(program: str | Path, bench: str | Path | Bench | None = None, *, bus: st
     (D2x002 feed 0–150 %, D2x004 rapid 0–100 %, D2x026 spindle 50–120 %); the MLC may change them.
     `check`: judge the run by the bench's [checks] (default: when it has any). `capture`: record the
     bus's frames (EtherCAT .pcapng, CAN .asc/.blf/.log; fieldbus/capture.py). `scope`: a started
-    `hil.scope.Scope` that streams this run's rows to its page."""
+    `hil.scope.Scope` that streams this run's rows to its page. `aux_timeout`: simulated seconds an
+    M/S/T code may wait for the MLC's finish before a warning (0: never)."""
     from hil.clock import make_clock
     from hil.progress import Progress
     from hil.remote_io import attach_remote_io
@@ -149,6 +155,8 @@ def run(program: str | Path, bench: str | Path | Bench | None = None, *, bus: st
 
     if not 0.0 <= m00_resume < float("inf"):
         raise InputError(f"--m00-resume {m00_resume:g}: seconds must be >= 0")
+    if not 0.0 <= aux_timeout < float("inf"):
+        raise InputError(f"--aux-timeout {aux_timeout:g}: seconds must be >= 0 (0: no warning)")
     feed = _percent("feed override", feed_override, 150.0)
     rapid = _percent("rapid override", rapid_override, 100.0)
     spindle = _percent("spindle override", spindle_override, 120.0)
@@ -167,6 +175,10 @@ def run(program: str | Path, bench: str | Path | Bench | None = None, *, bus: st
     clock = make_clock(b.cycle, realtime, b.realtime)
     if progress is True:
         progress = Progress(max((blk.line for blk in prog.blocks), default=1))
+    if aux_timeout:  # warn when an M/S/T code waits longer for the MLC's finish (decision T7)
+        from hil.aux_watch import AuxWatch
+
+        progress = AuxWatch(aux_timeout, progress)
     wants_events = bool(events or event_files)
     overridden = (feed, rapid, spindle) != (100.0, 100.0, 100.0)
     m, panel, signal_sources = mlc_setup(b, mlc, trace_signals, m00_resume, wants_events)

@@ -43,6 +43,7 @@ def as_dict(result: Any, allow_unfired: bool = False) -> dict[str, Any]:
         "bench": {"name": bench.name, "source": bench.source, "profile": bench.profile, "bus": bench.bus,
                   "cycle_s": bench.cycle},
         "alarms": [a.as_dict() for a in result.alarms],
+        "warnings": [w.as_dict() for w in getattr(result, "warnings", ())],
         "checks": [c.as_dict() for c in result.checks],
         "events": {"applied": [{"spec": e.spec, "t": e.fired_time, "cycle": e.fired_cycle, "line": e.fired_line,
                                 "action": str(e.action)} for e in applied],

@@ -158,3 +158,32 @@ def test_user_mlc_error_names_file_line_and_traceback(tmp_path):
     assert f'File "{mlc}", line 8, in scan' in r.stdout and f'File "{mlc}", line 2, in helper' in r.stdout
     assert "0x0000" not in r.stdout + r.stderr and "machine.py" not in r.stdout
     assert "result         STOPPED" in r.stdout
+
+
+def test_mst_code_the_mlc_never_answers_is_a_warning(tmp_path):
+    """M08 answered after 1.2 s, M09 never (an MLC that ignores it): with --aux-timeout 1 each gets a
+    warning once, on stderr while it waits, in the summary, in --json and in the trace's end record;
+    the NC keeps waiting as Delta's does, until max_time (0xDE03) ends the run, exit 1."""
+    import json
+
+    from hil.trace_read import TraceFile
+
+    mlc = tmp_path / "slow_mlc.py"
+    mlc.write_text('def scan(mlc):\n    if not mlc.m("M_STROBE"):\n        mlc.set("MST_FINISH", False)\n'
+                   '        return\n    if int(mlc.d("M_CODE")) == 8 and mlc.timer("fin", 1.2, True):\n'
+                   '        mlc.set("MST_FINISH")\n')
+    bench = tmp_path / "b.toml"
+    bench.write_text(Path(LATHE).read_text().replace('cycle_ms = 1.0', 'cycle_ms = 1.0\nmax_time = 3'))
+    prog = tmp_path / "p.nc"
+    prog.write_text("G98\nM08\nM09\nM30\n")
+    r = _hil("run", str(prog), "--bench", str(bench), "--mlc", str(mlc), "--aux-timeout", "1", "--json",
+             "--trace", str(tmp_path / "t.parquet"))
+    assert r.returncode == 1, r.stderr
+    out = json.loads(r.stdout)
+    assert out["alarms"][0]["code"] == "0xDE03"
+    w = out["warnings"]
+    assert [(x["code"], x["line"], x["waited_s"]) for x in w] == [("M08", 2, 1.0), ("M09", 3, 1.0)]
+    assert w[0]["answered_t"] == pytest.approx(w[0]["t"] + 1.2, abs=0.01) and w[1]["answered_t"] is None
+    assert "warning: M09 (line 3: M09) strobed at" in r.stderr and "never answered" in r.stderr
+    end = TraceFile(tmp_path / "t.parquet").meta["end"]
+    assert [x["code"] for x in end["warnings"]] == ["M08", "M09"]

@@ -58,6 +58,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--junit", metavar="FILE", help="write JUnit XML: a test case for the run and one per check")
     p.add_argument("--capture", metavar="FILE",
                    help="record the bus's frames: EtherCAT as .pcapng (Wireshark/tshark), CAN as .asc/.blf/.log")
+    p.add_argument("--aux-timeout", metavar="SECONDS", type=float, default=5.0,
+                   help="warn when an M/S/T code waits longer than this (simulated) for the MLC's finish "
+                        "M2x016; the run keeps waiting as the NC does (default 5, 0: never)")
     p.add_argument("--scope", action="store_true",
                    help="live scope: serve a page on 127.0.0.1 (free port, printed) that streams trace columns "
                         "while the run goes")
@@ -116,7 +119,7 @@ def _run_and_print(args: argparse.Namespace, scope) -> int:
                 trace_signals=args.trace_signals, m00_resume=args.m00_resume, realtime=args.realtime,
                 overrun=args.overrun, progress=True if wants_progress(args.progress) else None,
                 servo_modbus=args.servo_modbus, servo_baud=args.servo_baud,
-                capture=args.capture, scope=scope)
+                capture=args.capture, scope=scope, aux_timeout=args.aux_timeout)
     except InputError as exc:
         if exc.alarm is not None:
             print_alarm(exc.alarm)
@@ -152,6 +155,8 @@ def print_run(program: str, r, out) -> None:
     from hil.run_events import EventPlayer
 
     print_summary(program, r.bench, r.run, out)
+    for w in r.warnings:  # M/S/T codes the MLC left waiting (hil/aux_watch.py)
+        print(w.text, file=out)
     runner = r.runner
     waits = [(ln, w) for ln, w in runner.channel.planner.thread_waits if w] if runner.channel is not None else []
     if waits:  # threads armed only once the spindle settled at its command (motion decisions 33)
