@@ -506,7 +506,7 @@ class BenchRunner:
         return {"reason": reason, "alarm": pool[0].code_text if pool else None,
                 "alarm_line": pool[0].line if pool else None, "cycle": self.cycle, "t": round(self.time, 9),
                 "complete": reason != "interrupted", "bus": "closed" if self._bus_closed else "open",
-                "warnings": [w.as_dict() for w in getattr(self, "warnings", ())]}  # hil/aux_watch.py
+                **({"warnings": [w.as_dict() for w in self.warnings]} if getattr(self, "warnings", None) else {})}
 
     def _finish(self) -> RunResult:
         r = self.result
