@@ -24,7 +24,7 @@ import numpy as np
 from nc.alarm_table import PLANNING_STALL
 from nc.alarms import NcAlarm
 from nc.motion.limits import MotionConfig
-from nc.motion.lookahead import MARGIN, Block, Limits, backward, change_distance, reach
+from nc.motion.lookahead import MARGIN, Block, Limits, backward, change_distance, max_speed_at, reach
 from nc.motion.path import Segment
 from nc.motion.profile import Piecewise, solve_axes, solve_position, solve_velocity
 from nc.motion.smoothing import PositionFilter
@@ -595,9 +595,15 @@ class Planner:
                     or (b.vend >= vmax - 1e-9 and dist >= cruise_from):
                 return dist, min(b.vend, vmax), ra, rj, vmax
             if b.vjunc < cap - 1e-9:
-                if not extend or b.binding:
+                if b.binding and b.vend >= max_speed_at(self.v, self.a, dist - self.s, ra, rj):
+                    # Not reachable faster than it allows from the present state (a rising
+                    # chain of caps behind a corner): it cannot bind, and a profile that ended
+                    # there at zero acceleration would only lose time.
+                    pass
+                elif not extend or b.binding:
                     return dist, min(b.vend, vmax), ra, rj, vmax
-                vmax = min(vmax, b.vjunc)
+                else:
+                    vmax = min(vmax, b.vjunc)
             dist += nx.length
             ra, rj = min(ra, nx.a), min(rj, nx.j)
             k += 1
