@@ -83,10 +83,35 @@ def cam_polyline(n: int = 2000, seg: float = 0.775, turn_deg: float = 15.0, seed
         axis /= np.linalg.norm(axis)
         d = d * math.cos(ang) + np.cross(axis, d) * math.sin(ang)
         d[2] -= 0.3 * (p[2] - 98.0) / 5.0 * abs(d[2]) + 0.02 * (p[2] - 98.0)  # keep Z near 98
+        d[:2] -= 0.002 * p[:2]  # and X/Y within the bench's soft limits
         d /= np.linalg.norm(d)
         p = p + d * seg * rng.uniform(0.7, 1.3)
         pts.append(tuple(round(float(c), 3) for c in p))
-    return Program(f"CAM 3-D polyline {n} segments", feed, pts)
+    return Program(f"CAM 3-D random corners {n} segments", feed, pts)
+
+
+def cam_surface(n: int = 2000, seg: float = 0.775, feed: float = 2500.0) -> Program:
+    """A 3-D CAM finishing path as a CAM system samples it: a smooth space curve (curvature radius
+    2–6 mm, the turning plane drifting slowly, Z waving within a few mm), cut into chords of
+    about `seg` mm (±30 %) and written with 3 decimals, so the tangent steps carry rounding jitter."""
+    rng = np.random.default_rng(7)
+    d = np.array([1.0, 0.0, 0.0])
+    nrm = np.array([0.0, 0.0, 1.0])
+    p = np.array(START)
+    pts = []
+    for k in range(n):
+        nrm = nrm + rng.normal(0.0, 0.15, 3)
+        nrm -= nrm.dot(d) * d
+        nrm /= np.linalg.norm(nrm)
+        step = seg * rng.uniform(0.7, 1.3)
+        radius = 4.0 + 2.0 * math.sin(k / 37.0)
+        ang = step / radius
+        d = d * math.cos(ang) + np.cross(nrm, d) * math.sin(ang)
+        d[2] -= 0.05 * (p[2] - 98.0)  # keep Z near 98
+        d /= np.linalg.norm(d)
+        p = p + d * step
+        pts.append(tuple(round(float(c), 3) for c in p))
+    return Program(f"CAM 3-D curve {n} chords", feed, pts)
 
 
 def contour_90(side: float = 200.0, feed: float = 6000.0) -> Program:
@@ -110,7 +135,7 @@ def mixed(feed: float = 3000.0) -> Program:
 
 def programs() -> list[Program]:
     return [contour_90(), chord_circle(10.0), chord_circle(5.0), chord_circle(2.0), chord_circle(50.0),
-            cam_polyline(), mixed()]
+            cam_surface(), cam_polyline(), mixed()]
 
 
 # ---- measuring ---------------------------------------------------------------------------------
@@ -168,13 +193,16 @@ def run_lcnc(prog: Program, work: Path) -> Result | None:
     if not samples.exists():
         return None
     rows = [ln.split() for ln in samples.read_text().splitlines() if ln.strip()]
+    idx = np.array([int(r[0]) for r in rows])
     P = np.array([[float(v) for v in r[1:4]] for r in rows])
     line = np.array([int(r[4]) for r in rows])
     # From the cycle before the first motion of a program line (the runner's own rule).
     i0, i1 = motion_window(P)
     i0 = max(i0, int(np.nonzero(line > 0)[0][0]) - 1)
     S = P[i0:i1 + 1]
-    return Result((i1 - i0) * 0.001, polyline_deviation(S, [START] + prog.points), *shares(S))
+    gaps = int(np.sum(np.diff(idx[i0:i1 + 1]) != 1))  # halsampler overruns under load
+    return Result((i1 - i0) * 0.001, polyline_deviation(S, [START] + prog.points), *shares(S),
+                  f"LinuxCNC samples lost: {gaps}" if gaps else "")
 
 
 def lcnc_available() -> str | None:
@@ -209,7 +237,8 @@ def main() -> None:
             lcs = (f"{lc.time:8.3f} {lc.deviation:7.4f} {lc.v:4.2f}/{lc.a:4.2f}/{lc.j:5.1f}" if lc
                    else f"{'-':>8s} {'-':>7s} {'-':>15s}")
             print(f"{prog.name:32s} {prog.feed_limited():7.3f} | {h.time:7.3f} {h.deviation:7.4f} "
-                  f"{h.v:4.2f}/{h.a:4.2f}/{h.j:5.2f} | {lcs} | {ratio} {h.time / prog.feed_limited():9.3f}  {h.note}",
+                  f"{h.v:4.2f}/{h.a:4.2f}/{h.j:5.2f} | {lcs} | {ratio} {h.time / prog.feed_limited():9.3f}  {h.note}"
+                  + (f"; {lc.note}" if lc and lc.note else ""),
                   flush=True)
     finally:
         if not args.keep:
