@@ -51,16 +51,24 @@ class AxisScaling:
     lead: float = 10.0  # mm per load revolution (ball-screw lead); 360 for a rotary axis in degrees
     direction: int = 1  # +1, or -1 when the motor is mounted reversed
     units: DriveUnits = field(default=DELTA_UNITS)  # the drive's velocity / torque units
+    # Derived once: the bench cycle converts several values per axis every cycle.
+    _cpu: float = field(init=False, repr=False, compare=False)
+    _raw_per_cps: float = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "_cpu", self.counts_per_rev * self.gear_motor / (self.gear_load * self.lead)
+                           * self.direction)
+        object.__setattr__(self, "_raw_per_cps", self.units.raw_per_count_per_s(self.counts_per_rev))
 
     @property
     def counts_per_unit(self) -> float:
-        return self.counts_per_rev * self.gear_motor / (self.gear_load * self.lead) * self.direction
+        return self._cpu
 
     def to_counts(self, units: float) -> int:
-        return int(round(units * self.counts_per_unit))
+        return int(round(units * self._cpu))
 
     def to_units(self, counts: float) -> float:
-        return counts / self.counts_per_unit
+        return counts / self._cpu
 
     # ---- velocities: the drive's units (0x60FF / 0x606C) ----------------------------------------
     def velocity_to_drive(self, units_per_s: float) -> int:
@@ -69,10 +77,10 @@ class AxisScaling:
 
     def drive_to_velocity(self, raw: float) -> float:
         """The drive's velocity units to mm/s (deg/s)."""
-        return self.drive_to_counts_per_s(raw) / self.counts_per_unit
+        return raw / self._raw_per_cps / self._cpu
 
     def drive_to_counts_per_s(self, raw: float) -> float:
-        return self.units.raw_to_velocity(raw, self.counts_per_rev)
+        return raw / self._raw_per_cps  # DriveUnits.raw_to_velocity with the factor derived once
 
     def rpm_to_drive(self, rpm: float) -> int:
         """Load-side rev/min (spindles) to the drive's target-velocity units."""

@@ -9,17 +9,23 @@ from mlc.nc_link import DriveStatus
 
 
 def drive_status(runner: Any) -> list[DriveStatus]:
-    out = []
+    """The drives' status this cycle. The records are the runner's own, updated in place every cycle
+    (the MLC reads them within the cycle): no new objects per cycle."""
     n_axes = len(runner.axes)
     status = runner.link.status() if callable(getattr(runner.link, "status", None)) else None
-    for i, (m, tx, sc) in enumerate(zip(runner.masters, runner.tx, runner.scales)):
-        spindle = i >= n_axes
-        vel = sc.drive_to_velocity(tx.velocity_actual)
-        rpm = sc.drive_to_rpm(tx.velocity_actual)
-        connected = status is None or status.slave_ok(i)  # the slave in OP (issue 6)
-        out.append(DriveStatus(runner._name(i), connected=connected, servo_on=m.state is State.OPERATION_ENABLED,
-                               fault=m.faulted, torque=sc.torque_percent(tx.torque_actual) * 10.0,  # D30240: 0.1 %
-                               velocity=vel, rpm=rpm,
-                               position=sc.to_units(tx.position_actual), spindle=spindle,
-                               mode=getattr(tx, "mode_display", 8)))
+    out: list[DriveStatus] | None = getattr(runner, "_drive_status", None)
+    if out is None or len(out) != len(runner.masters):
+        out = [DriveStatus(runner._name(i), spindle=i >= n_axes) for i in range(len(runner.masters))]
+        runner._drive_status = out
+    enabled = State.OPERATION_ENABLED
+    for i, (m, tx, sc, d) in enumerate(zip(runner.masters, runner.tx, runner.scales, out)):
+        raw = tx.velocity_actual
+        d.connected = status is None or status.slave_ok(i)  # the slave in OP (issue 6)
+        d.servo_on = m.state is enabled
+        d.fault = m.faulted
+        d.torque = sc.torque_percent(tx.torque_actual) * 10.0  # D30240: 0.1 %
+        d.velocity = sc.drive_to_velocity(raw)
+        d.rpm = d.velocity / sc.lead * 60.0  # AxisScaling.drive_to_rpm, velocity not converted twice
+        d.position = sc.to_units(tx.position_actual)
+        d.mode = getattr(tx, "mode_display", 8)
     return out

@@ -17,6 +17,7 @@ from fieldbus.link import BusError, BusLink
 from fieldbus.pdo import RxPdo, TxPdo
 from hil.bench import Bench
 from hil.clock import CycleTiming, LockStepClock, RealTimeClock
+from hil.mlc_bridge import drive_status
 from hil.trace import TraceSource, TraceWriter, trace_columns
 from mlc.basic import BasicMlc
 from nc.alarm_table import MAX_TIME
@@ -309,8 +310,6 @@ class BenchRunner:
         ch = self.channel if not self._planner_failed else None  # a failed NC is not stepped again
         if ch is not None:
             if hasattr(self.mlc, "bus_feedback"):  # drive status for the MLC's special M/D (issue 8)
-                from hil.mlc_bridge import drive_status
-
                 self.mlc.bus_feedback(drive_status(self))
             if hasattr(self.mlc, "bus_status") and callable(getattr(self.link, "status", None)):
                 self.mlc.bus_status(self.link.status())  # M30000 / EIO relays from the bus state (issue 6)
@@ -366,7 +365,10 @@ class BenchRunner:
 
     def _new_alarms(self) -> str:
         """Codes of the alarms raised since the previous row (by the bench or by the channel)."""
-        pool = self.result.alarms + (self.channel.alarms if self.channel is not None else [])
+        ch_alarms = self.channel.alarms if self.channel is not None else []
+        if not self.result.alarms and not ch_alarms:
+            return ""  # the usual row: nothing to look through
+        pool = self.result.alarms + ch_alarms
         new = [a for a in pool if id(a) not in self._seen_alarms]
         self._seen_alarms.update(id(a) for a in new)
         return ";".join(dict.fromkeys(a.code_text for a in new))

@@ -24,6 +24,8 @@ XY_SIZE = 1024  # remote I/O points X0 … X1023 / Y0 … Y1023 (docs/decisions/
 
 _ADDR = re.compile(r"^\s*([MDAXY])\s*(\d{1,5})\s*$", re.IGNORECASE)
 
+_F32, _U32 = struct.Struct("<f"), struct.Struct("<I")  # compiled once: f32 ↔ raw pairs are per-scan work
+
 WordOrder = Literal["low-first", "high-first"]
 
 
@@ -122,10 +124,10 @@ class DeviceMemory:
     set_s32 = set_u32
 
     def f32(self, n: int) -> float:
-        return struct.unpack("<f", struct.pack("<I", self.u32(n)))[0]
+        return _F32.unpack(_U32.pack(self.u32(n)))[0]
 
     def set_f32(self, n: int, value: float) -> None:
-        self.set_u32(n, struct.unpack("<I", struct.pack("<f", float(value)))[0])
+        self._set_pair(n, _U32.unpack(_F32.pack(float(value)))[0])
 
     # ---- by name --------------------------------------------------------------------------
     def get(self, address: str) -> int:

@@ -74,14 +74,16 @@ class ChannelLink:
     cycle: int = 0
 
     # ---- helpers --------------------------------------------------------------------------------
+    # Called dozens of times per scan: the relay address (m2/m3) is computed inline and the bit read
+    # or written in the byte array itself.
     def _m2(self, i: int) -> bool:
-        return self.mem.bit(m2(self.x, i))
+        return bool(self.mem.m[20000 + 1000 * self.x + i])
 
     def _set3(self, i: int, on: bool) -> None:
-        self.mem.set_bit(m3(self.x, i), on)
+        self.mem.m[30000 + 1000 * self.x + i] = 1 if on else 0
 
     def _rising(self, address: int) -> bool:
-        now = self.mem.bit(address)
+        now = bool(self.mem.m[address])
         before = self._prev.get(address, False)
         self._prev[address] = now
         return now and not before
@@ -223,8 +225,12 @@ class ChannelLink:
                 setattr(ch, name, value)
 
     def _spindle_alarm(self, ch: Channel) -> None:
+        m, prev = self.mem.m, self._prev
         for k in range(8):
-            if self._rising(m2(self.x, 711 + 16 * k)):
+            a = m2(self.x, 711 + 16 * k)
+            if not m[a] and not prev.get(a, False):
+                continue  # low now and before: no edge, nothing to remember (what _rising would find)
+            if self._rising(a):
                 self._raise(ch, Alarm(SPINDLE_ALARM, f"MLC activated the alarm of spindle {k + 1}"))
 
     def _user_alarms(self, ch: Channel) -> None:
@@ -245,8 +251,12 @@ class ChannelLink:
             ex.on_write = self._variable_written
         x, mem = self.x, self.mem
         for (lo, hi, is_bit) in ex.input_ranges:
-            dev = ex.device(lo, x)
-            kind, first = dev[0], int(dev[1:])
+            named = ("dev", id(ex), getattr(ex, "legacy", False), lo, x)
+            where = self._var_cache.get(named)
+            if where is None:  # the device of a range is fixed: named once, not parsed every scan
+                dev = ex.device(lo, x)
+                where = self._var_cache[named] = (dev[0], int(dev[1:]))
+            kind, first = where
             count = hi - lo + 1
             raw = bytes(mem.m[first:first + count]) if kind == "M" else mem.d[first:first + count].tobytes()
             key = (lo, kind)
@@ -310,42 +320,45 @@ class ChannelLink:
     # ---- NC publishes its status -------------------------------------------------------------------
     def nc_outputs(self, ch: Channel, drives: list[DriveStatus] | None = None) -> None:
         x, mem = self.x, self.mem
+        m = mem.m
+        b3 = 30000 + 1000 * x  # M3x000: the relays below are written straight into the bit array
+        mode = self.mode
         for k in range(8):
-            self._set3(k, self.mode == k)
-        self._set3(32, self._mode_switch_cycles > 0)
+            m[b3 + k] = 1 if mode == k else 0
+        m[b3 + 32] = 1 if self._mode_switch_cycles > 0 else 0
         self._handshake_output(ch)
         self._css_output(ch)
-        held = ch.state.name == "HOLD"
-        running = ch.state in (RunState.RUNNING, RunState.WAIT_AUX) and self._system_hold is None
-        self._set3(16, running)
-        self._set3(17, held)
-        self._set3(18, self._m2(13))
+        state = ch.state
+        held = state.name == "HOLD"
+        running = state in (RunState.RUNNING, RunState.WAIT_AUX) and self._system_hold is None
+        m[b3 + 16] = 1 if running else 0
+        m[b3 + 17] = 1 if held else 0
+        m[b3 + 18] = 1 if m[20000 + 1000 * x + 13] else 0  # M3x018 follows the E-stop input M2x013
         if self._reset_pending and ch.planner.idle:
-            self._set3(19, True)
+            m[b3 + 19] = 1
         elif not self._reset_pending:
-            self._set3(19, False)
-        self._set3(31, bool(getattr(ch, "interrupt_active", False)))  # M3x031: M96 in execution
-        self._set3(25, ch.state is RunState.ALARM or any(not isinstance(a.code, str) for a in self.alarms))
-        self._set3(40, bool(mem.active_alarms()))
-        block_stop = ch.state.name == "BLOCK_STOP"
-        self._set3(24, block_stop)
-        self._set3(39, block_stop)
-        if ch.state is RunState.FINISHED and ch.end is not None and self._program_end is None:
+            m[b3 + 19] = 0
+        m[b3 + 31] = 1 if getattr(ch, "interrupt_active", False) else 0  # M3x031: M96 in execution
+        m[b3 + 25] = 1 if state is RunState.ALARM or any(not isinstance(a.code, str) for a in self.alarms) else 0
+        m[b3 + 40] = 1 if mem.active_alarms() else 0
+        block_stop = state.name == "BLOCK_STOP"
+        m[b3 + 24] = m[b3 + 39] = 1 if block_stop else 0
+        if state is RunState.FINISHED and ch.end is not None and self._program_end is None:
             self._program_end = ch.end.code
         end = self._program_end
-        self._set3(21, end is not None)
-        self._set3(22, end == 2)
-        self._set3(23, end == 30)
-        mem.set_bit(m3(0, 80 + x - 1), True)
+        m[b3 + 21] = 1 if end is not None else 0
+        m[b3 + 22] = 1 if end == 2 else 0
+        m[b3 + 23] = 1 if end == 30 else 0
+        m[30080 + x - 1] = 1  # M3008x: this channel exists
         if drives is not None:
             self._drive_outputs(drives, ch)
         if self.manual is not None:
             mm = self.manual
             for i, a in enumerate(self.axes):
                 st = mm.axes[a]
-                self._set3(320 + i, st.homed)
-                self._set3(336 + i, st.home_done)
-                self._set3(352 + i, abs(ch.planner.position[i]) < 1e-6)
+                m[b3 + 320 + i] = 1 if st.homed else 0
+                m[b3 + 336 + i] = 1 if st.home_done else 0
+                m[b3 + 352 + i] = 1 if abs(ch.planner.position[i]) < 1e-6 else 0
         mem.set_u32(d3(x, 320), len(ch.planner.queue))
 
     def _handshake_output(self, ch: Channel) -> None:
@@ -404,38 +417,41 @@ class ChannelLink:
 
     def _drive_outputs(self, drives: list[DriveStatus], ch: Channel | None = None) -> None:
         mem, x = self.mem, self.x
-        mem.set_bit(m3(0, 0), all(d.connected for d in drives))
-        mem.set_bit(m3(x, 34), any(d.fault for d in drives))
+        m = mem.m
+        b3 = 30000 + 1000 * x  # M3x000
+        m[30000] = 1 if all(d.connected for d in drives) else 0  # M30000
+        m[b3 + 34] = 1 if any(d.fault for d in drives) else 0
         axes = [d for d in drives if not d.spindle]
         spindles = [d for d in drives if d.spindle]
-        mem.set_bit(m3(x, 36), all(d.servo_on for d in drives))
+        m[b3 + 36] = 1 if all(d.servo_on for d in drives) else 0
         for k, d in enumerate(axes[:16]):
-            mem.set_bit(m3(x, 256 + k), d.connected)
-            mem.set_bit(m3(x, 272 + k), d.servo_on)
-            moving = abs(d.velocity) > 1e-4
-            mem.set_bit(m3(x, 464 + k), moving)
-            mem.set_bit(m3(x, 480 + k), d.velocity > 1e-4)
-            mem.set_bit(m3(x, 496 + k), d.velocity < -1e-4)
+            v = d.velocity
+            m[b3 + 256 + k] = 1 if d.connected else 0
+            m[b3 + 272 + k] = 1 if d.servo_on else 0
+            m[b3 + 464 + k] = 1 if abs(v) > 1e-4 else 0  # moving
+            m[b3 + 480 + k] = 1 if v > 1e-4 else 0
+            m[b3 + 496 + k] = 1 if v < -1e-4 else 0
         for k, d in enumerate((axes + spindles)[:32]):
-            mem.set_s16(d3(0, 240 + k), int(round(d.torque)))
+            torque = int(round(d.torque))
+            mem.set_s16(d3(0, 240 + k), torque)
             mem.set_f32(d3(0, 272 + 2 * k), d.velocity * 60.0)
             mem.set_f32(d3(0, 336 + 2 * k), d.rpm)
             peak = d3(0, 400 + k)
-            mem.set_u16(peak, max(mem.u16(peak), min(abs(int(round(d.torque))), 0xFFFF)) if d.servo_on else 0)
+            mem.set_u16(peak, max(mem.u16(peak), min(abs(torque), 0xFFFF)) if d.servo_on else 0)
         for k, d in enumerate(spindles[:8]):
-            mem.set_bit(m3(x, 96 + k), d.connected)
+            m[b3 + 96 + k] = 1 if d.connected else 0
             mem.set_s16(d3(0, 432 + k), int(round(d.torque)))
-            base = 704 + 16 * k
+            base = b3 + 704 + 16 * k
             cmd = self.commanded_rpm(k)
             if k == 0:  # what the drive is really given: G96, override, G50 clamp
                 css, clamp = (ch.css_rpm, ch.spindle_max) if ch is not None else (None, None)
                 ovr = ch.spindle_factor if ch is not None else self.mem.u16(d2(x, 26)) / 100.0
                 cmd = spindle_speed(cmd, css, clamp, self.spindle_max_rpm, ovr)
-            mem.set_bit(m3(x, base + 1), abs(d.rpm) < 1.0)
+            m[base + 1] = 1 if abs(d.rpm) < 1.0 else 0
             reached = abs(cmd) > 0 and abs(d.rpm - cmd) <= max(1.0, 0.02 * abs(cmd))
-            mem.set_bit(m3(x, base), reached)
-            mem.set_bit(m3(x, base + 6), d.servo_on)
-            mem.set_bit(m3(x, base + 5), d.mode == 8)
+            m[base] = 1 if reached else 0
+            m[base + 6] = 1 if d.servo_on else 0
+            m[base + 5] = 1 if d.mode == 8 else 0
             if k == 0:
                 mem.set_f32(d3(x, 26), d.rpm)
                 mem.set_f32(d3(x, 28), d.position % 360.0)

@@ -141,7 +141,14 @@ class ScanContext:
     def d(self, spec: str) -> float:
         sig = self.signal(spec)
         n, mem = sig.number, self.mem
-        return {"u16": mem.u16, "s16": mem.s16, "u32": mem.u32, "f32": mem.f32}.get(sig.width, mem.u16)(n)
+        w = sig.width  # no per-call dict of bound methods: user scans read registers every cycle
+        if w == "f32":
+            return mem.f32(n)
+        if w == "u32":
+            return mem.u32(n)
+        if w == "s16":
+            return mem.s16(n)
+        return mem.u16(n)
 
     def put(self, spec: str, value: float) -> None:
         sig = self.signal(spec)

@@ -189,16 +189,24 @@ class Cia402Drive:
             prev = target = self.command
             ff_vel = 0.0
         v_before = self.velocity
+        # The state and mode cannot change inside the cycle (faults are taken in _supervise, after
+        # it): the branch, the speed limit and the filter gain are chosen once, not per sub-step.
+        max_cps = self._max_cps
+        alpha = 1.0 - math.exp(-p.velocity_bandwidth * h)
+        limited = p.negative_limit is not None or p.positive_limit is not None
+        probing = bool(self._rx.touch_probe_function & 1)
+        enabled = self.state is State.OPERATION_ENABLED
+        csp, csv = enabled and self.mode == 8, enabled and self.mode == 9
         for k in range(1, n + 1):
             if not energised:
                 # Brake engaged / motor free: friction stops it within a few ms.
                 self.velocity *= math.exp(-h * 400.0)
                 v_cmd = self.velocity
                 self.command = self.position
-            elif self.state is State.OPERATION_ENABLED and self.mode == 8:
+            elif csp:
                 self.command = prev + (target - prev) * k / n
                 v_cmd = p.kff * ff_vel + p.kp * (self.command - self.position)
-            elif self.state is State.OPERATION_ENABLED and self.mode == 9:
+            elif csv:
                 want = self._want_cps
                 step = p.csv_accel * h
                 self.target_velocity += max(-step, min(step, want - self.target_velocity))
@@ -209,13 +217,18 @@ class Cia402Drive:
                 self.velocity -= max(-step, min(step, self.velocity))
                 v_cmd = self.velocity
                 self.command = self.position
-            v_cmd = max(-self._max_cps, min(self._max_cps, v_cmd))
+            v_cmd = max(-max_cps, min(max_cps, v_cmd))
             if energised and v_cmd != self.velocity:
-                alpha = 1.0 - math.exp(-p.velocity_bandwidth * h)
                 self.velocity += (v_cmd - self.velocity) * alpha
             new_pos = self.position + self.velocity * h
-            new_pos = self._limit(new_pos)
-            self._probe(self.position, new_pos)
+            if limited:
+                new_pos = self._limit(new_pos)
+            else:
+                self._no_limit()
+            if probing:
+                self._probe(self.position, new_pos)
+            else:
+                self._probe_latched = False
             self.position = new_pos
             self.time += h
         self.acceleration = (self.velocity - v_before) / dt
@@ -224,6 +237,12 @@ class Cia402Drive:
                      + (math.copysign(p.coulomb, self.velocity) if abs(self.velocity) > 1 else 0.0))
         self.torque = torque_nm / p.rated_torque * 1000.0 if energised else 0.0
         self._supervise()
+
+    def _no_limit(self) -> None:
+        """_limit on a drive without limit switches: only a stale limit alarm code is cleared."""
+        self._limit_flags = 0
+        if self.error_code in (AL_REVERSE_LIMIT, AL_FORWARD_LIMIT) and self.state is not State.FAULT:
+            self.error_code = 0
 
     def _limit(self, new_pos: float) -> float:
         p = self.params
