@@ -101,3 +101,24 @@ def test_three_point_middle_without_end_point_is_0x0260(capsys, tmp_path):
 def test_three_point_arc_is_refused_under_g68_app_a_0x025f(capsys, tmp_path):
     r = run_path(capsys, tmp_path, "G90 G00 X0 Y0 Z0\nG68 X0 Y0 R30.\nG2.4 X10. Y10. Z5. F300\nG2.4 X20. Y0 Z10.\nM30\n")
     assert r.code == 1 and r.alarm["code"] == "0x025F" and r.alarm["line"] == 3, r.alarm
+
+
+def test_path_text_prints_one_convention_and_says_which(capsys, tmp_path):
+    """Issue 19 item 6: the lathe listing printed diameter end points with radius centres in one line."""
+    from hil.cli import main
+    f = tmp_path / "l.nc"
+    f.write_text("G00 X40. Z5.\nG01 Z-10. F100\nG02 X60. Z-20. R10.\nM30\n")
+    capsys.readouterr()
+    assert main(["path", str(f), "--profile", "nc5-lathe-a"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0] == "# work coordinates as the program writes them, X as a diameter; arc centres in the same coordinates"
+    assert lines[-1] == "    3 arc    X60 Z-20 cw centre X60 Z-10 F100/rev"  # centre at radius 30 = diameter 60
+
+
+def test_path_format_page_states_the_resolution_the_json_prints(capsys, tmp_path):
+    """Issue 19 item 5: docs/path-format.md promised 0.1 µm while --json printed 7 decimals."""
+    from tests.conftest import ROOT
+    r = run_path(capsys, tmp_path, "#1=1/3\nG90 G01 X#1 Y0 F100\nM30\n")
+    assert r.ends("X") == [(0.3333333,)]
+    text = (ROOT / "docs" / "path-format.md").read_text()
+    assert "rounded to 7 decimals (1e-7 mm" in text and "Numbers are rounded to 0.1 µm" not in text

@@ -48,12 +48,13 @@ def test_offline_path_lists_writes_and_leaves_reads_vacant(hil, program):
     r = hil("path", p, "--vars", "100-101")
     assert r.code == 0, r.err
     lines = r.out.splitlines()
-    assert lines[1] == "    2 servo  write P2-00 = 150 on station 1 -- not sent (offline, #20024 = -2)"
-    assert lines[2] == "    3 servo  read P1-44 on station 2 -- not sent (offline, #20024 = -2)"
+    assert lines[0].startswith("# work coordinates")
+    assert lines[2] == "    2 servo  write P2-00 = 150 on station 1 -- not sent (offline, #20024 = -2)"
+    assert lines[3] == "    3 servo  read P1-44 on station 2 -- not sent (offline, #20024 = -2)"
     assert lines[-1] == "vars #100=vacant #101=-2.0"
     # the branch is not taken offline (#100 is vacant): X30 runs before X20
     assert [l.split()[-1] for l in lines if " rapid " in l] == ["Z5", "Z5", "Z5"]
-    assert "X30" in lines[3] and "X20" in lines[4]
+    assert "X30" in lines[4] and "X20" in lines[5]
     j = hil("path", p, "--json").json_lines()
     servo = [e for e in j if e["kind"] == "servo"]
     assert servo[0] == {"kind": "servo", "line": 2, "block": "G10 L41 I1 P2 D0 R150", "station": 1,

@@ -93,7 +93,8 @@ def suspend(interp: Interpreter, move: Move, fraction: float) -> Move:
 
 
 def fmt(v: float) -> float:
-    """Round away float noise so golden files compare cleanly (0.1 µm)."""
+    """Round away float noise so golden files compare cleanly: 7 decimals, 1e-7 mm (0.1 nm), far below
+    the NC5's 0.001 mm input unit yet keeping computed points (arc chords, offsets) true to 1e-7."""
     r = round(v, 7)
     return 0.0 if r == 0 else r
 
@@ -154,6 +155,8 @@ def cmd_path(args: argparse.Namespace) -> int:
         print_alarm(exc.alarm, as_json=args.json)
         return EXIT_ALARM
     listed = 0  # G10 L40-L46 servo accesses are listed where they happen (issue 8)
+    if not args.json:
+        print(text_header(profile.diameter_axes), file=out)
     try:
         program = store.load_main(args.program)
         plotted: list[Move] = []
@@ -168,7 +171,7 @@ def cmd_path(args: argparse.Namespace) -> int:
                 if args.json:
                     print(strict_json.dumps(move_dict(ev)), file=out)
                 else:
-                    print(_human(ev), file=out)
+                    print(_human(ev, profile.diameter_axes), file=out)
             elif args.preview_log and isinstance(ev, Sync):
                 print(strict_json.dumps(ev.as_dict()) if args.json else f"{ev.line:5d} sync   {ev.reason}", file=out)
     except NcAlarm as exc:
@@ -229,11 +232,24 @@ def _print_preview(interp: Interpreter, args: argparse.Namespace) -> None:
             print(f"preview {r.line:5d} {r.block:30s} ran {where}")
 
 
-def _human(m: Move) -> str:
+def text_header(diameter_axes: tuple[str, ...]) -> str:
+    """The one convention of the text listing, said once (issue 19: end points were work coordinates with
+    lathe diameters, arc centres machine coordinates with radii)."""
+    dia = f", {'/'.join(diameter_axes)} as a diameter" if diameter_axes else ""
+    return f"# work coordinates as the program writes them{dia}; arc centres in the same coordinates"
+
+
+def work_centre(m: Move, diameter_axes: tuple[str, ...]) -> dict[str, float]:
+    """The arc centre in the end point's convention: work = machine - origin, doubled on diameter axes."""
+    return {a: m.work[a] + (c - m.end[a]) * (2.0 if a in diameter_axes else 1.0)
+            for a, c in m.center.items() if a in m.work and a in m.end}
+
+
+def _human(m: Move, diameter_axes: tuple[str, ...] = ()) -> str:
     end = " ".join(f"{a}{fmt(v):g}" for a, v in m.work.items())
     extra = ""
     if m.kind == "arc" and m.center:
-        extra = f" {m.dir} centre " + " ".join(f"{a}{fmt(v):g}" for a, v in m.center.items())
+        extra = f" {m.dir} centre " + " ".join(f"{a}{fmt(v):g}" for a, v in work_centre(m, diameter_axes).items())
     if m.feed is not None:
         extra += f" F{m.feed:g}{'/rev' if m.per_rev else ''}"
     if m.duration is not None:
