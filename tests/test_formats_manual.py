@@ -1,0 +1,81 @@
+"""Format rows of the manuals' chapters 2–3, written as the manual writes them (every optional word), each
+run through `hil path --json` with the end point or state the row's description promises.
+
+Rows are cited by id (docs/formats.md, `python docs/build_formats.py`): `N<section>-<k>` is the k-th row of
+the NC5 G command guide's "Instruction format" tables under that section, `L<section>-<k>` the lathe guide's.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import sys
+from dataclasses import dataclass
+
+import pytest
+
+from lang_helpers import run_path
+from tests.conftest import ROOT
+
+
+@dataclass(frozen=True)
+class FormatCase:
+    rows: tuple[str, ...]
+    program: str
+    axes: str
+    end: tuple[float, ...]  # the last move's work end point
+    profile: str = "nc5-mill"
+
+
+FORMAT_CASES = [
+    FormatCase(("N3.3.1-1",), "G90 G00 X92. Y35. Z1.\nM30\n", "XYZ", (92.0, 35.0, 1.0)),
+    FormatCase(("N3.3.3-1", "N3.3.3-2"), "G90 G00 X0 Y0\nG17 G02 X10. Y10. I10. J0 F100\nG03 X20. Y0 R10.\nM30\n",
+               "XY", (20.0, 0.0)),
+    FormatCase(("N3.3.3-3", "N3.3.3-4"), "G90 G00 X0 Z0\nG18 G02 X10. Z10. I0 K10. F100\nG03 X20. Z0 R10.\nM30\n",
+               "XZ", (20.0, 0.0)),
+    FormatCase(("N3.3.3-5", "N3.3.3-6"), "G90 G00 Y0 Z0\nG19 G02 Y10. Z10. J10. K0 F100\nG03 Y20. Z0 R10.\nM30\n",
+               "YZ", (20.0, 0.0)),
+    FormatCase(("N3.3.4-1", "N3.3.4-2"), "G90 G00 X0 Y0 Z0\nG2.4 X10. Y10. Z5. F300\nG2.4 X20. Y0 Z10.\nM30\n",
+               "XYZ", (20.0, 0.0, 10.0)),
+    FormatCase(("N3.3.4-3", "N3.3.4-4"), "G90 G00 X0 Y0 Z0\nG3.4 X10. Y10. Z5. F300\nG3.4 X20. Y0 Z10.\nM30\n",
+               "XYZ", (20.0, 0.0, 10.0)),
+    FormatCase(("N3.3.5-1", "N3.3.5-2"), "G90 G17 G00 X0 Y0\nG16 G01 X10. Y90. F100\nG15\nM30\n", "XY", (0.0, 10.0)),
+    FormatCase(("N3.4.1-1",), "G90 G00 X0 Y0\nG09 G01 X10. Y5. F100\nM30\n", "XY", (10.0, 5.0)),
+    FormatCase(("N3.4.2-1", "N3.4.3-1"), "G90 G61\nG01 X10. F100\nG64\nX20.\nM30\n", "X", (20.0,)),
+    FormatCase(("N3.5.1-1", "N3.5.2-1"), "G90 G00 X10. Y10. Z0\nG28 X0 Y0\nG29 X30. Y20.\nM30\n", "XY", (30.0, 20.0)),
+    FormatCase(("N3.5.4-1",), "G90 G00 X0 Y0\nG31 X50. F150. P1\nM30\n", "X", (50.0,)),
+    FormatCase(("N3.6.1-1", "N3.6.1-2", "N3.6.1-3"),
+               "G90 G00 X0 Y0 Z0\nG17 G01 X10. F100\nG18 G02 X20. Z0 R5.\nG19 G03 Y10. Z0 R5.\nM30\n", "XYZ",
+               (20.0, 10.0, 0.0)),
+    FormatCase(("N3.6.2-1",), "G90 G52 X5. Y5.\nG00 X0 Y0\nM30\n", "XY", (0.0, 0.0)),
+    FormatCase(("N3.6.3-1",), "G90 G53 X10. Y10.\nM30\n", "XY", (10.0, 10.0)),
+    FormatCase(("N3.6.4-1", "N3.6.4-2", "N3.6.4-3", "N3.6.4-4", "N3.6.4-5", "N3.6.4-6"),
+               "G54\nG55\nG56\nG57\nG58\nG59\nG90 G00 X1. Y2.\nM30\n", "XY", (1.0, 2.0)),
+    FormatCase(("N3.6.5-1",), "G54 P1\nG90 G00 X3. Y4.\nM30\n", "XY", (3.0, 4.0)),
+    FormatCase(("N3.6.6-1",), "G90 G00 X10. Y10.\nG92 X0 Y0\nG00 X5.\nM30\n", "X", (5.0,)),
+    FormatCase(("N3.7.1-1", "N3.7.2-1"), "G90 G00 X10.\nG91 G00 X5.\nM30\n", "X", (15.0,)),
+    FormatCase(("N3.7.3-1", "N3.7.3-2"), "G21\nG90 G00 X10.\nM30\n", "X", (10.0,)),
+    FormatCase(("L2.1-1",), "G00 X20. Z5.\nG00 U10. W-5.\nM30\n", "XZ", (30.0, 0.0), "lathe-2018"),
+    FormatCase(("L2.1-2",), "G00 X20. Z5.\nG01 U10. W-5. F100\nM30\n", "XZ", (30.0, 0.0), "lathe-2018"),
+]
+
+
+@pytest.mark.parametrize("case", FORMAT_CASES, ids=[c.rows[0] for c in FORMAT_CASES])
+def test_format_row_runs_as_the_manual_writes_it(capsys, tmp_path, case: FormatCase):
+    r = run_path(capsys, tmp_path, case.program, profile=case.profile)
+    assert r.code == 0, (case.rows, r.alarm)
+    assert r.moves and tuple(round(v, 6) for v in r.ends(*case.axes)[-1]) == case.end, case.rows
+
+
+def _builder():
+    spec = importlib.util.spec_from_file_location("build_formats", ROOT / "docs" / "build_formats.py")
+    mod = importlib.util.module_from_spec(spec)
+    sys.modules["build_formats"] = mod
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def test_formats_page_is_up_to_date_and_cites_only_real_rows():
+    b = _builder()
+    assert (ROOT / "docs" / "formats.md").read_text() == b.build(), "docs/formats.md is stale: python docs/build_formats.py"
+    ids = {r.id for r in b.manual_rows()}
+    assert not set(b.tested_rows()) - ids
