@@ -49,7 +49,8 @@ def time_figure(tf: TraceFile) -> Any:
     k = _step(len(t))
     ts = t[::k]
     lim = _limits(tf)
-    rows = ["following error", "velocity", "acceleration", "jerk", "spindle", "cycle jitter", "program line"]
+    rows = ["following error", "velocity", "acceleration", "jerk", "spindle", "cycle jitter", "program line",
+            "M/S/T handshake"]
     fig = make_subplots(rows=len(rows), cols=1, shared_xaxes=True, vertical_spacing=0.02, subplot_titles=rows)
 
     def line(row: int, x, y, name: str, **kw) -> None:
@@ -90,9 +91,66 @@ def time_figure(tf: TraceFile) -> Any:
             fig.add_scatter(x=t[hit[:50]], y=cols["line"][hit[:50]], mode="markers", name="alarm",
                             marker={"color": "red", "size": 9}, row=7, col=1)
     fig.update_yaxes(title_text="line", row=7, col=1)
+    handshake_lane(fig, cols, 8)
     fig.update_xaxes(title_text="time (s)", row=len(rows), col=1)
     fig.update_layout(height=220 * len(rows), margin={"t": 40, "l": 70, "r": 20, "b": 40})
     return fig
+
+
+# App. B strobes (NC→MLC), their code data and the one finish (MLC→NC), as --trace-signals names them
+STROBES = (("M", "M31064", "D31048"), ("S", "M31065", "D31050"), ("T", "M31066", "D31052"))
+FINISH = "M21016"
+HANDSHAKE_SIGNALS = "M_STROBE,S_STROBE,T_STROBE,MST_FINISH,M_CODE,S_CODE,T_CODE"
+
+
+def handshakes(cols: dict[str, Any]) -> list[dict[str, Any]]:
+    """Each strobe's rising edge (commanded) and the first finish after it (answered, None if never)."""
+    t = cols["t"]
+    fin = cols.get(FINISH)
+    fin_up = np.flatnonzero(np.diff(np.asarray(fin, dtype=np.int8), prepend=0) > 0) if fin is not None else []
+    out = []
+    for kind, strobe, data in STROBES:
+        if strobe not in cols:
+            continue
+        for i in np.flatnonzero(np.diff(np.asarray(cols[strobe], dtype=np.int8), prepend=0) > 0):
+            later = [j for j in fin_up if j >= i]
+            code = cols[data][i] if data in cols else None
+            # the strobe's row may still carry the previous block's line: take the block it waits in
+            span = cols["line"][i:(later[0] + 1) if later else i + 1]
+            line = next((int(x) for x in span if x), int(cols["line"][i]))
+            out.append({"kind": kind, "code": f"{kind}{int(code)}" if code is not None else kind,
+                        "t": float(t[i]), "line": line,
+                        "answered": float(t[later[0]]) if later else None})
+    return sorted(out, key=lambda h: h["t"])
+
+
+def handshake_lane(fig: Any, cols: dict[str, Any], row: int) -> None:
+    """Event lane: a bar from each M/S/T strobe to the MLC's finish (red and open-ended if none)."""
+    events = handshakes(cols)
+    if not events and STROBES[0][1] not in cols:
+        fig.add_annotation(text=f"run with --trace-signals {HANDSHAKE_SIGNALS} for this lane", showarrow=False,
+                           xref="x domain", yref="y domain", x=0.5, y=0.5, row=row, col=1)
+    end = float(cols["t"][-1]) if len(cols["t"]) else 0.0
+    for kind, color in (("M", "#1f77b4"), ("S", "#2ca02c"), ("T", "#9467bd")):
+        xs, ys, text = [], [], []
+        for h in (e for e in events if e["kind"] == kind):
+            stop = h["answered"] if h["answered"] is not None else end
+            what = (f"answered after {(h['answered'] - h['t']) * 1000:.0f} ms" if h["answered"] is not None
+                    else "never answered")
+            xs += [h["t"], stop, None]
+            ys += [kind, kind, None]
+            where = f" line {h['line']}" if h["line"] else ""  # the trace's line is the moving block's
+            text += [f"{h['code']}{where}: strobe", f"{h['code']}: {what}", None]
+        if xs:
+            fig.add_scatter(x=xs, y=ys, text=text, hoverinfo="text+x", mode="lines+markers", name=f"{kind} handshake",
+                            line={"color": color, "width": 6}, marker={"size": 8}, row=row, col=1)
+    unanswered = [h for h in events if h["answered"] is None]
+    if unanswered:
+        fig.add_scatter(x=[h["t"] for h in unanswered], y=[h["kind"] for h in unanswered], mode="markers",
+                        name="no MLC finish", marker={"color": "red", "size": 12, "symbol": "x"},
+                        text=[h["code"] for h in unanswered], row=row, col=1)
+    fig.update_yaxes(title_text="strobe → finish", categoryorder="array", categoryarray=["T", "S", "M"],
+                     row=row, col=1)
 
 
 def path_figure(tf: TraceFile, plane: tuple[str, str]) -> Any:

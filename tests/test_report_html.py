@@ -21,7 +21,8 @@ PROGRAM = "G98\nM03 S600\nG00 X24. Z2.\nG01 Z-3. F600.\nG02 X30. Z-6. R3.\nM30\n
 def report(tmp_path_factory):
     d = tmp_path_factory.mktemp("rh")
     (d / "p.nc").write_text(PROGRAM)
-    assert main(["run", str(d / "p.nc"), "--bench", str(BENCH), "--trace", str(d / "run.parquet")]) == 0
+    assert main(["run", str(d / "p.nc"), "--bench", str(BENCH), "--trace", str(d / "run.parquet"),
+                 "--trace-signals", "M_STROBE,S_STROBE,T_STROBE,MST_FINISH,M_CODE,S_CODE,T_CODE"]) == 0
     assert main(["report", str(d / "run.parquet"), "--out", str(d / "rep"), "--bench", str(BENCH)]) == 0
     return d / "rep" / "report.html"
 
@@ -49,11 +50,19 @@ def test_report_html_in_browser_zoom_links_axes(report):
         d.save_screenshot(str(report.parent / "report.png"))
         d.execute_script("Plotly.relayout('time', {'xaxis.range': [0.1, 0.3]})")
         ranges = d.execute_script("var l=document.getElementById('time').layout;"
-                                  "return [l.xaxis.range, l.xaxis4.range, l.xaxis7.range];")
+                                  "return [l.xaxis.range, l.xaxis4.range, l.xaxis7.range, l.xaxis8.range];")
         for r in ranges:  # shared x: the lowest plot (program line) follows the top one
             assert r == pytest.approx([0.1, 0.3])
         if os.environ.get("HIL_GUIDE_SHOTS"):  # HIL_GUIDE_SHOTS=1 refreshes the guide's screenshot
             d.save_screenshot(str(ROOT / "docs" / "guide" / "img" / "report-html.png"))
+        # the M/S/T lane: M03 and S600 strobed at power-up of the program, each answered by the MLC
+        lane = d.execute_script("return document.getElementById('time').data.filter(t => t.name && "
+                                "t.name.endsWith(' handshake')).map(t => [t.name, t.x, t.text]);")
+        by = {name: (x, text) for name, x, text in lane}
+        assert set(by) == {"M handshake", "S handshake"}
+        mx, mtext = by["M handshake"]
+        assert mtext[0].startswith("M3") and mx[1] > mx[0] and "answered after" in mtext[1]
+        assert by["S handshake"][1][0].startswith("S600") and by["S handshake"][0][1] > by["S handshake"][0][0]
     finally:
         d.quit()
 
