@@ -111,7 +111,7 @@ def _modal_taper(host: Any, block: Block, code: str) -> float:
 
 def _explicit(host: Any, block: Block, code: str) -> bool:
     """Does the block itself carry the cycle's G code (a new cycle rather than a modal repeat)?"""
-    from nc.interp.context import LATHE_CYCLES, MILL_CYCLES
+    from nc.cycles.codes import LATHE_CYCLES, MILL_CYCLES
     if host.profile.is_lathe:
         table = LATHE_CYCLES.get(host.profile.lathe_type or "A", {})
     else:

@@ -18,10 +18,10 @@ from nc.alarms import NcAlarm
 from nc.moves import Busy, Event, Move, ProgramEnd
 
 if TYPE_CHECKING:  # pragma: no cover
-    from nc.interp.interpreter import Interpreter
+    from nc.interp.host import InterpHost
 
 
-def expand_corners(interp: "Interpreter", events: Iterator[Event]) -> Iterator[Event]:
+def expand_corners(interp: "InterpHost", events: Iterator[Event]) -> Iterator[Event]:
     pending: tuple[Move, str, float] | None = None
     held: list[Event] = []  # M/S/T or dwell events of the next block, issued after the corner
     for ev in events:
@@ -54,7 +54,7 @@ def _fail(pending: tuple[Move, str, float]) -> None:
                   block=first.block, program=first.program)
 
 
-def _mark(interp: "Interpreter", mv: Move) -> tuple[str, float] | None:
+def _mark(interp: "InterpHost", mv: Move) -> tuple[str, float] | None:
     """The ,C / ,R request of the block that produced this move (only its last move carries it)."""
     b = interp.block
     if b is None or b.line != mv.line or b.text != mv.block or "G31" in mv.tags:
@@ -74,7 +74,7 @@ def _unit(a: tuple[float, float], b: tuple[float, float]) -> tuple[tuple[float, 
     return (dx / d, dy / d), d
 
 
-def _join(interp: "Interpreter", m1: Move, m2: Move, kind: str, value: float) -> list[Move]:
+def _join(interp: "InterpHost", m1: Move, m2: Move, kind: str, value: float) -> list[Move]:
     if m1.kind not in ("line", "rapid", "arc") or m2.kind not in ("line", "rapid", "arc"):
         raise NcAlarm(0x021D, f",{kind} is supported between lines and arcs (G00–G03)", line=m1.line,
                       block=m1.block, program=m1.program)
@@ -236,7 +236,7 @@ def _foot(e: _Elem, fc: Pt) -> Pt:
     return (e.c[0] + e.r * ux / u, e.c[1] + e.r * uy / u)
 
 
-def _join_curved(interp: "Interpreter", m1: Move, m2: Move, kind: str, value: float) -> list[Move]:
+def _join_curved(interp: "InterpHost", m1: Move, m2: Move, kind: str, value: float) -> list[Move]:
     def fail(msg: str) -> NcAlarm:
         return NcAlarm(0x0207, msg, line=m1.line, block=m1.block, program=m1.program)
 

@@ -20,7 +20,7 @@ from nc.interp.state import N_EXT_WCS
 from nc.moves import Aux, Event
 
 if TYPE_CHECKING:  # pragma: no cover
-    from nc.interp.interpreter import Interpreter
+    from nc.interp.host import InterpHost
     from nc.program.blocks import Block
 
 
@@ -33,7 +33,7 @@ def _int(block: "Block", letter: str, code: int = 0x0243) -> int | None:
     return int(w.value)
 
 
-def g10(ip: "Interpreter", block: "Block") -> Iterator[Event]:
+def g10(ip: "InterpHost", block: "Block") -> Iterator[Event]:
     legacy = ip.profile.legacy
     L = _int(block, "L")
     if L in SERVO_L and not legacy:  # servo parameter read / write through the bench's bus (App. B.3.4.1)
@@ -128,7 +128,7 @@ def g10(ip: "Interpreter", block: "Block") -> Iterator[Event]:
         return
 
 
-def _set_axes(ip: "Interpreter", target: dict[str, float], words) -> None:
+def _set_axes(ip: "InterpHost", target: dict[str, float], words) -> None:
     for a, (w, inc) in words.items():
         v = ip.distance(w, a)
         if a in ip.profile.diameter_axes:
@@ -136,7 +136,7 @@ def _set_axes(ip: "Interpreter", target: dict[str, float], words) -> None:
         target[a] = target.get(a, 0.0) + v if inc else v
 
 
-def g11(ip: "Interpreter", block: "Block") -> Iterator[Event]:
+def g11(ip: "InterpHost", block: "Block") -> Iterator[Event]:
     L = _int(block, "L")
     if L == 30:
         ip.profile.params["spindle positioning offset"] = ip.profile.param("P405", 0.0)

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from functools import lru_cache
 
-from nc.interp.context import LATHE_CYCLES, MILL_CYCLES, MODAL_CYCLES
+from nc.cycles.codes import LATHE_CYCLES, MILL_CYCLES, MODAL_CYCLES
 from nc.profiles import Profile
 
 COMMON: dict[float, tuple[int, str]] = {

@@ -14,14 +14,15 @@ from collections import deque
 from collections.abc import Iterator
 from typing import TYPE_CHECKING
 
+from nc.interp.records import PreviewRecord
 from nc.moves import Busy, Event, Move, Sync
 
 if TYPE_CHECKING:  # pragma: no cover
-    from nc.interp.interpreter import Interpreter
+    from nc.interp.host import InterpHost
 
 
 class PreviewWindow:
-    def __init__(self, interp: "Interpreter", events: Iterator[Event], depth: int) -> None:
+    def __init__(self, interp: "InterpHost", events: Iterator[Event], depth: int) -> None:
         self.interp = interp
         self.events = events
         self.depth = max(0, depth)
@@ -30,7 +31,6 @@ class PreviewWindow:
         interp.on_statement = self._statement
 
     def _statement(self, block, program: str) -> None:
-        from nc.interp.interpreter import PreviewRecord
         ahead = next((e for e in self.buf if isinstance(e, Move)), None) or self.executing
         n_ahead = sum(1 for e in self.buf if isinstance(e, Move))
         self.interp.preview_log.append(PreviewRecord(

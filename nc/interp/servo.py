@@ -26,7 +26,7 @@ from typing import TYPE_CHECKING, Literal
 from nc.alarms import NcAlarm
 
 if TYPE_CHECKING:  # pragma: no cover
-    from nc.interp.interpreter import Interpreter
+    from nc.interp.host import InterpHost
     from nc.program.blocks import Block
 
 SERVO_ALARM_SYNTAX = 0x0252  # App. A: usage error of G10 L40 / L41 (servo parameter read / write)
@@ -117,7 +117,7 @@ def parse_access(block: "Block", L: int) -> ServoAccess:
     return ServoAccess(station, kind, index, sub, value, block.line, block.text.strip())
 
 
-def servo_g10(ip: "Interpreter", block: "Block", L: int) -> None:
+def servo_g10(ip: "InterpHost", block: "Block", L: int) -> None:
     """Run one G10 L4x: ask the bench (motion before it has finished: G10 stopped preview)."""
     req = parse_access(block, L)
     port = ip.servo

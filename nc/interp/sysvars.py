@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING
 from nc.alarms import NcAlarm
 
 if TYPE_CHECKING:  # pragma: no cover
-    from nc.interp.interpreter import Interpreter
+    from nc.interp.host import InterpHost
 
 CONSTANTS = [math.e, math.log2(math.e), math.log10(math.e), math.log(2), math.log(10), math.pi, math.pi / 2,
              math.pi / 4, 1 / math.pi, 2 / math.pi, 2 / math.sqrt(math.pi), math.sqrt(2), 1 / math.sqrt(2)]
@@ -28,7 +28,7 @@ NC5_TOOL_BASES = {26000: "length", 42000: "wear", 61000: "tolerance", 77000: "li
 
 
 class SystemVariables:
-    def __init__(self, interp: "Interpreter") -> None:
+    def __init__(self, interp: "InterpHost") -> None:
         self.i = interp
         self.t0 = time.monotonic()
 

@@ -1,0 +1,131 @@
+"""Interpreter speed: `hil path` beside LinuxCNC's standalone `rs274 -g` on the same program text.
+
+    python benchmarks/bench_interp.py [--blocks 100000] [--repeat 1] [--json]
+
+Three generated programs, each run by both (wall clock and peak RSS of the whole command, as a
+user runs it):
+  cam    a CAM spiral, `G1 X Y Z F` on every line (3 decimals), --blocks lines;
+  macro  WHILE loops with arithmetic and G65 macro calls (a G1 per pass);
+  lathe  a lathe-cycle program run by `hil path` (G71/G70 roughing and finishing, G76 threads); rs274
+         gets the same contour as plain moves (it has no Fanuc lathe cycles), so its figure is a
+         reference for the line count only.
+Prints seconds, peak MB and the ratio rs274 time / ours (1.0 = as fast as rs274). Figures, never a
+pass/fail. rs274 comes with the Debian package linuxcnc-uspace; without it the ratio is skipped.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def cam_program(n: int) -> str:
+    lines = ["%", "O1000", "G21 G90 G17 G54", "G0 X0 Y0 Z5"]
+    for i in range(n):
+        a = i * 0.01
+        r = 10.0 + i * 0.0005
+        lines.append(f"G1 X{r * math.cos(a):.3f} Y{r * math.sin(a):.3f} Z{-i * 0.00001:.3f} F{1200 + i % 7}")
+    lines += ["M30", "%"]
+    return "\n".join(lines) + "\n"
+
+
+def macro_program(passes: int) -> tuple[str, str]:
+    """(deltahil text with G65 and a macro O9001, rs274 text with an o-word sub). Same arithmetic."""
+    ours = ["O1001", "G21 G90 G17", "#1 = 0", f"WHILE [#1 LT {passes}] DO1",
+            "#2 = #1 * 0.5", "#3 = SIN[#1] * 10 + COS[#1 * 2] * 5",
+            "G65 P9001 A#2 B#3", "#1 = #1 + 1", "END1", "M30", "",
+            "O9001", "#10 = #1 + #2 * 2", "G1 X#10 Y[#2 - 1] F1000", "M99"]
+    theirs = ["G21 G90 G17", "o100 sub", "#<a> = #1", "#<b> = #2", "G1 X[#<a> + #<b> * 2] Y[#<b> - 1] F1000",
+              "o100 endsub", "#1 = 0", f"o101 while [#1 LT {passes}]", "#2 = [#1 * 0.5]",
+              "#3 = [SIN[#1] * 10 + COS[#1 * 2] * 5]", "o100 call [#2] [#3]", "#1 = [#1 + 1]",
+              "o101 endwhile", "M30"]
+    return "\n".join(ours) + "\n", "%\n" + "\n".join(theirs) + "\n%\n"
+
+
+def lathe_program(parts: int) -> tuple[str, str]:
+    """`parts` times the shipped example's part (examples/lathe_part_g71_g70_g76.nc): G71 roughing,
+    G70 finishing with nose radius compensation, G76 thread. rs274 (no Fanuc lathe cycles) gets
+    the finished contour and thread passes as plain moves, as many lines as our output."""
+    contour = ["G01 Z0. F0.12", "X24. Z-3.", "Z-25.", "X28.", "X32. Z-35.", "G02 X38. Z-38. R3.", "G01 Z-50."]
+    ours = ["O1002", "G10 L10 P1 R0.8 Q3", "G10 L10 P3 R0 Q0", "G21 G99", "G50 S2500"]
+    theirs = ["G21 G18 G90"]
+    for k in range(parts):
+        p, q = 1000 + 2 * k, 1001 + 2 * k
+        ours += ["T0101", "G96 S180 M03", "G00 X45. Z5.", "G71 U1.5 R0.5", f"G71 P{p} Q{q} U0.4 W0.1 F0.25",
+                 f"N{p} G00 X18.", *contour, f"N{q} X44.", "G00 X60. Z50.", "G42 G00 X45. Z2.",
+                 f"G70 P{p} Q{q}", "G40 G00 X60. Z50.", "T0303", "G97 S800 M03", "G00 X28. Z5.",
+                 "G76 P011060 Q50 R0.05", "G76 X21.4 Z-22. P1300 Q400 F2.", "G00 X60. Z50."]
+        theirs += [f"G1 X{20 + (j % 20)} Z{-(j % 50)} F200" for j in range(120)]
+    ours += ["M05", "M30"]
+    theirs += ["M30"]
+    return "\n".join(ours) + "\n", "%\n" + "\n".join(theirs) + "\n%\n"
+
+
+def timed(cmd: list[str], env: dict | None = None, cwd: str | None = None) -> tuple[float, float, int]:
+    """Wall seconds, peak RSS in MB of the child, output lines."""
+    t0 = time.perf_counter()
+    p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, env=env, cwd=cwd)
+    lines = sum(1 for _ in p.stdout)  # type: ignore[union-attr]
+    _, status, usage = os.wait4(p.pid, 0)
+    dt = time.perf_counter() - t0
+    return dt, usage.ru_maxrss / 1024.0, lines
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--blocks", type=int, default=100_000, help="CAM program length (default 100000)")
+    ap.add_argument("--passes", type=int, default=5000, help="macro WHILE passes (default 5000)")
+    ap.add_argument("--parts", type=int, default=200, help="lathe parts, each G71/G70/G76 (default 200)")
+    ap.add_argument("--repeat", type=int, default=1, help="best of N runs")
+    ap.add_argument("--only", choices=("cam", "macro", "lathe"), action="append")
+    ap.add_argument("--json", action="store_true")
+    ap.add_argument("--tree", default=str(ROOT), help="run `hil` from this source tree (e.g. another checkout, "
+                                                      "for before/after figures)")
+    args = ap.parse_args()
+    rs274 = shutil.which("rs274")
+    env = dict(os.environ, PYTHONPATH=args.tree)
+    hil = [sys.executable, "-m", "hil.cli", "path", "--json"]  # run in --tree (cwd below)
+    rows = []
+    with tempfile.TemporaryDirectory() as d:
+        cases = {"cam": (cam_program(args.blocks),) * 2, "macro": macro_program(args.passes),
+                 "lathe": lathe_program(args.parts)}
+        profiles = {"cam": "nc5-mill", "macro": "nc5-mill", "lathe": "nc5-lathe-a"}
+        for name, (ours, theirs) in cases.items():
+            if args.only and name not in args.only:
+                continue
+            (Path(d) / f"{name}.nc").write_text(ours)
+            (Path(d) / f"{name}.ngc").write_text(theirs)
+            best = min((timed(hil + ["--profile", profiles[name], str(Path(d) / f"{name}.nc")], env, args.tree)
+                        for _ in range(args.repeat)), key=lambda r: r[0])
+            row = {"case": name, "hil_s": round(best[0], 3), "hil_peak_mb": round(best[1], 1), "hil_lines": best[2]}
+            if rs274:
+                ref = min((timed([rs274, "-g", str(Path(d) / f"{name}.ngc")]) for _ in range(args.repeat)),
+                          key=lambda r: r[0])
+                row.update(rs274_s=round(ref[0], 3), rs274_peak_mb=round(ref[1], 1), rs274_lines=ref[2],
+                           ratio=round(ref[0] / best[0], 3))
+            rows.append(row)
+    if args.json:
+        print(json.dumps(rows, indent=1))
+        return 0
+    if not rs274:
+        print("rs274 not found (apt-get install linuxcnc-uspace): deltahil figures only", file=sys.stderr)
+    print(f"{'case':6s} {'hil path s':>10s} {'peak MB':>8s} {'rs274 -g s':>10s} {'peak MB':>8s} {'rs274/ours':>10s}")
+    for r in rows:
+        print(f"{r['case']:6s} {r['hil_s']:10.2f} {r['hil_peak_mb']:8.0f} {r.get('rs274_s', float('nan')):10.2f} "
+              f"{r.get('rs274_peak_mb', float('nan')):8.0f} {r.get('ratio', float('nan')):10.3f}")
+    print(f"(load average {os.getloadavg()[0]:.1f}: figures on a shared machine)")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
