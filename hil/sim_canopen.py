@@ -19,10 +19,11 @@ from hil.cli import EXIT_OK, EXIT_USAGE
 def add_canopen(sims: argparse._SubParsersAction) -> None:
     p = sims.add_parser("canopen", help="simulated CiA 402 CANopen servo nodes (python-canopen LocalNode)",
                         description="Serve the bench's drives as CANopen nodes 1, 2, … (axes, then spindles).")
-    p.add_argument("--interface", required=True,
-                   help="python-can interface: socketcan (vcan0/can0 on a bench) or udp_multicast (inside a "
-                        "loopback-only network namespace)")
-    p.add_argument("--channel", required=True, help="CAN channel: vcan0, can0, or a multicast group 239.x.x.x")
+    p.add_argument("--bus", metavar="canopen:INTERFACE:CHANNEL",
+                   help="the bus, spelled as hil run's --bus: canopen:socketcan:vcan0 (can0 on a bench) or "
+                        "canopen:udp_multicast:239.74.163.2 (inside a loopback-only network namespace); required")
+    p.add_argument("--interface", help=argparse.SUPPRESS)  # old spellings, kept working
+    p.add_argument("--channel", help=argparse.SUPPRESS)
     p.add_argument("--bench", help="bench file (TOML); default: the built-in 2-axis lathe")
     p.add_argument("--duration", type=float, help="stop after this many seconds")
     p.set_defaults(func=cmd_sim_canopen)
@@ -36,6 +37,7 @@ def cmd_sim_canopen(args: argparse.Namespace) -> int:
     from virtual_bus.canopen import serve
 
     try:
+        args.interface, args.channel = canopen_endpoint(args.bus, args.interface, args.channel)
         bench = load_bench(args.bench)
         if args.interface == "virtual":
             raise InputError("the virtual interface only reaches this process; use socketcan or udp_multicast "
@@ -70,3 +72,22 @@ def cmd_sim_canopen(args: argparse.Namespace) -> int:
                               for s in io])
         print(f"hil sim canopen: stopped ({states})", file=sys.stderr)
     return EXIT_OK
+
+
+def canopen_endpoint(bus: str | None, interface: str | None, channel: str | None) -> tuple[str, str]:
+    """(python-can interface, channel) from --bus canopen:INTERFACE:CHANNEL, or the old
+    --interface/--channel pair; ValueError says what to give."""
+    from fieldbus.factory import parse_bus
+
+    if bus:
+        if interface or channel:
+            raise ValueError("give --bus canopen:INTERFACE:CHANNEL, not --interface/--channel as well")
+        spec = parse_bus(bus)
+        if spec.kind != "canopen":
+            raise ValueError(f"--bus {bus}: hil sim canopen serves a CANopen bus, canopen:INTERFACE:CHANNEL")
+        interface, channel = spec.interface, spec.channel
+    if not interface:
+        raise ValueError("--bus canopen:INTERFACE:CHANNEL is required, e.g. --bus canopen:socketcan:vcan0")
+    if not channel and interface != "virtual":
+        raise ValueError(f"--bus canopen:{interface}:CHANNEL: the channel is missing (vcan0, can0, 239.x.x.x)")
+    return interface, channel or ""

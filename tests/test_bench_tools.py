@@ -68,9 +68,9 @@ def test_one_spelling_per_flag_old_ones_hidden():
     assert "--interface" not in _help("sim", "ethercat")
 
 
-def test_sim_ethercat_without_iface_is_usage():
+def test_sim_ethercat_without_bus_is_usage():
     r = _hil("sim", "ethercat")
-    assert r.returncode == 2 and "--iface" in r.stderr and "Traceback" not in r.stderr
+    assert r.returncode == 2 and "--bus ethercat:IFACE" in r.stderr and "Traceback" not in r.stderr
 
 
 def _cycles(stdout: str) -> int:
@@ -187,3 +187,26 @@ def test_mst_code_the_mlc_never_answers_is_a_warning(tmp_path):
     assert "warning: M09 (line 3: M09) strobed at" in r.stderr and "never answered" in r.stderr
     end = TraceFile(tmp_path / "t.parquet").meta["end"]
     assert [x["code"] for x in end["warnings"]] == ["M08", "M09"]
+
+
+@pytest.mark.parametrize("args, message", [
+    ("sim canopen --bus canopen:virtual", "the virtual interface only reaches this process"),
+    ("sim canopen --interface virtual --channel x", "the virtual interface only reaches this process"),  # old
+    ("sim canopen --bus canopen:socketcan", "the channel is missing"),
+    ("sim canopen --bus sim", "serves a CANopen bus"),
+    ("sim canopen", "--bus canopen:INTERFACE:CHANNEL is required"),
+    ("sim ethercat --bus ethercat:nosuch0", "cannot open nosuch0"),
+    ("sim ethercat --iface nosuch0", "cannot open nosuch0"),  # old spelling
+    ("sim ethercat --bus canopen:x", "serves an EtherCAT bus"),
+])
+def test_sim_takes_the_bus_as_hil_run_spells_it(args, message):
+    """`hil sim` names its bus with --bus as hil run/script/scan/servo do; the old --iface,
+    --interface/--channel still work but are hidden from --help."""
+    r = _hil(*args.split())
+    assert r.returncode == 2 and message in r.stderr, r.stderr
+
+
+def test_sim_help_shows_one_spelling():
+    for bus in ("canopen", "ethercat"):
+        h = _hil("sim", bus, "--help").stdout
+        assert "--bus" in h and "--interface" not in h and "--iface" not in h and "--channel" not in h

@@ -20,8 +20,10 @@ def _add_ethercat(sims: argparse._SubParsersAction) -> None:
                         formatter_class=argparse.RawDescriptionHelpFormatter,
                         description="Serve the bench's drives (axes, then spindles) as EtherCAT slaves on IFACE.",
                         epilog=_fault_help())
-    p.add_argument("--iface", help="network interface (e.g. one end of a veth pair); required")
-    p.add_argument("--interface", dest="iface", help=argparse.SUPPRESS)  # CANopen's word, accepted here too
+    p.add_argument("--bus", metavar="ethercat:IFACE",
+                   help="the bus, spelled as hil run's --bus: ethercat:IFACE (e.g. one end of a veth pair); required")
+    p.add_argument("--iface", help=argparse.SUPPRESS)  # old spellings, kept working
+    p.add_argument("--interface", dest="iface", help=argparse.SUPPRESS)
     p.add_argument("--bench", help="bench file (TOML); default: the built-in 2-axis lathe")
     p.add_argument("--io", type=int, default=0, metavar="N",
                    help="R1-EC class I/O slaves after the drives: one per [[io]] station of the bench (its `modules`), "
@@ -87,14 +89,29 @@ def build_chain(bench, io: int = 0, realtime: bool = False, faults=()):
     return Chain(slaves, list(faults))
 
 
+def ethercat_iface(bus: str | None, iface: str | None) -> str:
+    """IFACE from --bus ethercat:IFACE, or the old --iface/--interface; ValueError says what to give."""
+    from fieldbus.factory import parse_bus
+
+    if bus:
+        if iface:
+            raise ValueError("give --bus ethercat:IFACE, not --iface as well")
+        spec = parse_bus(bus)
+        if spec.kind != "ethercat":
+            raise ValueError(f"--bus {bus}: hil sim ethercat serves an EtherCAT bus, ethercat:IFACE")
+        return spec.interface
+    if not iface:  # not argparse's required=: the hidden aliases fill it too
+        raise ValueError("give the network interface: --bus ethercat:IFACE")
+    return iface
+
+
 def cmd_sim_ethercat(args: argparse.Namespace) -> int:
     from virtual_bus.ethercat.faults import parse_fault
     from virtual_bus.ethercat.network import RawSocketLine
     from hil.session import InputError, load_bench
 
     try:
-        if not args.iface:  # not argparse's required=: the hidden --interface alias fills it too
-            raise InputError("give the network interface: --iface IFACE")
+        args.iface = ethercat_iface(args.bus, args.iface)
         bench = load_bench(args.bench)
         faults = [parse_fault(f) for f in args.fault]
     except (InputError, ValueError) as exc:
