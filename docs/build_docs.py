@@ -12,7 +12,7 @@ from pathlib import Path
 
 DOCS = Path(__file__).resolve().parent
 
-ORDER = ["foundation", "language", "cycles", "motion", "ethercat", "canopen", "mlc", "bench", "campaign",
+ORDER = ["foundation", "language", "interp", "cycles", "motion", "ethercat", "canopen", "mlc", "bench", "campaign",
          "bench-tools", "budgets", "program-input", "inputs", "reliability", "report"]
 
 HEADERS = {

@@ -1,0 +1,39 @@
+"""`hil path --json` writes plain rapids and lines without intermediate dicts (hil.commands.path
+.move_json, issue 16): the line must be byte for byte what the general way (move_dict +
+strict_json.dumps) writes, for any move, the goldens' seam."""
+
+from __future__ import annotations
+
+import numpy as np
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from hil import strict_json
+from hil.commands.path import move_dict, move_json
+from nc.moves import Move
+
+number = st.one_of(st.floats(allow_nan=True, allow_infinity=True), st.integers(-10**6, 10**6),
+                   st.sampled_from([0.0, -0.0, 1e-8, -4.9e-8, 5e-8, 123.4567891, 1e16]),
+                   st.floats(-1e4, 1e4).map(np.float64))
+axes = st.dictionaries(st.sampled_from(["X", "Y", "Z", "A", "C", "Ä"]), number, min_size=1, max_size=5)
+moves = st.builds(
+    Move, kind=st.sampled_from(["rapid", "line", "arc", "thread", "dwell"]), line=st.integers(0, 10**7),
+    block=st.text(max_size=40), start=axes, end=axes, work=axes,
+    center=st.one_of(st.none(), axes), dir=st.sampled_from([None, "cw", "ccw"]),
+    feed=st.one_of(st.none(), number), duration=st.one_of(st.none(), st.floats(0, 10)),
+    per_rev=st.booleans(), exact_stop=st.booleans(), tags=st.sampled_from([(), ("G71 rough",)]),
+    comp=st.sampled_from([None, "G41"]))
+
+
+@settings(max_examples=300, deadline=None)
+@given(moves)
+def test_fast_line_is_the_general_line(m: Move) -> None:
+    assert move_json(m) == strict_json.dumps(move_dict(m))
+
+
+def test_a_plain_feed_move_takes_the_fast_way() -> None:
+    m = Move("line", 12, 'G1 X1 "q"', {"X": 0.0, "Z": -0.0}, {"X": 1.00000004, "Z": float("nan")},
+             {"X": 2.0, "Z": 1e-9}, feed=1200)
+    assert move_json(m) == ('{"kind": "line", "line": 12, "block": "G1 X1 \\"q\\"", "start": {"X": 0.0, "Z": 0.0}, '
+                            '"end": {"X": 1.0, "Z": null}, "work": {"X": 2.0, "Z": 0.0}, "center": null, '
+                            '"dir": null, "feed": 1200, "duration": null}')
