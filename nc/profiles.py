@@ -52,6 +52,7 @@ def default_params() -> dict[str, float]:
         "N1.042": 0.0,  # default cutting feed, mm/min (0: F must be programmed)
         "N1.010 Bit22": 0,  # 1: T codes call O9000 (nc5)
         "N1.010 Bit28": 0,  # 1: G-code macro calls allowed inside the called macro (8 layers)
+        "N1.010": 0,  # G43/G44/G49 block without Z: 0 moves to the compensated position, 1 internal only
         "N1.118": 0,  # first M code of the preview-halt function (0: none)
         "N1.119": 0,  # number of halt M codes from N1.118
         "N1.120": 0, "N1.121": 0, "N1.122": 0,  # continuous G-code macro call: first G, first O, amount

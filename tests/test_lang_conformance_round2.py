@@ -122,3 +122,15 @@ def test_path_format_page_states_the_resolution_the_json_prints(capsys, tmp_path
     assert r.ends("X") == [(0.3333333,)]
     text = (ROOT / "docs" / "path-format.md").read_text()
     assert "rounded to 7 decimals (1e-7 mm" in text and "Numbers are rounded to 0.1 µm" not in text
+
+
+@pytest.mark.parametrize("setting, z_moves", [(None, [10.0, 0.0]), ("0", [10.0, 0.0]), ("1", [])])
+def test_n1_010_length_comp_block_without_z_moves_or_not_n3_12_2_note_3(capsys, tmp_path, setting, z_moves):
+    """N§3.12.2 note (3): [N1.010] = 0 moves the tool to the compensated position in a G43/G44/G49 block
+    without Z; = 1 processes it internally only (no movement)."""
+    args = ("--param", f"N1.010={setting}") if setting is not None else ()
+    r = run_path(capsys, tmp_path, "G10 L10 P1 R10.\nG90 G00 X0 Y0 Z0\nG43 H1\nG01 X5. F100\nG49\nM30\n", *args)
+    assert r.code == 0, r.alarm
+    comp_blocks = [m for m in r.moves if m["line"] in (3, 5)]
+    assert [m["end"]["Z"] for m in comp_blocks] == z_moves  # machine Z: +10 under G43 H1, back to 0 at G49
+    assert all(m["work"]["Z"] == 0.0 for m in comp_blocks)  # the programmed Z is kept

@@ -130,6 +130,19 @@ class MotionMixin:
             move.css = st.surface_speed
         return move
 
+    def _length_comp_move(self, geo: _Geometry) -> _Geometry:
+        """N§3.12.2 note (3), parameter [N1.010]: 0 (default) moves the tool to the compensated position in
+        a G43/G44/G49 block without Z (the programmed Z is kept, the machine Z takes the new length); 1 only
+        changes the offset internally, the next Z move takes it up."""
+        z = "Z" if "Z" in self.axes else self.axes[-1]
+        if self.profile.is_lathe or z in geo.axes or self.profile.param("N1.010", 0.0) != 0:
+            return geo
+        work = dict(geo.target_work)
+        work[z] = self.last_target.get(z, work[z])
+        machine = self.to_machine(work)
+        moved = geo.moved or abs(machine[z] - self.position[z]) > 1e-12
+        return _Geometry(work, machine, moved, geo.axes | ({z} if moved else set()))
+
     def _motion(self, block: Block, funcs: set[str]) -> Iterator[Event]:
         st = self.state
         if "G04" in funcs:
@@ -138,6 +151,8 @@ class MotionMixin:
         # N§3.3.4 note (1): under G91 the end point of G2.4/G3.4 counts from the middle point
         mid = self._three_point
         geo = self._geometry(block, base=None if mid is None else self.to_work(mid))
+        if funcs & {"G43", "G44", "G49"}:
+            geo = self._length_comp_move(geo)
         if cyc is not None and not (funcs & {"G00", "G01", "G02", "G03"}):
             if geo.moved or self._cycle_fn(funcs):
                 self.unit_locked = True
