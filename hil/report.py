@@ -71,7 +71,8 @@ def path_axes(axes: list[str], profile: str | None) -> tuple[str, str] | None:
 
 def write_report(trace_path: str | Path, out: str | Path, bench: Bench | None = None,
                  moves: list[Move] | None = None, checks: list[CheckResult] | None = None,
-                 title: str | None = None) -> Report:
+                 title: str | None = None, interactive: bool = True) -> Report:
+    """`interactive=False`: the PNG report only, without report.html (campaigns at scale)."""
     tf = TraceFile(trace_path)
     out = Path(out)
     if out.exists() and not out.is_dir():
@@ -82,11 +83,13 @@ def write_report(trace_path: str | Path, out: str | Path, bench: Bench | None = 
         rep = Report(tmp, tmp / "index.html")
         figs = [_save(fig, tmp / name, rep, caption) for name, caption, fig in trace_figures(tf, bench, moves)]
         summary = format_summary(tf, summarise(tf))
-        rep.html.write_text(_html(title or f"Bench report: {tf.path.name}", summary, checks, figs), encoding="utf-8")
-        write_html_report(tf, tmp / "report.html", path_axes(axes_of(tf.columns), bench.profile if bench else None),
-                          title, summary)
+        rep.html.write_text(_html(title or f"Bench report: {tf.path.name}", summary, checks, figs, interactive),
+                            encoding="utf-8")
+        if interactive:
+            write_html_report(tf, tmp / "report.html", path_axes(axes_of(tf.columns), bench.profile if bench else None),
+                              title, summary)
     done = Report(out, out / "index.html", [out / p.name for p in rep.images])
-    done.interactive = out / "report.html"
+    done.interactive = out / "report.html" if interactive else None
     return done
 
 
@@ -189,7 +192,8 @@ def _save(fig, path: Path, rep: Report, caption: str) -> tuple[str, str]:
     return path.name, caption
 
 
-def _html(title: str, summary: str, checks: list[CheckResult] | None, figs: list[tuple[str, str]]) -> str:
+def _html(title: str, summary: str, checks: list[CheckResult] | None, figs: list[tuple[str, str]],
+          interactive: bool = True) -> str:
     e = html.escape
     parts = ["<!doctype html><html><head><meta charset='utf-8'>", f"<title>{e(title)}</title>",
              "<style>body{font-family:sans-serif;max-width:1100px;margin:2em auto;padding:0 1em}"
@@ -208,7 +212,8 @@ def _html(title: str, summary: str, checks: list[CheckResult] | None, figs: list
                          f"<td>{'' if c.t is None else f'{c.t:.3f}'}</td><td>{c.line or ''}</td>"
                          f"<td>{e(c.detail)}</td></tr>")
         parts.append("</table>")
-    parts.append("<p><a href='report.html'>Interactive report</a> (zoomable, linked time axes)</p>")
+    if interactive:
+        parts.append("<p><a href='report.html'>Interactive report</a> (zoomable, linked time axes)</p>")
     for name, caption in figs:
         parts.append(f"<h2>{e(caption)}</h2><img src='{e(name)}' alt='{e(caption)}'>")
     parts.append("</body></html>")

@@ -90,3 +90,13 @@ def test_report_html_full_circle_gets_iso_230_4(tmp_path):
     m = re.search(r"ISO 230-4 circular test, line 4: R ([\d.]+) mm .*circular deviation G ([\d.]+) µm",
                   (tmp_path / "r" / "report.html").read_text())
     assert m and float(m.group(1)) == pytest.approx(10.0, abs=0.01) and 0 < float(m.group(2)) < 20
+
+
+def test_report_without_html_for_campaigns(report, tmp_path):
+    """`hil campaign --no-report-html`: the PNG report only, no report.html and no link to one."""
+    from hil.report import write_report
+
+    rep = write_report(report.parent.parent / "run.parquet", tmp_path / "r", interactive=False)
+    assert rep.interactive is None and not (tmp_path / "r" / "report.html").exists()
+    page = (tmp_path / "r" / "index.html").read_text()
+    assert "report.html" not in page and "<img" in page

@@ -34,7 +34,8 @@ class CampaignOutcome:
 
 
 def run_campaign(path: str | Path, out: str | Path, engine: Engine | None = None, *, rerun: bool = False,
-                 quiet: bool = True, reports: bool = True) -> CampaignOutcome:
+                 quiet: bool = True, reports: bool = True,
+                 report_html: bool = True) -> CampaignOutcome:
     """Raises CampaignFileError (an InputError) for a bad campaign file, naming the field."""
     campaign = load_campaign(path)
     engine = engine or Engine()
@@ -71,13 +72,13 @@ def run_campaign(path: str | Path, out: str | Path, engine: Engine | None = None
     write_atomic(to_table(outcome.rows), outcome.results)
     journal.close(remove=not outcome.interrupted)
     if reports:
-        _reports(out, outcome.rows)
+        _reports(out, outcome.rows, report_html)
     page = matrix_page(f"campaign {campaign.name}", outcome.rows, out)
     _write_text(out / "summary.html", page)
     return outcome
 
 
-def _reports(out: Path, rows: list[dict[str, Any]]) -> None:
+def _reports(out: Path, rows: list[dict[str, Any]], interactive: bool = True) -> None:
     """A report for each kept trace, in DIR/reports/<input hash>/ (not beside the trace: the traces
     folder is a Parquet dataset and must hold nothing else), for the matrix to link to."""
     from hil.report import write_report
@@ -89,7 +90,7 @@ def _reports(out: Path, rows: list[dict[str, Any]]) -> None:
         target = out / report_dir(r)
         if trace.exists() and not (target / "index.html").exists():
             try:
-                write_report(trace, target, title=f"{r['program']} on {r['bench']}")
+                write_report(trace, target, title=f"{r['program']} on {r['bench']}", interactive=interactive)
             except Exception as exc:  # a report is a convenience: the row and trace stand without it
                 _write_text(target / "index.html", f"<p>report failed: {exc}</p>")
 
