@@ -78,3 +78,28 @@ def test_appendix_a_alarm_is_raised_at_its_line(capsys, tmp_path, case: Case):
     assert r.code == 1, (case.cite, r.moves[-1:] if r.moves else None)
     assert r.alarm["code"] == case.code, (case.cite, r.alarm)
     assert r.alarm["line"] == case.line, (case.cite, r.alarm)
+
+
+RUN_ALARM_CASES = [
+    Case("0x0C02", "G00 X30. Z5.\nG32 Z-20. F1.5\nM30\n", 2,
+         "App. A 0x0C02 'Spindle is not rotating before cutting': a thread (N§3.3 G32) with the spindle stopped",
+         profile="nc5-lathe-a"),
+    Case("0xB01D", "G00 X30. Z5.\nM03 S3000\nG32 Z-20. F100.\nM30\n", 3,
+         "App. A 0xB01D 'Spindle speed is over speed': 100 mm/rev at 3000 rpm is beyond the Z axis' feed",
+         profile="nc5-lathe-a"),
+]
+
+
+@pytest.mark.parametrize("case", RUN_ALARM_CASES, ids=[c.code for c in RUN_ALARM_CASES])
+def test_appendix_a_alarm_of_the_planner_on_the_bench(capsys, tmp_path, case: Case):
+    """Alarms the motion planner raises: `hil run` on the built-in lathe bench ends with the code (exit 1)."""
+    import json
+
+    from hil.cli import main
+
+    f = tmp_path / "p.nc"
+    f.write_text(case.program)
+    capsys.readouterr()
+    assert main(["run", str(f), "--json"]) == 1, case.cite
+    summary = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
+    assert [(a["code"], a["line"]) for a in summary["alarms"]] == [(case.code, case.line)], case.cite
