@@ -5,11 +5,13 @@ measured against the nominal circle as the standard defines it:
 - circular deviation G: radial band of the actual path about its least-squares centre (max − min);
 - radial deviation F: the actual path's largest and smallest radius minus the nominal radius,
   about the nominal (commanded) centre.
-Circular hysteresis H needs the same circle run both ways and is left to the reader of two runs."""
+- circular hysteresis H, where the program runs the same circle both ways (a G02 and a G03 full
+  circle about the same centre with the same radius): the largest difference of the two actual
+  paths' radii at the same angle. With one direction only, no H is given."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -22,6 +24,8 @@ class CircularTest:
     G: float  # circular deviation, mm (ISO 230-4 3.1)
     F_max: float  # radial deviation, largest, mm
     F_min: float  # radial deviation, smallest, mm
+    direction: int = 0  # +1 counter-clockwise (G03 in XY), -1 clockwise
+    profile: tuple[np.ndarray, np.ndarray] | None = field(default=None, repr=False)  # angle, actual radius
 
 
 def _fit(x: np.ndarray, y: np.ndarray) -> tuple[float, float, float]:
@@ -55,19 +59,45 @@ def full_circles(cols: dict[str, np.ndarray], plane: tuple[str, str]) -> list[Ci
         if on.mean() < 0.75:
             continue  # commanded points are not one circle
         ch, cv = ch[on], cv[on]
-        turn = np.sum(np.abs(np.diff(np.unwrap(np.arctan2(cv - cy, ch - cx)))))
+        steps = np.diff(np.unwrap(np.arctan2(cv - cy, ch - cx)))
+        turn = np.sum(np.abs(steps))
         if turn < 2 * np.pi * 0.9:  # start and end blends are trimmed, as ISO 230-4 drops overshoot arcs
             continue
         ah, av = cols[f"{h}_act"][sel][on], cols[f"{v}_act"][sel][on]
         lx, ly, _ = _fit(ah, av)
         band = np.hypot(ah - lx, av - ly)
         radial = np.hypot(ah - cx, av - cy) - r
+        angle = np.mod(np.arctan2(av - cy, ah - cx), 2 * np.pi)
         out.append(CircularTest(int(ln), (cx, cy), r, float(band.max() - band.min()),
-                                float(radial.max()), float(radial.min())))
+                                float(radial.max()), float(radial.min()), int(np.sign(np.sum(steps))),
+                                (angle, radial + r)))
     return out
 
 
+def hysteresis(tests: list[CircularTest], tol: float = 1e-3) -> list[tuple[int, int, float]]:
+    """(line, line, H in mm) for each pair of circles run both ways about the same centre and radius
+    (within `tol` mm): the largest difference of the actual radii at the same angle (1° grid)."""
+    out = []
+    grid = np.radians(np.arange(0.0, 360.0, 1.0))
+    for i, a in enumerate(tests):
+        for b in tests[i + 1:]:
+            same = (abs(a.radius - b.radius) < tol and np.hypot(a.centre[0] - b.centre[0],
+                                                                  a.centre[1] - b.centre[1]) < tol)
+            if not same or a.direction * b.direction >= 0 or a.profile is None or b.profile is None:
+                continue
+            ra, rb = (np.interp(grid, *_sorted(t.profile), period=2 * np.pi) for t in (a, b))
+            out.append((a.line, b.line, float(np.max(np.abs(ra - rb)))))
+    return out
+
+
+def _sorted(profile: tuple[np.ndarray, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    order = np.argsort(profile[0])
+    return profile[0][order], profile[1][order]
+
+
 def format_circular(tests: list[CircularTest]) -> str:
-    return "\n".join(f"ISO 230-4 circular test, line {c.line}: R {c.radius:.4f} mm about "
+    lines = [f"ISO 230-4 circular hysteresis, lines {a} and {b}: H {h * 1000:.2f} µm"
+             for a, b, h in hysteresis(tests)]
+    return "\n".join([f"ISO 230-4 circular test, line {c.line}: R {c.radius:.4f} mm about "
                      f"({c.centre[0]:.4f}, {c.centre[1]:.4f}); circular deviation G {c.G * 1000:.2f} µm; "
-                     f"radial deviation F {c.F_min * 1000:+.2f} … {c.F_max * 1000:+.2f} µm" for c in tests)
+                     f"radial deviation F {c.F_min * 1000:+.2f} … {c.F_max * 1000:+.2f} µm" for c in tests] + lines)

@@ -100,3 +100,22 @@ def test_report_without_html_for_campaigns(report, tmp_path):
     assert rep.interactive is None and not (tmp_path / "r" / "report.html").exists()
     page = (tmp_path / "r" / "index.html").read_text()
     assert "report.html" not in page and "<img" in page
+
+
+def test_circular_hysteresis_when_the_circle_is_run_both_ways():
+    """ISO 230-4 H: the same 10 mm circle CCW (actual +1 µm) then CW (actual −2 µm + 1 µm cos θ):
+    H is the largest radius difference at one angle, 4 µm at θ = 0; one direction alone gives no H."""
+    from hil.circular_test import format_circular, full_circles, hysteresis
+
+    th = np.linspace(0, 2 * np.pi, 2000)
+    back = th[::-1]
+    r1, r2 = 10.001 + 0 * th, 9.998 + 0.001 * np.cos(back)
+    cols = {"line": np.r_[np.full(th.size, 7), np.full(th.size, 9)],
+            "X_cmd": np.r_[10 * np.cos(th), 10 * np.cos(back)], "Y_cmd": np.r_[10 * np.sin(th), 10 * np.sin(back)],
+            "X_act": np.r_[r1 * np.cos(th), r2 * np.cos(back)], "Y_act": np.r_[r1 * np.sin(th), r2 * np.sin(back)]}
+    tests = full_circles(cols, ("X", "Y"))
+    assert [t.direction for t in tests] == [1, -1]
+    ((a, b, h),) = hysteresis(tests)
+    assert (a, b) == (7, 9) and h == pytest.approx(0.004, abs=2e-5)
+    assert "ISO 230-4 circular hysteresis, lines 7 and 9: H 4.00 µm" in format_circular(tests)
+    assert hysteresis(tests[:1]) == [] and "hysteresis" not in format_circular(tests[:1])
