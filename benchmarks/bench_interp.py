@@ -94,6 +94,7 @@ def main() -> int:
     args = ap.parse_args()
     rs274 = shutil.which("rs274")
     env = dict(os.environ, PYTHONPATH=args.tree)
+    env.pop("PYTHONUNBUFFERED", None)  # as a user runs it: a syscall per output line is not the interpreter's cost
     hil = [sys.executable, "-m", "hil.cli", "path", "--json"]  # run in --tree (cwd below)
     rows = []
     with tempfile.TemporaryDirectory() as d:
