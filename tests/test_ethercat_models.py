@@ -119,3 +119,74 @@ drive = {{ model = "asda-a2-e" }}
                 "--bus", f"ethercat:{sim.iface}")
         assert r.returncode == 0, r.stdout + r.stderr
         assert "result         completed" in r.stdout
+
+
+# A vendor's ESI as ETG.2000 writes it: <DataTypes>, <Type> naming them, <Flags>, <Info><DefaultData> in
+# little-endian hex, a Beckhoff-style mapping array, two devices in one file, and a <Modules> section.
+VENDOR_ESI = """<?xml version="1.0"?>
+<EtherCATInfo><Vendor><Id>#x1DD</Id><Name>Delta Electronics, Inc.</Name></Vendor>
+<Descriptions><Groups><Group><Type>ASDA</Type><Name>Servo</Name></Group></Groups><Devices>
+ <Device Physics="YY"><Type ProductCode="#x00006099" RevisionNo="#x1">Other</Type><Name>Other drive</Name>
+  <Sm StartAddress="#x1000" DefaultSize="128" ControlByte="#x26" Enable="1">MBoxOut</Sm>
+  <Sm StartAddress="#x1080" DefaultSize="128" ControlByte="#x22" Enable="1">MBoxIn</Sm></Device>
+ <Device Physics="YY"><Type ProductCode="#x00006010" RevisionNo="#x00030000">ASDA-A3-E</Type>
+  <Name>ASDA-A3-E CoE Drive</Name><GroupType>ASDA</GroupType>
+  <Fmmu>Outputs</Fmmu><Fmmu>Inputs</Fmmu><Fmmu>MBoxState</Fmmu>
+  <Sm StartAddress="#x1000" DefaultSize="256" ControlByte="#x26" Enable="1">MBoxOut</Sm>
+  <Sm StartAddress="#x1200" DefaultSize="256" ControlByte="#x22" Enable="1">MBoxIn</Sm>
+  <Sm StartAddress="#x1400" ControlByte="#x64" Enable="1">Outputs</Sm>
+  <Sm StartAddress="#x1600" ControlByte="#x20" Enable="1">Inputs</Sm>
+  <RxPdo Sm="2"><Index>#x1600</Index><Name>RxPDO 1</Name>
+   <Entry><Index>#x6040</Index><SubIndex>0</SubIndex><BitLen>16</BitLen><Name>Controlword</Name><DataType>UINT</DataType></Entry></RxPdo>
+  <TxPdo Sm="3"><Index>#x1A00</Index><Name>TxPDO 1</Name>
+   <Entry><Index>#x6041</Index><SubIndex>0</SubIndex><BitLen>16</BitLen><Name>Statusword</Name><DataType>UINT</DataType></Entry></TxPdo>
+  <Mailbox><CoE SdoInfo="1" PdoAssign="1" PdoConfig="1"/></Mailbox>
+  <Profile><Dictionary>
+   <DataTypes>
+    <DataType><Name>DT1018</Name><BitSize>144</BitSize>
+     <SubItem><SubIdx>0</SubIdx><Name>Number of entries</Name><Type>USINT</Type><BitSize>8</BitSize><Flags><Access>ro</Access></Flags></SubItem>
+     <SubItem><SubIdx>1</SubIdx><Name>Vendor ID</Name><Type>UDINT</Type><BitSize>32</BitSize><Flags><Access>ro</Access></Flags></SubItem>
+     <SubItem><SubIdx>2</SubIdx><Name>Product code</Name><Type>UDINT</Type><BitSize>32</BitSize><Flags><Access>ro</Access></Flags></SubItem></DataType>
+    <DataType><Name>DT1600ARR</Name><BaseType>UDINT</BaseType><BitSize>256</BitSize><ArrayInfo><LBound>1</LBound><Elements>8</Elements></ArrayInfo></DataType>
+    <DataType><Name>DT1600</Name><BitSize>272</BitSize>
+     <SubItem><SubIdx>0</SubIdx><Name>SubIndex 000</Name><Type>USINT</Type><BitSize>8</BitSize><Flags><Access>rw</Access></Flags></SubItem>
+     <SubItem><Name>Elements</Name><Type>DT1600ARR</Type><BitSize>256</BitSize><Flags><Access>rw</Access></Flags></SubItem></DataType>
+   </DataTypes>
+   <Objects>
+    <Object><Index>#x1000</Index><Name>Device type</Name><Type>UDINT</Type><BitSize>32</BitSize>
+     <Info><DefaultData>92010200</DefaultData></Info><Flags><Access>ro</Access></Flags></Object>
+    <Object><Index>#x1018</Index><Name>Identity</Name><Type>DT1018</Type><BitSize>144</BitSize>
+     <Info><SubItem><Name>Number of entries</Name><Info><DefaultData>02</DefaultData></Info></SubItem>
+      <SubItem><Name>Vendor ID</Name><Info><DefaultData>DD010000</DefaultData></Info></SubItem>
+      <SubItem><Name>Product code</Name><Info><DefaultData>10600000</DefaultData></Info></SubItem></Info>
+     <Flags><Access>ro</Access></Flags></Object>
+    <Object><Index>#x1600</Index><Name>RxPDO 1</Name><Type>DT1600</Type><BitSize>272</BitSize><Flags><Access>rw</Access></Flags></Object>
+    <Object><Index>#x6040</Index><Name>Controlword</Name><Type>UINT</Type><BitSize>16</BitSize>
+     <Info><DefaultData>0000</DefaultData></Info><Flags><Access>rw</Access><PdoMapping>R</PdoMapping></Flags></Object>
+    <Object><Index>#x6041</Index><Name>Statusword</Name><Type>UINT</Type><BitSize>16</BitSize>
+     <Flags><Access>ro</Access><PdoMapping>RT</PdoMapping></Flags></Object>
+   </Objects></Dictionary></Profile>
+ </Device></Devices></Descriptions>
+<Modules><Module><Type ModuleIdent="#x1">Unused</Type><Name>not a drive</Name></Module></Modules>
+</EtherCATInfo>
+"""
+
+
+def test_a_vendor_esi_file_loads(tmp_path):
+    """ETG.2000 object form (DataTypes, Flags, DefaultData), several devices in one file, a Modules
+    section: the device of the model's product code is taken, with its objects and defaults."""
+    from virtual_bus.ethercat.coe import ObjectDictionary
+    from virtual_bus.ethercat.sii import build_sii
+
+    path = tmp_path / "Delta_vendor.xml"
+    path.write_text(VENDOR_ESI)
+    assert [d.product_code for d in parse_devices(path)] == [0x6099, 0x6010]
+    dev = load_device(str(path), MODELS["asda-a3-e"].product_code)
+    assert dev.name == "ASDA-A3-E CoE Drive" and not dev.coe_complete_access
+    od = ObjectDictionary(dev)
+    assert od.value(0x1000) == 0x00020192 and od.value(0x1018, 1) == 0x1DD and od.value(0x1018, 2) == 0x6010
+    assert od.objects[0x1600].max_sub == 8 and od.value(0x1600, 0) == 1 and od.value(0x1600, 1) == 0x60400010
+    assert od.entry(0x6040, 0).pdo == "R" and "T" in od.entry(0x6041, 0).pdo
+    assert build_sii(dev)[0x08 * 2 + 4:0x08 * 2 + 8] == (0x6010).to_bytes(4, "little")
+    with pytest.raises(ValueError, match="no device with product code 0x00006080"):
+        load_device(str(path), 0x6080)

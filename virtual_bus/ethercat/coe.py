@@ -163,7 +163,7 @@ class ObjectDictionary:
             want = "R" if index < 0x1A00 else "T"
             target = self.objects.get(mi)
             entry = target.entries.get(ms) if target else None
-            if entry is None or entry.pdo != want:
+            if entry is None or want not in entry.pdo:  # "R", "T", or both ("RT") in a vendor ESI
                 raise SdoAbort(ABORT_NOT_MAPPABLE)
             if entry.bits != bits:
                 raise SdoAbort(ABORT_TYPE_LENGTH)
@@ -192,9 +192,9 @@ class ObjectDictionary:
 
     def access_bits(self, e: OdEntry) -> int:
         bits = ACCESS_RW if e.writable else ACCESS_RO
-        if e.pdo == "R":
+        if "R" in e.pdo:
             bits |= ACCESS_RXPDO
-        if e.pdo == "T":
+        if "T" in e.pdo:
             bits |= ACCESS_TXPDO
         return bits
 
@@ -333,8 +333,8 @@ class CoeServer:
         objs = sorted(self.od.objects)
         lists = {
             1: objs,
-            2: [i for i in objs if any(e.pdo == "R" for e in self.od.objects[i].entries.values())],
-            3: [i for i in objs if any(e.pdo == "T" for e in self.od.objects[i].entries.values())],
+            2: [i for i in objs if any("R" in e.pdo for e in self.od.objects[i].entries.values())],
+            3: [i for i in objs if any("T" in e.pdo for e in self.od.objects[i].entries.values())],
             4: [], 5: [],
         }
         if list_type == 0:

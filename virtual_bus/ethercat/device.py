@@ -239,8 +239,11 @@ def _device(vendor: ET.Element, dev: ET.Element) -> Device:
         eeprom_bytes=_int(_text(dev, "Eeprom/ByteSize"), 2048),
         config_data=bytes.fromhex(_text(dev, "Eeprom/ConfigData", "")),
     )
+    from virtual_bus.ethercat.esi_objects import esi_object, is_esi_object  # it builds on this module
+
+    datatypes = {_text(t, "Name"): t for t in dev.findall("Profile/Dictionary/DataTypes/DataType")}
     for o in dev.findall("Profile/Dictionary/Objects/Object"):
-        obj = _object(o, pdos)
+        obj = esi_object(o, datatypes, pdos) if is_esi_object(o) else _object(o, pdos)
         device.objects[obj.index] = obj
     return device
 
