@@ -89,6 +89,8 @@ def test_sm_watchdog_expiry_drops_to_safeop_with_0x001b():
     result, history, _ = run(stall_at=300, stall=0.8)  # master stalls past the 500 ms watchdog
     a = result.alarms[0]
     assert a.code == 0x0601 and a.info == 0x001B and "SAFE-OP+ERR" in a.message
+    # drives that fault on the lost outputs name CiA 402's communication fault, read by SDO (no 0x603F PDO)
+    assert all(s.info == 0x7500 for s in result.alarms if s.code == 0xF002)
     assert_stopped_after_alarm(run.recorder, result)
 
 

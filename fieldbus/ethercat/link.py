@@ -321,10 +321,14 @@ class EthercatLink:
         """What the layout does not carry (no Delta PDO set maps 0x60F4; ASDA_E leaves 0x603F out):
         the following error in CSP is the target just sent less the position reached (the drive's own
         0x60F4 in lock-step), and the error code is read over SDO once when the fault bit rises."""
-        for i, (s, layout, rx, tx) in enumerate(zip(self.drives, self._structs, outputs, self._last)):
+        for layout, rx, tx in zip(self._structs, outputs, self._last):
             if not layout.carries(0x60F4):  # the drive's command follows the actual position until enabled
                 live = tx.mode_display == 8 and tx.statusword & 0x6F == 0x27
                 tx.following_error = rx.target_position - tx.position_actual if live else 0
+        self._read_error_codes()
+
+    def _read_error_codes(self) -> None:
+        for s, layout, tx in zip(self.drives, self._structs, self._last):
             if not layout.carries(0x603F):
                 if not tx.statusword & SW_FAULT:
                     tx.error_code = 0
@@ -357,6 +361,7 @@ class EthercatLink:
             live = (pysoem.SAFEOP_STATE, pysoem.OP_STATE)
             self._last = [layout.unpack_tx(s.input, tx) if s.state & 0x0F in live else tx
                           for s, layout, tx in zip(self.drives, self._structs, self._last)]
+            self._read_error_codes()  # a drive that faults on the bus alarm names its code (0x7500 …)
         return list(self._last)
 
     def _judge_bad_cycle(self, m, wkc: int) -> list[TxPdo]:
