@@ -34,7 +34,8 @@ class _Version(argparse.Action):
     def __call__(self, parser, namespace, values, option_string=None):
         from hil.version import version
 
-        parser.exit(message=f"hil (deltahil) {version()}\n")
+        print(f"hil (deltahil) {version()}")  # on stdout, as argparse's own version action does
+        parser.exit()
 
 
 def build_parser() -> argparse.ArgumentParser:
