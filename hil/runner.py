@@ -81,6 +81,7 @@ class BenchRunner:
         for rx in self.rx[n_axes:]:
             rx.touch_probe_function = 0x0001  # latch the spindle encoder index (thread sync)
         self.tx: list[TxPdo] = [TxPdo() for _ in self.rx]
+        self._probe_axes = [i for i, ax in enumerate(bench.axes) if ax.drive.probe_position is not None]  # G31
         self._rest = [0] * len(self.rx)  # cycles each drive's feedback has stood still (see REST_CYCLES)
         self._last_position: list[int | None] = [None] * len(self.rx)
         self.scales = [a.scaling for a in bench.axes] + [s.scaling for s in bench.spindles]
@@ -273,9 +274,8 @@ class BenchRunner:
         a skip move is pending; a latch (0x60B9 bit 1, position 0x60BA) is the skip input."""
         armed = ch.skip_armed
         latched: dict[str, float] = {}
-        for i, ax in enumerate(self.bench.axes):
-            if ax.drive.probe_position is None:
-                continue
+        for i in self._probe_axes:
+            ax = self.bench.axes[i]
             if armed and self.rx[i].touch_probe_function & 1 and self.tx[i].touch_probe_status & 0x0002:
                 latched[ax.name] = self.scales[i].to_units(self.tx[i].touch_probe_pos1) + self.origin[i]
             self.rx[i].touch_probe_function = 0x0001 if armed else 0
@@ -340,9 +340,10 @@ class BenchRunner:
             if ferr > self.result.max_ferr[self.axes[i]]:
                 self.result.max_ferr[self.axes[i]] = ferr
         for k, sc in enumerate(self.scales[n_axes:]):
-            rpm = self.mlc.spindle.signed_rpm if (ch is not None and ch.state is not RunState.ALARM) else 0.0
             if k == 0 and ch is not None:  # G96 speed, override, G50/G92 S clamp (issue 5; decisions A39, 32)
-                rpm = self.spindle_command_rpm()
+                rpm = self.spindle_command_rpm()  # the speed is computed once, not also as below
+            else:
+                rpm = self.mlc.spindle.signed_rpm if (ch is not None and ch.state is not RunState.ALARM) else 0.0
             if self._winding_down:
                 rpm = 0.0  # the run is over: spindles ramp down before their drives are disabled
             self.rx[n_axes + k].target_velocity = sc.rpm_to_drive(rpm)
