@@ -16,7 +16,6 @@ docs/decisions/cycles.md).
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -61,7 +60,3 @@ def corner_offset(corners: list[ThreadCorner], u: float) -> np.ndarray | None:
             out = d if out is None else out + d
     return out
 
-
-def peak_deviation(c: ThreadCorner) -> float:
-    """How far the rounded corner passes from the vertex (at u = u_c)."""
-    return float(np.linalg.norm(c.dk)) * c.w / 6.0 if math.isfinite(c.w) else 0.0
