@@ -171,18 +171,34 @@ def check_following_error(cols: _Cols, axis: str, limit: float, unit: str = "mm"
                        **cols.where(i))
 
 
-def _polyline(moves: list[Move], axes: list[str]) -> tuple[np.ndarray, np.ndarray]:
-    """Segment end points (A, B) approximating each move; arcs to 0.1 µm chord error."""
+def _move_points(m: Move, axes: tuple[str, ...]) -> np.ndarray | None:
+    """The points of one move's polyline (arcs to 0.1 µm chord error); None for a dwell."""
+    if m.kind == "dwell":
+        return None
+    seg = Segment.of(m, axes)
+    n = 1
+    if seg.kind == "arc" and seg.radius > 0:
+        step = math.sqrt(8 * 1e-4 / seg.radius)
+        n = int(min(20_000, max(4, math.ceil(abs(seg.theta) * (1 + abs(m.turns)) / step))))
+    return seg.points(np.linspace(0.0, seg.length, n + 1)) if seg.length > 0 else np.vstack([seg.start, seg.end])
+
+
+def _polyline(moves: list[Move], axes: list[str],
+              cache: dict[int, np.ndarray | None] | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Segment end points (A, B) approximating each move; arcs to 0.1 µm chord error. `cache` (keyed
+    by id(move)) keeps each move's points across calls: the contour check asks for the same
+    neighbouring moves run after run (a quarter of a chord-circle command went into rebuilding them)."""
     a_list, b_list = [], []
+    key = tuple(axes)
     for m in moves:
-        if m.kind == "dwell":
+        if cache is None:
+            pts = _move_points(m, key)
+        elif id(m) in cache:
+            pts = cache[id(m)]
+        else:
+            pts = cache[id(m)] = _move_points(m, key)
+        if pts is None:
             continue
-        seg = Segment.of(m, tuple(axes))
-        n = 1
-        if seg.kind == "arc" and seg.radius > 0:
-            step = math.sqrt(8 * 1e-4 / seg.radius)
-            n = int(min(20_000, max(4, math.ceil(abs(seg.theta) * (1 + abs(m.turns)) / step))))
-        pts = seg.points(np.linspace(0.0, seg.length, n + 1)) if seg.length > 0 else np.vstack([seg.start, seg.end])
         a_list.append(pts[:-1])
         b_list.append(pts[1:])
     if not a_list:
@@ -239,6 +255,7 @@ def check_contour(cols: _Cols, axes: list[str], moves: list[Move], limit: float,
     line = cols["line"]
     act = np.column_stack([cols[f"{a}_act"] for a in mv_axes]) if mv_axes else np.zeros((len(line), 0))
     dist = np.zeros(len(line))
+    points: dict[int, np.ndarray | None] = {}  # each move's polyline, built once (see _polyline)
     # Runs of cycles on one line (a line met again later, in a loop, starts a new run).
     starts = np.flatnonzero(np.diff(line, prepend=np.nan) != 0) if len(line) else np.zeros(0, int)
     ends = np.append(starts[1:], len(line))
@@ -250,7 +267,7 @@ def check_contour(cols: _Cols, axes: list[str], moves: list[Move], limit: float,
             idx |= by_line.get(int(ln), set())
         cand = [moves[j] for j in sorted(idx)]
         boxes = [m for m in cand if independent_rapids and m.kind == "rapid"]
-        a, b = _polyline([m for m in cand if not (independent_rapids and m.kind == "rapid")], mv_axes)
+        a, b = _polyline([m for m in cand if not (independent_rapids and m.kind == "rapid")], mv_axes, points)
         d = distance_to_polyline(act[r0:r1], a, b) if len(a) else np.full(r1 - r0, np.inf)
         if boxes:
             d = np.minimum(d, _distance_to_boxes(act[r0:r1], boxes, mv_axes))
