@@ -31,10 +31,66 @@ class FormatRow:
     text: str  # as the manual writes it (tabs and subscripts kept, whitespace folded)
 
 
-def _rows(lines: list[str], manual: str) -> list[FormatRow]:
-    out: list[FormatRow] = []
-    section, title, counts = "", "", {}
-    in_fmt = False
+# A format row is made of codes and argument words only (prose, group tables and definitions are not rows).
+TOKEN = re.compile(r"^(?:[GM]\d{1,3}(?:\.\d)?|[A-Z]{1,2}[_\d₁₂]*(?:_?[A-Z]_?)*|,|[₁₂])$")
+NC5_BLOCK = re.compile(r"^(?:Instruction format|Command format|Milling instruction format)\s*:|^G10\s+L\d")
+
+
+def _nc5_row(line: str) -> tuple[str, bool] | None:
+    """(text, has a code) when the line is a row of an NC5 format table, else None."""
+    text = " ".join(line.replace("\t", " ").split())
+    bare = re.sub(r"\([^)]*\)", " ", re.sub(r"^Format \d+\s+", "", text))
+    toks = bare.split()
+    if not toks or not all(TOKEN.match(t) for t in toks):
+        return None
+    has_code = any(CODE.fullmatch(t) for t in toks)
+    if has_code and not CODE.fullmatch(toks[0]):
+        return None  # an ID table's line (G10 L02's "P1 G54"), not a format
+    return text, has_code
+
+
+def _nc5_rows(lines: list[str]) -> list[tuple[str, str, str]]:
+    """(section, title, text) of every row of the NC5 guide's format tables. A line of a table that carries
+    only argument words (G30's P3, G04's X_, M98's Q_) continues the row above and is shown as `[G30] P3`."""
+    out: list[tuple[str, str, str]] = []
+    section, title, in_fmt, last_code = "", "", False, ""
+    for raw in lines:
+        line = raw.rstrip()
+        h = HEADING.match(line)
+        if h and h.group(1)[0] in "23" and "\t" not in line and len(line) < 90:
+            section, title, in_fmt, last_code = h.group(1), line, False, ""
+            continue
+        if not section:
+            continue
+        if NC5_BLOCK.match(line.strip()):
+            in_fmt, last_code = True, ""
+            if not line.strip().startswith("G10"):
+                continue
+        if not in_fmt:
+            continue
+        if line.startswith(("Instruction description", "Notes", "Note:", "Example", "Description")):
+            in_fmt, last_code = False, ""
+            continue
+        if not line.strip():
+            continue
+        row = _nc5_row(line)
+        if row is None:
+            last_code = ""
+            continue
+        text, has_code = row
+        if has_code:
+            last_code = CODE.search(text).group(1)
+            out.append((section, title, text))
+        elif last_code:
+            out.append((section, title, f"[{last_code}] {text}"))
+    return out
+
+
+def _lathe_rows(lines: list[str]) -> list[tuple[str, str, str]]:
+    """(section, title, text) of every format of the lathe guide: the "Format…:" line and the code-led
+    lines that follow it (the `or` alternatives, a cycle's second block), up to the first prose line."""
+    out: list[tuple[str, str, str]] = []
+    section, title, in_fmt = "", "", False
     for raw in lines:
         line = raw.rstrip()
         h = HEADING.match(line)
@@ -43,20 +99,22 @@ def _rows(lines: list[str], manual: str) -> list[FormatRow]:
             continue
         if not section:
             continue
-        if manual == "N":
-            if line.startswith("Instruction format"):
-                in_fmt = True
-                continue
-            if in_fmt and (line.startswith(("Instruction description", "Notes", "Example", "Description"))):
-                in_fmt = False
-            cand = line if in_fmt else ""
-        else:
-            cand = line[len("Format:"):] if line.startswith("Format:") else ""
-            in_fmt = bool(cand) or (in_fmt and bool(line.strip()) and CODE.match(line.strip()) is not None)
-            cand = cand or (line if in_fmt else "")
-        text = " ".join(cand.replace("\t", " ").split())
-        if not text or not CODE.search(text):
+        s = line.strip()
+        if s.startswith("Format"):
+            in_fmt, s = True, s.split(":", 1)[1].strip() if ":" in s else ""
+        elif not in_fmt or not s:
             continue
+        if re.match(r"^[GM]\d{1,3}(?:\.\d)?(?:/[GM]\d+)*(?!:)(?:\s|;|$)", s):
+            out.append((section, title, " ".join(s.split())))
+        elif not (s.endswith(":") or s.startswith("Input parameter") or line.startswith("Format")):
+            in_fmt = False
+    return out
+
+
+def _rows(lines: list[str], manual: str) -> list[FormatRow]:
+    out: list[FormatRow] = []
+    counts: dict[str, int] = {}
+    for section, title, text in (_nc5_rows(lines) if manual == "N" else _lathe_rows(lines)):
         k = counts[section] = counts.get(section, 0) + 1
         out.append(FormatRow(f"{manual}{section}-{k}", section, title, text))
     return out
@@ -69,8 +127,28 @@ def manual_rows() -> list[FormatRow]:
     return rows
 
 
-def tested_rows(test_file: Path = ROOT / "tests" / "test_formats_manual.py") -> dict[str, list[str]]:
-    """row id -> test names that run it (ids written in a test's name, docstring or case table)."""
+TEST_FILES = "test_formats*.py"
+UNRUN = DOCS / "formats-unrun.toml"
+
+
+def tested_rows(tests_dir: Path = ROOT / "tests") -> dict[str, list[str]]:
+    """row id -> test names that run it (ids written in a test's name, docstring or case table), over
+    tests/test_formats*.py."""
+    out: dict[str, list[str]] = {}
+    for f in sorted(tests_dir.glob(TEST_FILES)):
+        for rid, names in _tested_in(f).items():
+            out.setdefault(rid, []).extend(f"{f.stem}::{n}" for n in names)
+    return out
+
+
+def unrun_rows() -> dict[str, str]:
+    """row id -> why no test runs it (docs/formats-unrun.toml)."""
+    import tomllib
+
+    return {k: v["reason"] for k, v in tomllib.loads(UNRUN.read_text()).items()} if UNRUN.exists() else {}
+
+
+def _tested_in(test_file: Path) -> dict[str, list[str]]:
     import ast
 
     src = test_file.read_text()
@@ -93,18 +171,26 @@ def tested_rows(test_file: Path = ROOT / "tests" / "test_formats_manual.py") -> 
 
 
 def build() -> str:
-    rows, tested = manual_rows(), tested_rows()
+    rows, tested, unrun = manual_rows(), tested_rows(), unrun_rows()
     n_tested = sum(1 for r in rows if r.id in tested)
+    n_unrun = sum(1 for r in rows if r.id in unrun and r.id not in tested)
     head = ["# Format coverage: G and M code formats of the manuals, chapters 2–3", "",
-            "*Generated by `python docs/build_formats.py` from the manuals (`shared/seeds/`) and "
-            "`tests/test_formats_manual.py`; that test file fails when this page is stale.*", "",
+            "*Generated by `python docs/build_formats.py` from the manuals (`shared/seeds/`), "
+            "`tests/test_formats*.py` and `docs/formats-unrun.toml`; tests/test_formats_manual.py fails when this "
+            "page is stale.*", "",
             f"{len(rows)} format rows ({sum(r.id[0] == 'N' for r in rows)} in the NC5 G command guide's "
-            f"\"Instruction format\" tables, {sum(r.id[0] == 'L' for r in rows)} in the lathe guide's \"Format:\" "
-            f"lines); **{n_tested} are run by a test** as the manual writes them.", "",
+            f"format tables, {sum(r.id[0] == 'L' for r in rows)} in the lathe guide's \"Format…:\" "
+            f"lines and the alternatives written under them); **{n_tested} are run by a test** as the manual "
+            f"writes them, {n_unrun} are not emulated (reason given).", "",
+            "A row `[G30] P3` is a line of the manual's table that carries only arguments: it continues the row "
+            "above it (here `G30 P3 CP`). Row ids: `N<section>-<k>` is the k-th row under that section of the "
+            "NC5 guide, `L<section>-<k>` of the lathe guide.", "",
             "| row | section | format as the manual writes it | test |", "|---|---|---|---|"]
     body = []
     for r in rows:
         t = ", ".join(f"`{x}`" for x in sorted(set(tested.get(r.id, []))))
+        if not t and r.id in unrun:
+            t = "not emulated: " + unrun[r.id].replace("|", "/")
         text = r.text.replace("|", "\\|")
         body.append(f"| {r.id} | {r.title.replace('|', '/')} | `{text}` | {t or 'untested'} |")
     return "\n".join(head + body) + "\n"
