@@ -4,7 +4,11 @@ per cycle of a dense CAM program on the mill bench (position filter on), the iss
 benches/mill-3axis.toml) as simulated time / wall time with the µs per cycle of each stage, and
 the real-time pacer's jitter on this machine. Prints figures, asserts nothing.
 
-Usage: python benchmarks/bench_loop.py [PACER_SECONDS] [--stages-only]"""
+EtherCAT lock-step (root: a veth pair and `hil sim ethercat` in a network namespace, skipped with the
+reason otherwise) prints cycles/s of the bus alone and of a bench program, with the CPU each side spent;
+`hil run --realtime` of the lathe demo and a CAM program prints p50/p99/max cycle work at 1 ms.
+
+Usage: python benchmarks/bench_loop.py [PACER_SECONDS] [--stages-only | --ethercat-only | --realtime-only]"""
 
 from __future__ import annotations
 
@@ -131,6 +135,92 @@ def issue17(d: str) -> None:
            os.path.join(d, "cam.parquet"))
 
 
+def ethercat_lockstep(cycles: int = 5000) -> None:
+    """Lock-step over EtherCAT: `hil sim ethercat` (the default lathe's 3 drives: X, Z, spindle) in a
+    network namespace behind a veth pair, the pysoem master here. Two figures: the bus alone (the link's
+    exchange, drives enabled, setpoints held), and the bench program run by BenchRunner over that bus
+    (MLC, NC, trace off). Needs root; prints why it is skipped otherwise."""
+    from fieldbus.cia402 import Cia402Master, Target
+    from fieldbus.ethercat.link import EthercatLink
+    from fieldbus.pdo import RxPdo
+    from virtual_bus.ethercat.veth import SimProcess, can_create
+
+    why = can_create()
+    if why is not None:
+        print(f"EtherCAT lock-step: skipped ({why})")
+        return
+    bench = default_lathe()
+    with SimProcess(tag="b") as sim:
+        link = EthercatLink.for_bench(bench, sim.iface)
+        link.open()
+        try:
+            n = len(link.drives)
+            masters = [Cia402Master() for _ in range(n)]
+            rx = [RxPdo(mode=8) for _ in range(n - len(bench.spindles))] + [RxPdo(mode=9) for _ in bench.spindles]
+            tx = link.exchange(rx)
+            for m in masters:
+                m.request(Target.ENABLED)
+            for _ in range(200):  # enable every drive, then hold the position each reports
+                for m, r, t in zip(masters, rx, tx):
+                    r.controlword = m.step(t.statusword)
+                    r.target_position = t.position_actual
+                tx = link.exchange(rx)
+            enabled = sum(m.enabled for m in masters)
+            t0, c0, s0 = time.perf_counter(), time.thread_time(), _cpu_of(sim.proc.pid)
+            for _ in range(cycles):
+                for m, r, t in zip(masters, rx, tx):
+                    r.controlword = m.step(t.statusword)
+                tx = link.exchange(rx)
+            wall, cpu, slaves = time.perf_counter() - t0, time.thread_time() - c0, _cpu_of(sim.proc.pid) - s0
+        finally:
+            link.close()
+        print(f"EtherCAT lock-step, bus alone ({n} drives, {enabled} enabled, veth + hil sim ethercat): "
+              f"{cycles} cycles in {wall:.2f} s wall = {cycles / wall:,.0f} cycles/s; CPU per cycle: master "
+              f"{cpu / cycles * 1e6:.0f} µs, slaves {slaves / cycles * 1e6:.0f} µs, so {cycles / (cpu + slaves):,.0f} "
+              "cycles/s when the two take turns on an otherwise idle machine")
+        runner = BenchRunner(bench, EthercatLink.for_bench(bench, sim.iface), None)
+        t0, c0, s0 = time.perf_counter(), time.thread_time(), _cpu_of(sim.proc.pid)
+        r = runner.run_program(parse_program(PROGRAM, name="bench.nc"))
+        wall, cpu, slaves = time.perf_counter() - t0, time.thread_time() - c0, _cpu_of(sim.proc.pid) - s0
+        print(f"EtherCAT lock-step, bench program ({n} drives): {r.cycles} cycles, {r.sim_time:.2f} s simulated in "
+              f"{wall:.2f} s wall = {r.cycles / wall:,.0f} cycles/s ({r.sim_time / wall:.1f}x real time, "
+              f"{'completed' if r.ok else 'alarm ' + ', '.join(a.code_text for a in r.alarms)}); CPU per cycle: "
+              f"master {cpu / r.cycles * 1e6:.0f} µs, slaves {slaves / r.cycles * 1e6:.0f} µs")
+
+
+def _cpu_of(pid: int) -> float:
+    """User + system CPU seconds of another process (/proc/PID/stat), 0 where /proc cannot say."""
+    try:
+        fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+        return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+    except (OSError, IndexError, ValueError):
+        return 0.0
+
+
+def realtime_runs(d: str, cam_blocks: int = 1500) -> None:
+    """`hil run --realtime` at the bench's 1 ms cycle, as a user runs it (hil.api.run: the bench's MLC,
+    a Parquet trace): cycle work p50/p99/max for the lathe demo (lathe MLC) and a CAM program on
+    benches/mill-3axis.toml. Figures, not a test: the machine's other load sets the tail."""
+    from hil import api
+
+    root = Path(__file__).resolve().parent.parent
+    sys.path.insert(0, str(root))
+    from benchmarks.bench_motion import cam_program
+
+    cam = Path(d) / f"cam{cam_blocks}.nc"
+    cam.write_text(cam_program(cam_blocks))
+    for label, program, bench in (("lathe demo, lathe MLC", root / "examples" / "lathe_demo.nc", None),
+                                  (f"CAM {cam_blocks:,} blocks, mill-3axis", cam, root / "benches" / "mill-3axis.toml")):
+        res = api.run(program, str(bench) if bench else None, trace=os.path.join(d, "rt.parquet"), realtime=True,
+                      check=False)
+        r = res.run
+        e, j = r.timing.get("exec", {}), r.timing.get("jitter", {})
+        print(f"real time, {label}, 1 ms ({r.granted}): {r.cycles} cycles, {r.overruns} overruns; cycle work "
+              + "  ".join(f"{k} {e[k] * 1e6:.0f} µs" for k in ("p50", "p99", "p99.9", "max") if k in e)
+              + "; jitter " + "  ".join(f"{k} {j[k] * 1e6:.1f} µs" for k in ("p50", "p99", "max") if k in j)
+              + ("" if r.ok else "  (" + ", ".join(a.code_text for a in r.alarms) + ")"))
+
+
 def realtime(seconds: float) -> None:
     bench = default_lathe()
     clk = RealTimeClock(bench.cycle, bench.realtime)
@@ -149,9 +239,17 @@ def realtime(seconds: float) -> None:
 if __name__ == "__main__":
     args = [a for a in sys.argv[1:] if not a.startswith("--")]
     with tempfile.TemporaryDirectory() as d:
+        if "--ethercat-only" in sys.argv:
+            ethercat_lockstep()
+            sys.exit(0)
+        if "--realtime-only" in sys.argv:
+            realtime_runs(d)
+            sys.exit(0)
         issue17(d)
         if "--stages-only" in sys.argv:
             sys.exit(0)
+        ethercat_lockstep()
+        realtime_runs(d)
         lockstep(None)
         lockstep(os.path.join(d, "t.csv"))
         lockstep(os.path.join(d, "t.parquet"))
