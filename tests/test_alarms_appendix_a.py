@@ -22,6 +22,7 @@ class Case:
     cite: str
     profile: str = "nc5-mill"
     files: tuple[tuple[str, str], ...] = ()
+    args: tuple[str, ...] = ()  # hil path options (--param NAME=VALUE)
 
 
 SUB = "O2000\nG01 X1. F100\nM99\n"
@@ -69,12 +70,37 @@ ALARM_CASES = [
          "App. A 0x1206 'Changing tool diameter during arc command performing'"),
     Case("0x025B", "G90 G00 X0 Y0 Z0\nG2.4 X10. Y0 Z0 F300\nG2.4 X20. Y0 Z0\nM30\n", 3,
          "App. A 0x025B 3-dimension arc command error: three points on one line make no circle (N§3.3.4)"),
+    Case("0x0004", "G100 X1.\nM30\n", 1, "App. A 0x0004 'Macro file call error. Macro number error.': G100 calls "
+         "O9100 through N1.200 (N§3.11.4.8 G-code macro call), and no such program exists", args=("--param", "N1.200=100")),
+    Case("0x020D", "#1>G01\nM30\n", 1, "App. A 0x020D error example '#1>G01' (judgement operator as a statement)"),
+    Case("0x0239", "#1=0\nWHILE [#1 LT 3] THEN\n#1=#1+1\nEND 1\nM30\n", 2,
+         "App. A 0x0239 THEN command error: THEN after a WHILE condition (N§3.11.3.3 WHILE [] DO; THEN only after IF/ELSEIF)"),
+    Case("0x0247", "G00 X50. Z5.\nG71 U2. R1.\nG00 X60.\nM30\n", 2,
+         "App. A 0x0247 / N§3.15.2 G71 note (4): 'two continuous blocks as one complete instruction'", profile="nc5-lathe-a"),
+    Case("0x0245", "G00 X50. Z5.\nG72 W2. R1.\nG72 U0.5 W0.2 F100\nN10 G01 Z-10.\nN20 X30.\nM30\n", 2,
+         "App. A 0x0245 'The command P or Q is not used in the nested loop': the second G72 block (N§3.15.3 "
+         "format G72 P_ Q_ U_ W_ F_) names neither", profile="nc5-lathe-a"),
+    Case("0xB6A5", "G21 G98\nG00 X30. Z10.\nM03 S500\nG83 X20. Z-12. R5. F100.\nG80\nM30\n", 4,
+         "App. A 0xB6A5 / N§3.14 G83 note (3), lathe guide G83 'X(U)_C_: hole position': a face hole off X0 on a "
+         "lathe without a C axis (never in turn-mill mode)", profile="nc5-lathe-a"),
+    Case("0x0C03", "G97 S2000 M03\nG00 X10.\nS4500\nM30\n", 3,
+         "App. A 0x0C03: N0.1000 bit7 on and S above N0.1008 (the spindle's maximum speed)", profile="nc5-lathe-a",
+         args=("--param", "N0.1000 Bit7=1", "--param", "N0.1008=4000")),
+    Case("0x1204", "G10 L12 P1 R2.\nG90 G00 X-50. Y-50.\nG42 D1 G01 X0 Y0 F100\nG02 X28.2 Y28.2 R32.1\n"
+         "G01 X16.7 Y23.5\nG40 G01 X-50. Y-50.\nM30\n", 5,
+         "App. A 0x1204: arc then line at an inner corner whose compensated elements do not meet (N§3.6.2 G41/G42)"),
+    Case("0x1207", "G10 L12 P1 R4.\nG90 G00 X-50. Y-50.\nG42 D1 G01 X0 Y0 F100\nG02 X-24.8 Y9.8 R22.3\n"
+         "G02 X-6.4 Y-0.6 R14.4\nG40 G01 X-50. Y-50.\nM30\n", 5,
+         "App. A 0x1207: arc then arc at an inner corner whose compensated circles do not meet (N§3.6.2)"),
+    Case("0x1209", "G10 L12 P1 R6.\nG90 G00 X-50. Y-50.\nG42 D1 G01 X0 Y0 F100\nG01 X-15.2 Y-23.9\n"
+         "G02 X18.5 Y-24.5 R17.9\nG40 G01 X-50. Y-50.\nM30\n", 5,
+         "App. A 0x1209: line then arc at an inner corner whose compensated elements do not meet (N§3.6.2)"),
 ]
 
 
 @pytest.mark.parametrize("case", ALARM_CASES, ids=[c.code for c in ALARM_CASES])
 def test_appendix_a_alarm_is_raised_at_its_line(capsys, tmp_path, case: Case):
-    r = run_path(capsys, tmp_path, case.program, profile=case.profile, files=dict(case.files))
+    r = run_path(capsys, tmp_path, case.program, *case.args, profile=case.profile, files=dict(case.files))
     assert r.code == 1, (case.cite, r.moves[-1:] if r.moves else None)
     assert r.alarm["code"] == case.code, (case.cite, r.alarm)
     assert r.alarm["line"] == case.line, (case.cite, r.alarm)

@@ -140,6 +140,8 @@ def _g71_g72(host: Any, code: str, block: Block) -> list[Event]:
                     "h": _raw(block, "H"), "line": block.line}
         if block.has("P") or block.has("Q"):
             raise NcAlarm(0x0264, f"{code} needs both P and Q")
+        if not host.profile.legacy:
+            _check_second_block(host, code, block)
         return []
     first = mem.pop(key, {})
     prm = host.profile.param
@@ -162,6 +164,30 @@ def _g71_g72(host: Any, code: str, block: Block) -> list[Event]:
     turning.rough(b, segs_from_moves(moves, LATHE_PLANE),
                   turning.RoughSpec(code, depth, retract, u, w, h))
     return _finish(host, b)
+
+
+def _check_second_block(host: Any, code: str, block: Block) -> None:
+    """N§3.15.2 note (4): G71/G72 is two consecutive blocks; the first (U/W R H) must be followed by the
+    second (P Q U W F): another block there is 0x0247, a second G71/G72 naming neither P nor Q is 0x0245
+    (decisions language: the two App. A codes of the nested loop)."""
+    frame = getattr(host, "frame", None)
+    if frame is None:
+        return
+    blocks = frame.program.blocks
+    at = next((i for i, b in enumerate(blocks) if b.line == block.line), None)
+    if at is None:
+        return
+    nxt = next((b for b in blocks[at + 1:] if b.words or b.stmt is not None), None)
+    try:
+        second = nxt is not None and nxt.stmt is None and _explicit(host, nxt, code)
+    except (TypeError, ValueError):  # a G word given by an expression: judged when it runs
+        return
+    if not second:
+        raise NcAlarm(0x0247, f"{code} (first block) must be followed by its second block {code} P_ Q_"
+                              + (f"; line {nxt.line} is {nxt.text.strip()!r}" if nxt is not None else ""))
+    if not (nxt.has("P") or nxt.has("Q")):
+        raise NcAlarm(0x0245, f"the second {code} block (line {nxt.line}) names neither P nor Q "
+                              "(the contour's first and last N)")
 
 
 def _g73(host: Any, block: Block) -> Iterator[Event]:
@@ -421,6 +447,11 @@ def _lathe_hole(host: Any, code: str, block: Block) -> Iterator[Event]:
     k_word = block.get("K")
     repeats = int(k_word.value) if k_word is not None else 1
     tgt = _target(host, block)
+    if face and "C" not in host.profile.axes and abs(tgt.get("X", 0.0)) > 1e-6:
+        # N§3.14 note (3), lathe guide G83/G84/G85: with no C axis the lathe never leaves turning mode, the
+        # work spins under the drill and only the centre (X0) can be drilled or tapped
+        raise NcAlarm(0xB6A5, f"{code} face hole off the centre (X not 0): drilling there needs the C axis "
+                              "(turn-mill mode); without it the hole must be at X0")
     pos_axes = tuple(a for a in host.profile.axes if a != axis)
     initial = st["initial"]
     bottom = st["bottom"]

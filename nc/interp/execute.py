@@ -96,6 +96,9 @@ def step_spindle(ip, run: BlockRun) -> Iterator[Event]:
     if s is not None and not ("set" in funcs) and not ip._cycle_fn(funcs):
         if s.value < 0 or s.value > 600000:
             raise NcAlarm(0x0223, f"S{s.value:g} out of range 0-600000")
+        top = ip.profile.param("N0.1008", 0.0)
+        if not st.css and top > 0 and s.value > top and ip.profile.bit("N0.1000 Bit7"):  # App. A 0x0C03
+            raise NcAlarm(0x0C03, f"S{s.value:g} exceeds the spindle's maximum speed N0.1008 = {top:g} rpm")
         st.spindle_speed = s.value
         if st.css:
             st.surface_speed = s.value

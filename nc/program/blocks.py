@@ -281,7 +281,7 @@ class _BlockParser:
             return End(None)
         if kw == "END":
             return End(self._loop_id("END", 0x0225))
-        raise self.alarm(0x0207, f"{kw} out of place")
+        raise self.alarm(0x0239 if kw == "THEN" else 0x0207, f"{kw} out of place")
 
     def _loop_id(self, what: str, code: int) -> int:
         self.p.skip()
@@ -335,6 +335,9 @@ class _BlockParser:
                     raise self.alarm(0x0208, "an assignment and other words cannot share a block")
                 target = p.variable()
                 p.skip()
+                judge = next((op for op in ("==", "<>", ">=", "<=", ">", "<") if self.s.startswith(op, p.pos)), None)
+                if judge is not None:  # App. A 0x020D wrong example '#1>G01': a judgement is no statement
+                    raise self.alarm(0x020D, f"judgement operator {judge!r} where an assignment '=' belongs")
                 if not self.s.startswith("=", p.pos):
                     raise self.alarm(0x0211, "# variable without '=' (assignment expected)")
                 p.pos += 1
@@ -365,7 +368,9 @@ class _BlockParser:
             kw = self.keyword()
             if kw:
                 if block.stmt is not None or (kw in ("IF", "WHILE") and block.words):
-                    raise self.alarm(0x0203 if kw in ("IF", "WHILE") else 0x0207, f"{kw} out of place")
+                    code = 0x0203 if kw in ("IF", "WHILE") else 0x0239 if kw == "THEN" else 0x0207
+                    raise self.alarm(code, f"{kw} out of place" + (" (THEN follows only IF [..] or ELSEIF [..])"
+                                                                   if kw == "THEN" else ""))
                 block.stmt = self.statement(kw, first)
                 if kw in ("END", "ENDW", "ENDIF", "ELSE", "EXITW") or isinstance(block.stmt, (IfThen, ElseIf)):
                     if not self.at_end():
