@@ -89,11 +89,18 @@ def step_feed_d(ip, run: BlockRun) -> None:
         st.d_number = int(d)
 
 
+def _cycle_owns_s_t(ip, funcs: set[str]) -> bool:
+    """Whether a cycle takes the block's S and T as its own words. The lathe's stock removal cycles do not:
+    their `P_ Q_ U_ W_ F_ S_ T_` block names the roughing tool and spindle speed (N§3.15.2-3.15.4)."""
+    fn = ip._cycle_fn(funcs)
+    return fn is not None and not (ip.profile.is_lathe and fn in ("G71", "G72", "G73"))
+
+
 def step_spindle(ip, run: BlockRun) -> Iterator[Event]:
     """S: spindle speed or (G96) surface speed, issued before the motion; G96/G97 alone switch now."""
     block, funcs, st = run.block, run.funcs, ip.state
     s = block.get("S")
-    if s is not None and not ("set" in funcs) and not ip._cycle_fn(funcs):
+    if s is not None and not ("set" in funcs) and not _cycle_owns_s_t(ip, funcs):
         if s.value < 0 or s.value > 600000:
             raise NcAlarm(0x0223, f"S{s.value:g} out of range 0-600000")
         top = ip.profile.param("N0.1008", 0.0)
@@ -117,7 +124,7 @@ def step_spindle(ip, run: BlockRun) -> Iterator[Event]:
 def step_tool(ip, run: BlockRun) -> Iterator[Event] | None:
     """T: tool selection and offsets (not a cycle's T)."""
     t = run.block.get("T")
-    if t is not None and not ip._cycle_fn(run.funcs):
+    if t is not None and not _cycle_owns_s_t(ip, run.funcs):
         return ip._tool(run.block, t)
     return None
 
