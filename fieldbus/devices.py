@@ -65,7 +65,7 @@ class DeviceModel:
     extra_tx: tuple[Entry, ...] = _EXTRA_TX
     units: DriveUnits = DELTA_UNITS
     max_entries: int = 8  # entries per PDO (the largest predefined set)
-    modes: tuple[int, ...] = (8, 9)  # 0x6060 values the virtual drive runs (0x6502 advertises them)
+    modes: tuple[int, ...] = (1, 3, 6, 8, 9, 10)  # 0x6060 values the virtual drive runs (0x6502 = 0x3A5 advertises them)
     sync0_min_ns: int = 125_000
 
     def mappable(self, direction: str) -> set[tuple[int, int]]:

@@ -19,7 +19,7 @@ class RxPdo:
     target_position: int = 0  # 0x607A, counts
     mode: int = 8  # 0x6060 (8 = CSP, 9 = CSV, 6 = homing)
     target_velocity: int = 0  # 0x60FF, drive units (Delta: 0.1 rpm)
-    target_torque: int = 0  # 0x6071, 0.1 % of rated (in Delta's 0x1602 set; CST is not used)
+    target_torque: int = 0  # 0x6071, 0.1 % of rated (CST; in Delta's 0x1602 set)
     touch_probe_function: int = 0  # 0x60B8
     digital_outputs: int = 0  # 0x60FE:1
 

@@ -1,12 +1,14 @@
 """Conformance of the simulated CANopen CiA 402 node (issue 23), checked by plain python-canopen clients
 (none of hil's master code) on python-can's in-process `virtual` bus; SIGTERM across processes inside a
-network namespace. Expectations cite CiA 301 (NMT, SDO, PDO mapping), CiA 402 (0x6060/0x6502) and
+network namespace. Expectations cite CiA 301 (NMT, SDO, PDO mapping), CiA 402 (0x6060/0x6502, the modes) and
 python-canopen's BaseNode402, never our implementation."""
 
 from __future__ import annotations
 
+import logging
 import struct
 import subprocess
+import time
 import uuid
 
 import canopen
@@ -99,17 +101,59 @@ def test_pdo_mapping_changes_only_while_the_pdo_is_invalid(bus):
 
 
 def test_modes_of_operation_and_basenode402(bus):
-    """CiA 402: 0x6060 refuses unsupported values with 0x06090030; 0x6502 lists what runs, the same
-    value as on EtherCAT (CSP and CSV); python-canopen's BaseNode402 reads it so."""
+    """CiA 402: 0x6060 refuses unsupported values with 0x06090030; 0x6502 lists what runs, the same value as on
+    EtherCAT (PP, PV, HM, CSP, CSV, CST: the ASDA-A3-E's modes, profile torque not); BaseNode402 reads it so."""
     _, _, node = bus
-    assert node.sdo[0x6502].raw == 0x00000180
-    for bad in (0x55, 2, 1, 6, 10):
+    assert node.sdo[0x6502].raw == 0x000003A5
+    for bad in (0x55, 2, 4, 7, 11):
         assert abort_of(lambda: setattr(node.sdo[0x6060], "raw", bad)) == 0x06090030
     node.sdo[0x6060].raw = 9
     assert node.sdo[0x6061].raw == 9
-    assert node.is_op_mode_supported("CYCLIC SYNCHRONOUS POSITION")
-    assert node.is_op_mode_supported("CYCLIC SYNCHRONOUS VELOCITY")
-    assert not node.is_op_mode_supported("HOMING") and not node.is_op_mode_supported("PROFILED POSITION")
+    for mode in ("CYCLIC SYNCHRONOUS POSITION", "CYCLIC SYNCHRONOUS VELOCITY", "CYCLIC SYNCHRONOUS TORQUE",
+                 "HOMING", "PROFILED POSITION", "PROFILED VELOCITY"):
+        assert node.is_op_mode_supported(mode)
+    assert not node.is_op_mode_supported("PROFILED TORQUE")
+    assert abort_of(lambda: setattr(node.sdo[0x6098], "raw", 7)) == 0x06090030  # a homing method it lacks
+
+
+def test_basenode402_homing_then_a_profile_position_move(bus):
+    """python-canopen's BaseNode402.homing() with CiA 402 method 21 (negative home switch, ends moving positive
+    off it) and home offset 0x607C; then a profile-position move by 0x607A and controlword bit 4, ended by
+    statusword bit 10. The client produces SYNC (1 ms interpolation period each)."""
+    slaves, net, node = bus
+    logging.getLogger("canopen").setLevel(logging.ERROR)  # BaseNode402 warns on every SDO fallback
+    drive = slaves[1].drive
+    edge = int(drive.position) - 64_000  # the home switch: active below this
+    drive.params.home_switch = edge
+    net.sync.start(0.002)
+    try:
+        node.sdo[0x6098].raw = 21
+        node.sdo[0x607C].raw = 5000
+        assert node.homing(timeout=20)
+        wait_for(lambda: node.sdo[0x6041].raw & 0x3400 == 0x1400)  # homing attained, target reached
+        assert abs(node.sdo[0x6064].raw - 5000) <= 100  # 0x6067 window
+        assert abs(drive.position - edge) <= 100  # on the switch edge
+        node.controlword = 0x0F
+        node.op_mode = "PROFILED POSITION"
+        assert node.op_mode == "PROFILED POSITION"
+        node.sdo[0x6081].raw = 640_000  # PUU/s
+        node.sdo[0x607A].raw = 300_000
+        t0 = drive.time
+        node.controlword = 0x1F  # new set-point
+        assert node.sdo[0x6041].raw & 0x1000  # set-point acknowledge
+        node.controlword = 0x0F
+        wait_for(lambda: node.sdo[0x6041].raw & 0x0400)
+        assert abs(node.sdo[0x6064].raw - 300_000) <= 100
+        assert drive.time - t0 == pytest.approx(295_000 / 640_000, abs=0.1)  # simulated time at 0x6081
+    finally:
+        net.sync.stop()
+
+
+def wait_for(predicate, timeout: float = 20.0) -> None:
+    end = time.monotonic() + timeout
+    while not predicate():
+        assert time.monotonic() < end, "timed out"
+        time.sleep(0.01)
 
 
 def test_sdo_size_must_match_the_object(bus):

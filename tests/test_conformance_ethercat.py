@@ -36,7 +36,7 @@ drive = { model = "asda-a3-e" }
 [[axes]]
 name = "Z"
 lead = 10.0
-drive = { model = "asda-b3-e" }
+drive = { model = "asda-b3-e", home_switch = -64000 }
 [[spindles]]
 name = "S1"
 drive = { model = "asda-a2-e" }
@@ -112,6 +112,22 @@ def assign(s, rx: int, tx: int) -> None:
         s.sdo_write(a, 0, b"\x01")
 
 
+def to_op(master, s) -> None:
+    """SAFE-OP after config_map, then OP with process data flowing (SOEM's usual start)."""
+    assert master.state_check(pysoem.SAFEOP_STATE, 2_000_000) == pysoem.SAFEOP_STATE
+    master.state = pysoem.OP_STATE
+    master.send_processdata()
+    master.receive_processdata(100_000)
+    master.write_state()
+    for _ in range(200):
+        master.send_processdata()
+        master.receive_processdata(100_000)
+        if master.state_check(pysoem.OP_STATE, 5_000) == pysoem.OP_STATE:
+            break
+    master.read_state()
+    assert s.state == pysoem.OP_STATE, [(x.state, hex(x.al_status)) for x in master.slaves]
+
+
 def test_01_identity_and_default_image(master):
     """ESI: identity per model; the power-on assignment gives 12 bytes out (0x1600) and 22 in (0x1A01) on
     the A3-E/B3-E; a plain master that maps nothing gets exactly that image."""
@@ -160,18 +176,7 @@ def test_04_linuxcnc_deasda_configuration_runs_csv(master):
     s.sdo_write(0x60C2, 2, struct.pack("<b", -3))
     master.config_map()
     assert (len(s.output), len(s.input)) == (6, 14)
-    assert master.state_check(pysoem.SAFEOP_STATE, 2_000_000) == pysoem.SAFEOP_STATE
-    master.state = pysoem.OP_STATE
-    master.send_processdata()
-    master.receive_processdata(100_000)
-    master.write_state()
-    for _ in range(200):
-        master.send_processdata()
-        master.receive_processdata(100_000)
-        if master.state_check(pysoem.OP_STATE, 5_000) == pysoem.OP_STATE:
-            break
-    master.read_state()
-    assert s.state == pysoem.OP_STATE, [(x.state, hex(x.al_status)) for x in master.slaves]
+    to_op(master, s)
     velocity = 0
     for cw in [0x06] * 3 + [0x07] * 3 + [0x0F] * 1000:  # 1 s: the CSV ramp is 0.43 s to 1000 rpm
         s.output = struct.pack("<Hi", cw, 10000 if cw == 0x0F else 0)
@@ -184,14 +189,55 @@ def test_04_linuxcnc_deasda_configuration_runs_csv(master):
 
 def test_05_modes_of_operation(master):
     """CiA 402: 0x6060 refuses what the drive does not run with 0x06090030; 0x6502 lists exactly the modes
-    that run (the virtual drive: CSP and CSV, bits 7 and 8; decisions E13)."""
+    that run (PP, PV, HM, CSP, CSV, CST: bits 0, 2, 5, 7, 8, 9, the ASDA-A3-E's; decisions E13)."""
     for s in master.slaves:
-        assert u(s.sdo_read(0x6502, 0)) == 0x00000180
-        for bad in (0x55, 2, 1, 6, 10):
+        assert u(s.sdo_read(0x6502, 0)) == 0x000003A5
+        for bad in (0x55, 2, 4, 7, 11):
             assert abort_of(lambda: s.sdo_write(0x6060, 0, bytes([bad]))) == 0x06090030
         s.sdo_write(0x6060, 0, b"\x09")
         s.sdo_write(0x6060, 0, b"\x08")
         assert s.sdo_read(0x6060, 0) == b"\x08"
+
+
+def test_05b_homing_and_profile_position_over_pdo(master):
+    """CiA 402-2 homing (mode 6, method 21: negative home switch, home offset 0x607C) and then a profile-position
+    move (mode 1, 0x6081, 0x607A, controlword bit 4), all by process data in OP as a plain master sends it; the
+    statusword's mode bits (12 homing attained / set-point acknowledge, 10 target reached) end each step."""
+    s = master.slaves[1]  # Z: ASDA-B3-E, home switch 64 000 counts below where it stands
+    write_pdo(s, 0x1602, [0x60400010, 0x607A0020, 0x60600008])
+    write_pdo(s, 0x1A02, [0x60410010, 0x60640020, 0x60610008])
+    assign(s, 0x1602, 0x1A02)
+    s.sdo_write(0x6098, 0, struct.pack("<b", 21))
+    s.sdo_write(0x607C, 0, struct.pack("<i", 5000))
+    s.sdo_write(0x6081, 0, struct.pack("<I", 640_000))
+    assert abort_of(lambda: s.sdo_write(0x6098, 0, struct.pack("<b", 7))) == 0x06090030  # a method it lacks
+    master.config_map()
+    to_op(master, s)
+
+    def cycle(cw: int, mode: int, target: int = 0) -> tuple[int, int, int]:
+        s.output = struct.pack("<Hib", cw, target, mode)
+        master.send_processdata()
+        master.receive_processdata(100_000)
+        return struct.unpack("<Hib", bytes(s.input))
+
+    def until(cw: int, mode: int, target: int, done, cycles: int = 5000) -> tuple[int, int, int]:
+        for _ in range(cycles):
+            sw, pos, shown = cycle(cw, mode, target)
+            if done(sw):
+                return sw, pos, shown
+        raise AssertionError(f"statusword 0x{sw:04X}")
+
+    for cw in (0x06, 0x07, 0x0F):
+        cycle(cw, 6)
+    sw, _, shown = until(0x0F, 6, 0, lambda sw: sw & 0x6F == 0x27)
+    assert shown == 6 and sw & 0x3400 == 0x0400  # homing not started
+    sw, pos, _ = until(0x1F, 6, 0, lambda sw: sw & 0x3400 == 0x1400)  # attained and reached
+    assert abs(pos - 5000) <= 100
+    until(0x0F, 1, pos, lambda sw: True, 2)
+    sw, _, shown = until(0x1F, 1, 300_000, lambda sw: sw & 0x1000)  # set-point acknowledged
+    assert shown == 1
+    sw, pos, _ = until(0x0F, 1, 300_000, lambda sw: sw & 0x0400)
+    assert abs(pos - 300_000) <= 100
 
 
 def test_06_sdo_size_must_match_the_object(master):

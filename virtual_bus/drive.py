@@ -16,6 +16,7 @@ from fieldbus.cia402 import (STATE_BITS, SW_FOLLOWING, SW_FOLLOWING_ERROR, SW_IN
                              SW_TARGET_REACHED, SW_VOLTAGE, SW_QUICK_STOP, State, command_of)
 from fieldbus.pdo import RxPdo, TxPdo
 from fieldbus.units import DELTA_UNITS, DriveUnits
+from virtual_bus.drive_modes import CST, HM, PROFILE_MODES, DriveModes
 from virtual_bus.servo_params import ServoParams
 
 # Delta ASDA alarm numbers as the drive reports them in 0x603F (the NC shows 0xF002 + this code)
@@ -72,6 +73,7 @@ class Cia402Drive:
     _limit_flags: int = 0
     _want_cps: float = 0.0  # 0x60FF converted to counts/s
     servo_params: ServoParams = field(default_factory=ServoParams)  # P0-xx…P6-xx over SDO / Modbus (issue 8)
+    modes: DriveModes = field(default_factory=DriveModes)  # PP, PV, HM, CST and the home origin (drive_modes.py)
 
     # ---- process data -----------------------------------------------------------------
     def apply(self, rx: RxPdo) -> None:
@@ -82,6 +84,9 @@ class Cia402Drive:
         if rx.mode != self.mode:
             self.mode = rx.mode
             self._prev_target = None
+            self.modes.restart(rx.controlword)
+        if self.mode in PROFILE_MODES:
+            self.modes.apply(self, rx.controlword, rx.target_position, rx.target_torque)
 
     def feedback(self) -> TxPdo:
         sw = STATE_BITS[self.state] | SW_REMOTE
@@ -90,26 +95,29 @@ class Cia402Drive:
         if self.state is not State.QUICK_STOP_ACTIVE:
             sw |= SW_QUICK_STOP if self.state is not State.FAULT else 0
         if self.state is State.OPERATION_ENABLED:
-            sw |= SW_FOLLOWING
-            if abs(self.velocity) < 0.001 * self._max_cps and abs(self.command - self.position) < 10:
-                sw |= SW_TARGET_REACHED
-        if self._limit_flags:
+            if self.mode in PROFILE_MODES:
+                sw |= self.modes.status_bits(self)
+            else:
+                sw |= SW_FOLLOWING
+                if abs(self.velocity) < 0.001 * self._max_cps and abs(self.command - self.position) < 10:
+                    sw |= SW_TARGET_REACHED
+        if self._limit_flags and self.mode != HM:  # homing on a limit switch is no limit violation
             sw |= SW_INTERNAL_LIMIT
-        if abs(self.command - self.position) > self.params.following_error_window:
+        if abs(self.command - self.position) > self.params.following_error_window and self.mode not in PROFILE_MODES:
             sw |= SW_FOLLOWING_ERROR
         di = self._limit_flags
         if self.params.home_switch is not None and self.position < self.params.home_switch:
             di |= 0x4
         return TxPdo(
             statusword=sw,
-            position_actual=int(round(self.position)),
+            position_actual=int(round(self.position + self.modes.origin)),
             velocity_actual=self.params.units.velocity_to_raw(self.velocity, self.params.counts_per_rev),
             torque_actual=int(round(self.torque * 0.1 / self.params.units.torque_percent)),
             following_error=int(round(self.command - self.position)) if self.mode == 8 else 0,
             error_code=self.error_code,
             mode_display=self.mode,
             touch_probe_status=0x0003 if self._probe_latched else (0x0001 if self._rx.touch_probe_function & 1 else 0),
-            touch_probe_pos1=self._probe_pos,
+            touch_probe_pos1=self._probe_pos + int(round(self.modes.origin)),
             digital_inputs=di,
         )
 
@@ -154,6 +162,7 @@ class Cia402Drive:
                 # The drive takes over the actual position so enabling never jumps.
                 self.command = self.position
                 self._prev_target = None
+                self.modes.restart(cw)
                 self.state = State.OPERATION_ENABLED
             elif s is State.READY_TO_SWITCH_ON:
                 self.state = State.SWITCHED_ON
@@ -179,7 +188,7 @@ class Cia402Drive:
         n = max(1, p.substeps)
         h = dt / n
         energised = self.state in (State.OPERATION_ENABLED, State.QUICK_STOP_ACTIVE, State.FAULT_REACTION_ACTIVE)
-        target = float(self._rx.target_position)
+        target = float(self._rx.target_position) - self.modes.origin  # 0x607A in PUU, homing shifted them
         # CSP: the drive's interpolator spreads the new target over the cycle.
         if self.state is State.OPERATION_ENABLED and self.mode == 8:
             prev = self._prev_target if self._prev_target is not None else self.command
@@ -197,6 +206,8 @@ class Cia402Drive:
         probing = bool(self._rx.touch_probe_function & 1)
         enabled = self.state is State.OPERATION_ENABLED
         csp, csv = enabled and self.mode == 8, enabled and self.mode == 9
+        profile = enabled and self.mode in PROFILE_MODES  # PP, PV, HM, CST: virtual_bus/drive_modes.py
+        direct = profile and self.mode == CST  # torque mode: the velocity is the motor's, no velocity loop
         for k in range(1, n + 1):
             if not energised:
                 # Brake engaged / motor free: friction stops it within a few ms.
@@ -206,6 +217,8 @@ class Cia402Drive:
             elif csp:
                 self.command = prev + (target - prev) * k / n
                 v_cmd = p.kff * ff_vel + p.kp * (self.command - self.position)
+            elif profile:
+                v_cmd = self.modes.velocity_command(self, h)
             elif csv:
                 want = self._want_cps
                 step = p.csv_accel * h
@@ -219,7 +232,7 @@ class Cia402Drive:
                 self.command = self.position
             v_cmd = max(-max_cps, min(max_cps, v_cmd))
             if energised and v_cmd != self.velocity:
-                self.velocity += (v_cmd - self.velocity) * alpha
+                self.velocity = v_cmd if direct else self.velocity + (v_cmd - self.velocity) * alpha
             new_pos = self.position + self.velocity * h
             if limited:
                 new_pos = self._limit(new_pos)

@@ -26,6 +26,7 @@ DIO_EDS: Path = Path(str(resources.files("fieldbus.canopen") / "eds" / "delta_di
 OBJECT_ATTRS: dict[tuple[int, int], str] = {
     (0x6040, 0): "controlword", (0x607A, 0): "target_position", (0x6060, 0): "mode",
     (0x60FF, 0): "target_velocity", (0x60B8, 0): "touch_probe_function", (0x60FE, 1): "digital_outputs",
+    (0x6071, 0): "target_torque",
     (0x6041, 0): "statusword", (0x6064, 0): "position_actual", (0x606C, 0): "velocity_actual",
     (0x6077, 0): "torque_actual", (0x60F4, 0): "following_error", (0x603F, 0): "error_code",
     (0x6061, 0): "mode_display", (0x60B9, 0): "touch_probe_status", (0x60BA, 0): "touch_probe_pos1",

@@ -24,6 +24,7 @@ from fieldbus.canopen.objects import ASDA_B3_EDS, MAX_PDO_BYTES, MAX_PDOS, OBJEC
 from fieldbus.cia402 import State
 from fieldbus.pdo import PdoEntry, PdoLayout, RxPdo
 from virtual_bus.drive import Cia402Drive
+from virtual_bus.drive_modes import MODE_OBJECTS, check_value
 from virtual_bus.servo_params import ServoParamError, ServoParams, coe_objects
 
 log = logging.getLogger("virtual_bus.canopen")
@@ -34,7 +35,7 @@ ABORT_NOT_MAPPABLE = 0x06040041
 ABORT_PDO_LENGTH = 0x06040042
 ABORT_VALUE_RANGE = 0x06090030
 
-_RX_OBJECTS = {0x6040, 0x607A, 0x6060, 0x60FF, 0x60B8, 0x60FE}
+_RX_OBJECTS = {0x6040, 0x607A, 0x6060, 0x60FF, 0x60B8, 0x60FE, 0x6071}
 _SIGNED = {odmod.INTEGER8, odmod.INTEGER16, odmod.INTEGER32}
 
 
@@ -67,6 +68,7 @@ class Cia402Slave:
         self._dirty = True
         self._fault_reported = 0
         self._add_servo_params()
+        self._mode_defaults()
         self.node.add_read_callback(self._on_read)
         self.node.add_write_callback(self._on_write)
 
@@ -119,6 +121,8 @@ class Cia402Slave:
         for index in [i for i in self.node.data_store if 0x6000 <= i <= 0x9FFF]:
             del self.node.data_store[index]
         d = self.drive
+        d.modes.reset()  # the profile modes' objects and the home origin (a real drive forgets it too)
+        self._mode_defaults()
         d.external_fault = 0
         d.error_code = 0
         d.state = State.SWITCH_ON_DISABLED
@@ -155,7 +159,17 @@ class Cia402Slave:
             var.access_type = "rw" if p.writable else "ro"
             od.add_object(var)
 
+    def _mode_defaults(self) -> None:
+        """The profile modes' objects (virtual_bus/drive_modes.py) start at the EDS defaults."""
+        for (index, sub), attr in MODE_OBJECTS.items():
+            var = self._od_var(index, sub)
+            if var is not None and var.default is not None:
+                setattr(self.drive.modes.objects, attr, int(var.default))
+
     def _on_read(self, index: int, subindex: int, od: odmod.ODVariable):
+        mode_attr = MODE_OBJECTS.get((index, subindex))
+        if mode_attr is not None:
+            return getattr(self.drive.modes.objects, mode_attr)
         if 0x2000 <= index <= 0x26FF:
             return self.drive.servo_params.read(ServoParams.from_index(index, subindex))
         attr = OBJECT_ATTRS.get((index, subindex))
@@ -185,6 +199,13 @@ class Cia402Slave:
             mode, supported = od.decode_raw(data), self._value(0x6502, 0)
             if mode != 0 and not (1 <= mode <= 32 and supported >> (mode - 1) & 1):
                 raise SdoAbortedError(ABORT_VALUE_RANGE)
+        mode_attr = MODE_OBJECTS.get((index, subindex))
+        if mode_attr is not None:  # the drive's profile-mode objects: it checks what it can run
+            value = od.decode_raw(data)
+            if not check_value(index, subindex, value, self.drive.modes.objects):
+                raise SdoAbortedError(ABORT_VALUE_RANGE)
+            setattr(self.drive.modes.objects, mode_attr, value)
+            return
         attr = OBJECT_ATTRS.get((index, subindex))
         if attr is not None and index in _RX_OBJECTS:
             setattr(self.rx, attr, od.decode_raw(data))

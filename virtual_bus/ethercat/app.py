@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 from fieldbus.pdo import ASDA_CSP_CSV, ASDA_E, RxPdo
 from fieldbus.cia402 import State
 from virtual_bus.drive import Cia402Drive
+from virtual_bus.drive_modes import CST, MODE_OBJECTS, check_value
 from virtual_bus.ethercat.coe import ABORT_VALUE_RANGE, ObjectDictionary, SdoAbort
 from virtual_bus.ethercat.device import OBJ_VAR, TYPES, OdEntry, OdObject
 from virtual_bus.ethercat.esc import SlaveApp
@@ -58,6 +59,10 @@ class DriveApp(SlaveApp):
                 0, p.label, dtype, bits, signed, "rw" if p.writable else "ro", value=p.default)})
         od.after_write = self._after_write
         od.before_write = self._before_write
+        objects = self.drive.modes.objects  # the profile modes' objects start at the ESI's defaults
+        for (index, sub), attr in MODE_OBJECTS.items():
+            if index in od.objects and sub in od.objects[index].entries:
+                setattr(objects, attr, od.value(index, sub))
         self._publish()
 
     def _before_write(self, index: int, sub: int, value) -> None:
@@ -67,11 +72,17 @@ class DriveApp(SlaveApp):
             supported = od.value(0x6502)
             if value != 0 and not (1 <= value <= 32 and supported >> (value - 1) & 1):
                 raise SdoAbort(ABORT_VALUE_RANGE)
+        if (index, sub) in MODE_OBJECTS and not check_value(index, sub, value, self.drive.modes.objects):
+            raise SdoAbort(ABORT_VALUE_RANGE)
 
     def _after_write(self, index: int, sub: int) -> None:
         """A servo parameter written over SDO goes through the drive's checks; a refusal restores
         the old value and aborts the transfer with the drive's code."""
         od, params = self.od, self.drive.servo_params
+        attr = MODE_OBJECTS.get((index, sub))
+        if attr is not None and od is not None:  # the drive's copy of a profile-mode object (drive_modes.py)
+            setattr(self.drive.modes.objects, attr, od.value(index, sub))
+            return
         if od is None or index not in self._params:  # 0x2511 (P5-17, auxiliary encoder) is the device's own
             return
         try:
@@ -106,6 +117,9 @@ class DriveApp(SlaveApp):
             self.drive.step(dt)
         elif step:
             _unpack(outputs, rx_map, od)
+            if self.drive.mode == CST and 0x60E0 in od.objects:  # torque limits may travel in 0x1603
+                self.drive.modes.objects.positive_torque_limit = od.value(0x60E0)
+                self.drive.modes.objects.negative_torque_limit = od.value(0x60E1)
             rx = RxPdo(mode=self.drive.mode)
             for (index, sub), attr in RX_ATTR.items():
                 if index in od.objects:
