@@ -24,3 +24,16 @@ MILL_CYCLES: dict[int, str] = {n: f"MG{n}" for n in (73, 74, 76, 81, 82, 83, 84,
 
 # cycles that stay active for following blocks (group 09 modal); G70–G76 and G32/G34 are one block
 MODAL_CYCLES = {"G90", "G92", "G94", "G83", "G84", "G85", "G87", "G88", "G89"} | set(MILL_CYCLES.values())
+
+
+LATHE_HOLES = ("G83", "G84", "G85", "G87", "G88", "G89")
+
+
+def lathe_hole_clamp(profile, code: str | None, block) -> int | None:
+    """The M_ of a lathe guide hole cycle block (L§2.1 G83-G89: "M-code call, usually C-axis clamping"): that
+    M goes out at the hole position and M+1 back at R (nc.cycles.holes), not as the block's ordinary M.
+    The NC5 formats have no M_ (N§3.14): there an M stays an ordinary M code of the block."""
+    m = block.get("M")
+    if m is None or code not in LATHE_HOLES or not profile.legacy or not profile.is_lathe:
+        return None
+    return int(m.value)

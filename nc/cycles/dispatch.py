@@ -15,6 +15,7 @@ from typing import Any
 from nc.alarms import NcAlarm
 from nc.cycles import holes, lathe_single, threading, turning
 from nc.cycles.builder import PathBuilder
+from nc.cycles.codes import lathe_hole_clamp
 from nc.cycles.profile import segs_from_moves
 from nc.moves import Event
 from nc.program.blocks import Block
@@ -479,11 +480,13 @@ def _lathe_hole(host: Any, code: str, block: Block) -> Iterator[Event]:
         kind = "bore_feed"
     b = _builder(host, block)
     b.feed = feed
+    clamp_m = lathe_hole_clamp(host.profile, code, block)
+
     def each_hole() -> Iterator[None]:
         for _ in range(max(repeats, 0)):  # lazy, as `_mill_hole`
             hole = holes.Hole(kind, code, axis, {a: tgt[a] for a in pos_axes}, r_level, bottom, initial, return_r,
                               peck=peck, clearance=host.profile.param("N1.151", 1.0), dwell=st.get("P", 0.0),
-                              spindle_dir=int(host.state.spindle_dir))
+                              spindle_dir=int(host.state.spindle_dir), clamp_m=clamp_m)
             yield from holes.drill_hole(b, hole)
             yield
         st["last_level"] = b.position[axis]

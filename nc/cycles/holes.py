@@ -31,6 +31,22 @@ class Hole:
     shift: dict[str, float] | None = None  # G76/G87 tool shift (machine delta)
     spindle_dir: int = 1  # direction before the cycle (+1 M03, -1 M04, 0 stopped)
     reverse_tap: bool = False  # G74 left-hand tapping
+    clamp_m: int | None = None  # lathe guide M_: this M at the hole position, M+1 back at R (C clamp / unclamp)
+
+
+def _unclamp(b: PathBuilder, h: Hole, tag: tuple[str, ...]) -> None:
+    """Lathe guide G83-G89 `M_`: back at R (rapid there if the tool is below it), M+1 before the top pause."""
+    if h.clamp_m is None:
+        return
+    if b.position[h.axis] != h.r_level:
+        b.rapid_axes({h.axis: h.r_level}, tag + ("return",))
+    b.aux("M", h.clamp_m + 1)
+
+
+def _return(b: PathBuilder, h: Hole, tag: tuple[str, ...], level: float) -> None:
+    _unclamp(b, h, tag)
+    if b.position[h.axis] != level:
+        b.rapid_axes({h.axis: level}, tag + ("return",))
 
 
 def _levels(start: float, end: float, step: float) -> Iterator[float]:
@@ -60,6 +76,8 @@ def drill_hole(b: PathBuilder, h: Hole) -> Iterator[None]:
     ax = h.axis
     tag = (h.code,)
     b.rapid_axes(h.position, tag + ("position",))
+    if h.clamp_m is not None:  # at the start point, before the drill axis moves (L§2.1 G83 "M_")
+        b.aux("M", h.clamp_m)
     sgn = 1.0 if h.bottom < h.r_level else -1.0  # toward the workpiece is toward `bottom`
     ret_level = h.r_level if h.return_r else h.initial
 
@@ -85,7 +103,7 @@ def drill_hole(b: PathBuilder, h: Hole) -> Iterator[None]:
         b.line_axes({ax: h.bottom}, tag + ("cut",))
         if h.dwell > 0:
             b.dwell(h.dwell, tag + ("dwell",))
-        b.rapid_axes({ax: ret_level}, tag + ("return",))
+        _return(b, h, tag, ret_level)
     elif h.kind in ("peck_full", "peck_chip"):
         prev = h.r_level
         for i, d in enumerate(_levels(h.r_level, h.bottom, h.peck), start=1):
@@ -103,7 +121,7 @@ def drill_hole(b: PathBuilder, h: Hole) -> Iterator[None]:
             yield
         if h.dwell > 0:
             b.dwell(h.dwell, tag + ("dwell",))
-        b.rapid_axes({ax: ret_level}, tag + ("return",))
+        _return(b, h, tag, ret_level)
     elif h.kind == "tap":
         into = -1 if h.reverse_tap else 1
         if h.spindle_dir != into:
@@ -117,6 +135,7 @@ def drill_hole(b: PathBuilder, h: Hole) -> Iterator[None]:
             b.aux("M", _spindle_code(-into))  # spindle reversal at the bottom of each peck
             b.line_axes({ax: h.r_level}, tag + ("tap_out", str(i)))
             yield
+        _unclamp(b, h, tag)
         b.aux("M", _spindle_code(h.spindle_dir if h.spindle_dir else into))
         if not h.return_r:
             b.rapid_axes({ax: h.initial}, tag + ("return",))
@@ -125,6 +144,7 @@ def drill_hole(b: PathBuilder, h: Hole) -> Iterator[None]:
         if h.dwell > 0:
             b.dwell(h.dwell, tag + ("dwell",))
         b.line_axes({ax: h.r_level}, tag + ("cut_out",))
+        _unclamp(b, h, tag)
         if not h.return_r:
             b.rapid_axes({ax: h.initial}, tag + ("return",))
     elif h.kind == "bore_stop":

@@ -14,6 +14,7 @@ from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
 
 from nc.alarms import NcAlarm
+from nc.cycles.codes import lathe_hole_clamp
 from nc.interp import context
 from nc.interp.gcodes import STOP_PREVIEW
 from nc.interp.records import (MAX_M_PER_BLOCK, M_BEFORE_MOTION, M_END, NO_MOTION_FUNCS, REFUSED_UNDER_G68,
@@ -100,7 +101,8 @@ def step_spindle(ip, run: BlockRun) -> Iterator[Event]:
     """S: spindle speed or (G96) surface speed, issued before the motion; G96/G97 alone switch now."""
     block, funcs, st = run.block, run.funcs, ip.state
     s = block.get("S")
-    if s is not None and not ("set" in funcs) and not _cycle_owns_s_t(ip, funcs):
+    # G50/G92 S is the speed clamp and G10 L1100 S the data setting's own speed (issued there, once)
+    if s is not None and not funcs & {"set", "G10"} and not _cycle_owns_s_t(ip, funcs):
         if s.value < 0 or s.value > 600000:
             raise NcAlarm(0x0223, f"S{s.value:g} out of range 0-600000")
         top = ip.profile.param("N0.1008", 0.0)
@@ -266,6 +268,8 @@ class ExecuteMixin:
             if w.value != int(w.value) or not 0 <= w.value <= 65534:
                 raise NcAlarm(0x0249, f"M code {w.text} out of range")
         mvals = [int(w.value) for w in mcodes]
+        if mvals and lathe_hole_clamp(self.profile, self._cycle_fn(funcs), block) is not None:
+            mvals = []  # the hole cycle's own M_ (clamp at the hole, M+1 at R), not an ordinary M
         if len(mvals) > MAX_M_PER_BLOCK:
             raise NcAlarm(0x0248, f"{len(mvals)} M codes in one block (at most {MAX_M_PER_BLOCK})")
         calls = [c for c in ("G65", "G66") if c in funcs] + [f"M{m}" for m in mvals if m in (98, 96)]
