@@ -105,7 +105,7 @@ def _lathe_rows(lines: list[str]) -> list[tuple[str, str, str, int]]:
             in_fmt, s = True, s.split(":", 1)[1].strip() if ":" in s else ""
         elif not in_fmt or not s:
             continue
-        if re.match(r"^[GM]\d{1,3}(?:\.\d)?(?:/[GM]\d+)*(?!:)(?:\s|;|$)", s):
+        if re.match(r"^(?:[A-Z] - [A-Z] plane:\s*)?[GM]\d{1,3}(?:\.\d)?(?:/[GM]\d+)*(?!:)(?:\s|;|$)", s):
             out.append((section, title, " ".join(s.split()), n))
         elif not (s.endswith(":") or s.startswith("Input parameter") or line.startswith("Format")):
             in_fmt = False
