@@ -36,6 +36,13 @@ LIMIT_BOUNDS = {"velocity": (1e-3, 1e5), "acceleration": (1e-3, 1e7), "jerk": (1
 _DRIVE_KEYS = {f.name for f in fields(DriveParams)} - {"counts_per_rev", "units"}
 
 
+def nc5(code: int) -> str:
+    """The NC5 start-up alarm a bench error corresponds to, for the message (exit stays 2: bad input)."""
+    from nc.alarm_table import ALARM_TABLE
+
+    return f" (NC5 alarm 0x{code:04X}: {ALARM_TABLE[code][1].rstrip('.')})"
+
+
 class BenchFileError(InputError):
     """A bench file that cannot be used; `errors` holds one `path: message` per bad field."""
 
@@ -244,7 +251,7 @@ def parse_bench(text: str, source: str = "bench.toml") -> Bench:
         ax = _axis(r, dict(a), f"axes[{i}]")
         if ax is not None:
             if ax.name in b.axis_names:
-                r.err(f"axes[{i}].name", f"duplicate axis name {ax.name!r}")
+                r.err(f"axes[{i}].name", f"duplicate axis name {ax.name!r}" + nc5(0x1419))
             else:
                 b.axes.append(ax)
 
@@ -256,7 +263,7 @@ def parse_bench(text: str, source: str = "bench.toml") -> Bench:
         sp = _spindle(r, dict(s), f"spindles[{i}]")
         if sp is not None:
             if any(o.name == sp.name for o in b.spindles):
-                r.err(f"spindles[{i}].name", f"duplicate spindle name {sp.name!r}")
+                r.err(f"spindles[{i}].name", f"duplicate spindle name {sp.name!r}" + nc5(0x141A))
             else:
                 b.spindles.append(sp)
 
@@ -333,6 +340,9 @@ def _axis(r: _Reader, d: dict, p: str) -> AxisConfig | None:
         r.err(f"{p}.name", f"must be one axis letter of {AXIS_LETTERS}, got {name!r}")
         name = None
     units = r.string(d, "units", f"{p}.units", "mm", ("mm", "deg")) or "mm"
+    if name is not None and name in "ABC" and units != "deg":  # the NC treats A/B/C as rotary (degrees)
+        r.err(f"{p}.units", f"{name} is a rotary axis: units must be \"deg\", got {units!r}"
+                            + nc5(0x0C05 if name == "C" else 0x141C))
     scaling = _scaling(r, d, p, 360.0 if units == "deg" else 10.0)
     start = r.number(d, "start", f"{p}.start", 0.0, minimum=-1e6, maximum=1e6) or 0.0
     soft = r.pair(d, "soft_limits", f"{p}.soft_limits", integers=False, positive=False)
@@ -365,7 +375,7 @@ def _spindle(r: _Reader, d: dict, p: str) -> SpindleConfig | None:
     base = SpindleConfig()
     name = r.string(d, "name", f"{p}.name", "S1") or "S1"
     if not (name[0] == "S" and name[1:].isdigit()):
-        r.err(f"{p}.name", f"must be S1, S2, ..., got {name!r}")
+        r.err(f"{p}.name", f"must be S1, S2, ..., got {name!r}" + nc5(0x141A))
     cpr = r.integer(d, "counts_per_rev", f"{p}.counts_per_rev", base.scaling.counts_per_rev, positive=True)
     ratio = r.pair(d, "ratio", f"{p}.ratio", integers=True, positive=True) or (1, 1)
     direction = r.integer(d, "direction", f"{p}.direction", 1, choices=(1, -1))
@@ -495,9 +505,9 @@ def _io_stations(r: _Reader, stations: Any, n_drives: int) -> list[IoStationConf
         x, y = next_x if x is None else x, next_y if y is None else y
         node = r.integer(d, "canopen_node", f"{p}.canopen_node", 64 + k, minimum=1, maximum=127) or 64 + k
         if node <= n_drives:
-            r.err(f"{p}.canopen_node", f"{node} is taken by a drive (drives are CANopen nodes 1–{n_drives})")
+            r.err(f"{p}.canopen_node", f"{node} is taken by a drive (drives are CANopen nodes 1–{n_drives})" + nc5(0x1417))
         elif any(o.canopen_node == node for o in out):
-            r.err(f"{p}.canopen_node", f"duplicate CANopen node {node}")
+            r.err(f"{p}.canopen_node", f"duplicate CANopen node {node}" + nc5(0x1417))
         tpdo = r.string(d, "canopen_tpdo", f"{p}.canopen_tpdo", "sync", ("sync", "change")) or "sync"
         eds = r.eds(d, f"{p}.canopen_eds", io=(n_in, n_out))
         r.unknown(d, f"{p}.", _IO_KEYS)

@@ -27,6 +27,7 @@ PARAMS: dict[str, ParamSpec] = {
     "N8.018 Bit10": _BIT, "N1.11 Bit4": _BIT, "N2.001 Bit10": _BIT, "N1.010 Bit22": _BIT,
     "N1.010 Bit28": _BIT, "N8.22 Bit5": _BIT, "M2x010": _BIT,
     "N1.010": ParamSpec(0, 1, True, "G43/G44/G49 without Z: 0 move, 1 internal only"),
+    "N0.1025": ParamSpec(0, 600000, False, "ms, 1st spindle positioning check time (0x0C01), 0 off"),
     "N0.1000 Bit7": _BIT, "N0.1008": ParamSpec(0, 600000, False, "rpm, 1st spindle maximum speed (0x0C03)"),
     "N1.08": ParamSpec(0, 2, True, "lathe type A/B/C"),
     "P306": ParamSpec(0, 2, True, "lathe type A/B/C (lathe-2018)"),

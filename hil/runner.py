@@ -41,6 +41,7 @@ STANDSTILL_TIMEOUT = 10.0  # s the stop path waits for the axes to stand before 
 # velocity feedback reads 0. Velocity alone cannot say it: Delta drives report 0x606C in 0.1 rpm of
 # the motor, which reads 0 below 1 rpm (2,133 counts/s at 1,280,000 counts/rev).
 REST_CYCLES = 3
+OVERSPEED = 1.2  # App. A 0x0602: measured axis speed above this multiple of its limit (the virtual drive's own AL007 margin)
 FROZEN_S = 0.2  # s of unchanged feedback from a moving drive that mean it left the bus
 
 
@@ -85,6 +86,10 @@ class BenchRunner:
         self._rest = [0] * len(self.rx)  # cycles each drive's feedback has stood still (see REST_CYCLES)
         self._last_position: list[int | None] = [None] * len(self.rx)
         self.scales = [a.scaling for a in bench.axes] + [s.scaling for s in bench.spindles]
+        # App. A 0x0602 overspeed protection: an axis's measured speed beyond OVERSPEED × its limit, in the
+        # drive's own 0x606C units so the cycle compares integers (decisions cycles.md)
+        self._overspeed = [abs(self.scales[i].velocity_to_drive(OVERSPEED * a.limits.max_velocity))
+                           for i, a in enumerate(bench.axes)]
         self.result = RunResult(max_ferr={a: 0.0 for a in self.axes})
         self.channel: Channel | None = None
         self.cycle = 0
@@ -175,10 +180,14 @@ class BenchRunner:
                 return True
             if any(m.faulted for m in self.masters):
                 break
-        bad = [self._name(i) for i, m in enumerate(self.masters) if not m.enabled]
-        states = ", ".join(f"{self._name(i)}: {self.masters[i].state.value}" for i in range(len(self.masters))
-                           if not self.masters[i].enabled)
-        self._alarm(Alarm(0x0A07, f"servo not ready: {states} after {self.cycle} cycles", axis=bad[0]))
+        n_axes = len(self.axes)
+        faulted = any(m.faulted for m in self.masters)  # the wait stopped at a fault: name the faulted drives
+        for code, what, idx in ((0x0A07, "servo not ready", range(n_axes)),  # App. A: the axis is not servo ON
+                                (0x0C06, "spindle not enabled", range(n_axes, len(self.masters)))):
+            bad = [i for i in idx if not self.masters[i].enabled and (self.masters[i].faulted or not faulted)]
+            if bad:
+                states = ", ".join(f"{self._name(i)}: {self.masters[i].state.value}" for i in bad)
+                self._alarm(Alarm(code, f"{what}: {states} after {self.cycle} cycles", axis=self._name(bad[0])))
         return False
 
     def make_planner(self) -> Planner:
@@ -301,6 +310,12 @@ class BenchRunner:
                 self._alarmed_drives.add(i)
                 self._alarm(Alarm(SERVO_ALARM, f"servo alarm on {self._name(i)}: drive error code 0x{tx.error_code:04X}",
                                   line=self.line or None, axis=self._name(i), info=tx.error_code))
+            if i < n_axes and abs(tx.velocity_actual) > self._overspeed[i] and i not in self._alarmed_drives:
+                self._alarmed_drives.add(i)
+                v = self.scales[i].drive_to_velocity(tx.velocity_actual)
+                self._alarm(Alarm(0x0602, f"overspeed protection: axis {self._name(i)} at {abs(v):.1f}/s, beyond "
+                                          f"{OVERSPEED:g} x its maximum velocity {self.bench.axes[i].limits.max_velocity:g}/s",
+                                  line=self.line or None, axis=self._name(i)))
             if tx.statusword & SW_INTERNAL_LIMIT and i < n_axes and i not in self._alarmed_drives:
                 self._alarmed_drives.add(i)
                 self._alarm(Alarm(0x0402, f"hardware limit reached on axis {self._name(i)}", line=self.line or None,

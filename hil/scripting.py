@@ -427,7 +427,10 @@ def build_mlc(bench: Bench, spec: str | None) -> Any:
     if spec == "basic":
         return BasicMlc(max_rpm=max_rpm)
     program = None if spec in ("lathe", "default") else load_mlc_program(spec)
-    return Mlc(program, axes=bench.axis_names, cycle=bench.cycle, motion=bench.motion_config(), max_rpm=max_rpm)
+    mlc = Mlc(program, axes=bench.axis_names, cycle=bench.cycle, motion=bench.motion_config(), max_rpm=max_rpm)
+    if "N0.1025" in bench.params:  # 1st spindle positioning check time, ms (App. A 0x0C01)
+        mlc.caxis.check_time = bench.params["N0.1025"] / 1000.0
+    return mlc
 
 
 def load_mlc_program(spec: str) -> Any:

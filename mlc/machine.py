@@ -26,9 +26,9 @@ import numpy as np
 from mlc.memory import DeviceMemory
 from mlc.nc_link import ChannelLink, DriveStatus
 from mlc.program import ScanContext
-from mlc.spindle_axis import SpindleAxisSwitch
+from mlc.spindle_axis import MODE_CSV, SpindleAxisSwitch
 from mlc.signals import d2, m2
-from nc.alarms import NcAlarm
+from nc.alarms import Alarm, NcAlarm
 from nc.channel import Channel
 from nc.manual import ManualMotion
 from nc.motion.limits import MotionConfig
@@ -98,6 +98,7 @@ class Mlc:
         self.bus: Any = None  # fieldbus.link.LinkStatus of this cycle, when the bench's link reports one
         self.time = 0.0
         self.caxis = SpindleAxisSwitch(self.mem, channel, cycle)  # spindle ↔ C axis, M19 (issue 8 item 5)
+        self.caxis_alarmed = False
         self._power_on_image(channel)
         setup = getattr(self.program, "setup", None)
         if callable(setup):
@@ -163,7 +164,21 @@ class Mlc:
         tx = runner.tx[n]
         index = runner.spindle_index_angle() if tx.touch_probe_status & 0x0002 else None
         c_cmd = float(runner._commands[runner.axes.index("C")]) if "C" in runner.axes else None
-        return self.caxis.drive(runner.spindle_actual_angle(), runner.spindle_actual_rpm(), index, c_cmd)
+        if c_cmd is None and self.caxis._want_c():  # App. A 0x0C04: no C axis in the channel to switch to
+            if not self.caxis_alarmed:
+                self.caxis_alarmed = True
+                runner._alarm(Alarm(0x0C04, "incorrect switching of the spindle and C-axis: the MLC asks for C-axis "
+                                            "mode (M2x708 / M1126) but the channel has no C axis",
+                                    line=runner.line or None, axis=runner.bench.spindles[0].name))
+            return MODE_CSV, None, None  # the spindle stays a spindle; the alarm stops the channel
+        out = self.caxis.drive(runner.spindle_actual_angle(), runner.spindle_actual_rpm(), index, c_cmd)
+        if self.caxis.failed and not self.caxis_alarmed:
+            self.caxis_alarmed = True
+            runner._alarm(Alarm(0x0C01, f"spindle positioning failed: not {'in C-axis mode' if self.caxis.purpose == 'C' else 'oriented'} "
+                                        f"({self.caxis.state}) within the check time N0.1025 = "
+                                        f"{self.caxis.check_time * 1000:g} ms", line=runner.line or None,
+                                axis=runner.bench.spindles[0].name))
+        return out
 
     def _clocks(self) -> None:
         t = self.time

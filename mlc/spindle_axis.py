@@ -47,12 +47,15 @@ class SpindleAxisSwitch:
     max_velocity: float = 360.0  # deg/s, positioning move
     max_acceleration: float = 3600.0  # deg/s²
     max_jerk: float = 360000.0  # deg/s³
+    check_time: float = 10.0  # s: N0.1025 positioning check time; positioning not done by then is 0x0C01 (0: off)
+    failed: bool = False  # the positioning outlasted check_time (Mlc.spindle_drive raises 0x0C01 once)
     state: str = SPINDLE
     purpose: str = ""  # "C" or "orient": where POSITIONING goes when it is done
     goal: float = 0.0  # cumulative spindle degrees of the positioning target
     offset: float = 0.0  # spindle degrees = offset + C command, while in C mode
     log: list[tuple[int, str]] = field(default_factory=list)  # (cycle, state entered)
     _setpoint: float = 0.0
+    _started: int | None = None  # cycle the current positioning (C switch or M19) was asked for
     _last_c: float | None = None
     _cycles: int = 0
     _otg: Ruckig | None = None
@@ -67,6 +70,10 @@ class SpindleAxisSwitch:
         return self.mem.bit(m2(self.x, 706))
 
     def _enter(self, state: str) -> None:
+        if state == STOPPING:
+            self._started = self._cycles
+        elif state in (SPINDLE, C_AXIS, ORIENTED):
+            self._started = None
         self.state = state
         self.log.append((self._cycles, state))
         self.mem.set_bit(M_DONE_LATHE, state == C_AXIS)
@@ -81,6 +88,9 @@ class SpindleAxisSwitch:
         angle: measured cumulative spindle degrees; rpm: measured speed; index: latched index angle
         (None until seen); c_command: the channel's C axis command in degrees (None when the channel has no C axis)."""
         self._cycles += 1
+        if self._started is not None and self.check_time > 0 and \
+                (self._cycles - self._started) * self.cycle > self.check_time:
+            self.failed = True  # App. A 0x0C01: still stopping, seeking the index or positioning
         want_c, want_orient = self._want_c(), self._want_orient()
         s = self.state
         if s == SPINDLE:

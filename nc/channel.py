@@ -250,6 +250,13 @@ class Channel:
         does the braking (stop category 1)."""
         self.emergency = True
         self.alarms.append(alarm)
+        blk = self.planner.active
+        if blk is not None and {"tap", "tap_out"} & set(blk.move.tags):  # N§3.13 G84 note (6)
+            where = dict(line=blk.move.line or None, block=blk.move.block or None, program=blk.move.program)
+            self.alarms += [Alarm(0x0270, "axis movement prohibited: the E-stop interrupted a tapping cycle "
+                                          "(N§3.13 G84 note 6: retract to R after the reset)", **where),
+                            Alarm(0x0C09, "spindle movement prohibited: the E-stop interrupted a tapping cycle",
+                                  **where)]
         self.planner.abort()
         self.state = RunState.ALARM
         self.pending_aux = None

@@ -128,3 +128,16 @@ def test_link_recover_brings_the_line_back_to_op_after_an_outage():
             assert link.stats.recoveries == 1
         finally:
             link.close()
+
+
+@pytest.mark.parametrize("state, code, label", [(4, 0x1427, "SAFE-OP"), (8, 0x1428, "OP")], ids=["0x1427", "0x1428"])
+def test_a_slave_refusing_safeop_or_op_raises_its_bringup_alarm(state, code, label):
+    """App. A 0x1427 'Failed to trigger the EtherCAT communication OP mode' (the way into SAFE-OP) and 0x1428
+    'Failed to switch the EtherCAT communication to OP mode': the Z drive's slave refuses that AL state with AL
+    status 0x0001 (unspecified: neither a mapping nor a sync problem, which have codes of their own); the
+    alarm names the slave, no drive was enabled and nothing moved."""
+    result, history, _ = run(f"refuse:1@{state}:0x0001")
+    a = result.alarms[0]
+    assert a.code == code, result.alarms
+    assert f"did not reach {label}" in a.message and "slave Z" in a.message and "0x0001" in a.message
+    assert not result.finished and not history  # no cycle ran

@@ -191,6 +191,24 @@ def test_a_station_built_otherwise_than_the_bench_says_raises_0x142e(modules, me
 
 
 @pytest.mark.skipif(ROOT_REASON is not None, reason=ROOT_REASON or "")
+def test_a_station_with_no_slave_at_its_port_raises_0x142f():
+    """App. A 0x142F 'The corresponding port number for the remote module (EIO) connection was not found': the
+    line carries one I/O station, the bench declares two; the second (EIO node 502, the 2nd I/O slave in
+    connection order) has no slave at its port."""
+    chain = build_chain(parse_bench(AXES + "[[io]]\n"))
+    bench = parse_bench(AXES + '[[io]]\n[[io]]\nname = "panel"\n')
+    with ForkedLine(chain, "iop") as line:
+        m = make_machine(bench, EthercatLink.for_bench(bench, line.iface), [])
+        with pytest.raises(BusError) as err:
+            m.power_up()
+            m.cycle(2)
+        m.close()
+    alarm = err.value.alarm
+    assert alarm.code == 0x142F, alarm.message
+    assert "panel (EIO node 502) not found: only 1 I/O slaves on the line" in alarm.message
+
+
+@pytest.mark.skipif(ROOT_REASON is not None, reason=ROOT_REASON or "")
 def test_hil_sim_serves_the_bench_stations_and_hil_scan_names_their_modules(hil, tmp_path):
     from virtual_bus.ethercat.veth import SimProcess
 

@@ -64,7 +64,8 @@ def test_bad_stations_are_reported_per_field():
         parse_bench(text)
     msgs = err.value.errors
     assert "io[0].inputs: must be at most 64, got 65" in msgs
-    assert "io[0].canopen_node: 2 is taken by a drive (drives are CANopen nodes 1–2)" in msgs
+    assert "io[0].canopen_node: 2 is taken by a drive (drives are CANopen nodes 1–2) (NC5 alarm 0x1417: " \
+        "The slave address is duplicated)" in msgs
     assert "io[0].colour: unknown key" in msgs
     assert any(m.startswith("io[1].canopen_tpdo: must be one of 'sync', 'change'") for m in msgs)
     assert "io: EIO-502: X1020–X1027 runs past X1023" in msgs

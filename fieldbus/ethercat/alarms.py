@@ -19,6 +19,7 @@ OP_TRIGGER_FAILED = 0x1427  # failed to trigger OP mode (SAFE-OP not reached)
 OP_SWITCH_FAILED = 0x1428  # failed to switch to OP mode
 DISCONNECTED = 0x0601  # communication disconnected after established
 EIO_MISMATCH = 0x142E  # the EIO station on the line does not match the configured one (points)
+EIO_NOT_FOUND = 0x142F  # the configured EIO station's port (k-th I/O slave) is not on the line
 EIO_FAILED = 0x1426  # the system remote module (EIO) failed: only I/O slaves left OP (mlc/remote_io.py)
 DC_DRIFT = CYCLE_UNSUPPORTED  # a slave's DC clock drifted past the limit: it cannot hold the sync cycle (E8)
 

@@ -35,10 +35,13 @@ class EthercatIoPort:
         self._checked = True
         n_in, n_out = self.link.io_bits(self.index)
         found = len(self.link.io)
-        if self.index >= found or n_in < self.inputs or n_out < self.outputs:
-            have = f"{n_in} inputs / {n_out} outputs" if self.index < found else f"only {found} I/O slaves on the line"
+        if self.index >= found:  # App. A 0x142F: no I/O slave at the station's port (connection order)
+            raise BusError(Alarm(A.EIO_NOT_FOUND, f"remote I/O station {self.name} (EIO node {501 + self.index}) "
+                                                  f"not found: only {found} I/O slaves on the line"))
+        if n_in < self.inputs or n_out < self.outputs:
             raise BusError(Alarm(A.EIO_MISMATCH, f"remote I/O station {self.name} (EIO node {501 + self.index}) needs "
-                                         f"{self.inputs} inputs / {self.outputs} outputs; EtherCAT has {have}"))
+                                         f"{self.inputs} inputs / {self.outputs} outputs; EtherCAT has "
+                                         f"{n_in} inputs / {n_out} outputs"))
         found_mods = self.link.io_modules(self.index) if self.modules else None
         # Idents outside our catalogue (a real R1-EC's own codes) cannot be named: the sizes above decide.
         if found_mods is not None and all(m in MODULES for m in found_mods) and found_mods != list(self.modules):

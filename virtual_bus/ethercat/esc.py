@@ -123,6 +123,7 @@ class Esc:
         self.outputs_written = 0
         self.events: list[str] = []
         self.wkc_fault = False
+        self.refuse: dict[int, int] = {}  # AL state -> AL status code it is refused with (fault injection)
         self.power_on()
 
     # ---- reset --------------------------------------------------------------------------
@@ -315,7 +316,7 @@ class Esc:
         # ETG.1020 order), and again into OP for masters that start SYNC0 in SAFE-OP (SOEM).
         check = {PREOP: self._check_mailbox, SAFEOP: lambda: self._check_sync() or self._check_process_data(),
                  OP: self._check_sync}[req]
-        code = check()
+        code = self.refuse.get(req) or check()
         if code:
             self.al_error(code, cur)
             return

@@ -10,6 +10,8 @@ Spec grammar (`hil sim ethercat --fault SPEC`, repeatable):
   drivefault:S@N[:CODE]   the drive behind slave S faults with error code CODE (default 0x0009)
   drift:S@N:NS            from frame N on, slave S's local DC clock gains NS ns per frame (a bad
                           oscillator its control loop, trimming at most 5 µs a frame, cannot follow)
+  refuse:S@T[:CODE]       slave S refuses every request into AL state T (2 PRE-OP, 4 SAFE-OP, 8 OP) with AL
+                          status CODE (default 0x0001, unspecified error): a bring-up that cannot finish
 """
 
 from __future__ import annotations
@@ -17,7 +19,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 
-_RE = re.compile(r"^(?P<kind>drop|late|leave|wkc|alerr|drivefault|drift)(?::(?P<slave>\d+))?@(?P<at>\d+)"
+_RE = re.compile(r"^(?P<kind>drop|late|leave|wkc|alerr|drivefault|drift|refuse)(?::(?P<slave>\d+))?@(?P<at>\d+)"
                  r"(?:x(?P<count>\d+))?(?:\+(?P<back>\d+))?(?::(?P<arg>(?:0x)?[0-9a-fA-F.]+))?$")
 
 
@@ -43,7 +45,7 @@ def parse_fault(spec: str) -> Fault:
     if not m:
         raise ValueError(f"bad fault spec {spec!r} (see `hil sim ethercat --help`)")
     kind = m["kind"]
-    if kind in ("leave", "wkc", "alerr", "drivefault", "drift") and m["slave"] is None:
+    if kind in ("leave", "wkc", "alerr", "drivefault", "drift", "refuse") and m["slave"] is None:
         raise ValueError(f"fault {kind} needs a slave: {kind}:S@N")
     arg = m["arg"]
     value = float(int(arg, 16)) if arg and arg.lower().startswith("0x") else float(arg or 0)
@@ -51,4 +53,8 @@ def parse_fault(spec: str) -> Fault:
         value = 0x001A
     if kind == "drivefault" and not arg:
         value = 0x0009
+    if kind == "refuse":
+        if int(m["at"]) not in (2, 4, 8):
+            raise ValueError(f"fault refuse: the state must be 2 (PRE-OP), 4 (SAFE-OP) or 8 (OP), got {m['at']}")
+        value = value or 0x0001
     return Fault(kind, int(m["at"]), int(m["slave"] or 0), int(m["count"] or 1), int(m["back"] or 0), value)

@@ -34,6 +34,11 @@ class Chain:
     _applied: set[int] = field(default_factory=set)
     _left: set[int] = field(default_factory=set)
 
+    def __post_init__(self) -> None:
+        for f in self.faults:  # bring-up refusals are the slave's own answer, not keyed to frames
+            if f.kind == "refuse" and f.slave < len(self.slaves):
+                self.slaves[f.slave].refuse[f.at] = int(f.arg)
+
     # ---- faults ---------------------------------------------------------------------------
     def _fault_step(self, is_pd: bool) -> tuple[bool, float]:
         """Apply faults due at this frame. Returns (drop the frame, delay in s)."""
