@@ -29,6 +29,7 @@ class FormatRow:
     section: str
     title: str
     text: str  # as the manual writes it (tabs and subscripts kept, whitespace folded)
+    line: int = 0  # 1-based line of the manual's text (shared/seeds/<manual>.txt)
 
 
 # A format row is made of codes and argument words only (prose, group tables and definitions are not rows).
@@ -49,12 +50,12 @@ def _nc5_row(line: str) -> tuple[str, bool] | None:
     return text, has_code
 
 
-def _nc5_rows(lines: list[str]) -> list[tuple[str, str, str]]:
+def _nc5_rows(lines: list[str]) -> list[tuple[str, str, str, int]]:
     """(section, title, text) of every row of the NC5 guide's format tables. A line of a table that carries
     only argument words (G30's P3, G04's X_, M98's Q_) continues the row above and is shown as `[G30] P3`."""
     out: list[tuple[str, str, str]] = []
     section, title, in_fmt, last_code = "", "", False, ""
-    for raw in lines:
+    for n, raw in enumerate(lines, start=1):
         line = raw.rstrip()
         h = HEADING.match(line)
         if h and h.group(1)[0] in "23" and "\t" not in line and len(line) < 90:
@@ -80,18 +81,18 @@ def _nc5_rows(lines: list[str]) -> list[tuple[str, str, str]]:
         text, has_code = row
         if has_code:
             last_code = CODE.search(text).group(1)
-            out.append((section, title, text))
+            out.append((section, title, text, n))
         elif last_code:
-            out.append((section, title, f"[{last_code}] {text}"))
+            out.append((section, title, f"[{last_code}] {text}", n))
     return out
 
 
-def _lathe_rows(lines: list[str]) -> list[tuple[str, str, str]]:
+def _lathe_rows(lines: list[str]) -> list[tuple[str, str, str, int]]:
     """(section, title, text) of every format of the lathe guide: the "Format…:" line and the code-led
     lines that follow it (the `or` alternatives, a cycle's second block), up to the first prose line."""
     out: list[tuple[str, str, str]] = []
     section, title, in_fmt = "", "", False
-    for raw in lines:
+    for n, raw in enumerate(lines, start=1):
         line = raw.rstrip()
         h = HEADING.match(line)
         if h and h.group(1)[0] in "23" and "\t" not in line and len(line) < 90:
@@ -104,8 +105,8 @@ def _lathe_rows(lines: list[str]) -> list[tuple[str, str, str]]:
             in_fmt, s = True, s.split(":", 1)[1].strip() if ":" in s else ""
         elif not in_fmt or not s:
             continue
-        if re.match(r"^[GM]\d{1,3}(?:\.\d)?(?:/[GM]\d+)*(?!:)(?:\s|;|$)", s):
-            out.append((section, title, " ".join(s.split())))
+        if re.match(r"^(?:[A-Z] - [A-Z] plane:\s*)?[GM]\d{1,3}(?:\.\d)?(?:/[GM]\d+)*(?!:)(?:\s|;|$)", s):
+            out.append((section, title, " ".join(s.split()), n))
         elif not (s.endswith(":") or s.startswith("Input parameter") or line.startswith("Format")):
             in_fmt = False
     return out
@@ -114,9 +115,9 @@ def _lathe_rows(lines: list[str]) -> list[tuple[str, str, str]]:
 def _rows(lines: list[str], manual: str) -> list[FormatRow]:
     out: list[FormatRow] = []
     counts: dict[str, int] = {}
-    for section, title, text in (_nc5_rows(lines) if manual == "N" else _lathe_rows(lines)):
+    for section, title, text, n in (_nc5_rows(lines) if manual == "N" else _lathe_rows(lines)):
         k = counts[section] = counts.get(section, 0) + 1
-        out.append(FormatRow(f"{manual}{section}-{k}", section, title, text))
+        out.append(FormatRow(f"{manual}{section}-{k}", section, title, text, n))
     return out
 
 
@@ -184,15 +185,17 @@ def build() -> str:
             f"writes them, {n_unrun} are not emulated (reason given).", "",
             "A row `[G30] P3` is a line of the manual's table that carries only arguments: it continues the row "
             "above it (here `G30 P3 CP`). Row ids: `N<section>-<k>` is the k-th row under that section of the "
-            "NC5 guide, `L<section>-<k>` of the lathe guide.", "",
-            "| row | section | format as the manual writes it | test |", "|---|---|---|---|"]
+            "NC5 guide, `L<section>-<k>` of the lathe guide; the last column is the file and line of the manual's "
+            f"text (`shared/seeds/`, NC5 = `{NC5}`, lathe guide = `{LATHE}`).", "",
+            "| row | section | format as the manual writes it | test | manual line |", "|---|---|---|---|---|"]
     body = []
     for r in rows:
         t = ", ".join(f"`{x}`" for x in sorted(set(tested.get(r.id, []))))
         if not t and r.id in unrun:
             t = "not emulated: " + unrun[r.id].replace("|", "/")
         text = r.text.replace("|", "\\|")
-        body.append(f"| {r.id} | {r.title.replace('|', '/')} | `{text}` | {t or 'untested'} |")
+        src = f"{NC5 if r.id[0] == 'N' else LATHE}:{r.line}"
+        body.append(f"| {r.id} | {r.title.replace('|', '/')} | `{text}` | {t or 'untested'} | {src} |")
     return "\n".join(head + body) + "\n"
 
 

@@ -3,11 +3,14 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 from fieldbus.units import AxisScaling
-from mlc.remote_io import IoMap
 from nc.motion.limits import AxisLimits, MotionConfig
 from virtual_bus.drive import DriveParams
+
+if TYPE_CHECKING:  # mlc.memory pulls numpy: `hil path` starts without it (issue 16)
+    from mlc.remote_io import IoMap
 
 
 @dataclass

@@ -5,17 +5,17 @@ from __future__ import annotations
 import sys
 from dataclasses import replace
 from pathlib import Path
-from typing import Sequence
+from typing import TYPE_CHECKING, Sequence
 
-from fieldbus.factory import parse_bus
-from fieldbus.link import BusLink, SimLink
-from fieldbus.pdo import RxPdo
 from hil import strict_json
 from hil.bench import Bench, default_lathe
 from nc.alarms import Alarm, NcAlarm
 from nc.profiles import PROFILE_NAMES
 from nc.program import Program, parse_program
-from virtual_bus.drive import Cia402Drive
+
+if TYPE_CHECKING:  # the bus side loads where a link or a drive is made, not for `hil path` (issue 16)
+    from fieldbus.link import BusLink
+    from virtual_bus.drive import Cia402Drive
 
 
 class InputError(Exception):
@@ -62,6 +62,9 @@ def override_bench(bench: Bench, profile: str | None = None, bus: str | None = N
 
 def sim_slaves(bench: Bench) -> list[Cia402Drive]:
     """Virtual drives for every axis and spindle, at the bench's power-on positions."""
+    from fieldbus.pdo import RxPdo
+    from virtual_bus.drive import Cia402Drive
+
     drives = []
     for a in bench.axes:
         d = Cia402Drive(params=replace(a.drive, counts_per_rev=a.scaling.counts_per_rev, units=a.scaling.units), name=a.name)
@@ -85,6 +88,9 @@ def sim_io_stations(bench: Bench) -> list:
 
 
 def make_link(bench: Bench) -> BusLink:
+    from fieldbus.factory import parse_bus
+    from fieldbus.link import SimLink
+
     try:
         spec = parse_bus(bench.bus)
     except ValueError as exc:

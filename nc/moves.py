@@ -110,3 +110,47 @@ class Busy:
 BUSY = Busy()
 
 Event = Union[Move, Aux, Sync, ProgramEnd, Busy]
+
+
+@dataclass(slots=True)
+class MoveBatch:
+    """A run of plain rapids and lines (G0/G1 with axis words and F, nothing else) read in bulk by
+    `nc.interp.bulk` for a consumer that asked for it (`hil path`, issue 16): the moves as columns.
+    `moves()` gives exactly the Move objects the block-by-block path makes; a stream stage that
+    holds state (a pending ,C/,R corner, radius compensation) expands the batch into them."""
+
+    axes: tuple[str, ...]
+    lines: list[int]  # file line of each move
+    texts: list[str]  # block text of each move
+    rapid: list[bool]  # G00 (True) or G01 per move
+    start: dict[str, float]  # machine position before the first move
+    end: list[list[float]]  # machine end points: one column (a value per move) per axis, axes order
+    work: list[list[float]]  # work end points as the program writes them, columns likewise
+    feed: list[float | None]  # None for a rapid
+    per_rev: bool
+    program: str
+    plane: tuple[str, str]
+    css: float | None
+
+    def __len__(self) -> int:
+        return len(self.lines)
+
+    @property
+    def line(self) -> int:  # the last move's, as a Move's (the preview window's "executing" block)
+        return self.lines[-1]
+
+    @property
+    def block(self) -> str:
+        return self.texts[-1]
+
+    def moves(self) -> list[Move]:
+        axes, out = self.axes, []
+        start = dict(self.start)
+        for i, (line, e, w) in enumerate(zip(self.lines, zip(*self.end), zip(*self.work))):
+            end = dict(zip(axes, e))
+            rapid = self.rapid[i]
+            out.append(Move("rapid" if rapid else "line", line, self.texts[i], start, end, dict(zip(axes, w)),
+                            feed=self.feed[i], per_rev=False if rapid else self.per_rev, program=self.program,
+                            plane=self.plane, css=self.css))
+            start = dict(end)
+        return out

@@ -69,6 +69,23 @@ def test_arcs_in_the_three_planes_with_r_or_centre_words():
     assert arcs[0].feed == 100.0 and arcs[-1].feed == 100.0
 
 
+@pytest.mark.parametrize("plane,prog,arc_plane,centre", [
+    # machine X is a radius (X20. = 10): each arc is a quarter circle of radius 10 there and back
+    ("G17", "G17 G01 X20. Y0 F100\nG02 X0 Y10. R10.\nG03 X20. Y0 I10. J0", ("X", "Y"), (10.0, 10.0, 0.0)),
+    ("G18", "G18 G01 Z0 X20. F100\nG02 Z-10. X0 R10.\nG03 Z0 X20. K10. I0", ("Z", "X"), (10.0, 0.0, -10.0)),
+    ("G19", "G19 G01 Y10. Z0 F100\nG02 Y0 Z-10. R10.\nG03 Y10. Z0 J0 K10.", ("Y", "Z"), (10.0, 0.0, 0.0)),
+])
+def test_plane_designation_g17_g18_g19(plane, prog, arc_plane, centre):
+    """L2.1-22 `X - Y plane: G17 {G01 - G03} X_ Y_{I_ J_ or R_}F_`, L2.1-23
+    `Z - X plane: G18 {G01 - G03} Z_ X_{K_ I_ or R_}F_`, L2.1-24 `Y - Z plane: G19 {G01 - G03} Y_ Z_{J_ K_ or R_}F_`
+    (L§2.1 G17/G18/G19): the plane decides where G02/G03 turn and which centre words (or R) they take;
+    G01 is the same straight line in every plane."""
+    m = _moves(f"G00 X20. Y0 Z0\n{prog}\nM30\n")
+    assert [x.kind for x in m[1:]] == ["line", "arc", "arc"] and [x.dir for x in m[2:]] == ["cw", "ccw"]
+    assert {x.plane for x in m[2:]} == {arc_plane}
+    assert _pt(m[2].center, "XYZ") == centre and _pt(m[3].end, "XYZ") == _pt(m[1].end, "XYZ")
+
+
 def test_g04_x_seconds_or_p_milliseconds(capsys, tmp_path):
     """L2.1-9 `G04 X_ or`, L2.1-10 `G04 P_` (L§2.1 G04: X in s with decimals, P in 0.001 s)."""
     r = _run(capsys, tmp_path, "G00 X10.\nG04 X1.5\nG04 P2500\nM30\n")
@@ -118,7 +135,7 @@ def test_g10_l30_l1100_l3100_l4100_and_g11(capsys, tmp_path):
 
 
 def test_g21_or_g20_units(capsys, tmp_path):
-    """L2.1-22 `G21 or G20` (L§2.1 G21/G20): G20 inch, G21 mm, for linear axes (set at the program's start:
+    """L2.1-25 `G21 or G20` (L§2.1 G21/G20): G20 inch, G21 mm, for linear axes (set at the program's start:
     a change after motion is an alarm, docs/decisions/language.md)."""
     inch = _run(capsys, tmp_path, "G20\nG00 X1. Z-0.5\nM30\n")
     mm = _run(capsys, tmp_path, "G21\nG00 X1. Z-0.5\nM30\n")
@@ -128,7 +145,7 @@ def test_g21_or_g20_units(capsys, tmp_path):
 @pytest.mark.parametrize("g28,g29", [("G28 X50. Y5. Z20.", "G29 X30. Y0 Z5."),
                                      ("G28 U10. V5. W10.", "G29 U-20. V-5. W-15.")])
 def test_g28_g29_through_the_intermediate_point(g28, g29):
-    """L2.1-23 `G28 X_ Y_ Z_ or`, L2.1-24 `G28 U_ V_ W_`, L2.1-25 `G29 X_ Y_ Z_ or`, L2.1-26 `G29 U_ V_ W_`
+    """L2.1-26 `G28 X_ Y_ Z_ or`, L2.1-27 `G28 U_ V_ W_`, L2.1-28 `G29 X_ Y_ Z_ or`, L2.1-29 `G29 U_ V_ W_`
     (L§2.1 G28/G29): G28 through the intermediate point to the machine origin; G29 back through the same
     point to the target (U V W from the intermediate point)."""
     m = _moves(f"G00 X40. Y0 Z10.\n{g28}\n{g29}\nM30\n")
@@ -138,7 +155,7 @@ def test_g28_g29_through_the_intermediate_point(g28, g29):
 
 @pytest.mark.parametrize("p", [2, 3, 4])
 def test_g30_p2_p3_p4(p):
-    """L2.1-27 `G30 P2 X_ Y_ Z_ or`, L2.1-28 `G30 P3 X_ Y_ Z_ or`, L2.1-29 `G30 P4 X_ Y_ Z_` (L§2.1 G30):
+    """L2.1-30 `G30 P2 X_ Y_ Z_ or`, L2.1-31 `G30 P3 X_ Y_ Z_ or`, L2.1-32 `G30 P4 X_ Y_ Z_` (L§2.1 G30):
     through the intermediate point to the 2nd/3rd/4th reference point."""
     from nc.interp import Interpreter
     from nc.moves import Move
@@ -152,7 +169,7 @@ def test_g30_p2_p3_p4(p):
 
 
 def test_g31_skip(capsys, tmp_path):
-    """L2.1-30 `G31 X_Y_Z_F_P_` (L§2.1 G31): a feed move at F toward the point, ended by the skip signal
+    """L2.1-33 `G31 X_Y_Z_F_P_` (L§2.1 G31): a feed move at F toward the point, ended by the skip signal
     (offline: at the end point); its position latched."""
     m = _moves("G00 X0 Y0 Z0\nG31 X10.Y2.Z-5.F100P0\nM30\n")
     assert m[-1].kind == "line" and m[-1].feed == 100.0 and _pt(m[-1].work, "XYZ") == (10.0, 2.0, -5.0)
@@ -160,7 +177,7 @@ def test_g31_skip(capsys, tmp_path):
 
 @pytest.mark.parametrize("block", ["G32 X30. Z-20. F1.5 Q90000", "G32 U0 W-25. F1.5 Q90000"])
 def test_g32_thread(capsys, tmp_path, block):
-    """L2.1-31 `G32 X/U_ Z/W_ F_ Q_` (L§2.1 G32): one thread move at lead F from spindle angle Q (0.001°)."""
+    """L2.1-34 `G32 X/U_ Z/W_ F_ Q_` (L§2.1 G32): one thread move at lead F from spindle angle Q (0.001°)."""
     r = _run(capsys, tmp_path, f"G00 X30. Z5.\nM03 S500\n{block}\nM30\n")
     th = r.moves[-1]
     assert (th["kind"], th["lead"], th["start_angle"], r.ends("X", "Z")[-1]) == ("thread", 1.5, 90.0, (30.0, -20.0))
@@ -168,7 +185,7 @@ def test_g32_thread(capsys, tmp_path, block):
 
 @pytest.mark.parametrize("block", ["G34 X40. Z-20. F2. K0.1", "G34 U0 W-25. F2. K-0.05"])
 def test_g34_variable_lead(capsys, tmp_path, block):
-    """L2.1-32 `G34 X/U_ Z/W_ F_ K±` (L§2.1 G34): lead F changing by ±K per turn."""
+    """L2.1-35 `G34 X/U_ Z/W_ F_ K±` (L§2.1 G34): lead F changing by ±K per turn."""
     r = _run(capsys, tmp_path, f"G00 X40. Z5.\nM03 S500\n{block}\nM30\n")
     th = r.moves[-1]
     assert (th["kind"], th["lead"]) == ("thread", 2.0) and th["lead_change"] in (0.1, -0.05)
@@ -176,7 +193,7 @@ def test_g34_variable_lead(capsys, tmp_path, block):
 
 
 def test_g40_g41_g42_tool_nose_compensation(capsys, tmp_path):
-    """L2.1-33 `G40`, L2.1-34 `G00 G41 P_ or`, L2.1-35 `G00 G42 P_` (L§2.1 G40-G42; "P_: coordinates of
+    """L2.1-36 `G40`, L2.1-37 `G00 G41 P_ or`, L2.1-38 `G00 G42 P_` (L§2.1 G40-G42; "P_: coordinates of
     the target point", so P_ stands for the X/Z words): the nose centre runs left / right of the path by
     the nose radius of the T offset; G40 ends on the programmed point."""
     prog = ("G10 L10 P1 X0 Z0 R0.8 Q3\nT0101\nG00 X20. Z5.\nG00 {g} X20. Z2.\nG01 Z-20. F0.2\nG40 G00 X40. Z5.\nM30\n")
@@ -192,8 +209,8 @@ def test_g40_g41_g42_tool_nose_compensation(capsys, tmp_path):
 
 
 def test_g52_g53_g54_to_g59_coordinates(capsys, tmp_path):
-    """L2.1-36 `G52 X_ Y_ Z_`, L2.1-37 `G53 X_ Y_ Z_`, L2.1-38 `G54 X_ Y_ Z_ or`, L2.1-39 `G55 …`, L2.1-40 `G56 …`, L2.1-41 `G57 …`, L2.1-42 `G58 …`,
-    L2.1-43 `G59 X_ Y_ Z_`
+    """L2.1-39 `G52 X_ Y_ Z_`, L2.1-40 `G53 X_ Y_ Z_`, L2.1-41 `G54 X_ Y_ Z_ or`, L2.1-42 `G55 …`, L2.1-43 `G56 …`, L2.1-44 `G57 …`, L2.1-45 `G58 …`,
+    L2.1-46 `G59 X_ Y_ Z_`
     (L§2.1): G52 shifts the local origin, G53 moves in machine coordinates for one block, G54-G59 select
     the work system and move in it in the same block."""
     offs = "".join(f"G10 L2 P{k} X{2 * k}. Y{k}. Z-{k}.\n" for k in range(1, 7))
@@ -205,7 +222,7 @@ def test_g52_g53_g54_to_g59_coordinates(capsys, tmp_path):
 
 
 def test_g61_exact_stop_mode_and_g64_cutting_mode():
-    """L2.1-44 `G61`, L2.1-45 `G64` (L§2.1): under G61 every move ends in an exact stop until G64."""
+    """L2.1-47 `G61`, L2.1-48 `G64` (L§2.1): under G61 every move ends in an exact stop until G64."""
     m = _moves("G00 X0 Z0\nG61\nG01 X10. F100\nX20.\nG64\nX30.\nM30\n", "XZ")
     assert [x.exact_stop for x in m[1:]] == [True, True, False]
 
@@ -214,7 +231,7 @@ SUB = "O9010\n#100=#100+#9\n#101=#101+1\n#9=#9+100.\nM99\n"
 
 
 def test_g65_g66_g67_macro_calls(capsys, tmp_path):
-    """L2.1-46 `G65 P_ L_ I_`, L2.1-47 `G66 P_ L_ I_ or`, L2.1-48 `G67` (L§2.1): G65 calls P L times with
+    """L2.1-49 `G65 P_ L_ I_`, L2.1-50 `G66 P_ L_ I_ or`, L2.1-51 `G67` (L§2.1): G65 calls P L times with
     argument I (#9 in this guide's argument table), fresh on each repetition, G66 after every moving block until G67."""
     r = _run(capsys, tmp_path, "#100=0\n#101=0\nG65 P9010 L2 I1.5\nG66 P9010 L1 I1.\nG00 X10.\nZ-1.\nG67\nX20.\nM30\n"
              + SUB, "--vars", "100-101")
@@ -227,7 +244,7 @@ CONTOUR = "N100 G00 X20.\nG01 Z-20. F0.1\nX40.\nN200 Z-40.\n"
 
 
 def test_g71_g70_rough_and_finish(capsys, tmp_path):
-    """L2.1-49 `G71 U u R e ;`, L2.1-50 `G71 P p Q q U u W w F f S s T t ;`, L2.1-55 `G70 P_ Q_;` (L§2.1):
+    """L2.1-52 `G71 U u R e ;`, L2.1-53 `G71 P p Q q U u W w F f S s T t ;`, L2.1-58 `G70 P_ Q_;` (L§2.1):
     depth u (radius) per pass, retract e; allowances u (diameter) and w; feed f; then G70 along P-Q."""
     r = _run(capsys, tmp_path, "G00 X60. Z5.\nM03 S500\nG71 U2. R0.5\nG71 P100 Q200 U0.4 W0.1 F0.25 S600 T0101\n"
              + CONTOUR + "G70 P100 Q200\nM30\n", "--vars", "2023,2024")
@@ -239,7 +256,7 @@ def test_g71_g70_rough_and_finish(capsys, tmp_path):
 
 
 def test_g72_facing(capsys, tmp_path):
-    """L2.1-51 `G72 Wd Re;`, L2.1-52 `G72 P_Q Uu Ww F_S T_;` (L§2.1): depth d along Z, retract e."""
+    """L2.1-54 `G72 Wd Re;`, L2.1-55 `G72 P_Q Uu Ww F_S T_;` (L§2.1): depth d along Z, retract e."""
     r = _run(capsys, tmp_path, "G00 X82. Z2.\nM03 S500\nG72 W2. R0.5\nG72 P100 Q200 U0.4 W0.2 F0.25 S600 T0101\n"
              "N100 G00 Z-6.\nG01 X40. F0.1\nN200 Z0\nM30\n")
     rough = [m for m in r.moves if (m.get("tags") or [""])[:2] == ["G72", "rough"]]
@@ -247,7 +264,7 @@ def test_g72_facing(capsys, tmp_path):
 
 
 def test_g73_pattern_repeat(capsys, tmp_path):
-    """L2.1-53 `G73 U_i W_k R_d;`, L2.1-54 `G73 P_ Q_ U_u W_w F_ S_ T_;` (L§2.1): d passes, the first offset
+    """L2.1-56 `G73 U_i W_k R_d;`, L2.1-57 `G73 P_ Q_ U_u W_w F_ S_ T_;` (L§2.1): d passes, the first offset
     by i (X, radius) and k (Z)."""
     r = _run(capsys, tmp_path, "G00 X60. Z5.\nM03 S500\nG73 U4. W2. R3\nG73 P100 Q200 U0.4 W0.1 F0.25 S600 T0101\n"
              "N100 G00 X20. Z2.\nG01 Z-20. F0.1\nN200 X50.\nM30\n")
@@ -257,7 +274,7 @@ def test_g73_pattern_repeat(capsys, tmp_path):
 
 
 def test_g74_g75_pecking(capsys, tmp_path):
-    """L2.1-56 `G74 Re;`, L2.1-57 `G74 X/U_ Z/W_ PΔi QΔk RΔd F_;`, L2.1-58 `G75 R e ;`, L2.1-59
+    """L2.1-59 `G74 Re;`, L2.1-60 `G74 X/U_ Z/W_ PΔi QΔk RΔd F_;`, L2.1-61 `G75 R e ;`, L2.1-62
     `G75 X/U_ Z/W_ P Δ i Q Δ K R Δ d F_;` (L§2.1): G74 pecks Δk along Z and shifts Δi in X; G75 pecks Δi
     along X and shifts Δk in Z; each peck backs off e."""
     r = _run(capsys, tmp_path, "G00 X0 Z5.\nG74 R1.\nG74 U20. W-15. P5000 Q3000 R0 F0.1\nG00 X60. Z-10.\nG75 R1.\n"
@@ -271,7 +288,7 @@ def test_g74_g75_pecking(capsys, tmp_path):
 
 
 def test_g76_thread_cycle(capsys, tmp_path):
-    """L2.1-60 `G76 Pmra Q Δ dmin R d;`, L2.1-61 `G76 X/U Z/W R i P k Q Δ d F;` (L§2.1): m finish passes,
+    """L2.1-63 `G76 Pmra Q Δ dmin R d;`, L2.1-64 `G76 X/U Z/W R i P k Q Δ d F;` (L§2.1): m finish passes,
     least depth Δdmin, allowance d; taper i, height k, first depth Δd, lead F."""
     r = _run(capsys, tmp_path, "G00 X40. Z5.\nM03 S500\nG76 P021060 Q50 R0.05\nG76 X28. Z-20. R0 P975 Q400 F1.5\nM30\n")
     th = [m for m in r.moves if m["kind"] == "thread" and "chamfer" not in m["tags"]]
@@ -286,7 +303,7 @@ def test_g76_thread_cycle(capsys, tmp_path):
     ("G94 U-40. W-8. R-2. F0.2", [(60.0, -5.0), (20.0, -3.0), (20.0, 5.0), (60.0, 5.0)]),
 ])
 def test_g90_g94_single_cycles(capsys, tmp_path, block, path):
-    """L2.1-62 `G90 X/U_ Z/W_ R_ F_;`, L2.1-63 `G94 X/U_ Z/W_ R_ F_;` (L§2.1, type A): the four moves of
+    """L2.1-65 `G90 X/U_ Z/W_ R_ F_;`, L2.1-66 `G94 X/U_ Z/W_ R_ F_;` (L§2.1, type A): the four moves of
     the turning / facing cycle with taper R."""
     r = _run(capsys, tmp_path, "G00 X60. Z5.\nM03 S500\n" + block + "\nM30\n")
     assert [(round(m["work"]["X"], 4), round(m["work"]["Z"], 4)) for m in r.moves[1:]] == path
@@ -302,23 +319,23 @@ def _holes(prog: str) -> list:
 
 
 def test_g80_cancels():
-    """L2.1-64 `G80;` (L§2.1): an axis word after G80 is a plain move."""
+    """L2.1-67 `G80;` (L§2.1): an axis word after G80 is a plain move."""
     m = _holes("G00 X30. Z5. C0\nG83 X0 C0 Z-4. R-2. F0.1\nG80;\nG00 X40. Z10.\nM30\n")
     assert not m[-1].tags and _pt(m[-1].work, "XZ") == (40.0, 10.0)
 
 
 @pytest.mark.parametrize("code,block,axis,bottom", [
-    ("G83", "G83 X0 C45. Z-10. R-2. Q3000 P200 F0.1 K1 L1", "Z", -10.0),  # L2.1-65
-    ("G84", "G84 X20. C45. Z-10. R-2. Q0 P200 F1.5 K1 L0", "Z", -10.0),  # L2.1-66
-    ("G85", "G85 X20. C45. Z-8. R-2. P200 F0.1 K1", "Z", -8.0),  # L2.1-67
-    ("G87", "G87 Z-10. C45. X20. R-2. Q3000 P200 F0.1 K1 L1", "X", 20.0),  # L2.1-68
-    ("G88", "G88 Z-10. C45. X20. R-2. Q0 P200 F1.5 K1 L0", "X", 20.0),  # L2.1-69
-    ("G89", "G89 Z-10. C45. X20. R-2. P200 F0.1 K1", "X", 20.0),  # L2.1-70 (the guide writes it G85)
+    ("G83", "G83 X0 C45. Z-10. R-2. Q3000 P200 F0.1 K1 L1", "Z", -10.0),  # L2.1-68
+    ("G84", "G84 X20. C45. Z-10. R-2. Q0 P200 F1.5 K1 L0", "Z", -10.0),  # L2.1-69
+    ("G85", "G85 X20. C45. Z-8. R-2. P200 F0.1 K1", "Z", -8.0),  # L2.1-70
+    ("G87", "G87 Z-10. C45. X20. R-2. Q3000 P200 F0.1 K1 L1", "X", 20.0),  # L2.1-71
+    ("G88", "G88 Z-10. C45. X20. R-2. Q0 P200 F1.5 K1 L0", "X", 20.0),  # L2.1-72
+    ("G89", "G89 Z-10. C45. X20. R-2. P200 F0.1 K1", "X", 20.0),  # L2.1-73 (the guide writes it G85)
 ])
 def test_face_and_side_hole_cycles(code, block, axis, bottom):
-    """L2.1-65 `G83 X(U)_C_Z(W)_R_Q_P_F_K_L_M_;`, L2.1-66 `G84 X(U)_ C_ Z(W)_ R_ Q_ P_ F_ K_ L_ M_;`, L2.1-67
-    `G85 X(U)_ C_ Z(W)_ R_ P_ F_ K_ M_;`, L2.1-68 `G87 Z(W)_ C_ X(U)_ R_ Q_ P_ F_ K_L_M_;`, L2.1-69
-    `G88 Z(W)_ C_ X(U)_ R_ Q_ P_ F_ K_L_M_;`, L2.1-70 `G85 Z(W)_ C_ X(U)_ R_ P_ F_ K_ M_;` (the side boring
+    """L2.1-68 `G83 X(U)_C_Z(W)_R_Q_P_F_K_L_M_;`, L2.1-69 `G84 X(U)_ C_ Z(W)_ R_ Q_ P_ F_ K_ L_ M_;`, L2.1-70
+    `G85 X(U)_ C_ Z(W)_ R_ P_ F_ K_ M_;`, L2.1-71 `G87 Z(W)_ C_ X(U)_ R_ Q_ P_ F_ K_L_M_;`, L2.1-72
+    `G88 Z(W)_ C_ X(U)_ R_ Q_ P_ F_ K_L_M_;`, L2.1-73 `G85 Z(W)_ C_ X(U)_ R_ P_ F_ K_ M_;` (the side boring
     cycle G89, L§2.1): positioned at C45 and the other axis, to the bottom along Z (face) or X (side),
     dwell P ms there; the M_ word is in test_hole_cycle_m_word_clamps_and_unclamps_c."""
     m = _holes(f"G00 X60. Z5. C0\nM03 S500\n{block}\nG80\nM30\n")
@@ -329,14 +346,14 @@ def test_face_and_side_hole_cycles(code, block, axis, bottom):
 
 
 @pytest.mark.parametrize("block,code", [
-    ("G83 X0 C90. Z-10. R-2. Q3000 P200 F0.1 K1 L1 M80", "G83"),  # L2.1-65
-    ("G84 X20. C45. Z-10. R-2. Q0 P200 F1.5 K1 L0 M80", "G84"),  # L2.1-66
-    ("G85 X20. C45. Z-8. R-2. P200 F0.1 K1 M80", "G85"),  # L2.1-67
-    ("G87 Z-10. C45. X20. R-2. Q3000 P200 F0.1 K1 L1 M80", "G87"),  # L2.1-68
-    ("G89 Z-10. C45. X20. R-2. P200 F0.1 K1 M80", "G89"),  # L2.1-70
+    ("G83 X0 C90. Z-10. R-2. Q3000 P200 F0.1 K1 L1 M80", "G83"),  # L2.1-68
+    ("G84 X20. C45. Z-10. R-2. Q0 P200 F1.5 K1 L0 M80", "G84"),  # L2.1-69
+    ("G85 X20. C45. Z-8. R-2. P200 F0.1 K1 M80", "G85"),  # L2.1-70
+    ("G87 Z-10. C45. X20. R-2. Q3000 P200 F0.1 K1 L1 M80", "G87"),  # L2.1-71
+    ("G89 Z-10. C45. X20. R-2. P200 F0.1 K1 M80", "G89"),  # L2.1-73
 ])
 def test_hole_cycle_m_word_clamps_and_unclamps_c(block, code):
-    """The `M_` of L2.1-65 … L2.1-70 (L§2.1 G83-G89: "when the tool moves to the start point, the system
+    """The `M_` of L2.1-68 … L2.1-73 (L§2.1 G83-G89: "when the tool moves to the start point, the system
     executes the M-code (e.g., M80: C-axis clamping). Then, when the tool completes drilling and retracts
     to point R and before pausing at the top of the hole, the system executes M + 1 code"): M80 after the
     positioning move and before the drill axis moves, M81 with the tool back at R, and no M80 at the
@@ -358,14 +375,14 @@ def test_hole_cycle_m_word_clamps_and_unclamps_c(block, code):
 # ---- L§2.1 modes and settings
 
 def test_g90_g91_absolute_incremental_on_type_b(capsys, tmp_path):
-    """L2.1-71 `G90 X_ Y_ Z_`, L2.1-72 `G91 X_ Y_ Z_` (L§2.1, note 1-2: type B; the guide's example)."""
+    """L2.1-74 `G90 X_ Y_ Z_`, L2.1-75 `G91 X_ Y_ Z_` (L§2.1, note 1-2: type B; the guide's example)."""
     r = _run(capsys, tmp_path, "G90 G00 X30. Z30.\nG91 X20. Z20.\nG90 U20. W20.\nG91 U20. W20.\nM30\n",
              "--param", "P306=1")
     assert r.ends("X", "Z") == [(30.0, 30.0), (50.0, 50.0), (70.0, 70.0), (90.0, 90.0)]
 
 
 def test_g50_coordinate_setting_and_maximum_spindle_speed():
-    """L2.1-73 `G50 X_ Y_ Z_ (coordinate system setting)`, L2.1-74 `G50 S_ (maximum spindle speed)`
+    """L2.1-76 `G50 X_ Y_ Z_ (coordinate system setting)`, L2.1-77 `G50 S_ (maximum spindle speed)`
     (L§2.1 G50 and its example): G50 X Z makes the current point that coordinate; G50 S clamps the spindle."""
     from nc.moves import Aux, Move
 
@@ -377,13 +394,13 @@ def test_g50_coordinate_setting_and_maximum_spindle_speed():
 
 
 def test_g98_g99_feed_per_minute_and_per_revolution(capsys, tmp_path):
-    """L2.1-75 `G98 G01 X_ Y_ Z_ F_`, L2.1-76 `G99 G01 X_ Y_ Z_ F_` (L§2.1)."""
+    """L2.1-78 `G98 G01 X_ Y_ Z_ F_`, L2.1-79 `G99 G01 X_ Y_ Z_ F_` (L§2.1)."""
     m = _moves("G98 G01 X10. Y1. Z-1. F100\nG99 G01 X12. Y2. Z-2. F0.35\nM30\n")
     assert [(x.feed, x.per_rev) for x in m] == [(100.0, False), (0.35, True)]
 
 
 def test_g96_g97_surface_speed_and_rpm(capsys, tmp_path):
-    """L2.1-77 `G96 S_ (m/min)`, L2.1-78 `G97 S_ (rev/min)` (L§2.1)."""
+    """L2.1-80 `G96 S_ (m/min)`, L2.1-81 `G97 S_ (rev/min)` (L§2.1)."""
     from nc.moves import Aux
 
     ev, ip = _events("M03 S500\nG96 S120\nG01 X40. Z-1. F0.1\nG97 S800\nM30\n")
@@ -392,14 +409,14 @@ def test_g96_g97_surface_speed_and_rpm(capsys, tmp_path):
 
 
 @pytest.mark.parametrize("first,second,corner", [
-    ("G01 X20. Z-10. ,C2.", "G01 X40. Z-10.", "chamfer"),  # L2.1-79, L2.1-80
-    ("G01 X20. Z-10. ,R2.", "G01 X40. Z-10.", "round"),  # L2.1-81, L2.1-82
-    ("G02 U0 W-10. R20. ,C1.", "G01 X40. W0", "chamfer"),  # L2.1-79 with G02
-    ("G03 X20. W-10. R20. ,R1.", "G01 U20.", "round"),  # L2.1-81 with G03
+    ("G01 X20. Z-10. ,C2.", "G01 X40. Z-10.", "chamfer"),  # L2.1-82, L2.1-83
+    ("G01 X20. Z-10. ,R2.", "G01 X40. Z-10.", "round"),  # L2.1-84, L2.1-85
+    ("G02 U0 W-10. R20. ,C1.", "G01 X40. W0", "chamfer"),  # L2.1-82 with G02
+    ("G03 X20. W-10. R20. ,R1.", "G01 U20.", "round"),  # L2.1-84 with G03
 ])
 def test_chamfer_and_corner_rounding(capsys, tmp_path, first, second, corner):
-    """L2.1-79 `G01/G02/G03 X/U_ Z/W_ ,C_`, L2.1-80 `G01/G02/G03 X/U_ Z/W_`, L2.1-81
-    `G01/G02/G03 X/U_ Z/W_ ,R_`, L2.1-82 `G01/G02/G03 X/U_ Z/W_` (L§2.1): a chamfer / round of the given
+    """L2.1-82 `G01/G02/G03 X/U_ Z/W_ ,C_`, L2.1-83 `G01/G02/G03 X/U_ Z/W_`, L2.1-84
+    `G01/G02/G03 X/U_ Z/W_ ,R_`, L2.1-85 `G01/G02/G03 X/U_ Z/W_` (L§2.1): a chamfer / round of the given
     size between the ,C/,R block and the next one; the end point of the next block stays."""
     r = _run(capsys, tmp_path, f"G00 X20. Z0\nG01 F0.2\n{first}\n{second}\nM30\n")
     tag = ",C" if corner == "chamfer" else ",R"
@@ -409,7 +426,7 @@ def test_chamfer_and_corner_rounding(capsys, tmp_path, first, second, corner):
 
 
 def test_g01_angle_a(capsys, tmp_path):
-    """L2.1-83 `G01 X_ (Z_) ,A_` (L§2.1): a line at angle A (from +Z) that ends at the given X (or Z)."""
+    """L2.1-86 `G01 X_ (Z_) ,A_` (L§2.1): a line at angle A (from +Z) that ends at the given X (or Z)."""
     r = _run(capsys, tmp_path, "G00 X20. Z0\nG01 X40. ,A135. F0.2\nG01 Z-30. ,A180.\nM30\n")
     assert [tuple(round(v, 6) for v in e) for e in r.ends("X", "Z")[1:]] == [(40.0, -10.0), (40.0, -30.0)]
 

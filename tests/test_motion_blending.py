@@ -120,6 +120,19 @@ def test_arcs_and_lines_with_the_filter_stay_within_limits():
     assert min(abs(r1 - 10.0), abs(r2 - 10.0)) < 0.01  # on one of the arcs within the tolerance
 
 
+def test_ring_of_chords_runs_within_one_and_a_half_times_its_feed_limited_time():
+    """Issue 18: the r = 2 mm ring of 0.05 mm chords at F3000 on the 16+16 ms filter with N1.053 =
+    0.02 mm (benchmarks/bench_corners.py): 3.93× its feed-limited time before issue 18, 1.78× after
+    round 1, where the filter's corner acceleration share (25 %) held it at 38 mm/s. Between lines
+    the curvature share is free (decision motion 38): now the tolerance holds it (0.371 s, 1.48×)."""
+    ring = circle_chords(2.0, 0.05)
+    cfg = filtered(tol=0.02)
+    st = check(lines(ring, 3000), cfg, start=ring[0])
+    feed_limited = float(np.sum(np.linalg.norm(np.diff(np.array(ring, float), axis=0), axis=1))) / 50.0
+    assert st.time <= 1.5 * feed_limited, st.time / feed_limited
+    assert polyline_deviation(st.positions, ring) <= 0.02
+
+
 @pytest.mark.parametrize("ms", [4.0, 8.0, 16.0])
 def test_random_polylines_never_exceed_a_limit(ms):
     rng = np.random.default_rng(int(ms))

@@ -9,9 +9,11 @@ import argparse
 import dataclasses
 import gc
 import math
+import re
 import sys
 from json import dumps as _json_str
 from collections import deque
+from collections.abc import Sequence
 
 from typing import TYPE_CHECKING
 
@@ -21,7 +23,7 @@ from nc.alarms import NcAlarm, internal_error
 
 if TYPE_CHECKING:  # the interpreter and the bench load when the command runs, not at `hil` start-up
     from nc.interp import Interpreter
-    from nc.moves import Move
+    from nc.moves import Move, MoveBatch
 
 
 def parse_ranges(text: str) -> list[int]:
@@ -151,10 +153,76 @@ def move_json(m: Move) -> str:
             f'"center": null, "dir": null, "feed": {_num(m.feed)}, "duration": null}}')
 
 
+def _coord(v: float) -> str:
+    """`_num(fmt(v))` for a finite float: round(v, 7) is v itself when |v| < 1e7 and v's shortest repr
+    has at most 7 decimals and no exponent, which is every coordinate read from a program written
+    to 0.001 mm (pinned against the general form by tests/test_interp_bulk.py)."""
+    r = repr(v)
+    dot = r.find(".")
+    if dot > 0 and len(r) - dot <= 8 and "e" not in r and -1e7 < v < 1e7:
+        return "0.0" if v == 0 else r
+    return _num(fmt(v))
+
+
+# reprs `_coord` takes as they are have no exponent, at most 7 decimals and at most 7 integer digits
+_DECIMALS_8 = re.compile(r"\.[0-9]{8}")
+_DIGITS_8 = re.compile(r"[0-9]{8}")  # without an exponent and beyond 7 decimals: an integer part >= 1e7
+
+
+def _coords(col: Sequence[float]) -> list[str]:
+    """`_coord` of every value of a column: reprs in one go, checked in one pass over their text."""
+    r = list(map(repr, col))
+    text = "\n".join(r)
+    if "e" in text or _DECIMALS_8.search(text) or _DIGITS_8.search(text):
+        return [_coord(v) for v in col]
+    if "-0.0" in r:
+        r = ["0.0" if x == "-0.0" else x for x in r]
+    return r
+
+
+def _points(axes: tuple[str, ...], cols: Sequence[Sequence[float]]) -> list[str]:
+    """`_axes` of each row of per-axis columns."""
+    template = "{" + ", ".join(f"{_json_str(a)}: %s" for a in axes) + "}"
+    return [template % t for t in zip(*map(_coords, cols))]
+
+
+def batch_json(b: MoveBatch) -> str:
+    """The JSON lines of a MoveBatch, byte for byte `move_json` of each of `b.moves()` (a batch holds
+    rapids and lines without additive keys but `per_rev`): numbers formatted column by column, each
+    end point once (it is the next move's start), a work point equal to it not again."""
+    if not b.lines:
+        return ""
+    ends = _points(b.axes, b.end)
+    works = ends if b.work == b.end else _points(b.axes, b.work)
+    starts = [_axes(b.start)] + ends[:-1]
+    per_rev = ', "per_rev": true' if b.per_rev else ""
+    tails: dict[float | None, str] = {None: 'null, "duration": null}'}
+    out = []
+    for line, text, rapid, start, end, work, feed in zip(b.lines, b.texts, b.rapid, starts, ends, works, b.feed):
+        tail = tails.get(feed)
+        if tail is None:
+            tail = tails[feed] = f'{_num(feed)}, "duration": null{per_rev}}}'
+        block = f'"{text}"' if "\t" not in text else _json_str(text)
+        out.append(f'{{"kind": "{"rapid" if rapid else "line"}", "line": {line}, "block": {block}, '
+                   f'"start": {start}, "end": {end}, "work": {work}, "center": null, "dir": null, "feed": {tail}')
+    return "\n".join(out)
+
+
+def batch_text(b: MoveBatch) -> str:
+    """The text listing lines of a MoveBatch, as `_human` writes each of `b.moves()`."""
+    unit = "/rev" if b.per_rev else ""
+    out = []
+    for line, rapid, work, feed in zip(b.lines, b.rapid, zip(*b.work), b.feed):
+        end = " ".join([f"{a}{fmt(v):g}" for a, v in zip(b.axes, work)])
+        extra = "" if feed is None else f" F{feed:g}{unit}"
+        out.append(f"{line:5d} {'rapid' if rapid else 'line':6s} {end}{extra}")
+    return "\n".join(out)
+
+
 def cmd_path(args: argparse.Namespace) -> int:
     from hil.session import InputError, load_bench, print_alarm
     from nc.interp import Interpreter
-    from nc.moves import Move, Sync
+    from nc.moves import Move, MoveBatch, Sync
     from nc.profiles import make_profile
     from nc.store import ProgramStore
 
@@ -179,6 +247,9 @@ def cmd_path(args: argparse.Namespace) -> int:
     interp = Interpreter(profile, store=store)
     if args.preview_log:  # asked for: the whole log, not only the last statements (decisions B3)
         interp.preview_log = deque()
+    # runs of plain G0/G1 blocks come as MoveBatch events, formatted in bulk (issue 16); the plot,
+    # the preview log and an M96 interrupt want every Move on its own
+    interp.bulk = not (args.preview_log or interrupt or getattr(args, "plot", None))
     out = sys.stdout
     try:
         store.add_libs(args.lib)
@@ -203,7 +274,9 @@ def cmd_path(args: argparse.Namespace) -> int:
         plotted: list[Move] = []
         for ev in interp.run(program, preview=interrupt is None):
             listed = _print_servo(interp, args, listed)
-            if isinstance(ev, Move):
+            if type(ev) is MoveBatch:
+                print(batch_json(ev) if args.json else batch_text(ev), file=out)
+            elif isinstance(ev, Move):
                 if interrupt and ev.line == interrupt[0] and ev.program == program.name \
                         and interp.interrupt_program is not None:
                     ev, interrupt = suspend(interp, ev, interrupt[1]), None

@@ -25,7 +25,7 @@ from nc.alarms import NcAlarm
 from nc.compensation import offset as geo
 from nc.compensation.nose import tip_vector
 from nc.cycles.geometry import Pt, Seg, dist
-from nc.moves import Busy, Event, Move, ProgramEnd
+from nc.moves import Busy, Event, Move, MoveBatch, ProgramEnd
 
 PLANE_MOVES = ("rapid", "line", "arc", "thread")
 
@@ -283,5 +283,12 @@ def compensate(events: Iterable[Event], profile: object | None = None) -> Iterat
         return
     comp = Compensator()
     for ev in events:
+        if type(ev) is MoveBatch:  # plain uncompensated moves (nc.interp.bulk): through whole when idle
+            if comp.pending is None and comp.out_pos is None:
+                yield ev
+                continue
+            for m in ev.moves():
+                yield from comp.push(m)
+            continue
         yield from comp.push(ev)
     yield from comp.finish()

@@ -15,7 +15,7 @@ from collections.abc import Iterator
 from typing import TYPE_CHECKING
 
 from nc.alarms import NcAlarm
-from nc.moves import Busy, Event, Move, ProgramEnd
+from nc.moves import Busy, Event, Move, MoveBatch, ProgramEnd
 
 if TYPE_CHECKING:  # pragma: no cover
     from nc.interp.host import InterpHost
@@ -25,6 +25,13 @@ def expand_corners(interp: "InterpHost", events: Iterator[Event]) -> Iterator[Ev
     pending: tuple[Move, str, float] | None = None
     held: list[Event] = []  # M/S/T or dwell events of the next block, issued after the corner
     for ev in events:
+        if type(ev) is MoveBatch:  # plain moves (no ,C/,R): through whole unless a corner waits for them
+            if pending is None:
+                yield ev
+                continue
+            yield from _corners_of(interp, ev.moves(), pending, held)
+            pending, held = None, []
+            continue
         if isinstance(ev, Move) and ev.kind in ("line", "arc", "rapid", "thread"):
             mark = _mark(interp, ev)
             if pending is not None:
@@ -46,6 +53,16 @@ def expand_corners(interp: "InterpHost", events: Iterator[Event]) -> Iterator[Ev
         yield ev
     if pending is not None:
         _fail(pending)
+
+
+def _corners_of(interp: "InterpHost", moves: list[Move], pending: tuple[Move, str, float],
+                held: list[Event]) -> Iterator[Event]:
+    """A batch's moves after a held ,C/,R block: the first is joined to it (`_join` trims it), then
+    they pass as the block-by-block path passes them."""
+    first, kind, value = pending
+    yield from _join(interp, first, moves[0], kind, value)
+    yield from held
+    yield from moves
 
 
 def _fail(pending: tuple[Move, str, float]) -> None:

@@ -78,6 +78,9 @@ class Interpreter(ExecuteMixin, ReadingMixin, ModalMixin, MotionMixin, NonModalM
         self._gcall_depth = 0
         self._three_point: dict[str, float] | None = None  # G2.4/G3.4 middle point
         self._plain_axes = frozenset(self.axes) - {"G", "M", "T", "F", "S", "D"}  # `_axis_block` letters
+        # True: runs of plain G0/G1 blocks come as one MoveBatch event (nc.interp.bulk); for a consumer
+        # that formats them in bulk (`hil path`), never the channel, which plans Move by Move
+        self.bulk = False
 
     # ---- public ---------------------------------------------------------------------------
 
@@ -113,6 +116,9 @@ class Interpreter(ExecuteMixin, ReadingMixin, ModalMixin, MotionMixin, NonModalM
         limit = int(self.profile.param("max blocks", 1_000_000))
         last: Block | None = None
         budget = self.budget
+        bulk = None
+        if self.bulk:  # a consumer that takes MoveBatch events (`hil path`)
+            from nc.interp import bulk
         while self.stack:
             if budget is not None and budget.spent:
                 yield BUSY  # the rest of the macro next cycle; the cycle never stalls (decisions B2)
@@ -126,6 +132,10 @@ class Interpreter(ExecuteMixin, ReadingMixin, ModalMixin, MotionMixin, NonModalM
                 if len(self.stack) == 1:
                     break
                 self._return(None)  # end of a subprogram without M99 returns like M99
+                continue
+            if bulk is not None and (batch := bulk.take(self, fr, limit)) is not None:
+                yield batch  # a run of plain G0/G1 blocks read in one pass (nc.interp.bulk)
+                last = self.block
                 continue
             last = fr.program.blocks[fr.pc]
             block = self._take_block(fr, limit)

@@ -15,7 +15,7 @@ from collections.abc import Iterator
 from typing import TYPE_CHECKING
 
 from nc.interp.records import PreviewRecord
-from nc.moves import Busy, Event, Move, Sync
+from nc.moves import Busy, Event, Move, MoveBatch, Sync
 
 if TYPE_CHECKING:  # pragma: no cover
     from nc.interp.host import InterpHost
@@ -62,6 +62,8 @@ class PreviewWindow:
                 buf.append(ev)
                 if isinstance(ev, Move):
                     moves += 1
+                elif type(ev) is MoveBatch:  # a run of plain moves (nc.interp.bulk) counts as its moves
+                    moves += len(ev)
                 elif isinstance(ev, Sync):
                     syncs += 1
             if not buf:
@@ -72,6 +74,9 @@ class PreviewWindow:
             if isinstance(ev, Move):
                 moves -= 1
                 self.executing = ev
+            elif type(ev) is MoveBatch:
+                moves -= len(ev)
+                self.executing = ev  # type: ignore[assignment]  # its .line/.block: the last move's
             elif isinstance(ev, Sync):
                 syncs -= 1
             yield ev

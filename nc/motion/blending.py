@@ -63,6 +63,11 @@ class FilterCorners:
         sc = cfg.share_corner
         self.budget_a = tuple(sc * a * t1 for a in acc)
         self.budget_j = tuple(sc * j * t1 * t2 for j in jerk)
+        # Between lines only, the curvature share (arcs' centripetal terms, curvature jumps) is
+        # unused: the filter's corners may have it too (issue 18, decision motion 38).
+        lines = (sc + cfg.share_curvature) / sc if sc > 0.0 else 1.0
+        self.budget_al = tuple(x * lines for x in self.budget_a)
+        self.budget_jl = tuple(x * lines for x in self.budget_j)
         self.tol = cfg.path_tolerance
         self.kd = KernelDeviation(n1, n2, cfg.cycle)
         self.t2sum = t1 * t1 + t2 * t2
@@ -86,21 +91,29 @@ class FilterCorners:
         self._m = 0  # where the last search for the first junction taken ended
         self._seq0 = 0  # junctions dropped from the front of _hist so far
         self._lim_s = -math.inf  # path position of the newest junction the tolerance limits
+        self._arc_s = -math.inf  # path position where the newest arc block ends
         # Sliding maxima over _hist[_m:] as (sequence number, value) of the blocks' tangential
         # acceleration, vtop and length.
         self._maxima: tuple[deque[tuple[int, float]], ...] = (deque(), deque(), deque())
 
-    def corner(self, du: Sequence[float], acc: float) -> float:
+    def corner(self, du: Sequence[float], acc: float, lines: bool = False) -> float:
         """Speed cap of one isolated tangent jump (|Δu| per axis) between blocks whose path
         acceleration reaches `acc`: the acceleration and jerk budgets. The path tolerance is the
         deviation model's (`_tolerance`), except that a corner whose braking alone cuts it by
-        more than the tolerance is an exact stop."""
+        more than the tolerance is an exact stop. `lines`: both blocks are lines."""
         v = math.inf
-        for d, ba, bj in zip(du, self.budget_a, self.budget_j):
+        for d, ba, bj in zip(du, self.budget_al if lines else self.budget_a,
+                             self.budget_jl if lines else self.budget_j):
             if d > 1e-12:
                 v = min(v, ba / d, bj / d)
-        if self.tol is not None and self.braking(math.sqrt(sum(d * d for d in du)), acc) >= self.tol:
-            return 0.0
+        if self.tol is not None:
+            du_n = math.sqrt(sum(d * d for d in du))
+            room = self.tol - self.braking(du_n, acc)
+            if room <= 0.0:
+                return 0.0
+            # The corner's own term of the kernel model, alone: v·|Δu|·G(0) (nc.motion.deviation).
+            # A cap that only falls, so the model may charge each step at min(c, this cap).
+            v = min(v, room / (du_n * self.kd.g0))
         return v
 
     def braking(self, du_n: float, acc: float) -> float:
@@ -190,7 +203,13 @@ class FilterCorners:
         pad = 0.5 * acc_q[0][1] * t_w2
         two_al = 2.0 * acc_q[0][1] * len_q[0][1]
         v_hi = top_q[0][1]
-        budget_a, budget_j = self.budget_a, self.budget_j
+        for b in (j_new, tail):  # J's block is the tail of the previous call, unless a stop cleared
+            if b.seg is not None and b.seg.kind == "arc" and b.s_end > self._arc_s:
+                self._arc_s = b.s_end
+        # Every junction a window ending at J charges lies within span_max behind J, so the
+        # blocks it spans (and the tail's) are lines when the newest arc ended before that.
+        lines = self._arc_s < s_j - span_max
+        budget_a, budget_j = (self.budget_al, self.budget_jl) if lines else (self.budget_a, self.budget_j)
         axes = self._axes
         zero = self._zero
         rng = range(axes)
@@ -276,7 +295,7 @@ class FilterCorners:
             # The sums over the whole stretch bound the filter's acceleration and jerk from
             # above; the windows themselves (at the speed they are crossed) are far less on a
             # curve, where consecutive windows hold nearly the same signed sum.
-            c2 = self._refine(hist, h0, last, c, top)
+            c2 = self._refine(hist, h0, last, c, top, budget_a, budget_j)
             if c2 > c:
                 c = c2
                 while m > h0 and s_j - hist[m - 1].s_end <= c * t_w + pad:
@@ -303,7 +322,8 @@ class FilterCorners:
             idx -= 1
         return depth
 
-    def _refine(self, hist: list["Block"], h0: int, last: int, c: float, top: float) -> float:
+    def _refine(self, hist: list["Block"], h0: int, last: int, c: float, top: float,
+                budget_a: tuple[float, ...], budget_j: tuple[float, ...]) -> float:
         """The highest speed ≤ top (above the safe cap c, else c) at which every filter window
         whose last junction is J meets the budgets, the windows taken at that speed: per axis
         the acceleration |Σ v_i·Δu_i|/T1 over a T1 window and the jerk over the difference of two
@@ -321,8 +341,8 @@ class FilterCorners:
         # A junction's velocity step is its own speed times Δu: no more than the cap it already
         # has (vbase only ever falls), nor than the speed the windows are taken at.
         vb = np.fromiter((b.vbase for b in seg), float, len(seg))
-        ba = np.array(self.budget_a)
-        bj = np.array(self.budget_j)
+        ba = np.array(budget_a)
+        bj = np.array(budget_j)
 
         def sums(v: float) -> tuple[np.ndarray, np.ndarray]:
             """Largest |Σ v_i·Δu_i| per axis over T1 windows, and over their differences."""
@@ -392,6 +412,7 @@ class FilterCorners:
         seg = hist[lo:]
         s = np.fromiter((b.s_end for b in seg), float, len(seg))
         du = np.array([b.dv for b in seg], dtype=float)
+        vb = np.fromiter((b.vbase for b in seg), float, len(seg))
         ev = np.nonzero(s >= s_j - h - 1e-12)[0]
         room = np.empty(len(ev))
         for r, i in enumerate(ev):
@@ -399,7 +420,7 @@ class FilterCorners:
             nx = seg[i + 1] if i + 1 < len(seg) else blocks[-1]
             room[r] = self.tol - self.braking(b.du_n, b.a if b.a > nx.a else nx.a)
         near = s >= s_j - 2.0 * h - 1e-12
-        caps = self.kd.caps(s[ev], room, vt, s[near], du[near])
+        caps = self.kd.caps(s[ev], room, vt, s[near], du[near], vb[near])
         for r, i in enumerate(ev):
             seg[i].ctol = float(caps[r])
             if caps[r] < vt * (1.0 - 1e-9) and seg[i].s_end > self._lim_s:

@@ -34,20 +34,26 @@ class KernelDeviation:
         """G(x) for time offsets x (s)."""
         return np.interp(np.abs(x), self._y, self._g, right=0.0)
 
-    def deviation(self, c: np.ndarray, s_eval: np.ndarray, s_all: np.ndarray, du: np.ndarray) -> np.ndarray:
+    def deviation(self, c: np.ndarray, s_eval: np.ndarray, s_all: np.ndarray, du: np.ndarray,
+                  vb: np.ndarray | None = None) -> np.ndarray:
         """|e| at each evaluation junction (path positions s_eval, speeds c) from the signed steps
-        du (n × axes) at path positions s_all."""
+        du (n × axes) at path positions s_all, each crossed at min(c, vb) (vb: a cap the junction
+        can never exceed; a slow corner's step is its own speed times Δu, not c's)."""
         w = self.weights((s_all[None, :] - s_eval[:, None]) / c[:, None])
-        return c * np.linalg.norm(w @ du, axis=1)
+        if vb is None:
+            return c * np.linalg.norm(w @ du, axis=1)
+        return np.linalg.norm((w * np.minimum(vb[None, :], c[:, None])) @ du, axis=1)
 
     def caps(self, s_eval: np.ndarray, room: np.ndarray, top: float, s_all: np.ndarray,
-             du: np.ndarray) -> np.ndarray:
+             du: np.ndarray, vb: np.ndarray | None = None) -> np.ndarray:
         """Highest speeds (≤ top) whose deviation at each evaluation junction stays within room.
 
         The deviation grows with the speed about as c^p, 1 ≤ p ≤ 2 (a corner: p = 1; a curve:
         p = 2), so a step down by room/e lands at or below the room and a step up by √(room/e)
         does not pass it. Where cancelling steps make it grow slower, a step may miss: the last
-        passes only step down, and every speed returned was evaluated within the room.
+        passes only step down, and every speed returned was evaluated within the room. Steps
+        held below c by vb grow slower still (only through the time offsets, (s_i − s_K)/c):
+        what the steps leave unmet is bisected.
         """
         c = np.where(room > 0.0, float(top), 0.0)
         live = np.nonzero(room > 0.0)[0]
@@ -56,7 +62,7 @@ class KernelDeviation:
         cc, rr, se = c[live], room[live], s_eval[live]
         reduced = np.zeros(len(cc), dtype=bool)
         for it in range(12):
-            e = self.deviation(cc, se, s_all, du)
+            e = self.deviation(cc, se, s_all, du, vb)
             bad = e > rr
             if not bad.any() and (it >= 4 or not reduced.any()):
                 break
@@ -68,6 +74,13 @@ class KernelDeviation:
             reduced |= bad
             cc = np.minimum(np.maximum(cc * step, 1e-6), top)
         else:
-            cc[self.deviation(cc, se, s_all, du) > rr] = 0.0  # never met: stop there
+            bad = self.deviation(cc, se, s_all, du, vb) > rr
+            if bad.any():
+                lo, hi = np.zeros(int(bad.sum())), cc[bad]
+                for _ in range(24):
+                    mid = 0.5 * (lo + hi)
+                    ok = self.deviation(np.maximum(mid, 1e-9), se[bad], s_all, du, vb) <= rr[bad]
+                    lo, hi = np.where(ok, mid, lo), np.where(ok, hi, mid)
+                cc[bad] = lo  # evaluated within the room (0: never met, stop there)
         c[live] = cc
         return c

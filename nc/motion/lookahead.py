@@ -188,7 +188,7 @@ class Limits:
             b1.du = tuple(du)
             b1.du_n = math.sqrt(sum(d * d for d in du))
             if b1.du_n > 1e-9:
-                v = min(v, self.blend.corner(du, max(b1.a, b2.a)))
+                v = min(v, self.blend.corner(du, max(b1.a, b2.a), s1.kind == "line" and s2.kind == "line"))
         elif max(du) > 1e-9:
             vj = va = math.inf
             for d, cj, ca in zip(du, self._corner_j, self._corner_a):

@@ -14,8 +14,10 @@ from __future__ import annotations
 
 import re
 import unicodedata
+from array import array
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field, replace
-from typing import Any, Union
+from typing import Any, Union, overload
 
 from nc.alarms import NcAlarm
 from nc.program.expr import Expr, ExprParser, Num, Var
@@ -138,7 +140,7 @@ class Program:
     store: Any = field(default=None, repr=False, compare=False)
 
     def __post_init__(self) -> None:
-        if not self.labels:
+        if not self.labels and not isinstance(self.blocks, BlockList):  # a BlockList indexes its own
             for i, b in enumerate(self.blocks):
                 if b.n is not None:
                     self.labels.setdefault(b.n, []).append(i)
@@ -158,6 +160,79 @@ _SPACE_EQ = re.compile(r"[\s=]")
 # such block reads exactly as the general parser would read it; anything else takes the general path.
 _PLAIN_BLOCK = re.compile(r"[ \t]*(?:[A-Za-z][+-]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)[ \t]*)+")
 _PLAIN_WORD = re.compile(r"([A-Za-z])([+-]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+))")
+# A plain line that `_plain_block` reads without a doubt (no alarm possible): an optional leading
+# N of digits, then one-letter addresses other than N and O, each with a number of at most
+# MAX_DIGITS + 3 characters. Such lines are kept as text and read when the interpreter needs them.
+_WORD_OK = r"[A-MP-Za-mp-z](?=[-+.0-9]{1,12}(?![.0-9]))[+-]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)[ \t]*"
+_PLAIN_OK = re.compile(r"[ \t]*(?:[Nn]([0-9]{1,12})[ \t]*)?(?:" + _WORD_OK + ")*")
+_CACHE_LIMIT = 4096  # parsed plain lines kept (loops and GOTO come back to them); then the cache starts over
+
+
+class BlockList(Sequence):
+    """A program's blocks, streamed (issue 16): plain lines (`_PLAIN_OK`) are kept as their text and
+    parsed when the interpreter reaches them, every other block is parsed (and checked) when the
+    program is read. Memory stays near the size of the text however long the program; a bulk
+    reader (nc.interp.bulk) takes runs of the text without making blocks at all."""
+
+    __slots__ = ("_items", "_lines", "_cache")
+
+    def __init__(self) -> None:
+        self._items: list[Block | str] = []
+        self._lines = array("l")  # file line of each item
+        self._cache: dict[int, Block] = {}
+
+    def _add(self, item: Block | str, line: int) -> None:
+        self._items.append(item)
+        self._lines.append(line)
+
+    def __len__(self) -> int:
+        return len(self._items)
+
+    @overload
+    def __getitem__(self, i: int) -> Block: ...
+    @overload
+    def __getitem__(self, i: slice) -> list[Block]: ...
+
+    def __getitem__(self, i):
+        if isinstance(i, slice):
+            return [self[k] for k in range(*i.indices(len(self._items)))]
+        item = self._items[i]
+        if type(item) is not str:
+            return item
+        if i < 0:
+            i += len(self._items)
+        block = self._cache.get(i)
+        if block is None:
+            if len(self._cache) >= _CACHE_LIMIT:
+                self._cache.clear()
+            block = self._cache[i] = parse_block(self._lines[i], item)
+        return block
+
+    def __iter__(self) -> Iterator[Block]:
+        for i in range(len(self._items)):
+            yield self[i]
+
+    def raw(self, i: int) -> str | None:
+        """The text of a plain line not yet parsed (`_PLAIN_OK`), else None."""
+        item = self._items[i]
+        return item if type(item) is str else None
+
+    def line(self, i: int) -> int:
+        return self._lines[i]
+
+    def lines(self, i: int, count: int) -> list[int]:
+        """File lines of items i … i + count - 1."""
+        return self._lines[i:i + count].tolist()
+
+    def texts(self, i: int, most: int) -> list[str]:
+        """The texts of the unparsed plain lines from `i` on (at most `most`), up to the first block."""
+        out = self._items[i:i + most]
+        for k, item in enumerate(out):
+            if type(item) is not str:
+                return out[:k]  # type: ignore[return-value]
+        return out  # type: ignore[return-value]
+
+
 
 
 def strip_comments(text: str) -> tuple[str, str]:
@@ -484,8 +559,20 @@ _O_LINE = re.compile(r"\s*[Oo]([0-9]+)")
 def parse_program(text: str, name: str = "program", number: int | None = None) -> Program:
     """Parse one program (one O number).  The first line starting with ``O`` is its description
     (N ch.2).  Raises NcAlarm (with line and block) on the first malformed block."""
-    blocks: list[Block] = []
+    blocks = BlockList()
+    items, item_lines = blocks._items, blocks._lines
+    labels: dict[int, list[int]] = {}
+    plain_ok = _PLAIN_OK.fullmatch
     for idx, raw in enumerate(text.splitlines(), start=1):
+        m = plain_ok(raw)
+        if m is not None and m.end():  # kept as text (BlockList): no block object per line
+            if m.group(1) is not None:
+                labels.setdefault(int(m.group(1)), []).append(len(items))
+            elif not raw.strip():
+                continue
+            items.append(raw)
+            item_lines.append(idx)
+            continue
         stripped = raw.strip()
         if not stripped:
             continue
@@ -497,8 +584,10 @@ def parse_program(text: str, name: str = "program", number: int | None = None) -
             continue
         block = parse_block(idx, raw)
         if block.words or block.n is not None or block.comma or block.stmt is not None or block.comma_expr:
-            blocks.append(block)
-    return Program(name=name, blocks=blocks, number=number)
+            if block.n is not None:
+                labels.setdefault(block.n, []).append(len(blocks))
+            blocks._add(block, idx)
+    return Program(name=name, blocks=blocks, number=number, labels=labels)
 
 
 def parse_programs(text: str, name: str = "program") -> list[Program]:
