@@ -8,11 +8,11 @@ from fieldbus.cia402 import State
 from mlc.nc_link import DriveStatus
 
 
-def drive_status(runner: Any) -> list[DriveStatus]:
+def drive_status(runner: Any, status: Any) -> list[DriveStatus]:
     """The drives' status this cycle. The records are the runner's own, updated in place every cycle
-    (the MLC reads them within the cycle): no new objects per cycle."""
+    (the MLC reads them within the cycle): no new objects per cycle. `status`: the link's
+    `LinkStatus` of this cycle, read once by the runner (None: the link reports none)."""
     n_axes = len(runner.axes)
-    status = runner.link.status() if callable(getattr(runner.link, "status", None)) else None
     out: list[DriveStatus] | None = getattr(runner, "_drive_status", None)
     if out is None or len(out) != len(runner.masters):
         out = [DriveStatus(runner._name(i), spindle=i >= n_axes) for i in range(len(runner.masters))]

@@ -320,14 +320,16 @@ class BenchRunner:
                 self._alarmed_drives.add(i)
                 self._alarm(Alarm(0x0402, f"hardware limit reached on axis {self._name(i)}", line=self.line or None,
                                   axis=self._name(i)))
-        for i in range(n_axes):
-            self.actual[i] = self.scales[i].to_units(self.tx[i].position_actual) + self.origin[i]
+        scales, txs = self.scales, self.tx
+        self.actual[:] = [scales[i].to_units(txs[i].position_actual) + o for i, o in enumerate(self.origin.tolist())]
         ch = self.channel if not self._planner_failed else None  # a failed NC is not stepped again
         if ch is not None:
+            # The link's state is read once per cycle: the drive status and the bus relays share it.
+            status = self.link.status() if callable(getattr(self.link, "status", None)) else None
             if hasattr(self.mlc, "bus_feedback"):  # drive status for the MLC's special M/D (issue 8)
-                self.mlc.bus_feedback(drive_status(self))
-            if hasattr(self.mlc, "bus_status") and callable(getattr(self.link, "status", None)):
-                self.mlc.bus_status(self.link.status())  # M30000 / EIO relays from the bus state (issue 6)
+                self.mlc.bus_feedback(drive_status(self, status))
+            if hasattr(self.mlc, "bus_status") and status is not None:
+                self.mlc.bus_status(status)  # M30000 / EIO relays from the bus state (issue 6)
             self.mlc.scan(ch)
             self._skip_probe(ch)
             sp = ch.step()
@@ -338,10 +340,12 @@ class BenchRunner:
                 self._begin_quick_stop()  # E-stop: stop category 1, the drives brake on their own ramp
             elif self._braking and not ch.emergency and not self._planner_failed:
                 self._reenable(ch)  # E-stop released and reset: servo on again where the axes stand
+        following = ch is not None and not self._braking
+        cmds, org, max_ferr = self._commands.tolist(), self.origin.tolist(), self.result.max_ferr
         for i in range(n_axes):
             m, rx = self.masters[i], self.rx[i]
-            if m.enabled and ch is not None and not self._braking:
-                rx.target_position = self.scales[i].to_counts(self._commands[i] - self.origin[i])
+            if following and m.enabled:
+                rx.target_position = scales[i].to_counts(cmds[i] - org[i])
             elif self._braking and self.tx[i].statusword & 0x6F == 0x27:
                 # Until the drive takes its quick stop, the setpoint goes on at the speed it had:
                 # a setpoint that stopped dead would brake harder than the drive's own ramp.
@@ -351,9 +355,9 @@ class BenchRunner:
                 # Not enabled: follow the actual position so enabling never jumps.
                 rx.target_position = self.tx[i].position_actual
                 self._commands[i] = self.actual[i]
-            ferr = abs(self.scales[i].to_units(self.tx[i].following_error))
-            if ferr > self.result.max_ferr[self.axes[i]]:
-                self.result.max_ferr[self.axes[i]] = ferr
+            ferr = abs(scales[i].to_units(txs[i].following_error))
+            if ferr > max_ferr[self.axes[i]]:
+                max_ferr[self.axes[i]] = ferr
         for k, sc in enumerate(self.scales[n_axes:]):
             if k == 0 and ch is not None:  # G96 speed, override, G50/G92 S clamp (issue 5; decisions A39, 32)
                 rpm = self.spindle_command_rpm()  # the speed is computed once, not also as below
@@ -401,9 +405,9 @@ class BenchRunner:
         row: list = [round(self.time, 9), self.line, self.cycle, self.timing.period, self.timing.late,
                      self._new_alarms()]
         n_axes = len(self.axes)
-        for i in range(n_axes):
+        for i, (cmd, act) in enumerate(zip(self._commands.tolist(), self.actual.tolist())):
             tx, sc = self.tx[i], self.scales[i]
-            row += [float(self._commands[i]), float(self.actual[i]), sc.drive_to_velocity(tx.velocity_actual),
+            row += [cmd, act, sc.drive_to_velocity(tx.velocity_actual),
                     sc.torque_percent(tx.torque_actual), sc.to_units(tx.following_error), tx.statusword]
         for k, sc in enumerate(self.scales[n_axes:]):
             tx = self.tx[n_axes + k]

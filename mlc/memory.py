@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import re
 import struct
+import sys
 from dataclasses import dataclass, field
 from typing import Literal
 
@@ -54,6 +55,14 @@ class DeviceMemory:
     x: bytearray = field(default_factory=lambda: bytearray(XY_SIZE))  # remote inputs, written by the bus
     y: bytearray = field(default_factory=lambda: bytearray(XY_SIZE))  # remote outputs, written by the MLC
 
+    def __post_init__(self) -> None:
+        # Word and byte views of `d` for the per-scan accessors: a memoryview item is a plain int and
+        # costs a third of a numpy scalar read or write; pairs pack straight into the bytes.
+        self.words = memoryview(self.d).cast("B").cast("H")
+        self._b = memoryview(self.d).cast("B")
+        self._low_first = self.word_order == "low-first"
+        self._f32_in_place = self._low_first and sys.byteorder == "little"
+
     # ---- bits ---------------------------------------------------------------------------
     def bit(self, n: int) -> bool:
         return bool(self.m[n])
@@ -86,29 +95,31 @@ class DeviceMemory:
 
     # ---- single words ---------------------------------------------------------------------
     def u16(self, n: int) -> int:
-        return int(self.d[n])
+        return self.words[n]
 
     def s16(self, n: int) -> int:
-        v = int(self.d[n])
+        v = self.words[n]
         return v - 0x10000 if v & 0x8000 else v
 
     def set_u16(self, n: int, value: int) -> None:
         """Stores the low 16 bits; a negative value is kept as its two's complement."""
-        self.d[n] = int(value) & 0xFFFF
+        self.words[n] = int(value) & 0xFFFF
 
     set_s16 = set_u16
 
     # ---- pairs ----------------------------------------------------------------------------
     def _pair(self, n: int) -> tuple[int, int]:
-        lo, hi = int(self.d[n]), int(self.d[n + 1])
-        return (lo, hi) if self.word_order == "low-first" else (hi, lo)
+        w = self.words
+        lo, hi = w[n], w[n + 1]
+        return (lo, hi) if self._low_first else (hi, lo)
 
     def _set_pair(self, n: int, raw: int) -> None:
         lo, hi = raw & 0xFFFF, (raw >> 16) & 0xFFFF
-        if self.word_order == "low-first":
-            self.d[n], self.d[n + 1] = lo, hi
+        w = self.words
+        if self._low_first:
+            w[n], w[n + 1] = lo, hi
         else:
-            self.d[n], self.d[n + 1] = hi, lo
+            w[n], w[n + 1] = hi, lo
 
     def u32(self, n: int) -> int:
         lo, hi = self._pair(n)
@@ -124,10 +135,15 @@ class DeviceMemory:
     set_s32 = set_u32
 
     def f32(self, n: int) -> float:
+        if self._f32_in_place and 0 <= n < D_SIZE - 1:  # the low word at n: the float's bytes in place
+            return _F32.unpack_from(self._b, 2 * n)[0]
         return _F32.unpack(_U32.pack(self.u32(n)))[0]
 
     def set_f32(self, n: int, value: float) -> None:
-        self._set_pair(n, _U32.unpack(_F32.pack(float(value)))[0])
+        if self._f32_in_place and 0 <= n < D_SIZE - 1:
+            _F32.pack_into(self._b, 2 * n, float(value))
+        else:
+            self._set_pair(n, _U32.unpack(_F32.pack(float(value)))[0])
 
     # ---- by name --------------------------------------------------------------------------
     def get(self, address: str) -> int:

@@ -212,22 +212,20 @@ class ChannelLink:
 
     def _overrides(self, ch: Channel) -> None:
         """Overrides and program-flow switches are levels: applied whenever they differ from the channel."""
-        x = self.x
-        want = {
-            "feed_override": min(self.mem.u16(d2(x, 2)), 150) / 100.0,  # 0–150 %
-            "rapid_override": self.mem.u16(d2(x, 4)) / 100.0,
-            "spindle_override": self.mem.u16(d2(x, 26)) / 100.0,  # D2x026, applied by the NC (decisions 32)
-            "dry_run": self._m2(5),
-            "single_block": self._m2(8),
-        }
-        for name, value in want.items():
-            if hasattr(ch, name) and getattr(ch, name) != value:
+        w, m, b2 = self.mem.words, self.mem.m, 20000 + 1000 * self.x
+        for name, value in (("feed_override", min(w[b2 + 2], 150) / 100.0),  # 0–150 %
+                            ("rapid_override", w[b2 + 4] / 100.0),
+                            ("spindle_override", w[b2 + 26] / 100.0),  # D2x026, applied by the NC (decisions 32)
+                            ("dry_run", bool(m[b2 + 5])),
+                            ("single_block", bool(m[b2 + 8]))):
+            if getattr(ch, name, value) != value:
                 setattr(ch, name, value)
 
     def _spindle_alarm(self, ch: Channel) -> None:
         m, prev = self.mem.m, self._prev
-        for k in range(8):
-            a = m2(self.x, 711 + 16 * k)
+        first = m2(self.x, 711)
+        for a in range(first, first + 16 * 8, 16):  # M2x711, M2x727, … (spindles 1–8)
+            k = (a - first) // 16
             if not m[a] and not prev.get(a, False):
                 continue  # low now and before: no edge, nothing to remember (what _rising would find)
             if self._rising(a):
@@ -329,7 +327,7 @@ class ChannelLink:
         self._handshake_output(ch)
         self._css_output(ch)
         state = ch.state
-        held = state.name == "HOLD"
+        held = state is RunState.HOLD
         running = state in (RunState.RUNNING, RunState.WAIT_AUX) and self._system_hold is None
         m[b3 + 16] = 1 if running else 0
         m[b3 + 17] = 1 if held else 0
@@ -341,7 +339,7 @@ class ChannelLink:
         m[b3 + 31] = 1 if getattr(ch, "interrupt_active", False) else 0  # M3x031: M96 in execution
         m[b3 + 25] = 1 if state is RunState.ALARM or any(not isinstance(a.code, str) for a in self.alarms) else 0
         m[b3 + 40] = 1 if mem.active_alarms() else 0
-        block_stop = state.name == "BLOCK_STOP"
+        block_stop = state is RunState.BLOCK_STOP
         m[b3 + 24] = m[b3 + 39] = 1 if block_stop else 0
         if state is RunState.FINISHED and ch.end is not None and self._program_end is None:
             self._program_end = ch.end.code
@@ -431,16 +429,17 @@ class ChannelLink:
             m[b3 + 464 + k] = 1 if abs(v) > 1e-4 else 0  # moving
             m[b3 + 480 + k] = 1 if v > 1e-4 else 0
             m[b3 + 496 + k] = 1 if v < -1e-4 else 0
+        w, set_f32 = mem.words, mem.set_f32  # D30240… written as words into the memory itself
         for k, d in enumerate((axes + spindles)[:32]):
             torque = int(round(d.torque))
-            mem.set_s16(d3(0, 240 + k), torque)
-            mem.set_f32(d3(0, 272 + 2 * k), d.velocity * 60.0)
-            mem.set_f32(d3(0, 336 + 2 * k), d.rpm)
-            peak = d3(0, 400 + k)
-            mem.set_u16(peak, max(mem.u16(peak), min(abs(torque), 0xFFFF)) if d.servo_on else 0)
+            w[30240 + k] = torque & 0xFFFF  # s16
+            set_f32(30272 + 2 * k, d.velocity * 60.0)
+            set_f32(30336 + 2 * k, d.rpm)
+            peak = 30400 + k
+            w[peak] = max(w[peak], min(abs(torque), 0xFFFF)) if d.servo_on else 0
         for k, d in enumerate(spindles[:8]):
             m[b3 + 96 + k] = 1 if d.connected else 0
-            mem.set_s16(d3(0, 432 + k), int(round(d.torque)))
+            w[30432 + k] = int(round(d.torque)) & 0xFFFF
             base = b3 + 704 + 16 * k
             cmd = self.commanded_rpm(k)
             if k == 0:  # what the drive is really given: G96, override, G50 clamp

@@ -208,6 +208,55 @@ class Cia402Drive:
         csp, csv = enabled and self.mode == 8, enabled and self.mode == 9
         profile = enabled and self.mode in PROFILE_MODES  # PP, PV, HM, CST: virtual_bus/drive_modes.py
         direct = profile and self.mode == CST  # torque mode: the velocity is the motor's, no velocity loop
+        if energised and (csp or csv) and not limited:
+            self._step_following(n, h, prev, target, ff_vel, max_cps, alpha, csp, probing)
+        else:
+            self._step_general(n, h, prev, target, ff_vel, max_cps, alpha, energised, csp, csv, profile, direct,
+                               limited, probing)
+        self.acceleration = (self.velocity - v_before) / dt
+        rad = self._counts_to_rad
+        torque_nm = (p.inertia * self.acceleration * rad + p.viscous * self.velocity * rad
+                     + (math.copysign(p.coulomb, self.velocity) if abs(self.velocity) > 1 else 0.0))
+        self.torque = torque_nm / p.rated_torque * 1000.0 if energised else 0.0
+        self._supervise()
+
+    def _step_following(self, n: int, h: float, prev: float, target: float, ff_vel: float, max_cps: float,
+                        alpha: float, csp: bool, probing: bool) -> None:
+        """The usual cycle: an enabled drive following CSP setpoints (or its CSV ramp) with no limit
+        switches. The same arithmetic, in the same order, as _step_general, on local variables: the
+        sub-steps are where the bench's drive time goes (issue 17)."""
+        p = self.params
+        pos, vel, t = self.position, self.velocity, self.time
+        kff_ff, kp, span = p.kff * ff_vel, p.kp, target - prev
+        ramp, want, tv = p.csv_accel * h, self._want_cps, self.target_velocity
+        for k in range(1, n + 1):
+            if csp:
+                cmd = prev + span * k / n
+                v_cmd = kff_ff + kp * (cmd - pos)
+            else:
+                tv += max(-ramp, min(ramp, want - tv))
+                v_cmd, cmd = tv, pos  # CSV: the command follows the actual position
+            if not -max_cps <= v_cmd <= max_cps:
+                v_cmd = max(-max_cps, min(max_cps, v_cmd))
+            if v_cmd != vel:
+                vel += (v_cmd - vel) * alpha
+            new_pos = pos + vel * h
+            if probing:
+                self._probe(pos, new_pos)
+            pos = new_pos
+            t += h
+        if not csp:
+            self.target_velocity = tv
+        self.command = cmd
+        self.position, self.velocity, self.time = pos, vel, t
+        self._no_limit()
+        if not probing:
+            self._probe_latched = False
+
+    def _step_general(self, n: int, h: float, prev: float, target: float, ff_vel: float, max_cps: float,
+                      alpha: float, energised: bool, csp: bool, csv: bool, profile: bool, direct: bool,
+                      limited: bool, probing: bool) -> None:
+        p = self.params
         for k in range(1, n + 1):
             if not energised:
                 # Brake engaged / motor free: friction stops it within a few ms.
@@ -244,12 +293,6 @@ class Cia402Drive:
                 self._probe_latched = False
             self.position = new_pos
             self.time += h
-        self.acceleration = (self.velocity - v_before) / dt
-        rad = self._counts_to_rad
-        torque_nm = (p.inertia * self.acceleration * rad + p.viscous * self.velocity * rad
-                     + (math.copysign(p.coulomb, self.velocity) if abs(self.velocity) > 1 else 0.0))
-        self.torque = torque_nm / p.rated_torque * 1000.0 if energised else 0.0
-        self._supervise()
 
     def _no_limit(self) -> None:
         """_limit on a drive without limit switches: only a stale limit alarm code is cleared."""
