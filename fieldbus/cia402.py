@@ -70,11 +70,18 @@ STATE_BITS: dict[State, int] = {
 }
 
 
-def decode_state(statusword: int) -> State:
+def _decode(statusword: int) -> State:
     for mask, value, state in _DECODE:
         if statusword & mask == value:
             return state
     return State.NOT_READY_TO_SWITCH_ON
+
+
+_DECODED = tuple(_decode(sw) for sw in range(0x80))  # the masks read bits 0-6 only: one table lookup a cycle
+
+
+def decode_state(statusword: int) -> State:
+    return _DECODED[statusword & 0x7F]
 
 
 def command_of(controlword: int) -> str:

@@ -460,11 +460,11 @@ class ChannelLink:
         from D2x024 when M2x710 is ON. The spindle override D2x026 is not in it: the NC applies it
         with the G96 speed and the clamps (`nc.motion.css.spindle_speed`, motion decisions 32)."""
         x, mem = self.x, self.mem
-        base = 704 + 16 * k
-        fwd, rev = mem.bit(m2(x, base)), mem.bit(m2(x, base + 1))
+        m, base = mem.m, m2(x, 704 + 16 * k)
+        fwd, rev = bool(m[base]), bool(m[base + 1])
         if fwd == rev:
             return 0.0
-        src = (mem.u32(d2(x, 24)) if mem.bit(m2(x, base + 6)) else mem.f32(d3(x, 24))) if k == 0 else 0.0
+        src = (mem.u32(d2(x, 24)) if m[base + 6] else mem.f32(d3(x, 24))) if k == 0 else 0.0
         rpm = min(abs(src), self.spindle_max_rpm)
         return rpm if fwd else -rpm
 

@@ -27,6 +27,19 @@ AL_FORWARD_LIMIT = 0x0015
 AL_EMERGENCY = 0x0013
 
 
+def _status_base(state: State) -> int:
+    """The statusword bits a state always shows (0x6041: state, remote, voltage, quick stop)."""
+    sw = STATE_BITS[state] | SW_REMOTE
+    if state not in (State.SWITCH_ON_DISABLED, State.NOT_READY_TO_SWITCH_ON):
+        sw |= SW_VOLTAGE
+    if state is not State.QUICK_STOP_ACTIVE and state is not State.FAULT:
+        sw |= SW_QUICK_STOP
+    return sw
+
+
+_STATUS_BASE = {s: _status_base(s) for s in State}
+
+
 @dataclass
 class DriveParams:
     counts_per_rev: int = 1_280_000
@@ -89,31 +102,30 @@ class Cia402Drive:
             self.modes.apply(self, rx.controlword, rx.target_position, rx.target_torque)
 
     def feedback(self) -> TxPdo:
-        sw = STATE_BITS[self.state] | SW_REMOTE
-        if self.state not in (State.SWITCH_ON_DISABLED, State.NOT_READY_TO_SWITCH_ON):
-            sw |= SW_VOLTAGE
-        if self.state is not State.QUICK_STOP_ACTIVE:
-            sw |= SW_QUICK_STOP if self.state is not State.FAULT else 0
-        if self.state is State.OPERATION_ENABLED:
-            if self.mode in PROFILE_MODES:
+        p, state, mode = self.params, self.state, self.mode
+        sw = _STATUS_BASE[state]
+        gap = self.command - self.position
+        profile = mode in PROFILE_MODES
+        if state is State.OPERATION_ENABLED:
+            if profile:
                 sw |= self.modes.status_bits(self)
             else:
                 sw |= SW_FOLLOWING
-                if abs(self.velocity) < 0.001 * self._max_cps and abs(self.command - self.position) < 10:
+                if abs(self.velocity) < 0.001 * (p.max_speed_rpm / 60.0 * p.counts_per_rev) and abs(gap) < 10:
                     sw |= SW_TARGET_REACHED
-        if self._limit_flags and self.mode != HM:  # homing on a limit switch is no limit violation
-            sw |= SW_INTERNAL_LIMIT
-        if abs(self.command - self.position) > self.params.following_error_window and self.mode not in PROFILE_MODES:
-            sw |= SW_FOLLOWING_ERROR
         di = self._limit_flags
-        if self.params.home_switch is not None and self.position < self.params.home_switch:
+        if di and mode != HM:  # homing on a limit switch is no limit violation
+            sw |= SW_INTERNAL_LIMIT
+        if abs(gap) > p.following_error_window and not profile:
+            sw |= SW_FOLLOWING_ERROR
+        if p.home_switch is not None and self.position < p.home_switch:
             di |= 0x4
         return TxPdo(
             statusword=sw,
             position_actual=int(round(self.position + self.modes.origin)),
-            velocity_actual=self.params.units.velocity_to_raw(self.velocity, self.params.counts_per_rev),
-            torque_actual=int(round(self.torque * 0.1 / self.params.units.torque_percent)),
-            following_error=int(round(self.command - self.position)) if self.mode == 8 else 0,
+            velocity_actual=p.units.velocity_to_raw(self.velocity, p.counts_per_rev),
+            torque_actual=int(round(self.torque * 0.1 / p.units.torque_percent)),
+            following_error=int(round(gap)) if mode == 8 else 0,
             error_code=self.error_code,
             mode_display=self.mode,
             touch_probe_status=0x0003 if self._probe_latched else (0x0001 if self._rx.touch_probe_function & 1 else 0),
@@ -128,6 +140,8 @@ class Cia402Drive:
 
     # ---- state machine ------------------------------------------------------------------
     def _state_machine(self, cw: int) -> None:
+        if cw == self._last_cw and cw & 0x8F == 0x0F and self.state is State.OPERATION_ENABLED:
+            return  # enable operation held while enabled, the usual cycle: no transition, no edge
         cmd = command_of(cw)
         rising_reset = bool(cw & 0x80) and not (self._last_cw & 0x80)
         self._last_cw = cw
