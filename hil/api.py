@@ -206,43 +206,45 @@ def run(program: str | Path, bench: str | Path | Bench | None = None, *, bus: st
         fd, trace_path = tempfile.mkstemp(prefix="hil-run-", suffix=".parquet")
         os.close(fd)
     cap = None
+    from hil.stop_signals import stop_on_signals
+
     try:
-        if capture:
-            cap = _open_capture(str(capture), link, b)
-        if trace_path:
-            from hil.trace_meta import column_units, run_meta
+        # Signals are taken from before the trace is opened: opening it warms pyarrow up (≈ 0.5 s,
+        # longer on a loaded machine), and a Ctrl-C then must still end through the stop path.
+        with stop_on_signals(runner):
+            if capture:
+                cap = _open_capture(str(capture), link, b)
+            if trace_path:
+                from hil.trace_meta import column_units, run_meta
 
-            columns = runner.trace_columns()
+                columns = runner.trace_columns()
+                try:
+                    runner.trace = open_trace(trace_path, columns, run_meta(b, str(program)), column_units(columns, b))
+                except OSError as exc:
+                    raise InputError(f"cannot write trace {trace_path}: {exc.strerror}") from None
+            if scope is not None:  # the live scope reads the rows the trace is written from
+                try:
+                    runner.trace = scope.attach(runner.trace, runner.trace_columns())
+                except ValueError as exc:
+                    if runner.trace is not None:
+                        runner.trace.discard()
+                    raise InputError(str(exc)) from None
+            if servo_modbus:  # G10 L40/L41 over the drives' RS-485 port (issue 8)
+                import serial
+
+                from fieldbus.modbus import ModbusRtuMaster
+
+                try:
+                    runner.servo_modbus = ModbusRtuMaster.open(servo_modbus, baudrate=servo_baud)
+                except (serial.SerialException, OSError) as exc:
+                    if runner.trace is not None:
+                        runner.trace.discard()
+                    raise InputError(f"cannot open {servo_modbus}: {exc}") from None
             try:
-                runner.trace = open_trace(trace_path, columns, run_meta(b, str(program)), column_units(columns, b))
-            except OSError as exc:
-                raise InputError(f"cannot write trace {trace_path}: {exc.strerror}") from None
-        if scope is not None:  # the live scope reads the rows the trace is written from
-            try:
-                runner.trace = scope.attach(runner.trace, runner.trace_columns())
-            except ValueError as exc:
-                if runner.trace is not None:
-                    runner.trace.discard()
-                raise InputError(str(exc)) from None
-        if servo_modbus:  # G10 L40/L41 over the drives' RS-485 port (issue 8)
-            import serial
-
-            from fieldbus.modbus import ModbusRtuMaster
-
-            try:
-                runner.servo_modbus = ModbusRtuMaster.open(servo_modbus, baudrate=servo_baud)
-            except (serial.SerialException, OSError) as exc:
-                if runner.trace is not None:
-                    runner.trace.discard()
-                raise InputError(f"cannot open {servo_modbus}: {exc}") from None
-        from hil.stop_signals import stop_on_signals
-
-        try:
-            with stop_on_signals(runner):
                 result = runner.run_program(prog)
-        finally:
-            if servo_modbus:
-                runner.servo_modbus.close()
+            finally:
+                if servo_modbus:
+                    runner.servo_modbus.close()
         checks = _checks(trace_path, b, prog) if trace_path and want_checks else []
     finally:
         if temporary and trace_path:
