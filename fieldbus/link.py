@@ -107,12 +107,15 @@ class SimLink:
     # SDO to a simulated slave's object dictionary (Delta servo parameters 0x2000+); same signature
     # as EthercatLink.sdo_read / sdo_write.
     def sdo_read(self, position: int, index: int, sub: int = 0, size: int = 0) -> bytes:
-        return self._object_dictionary(position).sdo_read(index, sub)
+        return self._object_dictionary(position, index, sub).sdo_read(index, sub)
 
     def sdo_write(self, position: int, index: int, sub: int, data: bytes, complete: bool = False) -> None:
-        self._object_dictionary(position).sdo_write(index, sub, data)
+        self._object_dictionary(position, index, sub).sdo_write(index, sub, data)
 
-    def _object_dictionary(self, position: int) -> Any:
+    def _object_dictionary(self, position: int, index: int = 0, sub: int = 0) -> Any:
+        modes = getattr(self.slaves[position], "modes", None)  # CiA 402 profile-mode objects (homing, PP …)
+        if modes is not None and modes.holds(index, sub):
+            return modes
         od = getattr(self.slaves[position], "servo_params", None)
         if od is None:
             raise ValueError(f"slave {position} ({self.slaves[position].name}) has no object dictionary")

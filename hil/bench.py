@@ -7,6 +7,7 @@ from typing import TYPE_CHECKING
 
 from fieldbus.units import AxisScaling
 from nc.motion.limits import AxisLimits, MotionConfig
+from hil.drive_homing import DriveHoming
 from virtual_bus.drive import DriveParams
 
 if TYPE_CHECKING:  # mlc.memory pulls numpy: `hil path` starts without it (issue 16)
@@ -25,6 +26,7 @@ class AxisConfig:
     drive_model: str = "asda-a3-e"  # fieldbus.devices.MODELS: the identity its virtual EtherCAT slave presents
     drive_esi: str = ""  # a vendor ESI file the virtual EtherCAT slave is built from ("" = the packaged one)
     canopen_eds: str = ""  # the drive's EDS/DCF on a CANopen bus; "" = Bench.canopen_eds or the shipped ASDA-B3
+    homing: DriveHoming | None = None  # drive homing (CiA 402 mode 6) before every program (hil/drive_homing.py)
 
 
 @dataclass

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 import tomllib
-from dataclasses import fields
+from dataclasses import fields, replace
 from pathlib import Path
 from typing import Any
 
@@ -20,10 +20,12 @@ from fieldbus.devices import DEFAULT_MODEL, MODELS
 from fieldbus.units import AxisScaling
 from hil.bench_params import check_param
 from hil.bench import AxisConfig, Bench, ChecksConfig, IoStationConfig, RealtimeConfig, SpindleConfig
+from hil.drive_homing import DriveHoming
 from hil.session import InputError
 from nc.motion.limits import AxisLimits
 from nc.profiles import PROFILE_NAMES
 from virtual_bus.drive import DriveParams
+from virtual_bus.drive_modes import HOMING_METHODS
 
 AXIS_LETTERS = "XYZABCUVW"
 CIA301_BITRATES = (10_000, 20_000, 50_000, 125_000, 250_000, 500_000, 800_000, 1_000_000)  # CiA 301 bit timing table
@@ -294,6 +296,14 @@ def _scaling(r: _Reader, d: dict, p: str, default_lead: float) -> AxisScaling:
                        lead=lead or default_lead, direction=direction or 1)
 
 
+def _for_model(scaling: AxisScaling, model: str, cpr_given: bool, model_named: bool) -> AxisScaling:
+    """The drive model's units, and its default resolution where the bench names the model but gives no
+    `counts_per_rev` (decisions E17; a bench naming neither keeps the generic 1 280 000 PUU/rev)."""
+    m = MODELS[model]
+    cpr = m.counts_per_rev if model_named and not cpr_given else scaling.counts_per_rev
+    return replace(scaling, counts_per_rev=cpr, units=m.units)
+
+
 def _drive(r: _Reader, d: Any, p: str, base: DriveParams) -> tuple[DriveParams, str, str]:
     """The drive table: tuning, `model` (fieldbus.devices.MODELS) and `esi` (a vendor ESI file the
     virtual EtherCAT slave is built from instead of the packaged one; the model's product code picks
@@ -343,6 +353,7 @@ def _axis(r: _Reader, d: dict, p: str) -> AxisConfig | None:
     if name is not None and name in "ABC" and units != "deg":  # the NC treats A/B/C as rotary (degrees)
         r.err(f"{p}.units", f"{name} is a rotary axis: units must be \"deg\", got {units!r}"
                             + nc5(0x0C05 if name == "C" else 0x141C))
+    cpr_given, model_named = "counts_per_rev" in d, isinstance(d.get("drive"), dict) and "model" in d["drive"]
     scaling = _scaling(r, d, p, 360.0 if units == "deg" else 10.0)
     start = r.number(d, "start", f"{p}.start", 0.0, minimum=-1e6, maximum=1e6) or 0.0
     soft = r.pair(d, "soft_limits", f"{p}.soft_limits", integers=False, positive=False)
@@ -361,14 +372,38 @@ def _axis(r: _Reader, d: dict, p: str) -> AxisConfig | None:
                                           ("jerk", base.max_jerk))))
     r.unknown(lim, f"{p}.limits.", {"velocity", "acceleration", "jerk"})
     drive, model, esi = _drive(r, d.pop("drive", {}), f"{p}.drive", DriveParams())
+    scaling = _for_model(scaling, model, cpr_given, model_named)
     eds = r.eds(d, f"{p}.canopen_eds", ASDA_CSP)
+    homing = _homing(r, d, f"{p}.homing")
     r.unknown(d, f"{p}.", {"name", "units", "counts_per_rev", "ratio", "lead", "direction", "start", "soft_limits",
-                           "limits", "drive", "canopen_eds"})
+                           "limits", "drive", "canopen_eds", "homing"})
     if name is None:
         return None
     return AxisConfig(name, scaling, limits, drive, start=start, units=units,
                       soft_limits=(float(soft[0]), float(soft[1])) if soft else None, drive_model=model,
-                      canopen_eds=eds, drive_esi=esi)
+                      canopen_eds=eds, drive_esi=esi, homing=homing)
+
+
+def _homing(r: _Reader, d: dict, p: str) -> DriveHoming | None:
+    """An axis's `homing` table: drive homing (CiA 402 mode 6) before every program (hil/drive_homing.py)."""
+    if "homing" not in d:
+        return None
+    h = r.table(d, "homing", p)
+    method = r.integer(h, "method", f"{p}.method", None, choices=HOMING_METHODS)
+    if method is None and not any(e.startswith(f"{p}.method") for e in r.errors):
+        r.err(f"{p}.method", f"missing: a CiA 402 homing method ({', '.join(map(str, HOMING_METHODS))})")
+    base = DriveHoming(0)
+    out = DriveHoming(method or 0,
+                      r.number(h, "position", f"{p}.position", base.position, minimum=-1e6, maximum=1e6) or 0.0,
+                      r.number(h, "switch_rpm", f"{p}.switch_rpm", base.switch_rpm, positive=True, maximum=10000)
+                      or base.switch_rpm,
+                      r.number(h, "zero_rpm", f"{p}.zero_rpm", base.zero_rpm, positive=True, maximum=10000)
+                      or base.zero_rpm,
+                      r.integer(h, "accel_ms", f"{p}.accel_ms", base.accel_ms, positive=True, maximum=65500)
+                      or base.accel_ms,
+                      r.number(h, "timeout", f"{p}.timeout", base.timeout, positive=True, maximum=3600) or base.timeout)
+    r.unknown(h, f"{p}.", {"method", "position", "switch_rpm", "zero_rpm", "accel_ms", "timeout"})
+    return out if method is not None else None
 
 
 def _spindle(r: _Reader, d: dict, p: str) -> SpindleConfig | None:
@@ -376,6 +411,7 @@ def _spindle(r: _Reader, d: dict, p: str) -> SpindleConfig | None:
     name = r.string(d, "name", f"{p}.name", "S1") or "S1"
     if not (name[0] == "S" and name[1:].isdigit()):
         r.err(f"{p}.name", f"must be S1, S2, ..., got {name!r}" + nc5(0x141A))
+    cpr_given, model_named = "counts_per_rev" in d, isinstance(d.get("drive"), dict) and "model" in d["drive"]
     cpr = r.integer(d, "counts_per_rev", f"{p}.counts_per_rev", base.scaling.counts_per_rev, positive=True)
     ratio = r.pair(d, "ratio", f"{p}.ratio", integers=True, positive=True) or (1, 1)
     direction = r.integer(d, "direction", f"{p}.direction", 1, choices=(1, -1))
@@ -385,6 +421,7 @@ def _spindle(r: _Reader, d: dict, p: str) -> SpindleConfig | None:
     r.unknown(d, f"{p}.", {"name", "counts_per_rev", "ratio", "direction", "max_rpm", "drive", "canopen_eds"})
     scaling = AxisScaling(counts_per_rev=cpr or base.scaling.counts_per_rev, gear_motor=int(ratio[0]),
                           gear_load=int(ratio[1]), lead=360.0, direction=direction or 1)
+    scaling = _for_model(scaling, model, cpr_given, model_named)
     return SpindleConfig(name, scaling, max_rpm or base.max_rpm, drive, canopen_eds=eds, drive_model=model,
                          drive_esi=esi)
 

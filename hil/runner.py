@@ -17,6 +17,7 @@ from fieldbus.link import BusError, BusLink
 from fieldbus.pdo import RxPdo, TxPdo
 from hil.bench import Bench
 from hil.clock import CycleTiming, LockStepClock, RealTimeClock
+from hil.drive_homing import home_axes
 from hil.mlc_bridge import drive_status
 from hil.trace import TraceSource, TraceWriter, trace_columns
 from mlc.basic import BasicMlc
@@ -141,7 +142,7 @@ class BenchRunner:
             planner = self.make_planner()
             if paced:
                 _quiet_gc()
-            if not self.power_up():
+            if not self.power_up() or not home_axes(self):  # axes with a bench `homing` table: drive homing
                 return self._finish()
             interp.take_position(dict(zip(self.axes, self.actual.tolist())))
             self.run_events(interp.run(program), planner)

@@ -184,4 +184,5 @@ def test_hil_scan_lists_the_canopen_nodes(hil):
     rows = r.out.splitlines()
     assert len(rows) == 3
     assert all("vendor 0x000001DD" in row and "product 0x00006080" in row and " drive " in row for row in rows)
+    assert all("[asda-b3-e: 16777216 counts/rev, velocity 0.1 rpm, torque 0.1 %]" in row for row in rows)
     assert [int(row.split()[0]) for row in rows] == [1, 2, 3]

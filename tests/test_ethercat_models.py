@@ -41,6 +41,37 @@ def test_packaged_file_holds_three_devices_equal_to_the_catalogue():
         assert d.objects[0x1C12].entries[1].value == m.default_rx and d.objects[0x1C13].entries[1].value == m.default_tx
 
 
+def test_resolution_follows_the_named_model(tmp_path):
+    """A bench that names a model and no counts_per_rev converts with the model's default resolution (A3-E/B3-E
+    24-bit: 16 777 216, A2-E: 1 280 000, decisions E11/E17); an explicit counts_per_rev wins; a bench naming no
+    model keeps the generic 1 280 000. The master's conversion uses it: X10 on a 10 mm lead is one motor rev."""
+    from fieldbus.link import SimLink
+    from hil.bench_file import parse_bench
+    from hil.runner import BenchRunner
+    from hil.session import sim_slaves
+    from nc.program import parse_program
+
+    bench = parse_bench('''
+bus = "sim"
+[[axes]]
+name = "X"
+drive = { model = "asda-a3-e" }
+[[axes]]
+name = "Z"
+counts_per_rev = 100000
+drive = { model = "asda-b3-e" }
+[[spindles]]
+drive = { model = "asda-a2-e" }
+''')
+    assert [a.scaling.counts_per_rev for a in bench.axes] == [16_777_216, 100_000]
+    assert bench.spindles[0].scaling.counts_per_rev == 1_280_000
+    assert parse_bench('[[axes]]\nname = "X"\n').axes[0].scaling.counts_per_rev == 1_280_000
+    runner = BenchRunner(bench, SimLink(sim_slaves(bench), bench.cycle))
+    result = runner.run_program(parse_program("G00 U20. W10.\nM30\n"))  # lathe: U on the diameter
+    assert result.ok
+    assert abs(runner.tx[0].position_actual - 16_777_216) <= 2 and abs(runner.tx[1].position_actual - 100_000) <= 2
+
+
 def test_asda_e_fits_every_model():
     """hil's default layout stays within each model's limits: 8 entries, mappable objects only."""
     for m in MODELS.values():
@@ -107,6 +138,9 @@ drive = {{ model = "asda-a2-e" }}
         assert [re.search(r"product 0x([0-9A-F]{8})", row).group(1) for row in rows] == \
             ["00006010", "00006080", "10305070"]
         assert "ASDA-B3-E CoE Drive" in rows[1] and "ASDA-A2-E CoE Drive" in rows[2]
+        # the model's default resolution and units beside each drive (decisions E17)
+        assert "[asda-a3-e: 16777216 counts/rev, velocity 0.1 rpm" in rows[0]
+        assert "[asda-a2-e: 1280000 counts/rev" in rows[2]
         link = EthercatLink(sim.iface, names=["X", "Z", "S1"], complete_access=True)
         link.open()
         try:

@@ -14,10 +14,12 @@ in ms to go from 0 to 3000 rpm, 0x6099 homing speeds in 0.1 rpm, torques in 0.1 
 from __future__ import annotations
 
 import math
+import struct
 from dataclasses import dataclass, field, fields
 from typing import TYPE_CHECKING
 
 from fieldbus.cia402 import SW_FOLLOWING, SW_FOLLOWING_ERROR, SW_TARGET_REACHED
+from virtual_bus.servo_params import ServoParamError  # an SDO refused, with its abort code (.code)
 
 if TYPE_CHECKING:
     from virtual_bus.drive import Cia402Drive
@@ -71,6 +73,14 @@ MODE_OBJECTS: dict[tuple[int, int], str] = {
     (0x6091, 1): "gear_motor", (0x6091, 2): "gear_shaft", (0x605A, 0): "quick_stop_option",
 }
 assert set(MODE_OBJECTS.values()) == {f.name for f in fields(ModeObjects)}
+# their CoE/CANopen data types, as struct formats (the packaged ESI and EDS give the same)
+FORMATS: dict[tuple[int, int], str] = {
+    (0x6081, 0): "<I", (0x6083, 0): "<I", (0x6084, 0): "<I", (0x607C, 0): "<i", (0x6098, 0): "<b",
+    (0x6099, 1): "<I", (0x6099, 2): "<I", (0x609A, 0): "<I", (0x6072, 0): "<H", (0x60E0, 0): "<H",
+    (0x60E1, 0): "<H", (0x607D, 1): "<i", (0x607D, 2): "<i", (0x6091, 1): "<I", (0x6091, 2): "<I", (0x605A, 0): "<h",
+}
+ABORT_VALUE_RANGE = 0x06090030
+ABORT_TYPE_LENGTH = 0x06070010
 
 
 def check_value(index: int, sub: int, value: int, objects: ModeObjects) -> bool:
@@ -144,6 +154,22 @@ class DriveModes:
     _cw: int = 0
     _seen: float = 0.0  # HM: the encoder position at the previous sub-step
     _fresh: bool = True  # the generator starts from the drive's actual state
+
+    # ---- SDO on the in-process bench (SimLink); the buses keep their own object dictionaries --------
+    def holds(self, index: int, sub: int) -> bool:
+        return (index, sub) in MODE_OBJECTS
+
+    def sdo_read(self, index: int, sub: int = 0) -> bytes:
+        return struct.pack(FORMATS[(index, sub)], getattr(self.objects, MODE_OBJECTS[(index, sub)]))
+
+    def sdo_write(self, index: int, sub: int, data: bytes) -> None:
+        fmt = FORMATS[(index, sub)]
+        if len(data) != struct.calcsize(fmt):
+            raise ServoParamError(ABORT_TYPE_LENGTH, f"object 0x{index:04X}:{sub}: {len(data)} data bytes")
+        value = struct.unpack(fmt, data)[0]
+        if not check_value(index, sub, value, self.objects):
+            raise ServoParamError(ABORT_VALUE_RANGE, f"object 0x{index:04X}:{sub}: {value} is not taken")
+        setattr(self.objects, MODE_OBJECTS[(index, sub)], value)
 
     def reset(self) -> None:
         """Power-on (CANopen Reset Node): the objects back to their defaults, the origin lost."""

@@ -41,14 +41,25 @@ def cmd_scan(args: argparse.Namespace) -> int:
     except BusError as exc:
         print_alarm(exc.alarm, args.json)
         return EXIT_ALARM
+    from fieldbus.devices import model_by_identity
+
     for s in slaves:
+        # A drive hil knows by its identity: the model's default resolution and units (decisions E17), what a
+        # bench naming that model without counts_per_rev converts with.
+        m = model_by_identity(s.vendor_id, s.product_code) if s.kind == "drive" else None
         if args.json:
             print(strict_json.dumps({"position": s.position, "vendor": f"0x{s.vendor_id:08X}",
                               "product": f"0x{s.product_code:08X}", "name": s.name, "kind": s.kind,
-                              "state": s.state} | ({"modules": s.layout} if s.kind == "io" and s.layout else {})))
+                              "state": s.state} | ({"modules": s.layout} if s.kind == "io" and s.layout else {})
+                                    | ({"model": m.key, "counts_per_rev": m.counts_per_rev,
+                                        "velocity_unit": m.units.velocity,
+                                        "torque_unit_percent": m.units.torque_percent} if m else {})))
         else:
+            model = (f"  [{m.key}: {m.counts_per_rev} counts/rev, velocity {m.units.velocity}, "
+                     f"torque {m.units.torque_percent:g} %]") if m else ""
             print(f"{s.position:3d}  vendor 0x{s.vendor_id:08X}  product 0x{s.product_code:08X}  "
-                  f"{s.state:8s} {s.kind:5s}  {s.name}" + (f"  [{s.layout}]" if s.kind == "io" and s.layout else ""))
+                  f"{s.state:8s} {s.kind:5s}  {s.name}" + (f"  [{s.layout}]" if s.kind == "io" and s.layout else "")
+                  + model)
     return EXIT_OK
 
 

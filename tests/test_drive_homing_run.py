@@ -1,0 +1,110 @@
+"""`hil run` homes the axes whose bench entry has a `homing` table (issue 23): each drive runs its own CiA 402
+homing (mode 6) before the program, the home position becomes the bench's machine position, and the program then
+moves in those coordinates. A drive that cannot home stops the run with an alarm before the program starts."""
+
+from __future__ import annotations
+
+import csv
+
+import pytest
+
+CPU = 128_000  # counts per mm: 1 280 000 counts/rev, 10 mm lead
+BENCH = """
+name = "homing"
+bus = "{bus}"
+cycle_ms = 1.0
+[[axes]]
+name = "X"
+lead = 10.0
+[[axes]]
+name = "Z"
+lead = 10.0
+counts_per_rev = 1280000
+start = 60.0
+drive = {{ home_switch = {edge}{limit} }}
+homing = {{ method = {method}, position = 2.5, switch_rpm = 300, zero_rpm = 30 }}
+"""
+PROGRAM = "G90 G00 Z10.\nM30\n"
+
+
+def _run(hil, program, tmp_path, bus="sim", method=21, limit=""):
+    bench = tmp_path / "bench.toml"
+    bench.write_text(BENCH.format(bus=bus, edge=40 * CPU, method=method, limit=limit))
+    trace = tmp_path / "t.csv"
+    r = hil("run", program(PROGRAM), "--bench", bench, "--trace", trace)
+    return r, list(csv.DictReader(trace.open())) if trace.exists() else []
+
+
+@pytest.mark.parametrize("bus", ["sim", pytest.param("canopen:virtual", marks=pytest.mark.slow)])  # slow: 10 s under load
+def test_run_homes_z_on_its_switch_before_the_program(hil, program, tmp_path, bus):
+    r, rows = _run(hil, program, tmp_path, bus)
+    assert r.code == 0, r.out + r.err
+    x0 = float(rows[0]["Z_act"])
+    assert x0 == pytest.approx(60.0, abs=1e-3)  # machine position before homing: where the axis stood
+    # The switch edge (40 mm before homing) is now the home position, machine Z = 2.5: the program's Z10
+    # ends 7.5 mm beyond the edge, and the axis went there through the switch and back.
+    assert float(rows[-1]["Z_act"]) == pytest.approx(10.0, abs=1e-3)
+    xs = [float(row["Z_act"]) for row in rows]
+    assert min(xs) < 40.0  # onto the switch (its edge at 40 mm in the power-on coordinates) ...
+    assert any(abs(float(row["Z_act"]) - 2.5) < 0.01 for row in rows)  # ... and back off it onto the home position
+
+
+def test_a_homing_error_stops_the_run_before_the_program(hil, program, tmp_path):
+    # the home switch lies beyond the negative limit switch: the drive meets the limit first (bit 13)
+    r, rows = _run(hil, program, tmp_path, limit=f", negative_limit = {50 * CPU}")
+    assert r.code == 1
+    assert "0xDE11" in r.out + r.err and "homing error" in r.out + r.err
+
+
+def test_bench_refuses_a_homing_method_the_drive_lacks(hil, program, tmp_path):
+    r, _ = _run(hil, program, tmp_path, method=7)
+    assert r.code == 2 and "axes[1].homing.method" in r.out + r.err
+
+
+def test_a_stop_during_homing_brakes_then_disables_at_standstill(tmp_path):
+    """A stop request (a signal) while the drive homes: bit 4 drops (CiA 402: homing interrupted, the drive brakes
+    on the homing acceleration), the runner waits for standstill, then disables; no alarm."""
+    from fieldbus.link import SimLink
+    from hil.bench_file import load_bench_file
+    from hil.runner import BenchRunner
+    from hil.session import sim_slaves
+    from nc.program import parse_program
+
+    path = tmp_path / "bench.toml"
+    path.write_text(BENCH.format(bus="sim", edge=40 * CPU, method=21, limit=""))
+    bench = load_bench_file(path)
+    seen: list[tuple[int, int, int]] = []
+
+    def on_cycle(run: BenchRunner) -> None:
+        seen.append((run.tx[1].statusword, run.tx[1].velocity_actual, run.rx[1].mode))
+        if run.cycle == 60:
+            run.request_stop("SIGINT")
+
+    runner = BenchRunner(bench, SimLink(sim_slaves(bench), bench.cycle), on_cycle=on_cycle)
+    result = runner.run_program(parse_program(PROGRAM))
+    assert result.stopped_by == "SIGINT" and not result.alarms
+    moving = [k for k, (_, v, _) in enumerate(seen) if v]
+    assert seen[59][2] == 6 and abs(seen[59][1]) > 1000  # homing at speed when the stop came
+    disabled = next(k for k, (sw, _, _) in enumerate(seen) if k > 60 and sw & 0x6F != 0x27)
+    assert moving[-1] < disabled  # it stood before it was disabled
+    assert all(sw & 0x3400 == 0x0400 for sw, _, _ in seen[moving[-1]:disabled])  # homing interrupted
+
+
+def test_a_drive_that_refuses_the_method_raises_0x1604(tmp_path):
+    """A drive that aborts the 0x6098 write (a method it lacks: bench files refuse those, a library caller may not)
+    gives App. A 0x1604 "The home mode is not supported" before anything moves."""
+    import dataclasses
+
+    from fieldbus.link import SimLink
+    from hil.bench_file import load_bench_file
+    from hil.runner import BenchRunner
+    from hil.session import sim_slaves
+    from nc.program import parse_program
+
+    path = tmp_path / "bench.toml"
+    path.write_text(BENCH.format(bus="sim", edge=40 * CPU, method=21, limit=""))
+    bench = load_bench_file(path)
+    z = bench.axes[1]
+    bench.axes[1] = dataclasses.replace(z, homing=dataclasses.replace(z.homing, method=7))
+    result = BenchRunner(bench, SimLink(sim_slaves(bench), bench.cycle)).run_program(parse_program(PROGRAM))
+    assert [a.code for a in result.alarms] == [0x1604] and "0x06090030" in result.alarms[0].message
