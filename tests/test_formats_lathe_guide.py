@@ -100,7 +100,7 @@ def test_g09_exact_stop_on_one_block():
 
 # ---- L§2.1 G10 / G11 data setting
 
-def test_g10_l2_l10_l11_l20_l21_data_setting(capsys, tmp_path):
+def test_g10_l2_l10_l11_l20_l21_data_setting():
     """L2.1-12 `G10 L2 P_ X_ Y_ Z_`, L2.1-13 `G10 L10 P_ X/U_ Y/V_ Z/W_ R_ Q_`, L2.1-14
     `G10 L11 P_ X/U_ Y/V_ Z/W_ R_ Q_`, L2.1-15 `G10 L20 P_ X_ Y_ Z_`, L2.1-16 `G10 L21 P_ X_ Y_ Z_`
     (L§2.1 G10 items 1-5): work offset P0-P6, tool length / wear (U V W add), nose radius R and tip Q,
@@ -117,7 +117,7 @@ def test_g10_l2_l10_l11_l20_l21_data_setting(capsys, tmp_path):
     assert (p["soft limit 1 X"], p["soft limit 1 Z"], p["soft limit 2 Z"]) == (100.0, 20.0, -300.0)
 
 
-def test_g10_l30_l1100_l3100_l4100_and_g11(capsys, tmp_path):
+def test_g10_l30_l1100_l3100_l4100_and_g11():
     """L2.1-17 `G10 L30 P_`, L2.1-18 `G10 L1100 R_ S_`, L2.1-19 `G10 L3100 P_`, L2.1-20 `G10 L4100 P_`,
     L2.1-21 `G11;` (L§2.1 G10 items 6-8): spindle positioning offset P in 0.01 degree (G11 L30 back to
     Pr405); R the maximum and S the current spindle speed (one S to the spindle); M2080-M2111 set / cleared
@@ -168,7 +168,7 @@ def test_g30_p2_p3_p4(p):
     assert [_pt(x.end, "XYZ") for x in m[1:]] == [(25.0, 5.0, 20.0), (100.0, 7.0, 200.0)]
 
 
-def test_g31_skip(capsys, tmp_path):
+def test_g31_skip():
     """L2.1-33 `G31 X_Y_Z_F_P_` (L§2.1 G31): a feed move at F toward the point, ended by the skip signal
     (offline: at the end point); its position latched."""
     m = _moves("G00 X0 Y0 Z0\nG31 X10.Y2.Z-5.F100P0\nM30\n")
@@ -208,7 +208,7 @@ def test_g40_g41_g42_tool_nose_compensation(capsys, tmp_path):
     assert right.moves[-1]["work"] == {"X": 40.0, "Z": 5.0} and not right.moves[-1].get("comp")
 
 
-def test_g52_g53_g54_to_g59_coordinates(capsys, tmp_path):
+def test_g52_g53_g54_to_g59_coordinates():
     """L2.1-39 `G52 X_ Y_ Z_`, L2.1-40 `G53 X_ Y_ Z_`, L2.1-41 `G54 X_ Y_ Z_ or`, L2.1-42 `G55 …`, L2.1-43 `G56 …`, L2.1-44 `G57 …`, L2.1-45 `G58 …`,
     L2.1-46 `G59 X_ Y_ Z_`
     (L§2.1): G52 shifts the local origin, G53 moves in machine coordinates for one block, G54-G59 select
@@ -393,13 +393,13 @@ def test_g50_coordinate_setting_and_maximum_spindle_speed():
     assert any(isinstance(e, Aux) and e.kind == "S" and e.value == 1000.0 and e.args.get("max") for e in ev)
 
 
-def test_g98_g99_feed_per_minute_and_per_revolution(capsys, tmp_path):
+def test_g98_g99_feed_per_minute_and_per_revolution():
     """L2.1-78 `G98 G01 X_ Y_ Z_ F_`, L2.1-79 `G99 G01 X_ Y_ Z_ F_` (L§2.1)."""
     m = _moves("G98 G01 X10. Y1. Z-1. F100\nG99 G01 X12. Y2. Z-2. F0.35\nM30\n")
     assert [(x.feed, x.per_rev) for x in m] == [(100.0, False), (0.35, True)]
 
 
-def test_g96_g97_surface_speed_and_rpm(capsys, tmp_path):
+def test_g96_g97_surface_speed_and_rpm():
     """L2.1-80 `G96 S_ (m/min)`, L2.1-81 `G97 S_ (rev/min)` (L§2.1)."""
     from nc.moves import Aux
 

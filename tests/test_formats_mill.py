@@ -119,7 +119,7 @@ def test_g10_l14_registers_the_tool_length_tolerance(capsys, tmp_path):
     assert (r.vars["63001"], r.vars["61002"]) == (0.05, 0.02)
 
 
-def test_g10_l15_registers_the_tool_life(capsys, tmp_path):
+def test_g10_l15_registers_the_tool_life():
     """N3.8.3.5-1 `G10 L15 P_ D_ R_`, N3.8.3.5-2 `[G10] CP` (N§3.8.3.5): the actual life of tool P; D1 adds
     to it, without D the value is set; CP gives it when there is no R."""
     from nc.interp import Interpreter
@@ -138,16 +138,22 @@ def test_g10_l20_registers_an_extended_work_offset(capsys, tmp_path):
     assert r.vars["22077"] == -10.0 and r.machine("X", "Y") == [(-10.0, 20.0)]
 
 
-def test_g10_l21_registers_a_software_limit(capsys, tmp_path):
-    """N3.8.3.7-1 `G10 L21 P_ CP` (N§3.8.3.7): P1 the 1st positive soft limit; a later move beyond it is
-    refused before it starts."""
+def test_g10_l21_registers_a_software_limit():
+    """N3.8.3.7-1 `G10 L21 P_ CP` (N§3.8.3.7): P1 the 1st positive soft limit, P2 the negative; the channel's
+    limit check (nc.softlimits, run by `hil run`) then refuses a move beyond it before it starts (0x0A01)."""
     from nc.interp import Interpreter
+    from nc.moves import Move
     from nc.profiles import make_profile
     from nc.program import parse_program
+    from nc.softlimits import SoftLimits
 
     ip = Interpreter(make_profile("nc5-mill"))
-    list(ip.run(parse_program("G10 L21 P1 X50.\nG10 L21 P2 X-5.\nM30\n")))
+    moves = [e for e in ip.run(parse_program("G10 L21 P1 X50.\nG10 L21 P2 X-5.\nG90 G00 X40.\nX60.\nX-6.\nM30\n"))
+             if isinstance(e, Move)]
     assert (ip.profile.params["soft limit 1 X"], ip.profile.params["soft limit 2 X"]) == (50.0, -5.0)
+    limits = SoftLimits(params=ip.profile.params)
+    found = [limits.check(m) for m in moves]
+    assert found[0] is None and [(a.code, a.axis) for a in found[1:]] == [(0x0A01, "X"), (0x0A01, "X")]
 
 
 def test_g04_p_milliseconds_and_x_seconds(capsys, tmp_path):
@@ -158,16 +164,19 @@ def test_g04_p_milliseconds_and_x_seconds(capsys, tmp_path):
 
 
 def test_g900_p_q_sets_and_clears_an_mlc_relay():
-    """N3.8.5-1 `G900 P_ Q_` (N§3.8.5): P the M relay 30200-30339, Q the value (0 clears, else sets);
-    the block goes to the MLC without waiting for a finish."""
+    """N3.8.5-1 `G900 P_ Q_` (N§3.8.5): P the M relay, Q the value (0 clears, else sets); the block goes to
+    the MLC without waiting for a finish; a P out of range or a missing P/Q ignores the block (notes 1-2).
+    The format table says 30200~30339, App. B (M30200-M30399) 30399: decision C5 in mlc.md takes App. B."""
     from nc.interp import Interpreter
     from nc.moves import Aux
     from nc.profiles import make_profile
     from nc.program import parse_program
 
-    ev = [e for e in Interpreter(make_profile("nc5-mill")).run(parse_program("G900 P30200 Q1\nG900 P30339 Q0\nM30\n"))
+    prog = "G900 P30200 Q1\nG900 P30339 Q0\nG900 P30399 Q-1\nG900 P30400 Q1\nG900 P30201\nG900 Q1\nM30\n"
+    ev = [e for e in Interpreter(make_profile("nc5-mill")).run(parse_program(prog))
           if isinstance(e, Aux) and e.kind == "G900"]
-    assert [(e.value, e.args["Q"], e.wait) for e in ev] == [(30200, 1.0, False), (30339, 0.0, False)]
+    assert [(e.value, e.args["Q"], e.wait) for e in ev] == [(30200, 1.0, False), (30339, 0.0, False),
+                                                          (30399, 1.0, False)]
 
 
 def test_g96_s_constant_surface_speed_and_g97_s_rpm(capsys, tmp_path):
