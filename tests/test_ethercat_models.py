@@ -224,3 +224,35 @@ def test_a_vendor_esi_file_loads(tmp_path):
     assert build_sii(dev)[0x08 * 2 + 4:0x08 * 2 + 8] == (0x6010).to_bytes(4, "little")
     with pytest.raises(ValueError, match="no device with product code 0x00006080"):
         load_device(str(path), 0x6080)
+
+
+ETG2000_FILE = ROOT / "tests" / "data" / "esi" / "Delta_ASDA-E_etg2000.xml"
+
+
+def test_an_etg2000_vendor_file_equals_the_packaged_devices():
+    """A vendor-form file (ETG.2000: <DataTypes>, typed <Objects> with <Info><DefaultData> and <Flags>, <RxPdo>/
+    <TxPdo>, <Dc>, <Eeprom>, <Slots>, and a <Modules> section) holding all three Delta drives: the reader picks
+    each by product code and gives the same object dictionary, entry by entry (value, size, type, access, PDO
+    mapping), and the same SII image as the packaged description; a virtual drive built from it starts with
+    the file's profile-mode defaults."""
+    from virtual_bus.drive import Cia402Drive
+    from virtual_bus.ethercat.app import DriveApp
+    from virtual_bus.ethercat.coe import ObjectDictionary
+    from virtual_bus.ethercat.sii import build_sii
+
+    devices = parse_devices(ETG2000_FILE)
+    assert [(d.vendor_id, d.product_code, d.revision) for d in devices] == \
+        [(m.vendor_id, m.product_code, m.revision) for m in MODELS.values()]
+    for key, m in MODELS.items():
+        ours, theirs = load_device(key), load_device(str(ETG2000_FILE), m.product_code)
+        assert set(theirs.objects) == set(ours.objects)
+        for index, obj in ours.objects.items():
+            for sub, e in obj.entries.items():
+                f = theirs.objects[index].entries[sub]
+                assert (f.value, f.bits, f.dtype, f.signed, f.access, f.pdo) == \
+                    (e.value, e.bits, e.dtype, e.signed, e.access, e.pdo), (key, hex(index), sub)
+        assert build_sii(theirs) == build_sii(ours)
+        app = DriveApp(Cia402Drive())
+        app.attach(ObjectDictionary(theirs))
+        assert app.drive.modes.objects.homing_speed_switch == theirs.objects[0x6099].entries[1].value == 1000
+        assert theirs.objects[0x6502].entries[0].value == 0x3A5
