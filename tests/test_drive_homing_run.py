@@ -8,6 +8,8 @@ import csv
 
 import pytest
 
+from virtual_bus.ethercat.veth import SimProcess, can_create
+
 CPU = 128_000  # counts per mm: 1 280 000 counts/rev, 10 mm lead
 BENCH = """
 name = "homing"
@@ -47,6 +49,22 @@ def test_run_homes_z_on_its_switch_before_the_program(hil, program, tmp_path, bu
     xs = [float(row["Z_act"]) for row in rows]
     assert min(xs) < 40.0  # onto the switch (its edge at 40 mm in the power-on coordinates) ...
     assert any(abs(float(row["Z_act"]) - 2.5) < 0.01 for row in rows)  # ... and back off it onto the home position
+
+
+@pytest.mark.skipif(can_create() is not None, reason=can_create() or "")
+def test_run_homes_z_over_ethercat(hil, program, tmp_path):
+    """The same homing with the drives behind `hil sim ethercat` on a veth pair: the objects go over CoE in OP,
+    mode and controlword in the ASDA_E process data."""
+    bench = tmp_path / "bench.toml"
+    bench.write_text(BENCH.format(bus="sim", edge=40 * CPU, method=21, limit=""))
+    trace = tmp_path / "t.csv"
+    with SimProcess("--bench", str(bench), tag="h") as sim:
+        r = hil("run", program(PROGRAM), "--bench", bench, "--bus", f"ethercat:{sim.iface}", "--trace", trace)
+    assert r.code == 0, r.out + r.err
+    rows = list(csv.DictReader(trace.open()))
+    assert float(rows[0]["Z_act"]) == pytest.approx(60.0, abs=1e-3)
+    assert float(rows[-1]["Z_act"]) == pytest.approx(10.0, abs=1e-3)
+    assert min(float(row["Z_act"]) for row in rows) < 40.0
 
 
 def test_a_homing_error_stops_the_run_before_the_program(hil, program, tmp_path):
