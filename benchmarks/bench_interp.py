@@ -9,7 +9,8 @@ user runs it):
   lathe  a lathe-cycle program run by `hil path` (G71/G70 roughing and finishing, G76 threads); rs274
          gets the same contour as plain moves (it has no Fanuc lathe cycles), so its figure is a
          reference for the line count only.
-Prints seconds, peak MB and the ratio rs274 time / ours (1.0 = as fast as rs274). Figures, never a
+Prints seconds (wall and CPU), peak MB and the ratio rs274 time / ours (1.0 = as fast as rs274), by
+wall clock and by CPU time (the steadier figure on a shared machine). Figures, never a
 pass/fail. rs274 comes with the Debian package linuxcnc-uspace; without it the ratio is skipped.
 """
 
@@ -71,14 +72,15 @@ def lathe_program(parts: int) -> tuple[str, str]:
     return "\n".join(ours) + "\n", "%\n" + "\n".join(theirs) + "\n%\n"
 
 
-def timed(cmd: list[str], env: dict | None = None, cwd: str | None = None) -> tuple[float, float, int]:
-    """Wall seconds, peak RSS in MB of the child, output lines."""
+def timed(cmd: list[str], env: dict | None = None, cwd: str | None = None) -> tuple[float, float, int, float]:
+    """Wall seconds, peak RSS in MB of the child, output lines, CPU seconds (user + system) of the child:
+    on a shared machine the CPU time is the steadier figure."""
     t0 = time.perf_counter()
     p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, env=env, cwd=cwd)
     lines = sum(1 for _ in p.stdout)  # type: ignore[union-attr]
     _, status, usage = os.wait4(p.pid, 0)
     dt = time.perf_counter() - t0
-    return dt, usage.ru_maxrss / 1024.0, lines
+    return dt, usage.ru_maxrss / 1024.0, lines, usage.ru_utime + usage.ru_stime
 
 
 def main() -> int:
@@ -95,6 +97,7 @@ def main() -> int:
     rs274 = shutil.which("rs274")
     env = dict(os.environ, PYTHONPATH=args.tree)
     env.pop("PYTHONUNBUFFERED", None)  # as a user runs it: a syscall per output line is not the interpreter's cost
+    env.pop("PYTHONDONTWRITEBYTECODE", None)  # and with the compiled modules an installed package has
     hil = [sys.executable, "-m", "hil.cli", "path", "--json"]  # run in --tree (cwd below)
     rows = []
     with tempfile.TemporaryDirectory() as d:
@@ -108,22 +111,27 @@ def main() -> int:
             (Path(d) / f"{name}.ngc").write_text(theirs)
             best = min((timed(hil + ["--profile", profiles[name], str(Path(d) / f"{name}.nc")], env, args.tree)
                         for _ in range(args.repeat)), key=lambda r: r[0])
-            row = {"case": name, "hil_s": round(best[0], 3), "hil_peak_mb": round(best[1], 1), "hil_lines": best[2]}
+            row = {"case": name, "hil_s": round(best[0], 3), "hil_cpu_s": round(best[3], 3),
+                   "hil_peak_mb": round(best[1], 1), "hil_lines": best[2]}
             if rs274:
                 ref = min((timed([rs274, "-g", str(Path(d) / f"{name}.ngc")]) for _ in range(args.repeat)),
                           key=lambda r: r[0])
-                row.update(rs274_s=round(ref[0], 3), rs274_peak_mb=round(ref[1], 1), rs274_lines=ref[2],
-                           ratio=round(ref[0] / best[0], 3))
+                row.update(rs274_s=round(ref[0], 3), rs274_cpu_s=round(ref[3], 3), rs274_peak_mb=round(ref[1], 1),
+                           rs274_lines=ref[2], ratio=round(ref[0] / best[0], 3),
+                           cpu_ratio=round(ref[3] / best[3], 3) if best[3] else None)
             rows.append(row)
     if args.json:
         print(json.dumps(rows, indent=1))
         return 0
     if not rs274:
         print("rs274 not found (apt-get install linuxcnc-uspace): deltahil figures only", file=sys.stderr)
-    print(f"{'case':6s} {'hil path s':>10s} {'peak MB':>8s} {'rs274 -g s':>10s} {'peak MB':>8s} {'rs274/ours':>10s}")
+    nan = float("nan")
+    print(f"{'case':6s} {'hil path s':>10s} {'cpu s':>6s} {'peak MB':>8s} {'rs274 -g s':>10s} {'cpu s':>6s} "
+          f"{'peak MB':>8s} {'rs274/ours':>10s} {'(cpu)':>6s}")
     for r in rows:
-        print(f"{r['case']:6s} {r['hil_s']:10.2f} {r['hil_peak_mb']:8.0f} {r.get('rs274_s', float('nan')):10.2f} "
-              f"{r.get('rs274_peak_mb', float('nan')):8.0f} {r.get('ratio', float('nan')):10.3f}")
+        print(f"{r['case']:6s} {r['hil_s']:10.2f} {r['hil_cpu_s']:6.2f} {r['hil_peak_mb']:8.0f} "
+              f"{r.get('rs274_s', nan):10.2f} {r.get('rs274_cpu_s', nan):6.2f} {r.get('rs274_peak_mb', nan):8.0f} "
+              f"{r.get('ratio', nan):10.3f} {r.get('cpu_ratio', nan) or nan:6.3f}")
     print(f"(load average {os.getloadavg()[0]:.1f}: figures on a shared machine)")
     return 0
 

@@ -175,10 +175,16 @@ def _check_second_block(host: Any, code: str, block: Block) -> None:
     if frame is None:
         return
     blocks = frame.program.blocks
-    at = next((i for i, b in enumerate(blocks) if b.line == block.line), None)
+    # the block runs at pc - 1; looked for through the program only when it is not (a program's
+    # blocks are parsed as they are reached, issue 16: a scan of all of them per cycle made long programs quadratic)
+    pc = getattr(frame, "pc", 0) - 1
+    if 0 <= pc < len(blocks) and blocks[pc].line == block.line:
+        at: int | None = pc
+    else:
+        at = next((i for i, b in enumerate(blocks) if b.line == block.line), None)
     if at is None:
         return
-    nxt = next((b for b in blocks[at + 1:] if b.words or b.stmt is not None), None)
+    nxt = next((b for b in (blocks[k] for k in range(at + 1, len(blocks))) if b.words or b.stmt is not None), None)
     try:
         second = nxt is not None and nxt.stmt is None and _explicit(host, nxt, code)
     except (TypeError, ValueError):  # a G word given by an expression: judged when it runs

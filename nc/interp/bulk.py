@@ -94,47 +94,64 @@ def _shape_of(raw: str, shapes: dict, axes: dict[str, int]) -> _Shape | None:
 
 def take(ip: Interpreter, fr: Frame, limit: int) -> MoveBatch | None:
     """The run of bulk lines at `fr.pc` as one batch (and the interpreter's state after it), or None
-    when fewer than MIN_RUN lines qualify: the caller then runs the block the usual way."""
+    when fewer than MIN_RUN lines qualify: the caller then runs the block the usual way. The lines
+    are read in growing chunks, so a short run costs what it holds; a run found too short is
+    remembered (`_bulk_skip`), its later lines are not looked at again."""
     blocks = fr.program.blocks
+    pc = fr.pc
+    skip = ip._bulk_skip
+    if skip is not None and skip[0] is blocks and skip[1] <= pc < skip[2]:
+        return None  # a suffix of a run already found too short: shorter still
     raw_at = getattr(blocks, "raw", None)
-    if raw_at is None or raw_at(fr.pc) is None or not eligible(ip):
+    if raw_at is None or raw_at(pc) is None:
         return None
-    room = min(MAX_RUN, len(blocks) - fr.pc, limit - ip._executed)
-    texts = blocks.texts(fr.pc, room)
-    if len(texts) < MIN_RUN:
+    if not eligible(ip):
         return None
+    room = min(MAX_RUN, len(blocks) - pc, limit - ip._executed)
     shapes = ip.__dict__.setdefault("_bulk_shapes", {})  # per interpreter: the axes decide the shapes
     axes = {a: j for j, a in enumerate(ip.axes) if len(a) == 1 and a in ip._plain_axes}
     segments: list[tuple[_Shape, int, list[tuple[str, ...]]]] = []  # (shape, first row, groups per row)
-    first = _shape_of(texts[0], shapes, axes)
-    if first is None:
-        return None
-    rows = first.lines.findall("\n".join(texts))
-    if first.lines.groups == 1:  # findall gives the group itself, not a 1-tuple
-        rows = [(r,) for r in rows]
-    if len(rows) == len(texts):  # every line matched, one match a line: the whole run is of one shape
-        return _run(ip, fr, [(first, 0, rows)], texts)
+    texts: list[str] = []
     shape: _Shape | None = None
-    match = None
-    rows = []
-    n = 0
-    for raw in texts:
-        m = match(raw) if match is not None else None
-        if m is None:
-            shape = _shape_of(raw, shapes, axes)
-            if shape is None:
-                break
-            match = shape.pattern.fullmatch
-            m = match(raw)
+    rows: list[tuple[str, ...]] = []
+    want = MIN_RUN
+    while len(texts) < room:
+        part = blocks.texts(pc + len(texts), min(want, room - len(texts)))
+        if not part:
+            break
+        k = _same_shape(shape, part, rows) if shape is not None else 0
+        match = shape.pattern.fullmatch if shape is not None else None
+        for raw in part[k:]:
+            m = match(raw) if match is not None else None
             if m is None:
-                break
-            rows = []
-            segments.append((shape, n, rows))
-        rows.append(m.groups())
-        n += 1
-    if n < MIN_RUN:
+                shape = _shape_of(raw, shapes, axes)
+                if shape is None:
+                    break
+                match = shape.pattern.fullmatch
+                m = match(raw)
+                if m is None:
+                    break
+                rows = []
+                segments.append((shape, len(texts) + k, rows))
+            rows.append(m.groups())
+            k += 1
+        texts += part[:k]
+        if k < len(part):
+            break
+        want = min(want * 4, MAX_RUN)
+    if len(texts) < MIN_RUN:
+        ip._bulk_skip = (blocks, pc, pc + len(texts) + 1)
         return None
-    return _run(ip, fr, segments, texts[:n])
+    return _run(ip, fr, segments, texts)
+
+
+def _same_shape(shape: _Shape, part: list[str], rows: list[tuple[str, ...]]) -> int:
+    """How many lines of `part` were taken in one call because all are of `shape` (0: not all)."""
+    found = shape.lines.findall("\n".join(part))
+    if len(found) != len(part):  # one match a line, or some line is of another shape
+        return 0
+    rows.extend([(r,) for r in found] if shape.lines.groups == 1 else found)
+    return len(part)
 
 
 def _run(ip: Interpreter, fr: Frame, segments, texts: list[str]) -> MoveBatch | None:

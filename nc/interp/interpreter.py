@@ -81,6 +81,7 @@ class Interpreter(ExecuteMixin, ReadingMixin, ModalMixin, MotionMixin, NonModalM
         # True: runs of plain G0/G1 blocks come as one MoveBatch event (nc.interp.bulk); for a consumer
         # that formats them in bulk (`hil path`), never the channel, which plans Move by Move
         self.bulk = False
+        self._bulk_skip: tuple | None = None  # (blocks, first, end): a run nc.interp.bulk found too short
 
     # ---- public ---------------------------------------------------------------------------
 

@@ -31,8 +31,14 @@ class PreviewWindow:
         interp.on_statement = self._statement
 
     def _statement(self, block, program: str) -> None:
-        ahead = next((e for e in self.buf if isinstance(e, Move)), None) or self.executing
-        n_ahead = sum(1 for e in self.buf if isinstance(e, Move))
+        first = None
+        n_ahead = 0
+        for e in self.buf:  # one pass (this runs for every macro statement)
+            if isinstance(e, Move):
+                n_ahead += 1
+                if first is None:
+                    first = e
+        ahead = first or self.executing
         self.interp.preview_log.append(PreviewRecord(
             block.line, block.text.strip(), program,
             ahead.line if ahead is not None else None,

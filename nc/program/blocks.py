@@ -16,7 +16,7 @@ import re
 import unicodedata
 from array import array
 from collections.abc import Iterator, Sequence
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from typing import Any, Union, overload
 
 from nc.alarms import NcAlarm
@@ -125,7 +125,10 @@ class Block:
         return bool(self.comma_expr)
 
     def copy(self) -> "Block":
-        return replace(self, words=list(self.words), comma=dict(self.comma))
+        # the constructor, not dataclasses.replace (which inspects the fields on every call): every
+        # block with an expression is copied when it runs
+        return Block(self.line, self.text, list(self.words), self.n, self.skip, dict(self.comma), self.comment,
+                     self.stmt, self.comma_expr)
 
 
 @dataclass

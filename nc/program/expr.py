@@ -258,14 +258,15 @@ def _num(v: Value) -> float:
 
 def evaluate(e: Expr, read: Callable[[int], Value]) -> Value:
     """Evaluate; ``read(n)`` returns variable n (None when vacant).  Raises NcAlarm on domain errors."""
-    if isinstance(e, Num):
+    t = type(e)  # the node classes are final (no subclasses): an identity test is the cheapest dispatch
+    if t is Num:
         return e.value
-    if isinstance(e, Var):
+    if t is Var:
         return read(var_index(e, read))
-    if isinstance(e, Unary):
+    if t is Unary:
         a = _num(evaluate(e.arg, read))
         return -a if e.op == "-" else (0.0 if a else 1.0)
-    if isinstance(e, Binary):
+    if t is Binary:
         lv, rv = evaluate(e.left, read), evaluate(e.right, read)
         op = e.op
         if op in ("==", "EQ", "!=", "NE"):
@@ -297,19 +298,24 @@ def evaluate(e: Expr, read: Callable[[int], Value]) -> Value:
             return float(bool(a) and bool(b))
         if op == "||":
             return float(bool(a) or bool(b))
-        cmp = {"<": a < b, "LT": a < b, ">": a > b, "GT": a > b, "<=": a <= b, "LE": a <= b,
-               ">=": a >= b, "GE": a >= b}
-        if op in cmp:
-            return float(cmp[op])
+        if op in ("<", "LT"):
+            return float(a < b)
+        if op in (">", "GT"):
+            return float(a > b)
+        if op in ("<=", "LE"):
+            return float(a <= b)
+        if op in (">=", "GE"):
+            return float(a >= b)
         raise NcAlarm(0x0201, f"undefined operator {op}")
-    if isinstance(e, Call):
+    if t is Call:
         args = [_num(evaluate(a, read)) for a in e.args]
         return _call(e.name, args)
     raise NcAlarm(0x0000, f"bad expression node {e!r}")
 
 
 def var_index(v: Var, read: Callable[[int], Value]) -> int:
-    raw = evaluate(v.index, read)
+    ix = v.index
+    raw = ix.value if type(ix) is Num else evaluate(ix, read)  # `#1`: a number, most variables
     if raw is None:
         raise NcAlarm(0x0235, "#[...] index is vacant")
     idx = _round_half_away(raw)
