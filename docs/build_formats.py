@@ -143,7 +143,8 @@ def tested_rows(tests_dir: Path = ROOT / "tests") -> dict[str, list[str]]:
 
 
 def unrun_rows() -> dict[str, str]:
-    """row id -> why no test runs it (docs/formats-unrun.toml)."""
+    """row id -> why no test runs it, or (beside a test) what of the row deltahil does not model
+    (docs/formats-unrun.toml)."""
     import tomllib
 
     return {k: v["reason"] for k, v in tomllib.loads(UNRUN.read_text()).items()} if UNRUN.exists() else {}
@@ -182,7 +183,8 @@ def build() -> str:
             f"{len(rows)} format rows ({sum(r.id[0] == 'N' for r in rows)} in the NC5 G command guide's "
             f"format tables, {sum(r.id[0] == 'L' for r in rows)} in the lathe guide's \"Format…:\" "
             f"lines and the alternatives written under them); **{n_tested} are run by a test** as the manual "
-            f"writes them, {n_unrun} are not emulated (reason given).", "",
+            f"writes them, {n_unrun} are not emulated (reason given). Where a tested row has a part deltahil does "
+            f"not model, the test column says so after the test.", "",
             "A row `[G30] P3` is a line of the manual's table that carries only arguments: it continues the row "
             "above it (here `G30 P3 CP`). Row ids: `N<section>-<k>` is the k-th row under that section of the "
             "NC5 guide, `L<section>-<k>` of the lathe guide; the last column is the file and line of the manual's "
@@ -193,6 +195,8 @@ def build() -> str:
         t = ", ".join(f"`{x}`" for x in sorted(set(tested.get(r.id, []))))
         if not t and r.id in unrun:
             t = "not emulated: " + unrun[r.id].replace("|", "/")
+        elif r.id in unrun:
+            t += "; not modelled: " + unrun[r.id].replace("|", "/")
         text = r.text.replace("|", "\\|")
         src = f"{NC5 if r.id[0] == 'N' else LATHE}:{r.line}"
         body.append(f"| {r.id} | {r.title.replace('|', '/')} | `{text}` | {t or 'untested'} | {src} |")

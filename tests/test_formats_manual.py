@@ -108,6 +108,7 @@ def test_formats_page_is_up_to_date_and_cites_only_real_rows():
         marked = {r[1].strip() for r in rows if r[4].strip().startswith("`")}  # a test's name
         assert marked == set(b.tested_rows()), "docs/formats.md is stale: python docs/build_formats.py"
     assert not set(b.tested_rows()) - ids
+    assert not set(b.unrun_rows()) - ids, "docs/formats-unrun.toml names a row the manuals do not have"
 
 
 def test_every_format_row_is_run_by_a_test_or_says_why_not():
