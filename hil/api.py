@@ -133,7 +133,7 @@ def run(program: str | Path, bench: str | Path | Bench | None = None, *, bus: st
         check: bool | None = None, trace_signals: str | None = None, m00_resume: float = 0.5,
         realtime: bool = False, overrun: str | None = None, progress: Any = None,
         servo_modbus: str | None = None, servo_baud: int = 38400, capture: str | Path | None = None,
-        scope: Any = None, aux_timeout: float = 5.0) -> Result:
+        scope: Any = None, aux_timeout: float = 5.0, home: bool = True) -> Result:
     """Run `program` on a bench in lock-step virtual time (or `realtime`); see the module doc.
 
     `bench`: a bench file, a `Bench`, or None for the built-in 2-axis lathe. `events`: `--at`
@@ -142,7 +142,8 @@ def run(program: str | Path, bench: str | Path | Bench | None = None, *, bus: st
     `check`: judge the run by the bench's [checks] (default: when it has any). `capture`: record the
     bus's frames (EtherCAT .pcapng, CAN .asc/.blf/.log; fieldbus/capture.py). `scope`: a started
     `hil.scope.Scope` that streams this run's rows to its page. `aux_timeout`: simulated seconds an
-    M/S/T code may wait for the MLC's finish before a warning (0: never)."""
+    M/S/T code may wait for the MLC's finish before a warning (0: never). `home`: False skips the drive
+    homing of axes with a bench `homing` table (hil/drive_homing.py; the drives keep their last origin)."""
     from hil.clock import make_clock
     from hil.progress import Progress
     from hil.remote_io import attach_remote_io
@@ -163,6 +164,10 @@ def run(program: str | Path, bench: str | Path | Bench | None = None, *, bus: st
     if spindle < 50.0:
         raise InputError(f"spindle override {spindle_override!r}: a percentage from 50 to 120")
     b = _bench(bench, profile, bus)
+    if not home and any(a.homing for a in b.axes):
+        from dataclasses import replace
+
+        b = replace(b, axes=[replace(a, homing=None) for a in b.axes])
     try:
         prog = load_program(str(program), list(libs))
     except NcAlarm as exc:

@@ -126,3 +126,13 @@ def test_a_drive_that_refuses_the_method_raises_0x1604(tmp_path):
     bench.axes[1] = dataclasses.replace(z, homing=dataclasses.replace(z.homing, method=7))
     result = BenchRunner(bench, SimLink(sim_slaves(bench), bench.cycle)).run_program(parse_program(PROGRAM))
     assert [a.code for a in result.alarms] == [0x1604] and "0x06090030" in result.alarms[0].message
+
+
+def test_no_home_skips_the_drive_homing(hil, program, tmp_path):
+    bench = tmp_path / "bench.toml"
+    bench.write_text(BENCH.format(bus="sim", edge=40 * CPU, method=21, limit=""))
+    trace = tmp_path / "t.csv"
+    r = hil("run", program(PROGRAM), "--bench", bench, "--trace", trace, "--no-home")
+    assert r.code == 0, r.out + r.err
+    zs = [float(row["Z_act"]) for row in csv.DictReader(trace.open())]
+    assert min(zs) > 9.9 and zs[-1] == pytest.approx(10.0, abs=1e-3)  # straight from 60 to 10, no homing first
