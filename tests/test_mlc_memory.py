@@ -54,3 +54,25 @@ def test_resolve_by_name_is_channel_relative_and_bad_devices_are_rejected():
             resolve(bad)
     with pytest.raises(DeviceError):
         parse_address("D")
+
+
+@pytest.mark.parametrize("order", ["low-first", "high-first"])
+def test_floats_written_in_place_equal_the_word_pair_route(order):
+    """set_f32/f32 pack the float's bytes straight into the D words (issue 17): the words, and the value
+    read back, are those of the u32 route (struct of the float, split into a low and a high word)."""
+    import math
+    import struct
+
+    mem = DeviceMemory(word_order=order)
+    for k, value in enumerate((1200.5, -0.0, 1e-40, 3.4e38, -7.25e-3, math.inf, 16_777_217.0)):
+        n = 30272 + 2 * k
+        mem.set_f32(n, value)
+        raw = struct.unpack("<I", struct.pack("<f", value))[0]
+        lo, hi = raw & 0xFFFF, raw >> 16
+        assert (int(mem.d[n]), int(mem.d[n + 1])) == ((lo, hi) if order == "low-first" else (hi, lo))
+        assert mem.u32(n) == raw
+        assert struct.pack("<f", mem.f32(n)) == struct.pack("<f", value)
+    mem.set_f32(0, 2.5)  # the first and the last pair of the range take the same route
+    mem.set_f32(len(mem.d) - 2, -2.5)
+    assert (mem.f32(0), mem.f32(len(mem.d) - 2)) == (2.5, -2.5)
+    assert mem.words[30272] == int(mem.d[30272])  # the word view is the array itself
