@@ -304,6 +304,25 @@ def _for_model(scaling: AxisScaling, model: str, cpr_given: bool, model_named: b
     return replace(scaling, counts_per_rev=cpr, units=m.units)
 
 
+# Drive defaults held in counts are physical quantities (rev/s², motor revs) written at the generic
+# 1 280 000 counts/rev; at another resolution the same physics is more counts (decisions E17).
+_COUNT_FIELDS = ("csv_accel", "quick_stop_decel", "following_error_window")
+
+
+def _drive_at_resolution(drive: DriveParams, given: set[str], cpr: int) -> DriveParams:
+    """`drive` with the counts-valued defaults the bench did not set rescaled to `cpr` counts/rev."""
+    ratio = cpr / DriveParams.counts_per_rev
+    if ratio == 1.0:
+        return drive
+    return replace(drive, **{k: type(getattr(drive, k))(getattr(drive, k) * ratio)
+                             for k in _COUNT_FIELDS if k not in given})
+
+
+def _given(d: dict) -> set[str]:
+    table = d.get("drive")
+    return set(table) if isinstance(table, dict) else set()
+
+
 def _drive(r: _Reader, d: Any, p: str, base: DriveParams) -> tuple[DriveParams, str, str]:
     """The drive table: tuning, `model` (fieldbus.devices.MODELS) and `esi` (a vendor ESI file the
     virtual EtherCAT slave is built from instead of the packaged one; the model's product code picks
@@ -371,8 +390,10 @@ def _axis(r: _Reader, d: dict, p: str) -> AxisConfig | None:
                           for k, dflt in (("velocity", base.max_velocity), ("acceleration", base.max_acceleration),
                                           ("jerk", base.max_jerk))))
     r.unknown(lim, f"{p}.limits.", {"velocity", "acceleration", "jerk"})
+    given = _given(d)
     drive, model, esi = _drive(r, d.pop("drive", {}), f"{p}.drive", DriveParams())
     scaling = _for_model(scaling, model, cpr_given, model_named)
+    drive = _drive_at_resolution(drive, given, scaling.counts_per_rev)
     eds = r.eds(d, f"{p}.canopen_eds", ASDA_CSP)
     homing = _homing(r, d, f"{p}.homing")
     r.unknown(d, f"{p}.", {"name", "units", "counts_per_rev", "ratio", "lead", "direction", "start", "soft_limits",
@@ -416,12 +437,14 @@ def _spindle(r: _Reader, d: dict, p: str) -> SpindleConfig | None:
     ratio = r.pair(d, "ratio", f"{p}.ratio", integers=True, positive=True) or (1, 1)
     direction = r.integer(d, "direction", f"{p}.direction", 1, choices=(1, -1))
     max_rpm = r.number(d, "max_rpm", f"{p}.max_rpm", base.max_rpm, positive=True)
+    given = _given(d)
     drive, model, esi = _drive(r, d.pop("drive", {}), f"{p}.drive", base.drive)
     eds = r.eds(d, f"{p}.canopen_eds", ASDA_CSP_CSV)
     r.unknown(d, f"{p}.", {"name", "counts_per_rev", "ratio", "direction", "max_rpm", "drive", "canopen_eds"})
     scaling = AxisScaling(counts_per_rev=cpr or base.scaling.counts_per_rev, gear_motor=int(ratio[0]),
                           gear_load=int(ratio[1]), lead=360.0, direction=direction or 1)
     scaling = _for_model(scaling, model, cpr_given, model_named)
+    drive = _drive_at_resolution(drive, given, scaling.counts_per_rev)
     return SpindleConfig(name, scaling, max_rpm or base.max_rpm, drive, canopen_eds=eds, drive_model=model,
                          drive_esi=esi)
 

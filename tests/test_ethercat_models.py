@@ -72,6 +72,32 @@ drive = { model = "asda-a2-e" }
     assert abs(runner.tx[0].position_actual - 16_777_216) <= 2 and abs(runner.tx[1].position_actual - 100_000) <= 2
 
 
+def test_drive_defaults_in_counts_follow_the_resolution():
+    """The sim drive's defaults held in counts (CSV ramp, quick-stop deceleration 0x6085, following-error
+    window 0x6065) are the same physics at any resolution: on a 24-bit A3-E they are 16 777 216 / 1 280 000
+    times the generic figures, so S1000 still takes the same 0.43 s to reach (decisions E17). A value the
+    bench gives is taken as written."""
+    from hil.bench_file import parse_bench
+    from virtual_bus.drive import DriveParams
+
+    bench = parse_bench('''
+bus = "sim"
+[[axes]]
+name = "X"
+drive = { model = "asda-a3-e" }
+[[axes]]
+name = "Z"
+drive = { model = "asda-a3-e", csv_accel = 1.0e7 }
+''')
+    generic, k = DriveParams(), 16_777_216 / 1_280_000
+    x, z = bench.axes[0].drive, bench.axes[1].drive
+    assert x.csv_accel == pytest.approx(generic.csv_accel * k) and z.csv_accel == 1.0e7
+    assert x.quick_stop_decel == pytest.approx(generic.quick_stop_decel * k)
+    assert x.following_error_window == int(generic.following_error_window * k)
+    # rev/s² of the CSV ramp equal the generic drive's: 1000 rpm in the same time
+    assert x.csv_accel / 16_777_216 == pytest.approx(generic.csv_accel / 1_280_000)
+
+
 def test_asda_e_fits_every_model():
     """hil's default layout stays within each model's limits: 8 entries, mappable objects only."""
     for m in MODELS.values():

@@ -29,7 +29,9 @@ from virtual_bus.ethercat.veth import SimProcess, can_create
 
 ROOT = Path(__file__).resolve().parents[1]
 LATHE = ROOT / "benches" / "lathe-2axis.toml"
-LONG = "G98\nG00 X58. Z98.\nG01 Z-300. F6000\nG01 Z98.\nG01 Z-300.\nM30\n"  # Z at 100 mm/s from t≈0.7 s
+# Z at 100 mm/s from t≈0.7 s, back and forth for ≈ 170 s of simulated time: a signal sent once the run is
+# under way (its first trace part, ≈ 2 s of wall time) must land mid-program however fast the cycle runs.
+LONG = "G98\nG00 X58. Z98.\nG01 Z-300. F6000\n" + "G01 Z98.\nG01 Z-300.\n" * 21 + "M30\n"
 SHORT = "G98\nG00 X58. Z98.\nG01 Z50. F6000\nM30\n"
 OP_ENABLED, QUICK_STOP = 0x27, 0x07
 EC_REASON = can_create()
