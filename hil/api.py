@@ -164,7 +164,9 @@ def run(program: str | Path, bench: str | Path | Bench | None = None, *, bus: st
     if spindle < 50.0:
         raise InputError(f"spindle override {spindle_override!r}: a percentage from 50 to 120")
     b = _bench(bench, profile, bus)
-    if not home and any(a.homing for a in b.axes):
+    # axes that need homing but were not homed have no origin: G28/G30/G53 on them raise 0x0A08 (A42)
+    unreferenced = frozenset(a.name for a in b.axes if a.homing) if not home else frozenset()
+    if unreferenced:
         from dataclasses import replace
 
         b = replace(b, axes=[replace(a, homing=None) for a in b.axes])
@@ -200,6 +202,7 @@ def run(program: str | Path, bench: str | Path | Bench | None = None, *, bus: st
         traced = [c for src in signal_sources for c in src.columns]
         player = EventPlayer(parsed, m, b, link, panel, traced)
     runner = BenchRunner(b, link, None, m, player or panel, clock=clock, progress=progress)
+    runner.unreferenced = unreferenced
     runner.trace_sources += signal_sources
     if player is not None:
         runner.trace_sources.append(player)

@@ -114,6 +114,7 @@ class BenchRunner:
         self._winding_down = False  # the run is over; the stop path brings everything to rest
         self._bus_closed = False
         self.stop_request: str | None = None  # a signal's name (hil/stop_signals.py): stop, then end
+        self.unreferenced: frozenset[str] = frozenset()  # axes without origin (hil run --no-home): 0x0A08
         self._overrun_alarmed = False
 
     def trace_columns(self) -> list[str]:
@@ -130,6 +131,7 @@ class BenchRunner:
             # run (paced in real time), a cycle has no room for it.
             profile = make_profile(self.bench.profile, self.axes, self.bench.params)
             interp = Interpreter(profile)
+            interp.unreferenced = self.unreferenced
             interp.budget = StatementBudget.for_profile(profile)  # macro statements per cycle (decisions B2)
             self._interp = interp  # G31 skip hands the latch back to it (issue 5)
             from hil.servo_link import BusServoAccess  # G10 L40-L46 → SDO / Modbus on this bench (issue 8)

@@ -26,6 +26,7 @@ MANUAL_MODES = (MPG, JOG, RAPID, INC, HOME)
 SYSTEM_M = {0, 1, 2, 30, 98, 99}  # never handed to the MLC (NC5 §3.8.1)
 ESTOP_ALARM = 0x0401
 SPINDLE_ALARM = 0x0C0A
+OSCILLATION_IN_HOME = 0x1603  # App. A: "Oscillation function is not allowed in the home mode."
 
 
 @dataclass
@@ -308,9 +309,19 @@ class ChannelLink:
             if delta and i < len(self.axes):
                 mm.move_by(self.axes[i], delta * self.mem.u16(d2(x, 9)) * self.unit)
         elif self.mode == HOME:
+            # M2x264 (axes oscillation enable) is "only available on modes other than HOME and EDIT": ON in HOME
+            # mode stops the homing under way and refuses new ones, App. A 0x1603 (decisions mlc.md)
+            osc = self._m2(264)
+            if self._rising(m2(x, 264)):
+                mm.stop()
+                self._raise(ch, Alarm(OSCILLATION_IN_HOME, "M2x264 oscillation enable is ON in HOME mode"))
             for i, a in enumerate(self.axes):
                 if self._rising(m2(x, 320 + i)):
-                    mm.home(a)
+                    if osc:
+                        self._raise(ch, Alarm(OSCILLATION_IN_HOME, f"{a} homing refused: M2x264 oscillation "
+                                                                   f"enable is ON in HOME mode", axis=a))
+                    else:
+                        mm.home(a)
         pos = mm.step()
         if ch.planner.idle:
             ch.planner.position[:] = pos

@@ -95,6 +95,10 @@ ALARM_CASES = [
     Case("0x1209", "G10 L12 P1 R6.\nG90 G00 X-50. Y-50.\nG42 D1 G01 X0 Y0 F100\nG01 X-15.2 Y-23.9\n"
          "G02 X18.5 Y-24.5 R17.9\nG40 G01 X-50. Y-50.\nM30\n", 5,
          "App. A 0x1209: line then arc at an inner corner whose compensated elements do not meet (N§3.6.2)"),
+    Case("0x021B", "G90 G00 X10. Y10.\nG53.1\nM30\n", 2,
+         "App. A 0x021B 'The G53.1 command must be used after the G68.2 command': G53.1 with no G68.2 before it "
+         "(G68.2 is not in the N§2 G code list, so it is never active)"),
+    Case("0x021B", "G00 X10. Z5.\nG53.1\nM30\n", 2, "App. A 0x021B on the lathe profile too", profile="nc5-lathe-a"),
 ]
 
 

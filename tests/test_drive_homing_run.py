@@ -136,3 +136,36 @@ def test_no_home_skips_the_drive_homing(hil, program, tmp_path):
     assert r.code == 0, r.out + r.err
     zs = [float(row["Z_act"]) for row in csv.DictReader(trace.open())]
     assert min(zs) > 9.9 and zs[-1] == pytest.approx(10.0, abs=1e-3)  # straight from 60 to 10, no homing first
+
+
+def _no_home(tmp_path, text: str, home: bool = False):
+    import hil
+
+    path = tmp_path / "bench.toml"
+    path.write_text(BENCH.format(bus="sim", edge=40 * CPU, method=21, limit=""))
+    prog = tmp_path / "p.nc"
+    prog.write_text(text)
+    return hil.run(prog, bench=str(path), home=home, check=False)
+
+
+@pytest.mark.parametrize("block", ["G28 W0.", "G30 P2 Z20.", "G53 Z5."])
+def test_0x0a08_machine_coordinate_move_on_an_axis_run_without_homing(tmp_path, block):
+    """App. A 0x0A08 'Origin status of the axis is missing. Please execute the homing operation.' and L§G53
+    ('before using G53 ... please complete the homing procedure'): Z has a bench `homing` table and the run
+    skips it (--no-home), so a return to the reference point (N§3.4 G28/G30) or a G53 move of Z alarms at its
+    line when the block is read (G53 stops the look-ahead, so line 1 ran first; G28/G30 are read ahead of
+    line 1's motion), and Z never moves towards the reference point or the G53 position: it stays at or
+    above line 1's Z30 (power-on Z60)."""
+    r = _no_home(tmp_path, f"G00 X5. Z30.\n{block}\nM30\n")
+    assert [(a.code, a.line, a.axis) for a in r.alarms] == [(0x0A08, 2, "Z")]
+    assert not r.run.finished
+    assert 30.0 - 1e-3 <= r.run.final["Z"] <= 60.0 + 1e-3
+
+
+def test_no_home_leaves_machine_moves_of_axes_without_homing_and_homed_runs_alone(tmp_path):
+    """The 0x0A08 check is per axis and per run: G28 X on the --no-home run (X has no homing table, its origin
+    is the drive's) and G28 Z on a homed run reach the reference point N2.060 (0 here) without an alarm."""
+    r = _no_home(tmp_path, "G28 U0.\nM30\n")
+    assert r.alarms == [] and r.run.final["X"] == pytest.approx(0.0, abs=1e-3)
+    r = _no_home(tmp_path, "G00 Z30.\nG28 W0.\nM30\n", home=True)
+    assert r.alarms == [] and r.run.final["Z"] == pytest.approx(0.0, abs=1e-3)

@@ -132,3 +132,28 @@ def test_estop_brakes_on_the_drives_quick_stop_and_reset_enables_again(machine):
     assert machine.command("Z") == pytest.approx(z0 + 5.0, abs=1e-6)  # no jump: 5 mm on from there
 
 
+
+
+def test_0x1603_oscillation_enable_in_home_mode_stops_and_refuses_the_homing(machine):
+    """App. A 0x1603 'Oscillation function is not allowed in the home mode. The M2x264 oscillation function cannot
+    be enabled in the homing mode.' and N App. B M2x264 'Only available on modes other than HOME and EDIT': Z's
+    homing is under way when the MLC turns M2x264 on; the NC raises 0x1603, Z stops short of its home position
+    (0) without the homing-done status, and a new home trigger while M2x264 stays on is refused with 0x1603 too.
+    With M2x264 off and a reset, the same trigger homes Z."""
+    machine.mode("HOME")
+    z0 = machine.command("Z")
+    machine.pulse(21321)  # M2x321: Z homing
+    machine.wait(0.2)
+    machine.set("M21264")
+    machine.wait(1.0)
+    codes = [a.code for a in machine.mlc.link.alarms]
+    assert codes == [0x1603]
+    z_stop = machine.command("Z")
+    assert 1.0 < z0 - z_stop < z0 - 1.0  # moved towards home, stopped well before it
+    assert machine.get("M31337") == 0  # Z homing not done
+    machine.pulse(21321)
+    machine.wait(0.5)
+    assert [a.code for a in machine.mlc.link.alarms] == [0x1603, 0x1603] and machine.command("Z") == z_stop
+    machine.set("M21264", False)
+    machine.pulse(21004)  # M2x004 reset
+    assert machine.home("Z") > 0.0 and machine.command("Z") == pytest.approx(0.0, abs=1e-9)

@@ -62,6 +62,9 @@ class Interpreter(ExecuteMixin, ReadingMixin, ModalMixin, MotionMixin, NonModalM
         self._interrupt_resume: Move | None = None  # the way to the suspended block's end, due at M99
         self._angle_pending: tuple[Block, dict] | None = None  # two-block ,A form: first block held (A32)
         self.reference_via: dict[str, float] | None = None  # G28/G30 intermediate point (machine)
+        # axes whose origin status is missing (a bench axis that needs homing, run with --no-home): G28/G30/G53
+        # move them in machine coordinates and raise App. A 0x0A08 (decisions language.md A42)
+        self.unreferenced: frozenset[str] = frozenset()
         self.skip_position: dict[str, float] | None = None  # G31 trigger (machine), set by motion
         self.last_target: dict[str, float] = self.work_position()
         self.last_arc_ijk: tuple[float, float, float] = (0.0, 0.0, 0.0)

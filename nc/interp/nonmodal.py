@@ -97,6 +97,7 @@ class NonModalMixin:
         words = self._axis_words(block)
         if any(inc for _, inc in words.values()):
             return
+        self._need_origin(words, "G53")
         self._end_length_offsets()
         self.last_target = self.work_position()
         end = dict(self.position)
@@ -132,6 +133,7 @@ class NonModalMixin:
         words = self._axis_words(block)
         if not words:
             raise NcAlarm(0x0253, "G28/G30 needs the intermediate point of at least one axis")
+        self._need_origin(words, "G28" if ref == 1 else f"G30 P{ref}")
         g = self._geometry(block)
         via = {a: g.target_machine[a] for a in words}
         self.reference_via = dict(via)
@@ -162,6 +164,15 @@ class NonModalMixin:
         self.position = end
         self.last_target = self.work_position()
         yield mv
+
+    def _need_origin(self, words: dict, what: str) -> None:
+        """App. A 0x0A08 "Origin status of the axis is missing. Please execute the homing operation.": a move
+        to machine coordinates (the reference point N2.060-N2.063, G53's machine position) needs the axis's
+        origin; L§G53: "before using G53 ... please complete the homing procedure"."""
+        missing = [a for a in self.axes if a in words and a in self.unreferenced]
+        if missing:
+            raise NcAlarm(0x0A08, f"{what}: axis {', '.join(missing)} has no origin (not homed: run without "
+                                  f"--no-home, or home it first)", axis=missing[0])
 
     def _g_G30(self, block: Block) -> Iterator[Event]:
         p = block.get("P")

@@ -46,6 +46,10 @@ class ReadingMixin:
         out = []
         for w in block.all("G"):
             entry = lookup(self.profile, w.value)
+            if entry is None and round(w.value, 1) == 53.1 and not self.profile.legacy:
+                # App. A 0x021B "The G53.1 command must be used after the G68.2 command": G68.2 (tilted working
+                # plane) is not an NC5 G code of N§2 and never active here, so G53.1 is always out of place
+                raise NcAlarm(0x021B, f"{w.text} must follow G68.2 (tilted working plane), which is not active")
             if entry is None:
                 raise NcAlarm(0x021D, f"G code {w.text} is not supported on {self.profile.name}")
             grp, fn = entry
