@@ -65,6 +65,21 @@ def test_block_upload_is_aborted(bus):
     assert isinstance(node.sdo.upload(0x1008, 0), bytes)  # a segmented upload still works
 
 
+def test_block_download_is_aborted(bus):
+    """CiA 301 7.2.4.3.9: the same for a block download; the object keeps its value, an expedited write works."""
+    _, _, node = bus
+    before = node.sdo[0x6065].raw
+
+    def block_write() -> None:
+        with node.sdo.open(0x6065, 0, "wb", size=4, block_transfer=True) as f:
+            f.write(struct.pack("<I", before + 1000))
+
+    assert abort_of(block_write) == 0x05040001
+    assert node.sdo[0x6065].raw == before
+    node.sdo.download(0x6065, 0, struct.pack("<I", before + 1000))
+    assert node.sdo[0x6065].raw == before + 1000
+
+
 def test_reset_node_restores_the_power_on_profile_area(bus):
     """CiA 301 NMT Reset Node: the application restarts with its power-on values — a drive fault of the
     previous run is gone (CiA 402: switch on disabled), a profile object written before is back at its
@@ -175,6 +190,32 @@ def test_hil_sim_canopen_stops_cleanly_on_sigterm(netns):  # noqa: F811
             proc.kill()
             proc.wait()
     assert proc.returncode == 0 and "hil sim canopen: stopped" in err and "Traceback" not in err
+
+
+def test_every_identity_value_of_the_eds_has_a_source_or_is_assumed(bus):
+    """Issue 23: a documented source, or a clear "assumed" note, for every identity value in the EDS. CiA 306
+    [Comments] lines carry them; the node answers the same values over SDO (CiA 301 0x1000, 0x1008, 0x1018)."""
+    import configparser
+
+    eds = configparser.ConfigParser(interpolation=None, strict=False)
+    eds.optionxform = str
+    eds.read(ASDA_B3_EDS)
+    info = eds["DeviceInfo"]
+    values = {key: info[key] for key in ("VendorName", "VendorNumber", "ProductName", "ProductNumber",
+                                         "RevisionNumber", "OrderCode")}
+    objects = {"0x1000": "1000", "0x1008": "1008"} | {f"0x1018:{k}": f"1018sub{k}" for k in range(1, 5)}
+    values |= {key: eds[section]["DefaultValue"] for key, section in objects.items()}
+    comments = eds["Comments"]
+    lines = [comments[f"Line{k}"] for k in range(1, int(comments["Lines"]) + 1)]
+    for key, value in values.items():
+        said = [line for line in lines if key in line and value in line]
+        assert said, f"{key} = {value}: no comment line names it"
+        assert all("source:" in line or "ASSUMED" in line for line in said), said
+    _, _, node = bus
+    assert node.sdo[0x1000].raw == int(values["0x1000"], 16)
+    assert node.sdo[0x1008].raw == values["0x1008"]
+    for sub in (1, 2, 3, 4):
+        assert node.sdo[0x1018][sub].raw == int(values[f"0x1018:{sub}"], 0)
 
 
 def test_hil_scan_lists_the_canopen_nodes(hil):

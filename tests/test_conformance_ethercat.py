@@ -164,6 +164,25 @@ def test_03_mapping_rules_of_the_real_device(master):
     write_pdo(s, 0x1A02, A3_TX[0x1A02])
 
 
+def test_03b_no_mapping_change_while_assigned_and_live(master):
+    """ETG.1000.6 / ETG SSC: PDO mapping and assignment objects are writable in PRE-OP only; in SAFE-OP and OP
+    (the mapping is assigned and the process data live) a write aborts with 0x08000022 (data cannot be
+    transferred because of the present device state) and the mapping stays as it was."""
+    s = master.slaves[0]
+    master.config_map()
+    mapped = pdo_entries(s, 0x1A01)
+    for state in ("SAFE-OP", "OP"):
+        if state == "OP":
+            to_op(master, s)
+        else:
+            assert master.state_check(pysoem.SAFEOP_STATE, 2_000_000) == pysoem.SAFEOP_STATE
+        assert abort_of(lambda: s.sdo_write(0x1A01, 0, b"\x00")) == 0x08000022, state
+        assert abort_of(lambda: s.sdo_write(0x1600, 1, struct.pack("<I", 0x60400010))) == 0x08000022, state
+        assert abort_of(lambda: s.sdo_write(0x1C13, 0, b"\x00")) == 0x08000022, state
+        assert abort_of(lambda: s.sdo_write(0x1C12, 1, struct.pack("<H", 0x1602))) == 0x08000022, state
+        assert pdo_entries(s, 0x1A01) == mapped and u(s.sdo_read(0x1C13, 1)) == 0x1A01
+
+
 def test_04_linuxcnc_deasda_configuration_runs_csv(master):
     """LCEC: 0x1602 = 6040/60FF, 0x1A02 = 6041/606C/6064/2511, written entry by entry, 0x6060 = 9 and
     0x60C2 by SDO; the drive reaches OP and turns at 10000 × 0.1 rpm = 1000 rpm."""
