@@ -5,6 +5,8 @@ the trace and the MLC show rpm again."""
 
 from __future__ import annotations
 
+import math
+
 import pytest
 
 from hil.bench import default_lathe
@@ -33,6 +35,7 @@ def _run_s1000(bus: str) -> dict:
         seen["rpm"] = r.spindle_actual_rpm()
         seen["torque"] = r.tx[s].torque_actual
         seen["D30340"] = r.mlc.mem.f32(d3(0, 336 + 2 * s))  # velocity RPM of the (s+1)-th drive, to the MLC
+        seen["D30240"] = r.mlc.mem.words[30240 + s]  # its torque to the MLC, 0.1 % of rated (s16)
         if not bus.startswith("sim"):  # what the drive itself holds, read over the bus by SDO
             seen["60FF"] = int.from_bytes(r.link.sdo_read(s, 0x60FF, 0), "little", signed=True)
             seen["606C"] = int.from_bytes(r.link.sdo_read(s, 0x606C, 0), "little", signed=True)
@@ -48,7 +51,8 @@ def _check(seen: dict) -> None:
     assert seen["tx"] == pytest.approx(10000, abs=2)  # at speed, in the same unit
     assert seen["rpm"] == pytest.approx(1000.0, abs=0.2)  # the master converts back to rpm
     assert seen["D30340"] == pytest.approx(1000.0, abs=0.2)
-    assert abs(seen["torque"]) < 1000  # 0.1 % of rated: a free spindle at speed needs well under 100 %
+    assert 0 < seen["torque"] < 1000  # 0.1 % of rated: a free spindle at speed needs friction torque, well under 100 %
+    assert seen["D30240"] == seen["torque"]  # the MLC gets 0x6077 in its own 0.1 % unit, not scaled twice
     if "60FF" in seen:
         assert seen["60FF"] == 10000
         assert seen["606C"] == pytest.approx(10000, abs=2)
@@ -69,7 +73,9 @@ def test_s1000_is_10000_tenths_of_rpm_on_ethercat():
 
 
 def test_trace_shows_rpm(hil, program, tmp_path):
-    """The trace's S1 columns are rpm again."""
+    """The trace's S1 columns are rpm again, and its torque % of rated: 0x6077 comes in 0.1 % units, so a
+    spindle held at 1000 rpm against its friction (Coulomb + viscous of the built-in lathe's drive) reads
+    that torque over the rated one, about 3 %, not 30 %."""
     trace = tmp_path / "t.csv"
     r = hil("run", program(PROGRAM), "--trace", trace)
     assert r.code == 0, r.out
@@ -79,3 +85,6 @@ def test_trace_shows_rpm(hil, program, tmp_path):
     at_speed = [row for row in rows if float(row["t"]) > SAMPLE_AT][0]
     assert float(at_speed["S1_rpm_cmd"]) == pytest.approx(1000.0)
     assert float(at_speed["S1_rpm_act"]) == pytest.approx(1000.0, abs=0.2)
+    p = default_lathe().spindles[0].drive
+    friction = p.coulomb + p.viscous * 1000.0 / 60.0 * 2 * math.pi  # N·m at a constant 1000 rpm
+    assert float(at_speed["S1_torque"]) == pytest.approx(100.0 * friction / p.rated_torque, abs=0.1)
