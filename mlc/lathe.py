@@ -20,6 +20,7 @@ from __future__ import annotations
 from mlc.program import ScanContext
 
 NAME = "default lathe MLC"
+SCAN_ON_CHANGE = True  # the scan depends only on what it reads and on mlc.state (mlc/on_change.py)
 STATIONS = 12
 TURRET_DELAY = 0.15  # s per station indexed
 COOLANT = (0, 0)  # (remote I/O module, digital output)

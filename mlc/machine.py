@@ -25,6 +25,7 @@ import numpy as np
 
 from mlc.memory import DeviceMemory
 from mlc.nc_link import ChannelLink, DriveStatus
+from mlc.on_change import ScanGate, wants_gate
 from mlc.program import ScanContext
 from mlc.spindle_axis import MODE_CSV, SpindleAxisSwitch
 from mlc.signals import d2, m2
@@ -100,6 +101,8 @@ class Mlc:
         self.caxis = SpindleAxisSwitch(self.mem, channel, cycle)  # spindle ↔ C axis, M19 (issue 8 item 5)
         self.caxis_alarmed = False
         self._power_on_image(channel)
+        # SCAN_ON_CHANGE programs (the default lathe MLC): the scan runs when what it read changed
+        self.gate = ScanGate(self.ctx) if wants_gate(self.program) else None
         setup = getattr(self.program, "setup", None)
         if callable(setup):
             setup(self.ctx)
@@ -141,7 +144,11 @@ class Mlc:
         ctx.time, ctx.scan_count = self.time, ctx.scan_count + 1
         if not getattr(self, "program_failed", False):
             try:
-                self.program.scan(ctx)
+                gate = self.gate
+                if gate is None:
+                    self.program.scan(ctx)
+                elif not gate.quiet():
+                    gate.run(self.program.scan)
             except NcAlarm:
                 raise
             except Exception as exc:  # the user's MLC code, not the NC: its own alarm, file, line, traceback

@@ -1,0 +1,113 @@
+"""A/B of the bench cycle's shortcuts (issue 17): the same runs with a shortcut off and on must give
+the same Parquet trace, column by column (every column but the wall-clock `period`/`late`, MLC device
+columns included), the same end record, alarms, handshakes and final positions.
+
+    python benchmarks/trace_ab.py [--quick]      # --quick: the three short runs only
+
+Shortcuts compared: `mlc-on-change` (the lathe MLC's user scan skipped while nothing it read changed,
+mlc/on_change.py). Prints one line per run and per shortcut, exits 1 on any difference.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+import tempfile
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from pathlib import Path
+
+import pyarrow.parquet as pq
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))
+
+from benchmarks.bench_motion import cam_program  # noqa: E402
+from hil.api import run  # noqa: E402
+
+SIGNALS = ("M_STROBE,S_STROBE,T_STROBE,MST_FINISH,M_CODE,S_CODE,T_CODE,SPINDLE1_FWD,SPINDLE1_REV,"
+           "SPINDLE_ANALOG_1,SPINDLE1_SPEED_REACHED,PROGRAM_END,M21013,M31016,M31017,D30272,D30240,M21019")
+LATHE, LATHE_C, MILL = (str(ROOT / "benches" / f) for f in ("lathe-2axis.toml", "lathe-c-axis.toml", "mill-3axis.toml"))
+
+
+def runs(tmp: Path, quick: bool) -> Iterator[tuple[str, str, dict]]:
+    """(name, program path, hil.api.run keywords)."""
+    demo = str(ROOT / "examples" / "lathe_demo.nc")
+    cam = tmp / "cam800.nc"
+    cam.write_text(cam_program(800))
+    yield "C-axis drilling", str(ROOT / "examples" / "lathe_face_drilling_c.nc"), {"bench": LATHE_C}
+    yield "M96 interrupt", str(ROOT / "examples" / "m96_interrupt.nc"), {"bench": MILL, "events": ["t=1.1:pulse M21019"]}
+    yield "CAM 800 blocks", str(cam), {"bench": MILL}
+    if quick:
+        return
+    yield "lathe demo", demo, {}
+    yield "hold/resume/override", demo, {"events": ["t=2:feed-hold", "t=2.6:cycle-start", "t=4:set D21002=50"]}
+    yield "E-stop", demo, {"events": ["t=3:estop", "t=3.5:estop-off", "t=3.6:reset"]}
+    yield "overrides 70/110 %", demo, {"feed_override": 70.0, "spindle_override": 110.0}
+    yield "overrides 110/70 %", demo, {"feed_override": 110.0, "spindle_override": 70.0, "rapid_override": 70.0}
+
+
+@contextmanager
+def mlc_on_change(on: bool) -> Iterator[None]:
+    import mlc.lathe
+
+    old = mlc.lathe.SCAN_ON_CHANGE
+    mlc.lathe.SCAN_ON_CHANGE = on
+    try:
+        yield
+    finally:
+        mlc.lathe.SCAN_ON_CHANGE = old
+
+
+SHORTCUTS: dict[str, Callable[[bool], object]] = {"mlc-on-change": mlc_on_change}
+
+
+def one(program: str, kw: dict, trace: Path) -> tuple:
+    r = run(program, trace=str(trace), trace_signals=SIGNALS, check=False, **kw)
+    table = pq.read_table(trace)
+    cols = {c: table.column(c).to_pylist() for c in table.column_names if c not in ("period", "late")}
+    hs = getattr(getattr(r.runner, "mlc", None), "link", None)
+    handshakes = list(getattr(hs, "handshake_log", []))
+    meta = {k: json.loads(v) for k, v in (table.schema.metadata or {}).items()}
+    for m in meta.values():
+        if isinstance(m, dict):
+            m.pop("written", None)  # the wall-clock date of the file
+    summary = (r.run.cycles, [a.code_text for a in r.alarms], r.run.final, r.run.finished, handshakes, meta)
+    return cols, summary
+
+
+def compare(a: tuple, b: tuple) -> list[str]:
+    (ca, sa), (cb, sb) = a, b
+    out = [f"column {c}: first difference at row {next(i for i, (x, y) in enumerate(zip(ca[c], cb[c])) if x != y)}"
+           for c in ca if c in cb and len(ca[c]) == len(cb[c]) and ca[c] != cb[c]]
+    if set(ca) != set(cb) or any(len(ca[c]) != len(cb.get(c, ())) for c in ca):
+        out.append(f"shape: {len(next(iter(ca.values())))} vs {len(next(iter(cb.values())))} rows")
+    for name, x, y in zip(("cycles", "alarms", "final", "finished", "handshakes", "metadata"), sa, sb):
+        if x != y:
+            out.append(f"{name}: {x!r:.200} vs {y!r:.200}")
+    return out
+
+
+def main(argv: list[str]) -> int:
+    quick = "--quick" in argv
+    bad = 0
+    with tempfile.TemporaryDirectory() as d:
+        tmp = Path(d)
+        for name, program, kw in runs(tmp, quick):
+            for shortcut, toggle in SHORTCUTS.items():
+                results = []
+                for on in (False, True):
+                    with toggle(on):  # type: ignore[attr-defined]
+                        results.append(one(program, kw, tmp / f"{on}.parquet"))
+                diff = compare(*results)
+                rows = len(next(iter(results[0][0].values())))
+                print(f"{name:24s} {shortcut}: {'IDENTICAL' if not diff else 'DIFFERENT'} ({rows} rows, "
+                      f"{len(results[0][0])} columns)")
+                for line in diff:
+                    print("   ", line)
+                bad += bool(diff)
+    return 1 if bad else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
