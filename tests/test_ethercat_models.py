@@ -282,3 +282,29 @@ def test_an_etg2000_vendor_file_equals_the_packaged_devices():
         app.attach(ObjectDictionary(theirs))
         assert app.drive.modes.objects.homing_speed_switch == theirs.objects[0x6099].entries[1].value == 1000
         assert theirs.objects[0x6502].entries[0].value == 0x3A5
+
+
+def test_hil_sim_ethercat_esi_refuses_a_file_without_the_drives_model(tmp_path):
+    """`hil sim ethercat --esi FILE` needs the device of each drive's model in FILE: a file holding only another
+    product is refused before anything is served, exit 2, naming the model and the codes the file has."""
+    other = tmp_path / "other.xml"
+    other.write_text(ETG2000_FILE.read_text().replace("#x00006010", "#x00006011"))  # no A3-E left in it
+    r = hil("sim", "ethercat", "--bus", "ethercat:nowhere0", "--esi", str(other))
+    assert r.returncode == 2, r.stderr
+    assert "asda-a3-e" in r.stderr and "0x00006010" in r.stderr and "Traceback" not in r.stderr
+
+
+@pytest.mark.skipif(can_create() is not None, reason=can_create() or "")
+def test_hil_sim_ethercat_builds_the_drives_from_a_vendor_esi(tmp_path):
+    """`hil sim ethercat --esi FILE` builds the built-in lathe's drives (A3-E) from a vendor's ETG.2000 file:
+    the name a master reads from the SII is the file's, and hil runs the demo against them."""
+    esi = tmp_path / "vendor.xml"
+    esi.write_text(ETG2000_FILE.read_text().replace("<Name>ASDA-A3-E CoE Drive</Name>",
+                                                    "<Name>ASDA-A3-E from the vendor file</Name>"))
+    with SimProcess("--esi", str(esi), tag="v") as sim:
+        scan = hil("scan", "--bus", f"ethercat:{sim.iface}")
+        assert scan.returncode == 0, scan.stderr
+        rows = scan.stdout.splitlines()
+        assert len(rows) == 3 and all("ASDA-A3-E from the vendor file" in row for row in rows), rows
+        r = hil("run", str(ROOT / "examples" / "lathe_demo.nc"), "--bus", f"ethercat:{sim.iface}")
+        assert r.returncode == 0 and "result         completed" in r.stdout, r.stdout + r.stderr

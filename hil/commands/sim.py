@@ -25,6 +25,9 @@ def _add_ethercat(sims: argparse._SubParsersAction) -> None:
     p.add_argument("--iface", help=argparse.SUPPRESS)  # old spellings, kept working
     p.add_argument("--interface", dest="iface", help=argparse.SUPPRESS)
     p.add_argument("--bench", help="bench file (TOML); default: the built-in 2-axis lathe")
+    p.add_argument("--esi", metavar="FILE",
+                   help="a vendor ESI file (e.g. Delta's) the drives are built from: each takes the device of its "
+                        "model's product code; a bench drive's own `esi` wins")
     p.add_argument("--io", type=int, default=0, metavar="N",
                    help="R1-EC class I/O slaves after the drives: one per [[io]] station of the bench (its `modules`), "
                         "then DI16 + DO16 ones up to N")
@@ -89,6 +92,25 @@ def build_chain(bench, io: int = 0, realtime: bool = False, faults=()):
     return Chain(slaves, list(faults))
 
 
+def with_esi(bench, esi: str):
+    """The bench with every drive that names no ESI file of its own built from `esi`; ValueError when the
+    file cannot be read or lacks a drive's model (its product code)."""
+    from dataclasses import replace
+    from pathlib import Path
+
+    from fieldbus.devices import MODELS
+    from virtual_bus.ethercat.device import parse_device
+
+    path = str(Path(esi).expanduser().resolve())
+    for model in {c.drive_model for c in list(bench.axes) + list(bench.spindles) if not c.drive_esi}:
+        try:
+            parse_device(path, MODELS[model].product_code)
+        except (OSError, ValueError, KeyError, SyntaxError) as exc:  # ET.ParseError is a SyntaxError
+            raise ValueError(f"--esi {esi}: the {model} drives: {exc}") from None
+    return replace(bench, axes=[c if c.drive_esi else replace(c, drive_esi=path) for c in bench.axes],
+                   spindles=[c if c.drive_esi else replace(c, drive_esi=path) for c in bench.spindles])
+
+
 def ethercat_iface(bus: str | None, iface: str | None) -> str:
     """IFACE from --bus ethercat:IFACE, or the old --iface/--interface; ValueError says what to give."""
     from fieldbus.factory import parse_bus
@@ -113,6 +135,8 @@ def cmd_sim_ethercat(args: argparse.Namespace) -> int:
     try:
         args.iface = ethercat_iface(args.bus, args.iface)
         bench = load_bench(args.bench)
+        if args.esi:
+            bench = with_esi(bench, args.esi)
         faults = [parse_fault(f) for f in args.fault]
     except (InputError, ValueError) as exc:
         print(f"hil sim ethercat: {exc}", file=sys.stderr)
