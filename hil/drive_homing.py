@@ -39,10 +39,14 @@ class DriveHoming:
 
 def _objects(runner: BenchRunner, i: int, h: DriveHoming) -> list[tuple[int, int, bytes]]:
     sc = runner.scales[i]
+
+    def speed(motor_rpm: float) -> bytes:  # 0x6099 in the drive's velocity unit, as 0x60FF (0.1 rpm on Delta)
+        return struct.pack("<I", sc.units.velocity_to_raw(motor_rpm / 60.0 * sc.counts_per_rev, sc.counts_per_rev))
+
     return [(0x6098, 0, struct.pack("<b", h.method)),
             (0x607C, 0, struct.pack("<i", sc.to_counts(h.position))),
-            (0x6099, 1, struct.pack("<I", int(round(h.switch_rpm * 10)))),
-            (0x6099, 2, struct.pack("<I", int(round(h.zero_rpm * 10)))),
+            (0x6099, 1, speed(h.switch_rpm)),
+            (0x6099, 2, speed(h.zero_rpm)),
             (0x609A, 0, struct.pack("<I", h.accel_ms))]
 
 

@@ -169,3 +169,39 @@ def test_no_home_leaves_machine_moves_of_axes_without_homing_and_homed_runs_alon
     assert r.alarms == [] and r.run.final["X"] == pytest.approx(0.0, abs=1e-3)
     r = _no_home(tmp_path, "G00 Z30.\nG28 W0.\nM30\n", home=True)
     assert r.alarms == [] and r.run.final["Z"] == pytest.approx(0.0, abs=1e-3)
+
+
+def test_homing_speeds_go_out_in_the_drives_velocity_unit(tmp_path):
+    """The bench's switch_rpm reaches 0x6099 in the unit the drive model declares for its velocities (Delta:
+    0.1 rpm, as 0x60FF; a drive in counts/s gets counts/s): either way Z searches its switch at 300 motor rpm
+    and homes in the same simulated time."""
+    import dataclasses
+
+    from fieldbus.link import SimLink
+    from fieldbus.units import DriveUnits
+    from hil.bench_file import load_bench_file
+    from hil.runner import BenchRunner
+    from hil.session import sim_slaves
+    from nc.program import parse_program
+
+    path = tmp_path / "bench.toml"
+    path.write_text(BENCH.format(bus="sim", edge=40 * CPU, method=21, limit=""))
+    homed = {}
+    for unit in ("0.1 rpm", "count/s"):
+        bench = load_bench_file(path)
+        z = bench.axes[1]
+        bench.axes[1] = dataclasses.replace(z, scaling=dataclasses.replace(z.scaling, units=DriveUnits(unit)),
+                                            homing=dataclasses.replace(z.homing, timeout=10.0))
+        rpm: list[float] = []
+
+        def on_cycle(run: BenchRunner) -> None:
+            if run.rx[1].mode == 6:
+                rpm.append(abs(run.scales[1].drive_to_rpm(run.tx[1].velocity_actual)))
+
+        result = BenchRunner(bench, SimLink(sim_slaves(bench), bench.cycle), on_cycle=on_cycle).run_program(
+            parse_program(PROGRAM))
+        assert result.ok, (unit, result.alarms)
+        assert sorted(rpm)[len(rpm) // 2] == pytest.approx(300.0, abs=0.5), unit  # mostly at the search speed
+        homed[unit] = len(rpm)
+    assert homed["count/s"] == homed["0.1 rpm"]
+    assert homed["0.1 rpm"] * 0.001 > 20 / (300 / 60 * 10)  # at least the 20 mm to the switch at 50 mm/s

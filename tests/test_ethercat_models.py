@@ -99,7 +99,13 @@ drive = { model = "asda-a3-e", csv_accel = 1.0e7 }
 
 
 def test_asda_e_fits_every_model():
-    """hil's default layout stays within each model's limits: 8 entries, mappable objects only."""
+    """hil's default layout stays within each model's limits: 8 entries, mappable objects only. On the A3-E and
+    B3-E it is the ESI's own 0x1602/0x1A02 contents (LCEC's sets; the drive's predefined set as is, only
+    assigned), on the A2-E a remap of its 0x1602/0x1A02."""
+    for key in ("asda-a3-e", "asda-b3-e"):
+        m = MODELS[key]
+        assert [(e.index, e.subindex, e.bits) for e in ASDA_E.rx] == list(m.rx_sets[ASDA_E.rx_index])
+        assert [(e.index, e.subindex, e.bits) for e in ASDA_E.tx] == list(m.tx_sets[ASDA_E.tx_index])
     for m in MODELS.values():
         assert len(ASDA_E.rx) <= m.max_entries and len(ASDA_E.tx) <= m.max_entries
         assert {(e.index, e.subindex) for e in ASDA_E.rx} <= m.mappable("R")
