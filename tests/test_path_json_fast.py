@@ -1,5 +1,5 @@
-"""`hil path --json` writes plain rapids and lines without intermediate dicts (hil.commands.path
-.move_json, issue 16): the line must be byte for byte what the general way (move_dict +
+"""`hil path --json` writes every move without intermediate dicts (hil.commands.path.move_json,
+issue 16): the line must be byte for byte what the general way (move_dict +
 strict_json.dumps) writes, for any move, the goldens' seam."""
 
 from __future__ import annotations
@@ -21,8 +21,10 @@ moves = st.builds(
     block=st.text(max_size=40), start=axes, end=axes, work=axes,
     center=st.one_of(st.none(), axes), dir=st.sampled_from([None, "cw", "ccw"]),
     feed=st.one_of(st.none(), number), duration=st.one_of(st.none(), st.floats(0, 10)),
-    per_rev=st.booleans(), exact_stop=st.booleans(), tags=st.sampled_from([(), ("G71 rough",)]),
-    comp=st.sampled_from([None, "G41"]))
+    per_rev=st.booleans(), exact_stop=st.booleans(),
+    tags=st.sampled_from([(), ("G71 rough",), ("G70", "finish", "nose \u00e9\"R")]),
+    lead=st.one_of(st.none(), number), lead_change=number, start_angle=number,
+    comp=st.sampled_from([None, "G41", "G42"]), comp_radius=number, tip=st.integers(0, 9))
 
 
 @settings(max_examples=300, deadline=None)
@@ -37,3 +39,13 @@ def test_a_plain_feed_move_takes_the_fast_way() -> None:
     assert move_json(m) == ('{"kind": "line", "line": 12, "block": "G1 X1 \\"q\\"", "start": {"X": 0.0, "Z": 0.0}, '
                             '"end": {"X": 1.0, "Z": null}, "work": {"X": 2.0, "Z": 0.0}, "center": null, '
                             '"dir": null, "feed": 1200, "duration": null}')
+
+
+def test_a_compensated_thread_pass_writes_its_additive_keys() -> None:
+    m = Move("thread", 7, "G76 X21.4", {"X": 14.0, "Z": 5.0}, {"X": 13.35, "Z": -22.0}, {"X": 26.7, "Z": -22.0},
+             feed=2.0, per_rev=True, lead=2.0, tags=("G76", "pass 3"), comp="G42", comp_radius=0.4, tip=3)
+    assert move_json(m) == ('{"kind": "thread", "line": 7, "block": "G76 X21.4", "start": {"X": 14.0, "Z": 5.0}, '
+                            '"end": {"X": 13.35, "Z": -22.0}, "work": {"X": 26.7, "Z": -22.0}, "center": null, '
+                            '"dir": null, "feed": 2.0, "duration": null, "per_rev": true, "tags": ["G76", "pass 3"], '
+                            '"lead": 2.0, "lead_change": 0.0, "start_angle": 0.0, "comp": "G42", "comp_radius": 0.4, '
+                            '"tip": 3}')

@@ -122,9 +122,6 @@ def move_dict(m: Move) -> dict:
     return d
 
 
-_PLAIN_KINDS = frozenset({"rapid", "line"})
-
-
 def _num(v) -> str:
     """One number as strict_json.dumps writes it: floats by repr, non-finite as null; anything else
     (a float subclass such as numpy's, None) the general way."""
@@ -133,24 +130,60 @@ def _num(v) -> str:
         return repr(v) if math.isfinite(v) else "null"
     if t is int:
         return repr(v)
+    if v is None:
+        return "null"
     return _json_str(strict_json.finite(v), allow_nan=False)
 
 
+def _val(v) -> str:
+    """`_num(fmt(v))`: a float rounded to 7 decimals by repr, -0.0 as 0.0, non-finite as null."""
+    if type(v) is float:
+        r = round(v, 7)
+        return "0.0" if r == 0 else repr(r) if r - r == 0 else "null"  # r - r is nan for nan and ±inf
+    return _num(fmt(v))
+
+
+_TEMPLATES: dict[tuple, str] = {}  # axis names -> '{"X": %s, "Z": %s}'
+
+
 def _axes(d: dict[str, float]) -> str:
-    return "{" + ", ".join(f"{_json_str(a)}: {_num(fmt(v))}" for a, v in d.items()) + "}"
+    names = tuple(d)
+    t = _TEMPLATES.get(names)
+    if t is None:
+        t = _TEMPLATES[names] = "{" + ", ".join([_json_str(a).replace("%", "%%") + ": %s" for a in names]) + "}"
+    return t % tuple([_val(v) for v in d.values()])
+
+
+def _str(s) -> str:
+    """json.dumps of a string: as it is, quoted, when it holds nothing JSON escapes."""
+    if type(s) is str and s.isascii() and s.isprintable() and '"' not in s and "\\" not in s:
+        return f'"{s}"'
+    return _json_str(s)
 
 
 def move_json(m: Move) -> str:
-    """The JSON line of `move_dict(m)`, byte for byte as strict_json.dumps writes it, built without
-    the intermediate dicts for the common move (a rapid or line with no additive keys); every other
-    move goes the general way. Pinned by tests/test_path_json_fast.py (hypothesis)."""
-    if m.kind not in _PLAIN_KINDS or m.center is not None or m.dir is not None or m.duration is not None \
-            or m.exact_stop or m.tags or m.comp or (m.per_rev and m.feed is not None) or m.start is None \
-            or m.end is None or m.work is None or type(m.line) is not int:
+    """The JSON line of `move_dict(m)`, byte for byte as strict_json.dumps writes it, built as text
+    without the intermediate dicts (issue 16: the dicts and the generic encoder were half of `hil
+    path` on a lathe-cycle program); a move with a field of an unusual type goes the general way.
+    Pinned by tests/test_path_json_fast.py (hypothesis)."""
+    if m.start is None or m.end is None or m.work is None or type(m.line) is not int \
+            or type(m.kind) is not str:
         return strict_json.dumps(move_dict(m))
-    return (f'{{"kind": {_json_str(m.kind)}, "line": {m.line}, "block": {_json_str(m.block)}, '
+    text = (f'{{"kind": {_str(m.kind)}, "line": {m.line}, "block": {_str(m.block)}, '
             f'"start": {_axes(m.start)}, "end": {_axes(m.end)}, "work": {_axes(m.work)}, '
-            f'"center": null, "dir": null, "feed": {_num(m.feed)}, "duration": null}}')
+            f'"center": {"null" if m.center is None else _axes(m.center)}, '
+            f'"dir": {_str(m.dir)}, "feed": {_num(m.feed)}, "duration": {_num(m.duration)}')
+    if m.per_rev and m.feed is not None:  # the additive keys of move_dict, in its order
+        text += ', "per_rev": true'
+    if m.exact_stop:
+        text += ', "exact_stop": true'
+    if m.tags:
+        text += ', "tags": [' + ", ".join([_str(t) for t in m.tags]) + "]"
+    if m.kind == "thread":
+        text += f', "lead": {_num(m.lead)}, "lead_change": {_num(m.lead_change)}, "start_angle": {_num(m.start_angle)}'
+    if m.comp:
+        text += f', "comp": {_str(m.comp)}, "comp_radius": {_num(m.comp_radius)}, "tip": {_num(m.tip)}'
+    return text + "}"
 
 
 def _coord(v: float) -> str:
@@ -245,8 +278,8 @@ def cmd_path(args: argparse.Namespace) -> int:
         return EXIT_USAGE
     store = ProgramStore(usb_first=bool(profile.param("N8.22 Bit5")))
     interp = Interpreter(profile, store=store)
-    if args.preview_log:  # asked for: the whole log, not only the last statements (decisions B3)
-        interp.preview_log = deque()
+    # asked for: the whole log, not only the last statements (decisions B3); else none is kept
+    interp.preview_log = deque() if args.preview_log else deque(maxlen=0)
     # runs of plain G0/G1 blocks come as MoveBatch events, formatted in bulk (issue 16); the plot,
     # the preview log and an M96 interrupt want every Move on its own
     interp.bulk = not (args.preview_log or interrupt or getattr(args, "plot", None))

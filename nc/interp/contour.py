@@ -59,7 +59,7 @@ class ContourMixin:
         twin = copy.copy(self)
         twin.state = copy.deepcopy(self.state)
         twin.state.cycle = None
-        twin.frames = copy.deepcopy(self.frames)
+        twin.frames = self.frames.copy()
         twin.position = dict(self.position)
         twin.macro_modal = None
         twin.stack = list(self.stack)

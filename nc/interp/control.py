@@ -13,7 +13,7 @@ from collections.abc import Iterator
 from nc.alarms import NcAlarm
 from nc.moves import Event, Sync
 from nc.program.blocks import Assign, Block, Else, ElseIf, End, EndIf, ExitW, Goto, IfGoto, IfThen, While
-from nc.program.expr import evaluate, var_index
+from nc.program.expr_compiled import evaluate, var_index
 from nc.interp.records import Frame, MAX_IF_DEPTH, MAX_WHILE_DEPTH
 
 
@@ -45,22 +45,31 @@ class ControlMixin:
         return evaluate(e, self.vars.get)
 
     # ---- statements --------------------------------------------------------------------------
-    def _statement(self, block: Block) -> Iterator[Event]:
+    def _statement(self, block: Block) -> Event | None:
+        """Run one macro statement; the Sync it calls for (a write to a live # variable), else None.
+        A plain function, not a generator: statements are most blocks of a macro program (issue 16)."""
         s = block.stmt
-        fr = self.frame
+        fr = self.stack[-1]
         if self.on_statement is not None:
             self.on_statement(block, fr.program.name)
         if self.budget is not None:
             self.budget.spend()
-        if isinstance(s, Assign):
-            n = var_index(s.target, self.vars.get)
-            v = self.eval(s.value)
+        t = type(s)
+        if t is Assign:
+            read = self.vars.get
+            n = var_index(s.target, read)
+            v = evaluate(s.value, read)
             if v is not None and not math.isfinite(v):
                 raise NcAlarm(0x0257, "assignment of a non-finite value")
             self.vars.set(n, v)
             if self.sys.live(n):
-                yield Sync(block.line, block.text, f"#{n}")
-            return
+                return Sync(block.line, block.text, f"#{n}")
+            return None
+        self._control(s, fr)
+        return None
+
+    def _control(self, s, fr: Frame) -> None:
+        """GOTO, IF, WHILE/END and EXITW: where the program counter goes next."""
         if isinstance(s, Goto):
             self._jump_label(self._label(s.target))
             return
@@ -105,8 +114,9 @@ class ControlMixin:
                 raise NcAlarm(0x0215, "WHILE without DO")
             if s.do is not None and self.profile.legacy:
                 raise NcAlarm(0x0207, "lathe-2018 loops are WHILE [..] ... ENDW")
-            epc = self._scan_end(fr, wpc, s.do)
             active = fr.loops and fr.loops[-1][0] == wpc
+            # the END of a loop already entered is known; a scan only when the loop starts
+            epc = fr.loops[-1][1] if active else self._scan_end(fr, wpc, s.do)
             if self._truth(s.cond):
                 if not active:
                     if len(fr.loops) >= MAX_WHILE_DEPTH and not self.profile.legacy:

@@ -234,8 +234,10 @@ EXECUTION_ORDER: tuple[tuple[str, Step], ...] = (
 class ExecuteMixin:
     # ---- one block -----------------------------------------------------------------------------
     def _execute(self, raw: Block) -> Iterator[Event]:
-        if raw.stmt is not None:  # a macro statement (ControlMixin)
-            yield from self._statement(raw)
+        if raw.stmt is not None:  # a macro statement (ControlMixin); `_run` runs most of them itself
+            ev = self._statement(raw)
+            if ev is not None:
+                yield ev
             return
         block = self._resolve(raw)
         self.block = block

@@ -36,6 +36,13 @@ from nc.interp.reading import ReadingMixin
 from nc.interp.records import Frame, PreviewRecord, _compensation, _log_length
 
 
+def _located(exc: Exception, block: Block, program: str) -> NcAlarm:
+    """The alarm a block raised, or its numerical error as 0x0257, at the block's line."""
+    if isinstance(exc, NcAlarm):
+        return exc.at(block.line, block.text, program)
+    return NcAlarm(0x0257, f"numerical error: {exc}", line=block.line, block=block.text, program=program)
+
+
 class Interpreter(ExecuteMixin, ReadingMixin, ModalMixin, MotionMixin, NonModalMixin, ControlMixin, CallsMixin, ContourMixin, CanonicalMixin):
     def __init__(self, profile: Profile, start: dict[str, float] | None = None,
                  store: ProgramStore | None = None) -> None:
@@ -145,6 +152,14 @@ class Interpreter(ExecuteMixin, ReadingMixin, ModalMixin, MotionMixin, NonModalM
             block = self._take_block(fr, limit)
             if block is None:
                 continue
+            if block.stmt is not None:  # a macro statement: a plain call, no generator (issue 16)
+                try:
+                    ev = self._statement(block)
+                except (NcAlarm, ValueError, ArithmeticError, OverflowError) as exc:
+                    raise _located(exc, block, fr.program.name) from None
+                if ev is not None:
+                    yield ev
+                continue
             try:
                 end = False
                 for ev in self._execute(block):
@@ -153,11 +168,8 @@ class Interpreter(ExecuteMixin, ReadingMixin, ModalMixin, MotionMixin, NonModalM
                         end = True
                 if end:
                     return
-            except NcAlarm as alarm:
-                raise alarm.at(block.line, block.text, fr.program.name) from None
-            except (ValueError, ArithmeticError, OverflowError) as exc:
-                raise NcAlarm(0x0257, f"numerical error: {exc}", line=block.line, block=block.text,
-                              program=fr.program.name) from None
+            except (NcAlarm, ValueError, ArithmeticError, OverflowError) as exc:
+                raise _located(exc, block, fr.program.name) from None
         self._check_no_pending_angle()
         yield ProgramEnd(last.line if last else 0, last.text if last else "", 0)
 

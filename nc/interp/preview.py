@@ -28,7 +28,8 @@ class PreviewWindow:
         self.depth = max(0, depth)
         self.buf: deque[Event] = deque()
         self.executing: Move | None = None  # the motion block the machine is running now
-        interp.on_statement = self._statement
+        if interp.preview_log.maxlen != 0:  # a log that keeps nothing is not worth a call per statement
+            interp.on_statement = self._statement
 
     def _statement(self, block, program: str) -> None:
         first = None

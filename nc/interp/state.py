@@ -80,6 +80,12 @@ class Frames:
         if not self.work_offsets:
             self.work_offsets = [{a: 0.0 for a in self.axes} for _ in range(6 + N_EXT_WCS)]
 
+    def copy(self) -> "Frames":
+        """An independent copy (what copy.deepcopy gives, at a tenth of its cost: a lathe cycle's
+        contour is interpreted on a copy of the interpreter, issue 16)."""
+        return Frames(self.axes, [dict(w) for w in self.work_offsets], dict(self.external),
+                      dict(self.local_shift), dict(self.set_shift), dict(self.tool_shift))
+
     def origins(self, wcs: int, axes: tuple[str, ...]) -> dict[str, float]:
         """`origin` of every axis at once (the interpreter's per-block coordinate conversion)."""
         e, w, lo, s, t = self.external, self.work_offsets[wcs], self.local_shift, self.set_shift, self.tool_shift

@@ -315,7 +315,11 @@ def evaluate(e: Expr, read: Callable[[int], Value]) -> Value:
 
 def var_index(v: Var, read: Callable[[int], Value]) -> int:
     ix = v.index
-    raw = ix.value if type(ix) is Num else evaluate(ix, read)  # `#1`: a number, most variables
+    return checked_index(ix.value if type(ix) is Num else evaluate(ix, read))  # `#1`: a number, most variables
+
+
+def checked_index(raw: Value) -> int:
+    """The variable number a `#[...]` index value names, or the alarm."""
     if raw is None:
         raise NcAlarm(0x0235, "#[...] index is vacant")
     idx = _round_half_away(raw)
