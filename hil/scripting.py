@@ -33,6 +33,7 @@ from mlc.machine import Mlc
 from mlc.nc_link import MODE_NAMES
 from mlc.signals import d2, d3, m2, m3
 from nc.alarms import Alarm, NcAlarm
+from nc.softlimits import SoftLimits
 from nc.channel import Channel
 from nc.interp import Interpreter
 from nc.interrupt import m96_link
@@ -114,6 +115,8 @@ class Machine:
             raise ScriptError("; ".join(str(a) for a in r.result.alarms) or "drives did not enable")
         start = dict(zip(r.axes, r.actual.tolist()))
         r.channel = Channel(Planner(self.bench.motion_config(), start, spindle_rpm=lambda: self.mlc.spindle.rpm))
+        # the bench's soft limits hold for the manual modes too (App. A 0x0A01-0x0A04, nc.softlimits)
+        r.channel.soft_limits = SoftLimits.for_bench(self.bench, make_profile(self.bench.profile, r.axes, self.bench.params))
         self.mlc.manual.position[:] = r.actual
         self.mlc.manual.take_over(r.actual.copy())
         self.mlc.manual.home_input = r.home_input  # NC-side homing on the drive's home switch (issue 5)
@@ -315,6 +318,7 @@ class Machine:
         self.mlc.attach_variables(interp.vars)
         ch = Channel(Planner(self.bench.motion_config(), here, spindle_rpm=lambda: self.mlc.spindle.rpm))
         r.channel = ch
+        ch.soft_limits = SoftLimits.for_bench(self.bench, interp.profile)  # bench + this program's G10 L21
         ch.m96 = m96_link(interp)  # the MLC's M2x019 interrupts it (machine.interrupt())
         ch.load(interp.run(program))
         self.pulse(m2(self.x, OPERATOR_BUTTONS["cycle-start"]))

@@ -15,6 +15,7 @@ from typing import Any
 from mlc.memory import DeviceMemory
 from mlc.signals import d2, d3, m2, m3
 from nc.alarms import Alarm
+from nc.softlimits import ManualLimitLatch
 from nc.channel import Channel, RunState
 from nc.manual import ManualMotion
 from nc.motion.css import spindle_speed
@@ -72,6 +73,7 @@ class ChannelLink:
     _program_end: int | None = None
     _mode_switch_cycles: int = 0
     handshake_log: list[tuple[int, str, float]] = field(default_factory=list)  # (cycle, kind, value)
+    limit_latch: ManualLimitLatch = field(default_factory=ManualLimitLatch)  # App. A 0x0A01-0x0A04 in manual
     cycle: int = 0
 
     # ---- helpers --------------------------------------------------------------------------------
@@ -163,6 +165,8 @@ class ChannelLink:
         self.alarms.clear()
         self._alarms_seen.clear()
         self._reset_pending = True
+        for alarm in self.limit_latch.reset():  # an axis still on a soft limit: reset does not clear it
+            self._raise(ch, alarm)
 
     def _feed_hold(self, ch: Channel) -> None:
         hold = getattr(ch, "feed_hold", None)
@@ -278,11 +282,16 @@ class ChannelLink:
     def _manual(self, ch: Channel) -> None:
         mm, x = self.manual, self.x
         assert mm is not None
+        limits = getattr(ch, "soft_limits", None)
+        windows = {}
         for i, a in enumerate(self.axes):
             st = mm.axes[a]
             st.lock_pos = self._m2(336 + i)
             st.lock_neg = self._m2(352 + i)
-            st.soft_limit_disabled = self._m2(368 + i)
+            st.soft_limit_disabled = False  # M2x368 turns off the 1st segment only (the window below)
+            if limits is not None:  # the bench's soft_limits and G10 L21 clamp the manual moves too
+                windows[a] = low, high = self.limit_latch.window(limits, a, not self._m2(368 + i))
+                st.soft_min, st.soft_max = (low[0] if low else None), (high[0] if high else None)
         if self._estop or self.mode not in MANUAL_MODES or ch.busy:
             return
         pct = self.mem.u16(d2(x, 6))
@@ -323,6 +332,11 @@ class ChannelLink:
                     else:
                         mm.home(a)
         pos = mm.step()
+        for i, a in enumerate(self.axes):
+            if a in windows and (a in mm.clamped or a in self.limit_latch.latched):
+                alarm = self.limit_latch.update(a, float(pos[i]), *windows[a], a in mm.clamped)
+                if alarm is not None:
+                    self._raise(ch, alarm)
         if ch.planner.idle:
             ch.planner.position[:] = pos
 

@@ -64,6 +64,8 @@ class ManualMotion:
         self._vcap = np.array([self.cfg.limit(a).max_velocity for a in self.cfg.axes])
         # homing phase per axis: None, "leave", "search", "creep", "back", "fine", "return"
         self._phase: list[str | None] = [None] * n
+        self.clamped: set[str] = set()  # axes whose last step was cut at a soft limit, or ended on one
+        self._cut: set[str] = set()  # axes moving to a position target that was cut at a soft limit
 
     def _make_input(self, i: int) -> InputParameter:
         lim = self.cfg.limit(self.cfg.axes[i])
@@ -101,7 +103,11 @@ class ManualMotion:
     def move_to(self, axis: str, target: float, speed: float | None = None) -> None:
         i = self.index(axis)
         st = self.axes[axis]
-        target = self._clamp(axis, target)
+        wanted, target = target, self._clamp(axis, target)
+        if target != wanted:
+            self._cut.add(axis)  # an INC/MPG target cut at a soft limit: the axis will reach it
+        else:
+            self._cut.discard(axis)
         if (target > self.position[i] and st.lock_pos) or (target < self.position[i] and st.lock_neg):
             return
         self._move_raw(i, target, speed or self._vcap[i])
@@ -226,6 +232,7 @@ class ManualMotion:
 
     # ---- per cycle ----------------------------------------------------------------------------
     def step(self) -> np.ndarray:
+        self.clamped = set()
         for i, mode in enumerate(self._mode):
             if mode is None:
                 if self._phase[i] is not None:
@@ -245,12 +252,17 @@ class ManualMotion:
             new = out.new_position[0]
             a = self.cfg.axes[i]
             clamped = self._clamp(a, new)
+            if clamped != new:
+                self.clamped.add(a)  # cut at a soft limit: the axis reached it (App. A 0x0A01/0x0A03)
             self.position[i] = clamped
             self.velocity[i] = out.new_velocity[0] if clamped == new else 0.0
             self.acceleration[i] = out.new_acceleration[0] if clamped == new else 0.0
             at_rest = abs(self.velocity[i]) < 1e-9 and abs(self.acceleration[i]) < 1e-9
             # In the velocity interface "Finished" only means the target velocity is reached.
             done = at_rest and inp.target_velocity[0] == 0.0 if mode == "velocity" else res == Result.Finished
+            if done and a in self._cut:
+                self._cut.discard(a)
+                self.clamped.add(a)
             if done:
                 self._mode[i] = None
                 self.velocity[i] = self.acceleration[i] = 0.0

@@ -22,6 +22,7 @@ from nc.alarms import Alarm
 from nc.moves import Move
 
 _EPS = 1e-9
+_AWAY = 1e-6  # mm: a manual move left the limit position it was clamped on
 
 
 @dataclass
@@ -101,3 +102,55 @@ def _path_ranges(move: Move) -> dict[str, tuple[float, float]]:
                 lo, hi = r.get(ax, (v, v))
                 r[ax] = (min(lo, v), max(hi, v))
     return r
+
+
+@dataclass
+class ManualLimitLatch:
+    """The soft-limit alarms of the manual modes (JOG, INC, MPG), App. A 0x0A01-0x0A04.
+
+    A manual move is clamped at the limit (nc.manual), so there the axis *reaches* the limit position: 0x0A01
+    (1st segment) / 0x0A03 (2nd) is raised and latched. "The machine must move away from the limit position before
+    system reset": a reset while the axis still stands on it leaves the alarm; once the axis has moved away, 0x0A02
+    / 0x0A04 ("the status ... needs to be cleared") is raised, and the next reset clears the latch."""
+
+    latched: dict[str, tuple[int, str, bool]] = field(default_factory=dict)  # axis -> (segment, side, moved away)
+
+    @staticmethod
+    def window(limits: SoftLimits, axis: str, first_on: bool) -> tuple[tuple[float, int] | None, tuple[float, int] | None]:
+        """The tighter of both segments per side, as ((lower, segment) | None, (upper, segment) | None)."""
+        lows, highs = [], []
+        for seg in ((1, 2) if first_on else (2,)):
+            lo, hi = limits.window(axis, seg)
+            if lo is not None:
+                lows.append((lo, seg))
+            if hi is not None:
+                highs.append((hi, seg))
+        return (max(lows) if lows else None), (min(highs, key=lambda t: t[0]) if highs else None)
+
+    def update(self, axis: str, position: float, low: tuple[float, int] | None,
+               high: tuple[float, int] | None, clamped: bool) -> Alarm | None:
+        """After a manual step (`clamped`: the step was cut at a limit): the alarm this axis raises now, or None."""
+        held = self.latched.get(axis)
+        if held is not None:
+            seg, side, away = held
+            bound = low if side == "-" else high
+            if not away and (bound is None or abs(position - bound[0]) > _AWAY):
+                self.latched[axis] = (seg, side, True)
+                return Alarm(0x0A02 if seg == 1 else 0x0A04, f"software limit {seg} {side} of axis {axis}: moved away "
+                             f"to {position:.4f}; reset to clear", axis=axis)
+            return None
+        if not clamped:  # a program may end on a limit; only a manual move cut by it has *reached* it
+            return None
+        for bound, side in ((low, "-"), (high, "+")):
+            if bound is not None and abs(position - bound[0]) <= _EPS:
+                self.latched[axis] = (bound[1], side, False)
+                return Alarm(0x0A01 if bound[1] == 1 else 0x0A03, f"software limit {bound[1]} {side} of axis "
+                             f"{axis}: the axis reached the limit position {bound[0]:.4f} in manual mode; move it "
+                             f"away before reset", axis=axis)
+        return None
+
+    def reset(self) -> list[Alarm]:
+        """A reset: latches whose axis moved away are cleared; the alarms of axes still on the limit stay."""
+        self.latched = {a: v for a, v in self.latched.items() if not v[2]}
+        return [Alarm(0x0A01 if seg == 1 else 0x0A03, f"software limit {seg} {side} of axis {a}: still on the "
+                      f"limit position, move it away before reset", axis=a) for a, (seg, side, _) in self.latched.items()]
