@@ -15,6 +15,7 @@ from virtual_bus.drive_modes import CST, MODE_OBJECTS, check_value
 from virtual_bus.ethercat.coe import ABORT_VALUE_RANGE, ObjectDictionary, SdoAbort
 from virtual_bus.ethercat.device import OBJ_VAR, TYPES, OdEntry, OdObject
 from virtual_bus.ethercat.esc import SlaveApp
+from virtual_bus.ethercat.pdo_image import Images
 from virtual_bus.servo_params import ServoParamError, ServoParams, coe_objects
 
 # (index, subindex) -> RxPdo / TxPdo attribute, from the layouts' entries
@@ -23,30 +24,17 @@ TX_ATTR = {(e.index, e.subindex): e.attr for e in ASDA_CSP_CSV.tx + ASDA_E.tx}
 COMM_FAULT = 0x7500  # CiA 402 error code class "communication"
 
 
-def _unpack(data: bytes, mapping, od: ObjectDictionary) -> None:
-    pos = 0
-    for index, sub, bits in mapping:
-        n = bits // 8
-        e = od.objects[index].entries[sub]
-        od.set(index, sub, int.from_bytes(data[pos:pos + n], "little", signed=e.signed))
-        pos += n
-
-
-def _pack(mapping, od: ObjectDictionary) -> bytes:
-    out = bytearray()
-    for index, sub, bits in mapping:
-        n = bits // 8
-        v = od.value(index, sub)
-        out += (v & ((1 << bits) - 1)).to_bytes(n, "little")
-    return bytes(out)
-
-
 @dataclass
 class DriveApp(SlaveApp):
     drive: Cia402Drive
     od: ObjectDictionary | None = None
     _last_error: int = 0
     _params: set[int] = field(default_factory=set)  # object indices of the Delta Pn-xx parameters
+    # Compiled once at attach (issue 17): the OD entries behind RxPdo / TxPdo fields, so a frame
+    # makes no object lookups; entries keep their identity (SDO writes change their values only).
+    _rx_pairs: list[tuple[str, OdEntry]] = field(default_factory=list)
+    _tx_pairs: list[tuple[OdEntry, str]] = field(default_factory=list)
+    _images: Images = field(default_factory=Images)
 
     def attach(self, od: ObjectDictionary) -> None:
         self.od = od
@@ -63,6 +51,8 @@ class DriveApp(SlaveApp):
         for (index, sub), attr in MODE_OBJECTS.items():
             if index in od.objects and sub in od.objects[index].entries:
                 setattr(objects, attr, od.value(index, sub))
+        self._rx_pairs = [(attr, od.entry(index, sub)) for (index, sub), attr in RX_ATTR.items() if index in od.objects]
+        self._tx_pairs = [(od.entry(index, sub), attr) for (index, sub), attr in TX_ATTR.items() if index in od.objects]
         self._publish()
 
     def _before_write(self, index: int, sub: int, value) -> None:
@@ -92,12 +82,9 @@ class DriveApp(SlaveApp):
             raise SdoAbort(exc.code) from None
 
     def _publish(self) -> None:
-        od = self.od
-        assert od is not None
         fb = self.drive.feedback()
-        for (index, sub), attr in TX_ATTR.items():
-            if index in od.objects:
-                od.set(index, sub, int(getattr(fb, attr)))
+        for e, attr in self._tx_pairs:
+            e.value = int(getattr(fb, attr))
 
     def refresh(self, index: int) -> None:
         if any(index == i for i, _ in TX_ATTR):
@@ -108,6 +95,7 @@ class DriveApp(SlaveApp):
     def cycle(self, outputs: bytes, rx_map, tx_map, step: bool, dt: float = 0.0, lost: bool = False) -> bytes:
         od = self.od
         assert od is not None
+        images = self._images.get(rx_map, tx_map, od)
         if step and lost:
             # Out of OP by an error (SM watchdog, sync, AL error): the outputs are not valid any more.
             # The drive takes its communication fault reaction (CiA 402 0x6007 = 2: fault, braking on
@@ -116,18 +104,18 @@ class DriveApp(SlaveApp):
                 self.drive.fault(COMM_FAULT)  # a drive that was not powering its motor has nothing to stop
             self.drive.step(dt)
         elif step:
-            _unpack(outputs, rx_map, od)
+            images.unpack(outputs, rx_map, od)
             if self.drive.mode == CST and 0x60E0 in od.objects:  # torque limits may travel in 0x1603
                 self.drive.modes.objects.positive_torque_limit = od.value(0x60E0)
                 self.drive.modes.objects.negative_torque_limit = od.value(0x60E1)
             rx = RxPdo(mode=self.drive.mode)
-            for (index, sub), attr in RX_ATTR.items():
-                if index in od.objects:
-                    setattr(rx, attr, od.value(index, sub))
+            for attr, e in self._rx_pairs:
+                v = e.value
+                setattr(rx, attr, v if isinstance(v, int) else 0)  # ObjectDictionary.value's rule
             self.drive.apply(rx)
             self.drive.step(dt)
         self._publish()
-        return _pack(tx_map, od)
+        return images.pack(tx_map, od)
 
     def new_error(self) -> int:
         """The drive's error code if it changed to a new non-zero value since the last call."""
@@ -149,6 +137,7 @@ class DioApp(SlaveApp):
     history: list[int] = field(default_factory=list)
     in_objs: list[tuple[int, int]] = field(default_factory=list)  # (index, bits) per input module
     out_objs: list[tuple[int, int]] = field(default_factory=list)
+    _images: Images = field(default_factory=Images)
 
     def attach(self, od: ObjectDictionary) -> None:
         self.od = od
@@ -178,12 +167,13 @@ class DioApp(SlaveApp):
     def cycle(self, outputs: bytes, rx_map, tx_map, step: bool, dt: float = 0.0, lost: bool = False) -> bytes:
         od = self.od
         assert od is not None
+        images = self._images.get(rx_map, tx_map, od)
         if step and not lost:
-            _unpack(outputs, rx_map, od)
+            images.unpack(outputs, rx_map, od)
             value, shift = 0, 0
             for index, bits in self.out_objs:
                 value |= (od.value(index, 1) & ((1 << bits) - 1)) << shift
                 shift += bits
             self.outputs = value
         self._publish()
-        return _pack(tx_map, od)
+        return images.pack(tx_map, od)

@@ -124,6 +124,11 @@ class Esc:
         self.events: list[str] = []
         self.wkc_fault = False
         self.refuse: dict[int, int] = {}  # AL state -> AL status code it is refused with (fault injection)
+        # SyncManager and FMMU settings decoded once, and the copy plan of each logical datagram seen,
+        # until the master writes the 0x0600-0x087F registers again (issue 17: no per-frame decoding).
+        self._sms: dict[int, Sm] = {}
+        self._fmmus: list[tuple[int, int, int, int]] | None = None
+        self._plans: dict[tuple[int, int, int], tuple[list, list]] = {}
         self.power_on()
 
     # ---- reset --------------------------------------------------------------------------
@@ -145,6 +150,12 @@ class Esc:
         self.mbx_out.clear()
         self.mbx_full = False
         self.rx_map, self.tx_map = [], []
+        self._layout_changed()
+
+    def _layout_changed(self) -> None:
+        self._sms.clear()
+        self._fmmus = None
+        self._plans.clear()
 
     # ---- small register helpers -----------------------------------------------------------
     def u16(self, a: int) -> int:
@@ -169,8 +180,11 @@ class Esc:
         return self.u16(R_AL_CODE)
 
     def sm(self, k: int) -> Sm:
-        start, length, control, _status, act = struct.unpack_from("<HHBBB", self.mem, R_SM + 8 * k)
-        return Sm(start, length, control, bool(act & 1))
+        got = self._sms.get(k)
+        if got is None:
+            start, length, control, _status, act = struct.unpack_from("<HHBBB", self.mem, R_SM + 8 * k)
+            got = self._sms[k] = Sm(start, length, control, bool(act & 1))
+        return got
 
     # ---- DC clock -------------------------------------------------------------------------
     def local_ns(self, mono_ns: int | None = None) -> int:
@@ -246,6 +260,8 @@ class Esc:
             self._latch_receive_times()
         if hit(0x0300, 0x14):
             self.mem[0x0300:0x0314] = bytes(0x14)  # writing any error counter clears them
+        if hit(R_FMMU, 0x100) or hit(R_SM, 0x80):
+            self._layout_changed()
         if hit(R_SM + 6, 1) or hit(R_SM + 8 + 6, 1):
             self._mailbox_repeat()
 
@@ -363,12 +379,14 @@ class Esc:
     # ---- FMMUs and process data -------------------------------------------------------------
     def fmmus(self) -> list[tuple[int, int, int, int]]:
         """Active FMMUs as (logical start, physical start, type, length)."""
-        out = []
-        for k in range(8):
-            ls, ln, _sb, _eb, ps, _pb, typ, act = struct.unpack_from("<IHBBHBBB", self.mem, R_FMMU + 16 * k)
-            if act & 1 and ln:
-                out.append((ls, ps, typ, ln))
-        return out
+        if self._fmmus is None:
+            out = []
+            for k in range(8):
+                ls, ln, _sb, _eb, ps, _pb, typ, act = struct.unpack_from("<IHBBHBBB", self.mem, R_FMMU + 16 * k)
+                if act & 1 and ln:
+                    out.append((ls, ps, typ, ln))
+            self._fmmus = out
+        return self._fmmus
 
     def _write_inputs(self, data: bytes) -> None:
         if data:
@@ -378,25 +396,20 @@ class Esc:
     def logical(self, cmd: int, addr: int, data: bytearray) -> int:
         """LRD/LWR/LRW through the FMMUs. Returns the WKC increment. In lock-step the outputs are
         applied and the model advanced before the inputs are copied, so one frame = one cycle."""
-        state = self.al_state
-        if state not in (SAFEOP, OP):
+        mem = self.mem
+        state = mem[R_AL_STATUS] & 0x0F
+        if state != SAFEOP and state != OP:
             return 0
-        n = len(data)
-        reads, writes = [], []
-        for ls, ps, typ, ln in self.fmmus():
-            lo, hi = max(addr, ls), min(addr + n, ls + ln)
-            if lo >= hi:
-                continue
-            if typ & 2 and cmd in (LWR, LRW):
-                writes.append((lo, hi, ps + lo - ls))
-            if typ & 1 and cmd in (LRD, LRW):
-                reads.append((lo, hi, ps + lo - ls))
+        plan = self._plans.get((cmd, addr, len(data)))
+        if plan is None:
+            plan = self._plans[(cmd, addr, len(data))] = self._plan(cmd, addr, len(data))
+        writes, reads = plan
         inc = 0
-        if writes and not self.mem[R_AL_STATUS] & AL_ERROR:
+        if writes and not mem[R_AL_STATUS] & AL_ERROR:
             # The ESC takes outputs from SAFE-OP on (the SM is enabled); only OP applies them. After
             # an error (watchdog, sync) the application deactivates the output SM: no write WKC.
-            for lo, hi, p in writes:
-                self.mem[p:p + hi - lo] = data[lo - addr:hi - addr]
+            for d0, d1, p0, p1 in writes:
+                mem[p0:p1] = data[d0:d1]
             inc += 2 if cmd == LRW else 1
         # A slave without outputs (an R1-EC station of input modules only) cycles on its reads.
         if state == OP and (writes or (reads and not self.rx_map)):
@@ -408,18 +421,33 @@ class Esc:
             self.last_output_ns = now
             self.outputs_written += 1
             s2 = self.sm(2)
-            self._write_inputs(self.app.cycle(bytes(self.mem[s2.start:s2.end]), self.rx_map, self.tx_map,
+            self._write_inputs(self.app.cycle(memoryview(mem)[s2.start:s2.end], self.rx_map, self.tx_map,
                                               step=True, dt=dt))
         elif reads and state == SAFEOP:
             s2 = self.sm(2)
-            lost = bool(self.mem[R_AL_STATUS] & AL_ERROR) and self.outputs_written > 0  # dropped out of OP
-            self._write_inputs(self.app.cycle(bytes(self.mem[s2.start:s2.end]), self.rx_map, self.tx_map,
+            lost = bool(mem[R_AL_STATUS] & AL_ERROR) and self.outputs_written > 0  # dropped out of OP
+            self._write_inputs(self.app.cycle(memoryview(mem)[s2.start:s2.end], self.rx_map, self.tx_map,
                                               step=lost, dt=self.cycle_time, lost=lost))
         if reads:
-            for lo, hi, p in reads:
-                data[lo - addr:hi - addr] = self.mem[p:p + hi - lo]
+            for d0, d1, p0, p1 in reads:
+                data[d0:d1] = mem[p0:p1]
             inc += 1
         return 0 if self.wkc_fault else inc
+
+    def _plan(self, cmd: int, addr: int, n: int) -> tuple[list, list]:
+        """Where a logical datagram's bytes go: (datagram slice, physical slice) per FMMU it hits,
+        outputs (written) and inputs (read)."""
+        reads, writes = [], []
+        for ls, ps, typ, ln in self.fmmus():
+            lo, hi = max(addr, ls), min(addr + n, ls + ln)
+            if lo >= hi:
+                continue
+            part = (lo - addr, hi - addr, ps + lo - ls, ps + hi - ls)
+            if typ & 2 and cmd in (LWR, LRW):
+                writes.append(part)
+            if typ & 1 and cmd in (LRD, LRW):
+                reads.append(part)
+        return writes, reads
 
     # ---- watchdog -------------------------------------------------------------------------
     def watchdog_ns(self) -> int:
@@ -459,8 +487,10 @@ class Esc:
             self.post(MBX_TYPE_COE, self.coe.emergency(code, register, data))
 
     def _mailbox_fill(self) -> None:
+        if self.mbx_full or not self.mbx_out:
+            return
         mi = self.sm(1)
-        if self.mbx_full or not self.mbx_out or not mi.enabled:
+        if not mi.enabled:
             return
         msg = self.mbx_out.popleft()
         self.mem[mi.start:mi.end] = msg[:mi.length].ljust(mi.length, b"\x00")

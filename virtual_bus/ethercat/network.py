@@ -19,6 +19,8 @@ from virtual_bus.ethercat.esc import (APRD, APRW, APWR, ARMW, BRD, BRW, BWR, FPR
 from virtual_bus.ethercat.faults import Fault
 
 ETH_P_ECAT = 0x88A4
+_HEAD = struct.Struct("<BBHHH")  # datagram header: cmd, index, ADP, ADO, length (+ flags)
+_U16 = struct.Struct("<H")
 _READS = {APRD, FPRD, BRD}
 _WRITES = {APWR, FPWR, BWR}
 _RW = {APRW, FPRW, BRW}
@@ -87,21 +89,27 @@ class Chain:
     # ---- frames ---------------------------------------------------------------------------
     def process(self, frame: bytes) -> tuple[bytes | None, float]:
         """Process one Ethernet frame; returns (answer or None if lost, delay in s)."""
-        if len(frame) < 16 or struct.unpack_from(">H", frame, 12)[0] != ETH_P_ECAT:
+        if len(frame) < 16 or frame[12] != ETH_P_ECAT >> 8 or frame[13] != ETH_P_ECAT & 0xFF:
             return None, 0.0
-        hdr = struct.unpack_from("<H", frame, 14)[0]
+        hdr = _U16.unpack_from(frame, 14)[0]
         if hdr >> 12 != 1:
             return None, 0.0
         buf = bytearray(frame)
-        # pre-scan for logical datagrams: those frames are the process-data cycle
-        is_pd, pos, end = False, 16, 16 + (hdr & 0x7FF)
-        while pos + 12 <= len(buf):
-            cmd = buf[pos]
-            ln = struct.unpack_from("<H", buf, pos + 6)[0]
-            if cmd in (LRD, LWR, LRW):
+        view = memoryview(buf)
+        # The datagrams are found once per frame (their lengths do not change on the way); frames with
+        # a logical datagram are the process-data cycle.
+        is_pd, pos, end, size = False, 16, min(16 + (hdr & 0x7FF), len(buf)), len(buf)
+        grams = []
+        while pos + 12 <= size:
+            cmd, _idx, adp, ado, ln = _HEAD.unpack_from(buf, pos)
+            n = ln & 0x7FF
+            if LRD <= cmd <= LRW:
                 is_pd = True
-            pos += 10 + (ln & 0x7FF) + 2
-            if not ln & 0x8000:
+            wpos = pos + 10 + n
+            if wpos + 2 <= size:
+                grams.append((pos, cmd, adp | (ado << 16), wpos, view[pos + 10:wpos]))
+            pos = wpos + 2
+            if not ln & 0x8000 or wpos + 2 > size:
                 break
         self.frames += 1
         drop, delay = self._fault_step(is_pd)
@@ -114,29 +122,22 @@ class Chain:
         for i, s in enumerate(line):
             s.position, s.chain_len, s.frame_ns = i, len(line), now
             s.check_watchdog(now)
-            self._walk(s, buf, min(end, len(buf)))
+            self._walk(s, buf, end, grams)
             s.idle()
         buf[6] |= 0x02
         return bytes(buf), delay
 
-    def _walk(self, s: Esc, buf: bytearray, end: int) -> None:
-        pos = 16
-        while pos + 12 <= len(buf):
-            cmd, _idx, adp, ado, ln = struct.unpack_from("<BBHHH", buf, pos)
-            n = ln & 0x7FF
-            dstart = pos + 10
-            wpos = dstart + n
-            if wpos + 2 > len(buf):
-                break
-            data = memoryview(buf)[dstart:wpos]
-            wkc = struct.unpack_from("<H", buf, wpos)[0]
-            inc, adp = self._datagram(s, cmd, adp, ado, data)
-            struct.pack_into("<H", buf, pos + 2, adp)
+    def _walk(self, s: Esc, buf: bytearray, end: int, grams: list) -> None:
+        """One slave's pass over the frame's datagrams, in order."""
+        for pos, cmd, logical, wpos, data in grams:
+            if LRD <= cmd <= LRW:
+                inc = s.logical(cmd, logical, data)  # the address is not changed on the way
+            else:
+                _c, _i, adp, ado, _l = _HEAD.unpack_from(buf, pos)
+                inc, adp = self._datagram(s, cmd, adp, ado, data)
+                _U16.pack_into(buf, pos + 2, adp)
             if inc:
-                struct.pack_into("<H", buf, wpos, (wkc + inc) & 0xFFFF)
-            pos = wpos + 2
-            if not ln & 0x8000:
-                break
+                _U16.pack_into(buf, wpos, (_U16.unpack_from(buf, wpos)[0] + inc) & 0xFFFF)
 
     @staticmethod
     def _datagram(s: Esc, cmd: int, adp: int, ado: int, data: memoryview) -> tuple[int, int]:
@@ -151,11 +152,7 @@ class Chain:
             addressed = True
             new_adp = (adp + 1) & 0xFFFF
         elif cmd in (LRD, LWR, LRW):
-            logical = adp | (ado << 16)
-            tmp = bytearray(data)
-            inc = s.logical(cmd, logical, tmp)
-            data[:] = tmp
-            return inc, adp
+            return s.logical(cmd, adp | (ado << 16), data), adp
         else:
             return 0, adp
         inc = 0
