@@ -113,6 +113,27 @@ def test_pdo_mapping_changes_only_while_the_pdo_is_invalid(bus):
     tpdo[1].raw = 0x60410010
     assert abort_of(lambda: setattr(tpdo[0], "raw", 9)) == 0x06040042  # 8 entries in this object
     tpdo[0].raw = 1
+    rpdo, rcob = node.sdo[0x1600], node.sdo[0x1400][1]  # the same for a receive PDO
+    assert abort_of(lambda: setattr(rpdo[1], "raw", 0x60400010)) == 0x06010000
+    rcob.raw = rcob.raw | 0x80000000
+    rpdo[0].raw = 0
+    rpdo[1].raw = 0x60400010
+    rpdo[0].raw = 1
+    rcob.raw = rcob.raw & 0x7FFFFFFF
+
+
+def test_a_valid_pdo_keeps_its_can_id(bus):
+    """CiA 301 7.5.2.35/7.5.2.37: while the PDO exists (COB-ID bit 31 clear) bits 0-29 cannot change (CANopenNode:
+    0x06090030); invalid first, the new ID is taken, and validating it again changes only bit 31."""
+    _, _, node = bus
+    cob = node.sdo[0x1800][1]
+    valid = cob.raw
+    assert not valid & 0x80000000
+    assert abort_of(lambda: setattr(cob, "raw", valid + 1)) == 0x06090030
+    assert cob.raw == valid
+    cob.raw = (valid + 1) | 0x80000000
+    cob.raw = valid + 1
+    assert cob.raw == valid + 1
 
 
 def test_modes_of_operation_and_basenode402(bus):

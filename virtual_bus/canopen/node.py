@@ -213,6 +213,12 @@ class Cia402Slave:
                 self.drive.apply(copy.copy(self.rx))  # acyclic (SDO) device control acts at once
 
     def _check_mapping_write(self, index: int, subindex: int, value: int) -> None:
+        if index & 0xFF00 in (0x1400, 0x1800) and subindex == 1:
+            # CiA 301 7.5.2.35/37: while a PDO exists (bit 31 clear) its CAN-ID (bits 0-29) stays; CANopenNode
+            # answers 0x06090030. Setting bit 31 with a new ID in one write, as python-canopen does, is allowed.
+            old = self._value(index, 1)
+            if not (old | value) & 0x80000000 and (old ^ value) & 0x3FFFFFFF:
+                raise SdoAbortedError(ABORT_VALUE_RANGE)
         if index & 0xFF00 in (0x1600, 0x1A00):
             # CiA 301 7.5.2.36/38: a mapping changes only while its PDO is invalid (COB-ID bit 31 set)
             # and, for the entries, while sub 0 is 0; sub 0 never above the entries the object has.
