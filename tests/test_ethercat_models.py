@@ -314,3 +314,43 @@ def test_hil_sim_ethercat_builds_the_drives_from_a_vendor_esi(tmp_path):
         assert len(rows) == 3 and all("ASDA-A3-E from the vendor file" in row for row in rows), rows
         r = hil("run", str(ROOT / "examples" / "lathe_demo.nc"), "--bus", f"ethercat:{sim.iface}")
         assert r.returncode == 0 and "result         completed" in r.stdout, r.stdout + r.stderr
+
+
+@pytest.mark.skipif(can_create() is not None, reason=can_create() or "")
+def test_master_maps_over_a_drive_left_remapped():
+    """A drive keeps the last mapping written until power-off: a LinuxCNC session before ours left lcec_deasda's
+    0x1602 = 6040/60FF and 0x1A02 = 6041/606C/6064/2511 assigned. hil's master maps over it entry by entry, the
+    line reaches OP with the ASDA_E image (15 bytes out, 23 in) and the drive's 0x1602/0x1A02 read back as ASDA_E."""
+    import struct
+
+    pysoem = pytest.importorskip("pysoem")
+    lcec = {0x1602: [0x60400010, 0x60FF0020], 0x1A02: [0x60410010, 0x606C0020, 0x60640020, 0x25110020]}
+    with SimProcess(tag="r") as sim:
+        m = pysoem.Master()
+        m.open(sim.iface)
+        try:
+            assert m.config_init() == 3
+            for s in m.slaves:
+                for index, words in lcec.items():
+                    s.sdo_write(index, 0, b"\x00")
+                    for k, w in enumerate(words, 1):
+                        s.sdo_write(index, k, struct.pack("<I", w))
+                    s.sdo_write(index, 0, bytes([len(words)]))
+                for assign, pdo in ((0x1C12, 0x1602), (0x1C13, 0x1A02)):
+                    s.sdo_write(assign, 0, b"\x00")
+                    s.sdo_write(assign, 1, struct.pack("<H", pdo))
+                    s.sdo_write(assign, 0, b"\x01")
+        finally:
+            m.close()
+        link = EthercatLink(sim.iface, names=["X", "Z", "S1"])
+        link.open()
+        try:
+            assert [i.state for i in link.infos] == ["OP"] * 3
+            assert [(len(s.output), len(s.input)) for s in link.drives] == [(ASDA_E.rx_bytes, ASDA_E.tx_bytes)] * 3
+            assert (ASDA_E.rx_bytes, ASDA_E.tx_bytes) == (15, 23)
+            for pos in range(3):
+                for index, entries in ((0x1602, ASDA_E.rx), (0x1A02, ASDA_E.tx)):
+                    got = [int.from_bytes(link.sdo_read(pos, index, k), "little") for k in range(len(entries) + 1)]
+                    assert got == [len(entries)] + [e.index << 16 | e.subindex << 8 | e.bits for e in entries]
+        finally:
+            link.close()
