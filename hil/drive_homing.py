@@ -21,6 +21,7 @@ if TYPE_CHECKING:
 
 HOMING_FAILED = 0xDE11  # deltahil's own (nc/alarm_table.py)
 MODE_NOT_SUPPORTED = 0x1604  # App. A: "The home mode is not supported."
+LIMIT_DURING_HOMING = 0x1601  # App. A: "The hardware limit is triggered during execution of home mode 4 ..."
 HOMING_MODE = 6
 CSP = 8
 
@@ -48,6 +49,20 @@ def _objects(runner: BenchRunner, i: int, h: DriveHoming) -> list[tuple[int, int
             (0x6099, 1, speed(h.switch_rpm)),
             (0x6099, 2, speed(h.zero_rpm)),
             (0x609A, 0, struct.pack("<I", h.accel_ms))]
+
+
+def _homing_error(runner: BenchRunner, i: int, method: int, sw: int) -> Alarm:
+    """The drive ended homing with an error (bit 13). With a limit switch active (0x60FD bit 0/1) that is App. A
+    0x1601, "the hardware limit is triggered during homing ... check if the homing search direction is correct"
+    (decisions ethercat.md E16); otherwise deltahil's 0xDE11."""
+    axis = runner.axes[i]
+    switch = {1: "negative", 2: "positive"}.get(runner.tx[i].digital_inputs & 0x3, "both")
+    if runner.tx[i].digital_inputs & 0x3:
+        return Alarm(LIMIT_DURING_HOMING, f"axis {axis}: the {switch} limit switch was met during homing (method "
+                                          f"{method}): check the search direction and that the axis starts off the "
+                                          f"limits", axis=axis)
+    return Alarm(HOMING_FAILED, f"axis {axis}: the drive reports a homing error (method {method}, statusword "
+                                f"0x{sw:04X})", axis=axis)
 
 
 def home_axes(runner: BenchRunner) -> bool:
@@ -78,9 +93,7 @@ def home_axes(runner: BenchRunner) -> bool:
             if sw & 0x3400 == 0x1400:  # homing attained, target reached
                 done.add(i)
             elif sw & 0x2000:
-                runner._alarm(Alarm(HOMING_FAILED, f"axis {runner.axes[i]}: the drive reports a homing error "
-                                                   f"(method {todo[i].method}, statusword 0x{sw:04X})",
-                                    axis=runner.axes[i]))
+                runner._alarm(_homing_error(runner, i, todo[i].method, sw))
                 break
         else:
             if len(done) == len(todo):

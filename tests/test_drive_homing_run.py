@@ -67,11 +67,32 @@ def test_run_homes_z_over_ethercat(hil, program, tmp_path):
     assert min(float(row["Z_act"]) for row in rows) < 40.0
 
 
-def test_a_homing_error_stops_the_run_before_the_program(hil, program, tmp_path):
-    # the home switch lies beyond the negative limit switch: the drive meets the limit first (bit 13)
+def test_0x1601_a_limit_switch_met_during_homing_stops_the_run_before_the_program(hil, program, tmp_path):
+    """App. A 0x1601 'The hardware limit is triggered during homing ... Check if the homing search direction is
+    correct': the home switch (edge at 40 mm) lies beyond the negative limit switch (50 mm), so the drive's search
+    meets the limit first and ends homing with an error (statusword bit 13, 0x60FD bit 0); the run stops before
+    the program, Z never reaches the program's Z10."""
     r, rows = _run(hil, program, tmp_path, limit=f", negative_limit = {50 * CPU}")
     assert r.code == 1
-    assert "0xDE11" in r.out + r.err and "homing error" in r.out + r.err
+    assert "ALARM 0x1601" in r.out + r.err and "negative limit switch" in r.out + r.err
+    assert min(float(row["Z_act"]) for row in rows) > 49.0
+
+
+def test_0xde11_a_homing_that_does_not_finish_in_time(tmp_path):
+    """deltahil's 0xDE11 stays for a homing the drive does not finish: a 0.2 s timeout for a 20 mm search."""
+    from fieldbus.link import SimLink
+    from hil.bench_file import load_bench_file
+    from hil.runner import BenchRunner
+    from hil.session import sim_slaves
+    from nc.program import parse_program
+
+    path = tmp_path / "bench.toml"
+    path.write_text(BENCH.format(bus="sim", edge=40 * CPU, method=21, limit="").replace("zero_rpm = 30 }",
+                                                                                       "zero_rpm = 30, timeout = 0.2 }"))
+    bench = load_bench_file(path)
+    result = BenchRunner(bench, SimLink(sim_slaves(bench), bench.cycle)).run_program(parse_program(PROGRAM))
+    assert [(a.code, a.axis) for a in result.alarms] == [(0xDE11, "Z")]
+    assert "not done within 0.2 s" in result.alarms[0].message
 
 
 def test_bench_refuses_a_homing_method_the_drive_lacks(hil, program, tmp_path):
