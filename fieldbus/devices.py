@@ -3,8 +3,8 @@ identity, predefined PDO sets, default encoder resolution and object units.
 
 Sources (docs/decisions/ethercat.md E11–E14): the devices' ESI data as ingested by
 linuxcnc-ethercat/esi-data ("ASDA-A3-E CoE Drive" r3, "ASDA-B3-E CoE Drive" r3, "ASDA-A2-E CoE
-Drive" r516), linuxcnc-ethercat `lcec_deasda.c` (0.1 rpm velocity, 1 280 000 counts/rev on the
-A2-E, its 0x1602/0x1A02 remap) and Delta's encoder data (A3/B3: 24 bit, A2: 1 280 000 p/rev).
+Drive" r516), linuxcnc-ethercat `lcec_deasda.c` (0.1 rpm velocity; 1 280 000 counts/rev on the A2-E, 16 777 216 on the
+A3-E/B3-E "x3 series"; its 0x1602/0x1A02 remap) and Delta's encoder data (A3/B3: 24 bit).
 The master uses it to name and check slaves; the virtual slaves' ESI-like file holds the same.
 """
 

@@ -206,6 +206,46 @@ def test_04_linuxcnc_deasda_configuration_runs_csv(master):
     assert velocity == pytest.approx(10000, abs=2)  # 0.1 rpm
 
 
+def test_04b_current_linuxcnc_deasda_configuration_on_every_model(master):
+    """LCEC (linuxcnc-ethercat master, src/devices/lcec_deasda.c): 0x1602 = 6040, 607A (CSP, its default) or 60FF
+    (CSV), and 60FE:1 on the A2-E and A3-E (FLAG_DOUT; the B3-E has none), whose output ports 1-4 it enables by
+    SDO 0x60FE:2 = 0x000F0000; 0x1A02 = 6041 606C 6064 2511 6077 60FD; 0x6060 and 0x60C2 by SDO. All three drives
+    take it, reach OP, and the CSP one follows its target position; the digital output travels in 0x60FE:1."""
+    lcec_tx = [0x60410010, 0x606C0020, 0x60640020, 0x25110020, 0x60770010, 0x60FD0020]
+    setups = []  # (slave, mode, has digital outputs)
+    for s, mode, dout in zip(master.slaves, (8, 9, 8), (True, False, True)):  # A3-E, B3-E, A2-E
+        rx = [0x60400010, 0x607A0020 if mode == 8 else 0x60FF0020] + ([0x60FE0120] if dout else [])
+        write_pdo(s, 0x1602, rx)
+        write_pdo(s, 0x1A02, lcec_tx)
+        assign(s, 0x1602, 0x1A02)
+        if dout:
+            s.sdo_write(0x60FE, 2, struct.pack("<I", 0x000F0000))
+            assert u(s.sdo_read(0x60FE, 2)) == 0x000F0000
+        s.sdo_write(0x6060, 0, bytes([mode]))
+        s.sdo_write(0x60C2, 1, b"\x01")
+        s.sdo_write(0x60C2, 2, struct.pack("<b", -3))
+        setups.append((s, mode, dout))
+    master.config_map()
+    assert [(len(s.output), len(s.input)) for s in master.slaves] == [(10, 20), (6, 20), (10, 20)]
+    to_op(master, master.slaves[0])
+    master.read_state()
+    assert [s.state for s in master.slaves] == [pysoem.OP_STATE] * 3
+    a3 = master.slaves[0]
+    start = [struct.unpack("<Hiiihi", bytes(s.input))[2] for s in master.slaves]
+    for k, cw in enumerate([0x06] * 3 + [0x07] * 3 + [0x0F] * 400):
+        target = start[0] + (100 * (k - 6) if cw == 0x0F else 0)  # the A3-E: 100 counts a cycle once enabled
+        for (s, mode, dout), held in zip(setups, start):
+            first = target if s is a3 else (held if mode == 8 else 0)  # the others hold still
+            s.output = struct.pack("<Hi", cw, first) + (struct.pack("<I", 0x00010000) if dout else b"")
+        master.send_processdata()
+        master.receive_processdata(100_000)
+    status = [struct.unpack("<Hiiihi", bytes(s.input)) for s in master.slaves]
+    assert [sw & 0x6F for sw, *_ in status] == [0x27] * 3  # all three operation enabled
+    assert abs(status[0][2] - target) <= 2_000  # following a 100 000 counts/s ramp within its lag
+    assert abs(status[2][2] - start[2]) <= 10
+    assert u(a3.sdo_read(0x60FE, 1)) == 0x00010000
+
+
 def test_05_modes_of_operation(master):
     """CiA 402: 0x6060 refuses what the drive does not run with 0x06090030; 0x6502 lists exactly the modes
     that run (PP, PV, HM, CSP, CSV, CST: bits 0, 2, 5, 7, 8, 9, the ASDA-A3-E's; decisions E13)."""
