@@ -5,6 +5,7 @@ python-canopen's BaseNode402, never our implementation."""
 
 from __future__ import annotations
 
+import json
 import logging
 import struct
 import subprocess
@@ -248,3 +249,9 @@ def test_hil_scan_lists_the_canopen_nodes(hil):
     assert all("vendor 0x000001DD" in row and "product 0x00006080" in row and " drive " in row for row in rows)
     assert all("[asda-b3-e: 16777216 counts/rev, velocity 0.1 rpm, torque 0.1 %]" in row for row in rows)
     assert [int(row.split()[0]) for row in rows] == [1, 2, 3]
+    r = hil("scan", "--bus", "canopen:virtual", "--json")  # the same, one JSON record a node
+    assert r.code == 0, r.err
+    records = [json.loads(line) for line in r.out.splitlines()]
+    assert [(x["position"], x["product"], x["model"], x["counts_per_rev"], x["velocity_unit"],
+             x["torque_unit_percent"]) for x in records] == \
+        [(k, "0x00006080", "asda-b3-e", 16_777_216, "0.1 rpm", 0.1) for k in (1, 2, 3)]
