@@ -3,6 +3,8 @@ the same Parquet trace, column by column (every column but the wall-clock `perio
 columns included), the same end record, alarms, handshakes and final positions.
 
     python benchmarks/trace_ab.py [--quick]      # --quick: the three short runs only
+    PYTHONPATH=/work/main python benchmarks/trace_ab.py --save DIR     # one tree's runs, kept in DIR
+    python benchmarks/trace_ab.py --against DIR  # this tree's runs against those (tree A/B)
 
 Shortcuts compared: `mlc-on-change` (the lathe MLC's user scan skipped while nothing it read changed,
 mlc/on_change.py). Prints one line per run and per shortcut, exits 1 on any difference.
@@ -11,6 +13,7 @@ mlc/on_change.py). Prints one line per run and per shortcut, exits 1 on any diff
 from __future__ import annotations
 
 import json
+import pickle
 import sys
 import tempfile
 from collections.abc import Callable, Iterator
@@ -20,13 +23,15 @@ from pathlib import Path
 import pyarrow.parquet as pq
 
 ROOT = Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT))
+sys.path.append(str(ROOT))  # PYTHONPATH first: --save runs the tree it names
 
 from benchmarks.bench_motion import cam_program  # noqa: E402
 from hil.api import run  # noqa: E402
 
 SIGNALS = ("M_STROBE,S_STROBE,T_STROBE,MST_FINISH,M_CODE,S_CODE,T_CODE,SPINDLE1_FWD,SPINDLE1_REV,"
-           "SPINDLE_ANALOG_1,SPINDLE1_SPEED_REACHED,PROGRAM_END,M21013,M31016,M31017,D30272,D30240,M21019")
+           "SPINDLE_ANALOG_1,SPINDLE1_SPEED_REACHED,PROGRAM_END,M21013,M31016,M31017,D30272,D30240,M21019,"
+           # the drive status the NC writes (issue 17: written when it changed)
+           "D30242,D30274,D30338,D30400,D30401,M31256,M31272,M31464,M31480,M31497,M31034,D31026,D31028,M31705")
 LATHE, LATHE_C, MILL = (str(ROOT / "benches" / f) for f in ("lathe-2axis.toml", "lathe-c-axis.toml", "mill-3axis.toml"))
 
 
@@ -90,10 +95,27 @@ def compare(a: tuple, b: tuple) -> list[str]:
 
 def main(argv: list[str]) -> int:
     quick = "--quick" in argv
+    save = Path(argv[argv.index("--save") + 1]) if "--save" in argv else None
+    against = Path(argv[argv.index("--against") + 1]) if "--against" in argv else None
     bad = 0
     with tempfile.TemporaryDirectory() as d:
         tmp = Path(d)
-        for name, program, kw in runs(tmp, quick):
+        for k, (name, program, kw) in enumerate(runs(tmp, quick)):
+            if save is not None or against is not None:
+                res = one(program, kw, tmp / "t.parquet")
+                res[1][-1].get(b"deltahil", {}).pop("program", None)  # the CAM program's temporary path
+                kept = (save or against) / f"run{k}.pickle"
+                if save is not None:
+                    save.mkdir(parents=True, exist_ok=True)
+                    kept.write_bytes(pickle.dumps(res))
+                    print(f"{name:24s} saved ({len(next(iter(res[0].values())))} rows)")
+                    continue
+                diff = compare(pickle.loads(kept.read_bytes()), res)
+                print(f"{name:24s} against {against}: {'IDENTICAL' if not diff else 'DIFFERENT'}")
+                for line in diff:
+                    print("   ", line)
+                bad += bool(diff)
+                continue
             for shortcut, toggle in SHORTCUTS.items():
                 results = []
                 for on in (False, True):

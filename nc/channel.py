@@ -376,7 +376,7 @@ class Channel:
     def threading(self) -> bool:
         """A spindle-locked thread runs or waits in the look-ahead (G32/G34/G92/G76)."""
         pl = self.planner
-        return pl._thread is not None or any(b.kind == "thread" for b in pl.blocks)
+        return pl._thread is not None or pl.threads_queued > 0  # counted, not a scan of the queue
 
     @property
     def spindle_wait(self) -> bool:

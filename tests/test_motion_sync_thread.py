@@ -259,3 +259,29 @@ def test_spindle_settle_wait_from_the_command_line(hil, program, tmp_path):
     assert moving > 10  # stood still on line 4 for the settle cycles at least
     assert abs(float(rows[moving]["S1_rpm_act"]) - 600.0) <= 0.6
     assert abs(float(rows[0]["S1_rpm_act"]) - 600.0) > 0.6  # line 4 began before the spindle settled
+
+
+@pytest.mark.parametrize("stop_at", [None, 2500])
+def test_threading_flag_counts_the_thread_blocks_the_queue_holds(stop_at):
+    """Channel.threading (spindle override held at 100 %) reads a count kept by the planner (issue 17), not a
+    scan of the look-ahead queue: every cycle of four passes it equals the scan, as the passes leave the
+    queue one by one, and a stop (reset) in the second pass clears it."""
+    bench = default_lathe()
+    runner = BenchRunner(bench, SimLink(sim_slaves(bench), bench.cycle))
+    seen = []
+
+    def check(r):
+        ch = r.channel
+        if ch is None:
+            return
+        pl = ch.planner
+        scanned = pl._thread is not None or any(b.kind == "thread" for b in pl.blocks)
+        seen.append((ch.threading, scanned))
+        if r.cycle == stop_at:
+            r.request_stop("test")  # stop along the path, then flush the queue (the NC's reset)
+
+    runner.on_cycle = check
+    runner.run_program(parse_program(passes_program([19.4, 19.0, 18.7, 18.5])))
+    assert all(flag == scanned for flag, scanned in seen)
+    assert sum(flag for flag, _ in seen) > 2000 and not seen[-1][0]
+    assert runner.channel.planner.threads_queued == 0

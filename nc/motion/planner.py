@@ -68,6 +68,7 @@ class Planner:
         self.lim = Limits(cfg)
         self.position = np.array([(start or {}).get(a, 0.0) for a in self.axes], dtype=float)
         self.blocks: deque[Block] = deque()
+        self.threads_queued = 0  # thread blocks in `blocks`: Channel.threading asks every cycle (issue 17)
         self.spindle_rpm = spindle_rpm or (lambda: 0.0)
         # Spindle actual angle (cumulative degrees) and the angle of one index pulse; without a
         # spindle_angle source an ideal spindle at spindle_rpm() is integrated (offline runs).
@@ -144,6 +145,7 @@ class Planner:
             prev = self.blocks[-1]
             prev.vjunc = self.lim.junction(prev, b)
         self.blocks.append(b)
+        self.threads_queued += b.kind == "thread"
         self._pushed += 1
         # Blocks pushed since the last pass never had one: the pass must reach past all of them.
         need = max(self._need + 1, self._pushed)
@@ -452,6 +454,7 @@ class Planner:
         self.spindle_wait = False
         self._wait_cycles = 0
         self.blocks.clear()
+        self.threads_queued = 0
         self._pushed = self._need = 0
         self.plan = None
         self._buf_pos = None
@@ -731,7 +734,7 @@ class Planner:
 
     def _finish_block(self, keep_plan: bool = False) -> None:
         if self.blocks:
-            self.blocks.popleft()
+            self.threads_queued -= self.blocks.popleft().kind == "thread"
         self._started = False
         if not keep_plan:
             self.s = 0.0
