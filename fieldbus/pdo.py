@@ -8,6 +8,7 @@ Values are in the drive's units (`fieldbus.units.DriveUnits`): positions in coun
 from __future__ import annotations
 
 import struct
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 
@@ -67,13 +68,17 @@ class PdoLayout:
     tx_index: int = 0x1A00
     rx_struct: struct.Struct = field(init=False, repr=False, compare=False)
     tx_struct: struct.Struct = field(init=False, repr=False, compare=False)
+    _indices: frozenset[int] = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "rx_struct", struct.Struct("<" + "".join(e.struct_code for e in self.rx)))
         object.__setattr__(self, "tx_struct", struct.Struct("<" + "".join(e.struct_code for e in self.tx)))
+        object.__setattr__(self, "_indices", frozenset(e.index for e in self.rx + self.tx))
+        for name, fn in _codecs(self.rx, self.rx_struct, "rx").items() | _codecs(self.tx, self.tx_struct, "tx").items():
+            object.__setattr__(self, name, fn)
 
     def carries(self, index: int) -> bool:
-        return any(e.index == index for e in self.rx + self.tx)
+        return index in self._indices
 
     @property
     def rx_bytes(self) -> int:
@@ -83,23 +88,30 @@ class PdoLayout:
     def tx_bytes(self) -> int:
         return self.tx_struct.size
 
-    def pack_rx(self, pdo: RxPdo) -> bytes:
-        return self.rx_struct.pack(*(_fit(getattr(pdo, e.attr), e) for e in self.rx))
+    # pack_rx / unpack_rx / pack_tx / unpack_tx are compiled per layout in __post_init__ (`_codecs`).
+    pack_rx: Callable[[RxPdo], bytes] = field(init=False, repr=False, compare=False)
+    unpack_rx: Callable[..., RxPdo] = field(init=False, repr=False, compare=False)
+    pack_tx: Callable[[TxPdo], bytes] = field(init=False, repr=False, compare=False)
+    unpack_tx: Callable[..., TxPdo] = field(init=False, repr=False, compare=False)
 
-    def unpack_rx(self, data: bytes, into: RxPdo | None = None) -> RxPdo:
-        pdo = into or RxPdo()
-        for e, v in zip(self.rx, self.rx_struct.unpack(data[: self.rx_bytes])):
-            setattr(pdo, e.attr, v)
-        return pdo
 
-    def pack_tx(self, pdo: TxPdo) -> bytes:
-        return self.tx_struct.pack(*(_fit(getattr(pdo, e.attr), e) for e in self.tx))
-
-    def unpack_tx(self, data: bytes, into: TxPdo | None = None) -> TxPdo:
-        pdo = into or TxPdo()
-        for e, v in zip(self.tx, self.tx_struct.unpack(data[: self.tx_bytes])):
-            setattr(pdo, e.attr, v)
-        return pdo
+def _codecs(entries: tuple[PdoEntry, ...], st: struct.Struct, side: str) -> dict[str, Callable]:
+    """The layout's pack and unpack functions for one direction, generated once (issue 17): one
+    struct call and one tuple assignment per image instead of a getattr, `_fit` and setattr per
+    entry. Packing the value masked to its width with unsigned codes gives the bytes `_fit` then
+    the signed code give. Unpacking reads the first `st.size` bytes, as slicing them did."""
+    cls = "RxPdo" if side == "rx" else "TxPdo"
+    attrs = [e.attr for e in entries]
+    assert all(a.isidentifier() for a in attrs)
+    masked = ", ".join(f"int(pdo.{a}) & {(1 << e.bits) - 1:#x}" for a, e in zip(attrs, entries))
+    targets = "".join(f"pdo.{a}, " for a in attrs)
+    src = (f"def pack_{side}(pdo):\n    return _pack({masked})\n"
+           f"def unpack_{side}(data, into=None):\n    pdo = into or {cls}()\n"
+           f"    {targets + ' = ' if attrs else ''}_unpack(data)\n    return pdo\n")
+    unsigned = struct.Struct("<" + "".join(e.struct_code.upper() for e in entries))
+    scope: dict = {"_pack": unsigned.pack, "_unpack": st.unpack_from, cls: RxPdo if side == "rx" else TxPdo}
+    exec(compile(src, f"<pdo codec {side}>", "exec"), scope)
+    return {f"pack_{side}": scope[f"pack_{side}"], f"unpack_{side}": scope[f"unpack_{side}"]}
 
 
 def _fit(value: int, e: PdoEntry) -> int:

@@ -72,8 +72,10 @@ class AxisScaling:
 
     # ---- velocities: the drive's units (0x60FF / 0x606C) ----------------------------------------
     def velocity_to_drive(self, units_per_s: float) -> int:
-        """mm/s (deg/s) to the drive's target-velocity units."""
-        return self.units.velocity_to_raw(units_per_s * self.counts_per_unit, self.counts_per_rev)
+        """mm/s (deg/s) to the drive's target-velocity units (DriveUnits.velocity_to_raw, with the
+        factors derived once: the same products in the same order)."""
+        raw = round(units_per_s * self._cpu * self._raw_per_cps)
+        return max(-0x7FFFFFFF, min(0x7FFFFFFF, int(raw)))
 
     def drive_to_velocity(self, raw: float) -> float:
         """The drive's velocity units to mm/s (deg/s)."""
