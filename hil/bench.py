@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING
 from fieldbus.units import AxisScaling
 from nc.motion.limits import AxisLimits, MotionConfig
 from hil.drive_homing import DriveHoming
-from virtual_bus.drive import DriveParams
+from virtual_bus.drive_params import DriveParams
 
 if TYPE_CHECKING:  # mlc.memory pulls numpy: `hil path` starts without it (issue 16)
     from mlc.remote_io import IoMap

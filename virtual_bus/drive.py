@@ -18,6 +18,7 @@ from fieldbus.pdo import RxPdo, TxPdo
 from fieldbus.units import DELTA_UNITS, DriveUnits
 from virtual_bus.drive_modes import CST, HM, PROFILE_MODES, DriveModes
 from virtual_bus.servo_params import ServoParams
+from virtual_bus.drive_params import DriveParams  # noqa: F401  (its home before; the settings alone load light)
 
 # Delta ASDA alarm numbers as the drive reports them in 0x603F (the NC shows 0xF002 + this code)
 AL_OVERSPEED = 0x0007
@@ -38,29 +39,6 @@ def _status_base(state: State) -> int:
 
 
 _STATUS_BASE = {s: _status_base(s) for s in State}
-
-
-@dataclass
-class DriveParams:
-    counts_per_rev: int = 1_280_000
-    kp: float = 120.0  # position loop gain, 1/s (ASDA P2-00 style)
-    kff: float = 0.95  # velocity feed-forward fraction (P2-02 style)
-    velocity_bandwidth: float = 800.0  # rad/s of the velocity loop
-    max_speed_rpm: float = 5000.0
-    inertia: float = 1.0e-4  # kg·m², motor plus reflected load
-    rated_torque: float = 2.39  # N·m (750 W ASDA-A3 class)
-    viscous: float = 2.0e-4  # N·m per rad/s
-    coulomb: float = 0.05  # N·m
-    following_error_window: int = 3_840_000  # 0x6065 counts (3 motor revs)
-    quick_stop_decel: float = 2.0e8  # counts/s² (0x6085)
-    csv_accel: float = 5.0e7  # counts/s², the CSV ramp the drive applies (spindle)
-    negative_limit: int | None = None  # hardware limit switch positions in counts
-    positive_limit: int | None = None
-    home_switch: int | None = None  # counts where the home switch toggles (position < this reads active)
-    index_pulse_every: int | None = None  # counts between encoder index pulses; None = counts_per_rev
-    probe_position: int | None = None  # counts where a touch-probe input (G31 skip) switches; None = no probe
-    substeps: int = 4
-    units: DriveUnits = DELTA_UNITS  # what 0x606C/0x60FF and 0x6077 carry (the device model's)
 
 
 @dataclass

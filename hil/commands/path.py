@@ -143,22 +143,48 @@ def _val(v) -> str:
     return _num(fmt(v))
 
 
-_TEMPLATES: dict[tuple, str] = {}  # axis names -> '{"X": %s, "Z": %s}'
+_TEMPLATES: dict[tuple, tuple[str, dict]] = {}  # axis names -> ('{"X": %s, "Z": %s}', points written)
+_FLOATS = {float}
+_POINTS_LIMIT = 4096  # points remembered per axis set: a move's start is the last move's end
 
 
 def _axes(d: dict[str, float]) -> str:
     names = tuple(d)
-    t = _TEMPLATES.get(names)
-    if t is None:
-        t = _TEMPLATES[names] = "{" + ", ".join([_json_str(a).replace("%", "%%") + ": %s" for a in names]) + "}"
-    return t % tuple([_val(v) for v in d.values()])
+    entry = _TEMPLATES.get(names)
+    if entry is None:
+        entry = _TEMPLATES[names] = (
+            "{" + ", ".join([_json_str(a).replace("%", "%%") + ": %s" for a in names]) + "}", {})
+    t, points = entry
+    vals = tuple(d.values())
+    if set(map(type, vals)) == _FLOATS:  # plain floats: equal values (0.0 and -0.0 too) write the same
+        text = points.get(vals)
+        if text is not None:
+            return text
+        if (s := sum(vals)) - s == 0:  # all finite (a NaN or ±inf makes s - s nan)
+            # `_val` of each inline: round(v, 7) + 0.0 is fmt(v) (-0.0 + 0.0 is 0.0)
+            text = t % tuple([repr(round(v, 7) + 0.0) for v in vals])
+            if len(points) >= _POINTS_LIMIT:
+                points.clear()
+            points[vals] = text
+            return text
+    return t % tuple([_val(v) for v in vals])
+
+
+_QUOTED: dict[str, str] = {}  # block text -> its JSON string: the moves of a cycle share their block
+_QUOTED_LIMIT = 4096
 
 
 def _str(s) -> str:
     """json.dumps of a string: as it is, quoted, when it holds nothing JSON escapes."""
-    if type(s) is str and s.isascii() and s.isprintable() and '"' not in s and "\\" not in s:
-        return f'"{s}"'
-    return _json_str(s)
+    q = _QUOTED.get(s) if type(s) is str else None
+    if q is None:
+        q = f'"{s}"' if type(s) is str and s.isascii() and s.isprintable() and '"' not in s and "\\" not in s \
+            else _json_str(s)
+        if type(s) is str:
+            if len(_QUOTED) >= _QUOTED_LIMIT:
+                _QUOTED.clear()
+            _QUOTED[s] = q
+    return q
 
 
 def move_json(m: Move) -> str:
@@ -172,7 +198,7 @@ def move_json(m: Move) -> str:
     text = (f'{{"kind": {_str(m.kind)}, "line": {m.line}, "block": {_str(m.block)}, '
             f'"start": {_axes(m.start)}, "end": {_axes(m.end)}, "work": {_axes(m.work)}, '
             f'"center": {"null" if m.center is None else _axes(m.center)}, '
-            f'"dir": {_str(m.dir)}, "feed": {_num(m.feed)}, "duration": {_num(m.duration)}')
+            f'"dir": {"null" if m.dir is None else _str(m.dir)}, "feed": {_num(m.feed)}, "duration": {_num(m.duration)}')
     if m.per_rev and m.feed is not None:  # the additive keys of move_dict, in its order
         text += ', "per_rev": true'
     if m.exact_stop:

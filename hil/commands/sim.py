@@ -17,9 +17,9 @@ from hil.sim_canopen import add_canopen
 
 def _add_ethercat(sims: argparse._SubParsersAction) -> None:
     p = sims.add_parser("ethercat", help="software EtherCAT slaves (CiA 402 drives, DIO) on a raw socket",
-                        formatter_class=argparse.RawDescriptionHelpFormatter,
+                        formatter_class=_FaultHelpFormatter,
                         description="Serve the bench's drives (axes, then spindles) as EtherCAT slaves on IFACE.",
-                        epilog=_fault_help())
+                        epilog=_FAULT_HELP)
     p.add_argument("--bus", metavar="ethercat:IFACE",
                    help="the bus, spelled as hil run's --bus: ethercat:IFACE (e.g. one end of a veth pair); required")
     p.add_argument("--iface", help=argparse.SUPPRESS)  # old spellings, kept working
@@ -39,10 +39,21 @@ def _add_ethercat(sims: argparse._SubParsersAction) -> None:
     p.set_defaults(func=cmd_sim_ethercat)
 
 
+_FAULT_HELP = "(fault specs)"  # the epilog, written out when the help is shown
+
+
 def _fault_help() -> str:
     from virtual_bus.ethercat import faults
 
     return "fault specs:\n" + "\n".join(faults.__doc__.splitlines()[4:])
+
+
+class _FaultHelpFormatter(argparse.RawDescriptionHelpFormatter):
+    """Reads the fault specs for `hil sim ethercat --help` only: importing virtual_bus.ethercat when
+    the parser is built cost every `hil` command its start-up time (issue 16)."""
+
+    def _format_text(self, text: str) -> str:
+        return super()._format_text(_fault_help() if text == _FAULT_HELP else text)
 
 
 # name -> registrar; the CANopen simulator adds its own entry here.

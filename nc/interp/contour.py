@@ -57,7 +57,7 @@ class ContourMixin:
 
     def _clone(self):  # -> the same Interpreter class
         twin = copy.copy(self)
-        twin.state = copy.deepcopy(self.state)
+        twin.state = self.state.copy()
         twin.state.cycle = None
         twin.frames = self.frames.copy()
         twin.position = dict(self.position)

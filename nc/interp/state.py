@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
+import copy
+
 from dataclasses import dataclass, field
+from typing import ClassVar
 
 from nc.profiles import Profile
 
@@ -55,6 +58,12 @@ class ModalState:
     rotation: bool = False  # G68
     macro_modal: bool = False  # G66
 
+    def copy(self) -> "ModalState":
+        """An independent copy: every field is a number, flag or string but the groups dict."""
+        st = copy.copy(self)
+        st.groups = dict(self.groups)
+        return st
+
     @classmethod
     def power_on(cls, profile: Profile) -> "ModalState":
         g = power_on_groups(profile)
@@ -76,6 +85,8 @@ class Frames:
     set_shift: dict[str, float] = field(default_factory=dict)
     tool_shift: dict[str, float] = field(default_factory=dict)
 
+    _memo: ClassVar[tuple | None] = None  # (wcs, axes, the five offsets, origins) of the last call
+
     def __post_init__(self) -> None:
         if not self.work_offsets:
             self.work_offsets = [{a: 0.0 for a in self.axes} for _ in range(6 + N_EXT_WCS)]
@@ -87,11 +98,23 @@ class Frames:
                       dict(self.local_shift), dict(self.set_shift), dict(self.tool_shift))
 
     def origins(self, wcs: int, axes: tuple[str, ...]) -> dict[str, float]:
-        """`origin` of every axis at once (the interpreter's per-block coordinate conversion)."""
+        """`origin` of every axis at once (the interpreter's per-block coordinate conversion). The dict
+        may be shared with the next call: read it, never change it."""
         e, w, lo, s, t = self.external, self.work_offsets[wcs], self.local_shift, self.set_shift, self.tool_shift
+        # The last result again while the offsets it came from hold the same values (they are plain
+        # dicts, changed in place by G10, G92, #5221…; compared by value, a NaN never matches). Equal
+        # values give the same sums bit for bit: a sum can only be -0.0 where all five terms are -0.0,
+        # so equal dicts differing in the sign of a zero matter only where `e` holds a zero.
+        memo = self._memo
+        if memo is not None and memo[0] == wcs and memo[1] == axes and memo[2] == w and memo[3] == e \
+                and memo[4] == lo and memo[5] == s and memo[6] == t:
+            return memo[7]
         if not (e or lo or s or t):  # the usual case; 0.0 + w is the sum below bit for bit (even for -0.0)
-            return {a: 0.0 + w.get(a, 0.0) for a in axes}
-        return {a: e.get(a, 0.0) + w.get(a, 0.0) + lo.get(a, 0.0) + s.get(a, 0.0) + t.get(a, 0.0) for a in axes}
+            out = {a: 0.0 + w.get(a, 0.0) for a in axes}
+        else:
+            out = {a: e.get(a, 0.0) + w.get(a, 0.0) + lo.get(a, 0.0) + s.get(a, 0.0) + t.get(a, 0.0) for a in axes}
+        self._memo = None if 0 in e.values() else (wcs, axes, dict(w), dict(e), dict(lo), dict(s), dict(t), out)
+        return out
 
     def origin(self, wcs: int, axis: str) -> float:
         return (self.external.get(axis, 0.0) + self.work_offsets[wcs].get(axis, 0.0)
