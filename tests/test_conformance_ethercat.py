@@ -251,11 +251,13 @@ def test_05_modes_of_operation(master):
     that run (PP, PV, HM, CSP, CSV, CST: bits 0, 2, 5, 7, 8, 9, the ASDA-A3-E's; decisions E13)."""
     for s in master.slaves:
         assert u(s.sdo_read(0x6502, 0)) == 0x000003A5
+        s.sdo_write(0x6060, 0, b"\x09")
+        assert s.sdo_read(0x6061, 0) == b"\x09"  # 0x6061 shows the mode the drive runs, as the CANopen node
         for bad in (0x55, 2, 4, 7, 11):
             assert abort_of(lambda: s.sdo_write(0x6060, 0, bytes([bad]))) == 0x06090030
-        s.sdo_write(0x6060, 0, b"\x09")
+            assert s.sdo_read(0x6061, 0) == b"\x09"  # a refused mode is not echoed
         s.sdo_write(0x6060, 0, b"\x08")
-        assert s.sdo_read(0x6060, 0) == b"\x08"
+        assert s.sdo_read(0x6060, 0) == b"\x08" and s.sdo_read(0x6061, 0) == b"\x08"
 
 
 def test_05b_homing_and_profile_position_over_pdo(master):

@@ -73,11 +73,15 @@ class Cia402Drive:
         self._want_cps = self.params.units.raw_to_velocity(rx.target_velocity, self.params.counts_per_rev)
         self._state_machine(rx.controlword)
         if rx.mode != self.mode:
-            self.mode = rx.mode
-            self._prev_target = None
-            self.modes.restart(rx.controlword)
+            self.select_mode(rx.mode)
         if self.mode in PROFILE_MODES:
             self.modes.apply(self, rx.controlword, rx.target_position, rx.target_torque)
+
+    def select_mode(self, mode: int) -> None:
+        """Switch to `mode` (0x6060, by PDO or SDO): 0x6061 shows it from now on; a profile mode starts afresh."""
+        self.mode = mode
+        self._prev_target = None
+        self.modes.restart(self._rx.controlword)
 
     def feedback(self) -> TxPdo:
         p, state, mode = self.params, self.state, self.mode

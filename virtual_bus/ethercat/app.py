@@ -69,6 +69,11 @@ class DriveApp(SlaveApp):
         """A servo parameter written over SDO goes through the drive's checks; a refusal restores
         the old value and aborts the transfer with the drive's code."""
         od, params = self.od, self.drive.servo_params
+        if index == 0x6060 and od is not None:  # by SDO too: the drive takes the mode at once, 0x6061 shows it
+            if od.value(0x6060) != self.drive.mode:
+                self.drive.select_mode(od.value(0x6060))
+            self._publish()
+            return
         attr = MODE_OBJECTS.get((index, sub))
         if attr is not None and od is not None:  # the drive's copy of a profile-mode object (drive_modes.py)
             setattr(self.drive.modes.objects, attr, od.value(index, sub))
