@@ -27,5 +27,8 @@ def drive_status(runner: Any, status: Any) -> list[DriveStatus]:
         d.velocity = sc.drive_to_velocity(raw)
         d.rpm = d.velocity / sc.lead * 60.0  # AxisScaling.drive_to_rpm, velocity not converted twice
         d.position = sc.to_units(tx.position_actual)
+        if i < n_axes:  # the limit switch (0x60FD bits 0/1 when bit 11 is set) and the NC's machine position
+            d.limit = ((tx.digital_inputs & 0x3) or 0x3) if tx.statusword & 0x0800 else 0
+            d.machine_position = d.position + float(runner.origin[i])
         d.mode = getattr(tx, "mode_display", 8)
     return out

@@ -43,6 +43,7 @@ STANDSTILL_TIMEOUT = 10.0  # s the stop path waits for the axes to stand before 
 # the motor, which reads 0 below 1 rpm (2,133 counts/s at 1,280,000 counts/rev).
 REST_CYCLES = 3
 OVERSPEED = 1.2  # App. A 0x0602: measured axis speed above this multiple of its limit (the virtual drive's own AL007 margin)
+LIMIT_HYSTERESIS = 0.05  # mm (deg): how far off a limit switch an axis must get before a new hit counts
 FROZEN_S = 0.2  # s of unchanged feedback from a moving drive that mean it left the bus
 
 
@@ -98,6 +99,10 @@ class BenchRunner:
         self.line = 0
         self.actual = np.zeros(n_axes)
         self._alarmed_drives: set[int] = set()
+        # axis -> position (counts) where its drive reported the limit switch: 0x0402 once per hit; the hit ends
+        # when the axis is off the switch and LIMIT_HYSTERESIS away (a servo settling on the edge is no new hit)
+        self._at_limit: dict[int, int] = {}
+        self._limit_hysteresis = [abs(sc.to_counts(LIMIT_HYSTERESIS) - sc.to_counts(0.0)) for sc in self.scales]
         self._commands = np.zeros(n_axes)
         # Machine position minus drive position per axis (units); NC-side homing sets it (issue 5).
         self.origin = np.zeros(n_axes)
@@ -319,10 +324,14 @@ class BenchRunner:
                 self._alarm(Alarm(0x0602, f"overspeed protection: axis {self._name(i)} at {abs(v):.1f}/s, beyond "
                                           f"{OVERSPEED:g} x its maximum velocity {self.bench.axes[i].limits.max_velocity:g}/s",
                                   line=self.line or None, axis=self._name(i)))
-            if tx.statusword & SW_INTERNAL_LIMIT and i < n_axes and i not in self._alarmed_drives:
-                self._alarmed_drives.add(i)
-                self._alarm(Alarm(0x0402, f"hardware limit reached on axis {self._name(i)}", line=self.line or None,
-                                  axis=self._name(i)))
+            if tx.statusword & SW_INTERNAL_LIMIT and i < n_axes:
+                if i not in self._at_limit:
+                    self._at_limit[i] = p
+                    if i not in self._alarmed_drives:
+                        self._alarm(Alarm(0x0402, f"hardware limit reached on axis {self._name(i)}",
+                                          line=self.line or None, axis=self._name(i)))
+            elif self._at_limit and i in self._at_limit and abs(p - self._at_limit[i]) > self._limit_hysteresis[i]:
+                del self._at_limit[i]  # left the switch (hil script, App. A 0x0A06): the next hit raises again
         scales, txs = self.scales, self.tx
         self.actual[:] = [scales[i].to_units(txs[i].position_actual) + o for i, o in enumerate(self.origin.tolist())]
         ch = self.channel if not self._planner_failed else None  # a failed NC is not stepped again

@@ -127,6 +127,7 @@ class Mlc:
 
     def bus_feedback(self, drives: list[DriveStatus]) -> None:
         self.drives = drives
+        self.link.drives = drives  # the manual modes hold an axis its limit switch stopped (App. A 0x0A06)
 
     def bus_status(self, status: Any) -> None:
         """The link's state this cycle (`fieldbus.link.LinkStatus`): drives M30000 and the EIO relays."""

@@ -12,6 +12,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
+from mlc.manual_alarms import HardLimitLatch, home_mode
 from mlc.memory import DeviceMemory
 from mlc.signals import d2, d3, m2, m3
 from nc.alarms import Alarm
@@ -27,7 +28,6 @@ MANUAL_MODES = (MPG, JOG, RAPID, INC, HOME)
 SYSTEM_M = {0, 1, 2, 30, 98, 99}  # never handed to the MLC (NC5 §3.8.1)
 ESTOP_ALARM = 0x0401
 SPINDLE_ALARM = 0x0C0A
-OSCILLATION_IN_HOME = 0x1603  # App. A: "Oscillation function is not allowed in the home mode."
 
 
 @dataclass
@@ -43,6 +43,8 @@ class DriveStatus:
     rpm: float = 0.0  # motor/load rev per minute
     position: float = 0.0
     spindle: bool = False
+    limit: int = 0  # hardware limit switch reached: 1 negative, 2 positive (0x60FD bits 0/1), 3 unknown side
+    machine_position: float = 0.0  # position + the NC-side homing offset (the NC's machine coordinate)
     mode: int = 8
 
 
@@ -74,6 +76,8 @@ class ChannelLink:
     _mode_switch_cycles: int = 0
     handshake_log: list[tuple[int, str, float]] = field(default_factory=list)  # (cycle, kind, value)
     limit_latch: ManualLimitLatch = field(default_factory=ManualLimitLatch)  # App. A 0x0A01-0x0A04 in manual
+    hard_limits: HardLimitLatch = field(default_factory=HardLimitLatch)  # App. A 0x0402 / 0x0A06 in manual
+    drives: list[DriveStatus] | None = None  # this cycle's drive status (Mlc.bus_feedback)
     cycle: int = 0
 
     # ---- helpers --------------------------------------------------------------------------------
@@ -165,7 +169,7 @@ class ChannelLink:
         self.alarms.clear()
         self._alarms_seen.clear()
         self._reset_pending = True
-        for alarm in self.limit_latch.reset():  # an axis still on a soft limit: reset does not clear it
+        for alarm in self.limit_latch.reset() + self.hard_limits.reset():  # still on a limit: reset does not clear
             self._raise(ch, alarm)
 
     def _feed_hold(self, ch: Channel) -> None:
@@ -292,6 +296,9 @@ class ChannelLink:
             if limits is not None:  # the bench's soft_limits and G10 L21 clamp the manual moves too
                 windows[a] = low, high = self.limit_latch.window(limits, a, not self._m2(368 + i))
                 st.soft_min, st.soft_max = (low[0] if low else None), (high[0] if high else None)
+        if self.drives is not None:
+            for alarm in self.hard_limits.step(mm, self.axes, self.drives):
+                self._raise(ch, alarm)
         if self._estop or self.mode not in MANUAL_MODES or ch.busy:
             return
         pct = self.mem.u16(d2(x, 6))
@@ -318,19 +325,7 @@ class ChannelLink:
             if delta and i < len(self.axes):
                 mm.move_by(self.axes[i], delta * self.mem.u16(d2(x, 9)) * self.unit)
         elif self.mode == HOME:
-            # M2x264 (axes oscillation enable) is "only available on modes other than HOME and EDIT": ON in HOME
-            # mode stops the homing under way and refuses new ones, App. A 0x1603 (decisions mlc.md)
-            osc = self._m2(264)
-            if self._rising(m2(x, 264)):
-                mm.stop()
-                self._raise(ch, Alarm(OSCILLATION_IN_HOME, "M2x264 oscillation enable is ON in HOME mode"))
-            for i, a in enumerate(self.axes):
-                if self._rising(m2(x, 320 + i)):
-                    if osc:
-                        self._raise(ch, Alarm(OSCILLATION_IN_HOME, f"{a} homing refused: M2x264 oscillation "
-                                                                   f"enable is ON in HOME mode", axis=a))
-                    else:
-                        mm.home(a)
+            home_mode(self, ch, mm)  # the home triggers, and App. A 0x1603 (mlc/manual_alarms.py)
         pos = mm.step()
         for i, a in enumerate(self.axes):
             if a in windows and (a in mm.clamped or a in self.limit_latch.latched):

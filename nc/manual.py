@@ -223,6 +223,16 @@ class ManualMotion:
             self.position[:] = positions
             self._target[:] = positions
 
+    def hold_at(self, axis: str, position: float) -> None:
+        """The axis's drive stopped it on a hardware limit switch: the command stops there at once, so a move away
+        starts from where the axis stands (App. A 0x0402 / 0x0A06, mlc.manual_alarms)."""
+        i = self.index(axis)
+        self.position[i] = self._target[i] = position
+        self.velocity[i] = self.acceleration[i] = 0.0
+        self._mode[i] = self._phase[i] = None
+        self.axes[axis].homing = False
+        self._cut.discard(axis)
+
     @property
     def busy(self) -> bool:
         return any(m is not None for m in self._mode)

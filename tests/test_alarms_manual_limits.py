@@ -66,3 +66,31 @@ def test_m2x368_turns_the_first_segment_off_for_manual_moves():
     m.set("M21369")  # Z (2nd axis)
     m.jog("Z", -1, 0.6)
     assert m.command("Z") < 92.0 and _codes(m) == []
+
+
+def test_0x0402_then_0x0a06_jog_onto_the_drive_limit_switch_move_away_and_reset():
+    """App. A 0x0A06 'The status of hardware limit needs to be cleared. After moving away from the hardware limit,
+    this alarm will be displayed. Please reset the machine.': Z's drive has its positive limit switch at 105. The
+    jog runs onto it: the drive stops Z there and the NC raises 0x0402 (decisions B16) and holds the jog command at
+    the switch instead of running on. Jogging further into it does nothing; a reset on the switch keeps the limit
+    alarm; jogging away raises 0x0A06; a reset clears it, and the next hit raises 0x0402 again."""
+    bench = default_lathe()
+    z = bench.axes[1]
+    bench.axes[1] = dataclasses.replace(z, drive=dataclasses.replace(z.drive, positive_limit=z.scaling.to_counts(105.0)))
+    m = Machine(bench)
+    m.power_up()
+    m.jog("Z", 1, 1.0)  # from 100 at 16.7 mm/s: on the switch after 0.3 s
+    assert m.position("Z") == pytest.approx(105.0, abs=1e-3) and m.command("Z") < 105.1  # the command stopped too
+    assert [(a.code, a.axis) for a in m.runner.result.alarms] == [(0x0402, "Z")]
+    m.jog("Z", 1, 0.3)  # into the switch: locked
+    assert m.command("Z") < 105.1 and _codes(m) == []
+    m.reset()
+    assert _codes(m) == [0x0402]  # still on the switch
+    m.jog("Z", -1, 0.3)
+    assert m.position("Z") == pytest.approx(100.0, abs=0.05)  # 5 mm away: the move started at the switch
+    assert _codes(m) == [0x0402, 0x0A06]
+    m.reset()
+    m.cycle(5)
+    assert _codes(m) == []
+    m.jog("Z", 1, 1.0)
+    assert [a.code for a in m.runner.result.alarms] == [0x0402, 0x0402]

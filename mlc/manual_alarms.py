@@ -1,0 +1,89 @@
+"""Alarms of the manual modes: the hardware limit (App. A 0x0402, 0x0A06) and oscillation in HOME mode (0x1603).
+
+The drive stops the axis on its limit switch (CiA 402 statusword bit 11, 0x60FD bit 0/1) and the bench raises
+0x0402 "Hardware limit signal is triggered" (hil/runner.py, decisions bench.md B16). Here the NC then holds the
+manual command where the axis stands and locks the direction into the switch, so the axis can only move away.
+Once the switch is left, 0x0A06 "The status of hardware limit needs to be cleared. After moving away from the
+hardware limit, this alarm will be displayed. Please reset the machine." is raised; the next reset clears it. A
+reset while the axis still stands on the switch leaves the limit alarm (0x0402) raised.
+
+M2x264 (axes oscillation enable) is "only available on modes other than HOME and EDIT": ON in HOME mode it stops
+the homing under way and refuses new ones with 0x1603 "Oscillation function is not allowed in the home mode"."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
+
+from nc.alarms import Alarm
+
+from mlc.signals import m2
+
+if TYPE_CHECKING:
+    from mlc.nc_link import ChannelLink, DriveStatus
+    from nc.channel import Channel
+    from nc.manual import ManualMotion
+
+HARD_LIMIT_SIGNAL = 0x0402
+HARD_LIMIT_TO_CLEAR = 0x0A06
+OSCILLATION_IN_HOME = 0x1603
+PRESS = 0.01  # mm (deg) beyond the switch edge the held command stands
+
+
+@dataclass
+class HardLimitLatch:
+    latched: dict[str, tuple[str, bool]] = field(default_factory=dict)  # axis -> (side "+"/"-", moved away)
+    edge: dict[str, float] = field(default_factory=dict)  # axis -> machine position where the switch stopped it
+
+    def step(self, mm: ManualMotion, axes: tuple[str, ...], drives: list[DriveStatus]) -> list[Alarm]:
+        """Before the manual step: latch a new hit (hold the command there), lock the direction into the switch,
+        and raise 0x0A06 for an axis that has left it."""
+        out: list[Alarm] = []
+        for i, a in enumerate(axes):
+            if i >= len(drives):
+                break
+            d = drives[i]
+            held = self.latched.get(a)
+            if d.limit and held is None:
+                side = "-" if d.limit == 1 else "+" if d.limit == 2 else ("+" if mm.velocity[i] > 0 else "-")
+                held = self.latched[a] = (side, False)
+                self.edge[a] = d.machine_position
+                # the command stays a hair inside the switch: the drive keeps the axis on it (no edge chatter)
+                mm.hold_at(a, d.machine_position + (PRESS if side == "+" else -PRESS))
+            elif held is not None and not held[1] and not d.limit and self._commanded_away(mm, i, a, held[0]):
+                held = self.latched[a] = (held[0], True)
+                out.append(Alarm(HARD_LIMIT_TO_CLEAR, f"axis {a} moved away from its {held[0]} hardware limit to "
+                                                      f"{d.machine_position:.4f}; reset to clear", axis=a))
+            if held is not None and not held[1]:
+                st = mm.axes[a]
+                if held[0] == "+":
+                    st.lock_pos = True
+                else:
+                    st.lock_neg = True
+        return out
+
+    def _commanded_away(self, mm: ManualMotion, i: int, a: str, side: str) -> bool:
+        """The switch reads off and the command is back before the edge: a move away, not the servo settling."""
+        return mm.position[i] < self.edge[a] if side == "+" else mm.position[i] > self.edge[a]
+
+    def reset(self) -> list[Alarm]:
+        """A reset clears the axes that moved away; an axis still on its switch keeps the limit alarm."""
+        self.latched = {a: v for a, v in self.latched.items() if not v[1]}
+        return [Alarm(HARD_LIMIT_SIGNAL, f"hardware limit {side} of axis {a}: still on the switch, move it away "
+                                         f"before reset", axis=a) for a, (side, _) in self.latched.items()]
+
+
+def home_mode(link: ChannelLink, ch: Channel, mm: ManualMotion) -> None:
+    """One HOME-mode cycle: a rising M2x320+i homes axis i, unless M2x264 is on (App. A 0x1603)."""
+    x = link.x
+    osc = link._m2(264)
+    if link._rising(m2(x, 264)):
+        mm.stop()
+        link._raise(ch, Alarm(OSCILLATION_IN_HOME, "M2x264 oscillation enable is ON in HOME mode"))
+    for i, a in enumerate(link.axes):
+        if link._rising(m2(x, 320 + i)):
+            if osc:
+                link._raise(ch, Alarm(OSCILLATION_IN_HOME, f"{a} homing refused: M2x264 oscillation enable is ON "
+                                                           f"in HOME mode", axis=a))
+            else:
+                mm.home(a)
