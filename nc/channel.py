@@ -296,6 +296,8 @@ class Channel:
             if budget.spent:
                 budget.held_cycles += 1  # the last cycle ended with macro statements still to run
             budget.new_cycle()
+        # Nothing comes before the queue has run out to rest: its tail is a stop (nc.motion.shares).
+        pl.closed = self.end is not None or self._deferred is not None or self._limit_alarm is not None
         while self.state is RunState.RUNNING and self.end is None and not pl.full:
             if self._limit_alarm is not None:
                 if pl.idle:  # the legal moves before it have run out: the offending one never starts
@@ -320,6 +322,7 @@ class Channel:
                 ev = next(self.events)  # type: ignore[arg-type]
             except StopIteration:
                 self.end = ProgramEnd(0, "", 0)
+                pl.closed = True
                 return
             except NcAlarm as exc:
                 self.raise_alarm(exc.alarm)
@@ -344,11 +347,14 @@ class Channel:
                     self._issue(ev)
                     return
                 self._deferred = ev
+                pl.closed = True
             elif isinstance(ev, ProgramEnd):
                 self.end = ev
+                pl.closed = True
             elif isinstance(ev, Sync):
                 if not pl.idle:
                     self._deferred = ev
+                    pl.closed = True
                 elif self._skip_move is not None:
                     self._skip_done()
 

@@ -27,6 +27,9 @@ import numpy as np
 
 from nc.motion.deviation import KernelDeviation
 from nc.motion.limits import MotionConfig
+from nc.motion.shares import MAX_FACTOR
+
+USAGE_SCALE = 4.0  # below this many times the top speed a junction's budget use is worth refining
 
 if TYPE_CHECKING:
     from nc.motion.lookahead import Block
@@ -70,6 +73,7 @@ class FilterCorners:
         self.budget_jl = tuple(x * lines for x in self.budget_j)
         self.tol = cfg.path_tolerance
         self.kd = KernelDeviation(n1, n2, cfg.cycle)
+        self._boost: dict[tuple[float, float], float] = {}  # braking's growth per (a, j)
         self.t2sum = t1 * t1 + t2 * t2
         # One window of T1+T2 for both sums: a T1 window lies inside it.
         self.budget = tuple(min(ba, bj) for ba, bj in zip(self.budget_a, self.budget_j))
@@ -96,31 +100,43 @@ class FilterCorners:
         # acceleration, vtop and length.
         self._maxima: tuple[deque[tuple[int, float]], ...] = (deque(), deque(), deque())
 
-    def corner(self, du: Sequence[float], acc: float, lines: bool = False) -> float:
-        """Speed cap of one isolated tangent jump (|Δu| per axis) between blocks whose path
-        acceleration reaches `acc`: the acceleration and jerk budgets. The path tolerance is the
-        deviation model's (`_tolerance`), except that a corner whose braking alone cuts it by
-        more than the tolerance is an exact stop. `lines`: both blocks are lines."""
+    def corner_budget(self, du: Sequence[float], lines: bool = False) -> float:
+        """The acceleration and jerk budgets' cap of one isolated tangent jump."""
         v = math.inf
         for d, ba, bj in zip(du, self.budget_al if lines else self.budget_a,
                              self.budget_jl if lines else self.budget_j):
             if d > 1e-12:
                 v = min(v, ba / d, bj / d)
-        if self.tol is not None:
-            du_n = math.sqrt(sum(d * d for d in du))
-            room = self.tol - self.braking(du_n, acc)
-            if room <= 0.0:
-                return 0.0
-            # The corner's own term of the kernel model, alone: v·|Δu|·G(0) (nc.motion.deviation).
-            # A cap that only falls, so the model may charge each step at min(c, this cap).
-            v = min(v, room / (du_n * self.kd.g0))
         return v
 
-    def braking(self, du_n: float, acc: float) -> float:
+    def corner_tolerance(self, du_n: float, acc: float, jerk: float = 0.0) -> float:
+        """The path tolerance's cap of one isolated tangent jump of norm du_n: the deviation model
+        is `_tolerance`'s, except that a corner whose braking alone cuts the tolerance is an
+        exact stop (0). The corner's own term of the kernel model, alone: v·|Δu|·G(0)
+        (nc.motion.deviation), a cap that only falls, so the model may charge each step at
+        min(c, this cap)."""
+        if self.tol is None or du_n <= 1e-12:
+            return math.inf
+        room = self.tol - self.braking(du_n, acc, jerk)
+        if room <= 0.0:
+            return 0.0
+        return room / (du_n * self.kd.g0)
+
+    def braking(self, du_n: float, acc: float, jerk: float = 0.0) -> float:
         """How far braking into and speeding out of a corner inside the filter window cuts it:
         about |Δu|·a·(T1²+T2²)/192 (measured on 90° corners: 1/240). When that alone exceeds the
-        tolerance the corner is an exact stop (0), which the filter then passes exactly."""
-        return du_n * acc * self.t2sum / 192.0
+        tolerance the corner is an exact stop (0), which the filter then passes exactly.
+        `jerk`: the blocks' tangential jerk, given where a solve may raise it by up to
+        shares.MAX_FACTOR (between lines): a higher jerk reaches the deceleration closer to the
+        corner, so the term grows by the kernel's own ratio for the two jerks."""
+        b = du_n * acc * self.t2sum / 192.0
+        if jerk > 0.0:
+            key = (acc, jerk)
+            r = self._boost.get(key)
+            if r is None:
+                r = self._boost[key] = max(1.0, self.kd.speed_up(acc, jerk * MAX_FACTOR) / self.kd.speed_up(acc, jerk))
+            b *= r
+        return b
 
     def arc_speed(self, radius: float) -> float:
         """Highest speed on an arc whose filtered radius shrinks by no more than the tolerance.
@@ -290,19 +306,22 @@ class FilterCorners:
             for q in maxima:
                 _drop_before(q, self._seq0 + m)
         self._m = m
-        c = cap(m)
+        c = c_bud = cap(m)  # c_bud: the budgets' cap not held to top (nc.motion.shares)
         if c < top:
             # The sums over the whole stretch bound the filter's acceleration and jerk from
             # above; the windows themselves (at the speed they are crossed) are far less on a
             # curve, where consecutive windows hold nearly the same signed sum.
-            c2 = self._refine(hist, h0, last, c, top, budget_a, budget_j)
+            c2, c_bud = self._refine(hist, h0, last, c, top, budget_a, budget_j)
             if c2 > c:
                 c = c2
                 while m > h0 and s_j - hist[m - 1].s_end <= c * t_w + pad:
                     m -= 1
+        elif c < USAGE_SCALE * top:
+            # Capped by nothing, but the share the corners use (vjunc / vbud, nc.motion.shares) is
+            # read from the signed windows: the unsigned sums overstate it on a curve.
+            c_bud = max(c, self._refine(hist, h0, last, top, top, budget_a, budget_j)[1])
         depth = self._tolerance(blocks, v_hi) if self.tol is not None else 0
-        if c >= top_q[0][1]:
-            return depth  # no junction of the stretch can run as fast as this cap
+        fast = c >= top_q[0][1]  # no junction of the stretch can run as fast as this cap
         k = 2
         idx = last
         it = reversed(blocks)
@@ -310,7 +329,9 @@ class FilterCorners:
         for b in it:
             if idx < m:
                 break
-            if b.vbase > c:
+            if b.vbud > c_bud:
+                b.vbud = c_bud  # the budget share a junction uses is vjunc / vbud (nc.motion.shares)
+            if not fast and b.vbase > c:
                 b.vbase = c
                 if b.vjunc > c:
                     b.vjunc = c
@@ -323,12 +344,13 @@ class FilterCorners:
         return depth
 
     def _refine(self, hist: list["Block"], h0: int, last: int, c: float, top: float,
-                budget_a: tuple[float, ...], budget_j: tuple[float, ...]) -> float:
+                budget_a: tuple[float, ...], budget_j: tuple[float, ...]) -> tuple[float, float]:
         """The highest speed ≤ top (above the safe cap c, else c) at which every filter window
         whose last junction is J meets the budgets, the windows taken at that speed: per axis
         the acceleration |Σ v_i·Δu_i|/T1 over a T1 window and the jerk over the difference of two
         such windows T2 apart, divided by T1·T2 (the two moving averages' derivatives, exactly, at
-        constant speed), v_i the least of v and the junction's cap so far (vbase only ever falls)."""
+        constant speed), v_i the least of v and the junction's cap so far (vbase only ever falls).
+        Second: the cap the budgets give with the windows taken at that speed, not held to top."""
         t1, t2 = self.t_a, self.t_j - self.t_a
         s_j = hist[last].s_end
         lo = last
@@ -366,17 +388,18 @@ class FilterCorners:
                                float(np.min(np.where(sd > 1e-12, bj / sd, math.inf))))
 
         best = c
-        v = min(cap_at(c), top)
+        bud = nxt = cap_at(c)  # with the windows at `best`, the budgets allow `bud` (≥ best)
+        v = min(nxt, top)
         for _ in range(3):
             if v <= best * (1.0 + 1e-6):
                 break
             nxt = cap_at(v)
             if nxt >= v * (1.0 - 1e-9):  # v meets the budgets with its own windows
-                best = v
+                best, bud = v, nxt
                 v = min(nxt, top)
             else:
                 v = 0.5 * (best + v)
-        return best
+        return best, max(bud, best)
 
     def _tolerance(self, blocks: Sequence["Block"], v_hi: float) -> int:
         """Evaluate the deviation model (nc.motion.deviation) at the junctions within half a
@@ -418,7 +441,9 @@ class FilterCorners:
         for r, i in enumerate(ev):
             b = seg[i]
             nx = seg[i + 1] if i + 1 < len(seg) else blocks[-1]
-            room[r] = self.tol - self.braking(b.du_n, b.a if b.a > nx.a else nx.a)
+            lines = b.seg is not None and nx.seg is not None and b.seg.kind == nx.seg.kind == "line"
+            room[r] = self.tol - self.braking(b.du_n, b.a if b.a > nx.a else nx.a,
+                                              (b.j if b.j > nx.j else nx.j) if lines else 0.0)
         near = s >= s_j - 2.0 * h - 1e-12
         caps = self.kd.caps(s[ev], room, vt, s[near], du[near], vb[near])
         for r, i in enumerate(ev):

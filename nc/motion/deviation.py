@@ -29,6 +29,16 @@ class KernelDeviation:
         self._y = np.linspace(0.0, max(self.half, 1e-12), 97)
         self._g = np.array([float(np.sum(k * np.maximum(z - y, 0.0))) for y in self._y])
         self.g0 = float(self._g[0])
+        self._k, self._z = k, np.abs(z)
+
+    def speed_up(self, a: float, j: float) -> float:
+        """Half the kernel-weighted path a jerk-limited speed change (limits a, j, from zero
+        acceleration at the corner) adds around a corner: Σ k_m·D(|z_m|)/2, D(τ) = jτ³/6 up to
+        τ = a/j, then with the acceleration a (the braking term's shape, per unit |Δu|)."""
+        z, ta = self._z, a / j
+        d = np.where(z <= ta, j * z ** 3 / 6.0,
+                     j * ta ** 3 / 6.0 + j * ta * ta / 2.0 * (z - ta) + a * (z - ta) ** 2 / 2.0)
+        return float(np.sum(self._k * d)) / 2.0
 
     def weights(self, x: np.ndarray) -> np.ndarray:
         """G(x) for time offsets x (s)."""

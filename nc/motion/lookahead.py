@@ -66,6 +66,10 @@ class Block:
     vbase: float = math.inf
     ctol: float = math.inf
     vtol: float = math.inf
+    # The least cap the filter's acceleration/jerk budgets alone gave this junction (its corner and
+    # every window that held it; not the tolerance): vjunc / vbud is the share of the corner budget
+    # the junction can use (nc.motion.shares, decision motion 39).
+    vbud: float = math.inf
 
 
 def change_distance(v0: float, v1: float, a: float, j: float) -> float:
@@ -188,7 +192,10 @@ class Limits:
             b1.du = tuple(du)
             b1.du_n = math.sqrt(sum(d * d for d in du))
             if b1.du_n > 1e-9:
-                v = min(v, self.blend.corner(du, max(b1.a, b2.a), s1.kind == "line" and s2.kind == "line"))
+                lines = s1.kind == "line" and s2.kind == "line"
+                b1.vbud = self.blend.corner_budget(du, lines)
+                v = min(v, b1.vbud, self.blend.corner_tolerance(b1.du_n, max(b1.a, b2.a),
+                                                                 max(b1.j, b2.j) if lines else 0.0))
         elif max(du) > 1e-9:
             vj = va = math.inf
             for d, cj, ca in zip(du, self._corner_j, self._corner_a):

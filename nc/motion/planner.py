@@ -27,12 +27,14 @@ from nc.motion.limits import MotionConfig
 from nc.motion.lookahead import MARGIN, Block, Limits, backward, change_distance, max_speed_at, reach
 from nc.motion.path import Segment
 from nc.motion.profile import Piecewise, solve_axes, solve_position, solve_velocity
+from nc.motion.shares import jerk_factor
 from nc.motion.smoothing import PositionFilter
 from nc.motion.thread_corners import corner_offset
 from nc.motion import threading as thr
 from nc.moves import Move
 
 CHUNK = 64  # cycles sampled per vectorised step
+OPEN_CHUNK = 4  # ... while the queue cannot tell the jerk factor yet (the channel reads 4 blocks a cycle)
 MAX_SOLVES_PER_CYCLE = 1000  # plans one cycle may start and end before a sample is due (decisions B4)
 
 
@@ -55,6 +57,10 @@ class _Plan:
     rpm: float = 0.0  # spindle speed the feed-per-rev cap used
     settled: bool = False  # that speed was the command the spindle had reached
     emitted: bool = False  # some of its samples went out (the planner state is the last of them)
+    # A path solve whose jerk factor the queue could not tell yet (nc.motion.shares): sampled a
+    # few cycles at a time and solved again once more than `queued` moves were pushed.
+    open: bool = False
+    queued: int = 0
 
 
 class Planner:
@@ -126,10 +132,18 @@ class Planner:
         if cfg.filtered:
             self.filter = PositionFilter(*cfg.filter_cycles(), self.position)
         self._path_s = 0.0  # path length pushed so far (junction windows are measured on it)
+        # The channel sets `closed` when no move comes before the queue has run out to rest (program
+        # end, an M/S/T or preview barrier); a push clears it. _jf: tangential jerk factor of the
+        # last path solve (nc.motion.shares).
+        self.closed = False
+        self._jf = 1.0
+        self._pushes = 0  # moves pushed so far (an open plan re-solves when more came)
         self.output = self.position.copy()  # the last setpoint handed out (filtered)
 
     # ---- queue ----------------------------------------------------------------------------
     def push(self, move: Move) -> None:
+        self.closed = False
+        self._pushes += 1
         b = self._block(move)
         if b is None:
             return
@@ -473,9 +487,12 @@ class Planner:
                 if self.plan is None:
                     return
             p = self.plan
+            if p.open and p.emitted and self._pushes > p.queued and not self.held:
+                self._replan()  # more of the path is known: the jerk factor may rise
+                continue
             n = int(math.floor((p.duration - p.t_next) / T + 1e-9)) + 1
             if p.t_next <= p.duration + 1e-12 and n > 0:
-                self._sample(p, min(n, CHUNK))
+                self._sample(p, min(n, OPEN_CHUNK if p.open else CHUNK))
                 if not self._buf_done:
                     return
                 if self.plan is None:
@@ -550,14 +567,22 @@ class Planner:
             return _Plan("ramp", pw, pw.duration, t0, 0.0, 0.0)
         # The run: following blocks the profile may cross without a binding junction (same or
         # higher cap, end speed not below the cap); the target is the end of that run.
-        for extend in (False, True):
-            dist, v1, ra, rj, vmax = self._run_target(cap, extend, s + change_distance(v, cap, b.a, b.j))
-            # Forward pass: no more than the entry state can reach (a braking state first ramps
-            # its deceleration out, losing a²/2j of speed over v·|a|/j of path).
-            ve, de = (v - a * a / (2.0 * rj), dist - s - v * abs(a) / rj) if a < 0.0 else (v, dist - s)
-            v1 = min(v1, reach(max(ve, 0.0), max(de, 0.0), MARGIN * ra, MARGIN * rj))
-            pw = solve_position(s, v, a, dist, v1, vmax, ra, rj)
+        cruise = s + change_distance(v, cap, b.a, b.j)
+        jf, unknown = self._jerk_factor(b, s, cap, cruise)
+        # A profile continued at nonzero acceleration was solved with the previous factor: when
+        # the new one cannot meet its target from that state, the previous one still can.
+        for f in (jf, self._jf) if self._jf > jf and abs(a) > 1e-9 else (jf,):
+            for extend in (False, True):
+                dist, v1, ra, rj, vmax = self._run_target(cap, extend, cruise, f)
+                # Forward pass: no more than the entry state can reach (a braking state first ramps
+                # its deceleration out, losing a²/2j of speed over v·|a|/j of path).
+                ve, de = (v - a * a / (2.0 * rj), dist - s - v * abs(a) / rj) if a < 0.0 else (v, dist - s)
+                v1 = min(v1, reach(max(ve, 0.0), max(de, 0.0), MARGIN * ra, MARGIN * rj))
+                pw = solve_position(s, v, a, dist, v1, vmax, ra, rj)
+                if pw is not None and pw.p_max <= dist + 1e-7 and pw.v_min() >= -1e-7:
+                    break
             if pw is not None and pw.p_max <= dist + 1e-7 and pw.v_min() >= -1e-7:
+                self._jf = f
                 break
         if pw is None or pw.p_max > dist + 1e-7 or pw.v_min() < -1e-7:
             # Cannot meet the target from this state (an override just cut the cap): ramp down
@@ -569,10 +594,22 @@ class Planner:
                 pw.duration = max(pw.duration, (dist - s) / target)
                 pw.t0[:, -1] = np.minimum(pw.t0[:, -1], pw.duration)
             return _Plan("ramp", pw, pw.duration, t0, 0.0, target)
-        return _Plan("path", pw, pw.duration, t0, target=dist, rpm=rpm, settled=settled)
+        return _Plan("path", pw, pw.duration, t0, target=dist, rpm=rpm, settled=settled, open=unknown,
+                     queued=self._pushes)
 
-    def _run_target(self, cap: float, extend: bool = False,
-                    cruise_from: float = math.inf) -> tuple[float, float, float, float, float]:
+    def _jerk_factor(self, b: Block, s: float, cap: float, cruise: float) -> tuple[float, bool]:
+        """The tangential jerk factor for a solve from s in b, and whether the queue could not
+        tell it yet (nc.motion.shares): over the longest run any solve from here may take (the
+        extended one: a higher jerk only ends runs sooner)."""
+        blend = self.lim.blend
+        if blend is None:
+            return 1.0, False
+        dist = self._run_target(cap, True, cruise)[0]
+        start = b.s_end - b.length
+        return jerk_factor(self.cfg, blend, self.blocks, start + s, start + dist, self.closed)
+
+    def _run_target(self, cap: float, extend: bool = False, cruise_from: float = math.inf,
+                    jf: float = 1.0) -> tuple[float, float, float, float, float]:
         """(distance, end speed, acceleration, jerk, top speed) of the run that starts with blocks[0].
 
         A run ends at the first junction slower than the cap. With `extend` it carries on through
@@ -581,6 +618,7 @@ class Planner:
         held to the slowest of them so the profile crosses each at no more than it allows.
         A junction past `cruise_from` (where the cap is reached) that may be crossed at the cap
         ends the run too: the profile cruises there, so nothing beyond it changes this solve.
+        `jf`: factor on the run's tangential jerk (nc.motion.shares).
         """
         self.lookahead()
         blocks = self.blocks
@@ -592,19 +630,19 @@ class Planner:
         while True:
             b = blocks[k]
             if k + 1 >= n:
-                return dist, min(b.vend, vmax), ra, rj, vmax
+                return dist, min(b.vend, vmax), ra, rj * jf, vmax
             nx = blocks[k + 1]
             if nx.kind != "path" or nx.cap < cap - 1e-9 or b.vend <= 0.0 or k >= 2 * self.depth \
                     or (b.vend >= vmax - 1e-9 and dist >= cruise_from):
-                return dist, min(b.vend, vmax), ra, rj, vmax
+                return dist, min(b.vend, vmax), ra, rj * jf, vmax
             if b.vjunc < cap - 1e-9:
-                if b.binding and b.vend >= max_speed_at(self.v, self.a, dist - self.s, ra, rj):
+                if b.binding and b.vend >= max_speed_at(self.v, self.a, dist - self.s, ra, rj * jf):
                     # Not reachable faster than it allows from the present state (a rising
                     # chain of caps behind a corner): it cannot bind, and a profile that ended
                     # there at zero acceleration would only lose time.
                     pass
                 elif not extend or b.binding:
-                    return dist, min(b.vend, vmax), ra, rj, vmax
+                    return dist, min(b.vend, vmax), ra, rj * jf, vmax
                 else:
                     vmax = min(vmax, b.vjunc)
             dist += nx.length

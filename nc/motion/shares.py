@@ -1,0 +1,120 @@
+"""How much of each axis' jerk the tangential profile may use, from what the filter's corners near
+it really use (issue 18, decision motion 39).
+
+The static split (MotionConfig shares: tangential 0.5, corner 0.25, curvature 0.25) keeps the
+setpoint stream within the axis limits when all three act in the same cycle. Between lines the
+curvature share goes to the filter's corners (decision 38), so tangential + corner = 1. A corner
+J crossed at v_J ≤ vjunc uses no more than vjunc / vbud of its budget share: vbud is the least
+cap the acceleration/jerk budgets gave J (its own corner and every filter window that held it),
+and for any window W, Σ_W v·|Δu| ≤ v_m·Σ_W |Δu| ≤ (v_m / cap_W)·budget with m the fastest
+junction of W and cap_W ≥ vbud_m the cap made from a sum that holds W. So while every junction
+the filter can mix with a stretch of the tangential profile uses at most U of the corner share,
+that stretch may plan with jerk (1 − U·(corner + curvature share)) of the axis limits instead of
+the tangential share, up to MAX_FACTOR times it. Only the jerk is raised, not the acceleration.
+A higher jerk reaches the full deceleration closer to a corner, so the tolerance model's braking
+term between lines (FilterCorners.braking) is sized for MAX_FACTOR times the blocks' jerk: by the
+kernel's own weighting of the path a jerk-limited speed change adds around a corner
+(KernelDeviation.speed_up). A factor of 2 cost the 15° CAM vertices more in corner speed than it
+gained on the straights (docs/performance/motion.md); 1.5 gains on every dense program measured.
+
+"Can mix with": the filter's output at one cycle averages T1 + T2 of input, so a tangential jerk
+at path position p and a corner at q meet in some output cycle only if the path between them
+is crossed within T1 + T2: |p − q| ≤ v_hi·(T1+T2), v_hi the fastest any block in between can
+run (vtop: feed × the top override, or its geometric cap). The stretch a solve may use is the
+current position to the end of its run. Arcs (the curvature share's centripetal terms) near the
+stretch, or a queue that does not reach far enough past the run (the blocks still to come are
+unknown, unless the channel said none come before a stop: `closed`), leave the share as it was.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import TYPE_CHECKING
+
+from nc.motion.limits import MotionConfig
+
+# The most a solve raises the tangential jerk; the tolerance's braking term between lines is
+# sized for it (FilterCorners.braking).
+MAX_FACTOR = 1.5
+
+if TYPE_CHECKING:
+    from nc.motion.blending import FilterCorners
+    from nc.motion.lookahead import Block
+
+
+def jerk_factor(cfg: MotionConfig, fc: "FilterCorners", blocks: Sequence["Block"], pos: float,
+                run_end: float, closed: bool) -> tuple[float, bool]:
+    """Factor (1 … MAX_FACTOR) on the tangential jerk of a solve over path positions
+    [pos, run_end] (absolute path lengths, Block.s_end's scale) with the queue `blocks`; second:
+    the queue did not reach far enough to tell (more blocks may raise the factor)."""
+    st = cfg.share_tangential
+    pool = cfg.share_corner + cfg.share_curvature
+    if st <= 0.0 or st + pool > 1.0 + 1e-9 or not blocks:
+        return 1.0, False
+    t_w = fc.t_j
+    v_hi = max(b.vtop for b in (blocks[0], blocks[-1]))
+    for _ in range(4):  # the reach grows with the fastest block found inside it
+        reach = v_hi * t_w
+        got = _scan(fc, blocks, pos, run_end, reach, closed)
+        if got is None:
+            return 1.0, False
+        if got is UNKNOWN:
+            return 1.0, True
+        use, seen = got
+        if seen <= v_hi:
+            return min(MAX_FACTOR, max(1.0, (1.0 - use * pool) / st)), False
+        v_hi = seen
+    return 1.0, False
+
+
+UNKNOWN = (-1.0, -1.0)  # _scan: the queue ends before the reach does
+
+
+def _scan(fc: "FilterCorners", blocks: Sequence["Block"], pos: float, run_end: float, reach: float,
+          closed: bool) -> tuple[float, float] | None:
+    """(largest vjunc / vbud, fastest vtop) over the junctions within `reach` of [pos, run_end];
+    None when an arc is there, UNKNOWN when the queue does not tell what is there."""
+    seen = 0.0
+    hi = run_end + reach
+    covered = False
+    last = blocks[-1]
+    for b in blocks:
+        if b.kind != "path" or b.seg is None:
+            covered = True  # dwell, thread, independent rapid: a stop before it ends every window
+            break
+        if b.s_end - b.length > hi:
+            covered = True
+            break
+        if b.seg.kind == "arc":
+            return None  # the curvature share's centripetal terms
+        seen = max(seen, b.vtop)
+        if b is not last and b.vjunc <= 0.0 and b.s_end >= run_end - 1e-9:
+            covered = True  # an exact stop (G09/G61, G00): the filter settles there
+            break
+    if not covered and not (closed or last.s_end > hi):
+        return UNKNOWN
+    lo = pos - reach
+    use = 0.0
+    hist = fc._hist
+    # FilterCorners keeps every junction since the last stop (its _h0 is relative to the newest
+    # push, not to the executing block) and drops old ones only in bulk, counted in _seq0.
+    for k in range(len(hist) - 1, -1, -1):
+        j = hist[k]
+        if j.s_end > hi:
+            continue
+        if j.s_end < lo:
+            break
+        seen = max(seen, j.vtop)
+        if j.seg is not None and j.seg.kind == "arc":
+            return None
+        if j.du_n <= 1e-9:
+            continue
+        if j.vbud <= 1e-12:
+            return None
+        r = j.vjunc / j.vbud
+        if r > use:
+            use = min(r, 1.0)
+    else:
+        if fc._seq0 > 0:
+            return None  # junctions within the reach were dropped already
+    return use, seen
