@@ -10,7 +10,7 @@ import math
 import pytest
 
 from hil.bench import default_lathe
-from mlc.signals import d3
+from mlc.signals import d3, m3
 from hil.runner import BenchRunner
 from hil.scripting import build_mlc
 from hil.session import make_link
@@ -36,6 +36,7 @@ def _run_s1000(bus: str) -> dict:
         seen["torque"] = r.tx[s].torque_actual
         seen["D30340"] = r.mlc.mem.f32(d3(0, 336 + 2 * s))  # velocity RPM of the (s+1)-th drive, to the MLC
         seen["D30240"] = r.mlc.mem.words[30240 + s]  # its torque to the MLC, 0.1 % of rated (s16)
+        seen["relays"] = (r.mlc.mem.bit(m3(1, 704)), r.mlc.mem.bit(m3(1, 705)))  # channel 1: S1 speed reached, zero speed
         if not bus.startswith("sim"):  # what the drive itself holds, read over the bus by SDO
             seen["60FF"] = int.from_bytes(r.link.sdo_read(s, 0x60FF, 0), "little", signed=True)
             seen["606C"] = int.from_bytes(r.link.sdo_read(s, 0x606C, 0), "little", signed=True)
@@ -51,6 +52,7 @@ def _check(seen: dict) -> None:
     assert seen["tx"] == pytest.approx(10000, abs=2)  # at speed, in the same unit
     assert seen["rpm"] == pytest.approx(1000.0, abs=0.2)  # the master converts back to rpm
     assert seen["D30340"] == pytest.approx(1000.0, abs=0.2)
+    assert seen["relays"] == (True, False)  # the MLC's spindle relays judge rpm against S1000 (within 2 %)
     assert 0 < seen["torque"] < 1000  # 0.1 % of rated: a free spindle at speed needs friction torque, well under 100 %
     assert seen["D30240"] == seen["torque"]  # the MLC gets 0x6077 in its own 0.1 % unit, not scaled twice
     if "60FF" in seen:
