@@ -215,20 +215,43 @@ def step_g66_call(ip, run: BlockRun) -> None:
 
 
 Step = Callable[..., "Iterator[Event] | None"]
-# The NC5 order of execution of one block, after it is read and checked (docs/architecture.md).
-EXECUTION_ORDER: tuple[tuple[str, Step], ...] = (
-    ("G65 macro call", step_g65),
-    ("preview stops", step_preview_stop),
-    ("modal G codes, G66/G67", step_modal),
-    ("F, D", step_feed_d),
-    ("S", step_spindle),
-    ("T", step_tool),
-    ("M before motion", step_m_before),
-    ("group-0 G codes, lathe cycles", step_nonmodal),
-    ("motion", step_motion),
-    ("M after motion, calls, returns, end", step_m_after),
-    ("G66 call after a move", step_g66_call),
+
+
+class Shape:
+    """What a block holds that decides which steps can act on it: its letters, G functions and
+    their modal groups (the same for every run of a block whose G and M words are plain numbers)."""
+
+    __slots__ = ("letters", "funcs", "groups")
+
+    def __init__(self, letters: frozenset[str], funcs: frozenset[str], groups: frozenset[int]) -> None:
+        self.letters, self.funcs, self.groups = letters, funcs, groups
+
+
+# The NC5 order of execution of one block, after it is read and checked (docs/architecture.md):
+# (name, step, when it can act). A step whose condition is false for a block's shape is a no-op for
+# it (its body tests the same words) and is left out of the block's plan (issue 16).
+EXECUTION_ORDER: tuple[tuple[str, Step, Callable[[Shape], bool]], ...] = (
+    ("G65 macro call", step_g65, lambda s: "G65" in s.funcs),
+    ("preview stops", step_preview_stop, lambda s: "M" in s.letters or not s.funcs.isdisjoint(STOP_PREVIEW)),
+    ("modal G codes, G66/G67", step_modal, lambda s: bool(s.groups - {0})),
+    ("F, D", step_feed_d, lambda s: "F" in s.letters or "D" in s.letters),
+    ("S", step_spindle, lambda s: "S" in s.letters or 17 in s.groups),  # G96/G97 (group 17) switch alone
+    ("T", step_tool, lambda s: "T" in s.letters),
+    ("M before motion", step_m_before, lambda s: "M" in s.letters),
+    ("group-0 G codes, lathe cycles", step_nonmodal, lambda s: 0 in s.groups),
+    ("motion", step_motion, lambda s: True),
+    ("M after motion, calls, returns, end", step_m_after, lambda s: "M" in s.letters),
+    ("G66 call after a move", step_g66_call, lambda s: True),
 )
+ALL_STEPS: tuple[Step, ...] = tuple(step for _, step, _ in EXECUTION_ORDER)
+
+
+def plan(shape: Shape) -> tuple[Step, ...]:
+    """The steps of EXECUTION_ORDER that can act on a block of this shape, in order."""
+    return tuple(step for _, step, when in EXECUTION_ORDER if when(shape))
+
+
+_PLAN_LIMIT = 4096  # blocks whose plan is remembered; then the memo starts over (memory flat)
 
 
 class ExecuteMixin:
@@ -249,19 +272,42 @@ class ExecuteMixin:
         if called is not None:
             yield from called
             return
-        run = self._read_run(block)
-        for _name, step in EXECUTION_ORDER:
+        run, steps = self._read_run(block, raw)
+        for step in steps:
             r = step(self, run)
             if r is not None:
                 yield from r
             if run.done:
                 return
 
-    def _read_run(self, block: Block) -> BlockRun:
-        """Read and check the block's G and M codes: letters it may not hold, M ranges, one call per block."""
-        gcodes = self._gcodes(block)
-        funcs = {fn for _, fn, _ in gcodes}
-        self._check_letters(block, funcs)
+    def _read_run(self, block: Block, raw: Block | None = None) -> tuple[BlockRun, tuple[Step, ...]]:
+        """Read and check the block's G and M codes: letters it may not hold, M ranges, one call per
+        block; with the steps that can act on it. What depends on the block's text alone (G lookup,
+        letter check, plan) is done once per block `raw` whose G and M words are plain numbers
+        (a loop body runs thousands of times)."""
+        memo = self._plans
+        hit = memo.get(id(raw)) if raw is not None else None
+        if hit is not None and hit[0] is raw:
+            gcodes, funcs, steps = hit[1], hit[2], hit[3]
+            if steps is None:  # the block's own letters are refused: as checked on its values
+                self._check_letters(block, funcs)
+                steps = ALL_STEPS
+        else:
+            gcodes = self._gcodes(block)
+            funcs = {fn for _, fn, _ in gcodes}
+            self._check_letters(block, funcs)
+            steps = ALL_STEPS
+            if raw is not None and not any(w.expr is not None and w.letter in "GM" for w in raw.words):
+                try:  # the raw block's letters (a vacant word is dropped from `block`, never added)
+                    self._check_letters(raw, funcs)
+                    steps = plan(Shape(frozenset(w.letter for w in raw.words), frozenset(funcs),
+                                       frozenset(g for g, _, _ in gcodes)))
+                except NcAlarm:
+                    steps = None
+                if len(memo) >= _PLAN_LIMIT:
+                    memo.clear()
+                memo[id(raw)] = (raw, gcodes, funcs, steps)
+                steps = steps or ALL_STEPS
         if (self.state.rotation or "G68" in funcs) and "G69" not in funcs and funcs & REFUSED_UNDER_G68:
             raise NcAlarm(0x025F, f"{' '.join(sorted(funcs & REFUSED_UNDER_G68))} while G68 rotation is on: "
                                   "cancel it with G69 first")
@@ -279,7 +325,7 @@ class ExecuteMixin:
             raise NcAlarm(0x024B, f"one block can only hold one call command ({' '.join(calls)})")
         if 98 in mvals and len(mvals) > 1:
             raise NcAlarm(0x0249, "M98 must be the only M code of its block")
-        return BlockRun(block, gcodes, funcs, mvals, self.state.css)
+        return BlockRun(block, gcodes, funcs, mvals, self.state.css), steps
 
     def _halt_m(self, mvals: list[int]) -> int | None:
         first = int(self.profile.param("N1.118", 0))
