@@ -301,6 +301,46 @@ def test_05b_homing_and_profile_position_over_pdo(master):
     assert abs(pos - 300_000) <= 100
 
 
+def test_05c_profile_velocity_and_cyclic_torque_in_the_predefined_set(master):
+    """CiA 402-2 profile velocity (mode 3: 0x60FF, statusword bit 10 = speed within 0x606D) and cyclic synchronous
+    torque (mode 10: 0x6071 in 0.1 % of rated, bit 12 = target torque used) through the A3-E's own third set as the
+    ESI defines it (0x1602: 6040 607A 60FF 6071 6060 60B8, 0x1A02: 6041 6064 606C 6077 6061 60B9 60BA 60FD), only
+    assigned: the mode travels in 0x6060 and shows in 0x6061; velocities in 0.1 rpm (LCEC's DEASDA_RPM_FACTOR)."""
+    s = master.slaves[0]
+    write_pdo(s, 0x1602, A3_RX[0x1602])  # an earlier test remapped it; the ESI's contents again
+    write_pdo(s, 0x1A02, A3_TX[0x1A02])
+    assign(s, 0x1602, 0x1A02)
+    master.config_map()
+    assert (len(s.output), len(s.input)) == (15, 23)
+    to_op(master, s)
+    position = struct.unpack("<HiihbHiI", bytes(s.input))[1]
+
+    def cycle(cw: int, mode: int, velocity: int = 0, torque: int = 0) -> tuple:
+        s.output = struct.pack("<HiihbH", cw, position, velocity, torque, mode, 0)
+        master.send_processdata()
+        master.receive_processdata(100_000)
+        return struct.unpack("<HiihbHiI", bytes(s.input))
+
+    for cw in (0x06, 0x07):
+        cycle(cw, 8)
+    for _ in range(5):
+        sw, *_ = cycle(0x0F, 8)
+    assert sw & 0x6F == 0x27
+    for _ in range(300):  # 0 -> 1000 rpm at the default 0x6083 (200 ms per 3000 rpm): about 70 ms
+        sw, _pos, velocity, _torque, shown, *_ = cycle(0x0F, 3, velocity=10000)
+    assert shown == 3 and sw & 0x0400  # target reached
+    assert velocity == pytest.approx(10000, abs=20)
+    v0 = velocity
+    for _ in range(20):
+        sw, _pos, velocity, torque, shown, *_ = cycle(0x0F, 10, torque=200)  # 20 % of rated torque
+    assert shown == 10 and sw & 0x1000  # target torque used
+    assert torque == pytest.approx(200, abs=20) and velocity > v0  # it accelerates on that torque
+    for _ in range(300):
+        sw, _pos, velocity, *_ = cycle(0x0F, 3, velocity=0)
+    assert abs(velocity) <= 20 and sw & 0x0400
+    cycle(0x06, 3)
+
+
 def test_06_sdo_size_must_match_the_object(master):
     """ETG.1000.6 / CiA 301: a 4-byte write to the 2-byte controlword aborts with 0x06070010."""
     s = master.slaves[0]
