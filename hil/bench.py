@@ -27,6 +27,7 @@ class AxisConfig:
     drive_esi: str = ""  # a vendor ESI file the virtual EtherCAT slave is built from ("" = the packaged one)
     canopen_eds: str = ""  # the drive's EDS/DCF on a CANopen bus; "" = Bench.canopen_eds or the shipped ASDA-B3
     homing: DriveHoming | None = None  # drive homing (CiA 402 mode 6) before every program (hil/drive_homing.py)
+    station_alias: int | None = None  # EtherCAT configured station alias its slave must have (None: not checked)
 
 
 @dataclass
@@ -38,6 +39,7 @@ class SpindleConfig:
     canopen_eds: str = ""  # as AxisConfig.canopen_eds
     drive_model: str = "asda-a3-e"  # as AxisConfig.drive_model
     drive_esi: str = ""  # as AxisConfig.drive_esi
+    station_alias: int | None = None  # as AxisConfig.station_alias
 
 
 FILTER_MS = 16.0  # default N1.036 and N1.037 (ms)

@@ -323,14 +323,15 @@ def _given(d: dict) -> set[str]:
     return set(table) if isinstance(table, dict) else set()
 
 
-def _drive(r: _Reader, d: Any, p: str, base: DriveParams) -> tuple[DriveParams, str, str]:
-    """The drive table: tuning, `model` (fieldbus.devices.MODELS) and `esi` (a vendor ESI file the
+def _drive(r: _Reader, d: Any, p: str, base: DriveParams) -> tuple[DriveParams, str, str, int | None]:
+    """The drive table: tuning, `model` (fieldbus.devices.MODELS), `esi` (a vendor ESI file the
     virtual EtherCAT slave is built from instead of the packaged one; the model's product code picks
-    the device in it)."""
+    the device in it) and `alias` (the EtherCAT station alias the slave must have, App. A 0x1416)."""
     if not isinstance(d, dict):
         r.err(p, f"must be a table, got {_kind(d)}")
-        return base, DEFAULT_MODEL, ""
+        return base, DEFAULT_MODEL, "", None
     d = dict(d)
+    alias = r.integer(d, "alias", f"{p}.alias", None, minimum=0, maximum=0xFFFF)
     model = r.string(d, "model", f"{p}.model", DEFAULT_MODEL) or DEFAULT_MODEL
     model = MODEL_ALIASES.get(model, model)
     if model not in MODELS:
@@ -355,10 +356,10 @@ def _drive(r: _Reader, d: Any, p: str, base: DriveParams) -> tuple[DriveParams, 
             v = r.number(d, key, f"{p}.{key}", None, positive=True)
         if v is not None:
             values[key] = v
-    r.unknown(d, f"{p}.", _DRIVE_KEYS | {"model", "esi"})
+    r.unknown(d, f"{p}.", _DRIVE_KEYS | {"model", "esi", "alias"})
     kw = {f.name: getattr(base, f.name) for f in fields(DriveParams)}
     kw.update(values)
-    return DriveParams(**kw), model, esi
+    return DriveParams(**kw), model, esi, alias
 
 
 def _axis(r: _Reader, d: dict, p: str) -> AxisConfig | None:
@@ -391,7 +392,7 @@ def _axis(r: _Reader, d: dict, p: str) -> AxisConfig | None:
                                           ("jerk", base.max_jerk))))
     r.unknown(lim, f"{p}.limits.", {"velocity", "acceleration", "jerk"})
     given = _given(d)
-    drive, model, esi = _drive(r, d.pop("drive", {}), f"{p}.drive", DriveParams())
+    drive, model, esi, alias = _drive(r, d.pop("drive", {}), f"{p}.drive", DriveParams())
     scaling = _for_model(scaling, model, cpr_given, model_named)
     drive = _drive_at_resolution(drive, given, scaling.counts_per_rev)
     eds = r.eds(d, f"{p}.canopen_eds", ASDA_CSP)
@@ -402,7 +403,7 @@ def _axis(r: _Reader, d: dict, p: str) -> AxisConfig | None:
         return None
     return AxisConfig(name, scaling, limits, drive, start=start, units=units,
                       soft_limits=(float(soft[0]), float(soft[1])) if soft else None, drive_model=model,
-                      canopen_eds=eds, drive_esi=esi, homing=homing)
+                      canopen_eds=eds, drive_esi=esi, homing=homing, station_alias=alias)
 
 
 def _homing(r: _Reader, d: dict, p: str) -> DriveHoming | None:
@@ -438,7 +439,7 @@ def _spindle(r: _Reader, d: dict, p: str) -> SpindleConfig | None:
     direction = r.integer(d, "direction", f"{p}.direction", 1, choices=(1, -1))
     max_rpm = r.number(d, "max_rpm", f"{p}.max_rpm", base.max_rpm, positive=True)
     given = _given(d)
-    drive, model, esi = _drive(r, d.pop("drive", {}), f"{p}.drive", base.drive)
+    drive, model, esi, alias = _drive(r, d.pop("drive", {}), f"{p}.drive", base.drive)
     eds = r.eds(d, f"{p}.canopen_eds", ASDA_CSP_CSV)
     r.unknown(d, f"{p}.", {"name", "counts_per_rev", "ratio", "direction", "max_rpm", "drive", "canopen_eds"})
     scaling = AxisScaling(counts_per_rev=cpr or base.scaling.counts_per_rev, gear_motor=int(ratio[0]),
@@ -446,7 +447,7 @@ def _spindle(r: _Reader, d: dict, p: str) -> SpindleConfig | None:
     scaling = _for_model(scaling, model, cpr_given, model_named)
     drive = _drive_at_resolution(drive, given, scaling.counts_per_rev)
     return SpindleConfig(name, scaling, max_rpm or base.max_rpm, drive, canopen_eds=eds, drive_model=model,
-                         drive_esi=esi)
+                         drive_esi=esi, station_alias=alias)
 
 
 def _realtime(r: _Reader, d: dict) -> RealtimeConfig:

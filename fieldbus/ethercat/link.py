@@ -93,6 +93,7 @@ class EthercatLink:
     drift_limit_ns: int = 50_000  # |system time difference| above this raises 0x141F; 0 = only record it
     stats: LinkStats = field(default_factory=LinkStats)
     io_names: Sequence[str] = ()  # remote I/O stations, k-th I/O slave in connection order (EIO node 501+k)
+    aliases: Sequence[int | None] = ()  # per drive (axes, then spindles): the station alias it must have (0x1416)
 
     def __post_init__(self) -> None:
         self.master: pysoem.Master | None = None
@@ -115,6 +116,7 @@ class EthercatLink:
         link = cls(iface, bench.cycle, names, [layout] * len(names),
                    complete_access=bool(params.get("ethercat_complete_access", False)))
         link.io_names = [st.map.name for st in getattr(bench, "io", [])]
+        link.aliases = [getattr(c, "station_alias", None) for c in list(bench.axes) + list(bench.spindles)]
         # bench [params]: ethercat_drift_limit_ns, ethercat_drift_check_every (docs/decisions E8)
         link.drift_limit_ns = int(params.get("ethercat_drift_limit_ns", link.drift_limit_ns))
         link.drift_check_every = int(params.get("ethercat_drift_check_every", link.drift_check_every))
@@ -201,6 +203,7 @@ class EthercatLink:
             raise BusError(Alarm(A.NO_SLAVES, f"{len(self.drives)} CiA 402 drives found on {self.iface}, "
                                               f"the bench needs {len(self.names)} ({', '.join(self.names)})"))
         self.drives = self.drives[: len(self.names)]
+        self._check_aliases()
         layouts = list(self.layouts) or [ASDA_E] * len(self.names)
         self._structs = layouts
         errors: list[Alarm] = []
@@ -252,6 +255,21 @@ class EthercatLink:
         self._io_out = [bytes(len(s.output)) for s in self.io]
         self._io_in = [bytes(s.input) for s in self.io]
         return self.infos
+
+    def _check_aliases(self) -> None:
+        """App. A 0x1416 "The slave address is different from the system address setting": a drive whose bench
+        entry names a station alias (`drive.alias`) must carry it in its SII (word 4)."""
+        for k, (s, name, want) in enumerate(zip(self.drives, self.names, self.aliases)):
+            if want is None:
+                continue
+            try:
+                have = struct.unpack("<H", s.eeprom_read(4)[:2])[0]
+            except Exception as exc:  # the SII cannot be read: the address cannot be confirmed either
+                raise BusError(Alarm(A.SLAVE_MISMATCH, f"{name}: cannot read the station alias of drive slave {k + 1}: "
+                                                       f"{exc}", axis=name)) from None
+            if have != want:
+                raise BusError(Alarm(A.SLAVE_MISMATCH, f"{name}: drive slave {k + 1} on the line has station alias "
+                                                       f"{have}, the bench expects {want} (drive.alias)", axis=name))
 
     def _mapper(self, s, layout: PdoLayout, name: str, errors: list[Alarm]):
         def write_all(sdos, complete: bool) -> None:

@@ -81,17 +81,22 @@ def build_chain(bench, io: int = 0, realtime: bool = False, faults=()):
     from virtual_bus.ethercat.network import Chain
 
     from virtual_bus.ethercat.r1ec import DEFAULT_MODULES, r1ec_device
+    from virtual_bus.ethercat.sii import set_alias
 
     from fieldbus.devices import MODELS
 
     # each drive presents its model's identity and PDO sets, from the packaged file or the bench's ESI
     models = [(c.drive_model, c.drive_esi) for c in list(bench.axes) + list(bench.spindles)]
+    aliases = [c.station_alias for c in list(bench.axes) + list(bench.spindles)]
     devices = {(m, esi): load_device(esi, MODELS[m].product_code) if esi else load_device(m) for m, esi in set(models)}
     slaves = []
     for k, (d, model) in enumerate(zip(sim_slaves(bench), models)):
         # Clocks start apart and run at slightly different rates, so DC has something to do.
         slaves.append(Esc(devices[model], DriveApp(d), name=d.name, drift_ppm=(-1) ** k * 10.0 * k,
                           clock_base_ns=(k + 1) * 1_234_567_890, cycle_time=bench.cycle, lockstep=not realtime))
+        if aliases[k] is not None:  # the bench's `drive.alias`: this slave's station alias (App. A 0x1416)
+            set_alias(slaves[-1].sii, aliases[k])
+            slaves[-1].power_on()
     # the bench's [[io]] stations (each with its R1-EC modules), then extra default 16/16 ones
     stations = [(st.map.name, st.modules or DEFAULT_MODULES) for st in getattr(bench, "io", [])]
     io_devices = {mods: r1ec_device(mods) for _, mods in stations} | {DEFAULT_MODULES: load_device("r1-ec-dio")}

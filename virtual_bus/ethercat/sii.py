@@ -86,3 +86,9 @@ def build_sii(dev: Device) -> bytes:
     if len(image) > dev.eeprom_bytes:
         raise ValueError(f"{dev.name}: SII image of {len(image)} bytes exceeds the {dev.eeprom_bytes}-byte EEPROM")
     return image.ljust(dev.eeprom_bytes, b"\xff")
+
+
+def set_alias(sii: bytearray, alias: int) -> None:
+    """Write the configured station alias (SII word 4, ETG.1000.6) and the config area's checksum (word 7)."""
+    struct.pack_into("<H", sii, 8, alias)
+    sii[14] = crc8(bytes(sii[:14]))
