@@ -78,3 +78,21 @@ def test_process_data_follows_the_fmmu_the_master_writes_in_op():
     send(chain, (E.FPWR, 0x1001, E.R_FMMU + 12, b"\x00"))
     (_, data, wkc), = send(chain, (E.LRW, 0, 0, struct.pack("<HiiH", 0x07, 0, 0, 0) + bytes(0x40 - 12 + 22)))
     assert wkc == 1 and struct.unpack_from("<H", data, 0x40)[0] & 0x6F == 0x21
+
+
+def test_watchdog_time_the_master_writes_in_op_takes_effect():
+    import time
+
+    chain = build_chain(default_lathe())
+    address(chain)
+    _to_op(chain, 0x100)
+    frame = (E.LRW, 0, 0, struct.pack("<HiiH", 0x06, 0, 0, 0) + bytes(0x100 - 12 + 22))
+    send(chain, frame)
+    time.sleep(0.002)
+    (_, _, wkc), = send(chain, frame)  # 2 ms without outputs: within the default 100 ms
+    assert wkc == 3 and chain.slaves[0].al_state == E.OP
+    send(chain, (E.FPWR, 0x1001, E.R_WD_PD, struct.pack("<H", 5)))  # 5 ticks of 100 µs
+    time.sleep(0.002)
+    send(chain, frame)
+    s = chain.slaves[0]
+    assert s.al_state == E.SAFEOP and s.mem[E.R_AL_STATUS] & E.AL_ERROR and s.al_code == E.AL_SM_WATCHDOG

@@ -6,9 +6,11 @@ read from theirs), so the PDO mapping a master configures over SDO is the one th
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
+from operator import attrgetter
 
-from fieldbus.pdo import ASDA_CSP_CSV, ASDA_E, RxPdo
+from fieldbus.pdo import ASDA_CSP_CSV, ASDA_E, RxPdo, TxPdo
 from fieldbus.cia402 import State
 from virtual_bus.drive import Cia402Drive
 from virtual_bus.drive_modes import CST, MODE_OBJECTS, check_value
@@ -33,7 +35,8 @@ class DriveApp(SlaveApp):
     # Compiled once at attach (issue 17): the OD entries behind RxPdo / TxPdo fields, so a frame
     # makes no object lookups; entries keep their identity (SDO writes change their values only).
     _rx_pairs: list[tuple[str, OdEntry]] = field(default_factory=list)
-    _tx_pairs: list[tuple[OdEntry, str]] = field(default_factory=list)
+    _tx_entries: tuple[OdEntry, ...] = ()
+    _tx_values: Callable[[TxPdo], tuple] = field(default=lambda fb: ())
     _images: Images = field(default_factory=Images)
 
     def attach(self, od: ObjectDictionary) -> None:
@@ -52,7 +55,10 @@ class DriveApp(SlaveApp):
             if index in od.objects and sub in od.objects[index].entries:
                 setattr(objects, attr, od.value(index, sub))
         self._rx_pairs = [(attr, od.entry(index, sub)) for (index, sub), attr in RX_ATTR.items() if index in od.objects]
-        self._tx_pairs = [(od.entry(index, sub), attr) for (index, sub), attr in TX_ATTR.items() if index in od.objects]
+        tx = [(od.entry(index, sub), attr) for (index, sub), attr in TX_ATTR.items() if index in od.objects]
+        self._tx_entries = tuple(e for e, _ in tx)
+        getter = attrgetter(*(a for _, a in tx)) if tx else (lambda fb: ())
+        self._tx_values = getter if len(tx) != 1 else (lambda fb: (getter(fb),))
         self._publish()
 
     def _before_write(self, index: int, sub: int, value) -> None:
@@ -87,9 +93,8 @@ class DriveApp(SlaveApp):
             raise SdoAbort(exc.code) from None
 
     def _publish(self) -> None:
-        fb = self.drive.feedback()
-        for e, attr in self._tx_pairs:
-            e.value = int(getattr(fb, attr))
+        for e, v in zip(self._tx_entries, self._tx_values(self.drive.feedback())):
+            e.value = int(v)
 
     def refresh(self, index: int) -> None:
         if any(index == i for i, _ in TX_ATTR):

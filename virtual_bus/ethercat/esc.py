@@ -49,6 +49,7 @@ R_DC_RECV, R_DC_SYSTIME, R_DC_RECV_PU, R_DC_OFFSET, R_DC_DELAY, R_DC_DIFF = 0x09
 R_DC_CYCLIC, R_DC_ACTIVATION, R_DC_SYNC0_START, R_DC_SYNC0_CYCLE = 0x0980, 0x0981, 0x0990, 0x09A0
 MBX_TYPE_ERR, MBX_TYPE_COE = 0x00, 0x03
 
+_U16, _U32, _U64 = struct.Struct("<H"), struct.Struct("<I"), struct.Struct("<Q")
 HOP_NS = 500  # forwarding delay per ESC and cable, what the DC delay measurement sees
 
 
@@ -124,11 +125,12 @@ class Esc:
         self.events: list[str] = []
         self.wkc_fault = False
         self.refuse: dict[int, int] = {}  # AL state -> AL status code it is refused with (fault injection)
-        # SyncManager and FMMU settings decoded once, and the copy plan of each logical datagram seen,
-        # until the master writes the 0x0600-0x087F registers again (issue 17: no per-frame decoding).
+        # SyncManager, FMMU and watchdog settings decoded once, and the copy plan of each logical datagram
+        # seen, until the master writes those registers again (issue 17: no per-frame decoding).
         self._sms: dict[int, Sm] = {}
         self._fmmus: list[tuple[int, int, int, int]] | None = None
         self._plans: dict[tuple[int, int, int], tuple[list, list]] = {}
+        self._wd_ns: int | None = None  # the process-data watchdog time, from 0x0400 and 0x0420
         self.power_on()
 
     # ---- reset --------------------------------------------------------------------------
@@ -156,16 +158,17 @@ class Esc:
         self._sms.clear()
         self._fmmus = None
         self._plans.clear()
+        self._wd_ns = None
 
     # ---- small register helpers -----------------------------------------------------------
     def u16(self, a: int) -> int:
-        return struct.unpack_from("<H", self.mem, a)[0]
+        return _U16.unpack_from(self.mem, a)[0]
 
     def u32(self, a: int) -> int:
-        return struct.unpack_from("<I", self.mem, a)[0]
+        return _U32.unpack_from(self.mem, a)[0]
 
     def u64(self, a: int) -> int:
-        return struct.unpack_from("<Q", self.mem, a)[0]
+        return _U64.unpack_from(self.mem, a)[0]
 
     @property
     def station(self) -> int:
@@ -209,9 +212,9 @@ class Esc:
         own = self.system_ns(self.frame_ns + self.position * HOP_NS)
         diff = ((received - own + (1 << 63)) % (1 << 64)) - (1 << 63)
         mag = min(abs(diff), 0x7FFFFFFF)
-        struct.pack_into("<I", self.mem, R_DC_DIFF, mag | (0x80000000 if diff < 0 else 0))
+        _U32.pack_into(self.mem, R_DC_DIFF, mag | (0x80000000 if diff < 0 else 0))
         step = max(-5000, min(5000, diff // 8)) if abs(diff) < 1_000_000 else diff
-        struct.pack_into("<Q", self.mem, R_DC_OFFSET, (self.u64(R_DC_OFFSET) + step) & 0xFFFFFFFFFFFFFFFF)
+        _U64.pack_into(self.mem, R_DC_OFFSET, (self.u64(R_DC_OFFSET) + step) & 0xFFFFFFFFFFFFFFFF)
 
     # ---- register access with side effects ------------------------------------------------
     def read(self, addr: int, n: int) -> bytes | None:
@@ -260,7 +263,7 @@ class Esc:
             self._latch_receive_times()
         if hit(0x0300, 0x14):
             self.mem[0x0300:0x0314] = bytes(0x14)  # writing any error counter clears them
-        if hit(R_FMMU, 0x100) or hit(R_SM, 0x80):
+        if hit(R_FMMU, 0x100) or hit(R_SM, 0x80) or hit(R_WD_DIV, 2) or hit(R_WD_PD, 2):
             self._layout_changed()
         if hit(R_SM + 6, 1) or hit(R_SM + 8 + 6, 1):
             self._mailbox_repeat()
@@ -451,11 +454,12 @@ class Esc:
 
     # ---- watchdog -------------------------------------------------------------------------
     def watchdog_ns(self) -> int:
-        return self.u16(R_WD_PD) * (self.u16(R_WD_DIV) + 2) * 40
+        if self._wd_ns is None:
+            self._wd_ns = self.u16(R_WD_PD) * (self.u16(R_WD_DIV) + 2) * 40
+        return self._wd_ns
 
     def check_watchdog(self, now_ns: int) -> None:
-        s2 = self.sm(2)
-        if self.al_state != OP or not (s2.control & 0x40) or not self.rx_map:
+        if self.mem[R_AL_STATUS] & 0x0F != OP or not self.rx_map or not self.sm(2).control & 0x40:
             return
         wd = self.watchdog_ns()
         if wd and now_ns - self.last_output_ns > wd:
