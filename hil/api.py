@@ -133,7 +133,7 @@ def run(program: str | Path, bench: str | Path | Bench | None = None, *, bus: st
         check: bool | None = None, trace_signals: str | None = None, m00_resume: float = 0.5,
         realtime: bool = False, overrun: str | None = None, progress: Any = None,
         servo_modbus: str | None = None, servo_baud: int = 38400, capture: str | Path | None = None,
-        scope: Any = None, aux_timeout: float = 5.0, home: bool = True) -> Result:
+        scope: Any = None, aux_timeout: float = 5.0, home: bool = True, retain: str | Path | None = None) -> Result:
     """Run `program` on a bench in lock-step virtual time (or `realtime`); see the module doc.
 
     `bench`: a bench file, a `Bench`, or None for the built-in 2-axis lathe. `events`: `--at`
@@ -143,7 +143,8 @@ def run(program: str | Path, bench: str | Path | Bench | None = None, *, bus: st
     bus's frames (EtherCAT .pcapng, CAN .asc/.blf/.log; fieldbus/capture.py). `scope`: a started
     `hil.scope.Scope` that streams this run's rows to its page. `aux_timeout`: simulated seconds an
     M/S/T code may wait for the MLC's finish before a warning (0: never). `home`: False skips the drive
-    homing of axes with a bench `homing` table (hil/drive_homing.py; the drives keep their last origin)."""
+    homing of axes with a bench `homing` table (hil/drive_homing.py; the drives keep their last origin). `retain`: a
+    JSON file holding the retentive # variables from run to run (hil/retentive.py)."""
     from hil.clock import make_clock
     from hil.progress import Progress
     from hil.remote_io import attach_remote_io
@@ -203,6 +204,7 @@ def run(program: str | Path, bench: str | Path | Bench | None = None, *, bus: st
         player = EventPlayer(parsed, m, b, link, panel, traced)
     runner = BenchRunner(b, link, None, m, player or panel, clock=clock, progress=progress)
     runner.unreferenced = unreferenced
+    runner.retain = str(retain) if retain else None
     runner.trace_sources += signal_sources
     if player is not None:
         runner.trace_sources.append(player)

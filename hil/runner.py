@@ -17,6 +17,7 @@ from fieldbus.link import BusError, BusLink
 from fieldbus.pdo import RxPdo, TxPdo
 from hil.bench import Bench
 from hil.clock import CycleTiming, LockStepClock, RealTimeClock
+from hil import retentive
 from hil.drive_homing import home_axes
 from hil.mlc_bridge import drive_status
 from hil.trace import TraceSource, TraceWriter, trace_columns
@@ -120,6 +121,8 @@ class BenchRunner:
         self._bus_closed = False
         self.stop_request: str | None = None  # a signal's name (hil/stop_signals.py): stop, then end
         self.unreferenced: frozenset[str] = frozenset()  # axes without origin (hil run --no-home): 0x0A08
+        self.retain: str | None = None  # hil run --retain FILE: the retentive # variables (hil/retentive.py)
+        self._retained = None  # the variables loaded from it, saved back when the run ends
         self._overrun_alarmed = False
 
     def trace_columns(self) -> list[str]:
@@ -137,6 +140,9 @@ class BenchRunner:
             profile = make_profile(self.bench.profile, self.axes, self.bench.params)
             interp = Interpreter(profile)
             interp.unreferenced = self.unreferenced
+            if self.retain is not None:  # --retain: the retentive # variables of the last run (App. A 0x140B)
+                retentive.load(self.retain, interp.vars)
+                self._retained = interp.vars
             interp.budget = StatementBudget.for_profile(profile)  # macro statements per cycle (decisions B2)
             self._interp = interp  # G31 skip hands the latch back to it (issue 5)
             from hil.servo_link import BusServoAccess  # G10 L40-L46 → SDO / Modbus on this bench (issue 8)
@@ -168,6 +174,12 @@ class BenchRunner:
             raise
         finally:
             self._shutdown()
+            if self._retained is not None:
+                try:
+                    retentive.save(self.retain, self._retained)
+                except OSError as exc:  # the retentive memory cannot be written: the next run would lose it
+                    self.result.alarms.append(Alarm(retentive.RETENTIVE_ERROR, f"retentive variables {self.retain}: "
+                                                                                f"cannot be written ({exc.strerror})"))
             if paced:
                 gc.enable()
                 gc.unfreeze()

@@ -73,6 +73,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--scope-wait", action="store_true",
                    help="hold the run until a browser has the scope page open")
     p.add_argument("--scope-port", metavar="PORT", type=int, default=0, help=argparse.SUPPRESS)
+    p.add_argument("--retain", metavar="FILE",
+                   help="keep the retentive # variables (#2000-#11999; lathe-2018 #1601-#1800, #10001-#10450) in this "
+                        "JSON file from run to run: read before the program, written when the run ends")
     p.add_argument("--home", action=argparse.BooleanOptionalAction, default=True,
                    help="home the axes whose bench entry has a `homing` table by their drives before the program "
                         "(default); --no-home: the drives keep the origin of their last homing")
@@ -122,7 +125,8 @@ def _run_and_print(args: argparse.Namespace, scope) -> int:
                 trace_signals=args.trace_signals, m00_resume=args.m00_resume, realtime=args.realtime,
                 overrun=args.overrun, progress=True if wants_progress(args.progress) else None,
                 servo_modbus=args.servo_modbus, servo_baud=args.servo_baud,
-                capture=args.capture, scope=scope, aux_timeout=args.aux_timeout, home=args.home)
+                capture=args.capture, scope=scope, aux_timeout=args.aux_timeout, home=args.home,
+                retain=args.retain)
     except InputError as exc:
         if exc.alarm is not None:
             print_alarm(exc.alarm)

@@ -123,6 +123,13 @@ class Variables:
             return 51 <= n <= 250 or 1601 <= n <= 1800 or 10001 <= n <= 10450
         return 100 <= n <= 999 or 2000 <= n <= 11999
 
+    def is_retentive(self, n: int) -> bool:
+        """Kept through power-off: nc5 retentive #2000-#3999 and extend #4000-#11999 (N§3.11.1 table); lathe-2018
+        maintain #1601-#1800 and extension #10001-#10450 ("non-volatile", L§ macro variables)."""
+        if self.legacy:
+            return 1601 <= n <= 1800 or 10001 <= n <= 10450
+        return 2000 <= n <= 11999
+
     # ---- local frames (G65/G66/G-M-T call push one; M98 shares the caller's, decisions A19)
     def push_locals(self, args: dict[int, float]) -> None:
         self.frames.append(dict(args))
