@@ -1,11 +1,14 @@
-"""Alarms of the manual modes: the hardware limit (App. A 0x0402, 0x0A06) and oscillation in HOME mode (0x1603).
+"""Alarms of the manual modes: the hardware limit (App. A 0x0402, 0x0A06; met by homing 0x1601, 0x1602) and
+oscillation in HOME mode (0x1603).
 
 The drive stops the axis on its limit switch (CiA 402 statusword bit 11, 0x60FD bit 0/1) and the bench raises
 0x0402 "Hardware limit signal is triggered" (hil/runner.py, decisions bench.md B16). Here the NC then holds the
 manual command where the axis stands and locks the direction into the switch, so the axis can only move away.
 Once the switch is left, 0x0A06 "The status of hardware limit needs to be cleared. After moving away from the
 hardware limit, this alarm will be displayed. Please reset the machine." is raised; the next reset clears it. A
-reset while the axis still stands on the switch leaves the limit alarm (0x0402) raised.
+reset while the axis still stands on the switch leaves the limit alarm (0x0402) raised. When the NC's homing
+search (HOME mode) ran into the switch, the hit is also 0x1601, and a reset on the switch shows 0x1602 ("triggered
+after clearing 0x1601"); moving off and a reset clear it as above.
 
 M2x264 (axes oscillation enable) is "only available on modes other than HOME and EDIT": ON in HOME mode it stops
 the homing under way and refuses new ones with 0x1603 "Oscillation function is not allowed in the home mode"."""
@@ -27,12 +30,15 @@ if TYPE_CHECKING:
 HARD_LIMIT_SIGNAL = 0x0402
 HARD_LIMIT_TO_CLEAR = 0x0A06
 OSCILLATION_IN_HOME = 0x1603
+LIMIT_IN_HOMING = 0x1601  # "The hardware limit is triggered during execution of home mode 4 ..."
+LIMIT_AFTER_HOMING = 0x1602  # "The hardware limit alarm not cleared of the home mode 4."
 PRESS = 0.01  # mm (deg) beyond the switch edge the held command stands
 
 
 @dataclass
 class HardLimitLatch:
     latched: dict[str, tuple[str, bool]] = field(default_factory=dict)  # axis -> (side "+"/"-", moved away)
+    in_homing: set[str] = field(default_factory=set)  # axes whose homing search met the switch (0x1601 / 0x1602)
     edge: dict[str, float] = field(default_factory=dict)  # axis -> machine position where the switch stopped it
 
     def step(self, mm: ManualMotion, axes: tuple[str, ...], drives: list[DriveStatus]) -> list[Alarm]:
@@ -48,6 +54,11 @@ class HardLimitLatch:
                 side = "-" if d.limit == 1 else "+" if d.limit == 2 else ("+" if mm.velocity[i] > 0 else "-")
                 held = self.latched[a] = (side, False)
                 self.edge[a] = d.machine_position
+                if mm.axes[a].homing:  # the NC's homing search ran into the switch
+                    self.in_homing.add(a)
+                    out.append(Alarm(LIMIT_IN_HOMING, f"axis {a}: the {side} hardware limit was met during homing; "
+                                                      f"check the search direction and that the axis starts off the "
+                                                      f"limits", axis=a))
                 # the command stays a hair inside the switch: the drive keeps the axis on it (no edge chatter)
                 mm.hold_at(a, d.machine_position + (PRESS if side == "+" else -PRESS))
             elif held is not None and not held[1] and not d.limit and self._commanded_away(mm, i, a, held[0]):
@@ -67,10 +78,13 @@ class HardLimitLatch:
         return mm.position[i] < self.edge[a] if side == "+" else mm.position[i] > self.edge[a]
 
     def reset(self) -> list[Alarm]:
-        """A reset clears the axes that moved away; an axis still on its switch keeps the limit alarm."""
+        """A reset clears the axes that moved away; an axis still on its switch keeps the limit alarm: 0x1602 when
+        homing met it (App. A: "triggered after clearing 0x1601"), else 0x0402."""
         self.latched = {a: v for a, v in self.latched.items() if not v[1]}
-        return [Alarm(HARD_LIMIT_SIGNAL, f"hardware limit {side} of axis {a}: still on the switch, move it away "
-                                         f"before reset", axis=a) for a, (side, _) in self.latched.items()]
+        self.in_homing &= set(self.latched)
+        return [Alarm(LIMIT_AFTER_HOMING if a in self.in_homing else HARD_LIMIT_SIGNAL,
+                      f"hardware limit {side} of axis {a}: still on the switch, move it away before reset", axis=a)
+                for a, (side, _) in self.latched.items()]
 
 
 def home_mode(link: ChannelLink, ch: Channel, mm: ManualMotion) -> None:

@@ -94,3 +94,31 @@ def test_0x0402_then_0x0a06_jog_onto_the_drive_limit_switch_move_away_and_reset(
     assert _codes(m) == []
     m.jog("Z", 1, 1.0)
     assert [a.code for a in m.runner.result.alarms] == [0x0402, 0x0402]
+
+
+def test_0x1601_then_0x1602_the_nc_homing_search_runs_into_the_limit_switch():
+    """App. A 0x1601 'The hardware limit is triggered during homing ... Check if the homing search direction is
+    correct' and 0x1602 'This alarm will be triggered after clearing 0x1601 hardware limit alarm': Z's home switch
+    (active below 40) lies beyond its negative limit switch (60), so the NC's homing search (HOME mode, M2x321)
+    meets the limit first: 0x1601, Z held on the switch, not homed. A reset on the switch shows 0x1602; moving off
+    raises 0x0A06 and the next reset clears everything."""
+    from hil.scripting import ScriptError
+
+    bench = default_lathe()
+    z = bench.axes[1]
+    bench.axes[1] = dataclasses.replace(z, drive=dataclasses.replace(
+        z.drive, home_switch=z.scaling.to_counts(40.0), negative_limit=z.scaling.to_counts(60.0)))
+    m = Machine(bench)
+    m.power_up()
+    with pytest.raises(ScriptError, match="Z homing not reached"):
+        m.home("Z", timeout=5.0)
+    assert _codes(m) == [0x1601] and m.get("M31337") == 0  # not homed
+    assert m.position("Z") == pytest.approx(60.0, abs=1e-3) and m.command("Z") == pytest.approx(60.0, abs=0.02)
+    m.reset()
+    assert _codes(m) == [0x1602]
+    m.jog("Z", 1, 0.3)
+    assert m.position("Z") == pytest.approx(65.0, abs=0.05)
+    assert _codes(m) == [0x1602, 0x0A06]
+    m.reset()
+    m.cycle(5)
+    assert _codes(m) == []
