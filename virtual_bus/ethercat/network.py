@@ -76,8 +76,10 @@ class Chain:
                         self.log(f"slave {f.slave} drive fault 0x{int(f.arg):04X} at frame {n}")
         return drop, delay
 
-    def reachable(self) -> list[Esc]:
+    def reachable(self) -> Sequence[Esc]:
         """Slaves the frame reaches: a slave that left the line cuts off everything behind it."""
+        if not self._left:
+            return self.slaves  # the usual frame: the whole line, no list built
         out = []
         for i, s in enumerate(self.slaves):
             if i in self._left:
