@@ -186,6 +186,33 @@ def test_basenode402_homing_then_a_profile_position_move(bus):
         net.sync.stop()
 
 
+def test_basenode402_profile_velocity_then_cyclic_torque(bus):
+    """CiA 402-2 profile velocity (0x60FF in 0.1 rpm, statusword bit 10 once 0x606C is within 0x606D) and cyclic
+    synchronous torque (0x6071 in 0.1 % of rated, bit 12 = target torque used, 0x6077 follows it) set by
+    python-canopen's BaseNode402 (op_mode, state) and SDO, the client producing SYNC."""
+    _, net, node = bus
+    logging.getLogger("canopen").setLevel(logging.ERROR)
+    net.sync.start(0.002)
+    try:
+        node.op_mode = "PROFILED VELOCITY"
+        node.sdo[0x60FF].raw = 10000  # 1000 rpm
+        node.state = "OPERATION ENABLED"
+        wait_for(lambda: node.sdo[0x6041].raw & 0x0400 and abs(node.sdo[0x606C].raw - 10000) <= 20)
+        assert node.sdo[0x6061].raw == 3
+        v0 = node.sdo[0x606C].raw
+        node.sdo[0x6071].raw = 50  # 5 % of rated: more than the friction at 1000 rpm
+        node.op_mode = "CYCLIC SYNCHRONOUS TORQUE"
+        wait_for(lambda: node.sdo[0x6041].raw & 0x1000)
+        wait_for(lambda: node.sdo[0x606C].raw > v0 + 100)  # it accelerates on that torque
+        assert [abs(node.sdo[0x6077].raw - 50) <= 5 for _ in range(3)] == [True] * 3
+        node.op_mode = "PROFILED VELOCITY"
+        node.sdo[0x60FF].raw = 0
+        wait_for(lambda: abs(node.sdo[0x606C].raw) <= 20)
+        node.state = "SWITCH ON DISABLED"
+    finally:
+        net.sync.stop()
+
+
 def wait_for(predicate, timeout: float = 20.0) -> None:
     end = time.monotonic() + timeout
     while not predicate():

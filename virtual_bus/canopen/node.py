@@ -209,8 +209,9 @@ class Cia402Slave:
         attr = OBJECT_ATTRS.get((index, subindex))
         if attr is not None and index in _RX_OBJECTS:
             setattr(self.rx, attr, od.decode_raw(data))
-            if index in (0x6040, 0x6060):
-                self.drive.apply(copy.copy(self.rx))  # acyclic (SDO) device control acts at once
+            # Acyclic (SDO) device control acts at once, a target as well as the controlword: NMT states
+            # govern PDOs, not the application (a target written in PRE-OPERATIONAL moved nothing before).
+            self.drive.apply(copy.copy(self.rx))
 
     def _check_mapping_write(self, index: int, subindex: int, value: int) -> None:
         if index & 0xFF00 in (0x1400, 0x1800) and subindex == 1:
