@@ -5,6 +5,7 @@ limits (finite differences, as a drive sees them)."""
 from __future__ import annotations
 
 import math
+from collections import deque
 
 from dataclasses import replace
 
@@ -63,6 +64,65 @@ def test_filter_reproduces_a_point_exactly_once_it_stands():
     for _ in range(40):
         y = f.push(np.array([1.3, 2.7]))
     assert f.settled and y.tolist() == [1.3, 2.7]
+
+
+class _NumpyFilter:
+    """The filter as it was written on numpy arrays (before issue 17): the reference for the float lists."""
+
+    def __init__(self, n1: int, n2: int, x: np.ndarray) -> None:
+        self.n1, self.n2, self.span = n1, n2, n1 + n2 - 2
+        self.reset(x)
+
+    def reset(self, x: np.ndarray) -> None:
+        x = np.array(x, dtype=float)
+        self.w1, self.w2 = deque([x] * self.n1, maxlen=self.n1), deque([x] * self.n2, maxlen=self.n2)
+        self.s1, self.s2, self.output, self.last, self.still = x * self.n1, x * self.n2, x.copy(), x, self.span
+
+    def push(self, x: np.ndarray) -> np.ndarray:
+        same = np.array_equal(x, self.last)
+        if same and self.still >= self.span:
+            return self.output.copy()
+        if same:
+            self.still += 1
+        else:
+            self.still, self.last = 0, np.array(x, dtype=float)
+        x = self.last
+        self.s1 += x - self.w1[0]
+        self.w1.append(x)
+        y1 = self.s1 / self.n1
+        self.s2 += y1 - self.w2[0]
+        self.w2.append(y1)
+        if self.still >= self.span:
+            self.reset(x)
+            return x.copy()
+        self.output = self.s2 / self.n2
+        return self.output.copy()
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_filter_on_float_lists_equals_the_numpy_filter_bit_for_bit(seed):
+    """Moves, stops long enough to snap, short stops, -0.0 and large coordinates: every output identical."""
+    rng = np.random.default_rng(seed)
+    n1, n2 = int(rng.integers(1, 20)), int(rng.integers(1, 20))
+    axes = int(rng.integers(1, 5))
+    start = rng.uniform(-500, 500, axes)
+    f, ref = PositionFilter(n1, n2, start), _NumpyFilter(n1, n2, start)
+    x = start.copy()
+    for _ in range(3000):
+        r = rng.random()
+        if r < 0.55:
+            x = x + rng.normal(0, 0.05, axes)  # moving
+        elif r < 0.57:
+            x = np.where(rng.random(axes) < 0.5, -0.0, x)
+        elif r < 0.58:
+            x = x * 1e6
+        # else: stands (sometimes long enough to snap)
+        out, want = f.push(x), ref.push(x)
+        assert out.tolist() == want.tolist() and out.dtype == want.dtype
+        assert f.settled == (ref.still >= ref.span) and f.output.tolist() == ref.output.tolist()
+    if rng.random() < 0.5:
+        f.reset(x), ref.reset(x)
+        assert f.push(x).tolist() == ref.push(x).tolist()
 
 
 # ---- corners -----------------------------------------------------------------------------------
