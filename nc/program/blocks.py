@@ -15,6 +15,7 @@ from __future__ import annotations
 import re
 import unicodedata
 from array import array
+from bisect import bisect_left
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
 from typing import Any, Union, overload
@@ -172,24 +173,37 @@ _CACHE_LIMIT = 4096  # parsed plain lines kept (loops and GOTO come back to them
 
 
 class BlockList(Sequence):
-    """A program's blocks, streamed (issue 16): plain lines (`_PLAIN_OK`) are kept as their text and
-    parsed when the interpreter reaches them, every other block is parsed (and checked) when the
-    program is read. Memory stays near the size of the text however long the program; a bulk
-    reader (nc.interp.bulk) takes runs of the text without making blocks at all."""
+    """A program's blocks, streamed (issue 16): a plain line (`_PLAIN_OK`) is kept as where it stands
+    in the program text (offset and length, no object per line) and parsed when the interpreter
+    reaches it; every other block is parsed (and checked) when the program is read. Memory is the
+    text plus some 20 bytes a line however long the program; a bulk reader (nc.interp.bulk) takes
+    runs of the text without making blocks at all."""
 
-    __slots__ = ("_items", "_lines", "_cache")
+    __slots__ = ("_text", "_starts", "_lengths", "_lines", "_blocks", "_parsed", "_cache")
 
-    def __init__(self) -> None:
-        self._items: list[Block | str] = []
+    def __init__(self, text: str = "") -> None:
+        self._text = text  # the program text the plain lines are slices of
+        self._starts = array("q")  # offset of each item's line in _text (-1: a block parsed when read)
+        self._lengths = array("I")
         self._lines = array("l")  # file line of each item
+        self._blocks: dict[int, Block] = {}  # items parsed when the program was read
+        self._parsed = array("l")  # their indexes, ascending
         self._cache: dict[int, Block] = {}
 
-    def _add(self, item: Block | str, line: int) -> None:
-        self._items.append(item)
+    def _add(self, item: Block, line: int) -> None:
+        self._blocks[len(self._lines)] = item
+        self._parsed.append(len(self._lines))
+        self._starts.append(-1)
+        self._lengths.append(0)
+        self._lines.append(line)
+
+    def _add_text(self, start: int, end: int, line: int) -> None:
+        self._starts.append(start)
+        self._lengths.append(end - start)
         self._lines.append(line)
 
     def __len__(self) -> int:
-        return len(self._items)
+        return len(self._lines)
 
     @overload
     def __getitem__(self, i: int) -> Block: ...
@@ -198,27 +212,27 @@ class BlockList(Sequence):
 
     def __getitem__(self, i):
         if isinstance(i, slice):
-            return [self[k] for k in range(*i.indices(len(self._items)))]
-        item = self._items[i]
-        if type(item) is not str:
-            return item
+            return [self[k] for k in range(*i.indices(len(self._lines)))]
+        start = self._starts[i]  # IndexError as a list gives it
         if i < 0:
-            i += len(self._items)
+            i += len(self._lines)
+        if start < 0:
+            return self._blocks[i]
         block = self._cache.get(i)
         if block is None:
             if len(self._cache) >= _CACHE_LIMIT:
                 self._cache.clear()
-            block = self._cache[i] = parse_block(self._lines[i], item)
+            block = self._cache[i] = parse_block(self._lines[i], self._text[start:start + self._lengths[i]])
         return block
 
     def __iter__(self) -> Iterator[Block]:
-        for i in range(len(self._items)):
+        for i in range(len(self._lines)):
             yield self[i]
 
     def raw(self, i: int) -> str | None:
         """The text of a plain line not yet parsed (`_PLAIN_OK`), else None."""
-        item = self._items[i]
-        return item if type(item) is str else None
+        start = self._starts[i]
+        return None if start < 0 else self._text[start:start + self._lengths[i]]
 
     def line(self, i: int) -> int:
         return self._lines[i]
@@ -229,13 +243,11 @@ class BlockList(Sequence):
 
     def texts(self, i: int, most: int) -> list[str]:
         """The texts of the unparsed plain lines from `i` on (at most `most`), up to the first block."""
-        out = self._items[i:i + most]
-        for k, item in enumerate(out):
-            if type(item) is not str:
-                return out[:k]  # type: ignore[return-value]
-        return out  # type: ignore[return-value]
-
-
+        parsed = self._parsed
+        k = bisect_left(parsed, i)
+        stop = min(i + most, len(self._lines), parsed[k] if k < len(parsed) else len(self._lines))
+        text = self._text
+        return [text[s:s + n] for s, n in zip(self._starts[i:stop], self._lengths[i:stop])]
 
 
 def strip_comments(text: str) -> tuple[str, str]:
@@ -559,23 +571,39 @@ def o_number(digits: str, line: int | None, block: str | None) -> int:
 _O_LINE = re.compile(r"\s*[Oo]([0-9]+)")
 
 
-def parse_program(text: str, name: str = "program", number: int | None = None) -> Program:
-    """Parse one program (one O number).  The first line starting with ``O`` is its description
-    (N ch.2).  Raises NcAlarm (with line and block) on the first malformed block."""
-    blocks = BlockList()
-    items, item_lines = blocks._items, blocks._lines
+def parse_program(text: str, name: str = "program", number: int | None = None, *, start: int = 0,
+                  stop: int | None = None, line0: int = 0) -> Program:
+    """Parse one program (one O number): the lines of `text[start:stop]`, the first numbered
+    `line0` + 1.  The first line starting with ``O`` is its description (N ch.2).  Raises NcAlarm
+    (with line and block) on the first malformed block."""
+    return _parse(_one_line_break(text), name, number, start, stop, line0)
+
+
+def _parse(text: str, name: str, number: int | None, start: int, stop: int | None, line0: int) -> Program:
+    """`parse_program` of a text whose only line break is "\n"."""
+    blocks = BlockList(text)
+    add_text, n_items = blocks._add_text, blocks._lines
     labels: dict[int, list[int]] = {}
     plain_ok = _PLAIN_OK.fullmatch
-    for idx, raw in enumerate(text.splitlines(), start=1):
-        m = plain_ok(raw)
-        if m is not None and m.end():  # kept as text (BlockList): no block object per line
+    stop = len(text) if stop is None else stop
+    idx, pos = line0, start
+    while pos < stop:  # line by line without a list of lines (a 1M-block program, issue 16)
+        end = text.find("\n", pos, stop)
+        if end < 0:
+            end = stop
+        idx += 1
+        m = plain_ok(text, pos, end)
+        if m is not None and end > pos:  # kept as text (BlockList): no block object per line
             if m.group(1) is not None:
-                labels.setdefault(int(m.group(1)), []).append(len(items))
-            elif not raw.strip():
+                labels.setdefault(int(m.group(1)), []).append(len(n_items))
+            elif text[pos:end].isspace():
+                pos = end + 1
                 continue
-            items.append(raw)
-            item_lines.append(idx)
+            add_text(pos, end, idx)
+            pos = end + 1
             continue
+        raw = text[pos:end]
+        pos = end + 1
         stripped = raw.strip()
         if not stripped:
             continue
@@ -593,26 +621,42 @@ def parse_program(text: str, name: str = "program", number: int | None = None) -
     return Program(name=name, blocks=blocks, number=number, labels=labels)
 
 
+# Line breaks str.splitlines knows besides "\n"; a text holding one is rewritten with "\n" alone
+_OTHER_BREAKS = re.compile("[\r\x0b\x0c\x1c\x1d\x1e\x85\u2028\u2029]")
+
+
+def _one_line_break(text: str) -> str:
+    """`text` with its lines (as str.splitlines reads them) joined by "\n" alone: line numbers
+    stay; the common file (only "\n") is returned as it is, not copied."""
+    if _OTHER_BREAKS.search(text) is None:
+        return text
+    return "\n".join(text.splitlines())
+
+
+_O_START = re.compile(r"^[^\S\n]*[Oo]([0-9]+)", re.M)  # a line starting with O<n> (`_O_LINE` per line)
+
+
 def parse_programs(text: str, name: str = "program") -> list[Program]:
     """A file holding several O programs: each line starting with ``O<n>`` (outside a comment)
-    begins a new program.  Text before the first O line (if any code) is an unnamed program."""
-    lines = text.splitlines()
-    starts: list[tuple[int, int]] = []
-    for i, raw in enumerate(lines):
-        m = _O_LINE.match(raw)
-        if m and not raw.strip().startswith("("):
-            starts.append((i, o_number(m.group(1), i + 1, raw)))
+    begins a new program.  Text before the first O line (if any code) is an unnamed program.
+    The programs are parsed in place in the file's text (no copy of it, no list of its lines)."""
+    text = _one_line_break(text)
+    starts: list[tuple[int, int, int]] = []  # (offset, index of its line, O number)
+    line, last = 0, 0
+    for m in _O_START.finditer(text):
+        line += text.count("\n", last, m.start())
+        last = m.start()
+        eol = text.find("\n", last)
+        starts.append((last, line, o_number(m.group(1), line + 1, text[last:eol if eol >= 0 else len(text)])))
     out: list[Program] = []
-    first = starts[0][0] if starts else len(lines)
-    head = "\n".join(lines[:first])
-    if strip_comments(head.replace("\n", " "))[0].strip() or not starts:
-        prog = parse_program(head, name)
+    first = starts[0][0] if starts else len(text)
+    if not starts or strip_comments(text[:first].replace("\n", " "))[0].strip():
+        prog = _parse(text, name, None, 0, first, 0)
         prog.number = None
         out.append(prog)
-    for k, (i, num) in enumerate(starts):
-        end = starts[k + 1][0] if k + 1 < len(starts) else len(lines)
-        chunk = "\n" * i + "\n".join(lines[i:end])  # keep file line numbers
-        prog = parse_program(chunk, f"O{num:04d}" if len(starts) > 1 or out else name)
+    for k, (off, line, num) in enumerate(starts):
+        end = starts[k + 1][0] if k + 1 < len(starts) else len(text)
+        prog = _parse(text, f"O{num:04d}" if len(starts) > 1 or out else name, None, off, end, line)
         prog.number = num
         out.append(prog)
     return out
