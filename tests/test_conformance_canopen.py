@@ -113,6 +113,9 @@ def test_pdo_mapping_changes_only_while_the_pdo_is_invalid(bus):
     tpdo[0].raw = 0
     tpdo[1].raw = 0x60410010
     assert abort_of(lambda: setattr(tpdo[0], "raw", 9)) == 0x06040042  # 8 entries in this object
+    tpdo[2].raw = 0x60640020
+    tpdo[3].raw = 0x606C0020
+    assert abort_of(lambda: setattr(tpdo[0], "raw", 3)) == 0x06040042  # 80 bits: over a CAN frame's 64
     tpdo[0].raw = 1
     rpdo, rcob = node.sdo[0x1600], node.sdo[0x1400][1]  # the same for a receive PDO
     assert abort_of(lambda: setattr(rpdo[1], "raw", 0x60400010)) == 0x06010000
