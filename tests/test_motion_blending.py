@@ -125,6 +125,34 @@ def test_filter_on_float_lists_equals_the_numpy_filter_bit_for_bit(seed):
         assert f.push(x).tolist() == ref.push(x).tolist()
 
 
+@pytest.mark.parametrize("seed", range(8))
+def test_filter_push_many_equals_push_row_by_row(seed):
+    """A stretch of setpoints through the filter at once (issue 17's stretches) gives what pushing them one
+    cycle at a time gives, bit for bit, in chunks of any length, across stops that snap and short ones."""
+    rng = np.random.default_rng(seed)
+    n1, n2, axes = int(rng.integers(1, 20)), int(rng.integers(1, 20)), int(rng.integers(1, 4))
+    x = rng.uniform(-300, 300, axes)
+    rows = []
+    while len(rows) < 1500:
+        if rng.random() < 0.15:
+            rows += [x.copy()] * int(rng.integers(1, 45))  # stands: some long enough to snap
+        else:
+            for _ in range(int(rng.integers(1, 120))):
+                x = x + rng.normal(0, 0.2, axes) * (rng.random() < 0.9)
+                rows.append(x.copy())
+    xs = np.array(rows)
+    one, many = PositionFilter(n1, n2, xs[0]), PositionFilter(n1, n2, xs[0])
+    want = np.array([one.push(r) for r in xs])
+    got, k = [], 0
+    while k < len(xs):
+        c = int(rng.integers(1, 100))
+        got.append(many.push_many(xs[k:k + c]))
+        k += c
+    assert np.vstack(got).tolist() == want.tolist()
+    last = xs[-1] + 0.5
+    assert many.push(last).tolist() == one.push(last).tolist() and many.settled == one.settled
+
+
 # ---- corners -----------------------------------------------------------------------------------
 def test_square_corners_keep_speed_within_limits_and_end_exactly():
     plain = check(lines(SQUARE, 3000), mill_cfg())

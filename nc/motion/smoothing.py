@@ -77,3 +77,38 @@ class PositionFilter:
             return np.array(row)
         self._out = [s / n2 for s in s2]
         return np.array(self._out)
+
+    def push_many(self, xs: np.ndarray) -> np.ndarray:
+        """push() each row of `xs` (cycles × axes) in turn, the outputs as rows: the same values bit for bit.
+        A run of rows that each differ from the one before goes through both moving averages as one
+        cumulative sum with the carried sums and windows (numpy's accumulate adds in order, as push
+        does); rows equal to the one before (the still count, the snap at rest) go through push."""
+        xs = np.asarray(xs, dtype=float)
+        out = np.empty_like(xs)
+        k, m = 0, len(xs)
+        repeats = np.flatnonzero(np.all(xs[1:] == xs[:-1], axis=1)) + 1  # rows equal to the one before
+        while k < m:
+            if self.span == 0 or xs[k].tolist() == self._last:
+                out[k] = self.push(xs[k])
+                k += 1
+                continue
+            r = int(np.searchsorted(repeats, k, side="right"))
+            j = int(repeats[r]) if r < len(repeats) else m  # the run ends before the next repeated row
+            out[k:j] = self._moving(xs[k:j])
+            k = j
+        return out
+
+    def _moving(self, x: np.ndarray) -> np.ndarray:
+        """Rows each unlike the one before: no still count, no snap (see push_many)."""
+        n = len(x)
+        h1 = np.vstack([np.array(self._w1), x])  # the window's oldest row is what each push subtracts
+        s1 = np.cumsum(np.vstack([self._s1, x - h1[:n]]), axis=0)[1:]
+        y1 = s1 / self.n1
+        h2 = np.vstack([np.array(self._w2), y1])
+        s2 = np.cumsum(np.vstack([self._s2, y1 - h2[:n]]), axis=0)[1:]
+        y = s2 / self.n2
+        self._w1.extend(h1[-self.n1:].tolist())
+        self._w2.extend(h2[-self.n2:].tolist())
+        self._s1, self._s2 = s1[-1].tolist(), s2[-1].tolist()
+        self._last, self._out, self._still = x[-1].tolist(), y[-1].tolist(), 0
+        return y
