@@ -1,0 +1,96 @@
+"""A CSP drive stepped over a stretch of cycles at once (virtual_bus/drive_stretch.py, issue 17) gives, cycle by
+cycle, the feedback exchange() gives one cycle at a time, leaves the drive in the same state, and stops before
+a cycle that faults (which exchange() then takes)."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import astuple
+
+import numpy as np
+import pytest
+
+from fieldbus.cia402 import State
+from fieldbus.pdo import RxPdo
+from virtual_bus.drive import Cia402Drive, DriveParams
+from virtual_bus.drive_stretch import can_stretch, csp_stretch
+
+FIELDS = ("statusword", "position_actual", "velocity_actual", "torque_actual", "following_error")
+
+
+def _enabled(params: DriveParams, origin: float) -> tuple[Cia402Drive, RxPdo]:
+    d = Cia402Drive(params=params)
+    d.modes.origin = origin
+    rx = RxPdo(mode=8)
+    for cw in (0x06, 0x07, 0x0F):
+        rx.controlword = cw
+        d.exchange(rx, 0.001)
+    return d, rx
+
+
+def _targets(seed: int, n: int) -> list[int]:
+    rng = np.random.default_rng(seed)
+    k = np.arange(n)
+    path = 300_000 * (1 - np.cos(2 * math.pi * k / rng.uniform(300, 900))) + rng.normal(0, 30, n).cumsum()
+    path[n // 3: n // 3 + 40] = path[n // 3]  # a stop: target reached bits, torque settling
+    return [int(round(v)) for v in path]
+
+
+def _state(d: Cia402Drive) -> tuple:
+    return (d.position, d.velocity, d.command, d.time, d.acceleration, d.torque, d._prev_target, d.state,
+            d.error_code, d._want_cps)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_stretch_equals_exchange_cycle_by_cycle(seed):
+    params = DriveParams(home_switch=150_000 if seed % 2 else None)
+    origin = 1234.0 * seed
+    one, rx1 = _enabled(params, origin)
+    many, rx2 = _enabled(params, origin)
+    targets = _targets(seed, 1500)
+    want, states = [], []
+    for t in targets:
+        rx1.target_position = t
+        want.append(one.exchange(rx1, 0.001))
+        states.append(_state(one))
+    rng = np.random.default_rng(seed)
+    got, k = [], 0
+    while k < len(targets):
+        chunk = targets[k:k + int(rng.integers(1, 90))]
+        rx2.target_position = chunk[-1]
+        s = csp_stretch(many, rx2, chunk, 0.001)
+        assert s.done == len(chunk) and s.last is not None
+        got += list(zip(*(getattr(s, f) for f in FIELDS)))
+        assert astuple(s.last) == astuple(want[k + len(chunk) - 1])
+        assert _state(many) == states[k + len(chunk) - 1]  # every float of the model, at every stretch's end
+        k += len(chunk)
+    assert got == [tuple(getattr(tx, f) for f in FIELDS) for tx in want]
+    assert _state(many) == _state(one)
+    assert len({g[1] for g in got}) > 500  # it moved
+
+
+def test_stretch_stops_before_the_cycle_that_faults():
+    params = DriveParams(following_error_window=20_000)
+    one, rx1 = _enabled(params, 0.0)
+    many, rx2 = _enabled(params, 0.0)
+    targets = [0] * 30 + [100_000] * 30  # a step five times the following-error window
+    rx2.target_position = targets[-1]
+    s = csp_stretch(many, rx2, targets, 0.001)
+    assert s.done == 30  # the step's first cycle would fault: the stretch ends before it
+    for t in targets[:s.done]:
+        rx1.target_position = t
+        one.exchange(rx1, 0.001)
+    assert _state(many) == _state(one) and many.state is State.OPERATION_ENABLED
+    rx1.target_position = rx2.target_position = targets[s.done]
+    a, b = one.exchange(rx1, 0.001), many.exchange(rx2, 0.001)  # the faulting cycle, taken by exchange()
+    assert astuple(a) == astuple(b) and many.state is State.FAULT_REACTION_ACTIVE
+
+
+def test_no_stretch_where_the_plain_csp_path_does_not_hold():
+    d, rx = _enabled(DriveParams(negative_limit=-10**9), 0.0)
+    assert not can_stretch(d, rx) and csp_stretch(d, rx, [5, 6], 0.001).done == 0
+    d, rx = _enabled(DriveParams(), 0.0)
+    rx.touch_probe_function = 1  # a G31 probe armed: the latch is per sub-step
+    assert not can_stretch(d, rx)
+    rx.touch_probe_function, rx.controlword = 0, 0x0B  # quick stop requested
+    assert not can_stretch(d, rx)

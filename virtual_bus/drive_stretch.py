@@ -1,0 +1,110 @@
+"""A CSP drive stepped over a stretch of cycles at once (issue 17: "the sim drives step over the stretch").
+
+`csp_stretch(drive, rx, targets, dt)` does what `drive.exchange(rx, dt)` does once per target, for an
+enabled CSP drive whose master holds enable operation, without limit switches, touch probe or injected
+fault: the same arithmetic in the same order (Cia402Drive.step → _step_following, feedback), on local
+variables, with no PDO objects per cycle. It stops before the first cycle that would fault (following
+error window, overspeed): that cycle is left to `exchange`, which takes the fault as always. The CSP
+model's sub-step recurrence is sequential, so this is a loop, not a filter: a filter over the stretch
+(lfilter) would round differently and could flip an integer count.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+from fieldbus.cia402 import SW_FOLLOWING, SW_TARGET_REACHED, State
+from fieldbus.pdo import RxPdo, TxPdo
+from virtual_bus.drive import AL_FORWARD_LIMIT, AL_REVERSE_LIMIT, _STATUS_BASE, Cia402Drive
+
+ENABLE_HELD = 0x0F  # controlword bits 0-3 (and not 7) of enable operation
+
+
+@dataclass
+class Stretch:
+    """Feedback per cycle of the cycles done (`done` ≤ len(targets)); `last` is the last cycle's TxPdo."""
+
+    done: int = 0
+    position_actual: list[int] = field(default_factory=list)
+    velocity_actual: list[int] = field(default_factory=list)
+    torque_actual: list[int] = field(default_factory=list)
+    following_error: list[int] = field(default_factory=list)
+    statusword: list[int] = field(default_factory=list)
+    last: TxPdo | None = None
+
+
+def can_stretch(drive: Cia402Drive, rx: RxPdo) -> bool:
+    """The drive runs the plain CSP path the stretch reproduces."""
+    p = drive.params
+    cw = rx.controlword
+    return (drive.state is State.OPERATION_ENABLED and drive.mode == 8 and rx.mode == 8 and not drive.external_fault
+            and cw == drive._last_cw and cw & 0x8F == ENABLE_HELD and p.negative_limit is None
+            and p.positive_limit is None and not rx.touch_probe_function & 1)
+
+
+def csp_stretch(drive: Cia402Drive, rx: RxPdo, targets: Sequence[int], dt: float) -> Stretch:
+    """Step `drive` once per target position (0x607A counts) as exchange() would; see the module doc."""
+    out = Stretch()
+    if not targets or not can_stretch(drive, rx):
+        return out
+    p = drive.params
+    units, cpr = p.units, p.counts_per_rev
+    n = max(1, p.substeps)
+    h = dt / n
+    max_cps = p.max_speed_rpm / 60.0 * cpr
+    alpha = 1.0 - math.exp(-p.velocity_bandwidth * h)
+    rad = 2.0 * math.pi / cpr
+    kp, kff, window, origin = p.kp, p.kff, p.following_error_window, drive.modes.origin
+    reached_v = 0.001 * (p.max_speed_rpm / 60.0 * cpr)
+    base = _STATUS_BASE[State.OPERATION_ENABLED] | SW_FOLLOWING
+    pos, vel, t, command = drive.position, drive.velocity, drive.time, drive.command
+    prev_target = drive._prev_target
+    acc, torque = drive.acceleration, drive.torque
+    pa, va, ta, fe, sws = (out.position_actual, out.velocity_actual, out.torque_actual, out.following_error,
+                           out.statusword)
+    for raw in targets:
+        target = float(raw) - origin
+        prev = prev_target if prev_target is not None else command
+        ff_vel = (target - prev) / dt
+        kff_ff, span = kff * ff_vel, target - prev
+        c_pos, c_vel, c_t, cmd = pos, vel, t, command
+        for k in range(1, n + 1):  # Cia402Drive._step_following, csp, no probe
+            cmd = prev + span * k / n
+            v_cmd = kff_ff + kp * (cmd - c_pos)
+            if not -max_cps <= v_cmd <= max_cps:
+                v_cmd = max(-max_cps, min(max_cps, v_cmd))
+            if v_cmd != c_vel:
+                c_vel += (v_cmd - c_vel) * alpha
+            c_pos = c_pos + c_vel * h
+            c_t += h
+        if abs(cmd - c_pos) > window or abs(c_vel) > 1.2 * max_cps:
+            break  # Cia402Drive._supervise would fault in this cycle: exchange() takes it
+        c_acc = (c_vel - vel) / dt
+        torque_nm = (p.inertia * c_acc * rad + p.viscous * c_vel * rad
+                     + (math.copysign(p.coulomb, c_vel) if abs(c_vel) > 1 else 0.0))
+        torque = torque_nm / p.rated_torque * 1000.0
+        pos, vel, t, command, acc, prev_target = c_pos, c_vel, c_t, cmd, c_acc, target
+        gap = command - pos
+        sws.append(base | SW_TARGET_REACHED if abs(vel) < reached_v and abs(gap) < 10 else base)
+        pa.append(int(round(pos + origin)))
+        va.append(units.velocity_to_raw(vel, cpr))
+        ta.append(int(round(torque * 0.1 / units.torque_percent)))
+        fe.append(int(round(gap)))
+    out.done = len(pa)
+    if not out.done:
+        return out
+    drive._rx = rx
+    drive._want_cps = units.raw_to_velocity(rx.target_velocity, cpr)  # apply()'s latch of 0x60FF
+    drive.position, drive.velocity, drive.time, drive.command = pos, vel, t, command
+    drive._prev_target, drive.acceleration, drive.torque = prev_target, acc, torque
+    drive._limit_flags = 0  # _no_limit, _step_following's tail
+    if drive.error_code in (AL_REVERSE_LIMIT, AL_FORWARD_LIMIT):
+        drive.error_code = 0
+    drive._probe_latched = False
+    di = 0x4 if p.home_switch is not None and pos < p.home_switch else 0
+    out.last = TxPdo(statusword=sws[-1], position_actual=pa[-1], velocity_actual=va[-1], torque_actual=ta[-1],
+                     following_error=fe[-1], error_code=drive.error_code, mode_display=drive.mode,
+                     touch_probe_status=0, touch_probe_pos1=drive._probe_pos + int(round(origin)), digital_inputs=di)
+    return out
