@@ -13,15 +13,15 @@ import pytest
 from fieldbus.cia402 import State
 from fieldbus.pdo import RxPdo
 from virtual_bus.drive import Cia402Drive, DriveParams
-from virtual_bus.drive_stretch import can_stretch, csp_stretch
+from virtual_bus.drive_stretch import can_stretch, csp_stretch, csv_stretch
 
 FIELDS = ("statusword", "position_actual", "velocity_actual", "torque_actual", "following_error")
 
 
-def _enabled(params: DriveParams, origin: float) -> tuple[Cia402Drive, RxPdo]:
+def _enabled(params: DriveParams, origin: float, mode: int = 8) -> tuple[Cia402Drive, RxPdo]:
     d = Cia402Drive(params=params)
     d.modes.origin = origin
-    rx = RxPdo(mode=8)
+    rx = RxPdo(mode=mode)
     for cw in (0x06, 0x07, 0x0F):
         rx.controlword = cw
         d.exchange(rx, 0.001)
@@ -38,7 +38,7 @@ def _targets(seed: int, n: int) -> list[int]:
 
 def _state(d: Cia402Drive) -> tuple:
     return (d.position, d.velocity, d.command, d.time, d.acceleration, d.torque, d._prev_target, d.state,
-            d.error_code, d._want_cps)
+            d.error_code, d._want_cps, d.target_velocity, d._probe_latched, d._probe_pos)
 
 
 @pytest.mark.parametrize("seed", range(4))
@@ -94,3 +94,38 @@ def test_no_stretch_where_the_plain_csp_path_does_not_hold():
     assert not can_stretch(d, rx)
     rx.touch_probe_function, rx.controlword = 0, 0x0B  # quick stop requested
     assert not can_stretch(d, rx)
+
+
+@pytest.mark.parametrize("probe", [0, 1])
+def test_csv_spindle_stretch_equals_exchange_with_its_index_latch(probe):
+    """A spindle run up to 1200 rpm, held, reversed: stretches wherever can_stretch allows (with the index
+    probe armed: once it latched), exchange() elsewhere; the same feedback and model state every cycle."""
+    params = DriveParams()
+    one, rx1 = _enabled(params, 77.0, mode=9)
+    many, rx2 = _enabled(params, 77.0, mode=9)
+    for rx in (rx1, rx2):
+        rx.touch_probe_function = probe
+    speeds = [12000] * 700 + [-6000] * 600  # 0x60FF in 0.1 rpm
+    want, states = [], []
+    for v in speeds:
+        rx1.target_velocity = v
+        want.append(one.exchange(rx1, 0.001))
+        states.append(_state(one))
+    rng = np.random.default_rng(probe)
+    k = stretched = 0
+    while k < len(speeds):
+        rx2.target_velocity = speeds[k]
+        c = min(int(rng.integers(1, 70)), len(speeds) - k)
+        c = next((j for j in range(1, c) if speeds[k + j] != speeds[k]), c)  # a stretch holds one 0x60FF
+        s = csv_stretch(many, rx2, c, 0.001)
+        if s.done == 0:
+            assert astuple(many.exchange(rx2, 0.001)) == astuple(want[k])
+            k += 1
+        else:
+            got = list(zip(*(getattr(s, f) for f in FIELDS)))
+            assert got == [tuple(getattr(tx, f) for f in FIELDS) for tx in want[k:k + s.done]]
+            assert astuple(s.last) == astuple(want[k + s.done - 1])
+            k, stretched = k + s.done, stretched + s.done
+        assert _state(many) == states[k - 1]
+    assert stretched > 1000 and abs(want[699].velocity_actual - 12000) < 20
+    assert (want[-1].touch_probe_status == 3) == bool(probe)

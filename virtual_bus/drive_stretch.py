@@ -1,6 +1,6 @@
 """A CSP drive stepped over a stretch of cycles at once (issue 17: "the sim drives step over the stretch").
 
-`csp_stretch(drive, rx, targets, dt)` does what `drive.exchange(rx, dt)` does once per target, for an
+`csp_stretch(drive, rx, targets, dt)` (and `csv_stretch(drive, rx, cycles, dt)` for a spindle) does what `drive.exchange(rx, dt)` does once per target, for an
 enabled CSP drive whose master holds enable operation, without limit switches, touch probe or injected
 fault: the same arithmetic in the same order (Cia402Drive.step → _step_following, feedback), on local
 variables, with no PDO objects per cycle. It stops before the first cycle that would fault (following
@@ -35,13 +35,15 @@ class Stretch:
     last: TxPdo | None = None
 
 
-def can_stretch(drive: Cia402Drive, rx: RxPdo) -> bool:
-    """The drive runs the plain CSP path the stretch reproduces."""
+def can_stretch(drive: Cia402Drive, rx: RxPdo, mode: int = 8) -> bool:
+    """The drive runs the plain CSP (mode 8) or CSV (9) path the stretch reproduces. CSV may have its touch
+    probe armed once it latched the index (a spindle's thread sync): a latched probe waits, unchanged."""
     p = drive.params
     cw = rx.controlword
-    return (drive.state is State.OPERATION_ENABLED and drive.mode == 8 and rx.mode == 8 and not drive.external_fault
-            and cw == drive._last_cw and cw & 0x8F == ENABLE_HELD and p.negative_limit is None
-            and p.positive_limit is None and not rx.touch_probe_function & 1)
+    probe_ok = not rx.touch_probe_function & 1 or (mode == 9 and drive._probe_latched)
+    return (drive.state is State.OPERATION_ENABLED and drive.mode == mode and rx.mode == mode
+            and not drive.external_fault and cw == drive._last_cw and cw & 0x8F == ENABLE_HELD
+            and p.negative_limit is None and p.positive_limit is None and probe_ok)
 
 
 def csp_stretch(drive: Cia402Drive, rx: RxPdo, targets: Sequence[int], dt: float) -> Stretch:
@@ -82,9 +84,7 @@ def csp_stretch(drive: Cia402Drive, rx: RxPdo, targets: Sequence[int], dt: float
         if abs(cmd - c_pos) > window or abs(c_vel) > 1.2 * max_cps:
             break  # Cia402Drive._supervise would fault in this cycle: exchange() takes it
         c_acc = (c_vel - vel) / dt
-        torque_nm = (p.inertia * c_acc * rad + p.viscous * c_vel * rad
-                     + (math.copysign(p.coulomb, c_vel) if abs(c_vel) > 1 else 0.0))
-        torque = torque_nm / p.rated_torque * 1000.0
+        torque = _torque(drive, c_acc, c_vel, rad)
         pos, vel, t, command, acc, prev_target = c_pos, c_vel, c_t, cmd, c_acc, target
         gap = command - pos
         sws.append(base | SW_TARGET_REACHED if abs(vel) < reached_v and abs(gap) < 10 else base)
@@ -92,19 +92,84 @@ def csp_stretch(drive: Cia402Drive, rx: RxPdo, targets: Sequence[int], dt: float
         va.append(units.velocity_to_raw(vel, cpr))
         ta.append(int(round(torque * 0.1 / units.torque_percent)))
         fe.append(int(round(gap)))
-    out.done = len(pa)
-    if not out.done:
+    if pa:
+        drive._prev_target = prev_target
+        _finish(drive, rx, out, pos, vel, t, command, acc, torque)
+    return out
+
+
+def csv_stretch(drive: Cia402Drive, rx: RxPdo, cycles: int, dt: float) -> Stretch:
+    """Step a CSV drive (a spindle at its 0x60FF speed) `cycles` times as exchange(rx, dt) would."""
+    out = Stretch()
+    if cycles <= 0 or not can_stretch(drive, rx, 9):
         return out
+    p = drive.params
+    units, cpr = p.units, p.counts_per_rev
+    n = max(1, p.substeps)
+    h = dt / n
+    max_cps = p.max_speed_rpm / 60.0 * cpr
+    alpha = 1.0 - math.exp(-p.velocity_bandwidth * h)
+    rad = 2.0 * math.pi / cpr
+    origin, ramp = drive.modes.origin, p.csv_accel * h
+    want = units.raw_to_velocity(rx.target_velocity, cpr)  # apply()'s latch of 0x60FF
+    reached_v = 0.001 * (p.max_speed_rpm / 60.0 * cpr)
+    base = _STATUS_BASE[State.OPERATION_ENABLED] | SW_FOLLOWING
+    pos, vel, t, command, tv = drive.position, drive.velocity, drive.time, drive.command, drive.target_velocity
+    acc, torque = drive.acceleration, drive.torque
+    pa, va, ta, sws = out.position_actual, out.velocity_actual, out.torque_actual, out.statusword
+    for _ in range(cycles):
+        c_pos, c_vel, c_t, c_tv, cmd = pos, vel, t, tv, command
+        for _k in range(n):  # Cia402Drive._step_following, csv
+            c_tv += max(-ramp, min(ramp, want - c_tv))
+            v_cmd, cmd = c_tv, c_pos
+            if not -max_cps <= v_cmd <= max_cps:
+                v_cmd = max(-max_cps, min(max_cps, v_cmd))
+            if v_cmd != c_vel:
+                c_vel += (v_cmd - c_vel) * alpha
+            c_pos = c_pos + c_vel * h
+            c_t += h
+        if abs(c_vel) > 1.2 * max_cps:
+            break  # overspeed: exchange() takes the fault
+        c_acc = (c_vel - vel) / dt
+        torque = _torque(drive, c_acc, c_vel, rad)
+        pos, vel, t, command, tv, acc = c_pos, c_vel, c_t, cmd, c_tv, c_acc
+        sws.append(base | SW_TARGET_REACHED if abs(vel) < reached_v and abs(command - pos) < 10 else base)
+        pa.append(int(round(pos + origin)))
+        va.append(units.velocity_to_raw(vel, cpr))
+        ta.append(int(round(torque * 0.1 / units.torque_percent)))
+    out.following_error = [0] * len(pa)  # 0x60F4 is a CSP object: 0 in CSV
+    if pa:
+        drive.target_velocity = tv
+        _finish(drive, rx, out, pos, vel, t, command, acc, torque)
+    return out
+
+
+def _torque(drive: Cia402Drive, acc: float, vel: float, rad: float) -> float:
+    """Cia402Drive.step's torque of an energised drive, 0.1 % of rated."""
+    p = drive.params
+    torque_nm = p.inertia * acc * rad + p.viscous * vel * rad + (math.copysign(p.coulomb, vel) if abs(vel) > 1 else 0.0)
+    return torque_nm / p.rated_torque * 1000.0
+
+
+def _finish(drive: Cia402Drive, rx: RxPdo, out: Stretch, pos: float, vel: float, t: float, command: float,
+            acc: float, torque: float) -> None:
+    """The drive's state after the stretch's last cycle, and that cycle's TxPdo as feedback() builds it."""
+    p = drive.params
+    out.done = len(out.position_actual)
     drive._rx = rx
-    drive._want_cps = units.raw_to_velocity(rx.target_velocity, cpr)  # apply()'s latch of 0x60FF
+    drive._want_cps = p.units.raw_to_velocity(rx.target_velocity, p.counts_per_rev)  # apply()'s latch of 0x60FF
     drive.position, drive.velocity, drive.time, drive.command = pos, vel, t, command
-    drive._prev_target, drive.acceleration, drive.torque = prev_target, acc, torque
+    drive.acceleration, drive.torque = acc, torque
     drive._limit_flags = 0  # _no_limit, _step_following's tail
     if drive.error_code in (AL_REVERSE_LIMIT, AL_FORWARD_LIMIT):
         drive.error_code = 0
-    drive._probe_latched = False
+    probing = bool(rx.touch_probe_function & 1)
+    if not probing:
+        drive._probe_latched = False
     di = 0x4 if p.home_switch is not None and pos < p.home_switch else 0
-    out.last = TxPdo(statusword=sws[-1], position_actual=pa[-1], velocity_actual=va[-1], torque_actual=ta[-1],
-                     following_error=fe[-1], error_code=drive.error_code, mode_display=drive.mode,
-                     touch_probe_status=0, touch_probe_pos1=drive._probe_pos + int(round(origin)), digital_inputs=di)
-    return out
+    origin = drive.modes.origin
+    out.last = TxPdo(statusword=out.statusword[-1], position_actual=out.position_actual[-1],
+                     velocity_actual=out.velocity_actual[-1], torque_actual=out.torque_actual[-1],
+                     following_error=out.following_error[-1], error_code=drive.error_code, mode_display=drive.mode,
+                     touch_probe_status=0x0003 if drive._probe_latched else (0x0001 if probing else 0),
+                     touch_probe_pos1=drive._probe_pos + int(round(origin)), digital_inputs=di)
