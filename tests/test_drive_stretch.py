@@ -41,6 +41,16 @@ def _state(d: Cia402Drive) -> tuple:
             d.error_code, d._want_cps, d.target_velocity, d._probe_latched, d._probe_pos)
 
 
+def _reference(d: Cia402Drive, rx: RxPdo, field: str, values: list[int]) -> tuple[list, list]:
+    """exchange() once per value of `field`: the feedback and the model state after each cycle."""
+    want, states = [], []
+    for v in values:
+        setattr(rx, field, v)
+        want.append(d.exchange(rx, 0.001))
+        states.append(_state(d))
+    return want, states
+
+
 @pytest.mark.parametrize("seed", range(4))
 def test_stretch_equals_exchange_cycle_by_cycle(seed):
     params = DriveParams(home_switch=150_000 if seed % 2 else None)
@@ -48,11 +58,7 @@ def test_stretch_equals_exchange_cycle_by_cycle(seed):
     one, rx1 = _enabled(params, origin)
     many, rx2 = _enabled(params, origin)
     targets = _targets(seed, 1500)
-    want, states = [], []
-    for t in targets:
-        rx1.target_position = t
-        want.append(one.exchange(rx1, 0.001))
-        states.append(_state(one))
+    want, states = _reference(one, rx1, "target_position", targets)
     rng = np.random.default_rng(seed)
     got, k = [], 0
     while k < len(targets):
@@ -106,11 +112,7 @@ def test_csv_spindle_stretch_equals_exchange_with_its_index_latch(probe):
     for rx in (rx1, rx2):
         rx.touch_probe_function = probe
     speeds = [12000] * 700 + [-6000] * 600  # 0x60FF in 0.1 rpm
-    want, states = [], []
-    for v in speeds:
-        rx1.target_velocity = v
-        want.append(one.exchange(rx1, 0.001))
-        states.append(_state(one))
+    want, states = _reference(one, rx1, "target_velocity", speeds)
     rng = np.random.default_rng(probe)
     k = stretched = 0
     while k < len(speeds):

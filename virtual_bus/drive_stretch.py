@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 
 from fieldbus.cia402 import SW_FOLLOWING, SW_TARGET_REACHED, State
 from fieldbus.pdo import RxPdo, TxPdo
-from virtual_bus.drive import AL_FORWARD_LIMIT, AL_REVERSE_LIMIT, _STATUS_BASE, Cia402Drive
+from virtual_bus.drive import AL_FORWARD_LIMIT, AL_REVERSE_LIMIT, _STATUS_BASE, Cia402Drive, DriveParams
 
 ENABLE_HELD = 0x0F  # controlword bits 0-3 (and not 7) of enable operation
 
@@ -53,13 +53,8 @@ def csp_stretch(drive: Cia402Drive, rx: RxPdo, targets: Sequence[int], dt: float
         return out
     p = drive.params
     units, cpr = p.units, p.counts_per_rev
-    n = max(1, p.substeps)
-    h = dt / n
-    max_cps = p.max_speed_rpm / 60.0 * cpr
-    alpha = 1.0 - math.exp(-p.velocity_bandwidth * h)
-    rad = 2.0 * math.pi / cpr
+    n, h, max_cps, alpha, rad, reached_v = _model(p, dt)
     kp, kff, window, origin = p.kp, p.kff, p.following_error_window, drive.modes.origin
-    reached_v = 0.001 * (p.max_speed_rpm / 60.0 * cpr)
     base = _STATUS_BASE[State.OPERATION_ENABLED] | SW_FOLLOWING
     pos, vel, t, command = drive.position, drive.velocity, drive.time, drive.command
     prev_target = drive._prev_target
@@ -105,14 +100,9 @@ def csv_stretch(drive: Cia402Drive, rx: RxPdo, cycles: int, dt: float) -> Stretc
         return out
     p = drive.params
     units, cpr = p.units, p.counts_per_rev
-    n = max(1, p.substeps)
-    h = dt / n
-    max_cps = p.max_speed_rpm / 60.0 * cpr
-    alpha = 1.0 - math.exp(-p.velocity_bandwidth * h)
-    rad = 2.0 * math.pi / cpr
+    n, h, max_cps, alpha, rad, reached_v = _model(p, dt)
     origin, ramp = drive.modes.origin, p.csv_accel * h
     want = units.raw_to_velocity(rx.target_velocity, cpr)  # apply()'s latch of 0x60FF
-    reached_v = 0.001 * (p.max_speed_rpm / 60.0 * cpr)
     base = _STATUS_BASE[State.OPERATION_ENABLED] | SW_FOLLOWING
     pos, vel, t, command, tv = drive.position, drive.velocity, drive.time, drive.command, drive.target_velocity
     acc, torque = drive.acceleration, drive.torque
@@ -142,6 +132,16 @@ def csv_stretch(drive: Cia402Drive, rx: RxPdo, cycles: int, dt: float) -> Stretc
         drive.target_velocity = tv
         _finish(drive, rx, out, pos, vel, t, command, acc, torque)
     return out
+
+
+def _model(p: DriveParams, dt: float) -> tuple[int, float, float, float, float, float]:
+    """Cia402Drive.step's per-cycle constants, by the same expressions: sub-steps, sub-step, speed limit,
+    velocity-loop gain, counts → rad, and the speed under which the target counts as reached."""
+    n = max(1, p.substeps)
+    h = dt / n
+    max_cps = p.max_speed_rpm / 60.0 * p.counts_per_rev
+    return (n, h, max_cps, 1.0 - math.exp(-p.velocity_bandwidth * h), 2.0 * math.pi / p.counts_per_rev,
+            0.001 * (p.max_speed_rpm / 60.0 * p.counts_per_rev))
 
 
 def _torque(drive: Cia402Drive, acc: float, vel: float, rad: float) -> float:
