@@ -3,15 +3,12 @@ preview record and per-block geometry (plain data, no behaviour)."""
 
 from __future__ import annotations
 
+import sys
 from dataclasses import dataclass, field
 
 from nc.profiles import Profile
 from nc.program.blocks import Program
 
-try:  # imported once here: `_transforms` asks it on every block
-    import nc.transforms as _transforms_module
-except ImportError:  # a build without issue 4's transforms
-    _transforms_module = None
 
 M_BEFORE_MOTION = {3, 4, 8, 19, 29}  # issued to the MLC before the block's motion starts
 M_END = {2, 30}
@@ -82,8 +79,10 @@ def _log_length(profile: Profile) -> int | None:
 
 
 def _transforms(host):
-    """`nc.transforms` (issue 4) when scaling, mirror or rotation is active, else None."""
-    tr = _transforms_module
+    """`nc.transforms` (issue 4) when scaling, mirror or rotation is active, else None. The module is
+    loaded by the first G50.1/G51/G68 (ModalMixin); until then none can be active, and a program
+    without them never loads it (start-up, issue 16)."""
+    tr = sys.modules.get("nc.transforms")
     if tr is None:
         return None
     try:
