@@ -1,0 +1,65 @@
+"""The planner's samples handed out a stretch at a time (issue 17: "the runner asks the channel for the next N
+planned samples as arrays").
+
+The planner samples each plan into a buffer (`Planner._buf_pos`, up to 64 cycles, within one block) and
+`Planner.step` hands out one row per cycle, through the position filter. `sample_stretch(planner, n)` hands
+out the next rows of that buffer at once — at most to its end, where the planner solves again — filtered by
+`PositionFilter.push_many`, and leaves the planner as that many `step()` calls would. It refuses (None) what
+a cycle-by-cycle step does differently: an empty buffer (refill, solve), a feed-per-revolution path (the
+measured speed re-plans it), a thread or G31 move (they bypass the filter), an offline planner that
+integrates its own spindle angle. `step()` also counts how long the measured spindle speed has been at its
+command (threads arm on it): with a stretch the caller reports the speeds afterwards, `settle_stretch`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from nc.motion.planner import Planner
+from nc.moves import Move
+
+
+@dataclass
+class Samples:
+    """`step()`'s setpoints of the stretch's cycles, as rows."""
+
+    positions: np.ndarray  # (cycles, axes), filtered as step() returns them
+    lines: list[int]
+    path_velocity: np.ndarray
+    move: Move | None  # the same for every row: a buffer lies within one block
+
+
+def sample_stretch(pl: Planner, n: int) -> Samples | None:
+    """The next min(n, rows left in the buffer) setpoints, or None where step() must run (module doc)."""
+    if n <= 0 or pl._integrate_angle or pl._buf_done:
+        return None
+    blocks = pl.blocks
+    mv = blocks[0].move if blocks else None
+    p = pl.plan
+    if p is not None and p.kind == "path" and mv is not None and mv.per_rev:
+        return None  # Planner._check_spindle re-plans it from the measured speed
+    if mv is not None and (mv.kind == "thread" or "G31" in mv.tags):
+        return None
+    i = pl._buf_i
+    m = min(n, len(pl._buf_pos) - i)
+    j = i + m - 1
+    raw = pl._buf_pos[i:i + m]
+    pl._buf_i = i + m
+    pl.position = pl._buf_pos[j]
+    pl.line = pl._buf_line[j]
+    pl.s, pl.v, pl.a = pl._buf_state[j]
+    positions = pl.filter.push_many(raw) if pl.filter is not None else np.array(raw, dtype=float)
+    pl.output = positions[-1].copy()
+    return Samples(positions, list(pl._buf_line[i:i + m]), np.array(pl._buf_vel[i:i + m], dtype=float), mv)
+
+
+def settle_stretch(pl: Planner, rpms: Sequence[float], commands: Sequence[float]) -> None:
+    """The spindle settle count step() keeps, for a stretch's cycles: the measured and commanded speed each
+    cycle's step() would have read."""
+    if pl.spindle_command is None:
+        return
+    for rpm, cmd in zip(rpms, commands):
+        pl._settle.update(float(rpm), float(cmd))
