@@ -102,7 +102,8 @@ class DriveApp(SlaveApp):
         elif index in self._params and self.od is not None:
             self.od.set(index, 0, self.drive.servo_params.read(ServoParams.from_index(index, 0)))
 
-    def cycle(self, outputs: bytes, rx_map, tx_map, step: bool, dt: float = 0.0, lost: bool = False) -> bytes:
+    def cycle(self, outputs: bytes | memoryview, rx_map, tx_map, step: bool, dt: float = 0.0,
+              lost: bool = False) -> bytes:
         od = self.od
         assert od is not None
         images = self._images.get(rx_map, tx_map, od)
@@ -174,7 +175,8 @@ class DioApp(SlaveApp):
         if self.od is not None and any(index == i for i, _ in self.in_objs):
             self._publish()
 
-    def cycle(self, outputs: bytes, rx_map, tx_map, step: bool, dt: float = 0.0, lost: bool = False) -> bytes:
+    def cycle(self, outputs: bytes | memoryview, rx_map, tx_map, step: bool, dt: float = 0.0,
+              lost: bool = False) -> bytes:
         od = self.od
         assert od is not None
         images = self._images.get(rx_map, tx_map, od)

@@ -85,8 +85,10 @@ class SlaveApp:
 
     def attach(self, od: ObjectDictionary) -> None: ...
 
-    def cycle(self, outputs: bytes, rx_map, tx_map, step: bool, dt: float = 0.0, lost: bool = False) -> bytes:
-        """`lost`: the slave fell out of OP by an error; its outputs are stale, its time runs on."""
+    def cycle(self, outputs: bytes | memoryview, rx_map, tx_map, step: bool, dt: float = 0.0,
+              lost: bool = False) -> bytes:
+        """`outputs`: the SM2 area (a view of the ESC's memory, valid during the call). `lost`: the slave
+        fell out of OP by an error; its outputs are stale, its time runs on."""
         return b""
 
     def refresh(self, index: int) -> None: ...
@@ -396,7 +398,7 @@ class Esc:
             s = self.sm(3)
             self.mem[s.start:s.start + len(data)] = data
 
-    def logical(self, cmd: int, addr: int, data: bytearray) -> int:
+    def logical(self, cmd: int, addr: int, data: bytearray | memoryview) -> int:
         """LRD/LWR/LRW through the FMMUs. Returns the WKC increment. In lock-step the outputs are
         applied and the model advanced before the inputs are copied, so one frame = one cycle."""
         mem = self.mem

@@ -88,7 +88,7 @@ class Chain:
         return out
 
     # ---- frames ---------------------------------------------------------------------------
-    def process(self, frame: bytes) -> tuple[bytes | None, float]:
+    def process(self, frame: bytes | memoryview) -> tuple[bytes | None, float]:
         """Process one Ethernet frame; returns (answer or None if lost, delay in s)."""
         if len(frame) < 16 or frame[12] != ETH_P_ECAT >> 8 or frame[13] != ETH_P_ECAT & 0xFF:
             return None, 0.0

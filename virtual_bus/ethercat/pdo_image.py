@@ -18,7 +18,7 @@ Mapping = list[tuple[int, int, int]]  # (index, subindex, bits) per mapped entry
 _CODES = {8: "b", 16: "h", 32: "i", 64: "q"}
 
 
-def unpack_generic(data: bytes, mapping: Mapping, od: ObjectDictionary) -> None:
+def unpack_generic(data: bytes | memoryview, mapping: Mapping, od: ObjectDictionary) -> None:
     """Outputs into their objects entry by entry (mappings a `PdoImage` cannot take)."""
     pos = 0
     for index, sub, bits in mapping:
@@ -57,18 +57,18 @@ class PdoImage:
             if e is None or bits not in _CODES or e.dtype == VISIBLE_STRING or not isinstance(e.value, int):
                 return None
             entries.append(e)
-        bits = [b for _, _, b in mapping]
-        reader = "<" + "".join(_CODES[b] if e.signed else _CODES[b].upper() for e, b in zip(entries, bits))
-        return cls(tuple(entries), tuple((1 << b) - 1 for b in bits), struct.Struct(reader),
-                   struct.Struct("<" + "".join(_CODES[b].upper() for b in bits)))
+        widths = [b for _, _, b in mapping]
+        reader = "<" + "".join(_CODES[b] if e.signed else _CODES[b].upper() for e, b in zip(entries, widths))
+        return cls(tuple(entries), tuple((1 << b) - 1 for b in widths), struct.Struct(reader),
+                   struct.Struct("<" + "".join(_CODES[b].upper() for b in widths)))
 
-    def read(self, data) -> None:
+    def read(self, data: bytes | memoryview) -> None:
         """The outputs in `data` (bytes or a memoryview of the SM2 area) into their entries."""
         for e, v in zip(self.entries, self.reader.unpack_from(data)):
             e.value = v
 
     def write(self) -> bytes:
-        return self.writer.pack(*[e.value & m for e, m in zip(self.entries, self.masks)])
+        return self.writer.pack(*[e.value & m for e, m in zip(self.entries, self.masks)])  # type: ignore[operator]  # int entries only (compile)
 
 
 class Images:
@@ -86,7 +86,7 @@ class Images:
             self._maps = (rx_map, tx_map)
         return self
 
-    def unpack(self, data, rx_map: Mapping, od: ObjectDictionary) -> None:
+    def unpack(self, data: bytes | memoryview, rx_map: Mapping, od: ObjectDictionary) -> None:
         if self.rx is not None:
             self.rx.read(data)
         else:
