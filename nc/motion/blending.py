@@ -109,7 +109,7 @@ class FilterCorners:
                 v = min(v, ba / d, bj / d)
         return v
 
-    def corner_tolerance(self, du_n: float, acc: float, jerk: float = 0.0) -> float:
+    def corner_tolerance(self, du_n: float, acc: float) -> float:
         """The path tolerance's cap of one isolated tangent jump of norm du_n: the deviation model
         is `_tolerance`'s, except that a corner whose braking alone cuts the tolerance is an
         exact stop (0). The corner's own term of the kernel model, alone: v·|Δu|·G(0)
@@ -117,7 +117,7 @@ class FilterCorners:
         min(c, this cap)."""
         if self.tol is None or du_n <= 1e-12:
             return math.inf
-        room = self.tol - self.braking(du_n, acc, jerk)
+        room = self.tol - self.braking(du_n, acc)
         if room <= 0.0:
             return 0.0
         return room / (du_n * self.kd.g0)
@@ -126,9 +126,9 @@ class FilterCorners:
         """How far braking into and speeding out of a corner inside the filter window cuts it:
         about |Δu|·a·(T1²+T2²)/192 (measured on 90° corners: 1/240). When that alone exceeds the
         tolerance the corner is an exact stop (0), which the filter then passes exactly.
-        `jerk`: the blocks' tangential jerk, given where a solve may raise it by up to
-        shares.MAX_FACTOR (between lines): a higher jerk reaches the deceleration closer to the
-        corner, so the term grows by the kernel's own ratio for the two jerks."""
+        `jerk`: the blocks' tangential jerk, when a solve raises it to shares.MAX_FACTOR times
+        that (nc.motion.shares): a higher jerk reaches the deceleration closer to the corner, so
+        the term grows by the kernel's own ratio for the two jerks."""
         b = du_n * acc * self.t2sum / 192.0
         if jerk > 0.0:
             key = (acc, jerk)
@@ -441,9 +441,7 @@ class FilterCorners:
         for r, i in enumerate(ev):
             b = seg[i]
             nx = seg[i + 1] if i + 1 < len(seg) else blocks[-1]
-            lines = b.seg is not None and nx.seg is not None and b.seg.kind == nx.seg.kind == "line"
-            room[r] = self.tol - self.braking(b.du_n, b.a if b.a > nx.a else nx.a,
-                                              (b.j if b.j > nx.j else nx.j) if lines else 0.0)
+            room[r] = self.tol - self.braking(b.du_n, b.a if b.a > nx.a else nx.a)
         near = s >= s_j - 2.0 * h - 1e-12
         caps = self.kd.caps(s[ev], room, vt, s[near], du[near], vb[near])
         for r, i in enumerate(ev):

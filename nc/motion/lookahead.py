@@ -70,6 +70,7 @@ class Block:
     # every window that held it; not the tolerance): vjunc / vbud is the share of the corner budget
     # the junction can use (nc.motion.shares, decision motion 39).
     vbud: float = math.inf
+    vctol: float = math.inf  # the tolerance's cap of this junction's corner alone (FilterCorners.corner_tolerance)
 
 
 def change_distance(v0: float, v1: float, a: float, j: float) -> float:
@@ -194,8 +195,8 @@ class Limits:
             if b1.du_n > 1e-9:
                 lines = s1.kind == "line" and s2.kind == "line"
                 b1.vbud = self.blend.corner_budget(du, lines)
-                v = min(v, b1.vbud, self.blend.corner_tolerance(b1.du_n, max(b1.a, b2.a),
-                                                                 max(b1.j, b2.j) if lines else 0.0))
+                b1.vctol = self.blend.corner_tolerance(b1.du_n, max(b1.a, b2.a))
+                v = min(v, b1.vbud, b1.vctol)
         elif max(du) > 1e-9:
             vj = va = math.inf
             for d, cj, ca in zip(du, self._corner_j, self._corner_a):

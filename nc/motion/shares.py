@@ -11,11 +11,9 @@ junction of W and cap_W ≥ vbud_m the cap made from a sum that holds W. So whil
 the filter can mix with a stretch of the tangential profile uses at most U of the corner share,
 that stretch may plan with jerk (1 − U·(corner + curvature share)) of the axis limits instead of
 the tangential share, up to MAX_FACTOR times it. Only the jerk is raised, not the acceleration.
-A higher jerk reaches the full deceleration closer to a corner, so the tolerance model's braking
-term between lines (FilterCorners.braking) is sized for MAX_FACTOR times the blocks' jerk: by the
-kernel's own weighting of the path a jerk-limited speed change adds around a corner
-(KernelDeviation.speed_up). A factor of 2 cost the 15° CAM vertices more in corner speed than it
-gained on the straights (docs/performance/motion.md); 1.5 gains on every dense program measured.
+A higher jerk reaches the full deceleration closer to a corner, so no junction within reach may
+be one the tolerance slows, nor one whose tolerance cap would not survive the raised jerk's
+larger braking term (`_tolerance_free`).
 
 "Can mix with": the filter's output at one cycle averages T1 + T2 of input, so a tangential jerk
 at path position p and a corner at q meet in some output cycle only if the path between them
@@ -28,14 +26,14 @@ unknown, unless the channel said none come before a stop: `closed`), leave the s
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
 from nc.motion.limits import MotionConfig
 
-# The most a solve raises the tangential jerk; the tolerance's braking term between lines is
-# sized for it (FilterCorners.braking).
-MAX_FACTOR = 1.5
+# The most a solve raises the tangential jerk (2: the whole corner and curvature share).
+MAX_FACTOR = 2.0
 
 if TYPE_CHECKING:
     from nc.motion.blending import FilterCorners
@@ -109,7 +107,7 @@ def _scan(fc: "FilterCorners", blocks: Sequence["Block"], pos: float, run_end: f
             return None
         if j.du_n <= 1e-9:
             continue
-        if j.vbud <= 1e-12:
+        if j.vbud <= 1e-12 or not _tolerance_free(fc, j, blocks):
             return None
         r = j.vjunc / j.vbud
         if r > use:
@@ -118,3 +116,30 @@ def _scan(fc: "FilterCorners", blocks: Sequence["Block"], pos: float, run_end: f
         if fc._seq0 > 0:
             return None  # junctions within the reach were dropped already
     return use, seen
+
+
+def _tolerance_free(fc: "FilterCorners", j: "Block", blocks: Sequence["Block"]) -> bool:
+    """Whether junction j keeps N1.053 with the raised jerk at the fastest its blocks may pass it.
+
+    Its tolerance caps (the kernel windows' vtol, its corner alone vctol) were found with the
+    braking term of the blocks' own jerk: the deviation grows at least linearly with the speed
+    (nc.motion.deviation), so at a speed c below the cap V it is at most (tol − braking)·c/V, and
+    the raised jerk adds its larger braking term instead. A junction the tolerance slows below its
+    blocks' caps (a real corner, the 15° CAM vertices) fails this: near it the speed changes inside
+    the filter window, which the constant-speed kernel model does not see, and a raised jerk there
+    took the CAM vertices 0.0002–0.0036 mm over N1.053."""
+    if fc.tol is None:
+        return True
+    cap = j.vtop
+    for b in blocks:  # the next block (its cap is the feed's): one step, it follows j in the queue
+        if b.s_end > j.s_end:
+            cap = max(j.cap, b.cap)
+            break
+    tcap = min(j.vtol, j.vctol)
+    if tcap == math.inf:
+        return True
+    if tcap <= 0.0:
+        return False
+    unb = fc.braking(j.du_n, j.a)
+    boosted = fc.braking(j.du_n, j.a, j.j)
+    return cap * (fc.tol - unb) / tcap + boosted <= fc.tol
