@@ -81,9 +81,9 @@ def cycle_frames(chain, frames: int) -> float:
     return cpu
 
 
-def main() -> None:
-    frames = int(sys.argv[1]) if len(sys.argv) > 1 else 3000
-    rounds = int(sys.argv[2]) if len(sys.argv) > 2 else 5
+def main(args: list[str]) -> None:
+    frames = int(args[0]) if args else 3000
+    rounds = int(args[1]) if len(args) > 1 else 5
     best = min(cycle_frames(build_chain(default_lathe()), frames) for _ in range(rounds))
     print(f"virtual slaves in-process ({len(default_lathe().axes) + len(default_lathe().spindles)} drives, LRW + FRMW a frame): {best / frames * 1e6:.1f} µs CPU "
           f"per process-data frame (best of {rounds} rounds of {frames} frames), "
@@ -91,4 +91,4 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    main(sys.argv[1:])

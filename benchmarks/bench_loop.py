@@ -4,8 +4,9 @@ per cycle of a dense CAM program on the mill bench (position filter on), the iss
 benches/mill-3axis.toml) as simulated time / wall time with the µs per cycle of each stage, and
 the real-time pacer's jitter on this machine. Prints figures, asserts nothing.
 
-EtherCAT lock-step (root: a veth pair and `hil sim ethercat` in a network namespace, skipped with the
-reason otherwise) prints cycles/s of the bus alone and of a bench program, with the CPU each side spent;
+EtherCAT lock-step prints the virtual slaves' CPU per frame in-process, then (root: a veth pair and
+`hil sim ethercat` in a network namespace, skipped with the reason otherwise) cycles/s of the bus alone
+and of a bench program, with the CPU each side spent;
 `hil run --realtime` of the lathe demo and a CAM program prints p50/p99/max cycle work at 1 ms.
 
 Usage: python benchmarks/bench_loop.py [PACER_SECONDS] [--stages-only | --ethercat-only | --realtime-only]"""
@@ -139,12 +140,16 @@ def ethercat_lockstep(cycles: int = 5000) -> None:
     """Lock-step over EtherCAT: `hil sim ethercat` (the default lathe's 3 drives: X, Z, spindle) in a
     network namespace behind a veth pair, the pysoem master here. Two figures: the bus alone (the link's
     exchange, drives enabled, setpoints held), and the bench program run by BenchRunner over that bus
-    (MLC, NC, trace off). Needs root; prints why it is skipped otherwise."""
+    (MLC, NC, trace off). Needs root; prints why it is skipped otherwise. First, without root, the slaves'
+    own work per frame in-process (benchmarks/bench_ecat_slaves.py)."""
+    sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+    from benchmarks import bench_ecat_slaves
     from fieldbus.cia402 import Cia402Master, Target
     from fieldbus.ethercat.link import EthercatLink
     from fieldbus.pdo import RxPdo
     from virtual_bus.ethercat.veth import SimProcess, can_create
 
+    bench_ecat_slaves.main([])
     why = can_create()
     if why is not None:
         print(f"EtherCAT lock-step: skipped ({why})")
