@@ -210,19 +210,25 @@ class Esc:
     def _system_time_written(self, value: int) -> None:
         """A master (FRMW/ARMW) distributes the reference time: the ESC's control loop compares it
         with its own system time and trims the offset, and shows the difference in 0x092C."""
-        received = (value + self.u32(R_DC_DELAY)) & 0xFFFFFFFFFFFFFFFF
-        own = self.system_ns(self.frame_ns + self.position * HOP_NS)
+        # every process-data frame of a DC master comes here on all but the reference slave: system_ns
+        # and local_ns inlined (the same expressions), the offset read once
+        mem = self.mem
+        received = (value + _U32.unpack_from(mem, R_DC_DELAY)[0]) & 0xFFFFFFFFFFFFFFFF
+        offset = _U64.unpack_from(mem, R_DC_OFFSET)[0]
+        t = self.frame_ns + self.position * HOP_NS
+        local = (self.clock_base_ns + int(t * (1.0 + self.drift_ppm * 1e-6))) & 0xFFFFFFFFFFFFFFFF
+        own = (local + offset) & 0xFFFFFFFFFFFFFFFF
         diff = ((received - own + (1 << 63)) % (1 << 64)) - (1 << 63)
         mag = min(abs(diff), 0x7FFFFFFF)
-        _U32.pack_into(self.mem, R_DC_DIFF, mag | (0x80000000 if diff < 0 else 0))
+        _U32.pack_into(mem, R_DC_DIFF, mag | (0x80000000 if diff < 0 else 0))
         step = max(-5000, min(5000, diff // 8)) if abs(diff) < 1_000_000 else diff
-        _U64.pack_into(self.mem, R_DC_OFFSET, (self.u64(R_DC_OFFSET) + step) & 0xFFFFFFFFFFFFFFFF)
+        _U64.pack_into(mem, R_DC_OFFSET, (offset + step) & 0xFFFFFFFFFFFFFFFF)
 
     # ---- register access with side effects ------------------------------------------------
     def read(self, addr: int, n: int) -> bytes | None:
         end = addr + n
         if addr < R_DC_SYSTIME + 8 and end > R_DC_SYSTIME:
-            struct.pack_into("<Q", self.mem, R_DC_SYSTIME, self.system_ns(self.frame_ns + self.position * HOP_NS))
+            _U64.pack_into(self.mem, R_DC_SYSTIME, self.system_ns(self.frame_ns + self.position * HOP_NS))
         mi = self.sm(1)
         if mi.enabled and mi.length and addr < mi.end and end > mi.start:
             if not self.mbx_full:

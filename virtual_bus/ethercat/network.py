@@ -14,7 +14,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 from virtual_bus.ethercat.esc import (APRD, APRW, APWR, ARMW, BRD, BRW, BWR, FPRD, FPRW, FPWR, FRMW, LRD, LRW,
-                                      LWR, R_AL_CODE, Esc)
+                                      LWR, R_AL_CODE, R_STATION, Esc)
 from virtual_bus.ethercat.faults import Fault
 
 ETH_P_ECAT = 0x88A4
@@ -147,7 +147,8 @@ class Chain:
             addressed = adp == 0
             new_adp = (adp + 1) & 0xFFFF
         elif cmd in (FPRD, FPWR, FPRW, FRMW):
-            addressed = adp == s.station or (bool(s.mem[0x0103] & 0x01) and adp == s.u16(0x0012))
+            addressed = adp == _U16.unpack_from(s.mem, R_STATION)[0] \
+                or (bool(s.mem[0x0103] & 0x01) and adp == s.u16(0x0012))
             new_adp = adp
         elif cmd in (BRD, BWR, BRW):
             addressed = True
