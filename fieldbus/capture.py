@@ -1,7 +1,9 @@
 """Bus captures for `hil run --capture FILE`: what a bench engineer opens in Wireshark or a CAN tool.
 
-EtherCAT: every frame on the master's interface (out and in) as pcapng, link type DLT_EN10MB
-(EtherCAT rides in Ethernet frames with ethertype 0x88A4, which Wireshark's ecat dissector decodes).
+EtherCAT: every EtherCAT frame on the master's interface (out and in) as pcapng, link type DLT_EN10MB
+(EtherCAT rides in Ethernet frames with ethertype 0x88A4, which Wireshark's ecat dissector decodes). Other
+traffic the host puts on that interface (an IPv6 router solicitation when the link comes up, LLDP) is
+left out: it is not the bus's.
 The capture runs as its own process (`python -m fieldbus.capture IFACE FILE`) on an AF_PACKET
 socket, so it never takes the cyclic process's CPU or GIL.
 
@@ -24,6 +26,7 @@ from pathlib import Path
 from typing import Any, BinaryIO
 
 ETH_P_ALL = 0x0003
+ETHERTYPE_ECAT = b"\x88\xa4"
 PACKET_OUTGOING = 4
 LINKTYPE_ETHERNET = 1
 CAN_SUFFIXES = (".asc", ".blf", ".log")
@@ -62,7 +65,8 @@ def _option(code: int, value: bytes) -> bytes:
 
 
 def sniff(iface: str, path: str, stop: threading.Event, ready: Callable[[], None] = lambda: None) -> int:
-    """Write every frame seen on `iface` to `path` until `stop`; returns the number of frames."""
+    """Write every EtherCAT frame seen on `iface` to `path` until `stop`; returns the number of frames."""
+    # ETH_P_ALL, filtered here: a socket bound to 0x88A4 alone would not see the master's outgoing frames
     sock = socket.socket(socket.AF_PACKET, socket.SOCK_RAW, socket.htons(ETH_P_ALL))
     sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 8 << 20)  # a 1 ms bus is 2000 frames/s
     sock.bind((iface, 0))
@@ -79,6 +83,8 @@ def sniff(iface: str, path: str, stop: threading.Event, ready: Callable[[], None
                 continue
             except InterruptedError:
                 continue
+            if data[12:14] != ETHERTYPE_ECAT:
+                continue
             w.frame(data, time.time_ns(), outbound=addr[2] == PACKET_OUTGOING)
             n += 1
         sock.setblocking(False)
@@ -87,8 +93,9 @@ def sniff(iface: str, path: str, stop: threading.Event, ready: Callable[[], None
                 data, addr = sock.recvfrom(65535)
             except (BlockingIOError, InterruptedError):
                 break
-            w.frame(data, time.time_ns(), outbound=addr[2] == PACKET_OUTGOING)
-            n += 1
+            if data[12:14] == ETHERTYPE_ECAT:
+                w.frame(data, time.time_ns(), outbound=addr[2] == PACKET_OUTGOING)
+                n += 1
     sock.close()
     return n
 

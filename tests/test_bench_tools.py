@@ -115,7 +115,8 @@ def test_capture_refuses_what_it_cannot_write(tmp_path, args, words):
 
 def test_ethercat_capture_decodes_in_tshark(tmp_path):
     """`--capture run.pcapng` on the master's NIC: tshark decodes the EtherCAT datagrams; every
-    cycle's process-data frame (LRW) is there going out and coming back."""
+    cycle's process-data frame (LRW) is there going out and coming back; nothing but EtherCAT is (the
+    kernel's IPv6 router solicitation on a fresh link was frame 1, ahead of the bus's first BWR)."""
     import shutil
 
     from virtual_bus.ethercat.veth import SimProcess, can_create
@@ -141,6 +142,9 @@ def test_ethercat_capture_decodes_in_tshark(tmp_path):
     for r_ in rows:
         by_src[r_[1]] = by_src.get(r_[1], 0) + 1
     cycles = _cycles(r.stdout)
+    every = subprocess.run(["tshark", "-r", str(cap), "-T", "fields", "-e", "eth.type"], capture_output=True,
+                           text=True, timeout=120)
+    assert set(every.stdout.split()) == {"0x88a4"}
     assert len(by_src) == 2 and all(abs(n - cycles) <= 5 for n in by_src.values()), (by_src, cycles)
 
 

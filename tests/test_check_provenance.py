@@ -14,7 +14,7 @@ PROGRAM = ROOT / "examples" / "servo_params.nc"
 
 def fast_z_bench(tmp_path: Path) -> Path:
     """The shipped lathe bench with Z allowed 800 mm/s (the built-in lathe: 400). The program's
-    rapid runs Z at 414 mm/s: within the recorded bench, over the built-in one."""
+    rapid runs Z at 422 mm/s: within the recorded bench, over the built-in one."""
     text = (ROOT / "benches" / "lathe-2axis.toml").read_text()
     text = text.replace('name = "lathe-2axis"', 'name = "lathe-fast-z"')
     text = text.replace("limits = { velocity = 400.0, acceleration = 4000.0", "limits = { velocity = 800.0, acceleration = 4000.0")
@@ -32,7 +32,7 @@ def test_check_uses_the_bench_recorded_in_the_trace(hil, tmp_path, suffix):
     r = hil("check", trace, "--limits")
     assert r.code == 0, r.out + r.err  # the built-in lathe's 400 mm/s would fail it
     assert f"bench lathe-fast-z (recorded in the trace, {bench})" in r.out
-    assert "ok    velocity Z: 414.2 mm/s <= 800 mm/s" in r.out
+    assert "ok    velocity Z: 421.8 mm/s <= 800 mm/s" in r.out
 
 
 def test_a_trace_that_does_not_say_its_bench_is_refused(hil, tmp_path):
@@ -54,7 +54,7 @@ def test_an_explicit_bench_wins_and_the_mismatch_is_said(hil, tmp_path):
     r = hil("check", trace, "--limits", "--bench", ROOT / "benches" / "lathe-2axis.toml")
     assert r.code == 1, r.out + r.err
     assert "recorded on bench lathe-fast-z; checking against lathe-2axis" in r.err
-    assert "bench lathe-2axis (" in r.out and "FAIL  velocity Z: 414.2 mm/s > 400 mm/s" in r.out
+    assert "bench lathe-2axis (" in r.out and "FAIL  velocity Z: 421.8 mm/s > 400 mm/s" in r.out
 
 
 def test_no_flags_judges_the_trace_as_its_run_was(hil, tmp_path):
@@ -62,6 +62,6 @@ def test_no_flags_judges_the_trace_as_its_run_was(hil, tmp_path):
     trace = tmp_path / "t.parquet"
     assert hil("run", PROGRAM, "--bench", fast_z_bench(tmp_path), "--trace", trace).code == 0
     r = hil("check", trace)
-    assert "following error X" in r.out and "velocity Z: 414.2 mm/s <= 800" in r.out and "jitter p99" in r.out
+    assert "following error X" in r.out and "velocity Z: 421.8 mm/s <= 800" in r.out and "jitter p99" in r.out
     # the bench's contour check needs the program: not given, so nothing passes on it
     assert r.code == 1 and "SKIP  contour error: needs the program" in r.out
