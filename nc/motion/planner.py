@@ -27,7 +27,7 @@ from nc.motion.limits import MotionConfig
 from nc.motion.lookahead import MARGIN, Block, Limits, backward, change_distance, max_speed_at, reach
 from nc.motion.path import Segment
 from nc.motion.profile import Piecewise, solve_axes, solve_position, solve_velocity
-from nc.motion.shares import jerk_factor
+from nc.motion.shares import MAX_FACTOR, jerk_factor
 from nc.motion.smoothing import PositionFilter
 from nc.motion.thread_corners import corner_offset
 from nc.motion import threading as thr
@@ -594,8 +594,33 @@ class Planner:
                 pw.duration = max(pw.duration, (dist - s) / target)
                 pw.t0[:, -1] = np.minimum(pw.t0[:, -1], pw.duration)
             return _Plan("ramp", pw, pw.duration, t0, 0.0, target)
+        if self._jf < MAX_FACTOR and a >= 0.0 and v < cap * (1.0 - 1e-6) and vmax >= cap - 1e-9:
+            ramp = self._speed_up(b, s, v, a, cap, cruise, dist, v1, ra, rj, t0)
+            if ramp is not None:
+                return ramp
         return _Plan("path", pw, pw.duration, t0, target=dist, rpm=rpm, settled=settled, open=unknown,
                      queued=self._pushes)
+
+    def _speed_up(self, b: Block, s: float, v: float, a: float, cap: float, cruise: float, dist: float,
+                  v1: float, ra: float, rj: float, t0: float) -> _Plan | None:
+        """A run whose jerk stays low because of what lies near its end (decision motion 39) may
+        still speed up to its cap with a higher jerk when nothing near the speed-up holds it: a
+        ramp to the cap (ending at zero acceleration), after which the run is solved again. Only
+        when the run cruises at the cap and has room left to brake from it with its own limits."""
+        blend = self.lim.blend
+        if blend is None:
+            return None
+        start = b.s_end - b.length
+        f, unknown = jerk_factor(self.cfg, blend, self.blocks, start + s, start + cruise, self.closed)
+        if unknown or f <= self._jf * (1.0 + 1e-9):
+            return None
+        if dist - cruise < change_distance(cap, v1, MARGIN * ra, MARGIN * rj):
+            return None  # no cruise between the speed-up and the braking
+        pw = solve_velocity(s, v, a, cap, ra, rj / self._jf * f)
+        end_s = float(pw.sample(np.array([pw.duration]))[0][0])
+        if end_s > cruise + 1e-9:
+            return None
+        return _Plan("ramp", pw, pw.duration, t0, 0.0, cap)
 
     def _jerk_factor(self, b: Block, s: float, cap: float, cruise: float) -> tuple[float, bool]:
         """The tangential jerk factor for a solve from s in b, and whether the queue could not
