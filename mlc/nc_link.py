@@ -287,6 +287,9 @@ class ChannelLink:
         mm, x = self.manual, self.x
         assert mm is not None
         limits = getattr(ch, "soft_limits", None)
+        # The windows matter only to manual moves and their latches: not computed every automatic cycle.
+        if limits is not None and not (self.mode in MANUAL_MODES or mm.clamped or self.limit_latch.latched):
+            limits = None
         windows = {}
         for i, a in enumerate(self.axes):
             st = mm.axes[a]
