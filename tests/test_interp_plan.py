@@ -2,7 +2,8 @@
 16): the plan leaves out a step only where the step's body finds nothing to do. Random programs of
 blocks mixing G, M, F, S, T, D words, expressions, G96/G97, G65/G66 calls, G04/G10/G53, loops and
 vacant variables give the same events, the same alarm and the same state with the plan as with
-every step run for every block."""
+every step run for every block; so does a block the motion step skips as having nothing to move
+(`_still`: M99, M05, T0101 …)."""
 
 from __future__ import annotations
 
@@ -19,8 +20,10 @@ from nc.store import ProgramStore
 COMMON = ["G0", "G1", "G01", "G2 R5.", "G04 P100", "G96", "G97", "G40", "G54", "G55", "G53", "G61", "G64",
           "G80", "G10 L2 P1", "G67", "M3", "M4", "M5", "M8", "M9", "M0", "M19", "M3 M8", "S500", "S#5", "T0101",
           "T2", "D1", "F100", "F#4", "F0", "F-1", "X1.", "X#1", "Z-2.", "Z[#2 + 1]", "X#9", "N10", "B1.",
+          "G03 I1. K0", "G1 X2. ,A30", "G1 ,A45", "G81 Z-1. R1.", "I2.",
           "G65 P9100 A1.", "G66 P9100"]
-WORDS = {"nc5-mill": COMMON + ["G17", "G18", "G90", "G91", "G94", "G95", "Y3.", "G43 H1", "G49"],
+WORDS = {"nc5-mill": COMMON + ["G17", "G18", "G90", "G91", "G94", "G95", "Y3.", "G43 H1", "G49", "G16", "G15",
+                                "G2.4 X1. Y1.", "J1."],
          "nc5-lathe-a": COMMON + ["G18", "G98", "G99", "G50 S2000", "U1.", "W-1.", "G71 U1. R0.5"]}
 
 
@@ -38,9 +41,10 @@ MACRO = "O9100\nG1 X#1 F200\nM99\n"  # what G65 / G66 P9100 call
 
 
 def _run(text: str, profile, everything: bool) -> tuple:
-    plan = execute.plan
-    if everything:
+    plan, still = execute.plan, execute._still
+    if everything:  # every step for every block, and the motion step never skipped as having nothing to do
         execute.plan = lambda shape: execute.ALL_STEPS
+        execute._still = lambda ip, run: False
     try:
         store = ProgramStore()
         store.loaded[9100] = parse_program(MACRO, "O9100")
@@ -53,7 +57,7 @@ def _run(text: str, profile, everything: bool) -> tuple:
             alarm = (exc.alarm.code, exc.alarm.line, exc.alarm.message)
         return events, alarm, repr(ip.state), repr(ip.position), ip.macro_modal
     finally:
-        execute.plan = plan
+        execute.plan, execute._still = plan, still
 
 
 @pytest.mark.parametrize("name", sorted(WORDS))

@@ -17,8 +17,8 @@ from nc.alarms import NcAlarm
 from nc.cycles.codes import lathe_hole_clamp
 from nc.interp import context
 from nc.interp.gcodes import STOP_PREVIEW
-from nc.interp.records import (MAX_M_PER_BLOCK, M_BEFORE_MOTION, M_END, NO_MOTION_FUNCS, REFUSED_UNDER_G68,
-                               TRANSFORM_ARG_FUNCS, _transforms)
+from nc.interp.records import (INCREMENTAL, MAX_M_PER_BLOCK, M_BEFORE_MOTION, M_END, NO_MOTION_FUNCS,
+                               REFUSED_UNDER_G68, TRANSFORM_ARG_FUNCS, _transforms)
 from nc.moves import Aux, Event, Move, ProgramEnd, Sync
 from nc.program.blocks import Block, Word
 
@@ -165,8 +165,33 @@ def step_motion(ip, run: BlockRun) -> Iterator[Event] | None:
     the block's axis words."""
     nonmodal = [fn for grp, fn, _ in run.gcodes if grp == 0]
     if NO_MOTION_FUNCS.isdisjoint(nonmodal) and TRANSFORM_ARG_FUNCS.isdisjoint(run.funcs):
+        if _still(ip, run):
+            return None
         return _moves(ip._motion(run.block, run.funcs), run)
     return None
+
+
+_STILL_FUNCS = frozenset({"G43", "G44", "G49"})  # a length offset change moves Z without an axis word
+
+
+def _still(ip, run: BlockRun) -> bool:
+    """A block `_motion` would find nothing to do in (`M99`, `M05`, `T0101` …; issue 16): no axis,
+    incremental, centre word or ,A, no length offset code, and no modal cycle, pending ,A or G2.4
+    partner or polar mode that a block without axis words still acts on."""
+    st = ip.state
+    if st.cycle is not None or st.polar or ip._angle_pending is not None or ip._three_point is not None \
+            or "A" in run.block.comma or not _STILL_FUNCS.isdisjoint(run.funcs):
+        return False
+    letters = _MOTION_LETTERS.get(ip.axes)
+    if letters is None:
+        letters = _MOTION_LETTERS[ip.axes] = frozenset(ip.axes) | frozenset(INCREMENTAL) | {"I", "J", "K"}
+    for w in run.block.words:
+        if w.letter in letters:
+            return False
+    return True
+
+
+_MOTION_LETTERS: dict[tuple[str, ...], frozenset[str]] = {}
 
 
 def step_m_after(ip, run: BlockRun) -> Iterator[Event]:
