@@ -331,10 +331,11 @@ def cmd_path(args: argparse.Namespace) -> int:
             gc.enable()
         gc.freeze()
         plotted: list[Move] = []
+        write = out.write  # one call a line (print makes two): the same stream, so the order stays
         for ev in interp.run(program, preview=interrupt is None):
             listed = _print_servo(interp, args, listed)
             if type(ev) is MoveBatch:
-                print(batch_json(ev) if args.json else batch_text(ev), file=out)
+                write((batch_json(ev) if args.json else batch_text(ev)) + "\n")
             elif isinstance(ev, Move):
                 if interrupt and ev.line == interrupt[0] and ev.program == program.name \
                         and interp.interrupt_program is not None:
@@ -342,9 +343,9 @@ def cmd_path(args: argparse.Namespace) -> int:
                 if getattr(args, "plot", None):
                     plotted.append(ev)
                 if args.json:
-                    print(move_json(ev), file=out)
+                    write(move_json(ev) + "\n")
                 else:
-                    print(_human(ev, profile.diameter_axes), file=out)
+                    write(_human(ev, profile.diameter_axes) + "\n")
             elif args.preview_log and isinstance(ev, Sync):
                 print(strict_json.dumps(ev.as_dict()) if args.json else f"{ev.line:5d} sync   {ev.reason}", file=out)
     except NcAlarm as exc:
