@@ -140,17 +140,21 @@ class Interpreter(ExecuteMixin, ReadingMixin, ModalMixin, MotionMixin, NonModalM
                 self._interrupt_pending = False
                 yield from self._start_interrupt()
                 continue
-            if fr.pc >= len(fr.program.blocks):
+            blocks = fr.program.blocks
+            if fr.pc >= len(blocks):
                 if len(self.stack) == 1:
                     break
                 self._return(None)  # end of a subprogram without M99 returns like M99
                 continue
-            if bulk is not None and (batch := bulk.take(self, fr, limit)) is not None:
+            # the bulk lane is asked only at a line still held as text (a parsed block, such as a
+            # macro statement, is never the start of a run)
+            if bulk is not None and (plain := getattr(blocks, "plain_at", None)) is not None and plain(fr.pc) \
+                    and (batch := bulk.take(self, fr, limit)) is not None:
                 yield batch  # a run of plain G0/G1 blocks read in one pass (nc.interp.bulk)
                 last = self.block
                 continue
-            last = fr.program.blocks[fr.pc]
-            block = self._take_block(fr, limit)
+            last = blocks[fr.pc]
+            block = self._take_block(fr, limit, last)
             if block is None:
                 continue
             if block.stmt is not None:  # a macro statement: a plain call, no generator (issue 16)
@@ -174,9 +178,11 @@ class Interpreter(ExecuteMixin, ReadingMixin, ModalMixin, MotionMixin, NonModalM
         self._check_no_pending_angle()
         yield ProgramEnd(last.line if last else 0, last.text if last else "", 0)
 
-    def _take_block(self, fr: Frame, limit: int) -> Block | None:
-        """Advance `fr` by one block and count it; None for a skipped '/' block."""
-        block = fr.program.blocks[fr.pc]
+    def _take_block(self, fr: Frame, limit: int, block: Block | None = None) -> Block | None:
+        """Advance `fr` by one block (`block`, when the caller has read it) and count it; None for a
+        skipped '/' block."""
+        if block is None:
+            block = fr.program.blocks[fr.pc]
         fr.pc += 1
         self._executed += 1
         if self._executed > limit:

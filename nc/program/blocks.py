@@ -229,6 +229,10 @@ class BlockList(Sequence):
         for i in range(len(self._lines)):
             yield self[i]
 
+    def plain_at(self, i: int) -> bool:
+        """Whether item i is a plain line not yet parsed (what `raw` returns the text of)."""
+        return self._starts[i] >= 0
+
     def raw(self, i: int) -> str | None:
         """The text of a plain line not yet parsed (`_PLAIN_OK`), else None."""
         start = self._starts[i]
