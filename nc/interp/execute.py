@@ -276,6 +276,13 @@ def plan(shape: Shape) -> tuple[Step, ...]:
     return tuple(step for _, step, when in EXECUTION_ORDER if when(shape))
 
 
+def _one_call(funcs: set[str], mvals: list[int]) -> None:
+    """One call command per block (G65, G66, M98, M96), else 0x024B."""
+    calls = [c for c in ("G65", "G66") if c in funcs] + [f"M{m}" for m in mvals if m in (98, 96)]
+    if len(calls) > 1:
+        raise NcAlarm(0x024B, f"one block can only hold one call command ({' '.join(calls)})")
+
+
 _PLAN_LIMIT = 4096  # blocks whose plan is remembered; then the memo starts over (memory flat)
 
 
@@ -312,8 +319,9 @@ class ExecuteMixin:
         (a loop body runs thousands of times)."""
         memo = self._plans
         hit = memo.get(id(raw)) if raw is not None else None
+        has_m = True  # the block may hold M codes (known not to when its plan is remembered)
         if hit is not None and hit[0] is raw:
-            gcodes, funcs, steps = hit[1], hit[2], hit[3]
+            gcodes, funcs, steps, has_m = hit[1], hit[2], hit[3], hit[4]
             if steps is None:  # the block's own letters are refused: as checked on its values
                 self._check_letters(block, funcs)
                 steps = ALL_STEPS
@@ -331,11 +339,15 @@ class ExecuteMixin:
                     steps = None
                 if len(memo) >= _PLAN_LIMIT:
                     memo.clear()
-                memo[id(raw)] = (raw, gcodes, funcs, steps)
+                memo[id(raw)] = (raw, gcodes, funcs, steps, any(w.letter == "M" for w in raw.words))
                 steps = steps or ALL_STEPS
         if (self.state.rotation or "G68" in funcs) and "G69" not in funcs and funcs & REFUSED_UNDER_G68:
             raise NcAlarm(0x025F, f"{' '.join(sorted(funcs & REFUSED_UNDER_G68))} while G68 rotation is on: "
                                   "cancel it with G69 first")
+        if not has_m:  # no M word: only the G65/G66 pair can break the one-call rule
+            if "G65" in funcs and "G66" in funcs:
+                _one_call(funcs, [])
+            return BlockRun(block, gcodes, funcs, [], self.state.css), steps
         mcodes = block.all("M")
         for w in mcodes:
             if w.value != int(w.value) or not 0 <= w.value <= 65534:
@@ -345,9 +357,7 @@ class ExecuteMixin:
             mvals = []  # the hole cycle's own M_ (clamp at the hole, M+1 at R), not an ordinary M
         if len(mvals) > MAX_M_PER_BLOCK:
             raise NcAlarm(0x0248, f"{len(mvals)} M codes in one block (at most {MAX_M_PER_BLOCK})")
-        calls = [c for c in ("G65", "G66") if c in funcs] + [f"M{m}" for m in mvals if m in (98, 96)]
-        if len(calls) > 1:
-            raise NcAlarm(0x024B, f"one block can only hold one call command ({' '.join(calls)})")
+        _one_call(funcs, mvals)
         if 98 in mvals and len(mvals) > 1:
             raise NcAlarm(0x0249, "M98 must be the only M code of its block")
         return BlockRun(block, gcodes, funcs, mvals, self.state.css), steps
