@@ -130,13 +130,19 @@ class FilterCorners:
         that (nc.motion.shares): a higher jerk reaches the deceleration closer to the corner, so
         the term grows by the kernel's own ratio for the two jerks."""
         b = du_n * acc * self.t2sum / 192.0
-        if jerk > 0.0:
-            key = (acc, jerk)
-            r = self._boost.get(key)
-            if r is None:
-                r = self._boost[key] = max(1.0, self.kd.speed_up(acc, jerk * MAX_FACTOR) / self.kd.speed_up(acc, jerk))
-            b *= r
-        return b
+        return b * self._boost_ratio(acc, jerk) if jerk > 0.0 else b
+
+    def braking_pair(self, du_n: float, acc: float, jerk: float) -> tuple[float, float]:
+        """(braking(du_n, acc), braking(du_n, acc, jerk)) in one call: the shares' scan asks both per junction."""
+        b = du_n * acc * self.t2sum / 192.0
+        return b, b * self._boost_ratio(acc, jerk) if jerk > 0.0 else b
+
+    def _boost_ratio(self, acc: float, jerk: float) -> float:
+        key = (acc, jerk)
+        r = self._boost.get(key)
+        if r is None:
+            r = self._boost[key] = max(1.0, self.kd.speed_up(acc, jerk * MAX_FACTOR) / self.kd.speed_up(acc, jerk))
+        return r
 
     def arc_speed(self, radius: float) -> float:
         """Highest speed on an arc whose filtered radius shrinks by no more than the tolerance.

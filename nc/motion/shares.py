@@ -27,6 +27,7 @@ unknown, unless the channel said none come before a stop: `closed`), leave the s
 from __future__ import annotations
 
 import math
+from bisect import bisect_right
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
@@ -94,6 +95,7 @@ def _scan(fc: "FilterCorners", blocks: Sequence["Block"], pos: float, run_end: f
     lo = pos - reach
     use = 0.0
     hist = fc._hist
+    ends: list[float] | None = None  # the queue's s_end, built once a junction needs its next block
     # FilterCorners keeps every junction since the last stop (its _h0 is relative to the newest
     # push, not to the executing block) and drops old ones only in bulk, counted in _seq0.
     for k in range(len(hist) - 1, -1, -1):
@@ -107,7 +109,11 @@ def _scan(fc: "FilterCorners", blocks: Sequence["Block"], pos: float, run_end: f
             return None
         if j.du_n <= 1e-9:
             continue
-        if j.vbud <= 1e-12 or not _tolerance_free(fc, j, blocks):
+        if j.vbud <= 1e-12:
+            return None
+        if ends is None:
+            ends = [b.s_end for b in blocks]
+        if not _tolerance_free(fc, j, blocks, ends):
             return None
         r = j.vjunc / j.vbud
         if r > use:
@@ -118,7 +124,7 @@ def _scan(fc: "FilterCorners", blocks: Sequence["Block"], pos: float, run_end: f
     return use, seen
 
 
-def _tolerance_free(fc: "FilterCorners", j: "Block", blocks: Sequence["Block"]) -> bool:
+def _tolerance_free(fc: "FilterCorners", j: "Block", blocks: Sequence["Block"], ends: Sequence[float]) -> bool:
     """Whether junction j keeps N1.053 with the raised jerk at the fastest its blocks may pass it.
 
     Its tolerance caps (the kernel windows' vtol, its corner alone vctol) were found with the
@@ -130,16 +136,14 @@ def _tolerance_free(fc: "FilterCorners", j: "Block", blocks: Sequence["Block"]) 
     took the CAM vertices 0.0002–0.0036 mm over N1.053."""
     if fc.tol is None:
         return True
-    cap = j.vtop
-    for b in blocks:  # the next block (its cap is the feed's): one step, it follows j in the queue
-        if b.s_end > j.s_end:
-            cap = max(j.cap, b.cap)
-            break
+    # the next block (its cap is the feed's): one step, it follows j in the queue (`ends`: the queue's
+    # s_end, increasing)
+    k = bisect_right(ends, j.s_end)
+    cap = max(j.cap, blocks[k].cap) if k < len(ends) else j.vtop
     tcap = min(j.vtol, j.vctol)
     if tcap == math.inf:
         return True
     if tcap <= 0.0:
         return False
-    unb = fc.braking(j.du_n, j.a)
-    boosted = fc.braking(j.du_n, j.a, j.j)
+    unb, boosted = fc.braking_pair(j.du_n, j.a, j.j)
     return cap * (fc.tol - unb) / tcap + boosted <= fc.tol
