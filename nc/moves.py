@@ -8,7 +8,7 @@ in diameter mode).
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from typing import Literal, Union
 
 MoveKind = Literal["rapid", "line", "arc", "thread", "dwell"]
@@ -40,6 +40,13 @@ class Move:
     tip: int = 0  # lathe imaginary tool-tip number 0-9
     css: float | None = None  # G96 surface speed (m/min) in effect, None under G97
 
+    def replaced(self, **changes) -> "Move":
+        """`dataclasses.replace(self, **changes)` without its per-call look at the fields (compensation
+        rewrites every move it offsets, issue 16)."""
+        kw = {name: getattr(self, name) for name in _MOVE_FIELDS}
+        kw.update(changes)
+        return Move(**kw)
+
     def as_dict(self) -> dict:
         return {
             "kind": self.kind,
@@ -53,6 +60,9 @@ class Move:
             "feed": self.feed,
             "duration": self.duration,
         }
+
+
+_MOVE_FIELDS = tuple(f.name for f in fields(Move))
 
 
 @dataclass(slots=True)

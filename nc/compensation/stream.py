@@ -89,7 +89,7 @@ class Compensator:
             c = dict(m.center)
             if center is not None:
                 c[a1], c[a2] = center[0] + te[0], center[1] + te[1]
-        return replace(m, start=s, end=e, center=c, tags=tuple(m.tags) + ("comp",))
+        return m.replaced(start=s, end=e, center=c, tags=tuple(m.tags) + ("comp",))
 
     def _corner_move(self, m: Move, arc: Seg) -> Move:
         a1, a2 = m.plane
@@ -115,7 +115,7 @@ class Compensator:
                 for d in (s, e):
                     if a1 in d and a2 in d:
                         d[a1], d[a2] = at[0] + tv[0], at[1] + tv[1]
-                ev = replace(ev, start=s, end=e)
+                ev = ev.replaced(start=s, end=e)
             out.append(ev)
         return out
 
@@ -224,7 +224,7 @@ class Compensator:
                 a1, a2 = m.plane
                 s = dict(m.start)
                 s[a1], s[a2] = start[0] + tv[0], start[1] + tv[1]
-                return [replace(m, start=s, tags=tuple(m.tags) + ("comp", "cancel"))]
+                return [m.replaced(start=s, tags=tuple(m.tags) + ("comp", "cancel"))]
             if self.out_pos is not None and not _moves_in_plane(m) and m.kind != "dwell":
                 return self._fix_held([m], self.out_pos, True)
             return [m]
@@ -248,7 +248,7 @@ class Compensator:
         a1, a2 = m.plane
         s = dict(m.start)
         s[a1], s[a2] = end[0] + tv[0], end[1] + tv[1]
-        out.append(replace(m, start=s, tags=tuple(m.tags) + ("comp", "cancel")))
+        out.append(m.replaced(start=s, tags=tuple(m.tags) + ("comp", "cancel")))
         self.out_pos = None
         return out
 
