@@ -142,8 +142,23 @@ def test_endless_loop_guard_has_its_own_code(capsys, tmp_path) -> None:
     code, objs = path_json(capsys, prog, "--param", "max blocks=5000")
     a = alarm_of(objs)
     assert (code, a["code"], a["program"]) == (1, "0xDE01", "loop.nc")
-    assert a["line"] in (3, 4) and "5000 blocks" in a["message"]
+    assert a["line"] in (2, 3, 4) and "5000 blocks" in a["message"]  # a line of the loop
     assert "Endless-loop" in alarm_name(0xDE01)
+
+
+def test_a_straight_program_longer_than_max_blocks_runs_to_its_end(capsys, tmp_path) -> None:
+    """The guard counts what loops add beyond the program's own blocks: a CAM file of more lines than
+    'max blocks' (1M lines against the default 1,000,000) runs every line once, and a loop in it is
+    still caught (decision P5)."""
+    prog = tmp_path / "cam.nc"
+    prog.write_text("G21 G90\n" + "".join(f"G1 X{i * 0.01:.3f} Y0 F1000\n" for i in range(300)) + "M30\n")
+    code, objs = path_json(capsys, prog, "--profile", "nc5-mill", "--param", "max blocks=100")
+    assert code == 0 and not [o for o in objs if o["kind"] == "alarm"]
+    assert sum(o["kind"] == "line" for o in objs) == 300
+    loop = tmp_path / "loop.nc"
+    loop.write_text("".join(f"G1 X{i * 0.01:.3f} F1000\n" for i in range(300)) + "#1=1\nWHILE[#1GT0]DO1\n#2=#2+1\nEND1\nM30\n")
+    code, objs = path_json(capsys, loop, "--profile", "nc5-mill", "--param", "max blocks=100")
+    assert code == 1 and alarm_of(objs)["code"] == "0xDE01"
 
 
 # ---- P4: program roots --------------------------------------------------------------------------------

@@ -40,7 +40,7 @@ class CallsMixin:
         self.stack.append(Frame(prog, 0, "m96", False, 1))
         self.position.update({a: v for a, v in stopped_at.items() if a in self.position})
         self.last_target = self.work_position()
-        limit = int(self.profile.param("max blocks", 1_000_000))
+        limit = self._block_limit  # the run's guard (Interpreter._run)
         try:
             while len(self.stack) > base:
                 fr = self.stack[-1]

@@ -84,6 +84,7 @@ class Interpreter(ExecuteMixin, ReadingMixin, ModalMixin, MotionMixin, NonModalM
         self.budget: StatementBudget | None = None  # per-cycle statements; set by a channel (decisions B2)
         self.p_scale = 1.0
         self._executed = 0
+        self._block_limit = int(profile.param("max blocks", 1_000_000))  # set per run by _run
         self._call_tables = None  # G/M code-call tables from the parameters (CallsMixin._call_table)
         self._plans: dict[int, tuple] = {}  # id(block) -> (block, G codes, functions, steps, has M) (_read_run)
         self._gcall_depth = 0
@@ -125,7 +126,9 @@ class Interpreter(ExecuteMixin, ReadingMixin, ModalMixin, MotionMixin, NonModalM
             self.store = program.store
         if program.number is not None:
             self.store.loaded.setdefault(program.number, program)
-        limit = int(self.profile.param("max blocks", 1_000_000))
+        # A straight program runs each of its lines once, however long (a 1M-line CAM file); the guard
+        # counts what loops and calls add beyond that (decision P5).
+        limit = self._block_limit = int(self.profile.param("max blocks", 1_000_000)) + len(program.blocks)
         last: Block | None = None
         budget = self.budget
         bulk = None
@@ -186,7 +189,9 @@ class Interpreter(ExecuteMixin, ReadingMixin, ModalMixin, MotionMixin, NonModalM
         fr.pc += 1
         self._executed += 1
         if self._executed > limit:
-            raise NcAlarm(ENDLESS_LOOP, f"more than {limit} blocks executed (endless loop?; parameter 'max blocks')",
+            extra = int(self.profile.param("max blocks", 1_000_000))
+            raise NcAlarm(ENDLESS_LOOP, f"more than {extra} blocks executed beyond the program's own {limit - extra} "
+                                        "blocks (endless loop?; parameter 'max blocks')",
                           line=block.line, block=block.text, program=fr.program.name)
         if block.skip and self.block_skip:
             return None
