@@ -19,6 +19,9 @@ ROOT = Path(__file__).resolve().parent.parent
 BENCH = ROOT / "benches" / "lathe-2axis.toml"
 # about 5 s of simulated time: long enough to watch it stream in lock-step
 PROGRAM = "G98\nM03 S600\nG00 X24. Z2.\nG01 Z-3. F600.\nG04 X4.\nG01 Z2.\nM30\n"
+# ≈ 42 s simulated: long enough in wall time for the page to sample a lock-step run twice while it goes,
+# however fast the cycle runs (a 6 s program ended within a second on a quiet machine)
+LONG_PROGRAM = PROGRAM.replace("G04 X4.", "G04 X40.")
 POINTS = ("return (document.getElementById('scope').data || [])"
           ".reduce((n, d) => n + d.x.length, 0);")
 
@@ -56,7 +59,7 @@ def test_unknown_scope_column_is_bad_usage(tmp_path):
 
 def test_scope_streams_while_lock_step_run_goes(tmp_path):
     driver = chromium_driver()
-    (tmp_path / "p.nc").write_text(PROGRAM)
+    (tmp_path / "p.nc").write_text(LONG_PROGRAM)
     proc = subprocess.Popen([sys.executable, "-m", "hil.cli", "run", str(tmp_path / "p.nc"), "--bench", str(BENCH),
                              "--scope", "--scope-wait", "--scope-linger", "20"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                             text=True, env={**os.environ, "PYTHONPATH": str(ROOT)})
