@@ -41,6 +41,11 @@ def test_packaged_file_holds_three_devices_equal_to_the_catalogue():
         assert d.objects[0x1C12].entries[1].value == m.default_rx and d.objects[0x1C13].entries[1].value == m.default_tx
 
 
+def x_a3e_and_z(z: str) -> str:
+    """A sim bench: X an A3-E named by model, Z as the TOML lines `z` say."""
+    return 'bus = "sim"\n[[axes]]\nname = "X"\ndrive = { model = "asda-a3-e" }\n[[axes]]\nname = "Z"\n' + z
+
+
 def test_resolution_follows_the_named_model(tmp_path):
     """A bench that names a model and no counts_per_rev converts with the model's default resolution (A3-E/B3-E
     24-bit: 16 777 216, A2-E: 1 280 000, decisions E11/E17); an explicit counts_per_rev wins; a bench naming no
@@ -51,18 +56,11 @@ def test_resolution_follows_the_named_model(tmp_path):
     from hil.session import sim_slaves
     from nc.program import parse_program
 
-    bench = parse_bench('''
-bus = "sim"
-[[axes]]
-name = "X"
-drive = { model = "asda-a3-e" }
-[[axes]]
-name = "Z"
-counts_per_rev = 100000
+    bench = parse_bench(x_a3e_and_z('''counts_per_rev = 100000
 drive = { model = "asda-b3-e" }
 [[spindles]]
 drive = { model = "asda-a2-e" }
-''')
+'''))
     assert [a.scaling.counts_per_rev for a in bench.axes] == [16_777_216, 100_000]
     assert bench.spindles[0].scaling.counts_per_rev == 1_280_000
     assert parse_bench('[[axes]]\nname = "X"\n').axes[0].scaling.counts_per_rev == 1_280_000
@@ -80,15 +78,7 @@ def test_drive_defaults_in_counts_follow_the_resolution():
     from hil.bench_file import parse_bench
     from virtual_bus.drive import DriveParams
 
-    bench = parse_bench('''
-bus = "sim"
-[[axes]]
-name = "X"
-drive = { model = "asda-a3-e" }
-[[axes]]
-name = "Z"
-drive = { model = "asda-a3-e", csv_accel = 1.0e7 }
-''')
+    bench = parse_bench(x_a3e_and_z('drive = { model = "asda-a3-e", csv_accel = 1.0e7 }\n'))
     generic, k = DriveParams(), 16_777_216 / 1_280_000
     x, z = bench.axes[0].drive, bench.axes[1].drive
     assert x.csv_accel == pytest.approx(generic.csv_accel * k) and z.csv_accel == 1.0e7
