@@ -98,8 +98,8 @@ def assert_stopped_under_control(tf: TraceFile, moving_at_stop: bool) -> None:
         assert not energised[off:].any()
         assert abs(vel[off]) < 0.01 and abs(vel[off - 1]) < 2.0, (ax.name, vel[off - 1])  # disabled at standstill
         assert np.ptp(c[f"{ax.name}_act"][off:]) < 1e-3  # and nothing moved after
-    if moving_at_stop:  # stopped mid-program (≈ 170 s long), between two of its Z-300 reversals
-        assert tf.arrays(["t"])["t"][-1] < 160.0 and tf.arrays(["Z_cmd"])["Z_cmd"][-1] > -299.0
+    if moving_at_stop:  # stopped mid-program: before the end of its ≈ 170 s (Z passes Z-300 at every reversal,
+        assert tf.arrays(["t"])["t"][-1] < 160.0  # so where Z stood says nothing about the program's end)
 
 
 @pytest.mark.parametrize("reason", list(REASONS))
