@@ -8,7 +8,6 @@ See docs/guide/bench-file.md for the format.
 
 from __future__ import annotations
 
-import math
 import tomllib
 from dataclasses import fields, replace
 from pathlib import Path
@@ -21,7 +20,7 @@ from fieldbus.units import AxisScaling
 from hil.bench_params import check_param
 from hil.bench import AxisConfig, Bench, ChecksConfig, IoStationConfig, RealtimeConfig, SpindleConfig
 from hil.drive_homing import DriveHoming
-from hil.session import InputError
+from hil.toml_fields import BenchFileError, FieldReader, kind_of, read_text_file
 from nc.motion.limits import AxisLimits
 from nc.profiles import PROFILE_NAMES
 from virtual_bus.drive import DriveParams
@@ -45,160 +44,6 @@ def nc5(code: int) -> str:
     return f" (NC5 alarm 0x{code:04X}: {ALARM_TABLE[code][1].rstrip('.')})"
 
 
-class BenchFileError(InputError):
-    """A bench file that cannot be used; `errors` holds one `path: message` per bad field."""
-
-    def __init__(self, source: str, errors: list[str]) -> None:
-        self.errors = errors
-        super().__init__("\n".join(f"{source}: {e}" for e in errors))
-
-
-def _kind(v: Any) -> str:
-    if isinstance(v, bool):
-        return f"{str(v).lower()} (a boolean)"
-    if isinstance(v, dict):
-        return "a table"
-    if isinstance(v, list):
-        return "an array"
-    if isinstance(v, str):
-        return repr(v)
-    return repr(v)
-
-
-class _Reader:
-    """Takes fields out of a TOML table, recording an error per bad field instead of stopping."""
-
-    def __init__(self) -> None:
-        self.errors: list[str] = []
-        self.base = Path(".")  # relative paths in the file (canopen_eds) are relative to the file
-
-    def err(self, path: str, msg: str) -> None:
-        self.errors.append(f"{path}: {msg}")
-
-    def table(self, data: dict, key: str, path: str) -> dict:
-        v = data.pop(key, {})
-        if not isinstance(v, dict):
-            self.err(path, f"must be a table, got {_kind(v)}")
-            return {}
-        return v
-
-    def unknown(self, data: dict, prefix: str, allowed: set[str] | None = None) -> None:
-        for k in data:
-            hint = ""
-            if allowed:
-                close = [a for a in sorted(allowed) if a[:3] == k[:3]]
-                hint = f" (did you mean {close[0]!r}?)" if close else ""
-            self.err(f"{prefix}{k}", f"unknown key{hint}")
-
-    def number(self, data: dict, key: str, path: str, default: float | None, *, positive: bool = False,
-               minimum: float | None = None, maximum: float | None = None) -> float | None:
-        if key not in data:
-            return default
-        v = data.pop(key)
-        if isinstance(v, bool) or not isinstance(v, (int, float)):
-            self.err(path, f"must be a number, got {_kind(v)}")
-            return default
-        v = float(v)
-        if v != v or v in (float("inf"), float("-inf")):
-            self.err(path, f"must be a finite number, got {v}")
-        elif positive and v <= 0:
-            self.err(path, f"must be a positive number, got {v:g}")
-        elif minimum is not None and v < minimum:
-            self.err(path, f"must be at least {minimum:g}, got {v:g}")
-        elif maximum is not None and v > maximum:
-            self.err(path, f"must be at most {maximum:g}, got {v:g}")
-        else:
-            return v
-        return default
-
-    def integer(self, data: dict, key: str, path: str, default: int | None, *, positive: bool = False,
-                choices: tuple[int, ...] | None = None, minimum: int | None = None,
-                maximum: int | None = None) -> int | None:
-        if key not in data:
-            return default
-        v = data.pop(key)
-        what = "a positive integer" if positive else "an integer"
-        if isinstance(v, bool) or not isinstance(v, int):
-            self.err(path, f"must be {what}, got {_kind(v)}")
-        elif positive and v <= 0:
-            self.err(path, f"must be {what}, got {v}")
-        elif choices is not None and v not in choices:
-            self.err(path, f"must be one of {', '.join(map(str, choices))}, got {v}")
-        elif minimum is not None and v < minimum:
-            self.err(path, f"must be at least {minimum}, got {v}")
-        elif maximum is not None and v > maximum:
-            self.err(path, f"must be at most {maximum}, got {v}")
-        else:
-            return v
-        return default
-
-    def string(self, data: dict, key: str, path: str, default: str | None,
-               choices: tuple[str, ...] | None = None) -> str | None:
-        if key not in data:
-            return default
-        v = data.pop(key)
-        if not isinstance(v, str) or not v.strip():
-            self.err(path, f"must be a non-empty string, got {_kind(v)}")
-        elif choices is not None and v not in choices:
-            self.err(path, f"must be one of {', '.join(repr(c) for c in choices)}, got {v!r}")
-        else:
-            return v
-        return default
-
-    def boolean(self, data: dict, key: str, path: str, default: bool) -> bool:
-        if key not in data:
-            return default
-        v = data.pop(key)
-        if not isinstance(v, bool):
-            self.err(path, f"must be true or false, got {_kind(v)}")
-            return default
-        return v
-
-    def eds(self, data: dict, path: str, layout: Any = None, io: tuple[int, int] = (0, 0)) -> str:
-        """`canopen_eds`: a device file resolved against the bench file's folder, parsed and checked
-        for the objects the CANopen master uses on a drive with this PDO `layout` or on an I/O station
-        with `io` = (inputs, outputs) points (fieldbus/canopen/eds_check.py); "" when absent."""
-        v = self.string(data, "canopen_eds", path, None)
-        if v is None:
-            return ""
-        from fieldbus.canopen.eds_check import drive_objects, eds_problem, io_objects
-
-        full = (self.base / Path(v).expanduser()).resolve()
-        problem = eds_problem(full, drive_objects(layout) if layout is not None else io_objects(*io))
-        if problem:
-            self.err(path, problem)
-            return ""
-        return str(full)
-
-    def pair(self, data: dict, key: str, path: str, *, integers: bool, positive: bool) -> tuple | None:
-        if key not in data:
-            return None
-        v = data.pop(key)
-        ok_type = (lambda x: isinstance(x, int) and not isinstance(x, bool)) if integers else \
-            (lambda x: isinstance(x, (int, float)) and not isinstance(x, bool))
-        what = "positive integers" if integers and positive else "numbers"
-        if not isinstance(v, list) or len(v) != 2 or not all(ok_type(x) for x in v):
-            self.err(path, f"must be an array of two {what}, got {_kind(v)}")
-            return None
-        if not all(math.isfinite(x) for x in v):
-            self.err(path, f"must be finite numbers, got {v}")
-            return None
-        if positive and any(x <= 0 for x in v):
-            self.err(path, f"must be an array of two {what}, got {v}")
-            return None
-        return tuple(v)
-
-
-def read_text_file(path: str | Path, error: type[BenchFileError] = BenchFileError) -> str:
-    """A TOML input's text, or `error` naming the file: unreadable, not UTF-8."""
-    try:
-        return Path(path).read_text(encoding="utf-8")
-    except OSError as exc:
-        raise error(str(path), [f"cannot be read: {exc.strerror}"]) from None
-    except UnicodeDecodeError:
-        raise error(str(path), ["is not UTF-8 text"]) from None
-
-
 def load_bench_file(path: str | Path) -> Bench:
     return parse_bench(read_text_file(path), str(path))
 
@@ -208,7 +53,7 @@ def parse_bench(text: str, source: str = "bench.toml") -> Bench:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise BenchFileError(source, [f"not valid TOML: {exc}"]) from None
-    r = _Reader()
+    r = FieldReader()
     r.base = Path(source).parent
     b = Bench(source=source)
     b.name = r.string(data, "name", "name", Path(source).stem) or b.name
@@ -234,7 +79,7 @@ def parse_bench(text: str, source: str = "bench.toml") -> Bench:
     for k, v in params.items():
         where = f"params.{k!r}" if " " in k else f"params.{k}"
         if isinstance(v, bool) or not isinstance(v, (int, float)):
-            r.err(where, f"must be a number, got {_kind(v)}")
+            r.err(where, f"must be a number, got {kind_of(v)}")
         elif (problem := check_param(k, v)) is not None:
             r.err(where, problem)
         else:
@@ -245,7 +90,7 @@ def parse_bench(text: str, source: str = "bench.toml") -> Bench:
         r.err("axes", "missing: a bench needs at least one [[axes]] table")
         axes = []
     elif not isinstance(axes, list) or not all(isinstance(a, dict) for a in axes):
-        r.err("axes", f"must be an array of tables ([[axes]]), got {_kind(axes)}")
+        r.err("axes", f"must be an array of tables ([[axes]]), got {kind_of(axes)}")
         axes = []
     elif not axes:
         r.err("axes", "must list at least one axis")
@@ -259,7 +104,7 @@ def parse_bench(text: str, source: str = "bench.toml") -> Bench:
 
     spindles = data.pop("spindles", [])
     if not isinstance(spindles, list) or not all(isinstance(s, dict) for s in spindles):
-        r.err("spindles", f"must be an array of tables ([[spindles]]), got {_kind(spindles)}")
+        r.err("spindles", f"must be an array of tables ([[spindles]]), got {kind_of(spindles)}")
         spindles = []
     for i, s in enumerate(spindles):
         sp = _spindle(r, dict(s), f"spindles[{i}]")
@@ -285,7 +130,7 @@ def parse_bench(text: str, source: str = "bench.toml") -> Bench:
     return b
 
 
-def _scaling(r: _Reader, d: dict, p: str, default_lead: float) -> AxisScaling:
+def _scaling(r: FieldReader, d: dict, p: str, default_lead: float) -> AxisScaling:
     base = AxisScaling()
     cpr = r.integer(d, "counts_per_rev", f"{p}.counts_per_rev", base.counts_per_rev, positive=True,
                     maximum=2**31 - 1)  # CiA 402 position is a signed 32-bit count
@@ -323,12 +168,12 @@ def _given(d: dict) -> set[str]:
     return set(table) if isinstance(table, dict) else set()
 
 
-def _drive(r: _Reader, d: Any, p: str, base: DriveParams) -> tuple[DriveParams, str, str, int | None]:
+def _drive(r: FieldReader, d: Any, p: str, base: DriveParams) -> tuple[DriveParams, str, str, int | None]:
     """The drive table: tuning, `model` (fieldbus.devices.MODELS), `esi` (a vendor ESI file the
     virtual EtherCAT slave is built from instead of the packaged one; the model's product code picks
     the device in it) and `alias` (the EtherCAT station alias the slave must have, App. A 0x1416)."""
     if not isinstance(d, dict):
-        r.err(p, f"must be a table, got {_kind(d)}")
+        r.err(p, f"must be a table, got {kind_of(d)}")
         return base, DEFAULT_MODEL, "", None
     d = dict(d)
     alias = r.integer(d, "alias", f"{p}.alias", None, minimum=0, maximum=0xFFFF)
@@ -362,7 +207,7 @@ def _drive(r: _Reader, d: Any, p: str, base: DriveParams) -> tuple[DriveParams, 
     return DriveParams(**kw), model, esi, alias
 
 
-def _axis(r: _Reader, d: dict, p: str) -> AxisConfig | None:
+def _axis(r: FieldReader, d: dict, p: str) -> AxisConfig | None:
     if "name" not in d:
         r.err(f"{p}.name", "missing: every axis needs a name (X, Y, Z, C ...)")
     name = r.string(d, "name", f"{p}.name", None)
@@ -406,7 +251,7 @@ def _axis(r: _Reader, d: dict, p: str) -> AxisConfig | None:
                       canopen_eds=eds, drive_esi=esi, homing=homing, station_alias=alias)
 
 
-def _homing(r: _Reader, d: dict, p: str) -> DriveHoming | None:
+def _homing(r: FieldReader, d: dict, p: str) -> DriveHoming | None:
     """An axis's `homing` table: drive homing (CiA 402 mode 6) before every program (hil/drive_homing.py)."""
     if "homing" not in d:
         return None
@@ -428,7 +273,7 @@ def _homing(r: _Reader, d: dict, p: str) -> DriveHoming | None:
     return out if method is not None else None
 
 
-def _spindle(r: _Reader, d: dict, p: str) -> SpindleConfig | None:
+def _spindle(r: FieldReader, d: dict, p: str) -> SpindleConfig | None:
     base = SpindleConfig()
     name = r.string(d, "name", f"{p}.name", "S1") or "S1"
     if not (name[0] == "S" and name[1:].isdigit()):
@@ -450,7 +295,7 @@ def _spindle(r: _Reader, d: dict, p: str) -> SpindleConfig | None:
                          drive_esi=esi, station_alias=alias)
 
 
-def _realtime(r: _Reader, d: dict) -> RealtimeConfig:
+def _realtime(r: FieldReader, d: dict) -> RealtimeConfig:
     base = RealtimeConfig()
     d = dict(d)
     rt = RealtimeConfig(
@@ -464,7 +309,7 @@ def _realtime(r: _Reader, d: dict) -> RealtimeConfig:
     return rt
 
 
-def _checks(r: _Reader, d: dict, axes: tuple[str, ...]) -> ChecksConfig:
+def _checks(r: FieldReader, d: dict, axes: tuple[str, ...]) -> ChecksConfig:
     d = dict(d)
     c = ChecksConfig()
     if "max_following_error" in d:
@@ -475,13 +320,13 @@ def _checks(r: _Reader, d: dict, axes: tuple[str, ...]) -> ChecksConfig:
                 if axis not in axes:
                     r.err(pth, f"no axis {axis!r} on this bench (axes: {', '.join(axes)})")
                 elif isinstance(lim, bool) or not isinstance(lim, (int, float)) or lim <= 0:
-                    r.err(pth, f"must be a positive number of mm, got {_kind(lim)}")
+                    r.err(pth, f"must be a positive number of mm, got {kind_of(lim)}")
                 else:
                     c.max_following_error[axis] = float(lim)
         elif isinstance(v, (int, float)) and not isinstance(v, bool) and v > 0:
             c.max_following_error = {a: float(v) for a in axes}
         else:
-            r.err("checks.max_following_error", f"must be a positive number of mm or a table axis = mm, got {_kind(v)}")
+            r.err("checks.max_following_error", f"must be a positive number of mm or a table axis = mm, got {kind_of(v)}")
     c.contour_error = r.number(d, "contour_error", "checks.contour_error", None, positive=True)
     c.limits = r.boolean(d, "limits", "checks.limits", False)
     c.limit_tolerance = r.number(d, "limit_tolerance", "checks.limit_tolerance", c.limit_tolerance, minimum=0.0,
@@ -498,7 +343,7 @@ def _checks(r: _Reader, d: dict, axes: tuple[str, ...]) -> ChecksConfig:
 _IO_KEYS = {"name", "inputs", "outputs", "x", "y", "canopen_node", "canopen_tpdo", "modules", "canopen_eds"}
 
 
-def _io_modules(r: _Reader, d: dict, p: str, points_max: int) -> tuple[str, ...] | None:
+def _io_modules(r: FieldReader, d: dict, p: str, points_max: int) -> tuple[str, ...] | None:
     """`modules`: an R1-EC station's modules in slot order (DI8/16/32, DO8/16/32); () when absent,
     None when the list is bad (errors recorded)."""
     from fieldbus.ethercat.r1ec_modules import MODULES, points
@@ -507,7 +352,7 @@ def _io_modules(r: _Reader, d: dict, p: str, points_max: int) -> tuple[str, ...]
         return ()
     raw = d.pop("modules")
     if not isinstance(raw, list) or not raw:
-        r.err(f"{p}.modules", f"must be a non-empty list of module names like [\"DI16\", \"DO16\"], got {_kind(raw)}")
+        r.err(f"{p}.modules", f"must be a non-empty list of module names like [\"DI16\", \"DO16\"], got {kind_of(raw)}")
         return None
     mods = []
     for i, m in enumerate(raw):
@@ -525,13 +370,13 @@ def _io_modules(r: _Reader, d: dict, p: str, points_max: int) -> tuple[str, ...]
     return tuple(mods)
 
 
-def _io_stations(r: _Reader, stations: Any, n_drives: int) -> list[IoStationConfig]:
+def _io_stations(r: FieldReader, stations: Any, n_drives: int) -> list[IoStationConfig]:
     """[[io]]: remote I/O stations in EIO order (node 501, 502, …); see mlc/remote_io.py."""
     from mlc.remote_io import POINTS_MAX, STATIONS_MAX, IoMap, next_block, overlaps
     from mlc.memory import XY_SIZE
 
     if not isinstance(stations, list) or not all(isinstance(s, dict) for s in stations):
-        r.err("io", f"must be an array of tables ([[io]]), got {_kind(stations)}")
+        r.err("io", f"must be an array of tables ([[io]]), got {kind_of(stations)}")
         return []
     if len(stations) > STATIONS_MAX:
         r.err("io", f"at most {STATIONS_MAX} stations (EIO nodes 501–520), got {len(stations)}")

@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from hil.bench_file import BenchFileError, _Reader, read_text_file  # one field reader for every TOML input we take
+from hil.toml_fields import BenchFileError, FieldReader, read_text_file  # one field reader for every TOML input we take
 from hil.session import InputError
 
 BUSES = ("sim", "canopen:virtual")  # lock-step, in-process: what a worker can run with no hardware
@@ -88,7 +88,7 @@ def load_campaign(path: str | Path) -> Campaign:
 
 
 def parse_campaign(data: dict[str, Any], source: Path) -> Campaign:
-    r = _Reader()
+    r = FieldReader()
     root = source.parent
     c = Campaign(source=source, name=source.stem)
     top = r.table(data, "campaign", "campaign")
@@ -149,7 +149,7 @@ def parse_campaign(data: dict[str, Any], source: Path) -> Campaign:
     return c
 
 
-def _paths(r: _Reader, data: dict, key: str, path: str, root: Path, *, required: bool,
+def _paths(r: FieldReader, data: dict, key: str, path: str, root: Path, *, required: bool,
            dirs: bool = False) -> list[Path]:
     """A list of paths or globs, each of which must match something."""
     v = data.pop(key, None)
@@ -173,7 +173,7 @@ def _paths(r: _Reader, data: dict, key: str, path: str, root: Path, *, required:
     return out
 
 
-def _strings(r: _Reader, data: dict, key: str, path: str, default: list[str], choices: tuple[str, ...]) -> list[str]:
+def _strings(r: FieldReader, data: dict, key: str, path: str, default: list[str], choices: tuple[str, ...]) -> list[str]:
     v = data.pop(key, None)
     if v is None:
         return default
@@ -186,7 +186,7 @@ def _strings(r: _Reader, data: dict, key: str, path: str, default: list[str], ch
     return [x for x in v if x in choices]
 
 
-def _percents(r: _Reader, data: dict, key: str, path: str, low: float, high: float) -> list[float]:
+def _percents(r: FieldReader, data: dict, key: str, path: str, low: float, high: float) -> list[float]:
     """Override percentages, within the range the MLC's override registers take."""
     v = data.pop(key, None)
     if v is None:
@@ -203,7 +203,7 @@ def _percents(r: _Reader, data: dict, key: str, path: str, low: float, high: flo
     return out or [100.0]
 
 
-def _sweeps(r: _Reader, table: dict) -> dict[str, list[float]]:
+def _sweeps(r: FieldReader, table: dict) -> dict[str, list[float]]:
     """[params]: NC parameter name → list of values (a single number is a one-value sweep)."""
     out: dict[str, list[float]] = {}
     for name, v in table.items():
@@ -218,7 +218,7 @@ def _sweeps(r: _Reader, table: dict) -> dict[str, list[float]]:
     return out
 
 
-def _faults(r: _Reader, table: dict) -> dict[str, tuple[str, ...]]:
+def _faults(r: FieldReader, table: dict) -> dict[str, tuple[str, ...]]:
     """[faults]: name → the events (`hil run --at` grammar) that inject it; each event is checked
     against every bench's axes and MLC when the cases are built (variant.apply_variant)."""
     out: dict[str, tuple[str, ...]] = {}
@@ -235,7 +235,7 @@ def _faults(r: _Reader, table: dict) -> dict[str, tuple[str, ...]]:
     return out
 
 
-def _case(r: _Reader, item: dict, path: str, root: Path, faults: dict[str, tuple[str, ...]]) -> Case | None:
+def _case(r: FieldReader, item: dict, path: str, root: Path, faults: dict[str, tuple[str, ...]]) -> Case | None:
     n_err = len(r.errors)
     prog = _one_path(r, item, "program", f"{path}.program", root)
     bench = _one_path(r, item, "bench", f"{path}.bench", root)
@@ -258,7 +258,7 @@ def _case(r: _Reader, item: dict, path: str, root: Path, faults: dict[str, tuple
                 faults.get(fault, ()))
 
 
-def _one_path(r: _Reader, item: dict, key: str, path: str, root: Path) -> Path | None:
+def _one_path(r: FieldReader, item: dict, key: str, path: str, root: Path) -> Path | None:
     v = r.string(item, key, path, None)
     if v is None:
         r.err(path, "missing")
@@ -270,7 +270,7 @@ def _one_path(r: _Reader, item: dict, key: str, path: str, root: Path) -> Path |
     return p
 
 
-def _check_benches(r: _Reader, c: Campaign) -> None:
+def _check_benches(r: FieldReader, c: Campaign) -> None:
     """Each bench must load, take the campaign's [checks] and [params], and carry its own files."""
     from hil.campaign.inputs import bench_files
     from hil.campaign.variant import apply_variant

@@ -7,7 +7,8 @@ import json
 from typing import Any
 
 from hil.bench import Bench
-from hil.bench_file import BenchFileError, _checks, _Reader, parse_bench
+from hil.bench_file import _checks, parse_bench
+from hil.toml_fields import BenchFileError, FieldReader
 from hil.campaign.spec import Case
 
 
@@ -23,7 +24,7 @@ def apply_variant(text: str, source: str, case: Case | Any, checks: dict[str, An
     if isinstance(checks, str):
         checks = json.loads(checks) if checks else None
     if checks is not None:
-        r = _Reader()
+        r = FieldReader()
         bench.checks = _checks(r, checks, tuple(bench.axis_names))
         if r.errors:
             raise BenchFileError(f"{source} with the campaign's [checks]", r.errors)
