@@ -20,8 +20,6 @@ import logging
 import threading
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any
 
 import can
@@ -29,11 +27,12 @@ import canopen
 from canopen.sdo.exceptions import SdoAbortedError, SdoCommunicationError
 
 from fieldbus.canopen.budget import DEFAULT_BITRATE, BusLoad, bus_load, check_budget
-from fieldbus.canopen.emcy import ALARM_COMMUNICATION, ALARM_PDO_MAPPING, Emcy, emcy_alarm
+from fieldbus.canopen.emcy import ALARM_COMMUNICATION, ALARM_PDO_MAPPING, Emcy
 from fieldbus.canopen.lockstep import LockstepNetwork
 from fieldbus.canopen.netns import check_multicast_allowed
+from fieldbus.canopen.nodes import (FaultEpisode, IoNode, IoNodeConfig, Node, NodeConfig, fault_episodes,
+                                    interpolation_period)
 from fieldbus.canopen.objects import ASDA_B3_EDS, DIO_EDS, MAX_PDOS, frame_layouts
-from fieldbus.cia402 import SW_FAULT
 from fieldbus.link import BusError, SlaveInfo
 from fieldbus.pdo import ASDA_CSP, ASDA_CSP_CSV, PdoLayout, RxPdo, TxPdo
 from nc.alarms import Alarm
@@ -51,76 +50,6 @@ CIA401_DEVICE_PROFILE = 401  # generic I/O modules (remote I/O stations)
 ALARM_EIO_FAILED = 0x1426  # the system remote module (EIO) failed
 ALARM_EIO_MISMATCH = 0x142E  # the EIO connection device type does not match the settings
 _channels = itertools.count(1)
-
-
-@dataclass
-class NodeConfig:
-    node_id: int
-    name: str  # axis or spindle name
-    layout: PdoLayout
-    eds: str | Path = ASDA_B3_EDS  # EDS or DCF of the device
-
-
-@dataclass
-class IoNodeConfig:
-    """A CiA 401 remote I/O station (mlc/remote_io.py): `inputs` / `outputs` digital points, inputs sent
-    on every SYNC (`tpdo="sync"`) or on change of state (`"change"`)."""
-
-    node_id: int
-    name: str
-    inputs: int = 16
-    outputs: int = 16
-    tpdo: str = "sync"
-    eds: str | Path = ""  # default: fieldbus/canopen/eds/delta_dio_401.eds
-
-
-@dataclass
-class _IoNode:
-    cfg: IoNodeConfig
-    remote: canopen.RemoteNode
-    inputs: int = 0  # from the last TPDO
-    outputs: int = 0  # what the next RPDO carries
-    received: bool = False
-    nmt_state: int | None = None
-    last_heartbeat: float = 0.0
-    lost: bool = False
-    tpdo_misses: int = 0
-
-
-@dataclass
-class _Node:
-    cfg: NodeConfig
-    remote: canopen.RemoteNode
-    rx_frames: list[PdoLayout]
-    tx_frames: list[PdoLayout]
-    tx: TxPdo = field(default_factory=TxPdo)
-    tx_cobs: dict[int, PdoLayout] = field(default_factory=dict)
-    received: set[int] = field(default_factory=set)
-    nmt_state: int | None = None
-    last_heartbeat: float = 0.0
-    lost: bool = False
-    tpdo_misses: int = 0
-    fault: "FaultEpisode | None" = None  # the fault being reported, until the drive is reset
-
-
-@dataclass
-class FaultEpisode:
-    """One drive fault from its first sign (EMCY or statusword fault bit) to its reset (the fault bit
-    falling): the NC raises one alarm for it. `reported_by` says which path raised it: "EMCY" (the
-    link, with the EMCY's code) or "statusword" (the CiA 402 master in the runner, with 0x603F)."""
-
-    reported_by: str
-    emcys: list[Emcy] = field(default_factory=list)  # every EMCY of the episode, the first one raised
-    fault_bit_seen: bool = False
-
-
-def interpolation_period(cycle: float) -> tuple[int, int]:
-    """0x60C2: the cycle as value (sub 1, 1-255) × 10^index s (sub 2)."""
-    for index in range(-3, -7, -1):
-        value = cycle / 10.0 ** index
-        if abs(value - round(value)) < 1e-6 and 1 <= round(value) <= 255:
-            return int(round(value)), index
-    raise ValueError(f"cycle {cycle * 1000:g} ms cannot be written as 0x60C2 (1-255 × 10^-3..-6 s)")
 
 
 class CanopenLink:
@@ -163,11 +92,11 @@ class CanopenLink:
         self.cycles = 0
         self.infos: list[SlaveInfo] = []
         self.found: list[int] = []
-        self._nodes: list[_Node] = []
-        self._io: list[_IoNode] = []
+        self._nodes: list[Node] = []
+        self._io: list[IoNode] = []
         self._opened = False
         self._lock = threading.Condition()
-        self._emcys: list[tuple[_Node, Emcy]] = []
+        self._emcys: list[tuple[Node, Emcy]] = []
         self.faults: list[tuple[str, FaultEpisode]] = []  # (drive, episode) in the order they began
         self._next_sync = 0.0
         self._opened_at = 0.0
@@ -226,12 +155,12 @@ class CanopenLink:
             remote = canopen.RemoteNode(cfg.node_id, canopen.import_od(str(cfg.eds), cfg.node_id))
             net.add_node(remote)
             rx, tx = frame_layouts(cfg.layout)
-            node = _Node(cfg, remote, rx, tx)
+            node = Node(cfg, remote, rx, tx)
             self._nodes.append(node)
             net.subscribe(0x700 + cfg.node_id, self._heartbeat_cb(node))
             net.subscribe(0x80 + cfg.node_id, self._emcy_cb(node))
         for icfg in self.io_cfg:
-            io = _IoNode(icfg, canopen.RemoteNode(icfg.node_id, canopen.import_od(str(icfg.eds or DIO_EDS),
+            io = IoNode(icfg, canopen.RemoteNode(icfg.node_id, canopen.import_od(str(icfg.eds or DIO_EDS),
                                                                                   icfg.node_id)))
             net.add_node(io.remote)
             self._io.append(io)
@@ -283,20 +212,20 @@ class CanopenLink:
             n.remote.nmt.send_command(code)
         log.info("NMT %s sent to nodes %s", name, [n.cfg.node_id for n in self._nodes + self._io])
 
-    def _identity(self, n: _Node | _IoNode) -> tuple[int, int, int]:
+    def _identity(self, n: Node | IoNode) -> tuple[int, int, int]:
         """Device type (0x1000), vendor and product code (0x1018) of a node, over SDO."""
         sdo = n.remote.sdo
         return (self._sdo(n, lambda: sdo[0x1000].raw, 0x1000), self._sdo(n, lambda: sdo[0x1018][1].raw, 0x1018),
                 self._sdo(n, lambda: sdo[0x1018][2].raw, 0x1018))
 
-    def _identify(self, pos: int, n: _Node) -> SlaveInfo:
+    def _identify(self, pos: int, n: Node) -> SlaveInfo:
         device_type, vendor, product = self._identity(n)
         if device_type & 0xFFFF != CIA402_DEVICE_PROFILE:
             self._fail(Alarm(ALARM_PDO_MAPPING, f"{self._label(n)} is not a CiA 402 drive "
                              f"(device type 0x{device_type:08X})", axis=n.cfg.name))
         return SlaveInfo(pos, n.cfg.name, "drive", vendor, product, "PRE-OPERATIONAL", n.cfg.layout.name)
 
-    def _configure(self, n: _Node) -> None:
+    def _configure(self, n: Node) -> None:
         sdo, nid = n.remote.sdo, n.cfg.node_id
         value, index = self.ip_period
         self._sdo(n, lambda: setattr(sdo[0x60C2][1], "raw", value), 0x60C2)
@@ -324,14 +253,14 @@ class CanopenLink:
             self.network.subscribe(cob, self._tpdo_cb(n))
 
     # ---- remote I/O stations (CiA 401) ------------------------------------------------------------
-    def _identify_io(self, pos: int, n: _IoNode) -> SlaveInfo:
+    def _identify_io(self, pos: int, n: IoNode) -> SlaveInfo:
         device_type, vendor, product = self._identity(n)
         if device_type & 0xFFFF != CIA401_DEVICE_PROFILE:
             self._fail(Alarm(ALARM_EIO_MISMATCH, f"{self._label(n)} is not a CiA 401 I/O station "
                              f"(device type 0x{device_type:08X})"))
         return SlaveInfo(pos, n.cfg.name, "io", vendor, product, "PRE-OPERATIONAL", "cia401")
 
-    def _configure_io(self, n: _IoNode) -> None:
+    def _configure_io(self, n: IoNode) -> None:
         """Heartbeat, TPDO1 = the input bytes (0x6000:1…), RPDO1 = the output bytes (0x6200:1…); the
         other PDOs off. Outputs act on SYNC; inputs come on SYNC or on change (`cfg.tpdo`)."""
         sdo, nid, cfg = n.remote.sdo, n.cfg.node_id, n.cfg
@@ -354,7 +283,7 @@ class CanopenLink:
             self.network.unsubscribe(0x180 + nid)
             self.network.subscribe(0x180 + nid, self._io_tpdo_cb(n))
 
-    def _io_tpdo_cb(self, n: _IoNode) -> Callable[[int, bytes, float], None]:
+    def _io_tpdo_cb(self, n: IoNode) -> Callable[[int, bytes, float], None]:
         def cb(can_id: int, data: bytes, timestamp: float) -> None:
             with self._lock:
                 n.inputs = int.from_bytes(bytes(data), "little") & ((1 << n.cfg.inputs) - 1)
@@ -378,7 +307,7 @@ class CanopenLink:
         if k < len(self._io):
             self._io[k].outputs = value & ((1 << self._io[k].cfg.outputs) - 1)
 
-    def _sdo(self, n: _Node, op: Callable[[], Any], index: int, what: str = "") -> Any:
+    def _sdo(self, n: Node, op: Callable[[], Any], index: int, what: str = "") -> Any:
         try:
             return op()
         except SdoAbortedError as exc:
@@ -394,7 +323,7 @@ class CanopenLink:
         raise BusError(alarm)
 
     # ---- receive callbacks (the Notifier thread in real time) -----------------------------
-    def _heartbeat_cb(self, n: _Node) -> Callable[[int, bytes, float], None]:
+    def _heartbeat_cb(self, n: Node) -> Callable[[int, bytes, float], None]:
         def cb(can_id: int, data: bytes, timestamp: float) -> None:
             with self._lock:
                 n.nmt_state = data[0] & 0x7F if data else None
@@ -402,13 +331,13 @@ class CanopenLink:
                 self._lock.notify_all()
         return cb
 
-    def _emcy_cb(self, n: _Node) -> Callable[[int, bytes, float], None]:
+    def _emcy_cb(self, n: Node) -> Callable[[int, bytes, float], None]:
         def cb(can_id: int, data: bytes, timestamp: float) -> None:
             with self._lock:
                 self._emcys.append((n, Emcy.decode(data)))
         return cb
 
-    def _tpdo_cb(self, n: _Node) -> Callable[[int, bytes, float], None]:
+    def _tpdo_cb(self, n: Node) -> Callable[[int, bytes, float], None]:
         def cb(can_id: int, data: bytes, timestamp: float) -> None:
             frame = n.tx_cobs[can_id]
             if len(data) < frame.tx_bytes:
@@ -471,40 +400,8 @@ class CanopenLink:
         self._supervise(emcys)
         return out
 
-    def _fault_episodes(self, emcys: list[tuple[_Node, Emcy]]) -> Alarm | None:
-        """One alarm per drive fault, whichever of its two signs comes first. An EMCY opens an episode
-        and is the alarm (it carries the drive's error code and Delta alarm number); a statusword fault
-        bit without an EMCY before it opens one that the CiA 402 master raises from 0x603F. Later EMCYs
-        of the same episode are kept in `faults` but raise nothing; the episode ends when the fault
-        bit falls (fault reset), or at EMCY 0x0000 (error reset) if the fault bit never rose."""
-        alarm = None
-        for n, emcy in emcys:
-            if emcy.code == 0x0000:
-                if n.fault is not None and not n.fault.fault_bit_seen:
-                    n.fault = None
-                continue
-            if n.fault is not None:
-                n.fault.emcys.append(emcy)
-                log.info("EMCY 0x%04X from %s belongs to the fault already reported by %s", emcy.code,
-                         self._label(n), n.fault.reported_by)
-                continue
-            n.fault = FaultEpisode("EMCY", [emcy])
-            self.faults.append((n.cfg.name, n.fault))
-            alarm = alarm or emcy_alarm(emcy, n.cfg.node_id, n.cfg.name)
-        for n in self._nodes:
-            faulted = bool(n.tx.statusword & SW_FAULT) and not n.lost
-            if faulted and n.fault is None:
-                n.fault = FaultEpisode("statusword")
-                self.faults.append((n.cfg.name, n.fault))
-            if n.fault is not None:
-                if faulted:
-                    n.fault.fault_bit_seen = True
-                elif n.fault.fault_bit_seen:
-                    n.fault = None  # reset: the next fault is a new episode
-        return alarm
-
-    def _supervise(self, emcys: list[tuple[_Node, Emcy]]) -> None:
-        alarm = self._fault_episodes(emcys)
+    def _supervise(self, emcys: list[tuple[Node, Emcy]]) -> None:
+        alarm = fault_episodes(self._nodes, emcys, self.faults, self._label)
         now = self._now()
         for n in self._nodes:
             if n.lost:
@@ -536,7 +433,7 @@ class CanopenLink:
         if alarm is not None:
             raise BusError(alarm)
 
-    def _lose(self, n: _Node) -> None:
+    def _lose(self, n: Node) -> None:
         """A lost node reads 'not ready to switch on' and is no longer served or supervised."""
         n.lost = True
         n.tx = TxPdo(position_actual=n.tx.position_actual, error_code=n.tx.error_code)
@@ -581,7 +478,7 @@ class CanopenLink:
         return f"canopen:{self.interface}" + (f":{self.channel}" if self.channel else "")
 
     @staticmethod
-    def _label(n: _Node) -> str:
+    def _label(n: Node) -> str:
         return f"node {n.cfg.node_id} ({n.cfg.name})"
 
     @property
