@@ -10,6 +10,7 @@ Usage: python benchmarks/bench_ecat_slaves.py [FRAMES] [ROUNDS]
 
 from __future__ import annotations
 
+import argparse
 import struct
 import sys
 import time
@@ -17,7 +18,7 @@ import time
 from fieldbus.cia402 import State
 from hil.bench import default_lathe
 from hil.commands.sim import build_chain
-from virtual_bus.ethercat import esc as E
+from virtual_bus.ethercat import registers as E
 
 RX_BYTES, TX_BYTES = 12, 22  # the ESI default mapping: 0x1600 (6040 607A 60FF 60B8), 0x1A01 (…)
 
@@ -81,9 +82,12 @@ def cycle_frames(chain, frames: int) -> float:
     return cpu
 
 
-def main(args: list[str]) -> None:
-    frames = int(args[0]) if args else 3000
-    rounds = int(args[1]) if len(args) > 1 else 5
+def main(argv: list[str]) -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("frames", nargs="?", type=int, default=3000, help="frames a round (default 3000)")
+    ap.add_argument("rounds", nargs="?", type=int, default=5, help="rounds, the best is printed (default 5)")
+    args = ap.parse_args(argv)
+    frames, rounds = args.frames, args.rounds
     best = min(cycle_frames(build_chain(default_lathe()), frames) for _ in range(rounds))
     print(f"virtual slaves in-process ({len(default_lathe().axes) + len(default_lathe().spindles)} drives, LRW + FRMW a frame): {best / frames * 1e6:.1f} µs CPU "
           f"per process-data frame (best of {rounds} rounds of {frames} frames), "

@@ -14,7 +14,8 @@ from pathlib import Path
 import pytest
 
 from fieldbus.devices import MODELS
-from fieldbus.ethercat.link import EthercatLink, mapping_sdos
+from fieldbus.ethercat.link import EthercatLink
+from fieldbus.ethercat.pdo_mapping import mapping_sdos
 from fieldbus.pdo import ASDA_E
 from virtual_bus.ethercat.device import load_device, parse_devices
 from virtual_bus.ethercat.veth import SimProcess, can_create

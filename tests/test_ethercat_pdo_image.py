@@ -9,7 +9,7 @@ import struct
 
 from hil.bench import default_lathe
 from hil.commands.sim import build_chain
-from virtual_bus.ethercat import esc as E
+from virtual_bus.ethercat import registers as E
 from virtual_bus.ethercat.pdo_image import PdoImage, pack_generic, unpack_generic
 
 from tests.test_ethercat_slave import address, send, to_preop

@@ -8,7 +8,7 @@ import pytest
 
 from hil.bench import default_lathe
 from hil.commands.sim import build_chain
-from virtual_bus.ethercat import esc as E
+from virtual_bus.ethercat import registers as E
 from virtual_bus.ethercat.coe import ABORT_NO_OBJECT, ABORT_READ_ONLY, ABORT_STATE, COE_SDO_INFO
 from virtual_bus.ethercat.device import load_device
 from virtual_bus.ethercat.faults import parse_fault

@@ -18,6 +18,7 @@ from dataclasses import dataclass, field
 import pysoem
 
 from fieldbus.ethercat import alarms as A
+from fieldbus.ethercat.pdo_mapping import mapping_sdos, mapping_sdos_complete
 from fieldbus.link import BusError, LinkStatus, SlaveInfo
 from fieldbus.cia402 import SW_FAULT
 from fieldbus.pdo import ASDA_E, LAYOUTS, PdoLayout, RxPdo, TxPdo
@@ -39,33 +40,6 @@ class SdoAbort(Exception):
 def state_name(state: int) -> str:
     base = STATE_NAMES.get(state & 0x0F, f"0x{state & 0x0F:X}")
     return base + ("+ERR" if state & 0x10 else "")
-
-
-def mapping_sdos(layout: PdoLayout) -> list[tuple[int, int, bytes]]:
-    """The SDO writes (index, subindex, data) that configure `layout` entry by entry, as LinuxCNC
-    (IgH) does and every CoE slave takes (ETG.1000.6 5.6.7.4.9): assignment off, mapping count 0,
-    each entry, the count, then the PDO assigned and the assignment on."""
-    out = []
-    for assign, pdo, entries in ((0x1C12, layout.rx_index, layout.rx), (0x1C13, layout.tx_index, layout.tx)):
-        out.append((assign, 0, b"\x00"))
-        out.append((pdo, 0, b"\x00"))
-        out += [(pdo, k, struct.pack("<I", e.index << 16 | e.subindex << 8 | e.bits)) for k, e in enumerate(entries, 1)]
-        out.append((pdo, 0, bytes([len(entries)])))
-        out.append((assign, 1, struct.pack("<H", pdo)))
-        out.append((assign, 0, b"\x01"))
-    return out
-
-
-def mapping_sdos_complete(layout: PdoLayout) -> list[tuple[int, int, bytes]]:
-    """The same configuration in three complete-access writes per direction (faster on a line of many
-    drives); a drive that refuses complete access gets `mapping_sdos` instead."""
-    out = []
-    for assign, pdo, entries in ((0x1C12, layout.rx_index, layout.rx), (0x1C13, layout.tx_index, layout.tx)):
-        words = [e.index << 16 | e.subindex << 8 | e.bits for e in entries]
-        out.append((assign, 0, struct.pack("<BxH", 0, 0)))
-        out.append((pdo, 0, struct.pack("<Bx" + "I" * len(words), len(words), *words)))
-        out.append((assign, 0, struct.pack("<BxH", 1, pdo)))
-    return out
 
 
 @dataclass

@@ -13,8 +13,9 @@ import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
-from virtual_bus.ethercat.esc import (APRD, APRW, APWR, ARMW, BRD, BRW, BWR, FPRD, FPRW, FPWR, FRMW, LRD, LRW,
-                                      LWR, R_AL_CODE, R_STATION, Esc)
+from virtual_bus.ethercat.esc import Esc
+from virtual_bus.ethercat.registers import (APRD, APRW, APWR, ARMW, BRD, BRW, BWR, FPRD, FPRW, FPWR, FRMW, LRD, LRW,
+                                            LWR, R_AL_CODE, R_STATION)
 from virtual_bus.ethercat.faults import Fault
 
 ETH_P_ECAT = 0x88A4
