@@ -13,7 +13,7 @@ from collections.abc import Iterator
 from nc.alarms import NcAlarm
 from nc.moves import Event, Sync
 from nc.program.blocks import Assign, Block, Else, ElseIf, End, EndIf, ExitW, Goto, IfGoto, IfThen, While
-from nc.program.expr_compiled import evaluate, var_index
+from nc.program.expr_compiled import assignment, evaluate
 from nc.interp.records import Frame, MAX_IF_DEPTH, MAX_WHILE_DEPTH
 
 
@@ -54,22 +54,50 @@ class ControlMixin:
             self.on_statement(block, fr.program.name)
         if self.budget is not None:
             self.budget.spend()
-        t = type(s)
-        if t is Assign:
-            read = self.vars.get
-            n = var_index(s.target, read)
-            v = evaluate(s.value, read)
+        if type(s) is Assign:
+            vs = self.vars
+            n, v = assignment(s, s.target, s.value, vs.get)
             if v is not None and not math.isfinite(v):
                 raise NcAlarm(0x0257, "assignment of a non-finite value")
-            self.vars.set(n, v)
-            if self.sys.live(n):
+            vs.set(n, v)
+            if n > 99 and self.sys.live(n):  # no local variable (#1-#99) is a live system variable
                 return Sync(block.line, block.text, f"#{n}")
             return None
         self._control(s, fr)
         return None
 
     def _control(self, s, fr: Frame) -> None:
-        """GOTO, IF, WHILE/END and EXITW: where the program counter goes next."""
+        """GOTO, IF, WHILE/END and EXITW: where the program counter goes next (WHILE and END first: every
+        pass of a loop runs them)."""
+        t = type(s)  # the statement classes are final: identity is the cheapest test
+        if t is While:
+            wpc = fr.pc - 1
+            if s.do is not None and s.do not in (1, 2, 3):
+                raise NcAlarm(0x0214, f"DO{s.do}: loop numbers are 1, 2 and 3")
+            if s.do is None and not self.profile.legacy:
+                raise NcAlarm(0x0215, "WHILE without DO")
+            if s.do is not None and self.profile.legacy:
+                raise NcAlarm(0x0207, "lathe-2018 loops are WHILE [..] ... ENDW")
+            active = fr.loops and fr.loops[-1][0] == wpc
+            # the END of a loop already entered is known; a scan only when the loop starts
+            epc = fr.loops[-1][1] if active else self._scan_end(fr, wpc, s.do)
+            if self._truth(s.cond):
+                if not active:
+                    if len(fr.loops) >= MAX_WHILE_DEPTH and not self.profile.legacy:
+                        raise NcAlarm(0x0226, f"more than {MAX_WHILE_DEPTH} nested WHILE")
+                    fr.loops.append((wpc, epc, s.do))
+            else:
+                if active:
+                    fr.loops.pop()
+                fr.pc = epc + 1
+            return
+        if t is End:
+            if s.do is not None and s.do not in (1, 2, 3):
+                raise NcAlarm(0x0225, f"END{s.do}: loop numbers are 1, 2 and 3")
+            if not fr.loops or fr.loops[-1][2] != s.do or fr.loops[-1][1] != fr.pc - 1:
+                raise NcAlarm(0x022B, f"END{'' if s.do is None else s.do} has no matching WHILE")
+            fr.pc = fr.loops[-1][0]
+            return
         if isinstance(s, Goto):
             self._jump_label(self._label(s.target))
             return
@@ -106,34 +134,6 @@ class ControlMixin:
                 raise NcAlarm(0x023C, "ENDIF without IF...THEN")
             fr.ifs.pop()
             return
-        if isinstance(s, While):
-            wpc = fr.pc - 1
-            if s.do is not None and s.do not in (1, 2, 3):
-                raise NcAlarm(0x0214, f"DO{s.do}: loop numbers are 1, 2 and 3")
-            if s.do is None and not self.profile.legacy:
-                raise NcAlarm(0x0215, "WHILE without DO")
-            if s.do is not None and self.profile.legacy:
-                raise NcAlarm(0x0207, "lathe-2018 loops are WHILE [..] ... ENDW")
-            active = fr.loops and fr.loops[-1][0] == wpc
-            # the END of a loop already entered is known; a scan only when the loop starts
-            epc = fr.loops[-1][1] if active else self._scan_end(fr, wpc, s.do)
-            if self._truth(s.cond):
-                if not active:
-                    if len(fr.loops) >= MAX_WHILE_DEPTH and not self.profile.legacy:
-                        raise NcAlarm(0x0226, f"more than {MAX_WHILE_DEPTH} nested WHILE")
-                    fr.loops.append((wpc, epc, s.do))
-            else:
-                if active:
-                    fr.loops.pop()
-                fr.pc = epc + 1
-            return
-        if isinstance(s, End):
-            if s.do is not None and s.do not in (1, 2, 3):
-                raise NcAlarm(0x0225, f"END{s.do}: loop numbers are 1, 2 and 3")
-            if not fr.loops or fr.loops[-1][2] != s.do or fr.loops[-1][1] != fr.pc - 1:
-                raise NcAlarm(0x022B, f"END{'' if s.do is None else s.do} has no matching WHILE")
-            fr.pc = fr.loops[-1][0]
-            return
         if isinstance(s, ExitW):
             if s.cond is not None and not self._truth(s.cond):
                 return
@@ -145,7 +145,7 @@ class ControlMixin:
             return
 
     def _truth(self, cond) -> bool:
-        v = self.eval(cond)
+        v = evaluate(cond, self.vars.get)
         return bool(v) and v is not None
 
     def _label(self, e) -> int:

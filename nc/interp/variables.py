@@ -113,6 +113,7 @@ class Variables:
 
     def __post_init__(self) -> None:
         self.mlc.legacy = self.legacy
+        self._lmax = self.local_max  # `get`/`set` test it on every read and write (macro hot path)
 
     @property
     def local_max(self) -> int:
@@ -144,10 +145,10 @@ class Variables:
 
     def get(self, number: int) -> Value:
         n = number
+        if 0 < n <= self._lmax:  # locals first: most reads of a macro
+            return self.frames[-1].get(n)
         if n == 0:
             return None
-        if 1 <= n <= self.local_max:
-            return self.frames[-1].get(n)
         if self.is_user(n):
             return self.values.get(n)
         if self.mlc.kind(n):
@@ -160,14 +161,14 @@ class Variables:
 
     def set(self, number: int, value: Value) -> None:
         n = number
-        if n == 0:
-            raise NcAlarm(0x0254, "#0 is read-only (vacant)")
-        if 1 <= n <= self.local_max:
+        if 0 < n <= self._lmax:
             if value is None:
                 self.frames[-1].pop(n, None)
             else:
                 self.frames[-1][n] = float(value)
             return
+        if n == 0:
+            raise NcAlarm(0x0254, "#0 is read-only (vacant)")
         if self.is_user(n):
             if value is None:
                 self.values.pop(n, None)
