@@ -66,35 +66,37 @@ class CallsMixin:
         """Argument letters -> locals (N§3.11.4: 2nd/3rd use at +26/+52, T up to 5)."""
         args: dict[int, float] = {}
         counts: dict[str, int] = {}
+        legacy = self.profile.legacy
         for w in block.words:
-            if w.letter in skip or w.letter not in ARG_LETTERS:
-                if w.letter not in skip and w.letter not in ("G", "L", "N", "O", "P"):
-                    raise NcAlarm(0x0251, f"{w.letter} cannot be a macro argument")
+            letter = w.letter
+            if letter in skip:
                 continue
-            k = counts.get(w.letter, 0)
-            counts[w.letter] = k + 1
-            if self.profile.legacy:
-                args[ARG_LETTERS[w.letter]] = w.value  # one use per letter: last wins (A20)
+            slots = _ARG_SLOTS.get(letter)
+            if slots is None:
+                if letter not in ("G", "L", "N", "O", "P"):
+                    raise NcAlarm(0x0251, f"{letter} cannot be a macro argument")
                 continue
-            slots = [ARG_LETTERS[w.letter], ARG_LETTERS[w.letter] + 26, ARG_LETTERS[w.letter] + 52]
-            if w.letter == "T":
-                slots += [85, 92]
+            if legacy:
+                args[slots[0]] = w.value  # one use per letter: last wins (A20)
+                continue
+            k = counts.get(letter, 0)
+            counts[letter] = k + 1
             if k >= len(slots):
-                raise NcAlarm(0x0251, f"argument {w.letter} used more than {len(slots)} times")
+                raise NcAlarm(0x0251, f"argument {letter} used more than {len(slots)} times")
             args[slots[k]] = w.value  # unscaled (A4: macro arguments keep their value)
         return args
 
     def _push_macro(self, number: int, count: int, args: dict[int, float], kind: str,
                     code: str | None = None) -> None:
-        depth = sum(1 for f in self.stack if f.locals_pushed)
-        if depth >= MAX_MACRO_DEPTH:
+        # a count of the frames only when there are enough of them (every call pays for this test)
+        if len(self.stack) >= MAX_MACRO_DEPTH and sum(1 for f in self.stack if f.locals_pushed) >= MAX_MACRO_DEPTH:
             raise NcAlarm(0x0212, f"more than {MAX_MACRO_DEPTH} nested macro calls")
         prog = self.store.find(number, macro_call=kind in ("gcall", "mcall", "tcall"),
                                code=0x0004 if kind != "g65" else 0x0263)
         if count < 1:
             return
-        self.vars.push_locals(args)
-        self.stack.append(Frame(prog, 0, kind, True, count, call_code=code, args=dict(args)))
+        self.vars.push_locals(args)  # a copy: the macro writes its locals, every repetition starts from `args`
+        self.stack.append(Frame(prog, 0, kind, True, count, call_code=code, args=args))
 
     def _macro_call(self, block: Block, modal: bool) -> None:
         p = block.get("P")
@@ -128,9 +130,9 @@ class CallsMixin:
             if first.value != int(first.value):
                 return None
             number = self._call_table(first.letter, int(first.value))
-            code = f"{first.letter}{int(first.value)}"
             if number is None:
                 return None
+            code = f"{first.letter}{int(first.value)}"
             if any(f.call_code is not None and f.call_code[0] in "GM" for f in self.stack) and \
                     not (first.letter == "G" and self.profile.bit("N1.010 Bit28")):
                 return None  # inside a called macro the code is an ordinary code
@@ -278,6 +280,10 @@ class CallsMixin:
         mv.start = dict(self.position)  # from wherever the interrupt program left the tool
         self.position = dict(mv.end)
         return mv
+
+# the locals each argument letter fills, first use first (N§3.11.4: 2nd/3rd use at +26/+52, T also #85 #92)
+_ARG_SLOTS: dict[str, tuple[int, ...]] = {
+    letter: (n, n + 26, n + 52) + ((85, 92) if letter == "T" else ()) for letter, n in ARG_LETTERS.items()}
 
 CallTable = tuple[dict[int, int], tuple[int, int, int]]
 

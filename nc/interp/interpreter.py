@@ -161,8 +161,20 @@ class Interpreter(ExecuteMixin, ReadingMixin, ModalMixin, MotionMixin, NonModalM
             if block is None:
                 continue
             if block.stmt is not None:  # a macro statement: a plain call, no generator (issue 16)
+                # and the statements after it in this frame, without the checks above: a statement
+                # neither pushes nor pops a frame, and nothing outside runs until this generator yields
+                # (a statement budget is checked above, statement by statement)
+                plain_at = getattr(blocks, "plain_at", None)
                 try:
-                    ev = self._statement(block)
+                    while (ev := self._statement(block)) is None and budget is None:
+                        pc = fr.pc
+                        if pc >= len(blocks) or (plain_at is not None and plain_at(pc)) \
+                                or (nxt := blocks[pc]).stmt is None:
+                            break
+                        last = nxt
+                        block = self._take_block(fr, limit, nxt)
+                        if block is None:
+                            break
                 except (NcAlarm, ValueError, ArithmeticError, OverflowError) as exc:
                     raise _located(exc, block, fr.program.name) from None
                 if ev is not None:

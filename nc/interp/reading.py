@@ -6,12 +6,13 @@ they use is the Interpreter's (see its __init__)."""
 
 from __future__ import annotations
 
-import math
+from math import isfinite
 
 from nc.alarms import NcAlarm
 from nc.interp import context
 from nc.interp.gcodes import lookup
 from nc.program.blocks import Block, Word
+from nc.program.expr_compiled import evaluate
 from nc.interp.records import LETTERS
 
 
@@ -20,24 +21,25 @@ class ReadingMixin:
         """Evaluate the expressions of a block's words; vacant values drop the word (B.3.1.1)."""
         if not block.has_expr:
             return block
-        b = block.copy()
+        read = self.vars.get
         words = []
         for w in block.words:
-            if w.expr is None:
+            e = w.expr
+            if e is None:
                 words.append(w)
                 continue
-            v = self.eval(w.expr)
+            v = evaluate(e, read)
             if v is None:
                 continue
-            if not math.isfinite(v):
+            if not isfinite(v):
                 raise NcAlarm(0x0223, f"{w.text} is not a finite number")
             words.append(Word(w.letter, v, w.text, True))
-        b.words = words
+        # the constructor: Block.copy would copy the words just replaced (every pass of a loop, issue 16)
+        b = Block(block.line, block.text, words, block.n, block.skip, dict(block.comma), block.comment, block.stmt, {})
         for k, e in block.comma_expr.items():
-            v = self.eval(e)
+            v = evaluate(e, read)
             if v is not None:
                 b.comma[k] = v
-        b.comma_expr = {}
         return b
 
     # ---- G codes ---------------------------------------------------------------------------
