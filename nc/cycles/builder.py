@@ -45,17 +45,28 @@ class PathBuilder:
         return dict(line=self.line, block=self.block, start=dict(self.position), end=end,
                     work=self.to_work(end), program=self.program, plane=self.plane, tags=tags, css=self.css)
 
-    def _same(self, p: Pt) -> bool:
-        """A move shorter than float noise is dropped; the position snaps to the exact target."""
-        if abs(p[0] - self.here[0]) < 1e-12 and abs(p[1] - self.here[1]) < 1e-12:
-            self.position[self.plane[0]], self.position[self.plane[1]] = p
-            return True
-        return False
+    def _to(self, kind: str, p: Pt, tags: tuple[str, ...], feed: float | None, per_rev: bool,
+            center: dict[str, float] | None = None, dir: str | None = None, lead: float | None = None,
+            lead_change: float = 0.0, start_angle: float = 0.0) -> Move | None:
+        """The lean path of every plane move (issue 16: a lathe cycle emits thousands): the Move built
+        positionally, the old position dict handed over as its start, one copy for the new position.
+        A line or rapid shorter than float noise is dropped; the position snaps to the exact target."""
+        pos = self.position
+        a1, a2 = self.plane
+        if center is None and kind != "thread" and abs(p[0] - pos[a1]) < 1e-12 and abs(p[1] - pos[a2]) < 1e-12:
+            pos[a1], pos[a2] = p
+            return None
+        end = pos.copy()
+        end[a1], end[a2] = p
+        mv = Move(kind, self.line, self.block, pos, end, self.to_work(end), center, dir, feed,  # type: ignore[arg-type]
+                  None, per_rev, self.plane, False, lead, lead_change, start_angle, 0.0, self.program, tags,
+                  None, 0.0, 0, self.css)
+        self.events.append(mv)
+        self.position = end.copy()
+        return mv
 
     def rapid(self, p: Pt, tags: tuple[str, ...] = ()) -> Move | None:
-        if self._same(p):
-            return None
-        return self._emit(Move("rapid", **self._common(self._end(p), tags)))
+        return self._to("rapid", p, tags, None, False)
 
     def rapid_axes(self, target: dict[str, float], tags: tuple[str, ...] = ()) -> Move | None:
         end = dict(self.position)
@@ -73,10 +84,7 @@ class PathBuilder:
                                **self._common(end, tags)))
 
     def feed_to(self, p: Pt, tags: tuple[str, ...] = (), feed: float | None = None) -> Move | None:
-        if self._same(p):
-            return None
-        return self._emit(Move("line", feed=feed if feed is not None else self.feed, per_rev=self.per_rev,
-                               **self._common(self._end(p), tags)))
+        return self._to("line", p, tags, feed if feed is not None else self.feed, self.per_rev)
 
     def seg(self, s: Seg, tags: tuple[str, ...] = (), feed: float | None = None, rapid: bool | None = None) -> Move | None:
         """Add a contour element (the builder must already be at its start)."""
@@ -84,17 +92,15 @@ class PathBuilder:
             return self.rapid(s.p1, tags)
         if not s.is_arc:
             return self.feed_to(s.p1, tags, feed)
-        end = self._end(s.p1)
-        centre = dict(end)
+        centre = self._end(s.p1)
         centre[self.plane[0]], centre[self.plane[1]] = s.center
-        return self._emit(Move("arc", center=centre, dir="cw" if s.cw else "ccw",
-                               feed=feed if feed is not None else self.feed, per_rev=self.per_rev,
-                               **self._common(end, tags)))
+        return self._to("arc", s.p1, tags, feed if feed is not None else self.feed, self.per_rev, centre,
+                        "cw" if s.cw else "ccw")
 
     def thread(self, p: Pt, lead: float, start_angle: float, tags: tuple[str, ...] = (),
                lead_change: float = 0.0) -> Move:
-        return self._emit(Move("thread", lead=lead, lead_change=lead_change, start_angle=start_angle,
-                               feed=lead, per_rev=True, **self._common(self._end(p), tags)))
+        return self._to("thread", p, tags, lead, True, lead=lead, lead_change=lead_change,  # type: ignore[return-value]
+                        start_angle=start_angle)
 
     def dwell(self, seconds: float, tags: tuple[str, ...] = ()) -> Move:
         here = dict(self.position)

@@ -56,7 +56,9 @@ def _is_diameter(host: Any, axis: str = "X") -> bool:
 
 
 def _builder(host: Any, block: Block, plane: tuple[str, str] = LATHE_PLANE) -> PathBuilder:
-    return PathBuilder(dict(host.position), plane, block.line, block.text, host.to_work,
+    convert = getattr(host, "work_converter", None)  # the offsets hold through a cycle: precomputed
+    return PathBuilder(dict(host.position), plane, block.line, block.text,
+                       convert() if convert is not None else host.to_work,
                        getattr(host, "program_name", None), per_rev=bool(host.state.per_rev),
                        css=host.state.surface_speed if host.state.css else None)  # G96 holds in cycles
 
