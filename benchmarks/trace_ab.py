@@ -7,7 +7,7 @@ columns included), the same end record, alarms, handshakes and final positions.
     python benchmarks/trace_ab.py --against DIR  # this tree's runs against those (tree A/B)
 
 Shortcuts compared: `mlc-on-change` (the lathe MLC's user scan skipped while nothing it read changed,
-mlc/on_change.py). Prints one line per run and per shortcut, exits 1 on any difference.
+mlc/on_change.py), `stretch` (quiet cycles a stretch at a time, hil/stretch.py; DELTAHIL_STRETCH=0 is off). Prints one line per run and per shortcut, exits 1 on any difference.
 """
 
 from __future__ import annotations
@@ -31,7 +31,8 @@ from hil.api import run  # noqa: E402
 SIGNALS = ("M_STROBE,S_STROBE,T_STROBE,MST_FINISH,M_CODE,S_CODE,T_CODE,SPINDLE1_FWD,SPINDLE1_REV,"
            "SPINDLE_ANALOG_1,SPINDLE1_SPEED_REACHED,PROGRAM_END,M21013,M31016,M31017,D30272,D30240,M21019,"
            # the drive status the NC writes (issue 17: written when it changed)
-           "D30242,D30274,D30338,D30400,D30401,M31256,M31272,M31464,M31480,M31497,M31034,D31026,D31028,M31705")
+           "D30242,D30274,D30338,D30400,D30401,M31256,M31272,M31464,M31480,M31497,M31034,D31026,D31028,M31705,"
+           "M31352,M31353")  # the axes at 0 (the planner position the NC reads before its step)
 LATHE, LATHE_C, MILL = (str(ROOT / "benches" / f) for f in ("lathe-2axis.toml", "lathe-c-axis.toml", "mill-3axis.toml"))
 
 
@@ -65,11 +66,31 @@ def mlc_on_change(on: bool) -> Iterator[None]:
         mlc.lathe.SCAN_ON_CHANGE = old
 
 
-SHORTCUTS: dict[str, Callable[[bool], object]] = {"mlc-on-change": mlc_on_change}
+@contextmanager
+def stretches(on: bool) -> Iterator[None]:
+    import os
+
+    from hil.stretch import ENV
+
+    old = os.environ.get(ENV)
+    os.environ[ENV] = "1" if on else "0"
+    try:
+        yield
+    finally:
+        if old is None:
+            os.environ.pop(ENV, None)
+        else:
+            os.environ[ENV] = old
 
 
-def one(program: str, kw: dict, trace: Path) -> tuple:
+SHORTCUTS: dict[str, Callable[[bool], object]] = {"mlc-on-change": mlc_on_change, "stretch": stretches}
+
+
+def one(program: str, kw: dict, trace: Path, keep: list | None = None) -> tuple:
+    """(trace columns, summary) of a run; `keep` receives the run's result (tests/test_stretch_runner.py)."""
     r = run(program, trace=str(trace), trace_signals=SIGNALS, check=False, **kw)
+    if keep is not None:
+        keep.append(r)
     table = pq.read_table(trace)
     cols = {c: table.column(c).to_pylist() for c in table.column_names if c not in ("period", "late")}
     hs = getattr(getattr(r.runner, "mlc", None), "link", None)

@@ -20,6 +20,7 @@ from hil.clock import CycleTiming, LockStepClock, RealTimeClock
 from hil import retentive
 from hil.drive_homing import home_axes
 from hil.mlc_bridge import drive_status
+from hil.stretch import Stretcher
 from hil.trace import TraceSource, TraceWriter, trace_columns
 from mlc.basic import BasicMlc
 from nc.alarm_table import MAX_TIME
@@ -63,6 +64,7 @@ class RunResult:
     overruns: int = 0
     granted: str = ""  # what the system granted the real-time loop
     stopped_by: str | None = None  # the signal (SIGINT, SIGTERM, SIGHUP) whose stop ended the run
+    stretched: int = 0  # cycles run in stretches (hil/stretch.py), not stepped one by one
 
     @property
     def ok(self) -> bool:
@@ -237,16 +239,20 @@ class BenchRunner:
         max_cycles = int(self.bench.max_time / self.bench.cycle)
         give_up = max_cycles + int(STANDSTILL_TIMEOUT / self.bench.cycle)
         stopping = False
+        stretcher = Stretcher.for_runner(self)  # quiet cycles a stretch at a time (issue 17, decision B20)
         while ch.busy and self.cycle < give_up:
             if self.stop_request is not None and not stopping:
                 stopping = True  # along the path, jerk-limited, then flush: the NC's reset
                 ch.reset()
+            if stretcher is not None and not stopping and stretcher.run(max_cycles - 1 - self.cycle):
+                continue  # it ended before max_cycles: the check below is for a stepped cycle
             self._exchange()
             if self.cycle == max_cycles:  # an alarm like any other: the channel stops along the path
                 self._end_reason = "max_time"
                 ch.raise_alarm(Alarm(MAX_TIME_ALARM, f"run exceeded the bench's max_time of {self.bench.max_time:g} s",
                                      line=self.line or None))
         self.result.program_time = self.time - t0
+        self.result.stretched = stretcher.cycles if stretcher is not None else 0
         self.result.finished = ch.state is RunState.FINISHED
         self._settle()
 
@@ -316,7 +322,12 @@ class BenchRunner:
         self.timing = self.clock.tick()
         if self.timing.overrun:
             self._overrun()
-        self.tx = self.link.exchange(self.rx)
+        self._cycle(self.link.exchange(self.rx))
+
+    def _cycle(self, tx: list[TxPdo], step: Callable[[Channel], object] | None = None) -> None:
+        """One cycle from its feedback on (a stretch, hil/stretch.py, hands in feedback it computed and, as
+        `step`, the planner sample the channel step would return)."""
+        self.tx = tx
         self.cycle += 1
         self.time += self.bench.cycle
         n_axes = len(self.axes)
@@ -356,10 +367,10 @@ class BenchRunner:
                 self.mlc.bus_status(status)  # M30000 / EIO relays from the bus state (issue 6)
             self.mlc.scan(ch)
             self._skip_probe(ch)
-            sp = ch.step()
-            self._commands[:] = sp.positions
+            sp = ch.step() if step is None else step(ch)
+            self._commands[:] = sp.positions  # type: ignore[attr-defined]
             if not self._winding_down:
-                self.line = sp.line or self.line
+                self.line = sp.line or self.line  # type: ignore[attr-defined]
             if ch.emergency and not self._braking:
                 self._begin_quick_stop()  # E-stop: stop category 1, the drives brake on their own ramp
             elif self._braking and not ch.emergency and not self._planner_failed:

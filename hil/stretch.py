@@ -1,0 +1,313 @@
+"""Quiet cycles a stretch at a time (issue 17, decisions B19/B20).
+
+While the channel runs a planned move with nothing event-like pending, the runner takes up to
+MAX_CYCLES cycles at once: the planner's samples through `nc.motion.stretch.sample_stretch`, every drive
+over the stretch (`virtual_bus.drive_stretch`), then each cycle's feedback handed to the runner's own
+cycle (`BenchRunner._cycle`) in place of the bus exchange, with the cycle's sample in place of the
+channel step. What the cycle does with them (masters, checks, MLC exchange, setpoints, trace row) is the
+per-cycle code itself, so the trace is the cycle-by-cycle one; what a stretch saves is the bus, the drive
+models and the channel step.
+
+B19's order is kept: the drive steps in cycle k to the setpoint of cycle k-1, so a stretch of n cycles
+sends the pending target and the first n-1 samples; the last sample waits in the RxPdo. A stretch ends
+early, at the first cycle where it would differ from stepping:
+- a drive would fault (following error window, overspeed) or the bench's overspeed check would fire:
+  the stretch ends before that cycle, which runs through `_exchange`;
+- the MLC scan changed what the channel reads (state, overrides, hold, alarms ...): that cycle's step
+  is the channel's own, and the stretch ends after it;
+- the user scan ran and changed something, the operator panel or an `--at` event wrote a device, or a
+  cycle's outputs differ from what the drives were stepped with: the stretch ends after that cycle.
+Ending early restores the planner and the drives as they were and takes the shorter stretch again (the
+parts are deterministic, so its cycles are the same). `DELTAHIL_STRETCH=0` turns stretches off: tests
+compare both runs column by column.
+"""
+
+from __future__ import annotations
+
+import copy
+import os
+from collections import deque
+from typing import Any
+
+import numpy as np
+
+from fieldbus.cia402 import State, Target
+from fieldbus.link import SimLink
+from fieldbus.pdo import RxPdo, TxPdo
+from hil.clock import LockStepClock
+from mlc.basic import BasicMlc
+from mlc.machine import Mlc
+from mlc.spindle_axis import SPINDLE
+from nc.channel import Channel, RunState
+from nc.motion.planner import Planner, Setpoint
+from nc.motion.stretch import Samples, sample_stretch, settle_stretch
+from virtual_bus.drive import Cia402Drive
+from virtual_bus.drive_stretch import Stretch, can_stretch, csp_stretch, csv_stretch
+
+ENV = "DELTAHIL_STRETCH"  # "0": every cycle is stepped (the reference the tests compare against)
+MAX_CYCLES = 64  # the planner's buffers are up to 64 cycles: a stretch never spans two
+MODE_CSP, MODE_CSV = 8, 9
+
+
+def wanted() -> bool:
+    return os.environ.get(ENV, "1") != "0"
+
+
+class Stretcher:
+    """Takes stretches for one runner (a `hil.runner.BenchRunner`)."""
+
+    def __init__(self, runner: Any, drives: list[Cia402Drive]) -> None:
+        self.r = runner
+        self.drives = drives
+        self.n_axes = len(runner.axes)
+        self.stretches = 0  # stretches taken and cycles in them (benchmarks, tests)
+        self.cycles = 0
+
+    @classmethod
+    def for_runner(cls, runner: Any) -> "Stretcher | None":
+        """A stretcher where stretches can be exact: lock-step on the in-process bus with its simulated drives."""
+        link = runner.link
+        if not wanted() or type(link) is not SimLink or type(runner.clock) is not LockStepClock:
+            return None
+        drives = list(link.slaves)
+        if len(drives) != len(runner.rx) or any(type(d) is not Cia402Drive for d in drives):
+            return None
+        if type(runner.mlc) not in (Mlc, BasicMlc):
+            return None
+        return cls(runner, drives)
+
+    # ---- one stretch ---------------------------------------------------------------------------
+    def run(self, limit: int) -> bool:
+        """Up to `limit` cycles as one stretch; False when no stretch can start here (step this cycle)."""
+        r = self.r
+        ch: Channel | None = r.channel
+        if limit < 2 or ch is None or not self._quiet(r, ch):
+            return False
+        pl = ch.planner
+        n = min(limit, MAX_CYCLES, len(pl._buf_pos) - pl._buf_i - 1)  # the buffer's last row: step() refills
+        if n < 2:
+            return False
+        saved_pl = _save_planner(pl)
+        smp = sample_stretch(pl, n)
+        if smp is None:
+            return False
+        rx0 = [copy.copy(rx) for rx in r.rx]  # what the drives are stepped with (the runner's change per cycle)
+        saved_drives = [dict(d.__dict__) for d in self.drives]
+        targets = self._targets(smp, rx0, n)
+        outs = self._step_drives(rx0, targets, n)
+        m = min(o.done for o in outs)
+        for i in range(self.n_axes):  # the bench's overspeed check (App. A 0x0602) fires in that cycle
+            over = np.flatnonzero(np.abs(np.asarray(outs[i].velocity_actual[:m])) > r._overspeed[i])
+            if over.size:
+                m = int(over[0])
+        if m < 2:
+            _restore_planner(pl, saved_pl)
+            self._restore_drives(saved_drives)
+            return False
+        if m < n:
+            outs = self._cut(pl, saved_pl, saved_drives, rx0, targets, m, m)
+        return self._play(r, ch, pl, smp, outs, m, (saved_pl, saved_drives, rx0, targets))
+
+    def _play(self, r: Any, ch: Channel, pl: Planner, smp: Samples, outs: list[Stretch], m: int,
+              saved: tuple) -> bool:
+        """The stretch's cycles through the runner's cycle, each with its feedback and sample."""
+        saved_pl, saved_drives, rx0, targets = saved
+        sig = _signature(ch)
+        panel = _panel_state(r.on_cycle)
+        gate = getattr(r.mlc, "gate", None)
+        rpms: list[float] = []
+        cmds: list[float] = []
+        settle = pl.spindle_command is not None
+        dt, link, clock = r.bench.cycle, r.link, r.clock
+        fixed = [(d.error_code, d.mode) for d in self.drives]
+        probes = [(o.last.touch_probe_status, o.last.touch_probe_pos1, o.last.digital_inputs) for o in outs]
+        positions, lines, vel, mv = smp.positions, smp.lines, smp.path_velocity, smp.move
+        state = {"fell_back": False}
+        # The MLC exchange reads the planner's own position (M3x352+i, axis at 0) before the cycle's step: the
+        # raw sample of the cycle before, as it stood in stepping (sample_stretch moved it to the last one).
+        raw = [saved_pl["pl"]["position"], *pl._buf_pos[pl._buf_i - m:pl._buf_i - 1]]
+        last_raw = pl.position
+        k = 0
+
+        def step(channel: Channel) -> Setpoint:
+            if _signature(channel) != sig:  # the scan changed what the channel reads: its own step (B20)
+                self._cut(pl, saved_pl, saved_drives, rx0, targets, k, k + 1, rpms, cmds)
+                state["fell_back"] = True
+                return channel.step()
+            if settle:
+                rpms.append(float(pl.spindle_rpm()))
+                cmds.append(float(pl.spindle_command()))  # type: ignore[misc]
+            return Setpoint(positions[k], lines[k], float(vel[k]), mv)
+
+        while k < m:
+            r.timing = clock.tick()
+            link.time += dt
+            link.cycles += 1
+            tx = [TxPdo(o.statusword[k], o.position_actual[k], o.velocity_actual[k], o.torque_actual[k],
+                        o.following_error[k], ec, md, tps, tpp, di)
+                  for o, (ec, md), (tps, tpp, di) in zip(outs, fixed, probes)]
+            scans = gate.scans if gate is not None else 0
+            pl.position = raw[k]
+            r._cycle(tx, step)
+            k += 1
+            if state["fell_back"]:
+                break
+            pl.position = raw[k] if k < m else last_raw
+            if k < m and not self._still_quiet(r, gate, scans, panel, rx0, targets, k):
+                self._cut(pl, saved_pl, saved_drives, rx0, targets, k, k, rpms, cmds)
+                break
+        else:
+            if settle:
+                settle_stretch(pl, rpms, cmds)
+        for d, rx in zip(self.drives, r.rx):
+            d._rx = rx  # the runner's own RxPdo from now on, as exchange() latches it
+        self.stretches += 1
+        self.cycles += k
+        return True
+
+    # ---- conditions ----------------------------------------------------------------------------
+    def _quiet(self, r: Any, ch: Channel) -> bool:
+        """Nothing event-like is pending: the channel runs a planned move and every cycle of the stretch
+        would take the same path through the NC, the MLC exchange and the drives (module doc)."""
+        if (r.stop_request is not None or r._braking or r._winding_down or r._planner_failed or r._at_limit
+                or r._alarmed_drives or r.result.alarms or ch.alarms):
+            return False
+        if (ch.state is not RunState.RUNNING or ch.pending_aux is not None or ch.emergency or ch.css_rpm is not None
+                or ch._interrupt is not None or ch.skip_armed):
+            return False
+        pl = ch.planner
+        if pl.held or pl._thread is not None or pl.threads_queued or not pl.blocks or pl.blocks[0].move.css is not None:
+            return False
+        # Channel._feed_planner reads nothing in these cycles: the program has ended, the queue is full (asked as
+        # its loop asks), or it waits for the queue to drain (an M/S/T code, a sync, a limit alarm, single block)
+        if ch.end is None and not pl.full and ch._deferred is None and ch._limit_alarm is None \
+                and not (ch.single_block and ch._block_moves):
+            return False
+        budget = ch.statement_budget
+        if budget is not None and budget.spent:
+            return False
+        if _panel_state(r.on_cycle) is None or _event_due(r):
+            return False
+        mlc = r.mlc
+        if isinstance(mlc, Mlc):
+            if mlc.gate is None and not getattr(mlc, "program_failed", False):
+                return False  # a scan that runs every cycle may write anything: no stretch
+            if mlc.gate is not None and (mlc.gate.last is None or mlc.gate.last.dirty):
+                return False
+            if mlc.link._mode_switch_cycles or mlc.link._handed is not None or mlc.caxis.state != SPINDLE:
+                return False
+        for i, (d, rx, m) in enumerate(zip(self.drives, r.rx, r.masters)):
+            mode = MODE_CSP if i < self.n_axes else MODE_CSV
+            if (m.state is not State.OPERATION_ENABLED or m.target is not Target.ENABLED or rx.mode != mode
+                    or d.params.home_switch is not None or not can_stretch(d, rx, mode)):
+                return False
+        # what the first cycle's feed does before it finds nothing to read (the same every cycle after)
+        pl.closed = ch.end is not None or ch._deferred is not None or ch._limit_alarm is not None
+        if budget is not None:
+            budget.new_cycle()
+        return True
+
+    def _still_quiet(self, r: Any, gate: Any, scans: int, panel: tuple | None, rx0: list[RxPdo],
+                     targets: list[list[int]], k: int) -> bool:
+        """After cycle k-1 of the stretch: nothing it did changes what cycle k reads or is stepped with."""
+        if gate is not None and gate.scans != scans and (gate.last is None or gate.last.dirty):
+            return False  # the user scan ran and wrote: the NC reads it next cycle
+        if _panel_state(r.on_cycle) != panel:
+            return False
+        for i, (rx, was) in enumerate(zip(r.rx, rx0)):
+            if rx.controlword != was.controlword or rx.mode != was.mode or rx.target_velocity != was.target_velocity:
+                return False
+            if i < self.n_axes and rx.target_position != targets[i][k]:
+                return False
+        return True
+
+    # ---- parts ---------------------------------------------------------------------------------
+    def _targets(self, smp: Samples, rx0: list[RxPdo], n: int) -> list[list[int]]:
+        """Each axis drive's targets, cycle by cycle: the pending one, then the samples as the runner sends them."""
+        r = self.r
+        org = r.origin.tolist()
+        out = []
+        for i in range(self.n_axes):
+            sc, o = r.scales[i], org[i]
+            out.append([rx0[i].target_position] + [sc.to_counts(c - o) for c in smp.positions[: n - 1, i].tolist()])
+        return out
+
+    def _step_drives(self, rx0: list[RxPdo], targets: list[list[int]], n: int) -> list[Stretch]:
+        dt = self.r.bench.cycle
+        outs = []
+        for i, (d, rx) in enumerate(zip(self.drives, rx0)):
+            outs.append(csp_stretch(d, rx, targets[i][:n], dt) if i < self.n_axes else csv_stretch(d, rx, n, dt))
+        return outs
+
+    def _restore_drives(self, saved: list[dict]) -> None:
+        for d, s in zip(self.drives, saved):
+            d.__dict__.clear()
+            d.__dict__.update(s)
+
+    def _cut(self, pl: Planner, saved_pl: dict, saved_drives: list[dict], rx0: list[RxPdo],
+             targets: list[list[int]], samples: int, cycles: int, rpms: list[float] | None = None,
+             cmds: list[float] | None = None) -> list[Stretch]:
+        """The stretch shortened: the planner as after `samples` samples, the drives after `cycles` cycles
+        (taken again from the state before the stretch), the spindle settle count after those samples."""
+        _restore_planner(pl, saved_pl)
+        if samples:
+            sample_stretch(pl, samples)
+        if rpms is not None and cmds is not None and pl.spindle_command is not None:
+            settle_stretch(pl, rpms[:samples], cmds[:samples])
+        self._restore_drives(saved_drives)
+        return self._step_drives(rx0, targets, cycles)
+
+
+def _signature(ch: Channel) -> tuple:
+    """What the channel reads from the MLC exchange and the runner, as far as a stretch depends on it."""
+    pl = ch.planner
+    return (ch.state, ch.pending_aux, pl.feed_override, pl.rapid_override, ch.spindle_override, pl.dry_run,
+            ch.single_block, ch.emergency, len(ch.alarms), pl.held, ch._interrupt, ch.skip_armed, ch.end,
+            ch.css_rpm, ch.spindle_max)
+
+
+def _panel_state(on_cycle: Any) -> tuple | None:
+    """The on_cycle hook's state while it writes nothing (None: a hook a stretch cannot see into)."""
+    from hil.run_events import EventPlayer
+    from hil.scripting import OperatorPanel
+
+    if on_cycle is None:
+        return ()
+    if isinstance(on_cycle, OperatorPanel):
+        return None if on_cycle._pressed else (False,)
+    if isinstance(on_cycle, EventPlayer):
+        inner = _panel_state(on_cycle.inner)
+        if inner is None or on_cycle._release:
+            return None
+        return (inner, sum(e.fired_cycle is not None for e in on_cycle.events))
+    return None
+
+
+def _event_due(r: Any) -> bool:
+    """An `--at` event fired at the end of the last cycle: the scan of this one sees its write."""
+    from hil.run_events import EventPlayer
+
+    oc = r.on_cycle
+    return isinstance(oc, EventPlayer) and any(e.fired_cycle == r.cycle + 1 for e in oc.events)
+
+
+def _save_planner(pl: Planner) -> dict:
+    """What sample_stretch changes: the planner's own fields and its position filter's state."""
+    saved: dict[str, Any] = {"pl": dict(pl.__dict__)}
+    f = pl.filter
+    if f is not None:
+        fs = dict(f.__dict__)
+        fs["_w1"], fs["_w2"] = deque(f._w1, maxlen=f._w1.maxlen), deque(f._w2, maxlen=f._w2.maxlen)
+        saved["f"] = fs
+    return saved
+
+
+def _restore_planner(pl: Planner, saved: dict) -> None:
+    pl.__dict__.clear()
+    pl.__dict__.update(saved["pl"])
+    if "f" in saved:
+        f = pl.filter
+        fs = dict(saved["f"])
+        fs["_w1"], fs["_w2"] = deque(fs["_w1"], maxlen=fs["_w1"].maxlen), deque(fs["_w2"], maxlen=fs["_w2"].maxlen)
+        f.__dict__.clear()
+        f.__dict__.update(fs)

@@ -1,0 +1,111 @@
+"""The stretch runner (hil/stretch.py, issue 17, decision B20) gives the trace cycle-by-cycle stepping gives:
+each run below is made with stretches off (DELTAHIL_STRETCH=0) and on, and every trace column (MLC devices
+included, wall-clock period/late aside), the alarms, handshakes, end record and final positions are
+compared; each run must also have taken stretches, so the comparison covers them."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import pyarrow.parquet as pq
+import pytest
+
+from benchmarks.trace_ab import SIGNALS, compare, one
+from fieldbus.link import SimLink
+from hil.bench import default_lathe
+from hil.runner import BenchRunner
+from hil.session import sim_slaves
+from hil.stretch import ENV
+from hil.trace import open_trace
+from nc.alarms import SERVO_ALARM
+from nc.program import parse_program
+from tests.conftest import ROOT
+
+DEMO = str(ROOT / "examples" / "lathe_demo.nc")
+
+
+def _both(monkeypatch, tmp_path, program: str, **kw) -> tuple:
+    """(stepped, stretched) runs as trace_ab compares them, and the stretched run's result."""
+    out, kept = [], []
+    for on in ("0", "1"):
+        monkeypatch.setenv(ENV, on)
+        out.append(one(program, kw, tmp_path / f"{on}.parquet", kept))
+    assert kept[0].run.stretched == 0
+    return out[0], out[1], kept[1]
+
+
+def test_lathe_demo_stretched_equals_stepped(monkeypatch, tmp_path):
+    a, b, r = _both(monkeypatch, tmp_path, DEMO)
+    assert compare(a, b) == []
+    assert r.run.ok
+    assert r.run.stretched > 0.8 * r.run.cycles  # most of the demo's cycles go in stretches
+
+
+@pytest.mark.parametrize("events", [
+    ["t=2:feed-hold", "t=2.6:cycle-start", "t=4:set D21002=50"],  # hold, resume, feed override 50 %
+    ["t=3:estop", "t=3.5:estop-off", "t=3.6:reset"],
+    ["t=2.0005:set D21002=70", "t=2.0205:set D21002=120"],  # override changes inside a stretch's span
+])
+def test_operator_events_land_on_the_same_cycles(monkeypatch, tmp_path, events):
+    a, b, r = _both(monkeypatch, tmp_path, DEMO, events=events)
+    assert compare(a, b) == []
+    assert r.run.stretched > 1000
+    assert [c for c in b[0]["event"] if c]  # events fired, in the same rows (compared above)
+
+
+def test_overrides_at_power_on(monkeypatch, tmp_path):
+    a, b, r = _both(monkeypatch, tmp_path, DEMO, feed_override=70.0, spindle_override=110.0)
+    assert compare(a, b) == []
+    assert r.run.stretched > 1000
+
+
+def _direct(monkeypatch, tmp_path, on: str, program: str, tweak) -> tuple:
+    """A BenchRunner on the default lathe with its drives changed by `tweak`, traced; (rows, result)."""
+    monkeypatch.setenv(ENV, on)
+    bench = default_lathe()
+    drives = sim_slaves(bench)
+    tweak(drives)
+    runner = BenchRunner(bench, SimLink(drives, bench.cycle))
+    path = tmp_path / f"d{on}.parquet"
+    runner.trace = open_trace(path, runner.trace_columns())
+    result = runner.run_program(parse_program(program))
+    table = pq.read_table(path)
+    rows = {c: table.column(c).to_pylist() for c in table.column_names if c not in ("period", "late")}
+    return rows, result
+
+
+# the spindle turns first: its drive stretches once its index is latched (a thread's sync)
+PROGRAMS = {"following error": "G98\nM03 S500\nG04 X0.3\nG01 Z-20. F600\nG01 Z-160. F9000\nM30\n",
+            "overspeed": "G98\nM03 S500\nG04 X0.3\nG01 X100. Z-20. F600\nM30\n"}
+
+
+@pytest.mark.parametrize("what", ["following error", "overspeed"])
+def test_a_drive_fault_inside_a_stretch_lands_on_its_cycle(monkeypatch, tmp_path, what):
+    """A following-error fault of the Z drive (its window shrunk) and a runaway X drive (its position loop's sign
+    flipped: App. A 0x0602 from the bench's overspeed check) happen inside what would be a stretch: the stretch
+    ends before that cycle, which runs as a stepped one; the alarm, its cycle and the stop after it are the same."""
+    def tweak(drives):
+        if what == "following error":
+            drives[1].params = replace(drives[1].params, following_error_window=3000)
+        else:
+            drives[0].params = replace(drives[0].params, kp=-abs(drives[0].params.kp))
+
+    (ra, a), (rb, b) = (_direct(monkeypatch, tmp_path, on, PROGRAMS[what], tweak) for on in ("0", "1"))
+    assert ra == rb
+    assert [(x.code, x.axis) for x in a.alarms] == [(x.code, x.axis) for x in b.alarms]
+    assert a.alarms[0].code == (SERVO_ALARM if what == "following error" else 0x0602)
+    assert b.stretched > 0 and a.final == b.final
+    first = next(i for i, s in enumerate(rb["alarm"]) if s)
+    assert first > 100  # mid-program, after stretches ran
+
+
+def test_a_hardware_limit_switch_bench_steps_every_cycle_the_same(monkeypatch, tmp_path):
+    """A drive with a limit switch is not stretched (the stretch drive model has none): the run, with its 0x0402
+    at the switch, is the stepped one, while the spindle-free cycles of the other axes are not taken apart."""
+    def tweak(drives):
+        drives[0].params = replace(drives[0].params, positive_limit=85 * 1_280_000 // 5)
+
+    (ra, a), (rb, b) = (_direct(monkeypatch, tmp_path, on, "G98\nG01 U60. F3000\nM30\n", tweak) for on in ("0", "1"))
+    assert ra == rb
+    assert [x.code for x in b.alarms] == [0x0402]
+    assert b.stretched == 0
