@@ -126,6 +126,7 @@ def main(argv: list[str]) -> int:
             if save is not None or against is not None:
                 res = one(program, kw, tmp / "t.parquet")
                 res[1][-1].get(b"deltahil", {}).pop("program", None)  # the CAM program's temporary path
+                res[1][-1].get(b"deltahil", {}).get("bench", {}).pop("source", None)  # the bench file's tree
                 kept = (save or against) / f"run{k}.pickle"
                 if save is not None:
                     save.mkdir(parents=True, exist_ok=True)

@@ -71,6 +71,11 @@ class Block:
     # the junction can use (nc.motion.shares, decision motion 39).
     vbud: float = math.inf
     vctol: float = math.inf  # the tolerance's cap of this junction's corner alone (FilterCorners.corner_tolerance)
+    # nc.motion.shares._tolerance_free's verdict, kept between solves with the inputs it was found
+    # for (the caps beside the junction and min(vtol, vctol)): it is found again only when one changed.
+    tf_cap: float = math.nan
+    tf_tcap: float = math.nan
+    tf_ok: bool = False
 
 
 def change_distance(v0: float, v1: float, a: float, j: float) -> float:

@@ -66,6 +66,10 @@ def jerk_factor(cfg: MotionConfig, fc: "FilterCorners", blocks: Sequence["Block"
     return 1.0, False
 
 
+def _s_end(b: "Block") -> float:
+    return b.s_end
+
+
 UNKNOWN = (-1.0, -1.0)  # _scan: the queue ends before the reach does
 
 
@@ -86,7 +90,8 @@ def _scan(fc: "FilterCorners", blocks: Sequence["Block"], pos: float, run_end: f
             break
         if b.seg.kind == "arc":
             return None  # the curvature share's centripetal terms
-        seen = max(seen, b.vtop)
+        if b.vtop > seen:
+            seen = b.vtop
         if b is not last and b.vjunc <= 0.0 and b.s_end >= run_end - 1e-9:
             covered = True  # an exact stop (G09/G61, G00): the filter settles there
             break
@@ -95,29 +100,50 @@ def _scan(fc: "FilterCorners", blocks: Sequence["Block"], pos: float, run_end: f
     lo = pos - reach
     use = 0.0
     hist = fc._hist
+    tol = fc.tol
     ends: list[float] | None = None  # the queue's s_end, built once a junction needs its next block
+    i = n_ends = 0
     # FilterCorners keeps every junction since the last stop (its _h0 is relative to the newest
     # push, not to the executing block) and drops old ones only in bulk, counted in _seq0.
-    for k in range(len(hist) - 1, -1, -1):
+    # hist is in path order: the junctions past hi are skipped by bisection, not one by one. The
+    # loop runs over ~85 junctions per solve on dense CAM paths (issue 17): max()/min() spelt out.
+    for k in range(bisect_right(hist, hi, key=_s_end) - 1, -1, -1):
         j = hist[k]
-        if j.s_end > hi:
-            continue
         if j.s_end < lo:
             break
-        seen = max(seen, j.vtop)
+        if j.vtop > seen:
+            seen = j.vtop
         if j.seg is not None and j.seg.kind == "arc":
             return None
         if j.du_n <= 1e-9:
             continue
-        if j.vbud <= 1e-12:
+        vbud = j.vbud
+        if vbud <= 1e-12:
             return None
-        if ends is None:
-            ends = [b.s_end for b in blocks]
-        if not _tolerance_free(fc, j, blocks, ends):
-            return None
-        r = j.vjunc / j.vbud
+        if tol is not None:
+            if ends is None:
+                ends = [b.s_end for b in blocks]
+                i = n_ends = len(ends)
+            # _tolerance_free, its cached verdict inline: the next block follows j in the queue,
+            # at bisect_right(ends, j.s_end), found by stepping back (j walks back in path order)
+            while i > 0 and ends[i - 1] > j.s_end:
+                i -= 1
+            if i < n_ends:
+                cap = j.cap
+                c2 = blocks[i].cap
+                if c2 > cap:
+                    cap = c2
+            else:
+                cap = j.vtop
+            tcap = j.vtol if j.vtol < j.vctol else j.vctol
+            if cap == j.tf_cap and tcap == j.tf_tcap:
+                if not j.tf_ok:
+                    return None
+            elif not _tolerance_free(fc, j, blocks, ends):
+                return None
+        r = j.vjunc / vbud
         if r > use:
-            use = min(r, 1.0)
+            use = r if r < 1.0 else 1.0
     else:
         if fc._seq0 > 0:
             return None  # junctions within the reach were dropped already
@@ -140,10 +166,17 @@ def _tolerance_free(fc: "FilterCorners", j: "Block", blocks: Sequence["Block"], 
     # s_end, increasing)
     k = bisect_right(ends, j.s_end)
     cap = max(j.cap, blocks[k].cap) if k < len(ends) else j.vtop
-    tcap = min(j.vtol, j.vctol)
+    tcap = j.vtol if j.vtol < j.vctol else j.vctol
+    # A queued junction's inputs rarely change between solves (issue 17): the verdict is kept with
+    # the two it was found for; du_n, a, j and the tolerance are fixed once the junction is pushed.
+    if cap == j.tf_cap and tcap == j.tf_tcap:
+        return j.tf_ok
     if tcap == math.inf:
-        return True
-    if tcap <= 0.0:
-        return False
-    unb, boosted = fc.braking_pair(j.du_n, j.a, j.j)
-    return cap * (fc.tol - unb) / tcap + boosted <= fc.tol
+        ok = True
+    elif tcap <= 0.0:
+        ok = False
+    else:
+        unb, boosted = fc.braking_pair(j.du_n, j.a, j.j)
+        ok = cap * (fc.tol - unb) / tcap + boosted <= fc.tol
+    j.tf_cap, j.tf_tcap, j.tf_ok = cap, tcap, ok
+    return ok
