@@ -49,3 +49,19 @@ def test_rough_never_enters_contour(pts, depth, retract, h):
     lv = sorted(set(round(v, 9) for v in levels), reverse=True)
     assert all(a - b_ <= depth + 1e-9 for a, b_ in zip(lv, lv[1:]))
     assert (b.position["Z"], b.position["X"]) == start
+
+
+coord = st.floats(-1e4, 1e4, allow_nan=False)
+
+
+@settings(max_examples=300, deadline=None)
+@given(p0=st.tuples(coord, coord), p1=st.tuples(coord, coord))
+def test_line_depths_from_its_ends(p0, p1):
+    """The roughing contour reads a line's depths from its two ends (issue 16): the lowest, the highest
+    and the last value, and whether the depth ever falls, are those of its eight-step samples."""
+    from nc.cycles.profile import _sample_ds
+
+    full = [p[1] for p in Seg(p0, p1).samples(8)]
+    short = _sample_ds(Seg(p0, p1))
+    assert (min(short), max(short), short[0], short[-1]) == (min(full), max(full), full[0], full[-1])
+    assert any(b < a for a, b in zip(short, short[1:])) == any(b < a for a, b in zip(full, full[1:]))

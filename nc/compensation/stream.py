@@ -283,6 +283,11 @@ def compensate(events: Iterable[Event], profile: object | None = None) -> Iterat
         return
     comp = Compensator()
     for ev in events:
+        # idle and not compensated: push would hand the event back as it is (issue 16: a lathe cycle's
+        # thousands of moves pass here)
+        if comp.pending is None and comp.out_pos is None and (not isinstance(ev, Move) or ev.comp is None):
+            yield ev
+            continue
         if type(ev) is MoveBatch:  # plain uncompensated moves (nc.interp.bulk): through whole when idle
             if comp.pending is None and comp.out_pos is None:
                 yield ev

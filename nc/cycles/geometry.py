@@ -7,7 +7,7 @@ Coordinates are (first, second) axes of the plane as in `Move.plane` — (Z, X r
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 EPS = 1e-9
 Pt = tuple[float, float]
@@ -74,15 +74,27 @@ class Seg:
         return (-d[0], -d[1]) if self.cw else d
 
     def samples(self, n: int = 16) -> list[Pt]:
-        return [self.point(i / n) for i in range(n + 1)]
+        """`point(i / n)` for i = 0 … n, the arc's start angle and sweep computed once (the same
+        expressions as `point`, so the same values)."""
+        c = self.center
+        if c is None:
+            (x0, y0), (x1, y1) = self.p0, self.p1
+            dx, dy = x1 - x0, y1 - y0
+            return [(x0 + dx * t, y0 + dy * t) for t in [i / n for i in range(n + 1)]]
+        a0 = math.atan2(self.p0[1] - c[1], self.p0[0] - c[0])
+        sw = self.sweep()
+        r = self.radius
+        return [(c[0] + r * math.cos(a), c[1] + r * math.sin(a)) for a in [a0 + sw * (i / n) for i in range(n + 1)]]
 
     def reversed(self) -> "Seg":
-        return replace(self, p0=self.p1, p1=self.p0, cw=not self.cw if self.is_arc else self.cw)
+        return Seg(self.p1, self.p0, self.center, not self.cw if self.is_arc else self.cw, self.rapid, self.src)
 
     def mapped(self, fn, flips: bool) -> "Seg":
-        """Image under a point map; ``flips`` says the map reverses orientation (a reflection)."""
-        return replace(self, p0=fn(self.p0), p1=fn(self.p1), center=fn(self.center) if self.center else None,
-                       cw=(not self.cw) if (flips and self.is_arc) else self.cw)
+        """Image under a point map; ``flips`` says the map reverses orientation (a reflection).
+        Built directly: dataclasses.replace looks at the fields on every call (issue 16)."""
+        c = self.center
+        return Seg(fn(self.p0), fn(self.p1), fn(c) if c else None, (not self.cw) if (flips and c is not None) else self.cw,
+                   self.rapid, self.src)
 
     def contains_angle(self, ang: float) -> bool:
         """Does the arc sweep pass the polar angle `ang` (strictly inside)?"""

@@ -53,12 +53,15 @@ class Contour:
         self.f_start = self.segs[0].p0[0]
         self.f_end = self.segs[-1].p1[0]
         self._check(type_one)
-        pts = [p for s in self.segs for p in s.samples(8)]
+        ds = [d for s in self.segs for d in _sample_ds(s)]
         for s in self.segs:
             if s.is_arc:
-                pts.extend(self._arc_extremes(s))
-        self.d_min = min(p[1] for p in pts)
-        self.d_max = max(p[1] for p in pts)
+                ds.extend(p[1] for p in self._arc_extremes(s))
+        self.d_min = min(ds)
+        self.d_max = max(ds)
+        # (f low, f high, element) of the elements not vertical in f, for `depth_at`
+        self._spans = [(lo, hi, s) for s in self.segs
+                       for lo, hi in [(min(s.p0[0], s.p1[0]), max(s.p0[0], s.p1[0]))] if hi - lo >= TOL]
 
     def _check(self, type_one: bool) -> None:
         # Monotone along the cutting axis is judged on block end points. An arc may bulge past its end
@@ -73,7 +76,7 @@ class Contour:
                 raise NcAlarm(0x0246, "the P–Q contour turns back against the cutting direction "
                                       "(it must be monotone along the cutting axis)")
             if type_one:
-                ds = [p[1] for p in s.samples(8)]
+                ds = _sample_ds(s)
                 if any(b < a - TOL for a, b in zip([last_d] + ds, ds)):
                     raise NcAlarm(0x0246, "type I roughing needs a monotone contour; program X and Z in the "
                                           "P block for a type II (pocket) contour")
@@ -89,11 +92,10 @@ class Contour:
     def depth_at(self, f: float) -> float:
         """c(f) on the non-vertical element spanning f (max over touching elements)."""
         best: float | None = None
-        for s in self.segs:
-            lo, hi = min(s.p0[0], s.p1[0]), max(s.p0[0], s.p1[0])
-            if hi - lo < TOL or not (lo - TOL <= f <= hi + TOL):
+        for lo, hi, s in self._spans:
+            if not (lo - TOL <= f <= hi + TOL):
                 continue
-            if not s.is_arc:
+            if s.center is None:
                 t = (f - s.p0[0]) / (s.p1[0] - s.p0[0])
                 d = s.p0[1] + t * (s.p1[1] - s.p0[1])
             else:
@@ -155,6 +157,18 @@ class Contour:
                 else:
                     spans.append((hi, lo))
         return spans
+
+
+def _sample_ds(s: Seg) -> list[float]:
+    """The second coordinates of `s.samples(8)`. A line's come from its two ends alone when they do not
+    fall: p0 + (p1 - p0)·t with correctly rounded - and · never decreases in t then, so the samples
+    between add no extreme and no drop (issue 16: the roughing cycles sampled every line)."""
+    if s.center is None:
+        y0 = s.p0[1]
+        dy = s.p1[1] - y0
+        if dy >= 0:
+            return [y0 + dy * 0.0, y0 + dy * 1.0]
+    return [p[1] for p in s.samples(8)]
 
 
 def segs_from_moves(moves: list, plane: tuple[str, str]) -> list[Seg]:

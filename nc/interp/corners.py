@@ -74,7 +74,7 @@ def _fail(pending: tuple[Move, str, float]) -> None:
 def _mark(interp: "InterpHost", mv: Move) -> tuple[str, float] | None:
     """The ,C / ,R request of the block that produced this move (only its last move carries it)."""
     b = interp.block
-    if b is None or b.line != mv.line or b.text != mv.block or "G31" in mv.tags:
+    if b is None or not b.comma or b.line != mv.line or b.text != mv.block or "G31" in mv.tags:
         return None
     if "C" in b.comma:
         return "C", b.comma["C"] * (25.4 if interp.state.inch else 1.0)
