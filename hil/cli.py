@@ -38,15 +38,18 @@ class _Version(argparse.Action):
         parser.exit()
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser(command: str | None = None) -> argparse.ArgumentParser:
     """Every subcommand registers itself; command modules import only argparse at the top and load
     what they run (the bench, pyarrow, python-can, the runner) inside their command function, so
-    `hil path` does not pay for `hil run`'s imports (issue 16)."""
+    `hil path` does not pay for `hil run`'s imports (issue 16). `command`: only that subcommand's
+    module (each module registers the command of its name), for a command line that names it."""
     parser = argparse.ArgumentParser(prog="hil", description="Delta NC5 hardware-in-the-loop bench driver")
     parser.add_argument("--version", action=_Version, help="show program's version number and exit")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     sub.required = True
     for mod in sorted(pkgutil.iter_modules(hil.commands.__path__), key=lambda m: m.name):
+        if command is not None and mod.name != command:
+            continue
         module = importlib.import_module(f"hil.commands.{mod.name}")
         register = getattr(module, "register", None)
         if register is not None:
@@ -55,7 +58,12 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    parser = build_parser()
+    argv = sys.argv[1:] if argv is None else list(argv)
+    # `hil path …` registers `path` alone (some 150 arguments of every other command not built at
+    # start-up); anything else (`hil --help`, a misspelt command) gets the whole parser
+    first = argv[0] if argv else ""
+    known = first.isidentifier() and any(m.name == first for m in pkgutil.iter_modules(hil.commands.__path__))
+    parser = build_parser(first if known else None)
     args = parser.parse_args(argv)
     try:
         return int(args.func(args) or 0)

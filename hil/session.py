@@ -8,12 +8,12 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Sequence
 
 from hil import strict_json
-from hil.bench import Bench, default_lathe
 from nc.alarms import Alarm, NcAlarm
 from nc.profiles import PROFILE_NAMES
 from nc.program import Program, parse_program
 
 if TYPE_CHECKING:  # the bus side loads where a link or a drive is made, not for `hil path` (issue 16)
+    from hil.bench import Bench
     from fieldbus.link import BusLink
     from virtual_bus.drive import Cia402Drive
 
@@ -45,16 +45,23 @@ def load_bench(path: str | None, profile: str | None = None, bus: str | None = N
 
         bench = load_bench_file(path)
     else:
+        from hil.bench import default_lathe  # with the drive and fieldbus configs it holds
+
         bench = default_lathe()
     return override_bench(bench, profile, bus)
+
+
+def checked_profile(name: str) -> str:
+    """A `--profile` name, or the InputError listing the names."""
+    if name not in PROFILE_NAMES:
+        raise InputError(f"unknown profile {name!r}; choose one of {', '.join(PROFILE_NAMES)}")
+    return name
 
 
 def override_bench(bench: Bench, profile: str | None = None, bus: str | None = None) -> Bench:
     """`--profile` and `--bus` over what the bench says."""
     if profile:
-        if profile not in PROFILE_NAMES:
-            raise InputError(f"unknown profile {profile!r}; choose one of {', '.join(PROFILE_NAMES)}")
-        bench.profile = profile
+        bench.profile = checked_profile(profile)
     if bus:
         bench.bus = bus
     return bench

@@ -90,3 +90,17 @@ def test_feed_per_revolution_is_flagged(hil, program):
     moves = hil("path", program("G99 S500 M03\nG01 Z-5. F0.2\nG98\nG01 Z-10. F100\n"), "--json").json_lines()
     assert moves[0]["feed"] == 0.2 and moves[0]["per_rev"] is True
     assert moves[1]["feed"] == 100.0 and "per_rev" not in moves[1]
+
+
+def test_without_a_bench_path_runs_on_the_default_benchs_profile_and_parameters(hil, program):
+    """`hil path` without --bench does not load the bench module (start-up, issue 16): it takes the default
+    bench's profile and parameters as constants, which must stay what `default_lathe()` holds."""
+    from hil.bench import default_lathe
+    from hil.commands.path import DEFAULT_PROFILE
+
+    bench = default_lathe()
+    assert (bench.profile, bench.params) == (DEFAULT_PROFILE, {})
+    p = program("G00 X50. Z60.\n")
+    assert hil("path", p, "--json").json_lines()[0]["end"] == {"X": 25.0, "Z": 60.0}  # a lathe: X a diameter
+    r = hil("path", p, "--profile", "zz")
+    assert r.code == 2 and "unknown profile 'zz'" in r.err

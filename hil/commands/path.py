@@ -278,17 +278,23 @@ def batch_text(b: MoveBatch) -> str:
     return "\n".join(out)
 
 
+DEFAULT_PROFILE = "nc5-lathe-a"  # hil.bench.default_lathe's (tests/test_foundation_path.py holds them equal)
+
+
 def cmd_path(args: argparse.Namespace) -> int:
-    from hil.session import InputError, load_bench, print_alarm
+    from hil.session import InputError, checked_profile, load_bench, print_alarm
     from nc.interp import Interpreter
     from nc.moves import Move, MoveBatch, Sync
     from nc.profiles import make_profile
     from nc.store import ProgramStore
 
     try:
-        bench = load_bench(args.bench, args.profile)
+        if args.bench:
+            bench = load_bench(args.bench, args.profile)
+            profile_name, params = bench.profile, dict(bench.params)
+        else:  # the default bench's profile, no parameters: without loading the bench module (start-up)
+            profile_name, params = checked_profile(args.profile) if args.profile else DEFAULT_PROFILE, {}
         var_ids = parse_ranges(args.vars) if args.vars else []
-        params = dict(bench.params)
         for item in args.param:
             name, sep, value = item.partition("=")
             if not sep:
@@ -298,7 +304,7 @@ def cmd_path(args: argparse.Namespace) -> int:
             params["M2x010"] = 1
         interrupt = parse_interrupt(args.interrupt) if getattr(args, "interrupt", None) else None
         rotary = tuple(a.name for a in bench.axes if a.units == "deg") if args.bench else ()
-        profile = make_profile(bench.profile, bench.axis_names if args.bench else None, params, rotary)
+        profile = make_profile(profile_name, bench.axis_names if args.bench else None, params, rotary)
     except (InputError, ValueError) as exc:
         print(f"hil path: {exc}", file=sys.stderr)
         return EXIT_USAGE

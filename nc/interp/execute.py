@@ -23,7 +23,7 @@ from nc.moves import Aux, Event, Move, ProgramEnd, Sync
 from nc.program.blocks import Block, Word
 
 
-@dataclass
+@dataclass(slots=True)
 class BlockRun:
     """One block as read and checked: what its steps share."""
 
@@ -315,39 +315,44 @@ class ExecuteMixin:
     def _read_run(self, block: Block, raw: Block | None = None) -> tuple[BlockRun, tuple[Step, ...]]:
         """Read and check the block's G and M codes: letters it may not hold, M ranges, one call per
         block; with the steps that can act on it. What depends on the block's text alone (G lookup,
-        letter check, plan) is done once per block `raw` whose G and M words are plain numbers
-        (a loop body runs thousands of times)."""
+        letter check, M codes and their checks, plan) is done once per block `raw` whose G and M words
+        are plain numbers (a loop body runs thousands of times)."""
         memo = self._plans
         hit = memo.get(id(raw)) if raw is not None else None
-        has_m = True  # the block may hold M codes (known not to when its plan is remembered)
         if hit is not None and hit[0] is raw:
-            gcodes, funcs, steps, has_m = hit[1], hit[2], hit[3], hit[4]
+            gcodes, funcs, steps, mvals = hit[1], hit[2], hit[3], hit[4]
             if steps is None:  # the block's own letters are refused: as checked on its values
                 self._check_letters(block, funcs)
                 steps = ALL_STEPS
-        else:
-            gcodes = self._gcodes(block)
-            funcs = {fn for _, fn, _ in gcodes}
-            self._check_letters(block, funcs)
-            steps = ALL_STEPS
-            if raw is not None and not any(w.expr is not None and w.letter in "GM" for w in raw.words):
-                try:  # the raw block's letters (a vacant word is dropped from `block`, never added)
-                    self._check_letters(raw, funcs)
-                    steps = plan(Shape(frozenset(w.letter for w in raw.words), frozenset(funcs),
-                                       frozenset(g for g, _, _ in gcodes)))
-                except NcAlarm:
-                    steps = None
-                if len(memo) >= _PLAN_LIMIT:
-                    memo.clear()
-                memo[id(raw)] = (raw, gcodes, funcs, steps, any(w.letter == "M" for w in raw.words))
-                steps = steps or ALL_STEPS
+            self._check_g68(funcs)
+            return BlockRun(block, gcodes, funcs, mvals, self.state.css), steps
+        gcodes = self._gcodes(block)
+        funcs = {fn for _, fn, _ in gcodes}
+        self._check_letters(block, funcs)
+        steps: tuple[Step, ...] | None = ALL_STEPS
+        plain = raw is not None and not any(w.expr is not None and w.letter in "GM" for w in raw.words)
+        if plain:
+            try:  # the raw block's letters (a vacant word is dropped from `block`, never added)
+                self._check_letters(raw, funcs)
+                steps = plan(Shape(frozenset(w.letter for w in raw.words), frozenset(funcs),
+                                   frozenset(g for g, _, _ in gcodes)))
+            except NcAlarm:
+                steps = None
+        self._check_g68(funcs)
+        mvals = self._mcodes(block, funcs)
+        if plain:  # remembered once its M codes passed their checks (they alarm again on every read)
+            if len(memo) >= _PLAN_LIMIT:
+                memo.clear()
+            memo[id(raw)] = (raw, gcodes, funcs, steps, mvals)
+        return BlockRun(block, gcodes, funcs, mvals, self.state.css), steps or ALL_STEPS
+
+    def _check_g68(self, funcs: set[str]) -> None:
         if (self.state.rotation or "G68" in funcs) and "G69" not in funcs and funcs & REFUSED_UNDER_G68:
             raise NcAlarm(0x025F, f"{' '.join(sorted(funcs & REFUSED_UNDER_G68))} while G68 rotation is on: "
                                   "cancel it with G69 first")
-        if not has_m:  # no M word: only the G65/G66 pair can break the one-call rule
-            if "G65" in funcs and "G66" in funcs:
-                _one_call(funcs, [])
-            return BlockRun(block, gcodes, funcs, [], self.state.css), steps
+
+    def _mcodes(self, block: Block, funcs: set[str]) -> list[int]:
+        """The block's M codes, checked: range, count, one call per block, M98 alone."""
         mcodes = block.all("M")
         for w in mcodes:
             if w.value != int(w.value) or not 0 <= w.value <= 65534:
@@ -360,7 +365,7 @@ class ExecuteMixin:
         _one_call(funcs, mvals)
         if 98 in mvals and len(mvals) > 1:
             raise NcAlarm(0x0249, "M98 must be the only M code of its block")
-        return BlockRun(block, gcodes, funcs, mvals, self.state.css), steps
+        return mvals
 
     def _halt_m(self, mvals: list[int]) -> int | None:
         first = int(self.profile.param("N1.118", 0))

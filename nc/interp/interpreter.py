@@ -86,7 +86,7 @@ class Interpreter(ExecuteMixin, ReadingMixin, ModalMixin, MotionMixin, NonModalM
         self._executed = 0
         self._block_limit = int(profile.param("max blocks", 1_000_000))  # set per run by _run
         self._call_tables = None  # G/M code-call tables from the parameters (CallsMixin._call_table)
-        self._plans: dict[int, tuple] = {}  # id(block) -> (block, G codes, functions, steps, has M) (_read_run)
+        self._plans: dict[int, tuple] = {}  # id(block) -> (block, G codes, functions, steps, M codes) (_read_run)
         self._gcall_depth = 0
         self._three_point: dict[str, float] | None = None  # G2.4/G3.4 middle point
         self._plain_axes = frozenset(self.axes) - {"G", "M", "T", "F", "S", "D"}  # `_axis_block` letters
@@ -134,6 +134,7 @@ class Interpreter(ExecuteMixin, ReadingMixin, ModalMixin, MotionMixin, NonModalM
         bulk = None
         if self.bulk:  # a consumer that takes MoveBatch events (`hil path`)
             from nc.interp import bulk
+        cur = None  # the frame `blocks`, `count`, `plain_at` and `name` are of (read again when it changes)
         while self.stack:
             if budget is not None and budget.spent:
                 yield BUSY  # the rest of the macro next cycle; the cycle never stalls (decisions B2)
@@ -143,38 +144,47 @@ class Interpreter(ExecuteMixin, ReadingMixin, ModalMixin, MotionMixin, NonModalM
                 self._interrupt_pending = False
                 yield from self._start_interrupt()
                 continue
-            blocks = fr.program.blocks
-            if fr.pc >= len(blocks):
+            if fr is not cur:
+                cur, blocks, name = fr, fr.program.blocks, fr.program.name
+                count = len(blocks)
+                plain_at = getattr(blocks, "plain_at", None)
+            pc = fr.pc
+            if pc >= count:
                 if len(self.stack) == 1:
                     break
                 self._return(None)  # end of a subprogram without M99 returns like M99
                 continue
             # the bulk lane is asked only at a line still held as text (a parsed block, such as a
             # macro statement, is never the start of a run)
-            if bulk is not None and (plain := getattr(blocks, "plain_at", None)) is not None and plain(fr.pc) \
+            if bulk is not None and plain_at is not None and plain_at(pc) \
                     and (batch := bulk.take(self, fr, limit)) is not None:
                 yield batch  # a run of plain G0/G1 blocks read in one pass (nc.interp.bulk)
                 last = self.block
                 continue
-            last = blocks[fr.pc]
-            block = self._take_block(fr, limit, last)
-            if block is None:
+            block = last = blocks[pc]
+            # `_take_block`, inline: this runs for every block
+            fr.pc = pc + 1
+            self._executed += 1
+            if self._executed > limit:
+                self._too_many(fr, limit, block)
+            if block.skip and self.block_skip:
                 continue
+            self.program_name = name
             if block.stmt is not None:  # a macro statement: a plain call, no generator (issue 16)
                 # and the statements after it in this frame, without the checks above: a statement
                 # neither pushes nor pops a frame, and nothing outside runs until this generator yields
                 # (a statement budget is checked above, statement by statement)
-                plain_at = getattr(blocks, "plain_at", None)
                 try:
                     while (ev := self._statement(block)) is None and budget is None:
                         pc = fr.pc
-                        if pc >= len(blocks) or (plain_at is not None and plain_at(pc)) \
-                                or (nxt := blocks[pc]).stmt is None:
+                        if pc >= count or (plain_at is not None and plain_at(pc)) \
+                                or (nxt := blocks[pc]).stmt is None or nxt.skip:
                             break
-                        last = nxt
-                        block = self._take_block(fr, limit, nxt)
-                        if block is None:
-                            break
+                        last = block = nxt
+                        fr.pc = pc + 1
+                        self._executed += 1
+                        if self._executed > limit:
+                            self._too_many(fr, limit, block)
                 except (NcAlarm, ValueError, ArithmeticError, OverflowError) as exc:
                     raise _located(exc, block, fr.program.name) from None
                 if ev is not None:
@@ -201,14 +211,17 @@ class Interpreter(ExecuteMixin, ReadingMixin, ModalMixin, MotionMixin, NonModalM
         fr.pc += 1
         self._executed += 1
         if self._executed > limit:
-            extra = int(self.profile.param("max blocks", 1_000_000))
-            raise NcAlarm(ENDLESS_LOOP, f"more than {extra} blocks executed beyond the program's own {limit - extra} "
-                                        "blocks (endless loop?; parameter 'max blocks')",
-                          line=block.line, block=block.text, program=fr.program.name)
+            self._too_many(fr, limit, block)
         if block.skip and self.block_skip:
             return None
         self.program_name = fr.program.name
         return block
+
+    def _too_many(self, fr: Frame, limit: int, block: Block) -> None:
+        extra = int(self.profile.param("max blocks", 1_000_000))
+        raise NcAlarm(ENDLESS_LOOP, f"more than {extra} blocks executed beyond the program's own {limit - extra} "
+                                    "blocks (endless loop?; parameter 'max blocks')",
+                      line=block.line, block=block.text, program=fr.program.name)
 
     def _check_no_pending_angle(self) -> None:
         """A held two-block `,A` block never gets its partner at the end of the program."""
