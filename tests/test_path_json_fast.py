@@ -49,3 +49,15 @@ def test_a_compensated_thread_pass_writes_its_additive_keys() -> None:
                             '"dir": null, "feed": 2.0, "duration": null, "per_rev": true, "tags": ["G76", "pass 3"], '
                             '"lead": 2.0, "lead_change": 0.0, "start_angle": 0.0, "comp": "G42", "comp_radius": 0.4, '
                             '"tip": 3}')
+
+
+@settings(max_examples=2000, deadline=None)
+@given(st.one_of(st.floats(allow_nan=False, allow_infinity=False), st.floats(-1e9, 1e9),
+                 st.integers(-10**9, 10**9).map(lambda n: n / 10**7), st.integers(-10**9, 10**9).map(lambda n: n / 2**20),
+                 st.sampled_from([1e-4, -1e-4, 0.00009999995, 0.00010000005, 99999999.99999996, 1e8, 0.5e-7,
+                                  2.5e-7, 1.00000005, 0.00015])))
+def test_seven_decimals_is_repr_of_round(v: float) -> None:
+    """The 7-decimal number text of a coordinate ('%.7f' stripped) is repr(round(v, 7)) (issue 16)."""
+    from hil.commands.path import _seven
+
+    assert _seven(v) == repr(round(v, 7) + 0.0)

@@ -143,6 +143,18 @@ def _val(v) -> str:
     return _num(fmt(v))
 
 
+def _seven(v: float) -> str:
+    """`_val(v)` of a finite float, repr(round(v, 7) + 0.0), at a quarter of its cost: '%.7f' rounds
+    to the same 7-decimal number D as round() does (both correctly rounded from the exact double),
+    and between 1e-4 and 1e8 D has at most 15 significant digits, so the shortest repr of the double
+    nearest D is D itself without its trailing zeros (repr writes no exponent there). Outside that
+    range (zero, tiny, huge) the general way. Pinned by tests/test_path_json_fast.py."""
+    if 1e-4 <= abs(v) < 1e8:
+        t = ("%.7f" % v).rstrip("0")
+        return t + "0" if t[-1] == "." else t
+    return repr(round(v, 7) + 0.0)
+
+
 _TEMPLATES: dict[tuple, tuple[str, dict]] = {}  # axis names -> ('{"X": %s, "Z": %s}', points written)
 _FLOATS = {float}
 _POINTS_LIMIT = 4096  # points remembered per axis set: a move's start is the last move's end
@@ -161,8 +173,7 @@ def _axes(d: dict[str, float]) -> str:
         if text is not None:
             return text
         if (s := sum(vals)) - s == 0:  # all finite (a NaN or ±inf makes s - s nan)
-            # `_val` of each inline: round(v, 7) + 0.0 is fmt(v) (-0.0 + 0.0 is 0.0)
-            text = t % tuple([repr(round(v, 7) + 0.0) for v in vals])
+            text = t % tuple([_seven(v) for v in vals])
             if len(points) >= _POINTS_LIMIT:
                 points.clear()
             points[vals] = text
@@ -172,6 +183,8 @@ def _axes(d: dict[str, float]) -> str:
 
 _QUOTED: dict[str, str] = {}  # block text -> its JSON string: the moves of a cycle share their block
 _QUOTED_LIMIT = 4096
+_HEADS: dict[tuple, str] = {}  # (kind, line, block text) -> the line's text up to the start point
+_TAGS: dict[tuple, str] = {}  # tags (strings) -> their ', "tags": [...]' text
 
 
 def _str(s) -> str:
@@ -195,8 +208,15 @@ def move_json(m: Move) -> str:
     if m.start is None or m.end is None or m.work is None or type(m.line) is not int \
             or type(m.kind) is not str:
         return strict_json.dumps(move_dict(m))
-    text = (f'{{"kind": {_str(m.kind)}, "line": {m.line}, "block": {_str(m.block)}, '
-            f'"start": {_axes(m.start)}, "end": {_axes(m.end)}, "work": {_axes(m.work)}, '
+    key = (m.kind, m.line, m.block)
+    head = _HEADS.get(key)
+    if head is None:  # the moves of a cycle share their block: its head is written once
+        head = f'{{"kind": {_str(m.kind)}, "line": {m.line}, "block": {_str(m.block)}, "start": '
+        if type(m.block) is str:
+            if len(_HEADS) >= _QUOTED_LIMIT:
+                _HEADS.clear()
+            _HEADS[key] = head
+    text = (f'{head}{_axes(m.start)}, "end": {_axes(m.end)}, "work": {_axes(m.work)}, '
             f'"center": {"null" if m.center is None else _axes(m.center)}, '
             f'"dir": {"null" if m.dir is None else _str(m.dir)}, "feed": {_num(m.feed)}, "duration": {_num(m.duration)}')
     if m.per_rev and m.feed is not None:  # the additive keys of move_dict, in its order
@@ -204,7 +224,14 @@ def move_json(m: Move) -> str:
     if m.exact_stop:
         text += ', "exact_stop": true'
     if m.tags:
-        text += ', "tags": [' + ", ".join([_str(t) for t in m.tags]) + "]"
+        tags = _TAGS.get(m.tags)
+        if tags is None:
+            tags = ', "tags": [' + ", ".join([_str(t) for t in m.tags]) + "]"
+            if type(m.tags) is tuple and all(type(t) is str for t in m.tags):
+                if len(_TAGS) >= _QUOTED_LIMIT:
+                    _TAGS.clear()
+                _TAGS[m.tags] = tags
+        text += tags
     if m.kind == "thread":
         text += f', "lead": {_num(m.lead)}, "lead_change": {_num(m.lead_change)}, "start_angle": {_num(m.start_angle)}'
     if m.comp:
