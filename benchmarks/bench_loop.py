@@ -102,23 +102,34 @@ def staged(label: str, program: Path, bench_file: Path | None, trace: str | None
         finally:
             holder["wall"], holder["cpu"] = time.perf_counter() - t0, time.thread_time() - c0
 
+    import hil.stretch as stretch
+
     nc = _Stage(Channel.step)
     stages["NC"].append(nc)
+    # a stretch's planner samples count as NC, its drive models as bus + drives (hil/stretch.py)
+    patched = {name: _Stage(getattr(stretch, name)) for name in ("sample_stretch", "csp_stretch", "csv_stretch")}
+    stages["NC"].append(patched["sample_stretch"])
+    stages["bus + drives"] += [patched["csp_stretch"], patched["csv_stretch"]]
     BenchRunner.run_program = timed_run
     Channel.step = lambda self: nc(self)
+    for name, st in patched.items():
+        setattr(stretch, name, st)
     try:
         t0 = time.perf_counter()
         res = api.run(program, str(bench_file) if bench_file else None, trace=trace)
         total = time.perf_counter() - t0
     finally:
         BenchRunner.run_program, Channel.step = original, nc.fn
+        for name, st in patched.items():
+            setattr(stretch, name, st.fn)
     r, wall, cpu = res.run, holder["wall"], holder["cpu"]
     n = max(1, r.cycles)
     parts = {k: sum(st.seconds for st in v) for k, v in stages.items()}
     parts["rest"] = cpu - sum(parts.values())
     print(f"{label}: {r.cycles} cycles, {r.sim_time:.2f} s simulated; the cycles took {cpu:.2f} s CPU = "
           f"{r.sim_time / cpu:.1f}x real time ({wall:.2f} s wall = {r.sim_time / wall:.1f}x); whole run incl. "
-          f"post-run checks {total:.2f} s wall ({'completed' if r.ok else 'not completed'})")
+          f"post-run checks {total:.2f} s wall ({'completed' if r.ok else 'not completed'}; "
+          f"{r.stretched / n:.0%} of the cycles in stretches)")
     print("  CPU µs per cycle: " + "  ".join(f"{k} {v / n * 1e6:.1f}" for k, v in parts.items())
           + f"  | total {cpu / n * 1e6:.1f}")
 

@@ -35,6 +35,7 @@ from fieldbus.cia402 import State, Target
 from fieldbus.link import SimLink
 from fieldbus.pdo import RxPdo, TxPdo
 from hil.clock import LockStepClock
+from hil.stretch_bulk import bulk_cycles, bulk_ok
 from mlc.basic import BasicMlc
 from mlc.machine import Mlc
 from mlc.spindle_axis import SPINDLE
@@ -139,7 +140,13 @@ class Stretcher:
                 cmds.append(float(pl.spindle_command()))  # type: ignore[misc]
             return Setpoint(positions[k], lines[k], float(vel[k]), mv)
 
+        cut = False
         while k < m:
+            if k == 1 and bulk_ok(r):  # the first cycle wrote what the stretch's state decides: the rest at once
+                bulk_cycles(r, ch, pl, smp, outs, 1, m, raw[m - 1], (rpms, cmds) if settle else None)
+                k = m
+                pl.position = last_raw
+                break
             r.timing = clock.tick()
             link.time += dt
             link.cycles += 1
@@ -151,14 +158,15 @@ class Stretcher:
             r._cycle(tx, step)
             k += 1
             if state["fell_back"]:
+                cut = True
                 break
             pl.position = raw[k] if k < m else last_raw
             if k < m and not self._still_quiet(r, gate, scans, panel, rx0, targets, k):
                 self._cut(pl, saved_pl, saved_drives, rx0, targets, k, k, rpms, cmds)
+                cut = True
                 break
-        else:
-            if settle:
-                settle_stretch(pl, rpms, cmds)
+        if not cut and settle:
+            settle_stretch(pl, rpms, cmds)
         for d, rx in zip(self.drives, r.rx):
             d._rx = rx  # the runner's own RxPdo from now on, as exchange() latches it
         self.stretches += 1

@@ -109,3 +109,64 @@ def test_a_hardware_limit_switch_bench_steps_every_cycle_the_same(monkeypatch, t
     assert ra == rb
     assert [x.code for x in b.alarms] == [0x0402]
     assert b.stretched == 0
+
+
+_EXCHANGE = BenchRunner._exchange
+
+
+def _states(monkeypatch, on: str, program: str, **kw) -> tuple[dict, object]:
+    """The machine's state at the start of every stepped cycle: MLC device memory and counters, the runner's
+    counters and clock. A stretch's cycles are not stepped; the cycle after one must find what stepping left."""
+    monkeypatch.setenv(ENV, on)
+    seen: dict[int, tuple] = {}
+    original = _EXCHANGE  # not the hook a previous run of the test installed
+
+    def exchange(self: BenchRunner) -> None:
+        mlc = self.mlc
+        mem = getattr(mlc, "mem", None)
+        gate = getattr(mlc, "gate", None)
+        pl = self.channel.planner if self.channel is not None else None
+        seen[self.cycle] = (
+            bytes(mem.m) if mem is not None else None, mem.d.tobytes() if mem is not None else None,
+            getattr(mlc, "time", None), getattr(getattr(mlc, "link", None), "cycle", getattr(mlc, "cycle", None)),
+            (gate.scans, gate.skipped) if gate is not None else None, self.time, list(self._rest),
+            list(self._last_position), [m.cycles_in_state for m in self.masters], dict(self.result.max_ferr),
+            self.clock._n, self.link.time, self.line, self._commands.tolist(), self.actual.tolist(),
+            [(rx.target_position, rx.target_velocity, rx.controlword, rx.mode) for rx in self.rx],
+            pl._settle.cycles if pl is not None else None, getattr(getattr(mlc, "caxis", None), "_cycles", None))
+        original(self)
+
+    monkeypatch.setattr(BenchRunner, "_exchange", exchange)
+    from hil.api import run
+
+    r = run(program, check=False, **kw)
+    return seen, r
+
+
+@pytest.mark.parametrize("kw", [{}, {"mlc": "basic"}, {"feed_override": 80.0, "spindle_override": 110.0}])
+def test_the_machine_after_a_stretch_is_the_stepped_one(monkeypatch, kw):
+    """Stretches without device columns or events take their cycles after the first at once (hil/stretch_bulk.py):
+    whatever a stretch ends in (MLC memory, scan counts, clocks, rest counters, setpoints) is what stepping
+    reaches at the same cycle."""
+    stepped, a = _states(monkeypatch, "0", DEMO, **kw)
+    stretched, b = _states(monkeypatch, "1", DEMO, **kw)
+    assert b.run.stretched > 0.8 * b.run.cycles
+    assert len(stretched) < 0.2 * len(stepped)
+    for cycle, state in stretched.items():
+        assert state == stepped[cycle], cycle
+    assert (a.run.cycles, a.run.final, a.run.max_ferr) == (b.run.cycles, b.run.final, b.run.max_ferr)
+
+
+@pytest.mark.parametrize("kw", [{}, {"mlc": "basic", "feed_override": 120.0}])
+def test_plain_trace_of_bulk_stretches_equals_stepped(monkeypatch, tmp_path, kw):
+    """Without device columns the cycles after a stretch's first are taken at once: the trace is the stepped one."""
+    from hil.api import run
+
+    tables = []
+    for on in ("0", "1"):
+        monkeypatch.setenv(ENV, on)
+        r = run(DEMO, trace=str(tmp_path / f"p{on}.parquet"), check=False, **kw)
+        t = pq.read_table(tmp_path / f"p{on}.parquet")
+        tables.append({c: t.column(c).to_pylist() for c in t.column_names if c not in ("period", "late")})
+    assert r.run.stretched > 0.8 * r.run.cycles
+    assert tables[0] == tables[1]

@@ -1,0 +1,211 @@
+"""A stretch's cycles after its first, done at once (issue 17, decision B20).
+
+The first cycle of a stretch runs through the runner's own cycle (`BenchRunner._cycle`); it writes every NC
+output the stretch's state decides (modes, strobes, running, queue length ...). In the cycles after it
+nothing the NC or the MLC reads changes except what the drives feed back, so `bulk_ok` admits a stretch
+here when every cycle of it would do exactly this, and `bulk_cycles` does it once for all of them:
+- the runner: cycle and time (time summed cycle by cycle, so its rounding is the stepped one), the masters'
+  cycle count in their state (step() returns the same controlword), the rest counters, the maximum
+  following error, the last feedback, actual and command positions, the program line;
+- the MLC: its time and scan counts, the scans its gate skips (the gate's recorded reads are none of the
+  devices written here, and it waits for no timer), the drive status words of the last cycle with the peak
+  torque held over the stretch, the blink relays and the axis-at-0 relays of the last cycle;
+- the trace: one row per cycle from the drives' columns, the same values the row of a stepped cycle has.
+"""
+
+from __future__ import annotations
+
+import time as _time
+from typing import Any
+
+import numpy as np
+
+from hil.mlc_bridge import drive_status
+from mlc.basic import BasicMlc
+from mlc.machine import Mlc
+from mlc.nc_link import MANUAL_MODES
+from mlc.on_change import AREA_M, AREA_WORDS
+from mlc.spindle_axis import SPINDLE
+from nc.channel import Channel
+from nc.motion.planner import Planner
+from nc.motion.stretch import Samples
+from virtual_bus.drive_stretch import Stretch
+
+
+def written_devices(x: int) -> set[tuple[int, int]]:
+    """The devices a bulk stretch writes for its last cycle only (a superset of what changes cycle by cycle in
+    a quiet stretch): the blink relays, the drive status (ChannelLink._drive_outputs), the axis-at-0 relays."""
+    b3 = 30000 + 1000 * x
+    m = {29032, 29033, 30000, b3 + 34, b3 + 36}
+    for lo, hi in ((b3 + 96, b3 + 104), (b3 + 256, b3 + 288), (b3 + 352, b3 + 368), (b3 + 464, b3 + 512),
+                   (b3 + 704, b3 + 832)):
+        m.update(range(lo, hi))
+    d3 = 30000 + 100 * x  # d3(x, i) = D3x0ii: the spindle's rpm and angle (D3x026-D3x029)
+    words = set(range(30240, 30440)) | set(range(d3 + 26, d3 + 30))
+    return {(AREA_M, i) for i in m} | {(AREA_WORDS, i) for i in words}
+
+
+def bulk_ok(r: Any) -> bool:
+    """Every cycle after a stretch's first would take the path `bulk_cycles` takes (module doc)."""
+    from hil.scripting import OperatorPanel
+
+    if r.trace_sources or not (r.on_cycle is None or type(r.on_cycle) is OperatorPanel):
+        return False  # device columns and --at events are read cycle by cycle
+    mlc = r.mlc
+    if type(mlc) is BasicMlc:
+        return True
+    if type(mlc) is not Mlc or mlc.io_modules or mlc.caxis.state != SPINDLE or mlc.caxis._started is not None:
+        return False
+    link = mlc.link
+    if link.mode in MANUAL_MODES or link.hard_limits.latched or link.limit_latch.latched or \
+            (link.manual is not None and link.manual.clamped):
+        return False  # AUTO only: the manual windows and latches are not worked out
+    gate = mlc.gate
+    if gate is None or gate.last is None or gate.last.dirty or gate.last.timers:
+        return False
+    key = ("bulk-written", link.x)
+    devices = _CACHE.get(key)
+    if devices is None:
+        devices = _CACHE[key] = written_devices(link.x)
+    return devices.isdisjoint(gate.last.reads)
+
+
+_CACHE: dict[tuple, set] = {}
+
+
+def bulk_cycles(r: Any, ch: Channel, pl: Planner, smp: Samples, outs: list[Stretch], k0: int, m: int,
+                before_last_step: np.ndarray, settle: tuple[list[float], list[float]] | None) -> None:
+    """Cycles k0 … m-1 of the stretch as the runner's cycle would run them one by one (module doc)."""
+    t_wall = _time.perf_counter_ns()
+    cnt = m - k0
+    dt = r.bench.cycle
+    n_axes = len(r.axes)
+    times = []
+    t = r.time
+    for _ in range(cnt):
+        t += dt
+        times.append(t)
+    r.time = t
+    link = r.link
+    lt = link.time
+    for _ in range(cnt):
+        lt += dt
+    link.time = lt
+    link.cycles += cnt
+    first_cycle = r.cycle + 1
+    r.cycle += cnt
+    for master in r.masters:
+        master.cycles_in_state += cnt  # step() in a held state: the same controlword, one more cycle in it
+    rest, last = r._rest, r._last_position
+    for i, o in enumerate(outs):
+        n_rest, p_last = rest[i], last[i]
+        for p, v in zip(o.position_actual[k0:m], o.velocity_actual[k0:m]):
+            n_rest = n_rest + 1 if p == p_last and v == 0 else 0
+            p_last = p
+        rest[i], last[i] = n_rest, p_last
+    r.tx = tx = [o.last for o in outs]
+    scales, org = r.scales, r.origin.tolist()
+    r.actual[:] = [scales[i].to_units(tx[i].position_actual) + o for i, o in enumerate(org)]
+    positions, lines = smp.positions, smp.lines
+    line = r.line
+    row_lines = []
+    for ln in lines[k0:m]:
+        line = ln or line
+        row_lines.append(line)
+    if settle is not None:  # Planner.step's spindle settle count reads the measured speed of each cycle
+        rpms, cmds = settle
+        cmd = float(pl.spindle_command())  # type: ignore[misc]
+        if len(scales) > n_axes:
+            sc = scales[n_axes]
+            rpms += [sc.drive_to_rpm(v) for v in outs[n_axes].velocity_actual[k0:m]]
+        else:
+            rpms += [abs(r.spindle_command_rpm())] * cnt
+        cmds += [cmd] * cnt
+    _mlc(r, ch, outs, k0, m, before_last_step)
+    cmds_last = positions[m - 1].tolist()
+    r._commands[:] = cmds_last
+    r.line = line
+    max_ferr = r.result.max_ferr
+    for i in range(n_axes):
+        sc = scales[i]
+        r.rx[i].target_position = sc.to_counts(cmds_last[i] - org[i])
+        ferr = max(abs(sc.to_units(fe)) for fe in outs[i].following_error[k0:m])
+        if ferr > max_ferr[r.axes[i]]:
+            max_ferr[r.axes[i]] = ferr
+    mlc = r.mlc
+    if type(mlc) is Mlc and n_axes < len(r.rx):
+        mlc.caxis._cycles += cnt  # Mlc.spindle_drive → SpindleAxisSwitch.drive, a spindle staying one
+    if r.trace is not None:
+        _rows(r, outs, k0, m, times, first_cycle, row_lines, positions)
+    if r.on_cycle is not None:
+        r.on_cycle(r)  # the operator panel, with nothing held: the same call every cycle
+    if r.progress is not None:
+        r.progress.update(r)
+    clock = r.clock
+    clock._n += cnt
+    clock.jitter.add_many(np.zeros(cnt), first_cycle)
+    clock.exec.add_many(np.full(cnt, (_time.perf_counter_ns() - t_wall) * 1e-9 / cnt), first_cycle)
+
+
+def _mlc(r: Any, ch: Channel, outs: list[Stretch], k0: int, m: int, before_last_step: np.ndarray) -> None:
+    """The MLC's scans of cycles k0 … m-1: counts and time per scan, the NC's outputs of the last one."""
+    mlc = r.mlc
+    cnt = m - k0
+    if type(mlc) is BasicMlc:
+        mlc.cycle += cnt
+        return
+    t = mlc.time
+    for _ in range(cnt):
+        t += mlc.cycle
+    mlc.time = t
+    link = mlc.link
+    link.cycle += cnt
+    ctx = mlc.ctx
+    ctx.time, ctx.scan_count = t, ctx.scan_count + cnt
+    mlc.gate.skipped += cnt
+    mlc._clocks()
+    # the peak torque (D30400+k) is held over every cycle: the cycles before the last one here, the last
+    # one by _drive_outputs itself
+    words = mlc.mem.words
+    for k, o in enumerate(outs[:32]):
+        sc = r.scales[k]
+        peak = max((min(abs(int(round(sc.torque_percent(tq) * 10.0))), 0xFFFF) for tq in o.torque_actual[k0:m - 1]),
+                   default=0)
+        if peak > words[30400 + k]:
+            words[30400 + k] = peak
+    status = r.link.status() if callable(getattr(r.link, "status", None)) else None
+    mlc.bus_feedback(drive_status(r, status))
+    if status is not None:
+        mlc.bus_status(status)
+    link._drive_outputs(mlc.drives, ch)
+    if link.manual is not None:
+        bits, b3 = mlc.mem.m, 30000 + 1000 * link.x
+        for i, p in enumerate(before_last_step.tolist()):
+            bits[b3 + 352 + i] = 1 if abs(p) < 1e-6 else 0
+
+
+def _rows(r: Any, outs: list[Stretch], k0: int, m: int, times: list[float], first_cycle: int, lines: list[int],
+          positions: np.ndarray) -> None:
+    """The trace rows of cycles k0 … m-1, as BenchRunner._row makes them."""
+    n_axes = len(r.axes)
+    scales, org = r.scales, r.origin.tolist()
+    period, late = r.timing.period, r.timing.late
+    cols: list[list] = []
+    for i in range(n_axes):
+        sc, o, out = scales[i], org[i], outs[i]
+        to_units = sc.to_units
+        cols += [positions[k0:m, i].tolist(), [to_units(p) + o for p in out.position_actual[k0:m]],
+                 [sc.drive_to_velocity(v) for v in out.velocity_actual[k0:m]],
+                 [sc.torque_percent(t) for t in out.torque_actual[k0:m]],
+                 [to_units(fe) for fe in out.following_error[k0:m]], out.statusword[k0:m]]
+    cnt = m - k0
+    for k, sc in enumerate(scales[n_axes:]):
+        out = outs[n_axes + k]
+        cols += [[sc.drive_to_rpm(r.rx[n_axes + k].target_velocity)] * cnt,
+                 [sc.drive_to_rpm(v) for v in out.velocity_actual[k0:m]],
+                 [sc.to_units(p) % 360.0 for p in out.position_actual[k0:m]],
+                 [sc.torque_percent(t) for t in out.torque_actual[k0:m]], out.statusword[k0:m]]
+    write = r.trace.write
+    for j, values in enumerate(zip(*cols)):
+        write([round(times[j], 9), lines[j], first_cycle + j, period, late, "", *values])
+    r._row_cycle = r.cycle
