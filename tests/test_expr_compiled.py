@@ -68,3 +68,22 @@ def test_a_bad_constant_variable_number_alarms_when_evaluated() -> None:
             ev(e, {1: 1.0}.get)
         except NcAlarm as exc:
             assert exc.alarm.code == 0x0210  # the division comes first, as the tree walker finds it
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.one_of(st.sampled_from([1.0, 3.0, 100.0, 1.5, -2.0, 0.0]).map(Num), expressions), expressions, values)
+def test_an_assignment_gives_the_number_then_the_value_as_the_tree_walker(index, value, vs) -> None:
+    """`#[index] = value` compiled as one function: the variable number (or its alarm) first, then the value."""
+    def tree_pair(read):
+        return tree.var_index(Var(index), read), tree.evaluate(value, read)
+
+    def outcome(pair):
+        try:
+            n, v = pair(vs.get)
+        except NcAlarm as exc:
+            return ("alarm", exc.alarm.code, exc.alarm.message)
+        except (ValueError, ArithmeticError) as exc:
+            return ("error", type(exc).__name__)
+        return n, (("nan",) if v is not None and math.isnan(v) else ("value", v))
+
+    assert outcome(compiled._assignment(Var(index), value)) == outcome(tree_pair)

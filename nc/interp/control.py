@@ -59,6 +59,9 @@ class ControlMixin:
             n, v = assignment(s, s.target, s.value, vs.get)
             if v is not None and not math.isfinite(v):
                 raise NcAlarm(0x0257, "assignment of a non-finite value")
+            if 0 < n <= vs._lmax and v is not None:  # a local: `Variables.set` of it, inline (most writes)
+                vs.frames[-1][n] = float(v)
+                return None
             vs.set(n, v)
             if n > 99 and self.sys.live(n):  # no local variable (#1-#99) is a live system variable
                 return Sync(block.line, block.text, f"#{n}")

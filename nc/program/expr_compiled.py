@@ -55,9 +55,8 @@ def _assignment(target: Var, value: Expr) -> Callable[[Read], tuple[int, Value]]
             n = checked_index(ix.value)
         except NcAlarm:
             n = None
-        if n is not None:
-            fn = compiled(value)
-            return lambda read: (n, fn(read))
+        if n is not None and _depth(value) <= _MAX_DEPTH:  # one function gives both
+            return _compile(f"({n}, {{}})", value)  # type: ignore[return-value]
     index, fn = compiled(ix), compiled(value)
     return lambda read: (checked_index(index(read)), fn(read))
 
@@ -66,8 +65,13 @@ def compiled(e: Expr) -> Fn:
     """The function `fn(read)` that evaluates `e` (Python source compiled, else closures)."""
     if _depth(e) > _MAX_DEPTH:
         return compile_expr(e)
+    return _compile("{}", e)
+
+
+def _compile(shape: str, e: Expr) -> Fn:
+    """`def _fn(r): return <shape with e's source>`, compiled."""
     consts: dict[str, object] = dict(_HELPERS)
-    code = _source(e, consts, [0])
+    code = shape.format(_source(e, consts, [0]))
     namespace: dict[str, object] = {}
     exec(compile(f"def _fn(r):\n    return {code}\n", "<macro expression>", "exec"), consts, namespace)
     return namespace["_fn"]  # type: ignore[return-value]
