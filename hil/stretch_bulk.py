@@ -168,9 +168,12 @@ def _mlc(r: Any, ch: Channel, outs: list[Stretch], k0: int, m: int, before_last_
     # one by _drive_outputs itself
     words = mlc.mem.words
     for k, o in enumerate(outs[:32]):
-        sc = r.scales[k]
-        peak = max((min(abs(int(round(sc.torque_percent(tq) * 10.0))), 0xFFFF) for tq in o.torque_actual[k0:m - 1]),
-                   default=0)
+        if m - 1 <= k0:
+            break
+        # |round(torque % × 10)| grows with |0x6077| (a product, rounded half to even: odd-symmetric): the
+        # largest raw torque gives the peak
+        raw = max(abs(tq) for tq in o.torque_actual[k0:m - 1])
+        peak = min(abs(int(round(r.scales[k].torque_percent(raw) * 10.0))), 0xFFFF)
         if peak > words[30400 + k]:
             words[30400 + k] = peak
     status = r.link.status() if callable(getattr(r.link, "status", None)) else None
