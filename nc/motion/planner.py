@@ -38,6 +38,12 @@ OPEN_CHUNK = 4  # ... while the queue cannot tell the jerk factor yet (the chann
 MAX_SOLVES_PER_CYCLE = 1000  # plans one cycle may start and end before a sample is due (decisions B4)
 
 
+def _near(a: np.ndarray, b: np.ndarray) -> bool:
+    """np.allclose(a, b, atol=1e-6) on plain floats: checked at every block start, where numpy's
+    call cost more than the three comparisons (issue 17)."""
+    return all(abs(x - y) <= 1e-6 + 1e-5 * abs(y) for x, y in zip(a.tolist(), b.tolist()))
+
+
 @dataclass
 class Setpoint:
     positions: np.ndarray  # machine coordinates per axis, in MotionConfig.axes order
@@ -341,7 +347,7 @@ class Planner:
             if self._stopping:
                 self._flush()
                 return Setpoint(self.position.copy(), self.line, 0.0, None)
-            if b.seg is not None and np.allclose(b.seg.start, self.position, atol=1e-6):
+            if b.seg is not None and _near(b.seg.start, self.position):
                 b.seg.start = self.position.copy()
             self.line = b.move.line
             if self.spindle_command is not None and not self._settle.ready(float(self.spindle_command())):
@@ -524,7 +530,7 @@ class Planner:
                 self._started = True
                 self.s = 0.0
                 self.line = b.move.line
-                if b.seg is not None and np.allclose(b.seg.start, self.position, atol=1e-6):
+                if b.seg is not None and _near(b.seg.start, self.position):
                     b.seg.start = self.position.copy()
             if b.kind == "dwell":
                 if self.held:
