@@ -127,11 +127,19 @@ class CallsMixin:
                 return None
             number, code = 9000, "T"
         else:
-            if first.value != int(first.value):
+            n = int(first.value)
+            if first.value != n:
                 return None
-            number = self._call_table(first.letter, int(first.value))
+            # `_call_table`, inline: every block that starts with a G or M code asks
+            tables = self._call_tables
+            if tables is None:
+                tables = self._call_tables = call_tables(self.profile)
+            single, (f0, o0, cnt) = tables[first.letter]
+            number = single.get(n)
             if number is None:
-                return None
+                if not (cnt and f0 <= n < f0 + cnt):
+                    return None
+                number = o0 + n - f0
             code = f"{first.letter}{int(first.value)}"
             if any(f.call_code is not None and f.call_code[0] in "GM" for f in self.stack) and \
                     not (first.letter == "G" and self.profile.bit("N1.010 Bit28")):

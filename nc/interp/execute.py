@@ -296,7 +296,10 @@ class ExecuteMixin:
             return
         block = self._resolve(raw)
         self.block = block
-        if self._axis_block(block):  # lean path: every step below is a no-op for such a block
+        words = block.words
+        # lean path: every step below is a no-op for such a block (asked only of a block that starts
+        # with an axis word)
+        if words and words[0].letter in self._plain_axes and self._axis_block(block):
             yield from self._motion(block, set())
             return
         # code-called macros: the calling code must be first in the block (N§3.2.1)

@@ -41,7 +41,7 @@ class _Geometry:
     axes: set[str] = field(default_factory=set)
 
 
-@dataclass
+@dataclass(slots=True)
 class Frame:
     program: Program
     pc: int = 0
