@@ -8,7 +8,7 @@ in diameter mode).
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field
 from typing import Literal, Union
 
 MoveKind = Literal["rapid", "line", "arc", "thread", "dwell"]
@@ -43,9 +43,13 @@ class Move:
     def replaced(self, **changes) -> "Move":
         """`dataclasses.replace(self, **changes)` without its per-call look at the fields (compensation
         rewrites every move it offsets, issue 16)."""
-        kw = {name: getattr(self, name) for name in _MOVE_FIELDS}
-        kw.update(changes)
-        return Move(**kw)
+        new = Move(self.kind, self.line, self.block, self.start, self.end, self.work, self.center, self.dir,
+                   self.feed, self.duration, self.per_rev, self.plane, self.exact_stop, self.lead, self.lead_change,
+                   self.start_angle, self.turns, self.program, self.tags, self.comp, self.comp_radius, self.tip,
+                   self.css)
+        for name, value in changes.items():
+            setattr(new, name, value)
+        return new
 
     def as_dict(self) -> dict:
         return {
@@ -61,8 +65,6 @@ class Move:
             "duration": self.duration,
         }
 
-
-_MOVE_FIELDS = tuple(f.name for f in fields(Move))
 
 
 @dataclass(slots=True)

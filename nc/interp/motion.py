@@ -19,15 +19,22 @@ from nc.program.blocks import Block, Word
 from nc.interp.records import CHORD_TOL_3D, INCREMENTAL, _Geometry, _transforms
 
 
+_AXIS_LETTERS: dict[tuple, tuple[tuple[str, str | None], ...]] = {}
+
+
 class MotionMixin:
     def _axis_words(self, block: Block) -> dict[str, tuple[Word, bool]]:
         """axis -> (word, incremental) from X/Y/Z/… and the U/V/W/H incremental addresses (A5)."""
         out: dict[str, tuple[Word, bool]] = {}
-        lathe_inc = self.profile.is_lathe
-        for a in self.axes:
+        key = (self.axes, self.profile.is_lathe)
+        pairs = _AXIS_LETTERS.get(key)
+        if pairs is None:  # (axis, its incremental letter or None) per axes and machine type, found once
+            incs = {v: k for k, v in reversed(INCREMENTAL.items())}  # the first letter naming an axis
+            pairs = _AXIS_LETTERS[key] = tuple(
+                (a, (incs.get(a) if incs.get(a) not in self.axes else None) if key[1] else None) for a in self.axes)
+        for a, inc_letter in pairs:
             w_abs = block.get(a)
-            inc_letter = next((k for k, v in INCREMENTAL.items() if v == a), None) if lathe_inc else None
-            w_inc = block.get(inc_letter) if inc_letter and inc_letter not in self.axes else None
+            w_inc = block.get(inc_letter) if inc_letter else None
             if w_abs is not None and w_inc is not None:
                 raise NcAlarm(0x0202, f"{a} and {inc_letter} in one block")
             if w_abs is not None:

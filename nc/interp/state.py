@@ -94,8 +94,10 @@ class Frames:
     def copy(self) -> "Frames":
         """An independent copy (what copy.deepcopy gives, at a tenth of its cost: a lathe cycle's
         contour is interpreted on a copy of the interpreter, issue 16)."""
-        return Frames(self.axes, [dict(w) for w in self.work_offsets], dict(self.external),
-                      dict(self.local_shift), dict(self.set_shift), dict(self.tool_shift))
+        twin = Frames(self.axes, [w.copy() for w in self.work_offsets], self.external.copy(),
+                      self.local_shift.copy(), self.set_shift.copy(), self.tool_shift.copy())
+        twin._memo = self._memo  # compared by value and never changed: valid for the equal copy too
+        return twin
 
     def origins(self, wcs: int, axes: tuple[str, ...]) -> dict[str, float]:
         """`origin` of every axis at once (the interpreter's per-block coordinate conversion). The dict
