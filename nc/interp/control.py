@@ -12,7 +12,7 @@ from collections.abc import Iterator
 
 from nc.alarms import NcAlarm
 from nc.moves import Event, Sync
-from nc.program.blocks import Assign, Block, Else, ElseIf, End, EndIf, ExitW, Goto, IfGoto, IfThen, While
+from nc.program.syntax import Assign, Block, Else, ElseIf, End, EndIf, ExitW, Goto, IfGoto, IfThen, While
 from nc.program.expr_compiled import assignment, evaluate
 from nc.interp.records import Frame, MAX_IF_DEPTH, MAX_WHILE_DEPTH
 

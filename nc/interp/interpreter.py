@@ -134,7 +134,7 @@ class Interpreter(ExecuteMixin, ReadingMixin, ModalMixin, MotionMixin, NonModalM
         bulk = None
         if self.bulk:  # a consumer that takes MoveBatch events (`hil path`)
             from nc.interp import bulk
-        cur = None  # the frame `blocks`, `count`, `plain_at` and `name` are of (read again when it changes)
+        cur = None  # the frame `blocks`, `count`, `parsed` and `name` are of (read again when it changes)
         while self.stack:
             if budget is not None and budget.spent:
                 yield BUSY  # the rest of the macro next cycle; the cycle never stalls (decisions B2)
@@ -147,21 +147,23 @@ class Interpreter(ExecuteMixin, ReadingMixin, ModalMixin, MotionMixin, NonModalM
             if fr is not cur:
                 cur, blocks, name = fr, fr.program.blocks, fr.program.name
                 count = len(blocks)
-                plain_at = getattr(blocks, "plain_at", None)
+                # a BlockList's parsed items by index (None: a plain line, read when reached); a list of blocks
+                # has no plain lines
+                parsed = getattr(blocks, "parsed", None) or blocks.__getitem__
             pc = fr.pc
             if pc >= count:
                 if len(self.stack) == 1:
                     break
                 self._return(None)  # end of a subprogram without M99 returns like M99
                 continue
-            # the bulk lane is asked only at a line still held as text (a parsed block, such as a
-            # macro statement, is never the start of a run)
-            if bulk is not None and plain_at is not None and plain_at(pc) \
-                    and (batch := bulk.take(self, fr, limit)) is not None:
-                yield batch  # a run of plain G0/G1 blocks read in one pass (nc.interp.bulk)
-                last = self.block
-                continue
-            block = last = blocks[pc]
+            block = parsed(pc)
+            if block is None:  # a plain line: the bulk lane is asked only there (never at a statement)
+                if bulk is not None and (batch := bulk.take(self, fr, limit)) is not None:
+                    yield batch  # a run of plain G0/G1 blocks read in one pass (nc.interp.bulk)
+                    last = self.block
+                    continue
+                block = blocks[pc]
+            last = block
             # `_take_block`, inline: this runs for every block
             fr.pc = pc + 1
             self._executed += 1
@@ -177,8 +179,7 @@ class Interpreter(ExecuteMixin, ReadingMixin, ModalMixin, MotionMixin, NonModalM
                 try:
                     while (ev := self._statement(block)) is None and budget is None:
                         pc = fr.pc
-                        if pc >= count or (plain_at is not None and plain_at(pc)) \
-                                or (nxt := blocks[pc]).stmt is None or nxt.skip:
+                        if pc >= count or (nxt := parsed(pc)) is None or nxt.stmt is None or nxt.skip:
                             break
                         last = block = nxt
                         fr.pc = pc + 1
