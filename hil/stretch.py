@@ -85,7 +85,8 @@ class Stretcher:
         if limit < 2 or ch is None or not self._quiet(r, ch):
             return False
         pl = ch.planner
-        n = min(limit, MAX_CYCLES, len(pl._buf_pos) - pl._buf_i - 1)  # the buffer's last row: step() refills
+        # to the buffer's end: the planner stays busy on its block (it is dropped at the refill, a stepped cycle)
+        n = min(limit, MAX_CYCLES, len(pl._buf_pos) - pl._buf_i)
         if n < 2:
             return False
         saved_pl = _save_planner(pl)

@@ -16,11 +16,13 @@ here when every cycle of it would do exactly this, and `bulk_cycles` does it onc
 from __future__ import annotations
 
 import time as _time
+from itertools import repeat
 from typing import Any
 
 import numpy as np
 
 from hil.mlc_bridge import drive_status
+from hil.trace_parquet import ParquetTrace
 from mlc.basic import BasicMlc
 from mlc.machine import Mlc
 from mlc.nc_link import MANUAL_MODES
@@ -189,26 +191,31 @@ def _mlc(r: Any, ch: Channel, outs: list[Stretch], k0: int, m: int, before_last_
 
 def _rows(r: Any, outs: list[Stretch], k0: int, m: int, times: list[float], first_cycle: int, lines: list[int],
           positions: np.ndarray) -> None:
-    """The trace rows of cycles k0 … m-1, as BenchRunner._row makes them."""
+    """The trace rows of cycles k0 … m-1, as BenchRunner._row makes them: the unit conversions over the columns
+    in numpy, with the same operations in the same order (IEEE division and product, numpy's float remainder
+    is Python's %), back as Python floats."""
     n_axes = len(r.axes)
     scales, org = r.scales, r.origin.tolist()
-    period, late = r.timing.period, r.timing.late
-    cols: list[list] = []
-    for i in range(n_axes):
-        sc, o, out = scales[i], org[i], outs[i]
-        to_units = sc.to_units
-        cols += [positions[k0:m, i].tolist(), [to_units(p) + o for p in out.position_actual[k0:m]],
-                 [sc.drive_to_velocity(v) for v in out.velocity_actual[k0:m]],
-                 [sc.torque_percent(t) for t in out.torque_actual[k0:m]],
-                 [to_units(fe) for fe in out.following_error[k0:m]], out.statusword[k0:m]]
     cnt = m - k0
-    for k, sc in enumerate(scales[n_axes:]):
-        out = outs[n_axes + k]
-        cols += [[sc.drive_to_rpm(r.rx[n_axes + k].target_velocity)] * cnt,
-                 [sc.drive_to_rpm(v) for v in out.velocity_actual[k0:m]],
-                 [sc.to_units(p) % 360.0 for p in out.position_actual[k0:m]],
-                 [sc.torque_percent(t) for t in out.torque_actual[k0:m]], out.statusword[k0:m]]
-    write = r.trace.write
-    for j, values in enumerate(zip(*cols)):
-        write([round(times[j], 9), lines[j], first_cycle + j, period, late, "", *values])
+    cols: list[list] = []
+    for i, (sc, out) in enumerate(zip(scales, outs)):
+        cpu, rpc = sc._cpu, sc._raw_per_cps
+        pa = np.array(out.position_actual[k0:m], dtype=np.float64)
+        va = np.array(out.velocity_actual[k0:m], dtype=np.float64)
+        tq = (np.array(out.torque_actual[k0:m], dtype=np.float64) * sc.units.torque_percent).tolist()
+        if i < n_axes:  # AxisScaling.to_units, drive_to_velocity, torque_percent
+            cols += [positions[k0:m, i].tolist(), (pa / cpu + org[i]).tolist(), (va / rpc / cpu).tolist(), tq,
+                     (np.array(out.following_error[k0:m], dtype=np.float64) / cpu).tolist(), out.statusword[k0:m]]
+        else:  # drive_to_rpm of the command and the feedback, the angle mod 360
+            cols += [[sc.drive_to_rpm(r.rx[i].target_velocity)] * cnt, (va / rpc / cpu / sc.lead * 60.0).tolist(),
+                     np.remainder(pa / cpu, 360.0).tolist(), tq, out.statusword[k0:m]]
+    period, late = r.timing.period, r.timing.late
+    rows = zip([round(t, 9) for t in times], lines, range(first_cycle, first_cycle + cnt), repeat(period, cnt),
+               repeat(late, cnt), repeat("", cnt), *cols)
+    trace = r.trace
+    if type(trace) is ParquetTrace:
+        trace.write_many(rows)
+    else:
+        for row in rows:
+            trace.write(row)
     r._row_cycle = r.cycle

@@ -18,7 +18,7 @@ import os
 import shutil
 import time
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any, Iterable, Sequence
 
 import pyarrow as pa
 import pyarrow.parquet as pq
@@ -77,6 +77,15 @@ class ParquetTrace:
         n = len(self._rows)
         if n >= self.row_group or (n & 1023 == 0 and time.monotonic() - self._last_flush >= FLUSH_S):
             self._flush()
+
+    def write_many(self, rows: Iterable[tuple]) -> None:
+        """write() for each row (tuples), as a stretch of cycles hands them over (hil/stretch_bulk.py)."""
+        buf = self._rows
+        for row in rows:
+            buf.append(row)
+            n = len(buf)
+            if n >= self.row_group or (n & 1023 == 0 and time.monotonic() - self._last_flush >= FLUSH_S):
+                self._flush()
 
     def _make_schema(self, first: Sequence[Any]) -> pa.Schema:
         fields = []
