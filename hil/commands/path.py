@@ -185,6 +185,7 @@ _QUOTED: dict[str, str] = {}  # block text -> its JSON string: the moves of a cy
 _QUOTED_LIMIT = 4096
 _HEADS: dict[tuple, str] = {}  # (kind, line, block text) -> the line's text up to the start point
 _TAGS: dict[tuple, str] = {}  # tags (strings) -> their ', "tags": [...]' text
+_LAST_END: list = [None, (), ""]  # the last move's end dict, its items then, its text
 
 
 def _str(s) -> str:
@@ -216,7 +217,14 @@ def move_json(m: Move) -> str:
             if len(_HEADS) >= _QUOTED_LIMIT:
                 _HEADS.clear()
             _HEADS[key] = head
-    text = (f'{head}{_axes(m.start)}, "end": {_axes(m.end)}, "work": {_axes(m.work)}, '
+    # a cycle's move starts at the dict its last move ended at: that point's text again (checked by
+    # value, so a dict changed in place since is written anew)
+    start, end = m.start, m.end
+    last = _LAST_END
+    start_text = last[2] if start is last[0] and tuple(start.items()) == last[1] else _axes(start)
+    end_text = _axes(end)
+    last[0], last[1], last[2] = end, tuple(end.items()), end_text
+    text = (f'{head}{start_text}, "end": {end_text}, "work": {_axes(m.work)}, '
             f'"center": {"null" if m.center is None else _axes(m.center)}, '
             f'"dir": {"null" if m.dir is None else _str(m.dir)}, "feed": {_num(m.feed)}, "duration": {_num(m.duration)}')
     if m.per_rev and m.feed is not None:  # the additive keys of move_dict, in its order

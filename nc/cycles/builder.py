@@ -49,11 +49,13 @@ class PathBuilder:
             center: dict[str, float] | None = None, dir: str | None = None, lead: float | None = None,
             lead_change: float = 0.0, start_angle: float = 0.0) -> Move | None:
         """The lean path of every plane move (issue 16: a lathe cycle emits thousands): the Move built
-        positionally, the old position dict handed over as its start, one copy for the new position.
+        positionally; its end is the new position and the next move's start (one dict for both: no
+        stage changes a move's points in place, `hil path` writes the shared point once).
         A line or rapid shorter than float noise is dropped; the position snaps to the exact target."""
         pos = self.position
         a1, a2 = self.plane
         if center is None and kind != "thread" and abs(p[0] - pos[a1]) < 1e-12 and abs(p[1] - pos[a2]) < 1e-12:
+            pos = self.position = pos.copy()  # the last move's end: snap a copy
             pos[a1], pos[a2] = p
             return None
         end = pos.copy()
@@ -62,7 +64,7 @@ class PathBuilder:
                   None, per_rev, self.plane, False, lead, lead_change, start_angle, 0.0, self.program, tags,
                   None, 0.0, 0, self.css)
         self.events.append(mv)
-        self.position = end.copy()
+        self.position = end
         return mv
 
     def rapid(self, p: Pt, tags: tuple[str, ...] = ()) -> Move | None:
