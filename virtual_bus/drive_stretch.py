@@ -55,6 +55,8 @@ def csp_stretch(drive: Cia402Drive, rx: RxPdo, targets: Sequence[int], dt: float
     units, cpr = p.units, p.counts_per_rev
     n, h, max_cps, alpha, rad, reached_v = _model(p, dt)
     kp, kff, window, origin = p.kp, p.kff, p.following_error_window, drive.modes.origin
+    k_raw, t_pct = units.raw_per_count_per_s(cpr), units.torque_percent  # velocity_to_raw, 0x6077
+    inertia, viscous, coulomb, rated = p.inertia, p.viscous, p.coulomb, p.rated_torque
     base = _STATUS_BASE[State.OPERATION_ENABLED] | SW_FOLLOWING
     pos, vel, t, command = drive.position, drive.velocity, drive.time, drive.command
     prev_target = drive._prev_target
@@ -79,13 +81,17 @@ def csp_stretch(drive: Cia402Drive, rx: RxPdo, targets: Sequence[int], dt: float
         if abs(cmd - c_pos) > window or abs(c_vel) > 1.2 * max_cps:
             break  # Cia402Drive._supervise would fault in this cycle: exchange() takes it
         c_acc = (c_vel - vel) / dt
-        torque = _torque(drive, c_acc, c_vel, rad)
+        # Cia402Drive.step's torque of an energised drive (0.1 % of rated) and DriveUnits.velocity_to_raw inline,
+        # the same expressions: a call each per cycle cost a fifth of the loop
+        torque = (inertia * c_acc * rad + viscous * c_vel * rad
+                  + (math.copysign(coulomb, c_vel) if abs(c_vel) > 1 else 0.0)) / rated * 1000.0
         pos, vel, t, command, acc, prev_target = c_pos, c_vel, c_t, cmd, c_acc, target
         gap = command - pos
         sws.append(base | SW_TARGET_REACHED if abs(vel) < reached_v and abs(gap) < 10 else base)
         pa.append(int(round(pos + origin)))
-        va.append(units.velocity_to_raw(vel, cpr))
-        ta.append(int(round(torque * 0.1 / units.torque_percent)))
+        raw = round(vel * k_raw)
+        va.append(raw if -0x7FFFFFFF <= raw <= 0x7FFFFFFF else max(-0x7FFFFFFF, min(0x7FFFFFFF, raw)))
+        ta.append(int(round(torque * 0.1 / t_pct)))
         fe.append(int(round(gap)))
     if pa:
         drive._prev_target = prev_target
@@ -107,6 +113,8 @@ def csv_stretch(drive: Cia402Drive, rx: RxPdo, cycles: int, dt: float) -> Stretc
     pos, vel, t, command, tv = drive.position, drive.velocity, drive.time, drive.command, drive.target_velocity
     acc, torque = drive.acceleration, drive.torque
     pa, va, ta, sws = out.position_actual, out.velocity_actual, out.torque_actual, out.statusword
+    k_raw, t_pct = units.raw_per_count_per_s(cpr), units.torque_percent  # as in csp_stretch
+    inertia, viscous, coulomb, rated = p.inertia, p.viscous, p.coulomb, p.rated_torque
     for _ in range(cycles):
         c_pos, c_vel, c_t, c_tv, cmd = pos, vel, t, tv, command
         # The velocity-loop lines below repeat csp_stretch's on purpose: a call per sub-step would cost about
@@ -123,12 +131,14 @@ def csv_stretch(drive: Cia402Drive, rx: RxPdo, cycles: int, dt: float) -> Stretc
         if abs(c_vel) > 1.2 * max_cps:
             break  # overspeed: exchange() takes the fault
         c_acc = (c_vel - vel) / dt
-        torque = _torque(drive, c_acc, c_vel, rad)
+        torque = (inertia * c_acc * rad + viscous * c_vel * rad
+                  + (math.copysign(coulomb, c_vel) if abs(c_vel) > 1 else 0.0)) / rated * 1000.0
         pos, vel, t, command, tv, acc = c_pos, c_vel, c_t, cmd, c_tv, c_acc
         sws.append(base | SW_TARGET_REACHED if abs(vel) < reached_v and abs(command - pos) < 10 else base)
         pa.append(int(round(pos + origin)))
-        va.append(units.velocity_to_raw(vel, cpr))
-        ta.append(int(round(torque * 0.1 / units.torque_percent)))
+        raw = round(vel * k_raw)
+        va.append(raw if -0x7FFFFFFF <= raw <= 0x7FFFFFFF else max(-0x7FFFFFFF, min(0x7FFFFFFF, raw)))
+        ta.append(int(round(torque * 0.1 / t_pct)))
     out.following_error = [0] * len(pa)  # 0x60F4 is a CSP object: 0 in CSV
     if pa:
         drive.target_velocity = tv
@@ -144,13 +154,6 @@ def _model(p: DriveParams, dt: float) -> tuple[int, float, float, float, float, 
     max_cps = p.max_speed_rpm / 60.0 * p.counts_per_rev
     return (n, h, max_cps, 1.0 - math.exp(-p.velocity_bandwidth * h), 2.0 * math.pi / p.counts_per_rev,
             0.001 * (p.max_speed_rpm / 60.0 * p.counts_per_rev))
-
-
-def _torque(drive: Cia402Drive, acc: float, vel: float, rad: float) -> float:
-    """Cia402Drive.step's torque of an energised drive, 0.1 % of rated."""
-    p = drive.params
-    torque_nm = p.inertia * acc * rad + p.viscous * vel * rad + (math.copysign(p.coulomb, vel) if abs(vel) > 1 else 0.0)
-    return torque_nm / p.rated_torque * 1000.0
 
 
 def _finish(drive: Cia402Drive, rx: RxPdo, out: Stretch, pos: float, vel: float, t: float, command: float,
