@@ -54,6 +54,16 @@ class TimingStats:
         if v > self.max:
             self.max, self.max_at = v, cycle
 
+    def add_repeated(self, value: float, count: int, first_cycle: int = 1) -> None:
+        """add(value) `count` times (a stretch's cycles, hil/stretch_bulk.py)."""
+        if count <= 0:
+            return
+        v = abs(value)
+        self.hist[min(int(v / self.BIN), self.NBINS)] += count
+        self.count += count
+        if v > self.max:
+            self.max, self.max_at = v, first_cycle
+
     def add_many(self, values: np.ndarray, first_cycle: int = 1) -> None:
         v = np.abs(np.asarray(values, dtype=float))
         if v.size == 0:

@@ -145,8 +145,8 @@ def bulk_cycles(r: Any, ch: Channel, pl: Planner, smp: Samples, outs: list[Stret
         r.progress.update(r)
     clock = r.clock
     clock._n += cnt
-    clock.jitter.add_many(np.zeros(cnt), first_cycle)
-    clock.exec.add_many(np.full(cnt, (_time.perf_counter_ns() - t_wall) * 1e-9 / cnt), first_cycle)
+    clock.jitter.add_repeated(0.0, cnt, first_cycle)
+    clock.exec.add_repeated((_time.perf_counter_ns() - t_wall) * 1e-9 / cnt, cnt, first_cycle)
 
 
 def _mlc(r: Any, ch: Channel, outs: list[Stretch], k0: int, m: int, before_last_step: np.ndarray) -> None:

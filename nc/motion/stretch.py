@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from nc.motion.planner import Planner
+from nc.motion.threading import SETTLE_BAND, SETTLE_MIN_RPM
 from nc.moves import Move
 
 
@@ -61,5 +62,8 @@ def settle_stretch(pl: Planner, rpms: Sequence[float], commands: Sequence[float]
     cycle's step() would have read."""
     if pl.spindle_command is None:
         return
+    # SpindleSettle.update once per cycle, its test on locals (a method call per cycle was a tenth of a stretch)
+    n = pl._settle.cycles
     for rpm, cmd in zip(rpms, commands):
-        pl._settle.update(float(rpm), float(cmd))
+        n = n + 1 if abs(cmd) >= 1.0 and abs(rpm - cmd) <= max(SETTLE_BAND * abs(cmd), SETTLE_MIN_RPM) else 0
+    pl._settle.cycles = n
