@@ -319,10 +319,11 @@ class ExecuteMixin:
         """Read and check the block's G and M codes: letters it may not hold, M ranges, one call per
         block; with the steps that can act on it. What depends on the block's text alone (G lookup,
         letter check, M codes and their checks, plan) is done once per block `raw` whose G and M words
-        are plain numbers (a loop body runs thousands of times)."""
+        are plain numbers (a loop body runs thousands of times). Remembered by the block's text: a line
+        written again reads the same (a repeated part, a lathe contour's G71 and G70 runs, issue 16)."""
         memo = self._plans
-        hit = memo.get(id(raw)) if raw is not None else None
-        if hit is not None and hit[0] is raw:
+        hit = memo.get(raw.text) if raw is not None else None
+        if hit is not None:
             gcodes, funcs, steps, mvals = hit[1], hit[2], hit[3], hit[4]
             if steps is None:  # the block's own letters are refused: as checked on its values
                 self._check_letters(block, funcs)
@@ -346,7 +347,7 @@ class ExecuteMixin:
         if plain:  # remembered once its M codes passed their checks (they alarm again on every read)
             if len(memo) >= _PLAN_LIMIT:
                 memo.clear()
-            memo[id(raw)] = (raw, gcodes, funcs, steps, mvals)
+            memo[raw.text] = (raw, gcodes, funcs, steps, mvals)
         return BlockRun(block, gcodes, funcs, mvals, self.state.css), steps or ALL_STEPS
 
     def _check_g68(self, funcs: set[str]) -> None:

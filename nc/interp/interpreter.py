@@ -86,7 +86,7 @@ class Interpreter(ExecuteMixin, ReadingMixin, ModalMixin, MotionMixin, NonModalM
         self._executed = 0
         self._block_limit = int(profile.param("max blocks", 1_000_000))  # set per run by _run
         self._call_tables = None  # G/M code-call tables from the parameters (CallsMixin._call_table)
-        self._plans: dict[int, tuple] = {}  # id(block) -> (block, G codes, functions, steps, M codes) (_read_run)
+        self._plans: dict[str, tuple] = {}  # block text -> (block, G codes, functions, steps, M codes) (_read_run)
         self._gcall_depth = 0
         self._three_point: dict[str, float] | None = None  # G2.4/G3.4 middle point
         self._plain_axes = frozenset(self.axes) - {"G", "M", "T", "F", "S", "D"}  # `_axis_block` letters
