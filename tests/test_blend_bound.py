@@ -56,3 +56,22 @@ def test_bound_keeps_long_lines_at_feed_and_finds_dense_chords_slow():
     b = bound(np.array([START] + c.points), c.feed / 60.0, TOL, 1.0)
     # blends bounded by half of a 0.05 mm chord change curvature fast: far slower than the feed
     assert b > 1.7 * c.feed_limited()
+
+
+def test_blended_path_is_continuous_and_within_the_tolerance():
+    from benchmarks.bench_blend_bound import blended_path, sample_path
+    from benchmarks.bench_vs_linuxcnc import cam_polyline
+    from tests.motion_helpers import polyline_deviation
+
+    prog = cam_polyline(60)
+    pts = np.array([START] + prog.points, dtype=float)
+    pieces = blended_path(pts, TOL)
+    ds = 0.001
+    q = sample_path(pieces, ds * np.arange(int(sum(p[1] for p in pieces) / ds)))
+    step = np.linalg.norm(np.diff(q, axis=0), axis=1)
+    assert step.max() <= ds * (1.0 + 1e-6) and step.min() >= ds * (1.0 - 1e-3)  # no jump, no stall
+    u = np.diff(q, axis=0) / step[:, None]
+    turn = np.arccos(np.clip((u[1:] * u[:-1]).sum(axis=1), -1.0, 1.0))
+    assert turn.max() < 0.01  # tangent-continuous: the sharpest blend turns ≈ 2 mrad per µm here
+    dev = polyline_deviation(q, pts)
+    assert 0.9 * TOL < dev <= TOL * (1.0 + 1e-6)
