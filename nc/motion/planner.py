@@ -10,6 +10,13 @@ hold, a reset, a change of the spindle's actual speed under feed per revolution.
 Operator controls (the channel maps the MLC's relays onto them):
   feed_override (0..1.5), rapid_override (0..1; 0 = slow rapid), hold()/resume(), stop(),
   dry_run (feed of every cutting block replaced by `dry_run_feed`).
+
+Why one file of ~800 lines: the planner is one state machine. Its queue, active plan, sample buffer
+and event flags are read and written by every method below, in an order that the one-setpoint-per-
+cycle guarantee depends on; split across modules, those invariants would be spread over files that
+each see part of the state. The pure parts live beside it: look-ahead passes (lookahead.py), ruckig
+profiles (profile.py), tolerance shares (shares.py), the position filter (smoothing.py), threading
+geometry (threading.py, thread_corners.py) and stretch sampling (stretch.py).
 """
 
 from __future__ import annotations
