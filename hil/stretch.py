@@ -35,7 +35,7 @@ from fieldbus.cia402 import State, Target
 from fieldbus.link import SimLink
 from fieldbus.pdo import RxPdo, TxPdo
 from hil.clock import LockStepClock
-from hil.stretch_bulk import bulk_cycles, bulk_ok
+from hil.stretch_bulk import bulk_cycles, bulk_ok, outputs_hold
 from mlc.basic import BasicMlc
 from mlc.machine import Mlc
 from mlc.spindle_axis import SPINDLE
@@ -143,8 +143,10 @@ class Stretcher:
 
         cut = False
         while k < m:
-            if k == 1 and bulk_ok(r):  # the first cycle wrote what the stretch's state decides: the rest at once
-                bulk_cycles(r, ch, pl, smp, outs, 1, m, raw[m - 1], (rpms, cmds) if settle else None)
+            # The rest at once once the NC outputs the stretch's state decides are written: by its first cycle,
+            # or, from the first, when writing them now leaves every device the gated user scan read as it saw it
+            if (k == 1 and bulk_ok(r)) or (k == 0 and bulk_ok(r) and outputs_hold(r, ch, raw[0])):
+                bulk_cycles(r, ch, pl, smp, outs, k, m, raw[m - 1], (rpms, cmds) if settle else None)
                 k = m
                 pl.position = last_raw
                 break

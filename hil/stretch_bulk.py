@@ -75,6 +75,25 @@ def bulk_ok(r: Any) -> bool:
 _CACHE: dict[tuple, set] = {}
 
 
+def outputs_hold(r: Any, ch: Channel, position: np.ndarray) -> bool:
+    """The NC outputs of the stretch's state (ChannelLink.nc_outputs without the drive status, the planner at
+    `position`, where it stands before the first cycle's step) written now, ahead of the first cycle's scan:
+    True when the gated user scan would still skip (every device it read holds what it saw). The last cycle
+    writes them again (bulk_cycles); nothing reads them in between (the NC's inputs are the MLC's devices)."""
+    mlc = r.mlc
+    if type(mlc) is BasicMlc:
+        return True
+    pl = ch.planner
+    here, pl.position = pl.position, position
+    try:
+        mlc.link.nc_outputs(ch, None)
+    finally:
+        pl.position = here
+    mem = mlc.mem
+    areas = (mem.m, mem.words, mem.x, mem.y, mem.a, mlc.ctx.io.inputs)
+    return all(areas[area][i] == v for (area, i), v in mlc.gate.last.reads.items())
+
+
 def bulk_cycles(r: Any, ch: Channel, pl: Planner, smp: Samples, outs: list[Stretch], k0: int, m: int,
                 before_last_step: np.ndarray, settle: tuple[list[float], list[float]] | None) -> None:
     """Cycles k0 … m-1 of the stretch as the runner's cycle would run them one by one (module doc)."""
@@ -182,11 +201,12 @@ def _mlc(r: Any, ch: Channel, outs: list[Stretch], k0: int, m: int, before_last_
     mlc.bus_feedback(drive_status(r, status))
     if status is not None:
         mlc.bus_status(status)
-    link._drive_outputs(mlc.drives, ch)
-    if link.manual is not None:
-        bits, b3 = mlc.mem.m, 30000 + 1000 * link.x
-        for i, p in enumerate(before_last_step.tolist()):
-            bits[b3 + 352 + i] = 1 if abs(p) < 1e-6 else 0
+    pl = ch.planner  # the last cycle's outputs: those of the stretch's state, its drive status, axes at 0
+    here, pl.position = pl.position, before_last_step
+    try:
+        link.nc_outputs(ch, mlc.drives)
+    finally:
+        pl.position = here
 
 
 def _rows(r: Any, outs: list[Stretch], k0: int, m: int, times: list[float], first_cycle: int, lines: list[int],
