@@ -103,18 +103,21 @@ def take(ip: Interpreter, fr: Frame, limit: int) -> MoveBatch | None:
     if skip is not None and skip[0] is blocks and skip[1] <= pc < skip[2]:
         return None  # a suffix of a run already found too short: shorter still
     raw_at = getattr(blocks, "raw", None)
-    if raw_at is None or raw_at(pc) is None:
+    first = raw_at(pc) if raw_at is not None else None
+    if first is None:
+        return None
+    shapes = ip.__dict__.setdefault("_bulk_shapes", {})  # per interpreter: the axes decide the shapes
+    axes = {a: j for j, a in enumerate(ip.axes) if len(a) == 1 and a in ip._plain_axes}
+    if _shape_of(first, shapes, axes) is None:  # a line the lane never takes (T0101, M05 …): said at once
         return None
     if not eligible(ip):
         return None
     room = min(MAX_RUN, len(blocks) - pc, limit - ip._executed)
-    shapes = ip.__dict__.setdefault("_bulk_shapes", {})  # per interpreter: the axes decide the shapes
-    axes = {a: j for j, a in enumerate(ip.axes) if len(a) == 1 and a in ip._plain_axes}
     segments: list[tuple[_Shape, int, list[tuple[str, ...]]]] = []  # (shape, first row, groups per row)
     texts: list[str] = []
     shape: _Shape | None = None
     rows: list[tuple[str, ...]] = []
-    want = MIN_RUN
+    want = 4  # then 16, 64 …: a run that ends after a line or two is found so, not after slicing MIN_RUN lines
     while len(texts) < room:
         part = blocks.texts(pc + len(texts), min(want, room - len(texts)))
         if not part:
