@@ -8,7 +8,7 @@ elements (intersection at inner corners, arc insertion at outer corners) and int
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 from nc.alarms import NcAlarm
 from nc.cycles.geometry import Pt, Seg, circle_circle, cross, dist, dot, line_circle, unit
@@ -56,7 +56,7 @@ def offset_seg(s: Seg, side: float, r: float) -> Seg:
     p1 = offset_point(s.p1, s.tangent(1.0), side, r)
     if s.is_arc and offset_radius(s, side, r) <= 1e-9:
         raise NcAlarm(0x120A, f"arc radius {s.radius:g} is smaller than the compensation radius {r:g}")
-    return replace(s, p0=p0, p1=p1)
+    return Seg(p0, p1, s.center, s.cw, s.rapid, s.src)  # not dataclasses.replace: its field look per call
 
 
 def _intersections(a: Seg, b: Seg) -> list[Pt]:
@@ -136,6 +136,6 @@ def check_trimmed(prog: Seg, start: Pt, end: Pt, off: Seg) -> None:
             raise NcAlarm(0x120B, "compensation interference: the compensated block runs backwards "
                                   "(block shorter than the tool radius)")
         return
-    trimmed = replace(off, p0=start, p1=end)
+    trimmed = Seg(start, end, off.center, off.cw, off.rapid, off.src)
     if dist(start, end) > 1e-9 and abs(trimmed.sweep()) > abs(off.sweep()) + 1e-6 and abs(off.sweep()) < 2 * math.pi - 1e-9:
         raise NcAlarm(0x1207, "compensation interference: the compensated arc runs backwards")

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Iterator
 from contextlib import contextmanager
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 
 from nc.alarms import NcAlarm
 from nc.compensation import offset as geo
@@ -195,7 +195,8 @@ class Compensator:
             if dist(self.out_pos, off.p0) > 1e-9:
                 self.pending.start = self.out_pos
                 # a straight move to the new offset start is part of this element's start
-                self.pending = _Pending(m, seg, replace(off, p0=self.out_pos) if not seg.is_arc else off,
+                self.pending = _Pending(m, seg, Seg(self.out_pos, off.p1, off.center, off.cw, off.rapid, off.src)
+                                        if not seg.is_arc else off,
                                         self.out_pos, False)
             return out
         off = geo.offset_seg(seg, side, r)
