@@ -170,3 +170,26 @@ def test_plain_trace_of_bulk_stretches_equals_stepped(monkeypatch, tmp_path, kw)
         tables.append({c: t.column(c).to_pylist() for c in t.column_names if c not in ("period", "late")})
     assert r.run.stretched > 0.8 * r.run.cycles
     assert tables[0] == tables[1]
+
+
+def test_max_time_and_a_dwell_inside_stretches(monkeypatch, tmp_path):
+    """A dwell between moves and the bench's max_time running out in the middle of a move (deltahil's alarm
+    0xDE.., the stop along the path after it): the same rows, alarm and end with stretches on and off."""
+    program = "G98\nM03 S500\nG04 X0.3\nG01 Z-40. F600\nG04 X0.2\nG01 X120. Z-140. F900\nM30\n"
+    runs = []
+    for on in ("0", "1"):
+        monkeypatch.setenv(ENV, on)
+        bench = replace(default_lathe(), max_time=3.2)
+        runner = BenchRunner(bench, SimLink(sim_slaves(bench), bench.cycle))
+        path = tmp_path / f"m{on}.parquet"
+        runner.trace = open_trace(path, runner.trace_columns())
+        result = runner.run_program(parse_program(program))
+        t = pq.read_table(path)
+        runs.append(({c: t.column(c).to_pylist() for c in t.column_names if c not in ("period", "late")}, result))
+    (ra, a), (rb, b) = runs
+    assert ra == rb
+    assert [x.code for x in a.alarms] == [x.code for x in b.alarms] and a.alarms
+    assert b.stretched > 1000 and a.final == b.final
+    first = next(i for i, s in enumerate(rb["alarm"]) if s)
+    # raised after cycle 3,200 (max_time / cycle), so in the next cycle's row: not at the end of some stretch
+    assert ra["cycle"][first] == 3201
