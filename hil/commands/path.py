@@ -373,8 +373,10 @@ def cmd_path(args: argparse.Namespace) -> int:
         gc.freeze()
         plotted: list[Move] = []
         write = out.write  # one call a line (print makes two): the same stream, so the order stays
+        servo_log = interp.servo.log
         for ev in interp.run(program, preview=interrupt is None):
-            listed = _print_servo(interp, args, listed)
+            if len(servo_log) > listed:  # asked per event: a look at the log's length (hot path)
+                listed = _print_servo(interp, args, listed)
             if type(ev) is MoveBatch:
                 write((batch_json(ev) if args.json else batch_text(ev)) + "\n")
             elif isinstance(ev, Move):

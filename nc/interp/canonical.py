@@ -36,10 +36,13 @@ class CanonicalMixin:
         slow = self.to_work
 
         def convert(machine: dict[str, float]) -> dict[str, float]:
+            out = {}  # a loop, not a comprehension: no function frame per call (a move each)
             try:
-                return {a: (machine[a] - o) * f for a, o, f in spec}
+                for a, o, f in spec:
+                    out[a] = (machine[a] - o) * f
             except KeyError:
                 return slow(machine)
+            return out
         return convert
 
     def to_machine(self, work: dict[str, float]) -> dict[str, float]:
