@@ -155,28 +155,30 @@ def _seven(v: float) -> str:
     return repr(round(v, 7) + 0.0)
 
 
-_TEMPLATES: dict[tuple, tuple[str, dict]] = {}  # axis names -> ('{"X": %s, "Z": %s}', points written)
+_TEMPLATES: dict[tuple, str] = {}  # axis names -> '{"X": %s, "Z": %s}'
 _FLOATS = {float}
-_POINTS_LIMIT = 4096  # points remembered per axis set: a move's start is the last move's end
+_POINTS: dict[tuple, tuple[str, bool]] = {}  # ((axis, value), …) of floats -> (text, a value is integral)
+_POINTS_LIMIT = 4096  # points remembered: a program comes back to its points (a repeated part, a cycle's passes)
 
 
 def _axes(d: dict[str, float]) -> str:
+    key = tuple(d.items())
+    hit = _POINTS.get(key)
+    # stored for plain floats only; an int or bool equal to a float (5 == 5.0) writes otherwise, so a
+    # point with an integral value is taken only after a look at the types
+    if hit is not None and (not hit[1] or set(map(type, d.values())) == _FLOATS):
+        return hit[0]
     names = tuple(d)
-    entry = _TEMPLATES.get(names)
-    if entry is None:
-        entry = _TEMPLATES[names] = (
-            "{" + ", ".join([_json_str(a).replace("%", "%%") + ": %s" for a in names]) + "}", {})
-    t, points = entry
+    t = _TEMPLATES.get(names)
+    if t is None:
+        t = _TEMPLATES[names] = "{" + ", ".join([_json_str(a).replace("%", "%%") + ": %s" for a in names]) + "}"
     vals = tuple(d.values())
     if set(map(type, vals)) == _FLOATS:  # plain floats: equal values (0.0 and -0.0 too) write the same
-        text = points.get(vals)
-        if text is not None:
-            return text
         if (s := sum(vals)) - s == 0:  # all finite (a NaN or ±inf makes s - s nan)
             text = t % tuple([_seven(v) for v in vals])
-            if len(points) >= _POINTS_LIMIT:
-                points.clear()
-            points[vals] = text
+            if len(_POINTS) >= _POINTS_LIMIT:
+                _POINTS.clear()
+            _POINTS[key] = (text, any([v.is_integer() for v in vals]))
             return text
     return t % tuple([_val(v) for v in vals])
 
