@@ -107,8 +107,15 @@ def take(ip: Interpreter, fr: Frame, limit: int) -> MoveBatch | None:
     if first is None:
         return None
     shapes = ip.__dict__.setdefault("_bulk_shapes", {})  # per interpreter: the axes decide the shapes
+    # a line the lane never takes (T0101, M05 …) is refused at once, found by its text when seen before
+    known = ip.__dict__.setdefault("_bulk_refused", set())
+    if first in known:
+        return None
     axes = {a: j for j, a in enumerate(ip.axes) if len(a) == 1 and a in ip._plain_axes}
-    if _shape_of(first, shapes, axes) is None:  # a line the lane never takes (T0101, M05 …): said at once
+    if _shape_of(first, shapes, axes) is None:
+        if len(known) >= 4096:
+            known.clear()
+        known.add(first)
         return None
     if not eligible(ip):
         return None

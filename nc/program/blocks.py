@@ -62,7 +62,7 @@ class BlockList(Sequence):
     text plus some 20 bytes a line however long the program; a bulk reader (nc.interp.bulk) takes
     runs of the text without making blocks at all."""
 
-    __slots__ = ("_text", "_starts", "_lengths", "_lines", "_blocks", "_parsed", "_cache")
+    __slots__ = ("_text", "_starts", "_lengths", "_lines", "_blocks", "_parsed", "_cache", "_by_text")
 
     def __init__(self, text: str = "") -> None:
         self._text = text  # the program text the plain lines are slices of
@@ -72,6 +72,7 @@ class BlockList(Sequence):
         self._blocks: dict[int, Block] = {}  # items parsed when the program was read
         self._parsed = array("l")  # their indexes, ascending
         self._cache: dict[int, Block] = {}
+        self._by_text: dict[str, Block] = {}  # a line's text -> the block it read as (a line written again)
 
     def _add(self, item: Block, line: int) -> None:
         self._blocks[len(self._lines)] = item
@@ -105,7 +106,15 @@ class BlockList(Sequence):
         if block is None:
             if len(self._cache) >= _CACHE_LIMIT:
                 self._cache.clear()
-            block = self._cache[i] = parse_block(self._lines[i], self._text[start:start + self._lengths[i]])
+                self._by_text.clear()
+            text = self._text[start:start + self._lengths[i]]
+            seen = self._by_text.get(text)
+            if seen is None:
+                block = self._by_text[text] = parse_block(self._lines[i], text)
+            else:  # the same text reads the same (issue 16: a repeated part): its words, its own line
+                block = Block(self._lines[i], seen.text, list(seen.words), seen.n, seen.skip, dict(seen.comma),
+                              seen.comment, seen.stmt, seen.comma_expr)
+            self._cache[i] = block
         return block
 
     def __iter__(self) -> Iterator[Block]:
