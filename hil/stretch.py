@@ -35,13 +35,13 @@ from fieldbus.cia402 import State, Target
 from fieldbus.link import SimLink
 from fieldbus.pdo import RxPdo, TxPdo
 from hil.clock import LockStepClock
-from hil.stretch_bulk import bulk_cycles, bulk_ok, outputs_hold
+from hil.stretch_bulk import bulk_cycles, bulk_ok, first_change, outputs_hold
 from mlc.basic import BasicMlc
 from mlc.machine import Mlc
 from mlc.spindle_axis import SPINDLE
 from nc.channel import Channel, RunState
 from nc.motion.planner import Planner, Setpoint
-from nc.motion.stretch import Samples, sample_stretch, settle_stretch
+from nc.motion.stretch import Samples, sample_stretch, settle_stretch, stand_stretch
 from virtual_bus.drive import Cia402Drive
 from virtual_bus.drive_stretch import Stretch, can_stretch, csp_stretch, csv_stretch
 
@@ -61,6 +61,7 @@ class Stretcher:
         self.r = runner
         self.drives = drives
         self.n_axes = len(runner.axes)
+        self._sampler = sample_stretch  # the planner's samples of this stretch (stand_stretch while it waits)
         self.stretches = 0  # stretches taken and cycles in them (benchmarks, tests)
         self.cycles = 0
 
@@ -82,17 +83,28 @@ class Stretcher:
         """Up to `limit` cycles as one stretch; False when no stretch can start here (step this cycle)."""
         r = self.r
         ch: Channel | None = r.channel
-        if limit < 2 or ch is None or not self._quiet(r, ch):
+        if limit < 2 or ch is None:
+            return False
+        kind = self._quiet(r, ch)
+        if kind is None:
             return False
         pl = ch.planner
-        # to the buffer's end: the planner stays busy on its block (it is dropped at the refill, a stepped cycle)
-        n = min(limit, MAX_CYCLES, len(pl._buf_pos) - pl._buf_i)
+        if kind == "wait":  # standing while an M/S/T code waits for its finish
+            n = min(limit, MAX_CYCLES)
+            self._sampler = stand_stretch
+        else:  # to the buffer's end: the planner stays on its block (dropped at the refill, a stepped cycle)
+            n = min(limit, MAX_CYCLES, len(pl._buf_pos) - pl._buf_i)
+            self._sampler = sample_stretch
         if n < 2:
             return False
         saved_pl = _save_planner(pl)
-        smp = sample_stretch(pl, n)
+        smp = self._sampler(pl, n)
         if smp is None:
             return False
+        if kind == "run":  # what the first cycle's feed does before it finds nothing to read (the same after)
+            pl.closed = ch.end is not None or ch._deferred is not None or ch._limit_alarm is not None
+            if ch.statement_budget is not None:
+                ch.statement_budget.new_cycle()
         rx0 = [copy.copy(rx) for rx in r.rx]  # what the drives are stepped with (the runner's change per cycle)
         saved_drives = [dict(d.__dict__) for d in self.drives]
         targets = self._targets(smp, rx0, n)
@@ -127,7 +139,8 @@ class Stretcher:
         state = {"fell_back": False}
         # The MLC exchange reads the planner's own position (M3x352+i, axis at 0) before the cycle's step: the
         # raw sample of the cycle before, as it stood in stepping (sample_stretch moved it to the last one).
-        raw = [saved_pl["pl"]["position"], *pl._buf_pos[pl._buf_i - m:pl._buf_i - 1]]
+        raw = [saved_pl["pl"]["position"], *pl._buf_pos[pl._buf_i - m:pl._buf_i - 1]] \
+            if self._sampler is sample_stretch else [pl.position] * m
         last_raw = pl.position
         k = 0
 
@@ -146,10 +159,19 @@ class Stretcher:
             # The rest at once once the NC outputs the stretch's state decides are written: by its first cycle,
             # or, from the first, when writing them now leaves every device the gated user scan read as it saw it
             if (k == 1 and bulk_ok(r)) or (k == 0 and bulk_ok(r) and outputs_hold(r, ch, raw[0])):
-                bulk_cycles(r, ch, pl, smp, outs, k, m, raw[m - 1], (rpms, cmds) if settle else None)
-                k = m
-                pl.position = last_raw
-                break
+                j = first_change(r, ch, outs, k, m, raw)  # the first cycle whose scan would not be skipped
+                if j > k:
+                    if j < m:  # the stretch ends before it: that cycle is stepped
+                        outs = self._cut(pl, saved_pl, saved_drives, rx0, targets, j, j)
+                        m, last_raw, cut = j, pl.position, True
+                        if settle:
+                            rpms, cmds = rpms[:k], cmds[:k]
+                    bulk_cycles(r, ch, pl, smp, outs, k, m, raw[m - 1], (rpms, cmds) if settle else None)
+                    if cut and settle:
+                        settle_stretch(pl, rpms, cmds)
+                    k = m
+                    pl.position = last_raw
+                    break
             r.timing = clock.tick()
             link.time += dt
             link.cycles += 1
@@ -177,46 +199,56 @@ class Stretcher:
         return True
 
     # ---- conditions ----------------------------------------------------------------------------
-    def _quiet(self, r: Any, ch: Channel) -> bool:
-        """Nothing event-like is pending: the channel runs a planned move and every cycle of the stretch
-        would take the same path through the NC, the MLC exchange and the drives (module doc)."""
+    def _quiet(self, r: Any, ch: Channel) -> str | None:
+        """Nothing event-like is pending, so every cycle of a stretch would take the same path through the NC,
+        the MLC exchange and the drives (module doc): "run" (the channel runs a planned move), "wait" (an
+        M/S/T code handed to the MLC waits for its finish, nothing moving but the drives settling), else None."""
         if (r.stop_request is not None or r._braking or r._winding_down or r._planner_failed or r._at_limit
                 or r._alarmed_drives or r.result.alarms or ch.alarms):
-            return False
-        if (ch.state is not RunState.RUNNING or ch.pending_aux is not None or ch.emergency or ch.css_rpm is not None
-                or ch._interrupt is not None or ch.skip_armed):
-            return False
+            return None
+        if (ch.emergency or ch.css_rpm is not None or ch._css_surface is not None or ch._interrupt is not None
+                or ch.skip_armed or _panel_state(r.on_cycle) is None or _event_due(r)):
+            return None
         pl = ch.planner
-        if pl.held or pl._thread is not None or pl.threads_queued or not pl.blocks or pl.blocks[0].move.css is not None:
-            return False
-        # Channel._feed_planner reads nothing in these cycles: the program has ended, the queue is full (asked as
-        # its loop asks), or it waits for the queue to drain (an M/S/T code, a sync, a limit alarm, single block)
-        if ch.end is None and not pl.full and ch._deferred is None and ch._limit_alarm is None \
-                and not (ch.single_block and ch._block_moves):
-            return False
-        budget = ch.statement_budget
-        if budget is not None and budget.spent:
-            return False
-        if _panel_state(r.on_cycle) is None or _event_due(r):
-            return False
         mlc = r.mlc
         if isinstance(mlc, Mlc):
             if mlc.gate is None and not getattr(mlc, "program_failed", False):
-                return False  # a scan that runs every cycle may write anything: no stretch
+                return None  # a scan that runs every cycle may write anything: no stretch
             if mlc.gate is not None and (mlc.gate.last is None or mlc.gate.last.dirty):
-                return False
-            if mlc.link._mode_switch_cycles or mlc.link._handed is not None or mlc.caxis.state != SPINDLE:
-                return False
+                return None
+            if mlc.link._mode_switch_cycles or mlc.caxis.state != SPINDLE:
+                return None
         for i, (d, rx, m) in enumerate(zip(self.drives, r.rx, r.masters)):
             mode = MODE_CSP if i < self.n_axes else MODE_CSV
             if (m.state is not State.OPERATION_ENABLED or m.target is not Target.ENABLED or rx.mode != mode
                     or d.params.home_switch is not None or not can_stretch(d, rx, mode)):
-                return False
-        # what the first cycle's feed does before it finds nothing to read (the same every cycle after)
-        pl.closed = ch.end is not None or ch._deferred is not None or ch._limit_alarm is not None
-        if budget is not None:
-            budget.new_cycle()
-        return True
+                return None
+        if pl.held or pl._thread is not None or pl.threads_queued:
+            return None
+        if ch.state is RunState.WAIT_AUX:
+            # the code is handed (strobe up) and not finished: the NC's side of the handshake stands still
+            link = getattr(mlc, "link", None)
+            if (type(mlc) is not Mlc or ch.pending_aux is None or link._handed is not ch.pending_aux
+                    or link._system_hold is not None or link._m2(16) or pl.blocks):
+                return None
+            watch = r.progress
+            if hasattr(watch, "_aux") and watch._aux is not ch.pending_aux:
+                return None  # AuxWatch has not seen the code yet (it times the wait)
+            return "wait"
+        if ch.state is not RunState.RUNNING or ch.pending_aux is not None or not pl.blocks \
+                or pl.blocks[0].move.css is not None:
+            return None
+        if isinstance(mlc, Mlc) and mlc.link._handed is not None:
+            return None
+        # Channel._feed_planner reads nothing in these cycles: the program has ended, the queue is full (asked as
+        # its loop asks), or it waits for the queue to drain (an M/S/T code, a sync, a limit alarm, single block)
+        if ch.end is None and not pl.full and ch._deferred is None and ch._limit_alarm is None \
+                and not (ch.single_block and ch._block_moves):
+            return None
+        budget = ch.statement_budget
+        if budget is not None and budget.spent:
+            return None
+        return "run"
 
     def _still_quiet(self, r: Any, gate: Any, scans: int, panel: tuple | None, rx0: list[RxPdo],
                      targets: list[list[int]], k: int) -> bool:
@@ -262,7 +294,7 @@ class Stretcher:
         (taken again from the state before the stretch), the spindle settle count after those samples."""
         _restore_planner(pl, saved_pl)
         if samples:
-            sample_stretch(pl, samples)
+            self._sampler(pl, samples)
         if rpms is not None and cmds is not None and pl.spindle_command is not None:
             settle_stretch(pl, rpms[:samples], cmds[:samples])
         self._restore_drives(saved_drives)

@@ -21,12 +21,13 @@ from typing import Any
 
 import numpy as np
 
+from fieldbus.pdo import TxPdo
 from hil.mlc_bridge import drive_status
 from hil.trace_parquet import ParquetTrace
 from mlc.basic import BasicMlc
 from mlc.machine import Mlc
 from mlc.nc_link import MANUAL_MODES
-from mlc.on_change import AREA_M, AREA_WORDS
+from mlc.on_change import AREA_M, AREA_WORDS, TIMER_EPS
 from mlc.spindle_axis import SPINDLE
 from nc.channel import Channel
 from nc.motion.planner import Planner
@@ -63,16 +64,77 @@ def bulk_ok(r: Any) -> bool:
             (link.manual is not None and link.manual.clamped):
         return False  # AUTO only: the manual windows and latches are not worked out
     gate = mlc.gate
-    if gate is None or gate.last is None or gate.last.dirty or gate.last.timers:
-        return False
+    return gate is not None and gate.last is not None and not gate.last.dirty
+
+
+_CACHE: dict[tuple, set] = {}
+
+
+def first_change(r: Any, ch: Channel, outs: list[Stretch], k0: int, m: int, raw: list[np.ndarray]) -> int:
+    """The first of cycles k0 … m-1 whose gated user scan would run (a device it read among those the drive
+    status writes changes, or a timer it waits for is due) or whose AuxWatch would warn; m if none. Devices
+    it read among the drive status are worked out cycle by cycle (the drive status bridge and
+    ChannelLink._drive_outputs over the stretch's feedback, then put back), the rest need nothing."""
+    mlc = r.mlc
+    watch = r.progress if hasattr(r.progress, "timeout_s") else None  # hil.aux_watch.AuxWatch
+    due = (watch._since, watch.timeout_s) if watch is not None and watch._aux is not None and watch._warned is None \
+        else None
+    if type(mlc) is BasicMlc:
+        return m if due is None else _first_due(r.time, r.bench.cycle, k0, m, due)
+    rec = mlc.gate.last
+    link = mlc.link
     key = ("bulk-written", link.x)
     devices = _CACHE.get(key)
     if devices is None:
         devices = _CACHE[key] = written_devices(link.x)
-    return devices.isdisjoint(gate.last.reads)
+    watched = [(a, i, v) for (a, i), v in rec.reads.items() if (a, i) in devices]
+    if not watched and not rec.timers:
+        return m if due is None else _first_due(r.time, r.bench.cycle, k0, m, due)
+    mem = mlc.mem
+    areas = (mem.m, mem.words)
+    saved = (mlc.time, r.tx, bytes(mem.m), mem.d.copy())
+    t, rt = mlc.time, r.time
+    status = r.link.status() if callable(getattr(r.link, "status", None)) else None
+    pl = ch.planner
+    here = pl.position
+    try:
+        for k in range(k0, m):
+            t += mlc.cycle
+            rt += r.bench.cycle
+            if any(t - start >= seconds - TIMER_EPS for start, seconds in rec.timers):
+                return k
+            if due is not None and rt - due[0] >= due[1]:  # AuxWatch.update's test at the cycle's end
+                return k
+            if watched:
+                r.tx = [TxPdo(o.statusword[k], o.position_actual[k], o.velocity_actual[k], o.torque_actual[k],
+                              o.following_error[k], o.last.error_code, o.last.mode_display,
+                              o.last.touch_probe_status, o.last.touch_probe_pos1, o.last.digital_inputs)
+                        for o in outs]
+                mlc.time = t
+                mlc._clocks()
+                link._drive_outputs(drive_status(r, status), ch)
+                if link.manual is not None:
+                    pl.position = raw[k]
+                    bits, b3 = mem.m, 30000 + 1000 * link.x
+                    for i, p in enumerate(raw[k].tolist()):
+                        bits[b3 + 352 + i] = 1 if abs(p) < 1e-6 else 0
+                if any(areas[a][i] != v for a, i, v in watched):
+                    return k
+        return m
+    finally:  # the scans of these cycles write these devices themselves (stepped or at once)
+        mlc.time, r.tx = saved[0], saved[1]
+        mem.m[:] = saved[2]
+        mem.d[:] = saved[3]
+        pl.position = here
 
 
-_CACHE: dict[tuple, set] = {}
+def _first_due(time: float, dt: float, k0: int, m: int, due: tuple[float, float]) -> int:
+    """The first cycle whose end-of-cycle AuxWatch.update finds the wait past its timeout."""
+    for k in range(k0, m):
+        time += dt
+        if time - due[0] >= due[1]:
+            return k
+    return m
 
 
 def outputs_hold(r: Any, ch: Channel, position: np.ndarray) -> bool:

@@ -157,19 +157,25 @@ def test_the_machine_after_a_stretch_is_the_stepped_one(monkeypatch, kw):
     assert (a.run.cycles, a.run.final, a.run.max_ferr) == (b.run.cycles, b.run.final, b.run.max_ferr)
 
 
-@pytest.mark.parametrize("kw", [{}, {"mlc": "basic", "feed_override": 120.0}])
+@pytest.mark.parametrize("kw", [{}, {"mlc": "basic", "feed_override": 120.0}, {"aux_timeout": 0.02}])
 def test_plain_trace_of_bulk_stretches_equals_stepped(monkeypatch, tmp_path, kw):
-    """Without device columns the cycles after a stretch's first are taken at once: the trace is the stepped one."""
+    """Without device columns a stretch's cycles are taken at once: the trace and its end record (with the
+    slow-answer warnings of a 20 ms aux_timeout) are the stepped ones."""
+    import json
+
     from hil.api import run
 
-    tables = []
+    tables, ends = [], []
     for on in ("0", "1"):
         monkeypatch.setenv(ENV, on)
         r = run(DEMO, trace=str(tmp_path / f"p{on}.parquet"), check=False, **kw)
         t = pq.read_table(tmp_path / f"p{on}.parquet")
         tables.append({c: t.column(c).to_pylist() for c in t.column_names if c not in ("period", "late")})
+        ends.append(json.loads(t.schema.metadata[b"deltahil"])["end"])
     assert r.run.stretched > 0.8 * r.run.cycles
     assert tables[0] == tables[1]
+    assert ends[0] == ends[1]
+    assert bool(ends[1].get("warnings")) == ("aux_timeout" in kw)
 
 
 def test_max_time_and_a_dwell_inside_stretches(monkeypatch, tmp_path):
@@ -193,3 +199,14 @@ def test_max_time_and_a_dwell_inside_stretches(monkeypatch, tmp_path):
     first = next(i for i, s in enumerate(rb["alarm"]) if s)
     # raised after cycle 3,200 (max_time / cycle), so in the next cycle's row: not at the end of some stretch
     assert ra["cycle"][first] == 3201
+
+
+def test_an_aux_wait_stretches_and_warns_on_the_same_cycle(monkeypatch, tmp_path):
+    """While an M/S/T code waits for its finish (the spindle running up after M03, the turret indexing) the
+    cycles stretch too (the planner standing, nc/motion/stretch.stand_stretch); the finish and the slow-answer
+    warning (aux_timeout 20 ms) land on the stepped cycles and times."""
+    a, b, r = _both(monkeypatch, tmp_path, DEMO, aux_timeout=0.02)
+    assert compare(a, b) == []
+    warnings = b[1][-1][b"deltahil"]["end"]["warnings"]
+    assert warnings and warnings == a[1][-1][b"deltahil"]["end"]["warnings"]
+    assert r.run.stretched > 0.9 * r.run.cycles

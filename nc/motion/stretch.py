@@ -57,6 +57,24 @@ def sample_stretch(pl: Planner, n: int) -> Samples | None:
     return Samples(positions, list(pl._buf_line[i:i + m]), np.array(pl._buf_vel[i:i + m], dtype=float), mv)
 
 
+def stand_stretch(pl: Planner, n: int) -> Samples | None:
+    """`n` setpoints of a planner with nothing to move (no block, no plan: waiting for an M/S/T finish), as
+    step() gives them: the position where it stands through the filter (its tail still runs out). None
+    unless step() would change nothing else: it stood so already the cycle before (speed 0, carry one
+    cycle, no block started, no stop to flush) and the filter needs no reset to that position."""
+    if n <= 0 or pl.blocks or pl.plan is not None or not pl._buf_done or pl._integrate_angle or pl._stopping:
+        return None
+    if pl.v != 0.0 or pl.a != 0.0 or pl._started or pl._carry != pl.cfg.cycle:
+        return None
+    f = pl.filter
+    if f is not None and f.settled and not np.array_equal(pl.position, f.output):
+        return None  # step() resets the filter to the position first
+    raw = np.tile(pl.position, (n, 1))
+    positions = f.push_many(raw) if f is not None else raw
+    pl.output = positions[-1].copy()
+    return Samples(positions, [pl.line] * n, np.zeros(n), None)
+
+
 def settle_stretch(pl: Planner, rpms: Sequence[float], commands: Sequence[float]) -> None:
     """The spindle settle count step() keeps, for a stretch's cycles: the measured and commanded speed each
     cycle's step() would have read."""
