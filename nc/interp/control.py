@@ -49,9 +49,8 @@ class ControlMixin:
         """Run one macro statement; the Sync it calls for (a write to a live # variable), else None.
         A plain function, not a generator: statements are most blocks of a macro program (issue 16)."""
         s = block.stmt
-        fr = self.stack[-1]
         if self.on_statement is not None:
-            self.on_statement(block, fr.program.name)
+            self.on_statement(block, self.stack[-1].program.name)
         if self.budget is not None:
             self.budget.spend()
         if type(s) is Assign:
@@ -66,7 +65,7 @@ class ControlMixin:
             if n > 99 and self.sys.live(n):  # no local variable (#1-#99) is a live system variable
                 return Sync(block.line, block.text, f"#{n}")
             return None
-        self._control(s, fr)
+        self._control(s, self.stack[-1])
         return None
 
     def _control(self, s, fr: Frame) -> None:

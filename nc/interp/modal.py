@@ -12,13 +12,16 @@ from nc.moves import Aux
 from nc.program.blocks import Block, Word
 
 
+# group-01 functions -> the motion mode (a constant: every G0/G1 block sets it)
+_MOTION = {"G00": 0, "G01": 1, "G02": 2, "G03": 3, "G2.4": 2.4, "G3.4": 3.4, "G32": 32, "G34": 34}
+
+
 class ModalMixin:
     def _set_modal(self, grp: int, fn: str, w: Word, block: Block) -> None:
         st = self.state
         st.groups[grp] = w.value
         if grp == 1:
-            st.motion = {"G00": 0, "G01": 1, "G02": 2, "G03": 3, "G2.4": 2.4, "G3.4": 3.4, "G32": 32,
-                         "G34": 34}[fn]
+            st.motion = _MOTION[fn]
             if st.cycle is not None:  # a group-01 code cancels the cycle as G80 does
                 self.cycle_memory.pop("hole", None)
             st.cycle = None
