@@ -137,3 +137,29 @@ def test_a_cam_run_goes_through_in_batches(small_runs) -> None:
                  st.sampled_from([0.0, -0.0, 1e-5, -4.99999e-8, 9999999.9999999, 1e7, -1e7, 123.45678905])))
 def test_bulk_number_is_the_general_number(v: float) -> None:
     assert _coord(v) == _num(fmt(v))
+
+
+@pytest.mark.parametrize("text", [
+    "O1000\n\ng1 f1200\nG1 X4. ,C0.5\ng1 f1200\nM30\n",  # hypothesis found these: a run that moves nothing
+    "O1000\n\ng1 f1200\ng1 f1200\nG1 X4. ,C0.5\ng1 f1200\ng1 x0.000 f1200\ng1 f1200\nM30\n",  # after ,C
+])
+def test_a_run_without_moves_after_a_corner_block_is_as_block_by_block(small_runs, text: str) -> None:
+    _same("nc5-lathe-a", text, False)
+
+
+def test_a_long_run_of_blocks_without_moves_writes_no_line(tmp_path, capsys) -> None:
+    """`hil path --json`: 100 `G1 F1200` lines (one bulk run that moves nothing) print nothing, not an
+    empty line; after a ,C block they leave the corner without its motion block (0x0207), as
+    block by block, not an internal error."""
+    from hil.cli import main
+
+    still = "G1 F1200\n" * 100
+    p = tmp_path / "still.nc"
+    p.write_text("O1000\nG1 X1 F1200\n#1=1\n" + still + "M30\n")
+    assert main(["path", "--json", str(p)]) == 0
+    out = capsys.readouterr().out
+    assert out.count("\n") == 1 and '"line": 2' in out
+    p.write_text("O1000\nG1 F1200\nG1 X4. ,C0.5\n" + still + "M30\n")
+    assert main(["path", "--json", str(p)]) == 1
+    alarm = capsys.readouterr().out.strip().splitlines()[-1]
+    assert '"code": "0x0207"' in alarm and '"line": 3' in alarm

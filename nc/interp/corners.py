@@ -24,7 +24,14 @@ if TYPE_CHECKING:  # pragma: no cover
 def expand_corners(interp: "InterpHost", events: Iterator[Event]) -> Iterator[Event]:
     pending: tuple[Move, str, float] | None = None
     held: list[Event] = []  # M/S/T or dwell events of the next block, issued after the corner
-    for ev in events:
+    events = iter(events)
+    while True:
+        # while a corner waits for its motion block the interpreter reads block by block (no bulk run
+        # reads past the block that joins it, or past its alarm): said before the next event is read
+        interp.corner_pending = pending is not None
+        ev = next(events, None)
+        if ev is None:
+            break
         if type(ev) is MoveBatch:  # plain moves (no ,C/,R): through whole unless a corner waits for them
             if pending is None:
                 yield ev

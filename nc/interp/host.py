@@ -28,6 +28,7 @@ class InterpHost(Protocol):
     program_name: str
     preview_log: Any
     on_statement: Any
+    corner_pending: bool  # set by nc.interp.corners.expand_corners, read by the program counter
 
     def to_work(self, machine: dict[str, float]) -> dict[str, float]: ...
     def to_machine(self, work: dict[str, float]) -> dict[str, float]: ...

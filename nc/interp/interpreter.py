@@ -93,6 +93,7 @@ class Interpreter(ExecuteMixin, ReadingMixin, ModalMixin, MotionMixin, NonModalM
         # True: runs of plain G0/G1 blocks come as one MoveBatch event (nc.interp.bulk); for a consumer
         # that formats them in bulk (`hil path`), never the channel, which plans Move by Move
         self.bulk = False
+        self.corner_pending = False  # a ,C/,R block waits for its motion block (set by expand_corners)
         self._bulk_skip: tuple | None = None  # (blocks, first, end): a run nc.interp.bulk found too short
 
     # ---- public ---------------------------------------------------------------------------
@@ -158,8 +159,9 @@ class Interpreter(ExecuteMixin, ReadingMixin, ModalMixin, MotionMixin, NonModalM
                 continue
             block = parsed(pc)
             if block is None:  # a plain line: the bulk lane is asked only there (never at a statement)
-                if bulk is not None and (batch := bulk.take(self, fr, limit)) is not None:
-                    yield batch  # a run of plain G0/G1 blocks read in one pass (nc.interp.bulk)
+                if bulk is not None and not self.corner_pending and (batch := bulk.take(self, fr, limit)) is not None:
+                    if len(batch):  # a run of plain G0/G1 blocks read in one pass (nc.interp.bulk); one
+                        yield batch  # that moved nothing (`G1 F100` lines) is no event, as block by block
                     last = self.block
                     continue
                 block = blocks[pc]
