@@ -228,8 +228,10 @@ def move_json(m: Move) -> str:
     last[0], last[1], last[2] = end, tuple(end.items()), end_text
     text = (f'{head}{start_text}, "end": {end_text}, "work": {_axes(m.work)}, '
             f'"center": {"null" if m.center is None else _axes(m.center)}, '
-            f'"dir": {"null" if m.dir is None else _str(m.dir)}, "feed": {_num(m.feed)}, "duration": {_num(m.duration)}')
-    if m.per_rev and m.feed is not None:  # the additive keys of move_dict, in its order
+            f'"dir": {"null" if m.dir is None else _str(m.dir)}, '
+            f'"feed": {"null" if (feed := m.feed) is None else _num(feed)}, '
+            f'"duration": {"null" if (duration := m.duration) is None else _num(duration)}')
+    if m.per_rev and feed is not None:  # the additive keys of move_dict, in its order
         text += ', "per_rev": true'
     if m.exact_stop:
         text += ', "exact_stop": true'
