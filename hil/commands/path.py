@@ -364,6 +364,9 @@ def cmd_path(args: argparse.Namespace) -> int:
         print_alarm(exc.alarm, as_json=args.json)
         return EXIT_ALARM
     listed = 0  # G10 L40-L46 servo accesses are listed where they happen (issue 8)
+    # lines gather and go out a chunk at a time (issue 16: a write call per move), always before
+    # anything else is printed, so the order on the stream stays
+    lines: list[str] = []
     if not args.json:
         print(text_header(profile.diameter_axes), file=out)
     try:
@@ -376,26 +379,29 @@ def cmd_path(args: argparse.Namespace) -> int:
             gc.enable()
         gc.freeze()
         plotted: list[Move] = []
-        write = out.write  # one call a line (print makes two): the same stream, so the order stays
+        add = lines.append
         servo_log = interp.servo.log
         for ev in interp.run(program, preview=interrupt is None):
             if len(servo_log) > listed:  # asked per event: a look at the log's length (hot path)
+                _flush(out, lines)
                 listed = _print_servo(interp, args, listed)
             if type(ev) is MoveBatch:
-                write((batch_json(ev) if args.json else batch_text(ev)) + "\n")
+                add(batch_json(ev) if args.json else batch_text(ev))
             elif isinstance(ev, Move):
                 if interrupt and ev.line == interrupt[0] and ev.program == program.name \
                         and interp.interrupt_program is not None:
                     ev, interrupt = suspend(interp, ev, interrupt[1]), None
                 if getattr(args, "plot", None):
                     plotted.append(ev)
-                if args.json:
-                    write(move_json(ev) + "\n")
-                else:
-                    write(_human(ev, profile.diameter_axes) + "\n")
+                add(move_json(ev) if args.json else _human(ev, profile.diameter_axes))
             elif args.preview_log and isinstance(ev, Sync):
+                _flush(out, lines)
                 print(strict_json.dumps(ev.as_dict()) if args.json else f"{ev.line:5d} sync   {ev.reason}", file=out)
+            if len(lines) >= 256:
+                _flush(out, lines)
+        _flush(out, lines)
     except NcAlarm as exc:
+        _flush(out, lines)
         _print_servo(interp, args, listed)
         _print_preview(interp, args)
         print_alarm(exc.alarm, as_json=args.json)
@@ -403,6 +409,7 @@ def cmd_path(args: argparse.Namespace) -> int:
     except BrokenPipeError:  # `hil path … | head`: the reader left; hil.cli ends quietly
         raise
     except Exception as exc:  # a bug, reported as the NC internal alarm, never a traceback
+        _flush(out, lines)
         print_alarm(internal_error(exc), as_json=args.json)
         return EXIT_ALARM
     _print_servo(interp, args, listed)
@@ -422,6 +429,13 @@ def cmd_path(args: argparse.Namespace) -> int:
         print(strict_json.dumps({"kind": "vars", "values": values}) if args.json else
               "vars " + " ".join(f"#{k}={'vacant' if v is None else v}" for k, v in values.items()), file=out)
     return EXIT_OK
+
+
+def _flush(out, lines: list[str]) -> None:
+    """Write the gathered lines in one call and empty the list."""
+    if lines:
+        out.write("\n".join(lines) + "\n")
+        lines.clear()
 
 
 def _print_servo(interp: Interpreter, args: argparse.Namespace, listed: int) -> int:
