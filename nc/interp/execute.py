@@ -167,6 +167,8 @@ def step_motion(ip, run: BlockRun) -> Iterator[Event] | None:
     if NO_MOTION_FUNCS.isdisjoint(nonmodal) and TRANSFORM_ARG_FUNCS.isdisjoint(run.funcs):
         if _still(ip, run):
             return None
+        if ip.macro_modal is None:  # `run.moved` is read only for a modal G66 call: no wrapper per move
+            return ip._motion(run.block, run.funcs)
         return _moves(ip._motion(run.block, run.funcs), run)
     return None
 
@@ -373,6 +375,8 @@ class ExecuteMixin:
 
     def _halt_m(self, mvals: list[int]) -> int | None:
         first = int(self.profile.param("N1.118", 0))
+        if not first:  # no halt M codes (the default)
+            return None
         count = int(self.profile.param("N1.119", 0))
         for m in mvals:
             if first and first <= m < first + count:
