@@ -193,18 +193,23 @@ class MotionMixin:
                 return
         self.unit_locked = True
         exact = "G09" in funcs
+        motion = st.motion
+        if motion == 0 or motion == 1:  # `_move_common`'s fields, positionally (no dict per block)
+            move = Move("rapid" if motion == 0 else "line", block.line, block.text, dict(self.position),
+                        dict(geo.target_machine), dict(geo.target_work), None, None,
+                        self.feed() if motion == 1 else None, None, st.per_rev if motion == 1 else False,
+                        PLANES[st.plane], False, None, 0.0, 0.0, 0.0, self.program_name)
+            self.position = dict(geo.target_machine)
+            self.last_target = dict(geo.target_work)
+            yield self._decorate(move, exact)
+            return
         common = self._move_common(block, geo.target_machine, geo.target_work)
         if st.motion in (2.4, 3.4):
             yield from self._three_point_arc(block, geo, common)
             return
-        if st.motion == 0:
-            move = Move("rapid", **common)
-        elif st.motion == 1:
-            move = Move("line", feed=self.feed(), per_rev=st.per_rev, **common)
-        else:
-            move = self._arc(block, common)
-            if move is None:
-                return
+        move = self._arc(block, common)
+        if move is None:
+            return
         self.position = dict(geo.target_machine)
         self.last_target = dict(geo.target_work)
         yield self._decorate(move, exact)
