@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from nc.motion.planner import Planner
-from nc.motion.stretch import sample_stretch, settle_stretch
+from nc.motion.stretch import sample_stretch, settle_stretch, stand_stretch
 from tests.motion_helpers import AX, lines, mill_cfg
 
 
@@ -19,7 +19,7 @@ def _planner(cfg, rpms: list[float], at: list[int]) -> Planner:
 
 def _state(pl: Planner) -> tuple:
     return (pl.position.tolist(), pl.line, pl.s, pl.v, pl.a, pl._buf_i, pl._settle.cycles, pl.output.tolist(),
-            pl.filter.output.tolist() if pl.filter is not None else None, len(pl.blocks))
+            pl.filter.output.tolist() if pl.filter is not None else None, len(pl.blocks), pl._carry, pl._started)
 
 
 @pytest.mark.parametrize("filter_ms", [0.0, 16.0])
@@ -60,6 +60,8 @@ def test_sample_stretch_equals_step_cycle_by_cycle(filter_ms, seed):
             if k < stop < k + c:
                 c = stop - k
         s = sample_stretch(many, c)
+        if s is None and k > resume_at:  # the path's end: the filter's tail with the planner standing
+            s = stand_stretch(many, c)
         if s is None:
             many_at[0] = k
             sp = many.step()

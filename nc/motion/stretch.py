@@ -58,19 +58,27 @@ def sample_stretch(pl: Planner, n: int) -> Samples | None:
 
 
 def stand_stretch(pl: Planner, n: int) -> Samples | None:
-    """`n` setpoints of a planner with nothing to move (no block, no plan: waiting for an M/S/T finish), as
-    step() gives them: the position where it stands through the filter (its tail still runs out). None
-    unless step() would change nothing else: it stood so already the cycle before (speed 0, carry one
-    cycle, no block started, no stop to flush) and the filter needs no reset to that position."""
+    """`n` setpoints of a planner with nothing to move (no block, no plan: waiting for an M/S/T finish, or the
+    filter's tail after the last move), as step() gives them: the position where it stands through the filter.
+    None unless step() would change nothing else: it stood so the cycle before (speed 0, no block started, no
+    stop to flush, no axis moving on its own) and the filter needs no reset to that position. step()'s solve
+    (which finds nothing) runs once the filter has settled, and leaves the carry at one cycle."""
     if n <= 0 or pl.blocks or pl.plan is not None or not pl._buf_done or pl._integrate_angle or pl._stopping:
         return None
-    if pl.v != 0.0 or pl.a != 0.0 or pl._started or pl._carry != pl.cfg.cycle:
+    if pl.v != 0.0 or pl.a != 0.0 or pl._started or np.any(pl._axis_v):
         return None
     f = pl.filter
     if f is not None and f.settled and not np.array_equal(pl.position, f.output):
         return None  # step() resets the filter to the position first
     raw = np.tile(pl.position, (n, 1))
-    positions = f.push_many(raw) if f is not None else raw
+    if f is None:
+        positions, solved = raw, True
+    else:  # Planner._refill solves (Planner._start_plan) in a step that begins with the filter settled
+        head = f.push_many(raw[:-1])
+        solved = f.settled
+        positions = np.vstack([head, f.push_many(raw[-1:])])
+    if solved:
+        pl._carry = pl.cfg.cycle
     pl.output = positions[-1].copy()
     return Samples(positions, [pl.line] * n, np.zeros(n), None)
 
