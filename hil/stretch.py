@@ -89,8 +89,10 @@ class Stretcher:
         if kind is None:
             return False
         pl = ch.planner
-        if kind == "wait":  # standing while an M/S/T code waits for its finish
+        if kind in ("wait", "drain"):  # standing: an M/S/T code waits for its finish, or the filter's tail
             n = min(limit, MAX_CYCLES)
+            if kind == "drain":  # the cycle that begins with the filter settled issues the waiting code: stepped
+                n = min(n, pl.filter.span - pl.filter._still)
             self._sampler = stand_stretch
         else:  # to the buffer's end: the planner stays on its block (dropped at the refill, a stepped cycle)
             n = min(limit, MAX_CYCLES, len(pl._buf_pos) - pl._buf_i)
@@ -101,7 +103,7 @@ class Stretcher:
         smp = self._sampler(pl, n)
         if smp is None:
             return False
-        if kind == "run":  # what the first cycle's feed does before it finds nothing to read (the same after)
+        if kind != "wait":  # what the first cycle's feed does before it finds nothing to read (the same after)
             pl.closed = ch.end is not None or ch._deferred is not None or ch._limit_alarm is not None
             if ch.statement_budget is not None:
                 ch.statement_budget.new_cycle()
@@ -235,10 +237,17 @@ class Stretcher:
             if hasattr(watch, "_aux") and watch._aux is not ch.pending_aux:
                 return None  # AuxWatch has not seen the code yet (it times the wait)
             return "wait"
-        if ch.state is not RunState.RUNNING or ch.pending_aux is not None or not pl.blocks \
-                or pl.blocks[0].move.css is not None:
+        if ch.state is not RunState.RUNNING or ch.pending_aux is not None:
             return None
         if isinstance(mlc, Mlc) and mlc.link._handed is not None:
+            return None
+        if not pl.blocks:  # the last move's filter tail before a waiting code or the program's end
+            if (pl.plan is not None or pl.filter is None or pl.filter.settled or ch._limit_alarm is not None
+                    or (ch._deferred is None and ch.end is None) or ch.single_block):
+                return None
+            budget = ch.statement_budget
+            return None if budget is not None and budget.spent else "drain"
+        if pl.blocks[0].move.css is not None:
             return None
         # Channel._feed_planner reads nothing in these cycles: the program has ended, the queue is full (asked as
         # its loop asks), or it waits for the queue to drain (an M/S/T code, a sync, a limit alarm, single block)
