@@ -1,6 +1,6 @@
 """A CSP drive stepped over a stretch of cycles at once (virtual_bus/drive_stretch.py, issue 17) gives, cycle by
 cycle, the feedback exchange() gives one cycle at a time, leaves the drive in the same state, and stops before
-a cycle that faults (which exchange() then takes)."""
+a cycle that faults or reaches a limit switch (which exchange() then takes)."""
 
 from __future__ import annotations
 
@@ -92,9 +92,36 @@ def test_stretch_stops_before_the_cycle_that_faults():
     assert astuple(a) == astuple(b) and many.state is State.FAULT_REACTION_ACTIVE
 
 
+@pytest.mark.parametrize("seed", range(2))
+def test_a_limited_drive_stretches_short_of_its_switch(seed):
+    """A CSP drive with limit switches inside its path: stretches stop before a cycle whose sub-steps reach a
+    switch, exchange() takes that cycle (the drive holds at the switch, sets 0x60FD and its limit code), and
+    stretches go on once the path is back inside; the same feedback and model state every cycle."""
+    params = DriveParams(positive_limit=450_000, negative_limit=-50_000)
+    one, rx1 = _enabled(params, 0.0)
+    many, rx2 = _enabled(params, 0.0)
+    targets = _targets(seed, 1500)
+    want, states = _reference(one, rx1, "target_position", targets)
+    rng = np.random.default_rng(seed)
+    got, k, stepped = [], 0, 0
+    while k < len(targets):
+        chunk = targets[k:k + int(rng.integers(1, 90))]
+        s = csp_stretch(many, rx2, chunk, 0.001)
+        got += list(zip(*(getattr(s, f) for f in FIELDS)))
+        k += s.done
+        if s.done < len(chunk):  # the switch: this cycle by exchange()
+            rx2.target_position = targets[k]
+            tx = many.exchange(rx2, 0.001)
+            got.append(tuple(getattr(tx, f) for f in FIELDS))
+            k, stepped = k + 1, stepped + 1
+        assert _state(many) == states[k - 1]
+    assert got == [tuple(getattr(tx, f) for f in FIELDS) for tx in want]
+    assert stepped > 0 and any(tx.statusword & 0x0800 for tx in want)  # the switch was reached
+
+
 def test_no_stretch_where_the_plain_csp_path_does_not_hold():
-    d, rx = _enabled(DriveParams(negative_limit=-10**9), 0.0)
-    assert not can_stretch(d, rx) and csp_stretch(d, rx, [5, 6], 0.001).done == 0
+    d, rx = _enabled(DriveParams(negative_limit=-10**9), 0.0, mode=9)
+    assert not can_stretch(d, rx, 9) and csv_stretch(d, rx, 2, 0.001).done == 0  # a CSV drive with limits
     d, rx = _enabled(DriveParams(), 0.0)
     rx.touch_probe_function = 1  # a G31 probe armed: the latch is per sub-step
     assert not can_stretch(d, rx)

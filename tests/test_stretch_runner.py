@@ -99,16 +99,19 @@ def test_a_drive_fault_inside_a_stretch_lands_on_its_cycle(monkeypatch, tmp_path
     assert first > 100  # mid-program, after stretches ran
 
 
-def test_a_hardware_limit_switch_bench_steps_every_cycle_the_same(monkeypatch, tmp_path):
-    """A drive with a limit switch is not stretched (the stretch drive model has none): the run, with its 0x0402
-    at the switch, is the stepped one, while the spindle-free cycles of the other axes are not taken apart."""
+def test_a_hardware_limit_hit_inside_a_stretch_lands_on_its_cycle(monkeypatch, tmp_path):
+    """X's drive has its positive limit switch at 85 mm and the program feeds X to 90 mm: the stretch ends before
+    the cycle whose sub-steps reach the switch (the drive's limit handling, then the bench's 0x0402), which runs
+    as a stepped one; the rows, the alarm and where X is held are the stepped run's."""
     def tweak(drives):
         drives[0].params = replace(drives[0].params, positive_limit=85 * 1_280_000 // 5)
 
-    (ra, a), (rb, b) = (_direct(monkeypatch, tmp_path, on, "G98\nG01 U60. F3000\nM30\n", tweak) for on in ("0", "1"))
+    program = "G98\nM03 S500\nG04 X0.3\nG01 U60. F600\nM30\n"
+    (ra, a), (rb, b) = (_direct(monkeypatch, tmp_path, on, program, tweak) for on in ("0", "1"))
     assert ra == rb
-    assert [x.code for x in b.alarms] == [0x0402]
-    assert b.stretched == 0
+    assert [x.code for x in b.alarms] == [0x0402] == [x.code for x in a.alarms]
+    assert b.stretched > 1000 and a.final == b.final
+    assert 84.9 < b.final["X"] <= 85.0 + 1e-3
 
 
 _EXCHANGE = BenchRunner._exchange

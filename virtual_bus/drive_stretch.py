@@ -43,7 +43,7 @@ def can_stretch(drive: Cia402Drive, rx: RxPdo, mode: int = 8) -> bool:
     probe_ok = not rx.touch_probe_function & 1 or (mode == 9 and drive._probe_latched)
     return (drive.state is State.OPERATION_ENABLED and drive.mode == mode and rx.mode == mode
             and not drive.external_fault and cw == drive._last_cw and cw & 0x8F == ENABLE_HELD
-            and p.negative_limit is None and p.positive_limit is None and probe_ok)
+            and (mode == 8 or (p.negative_limit is None and p.positive_limit is None)) and probe_ok)
 
 
 def csp_stretch(drive: Cia402Drive, rx: RxPdo, targets: Sequence[int], dt: float) -> Stretch:
@@ -58,6 +58,10 @@ def csp_stretch(drive: Cia402Drive, rx: RxPdo, targets: Sequence[int], dt: float
     k_raw, t_pct = units.raw_per_count_per_s(cpr), units.torque_percent  # velocity_to_raw, 0x6077
     inertia, viscous, coulomb, rated = p.inertia, p.viscous, p.coulomb, p.rated_torque
     base = _STATUS_BASE[State.OPERATION_ENABLED] | SW_FOLLOWING
+    # limit switches (Cia402Drive._limit): a cycle that would reach one is left to exchange(); short of them the
+    # limited drive's sub-steps are the plain ones
+    lo = float(p.negative_limit) if p.negative_limit is not None else -math.inf
+    hi = float(p.positive_limit) if p.positive_limit is not None else math.inf
     pos, vel, t, command = drive.position, drive.velocity, drive.time, drive.command
     prev_target = drive._prev_target
     acc, torque = drive.acceleration, drive.torque
@@ -69,7 +73,8 @@ def csp_stretch(drive: Cia402Drive, rx: RxPdo, targets: Sequence[int], dt: float
         ff_vel = (target - prev) / dt
         kff_ff, span = kff * ff_vel, target - prev
         c_pos, c_vel, c_t, cmd = pos, vel, t, command
-        for k in range(1, n + 1):  # Cia402Drive._step_following, csp, no probe
+        inside = True
+        for k in range(1, n + 1):  # Cia402Drive._step_following (_step_general with limits), csp, no probe
             cmd = prev + span * k / n
             v_cmd = kff_ff + kp * (cmd - c_pos)
             if not -max_cps <= v_cmd <= max_cps:
@@ -77,9 +82,11 @@ def csp_stretch(drive: Cia402Drive, rx: RxPdo, targets: Sequence[int], dt: float
             if v_cmd != c_vel:
                 c_vel += (v_cmd - c_vel) * alpha
             c_pos = c_pos + c_vel * h
+            if not lo < c_pos < hi:
+                inside = False
             c_t += h
-        if abs(cmd - c_pos) > window or abs(c_vel) > 1.2 * max_cps:
-            break  # Cia402Drive._supervise would fault in this cycle: exchange() takes it
+        if not inside or abs(cmd - c_pos) > window or abs(c_vel) > 1.2 * max_cps:
+            break  # a limit switch, or Cia402Drive._supervise would fault in this cycle: exchange() takes it
         c_acc = (c_vel - vel) / dt
         # Cia402Drive.step's torque of an energised drive (0.1 % of rated) and DriveUnits.velocity_to_raw inline,
         # the same expressions: a call each per cycle cost a fifth of the loop
