@@ -381,19 +381,20 @@ def cmd_path(args: argparse.Namespace) -> int:
         plotted: list[Move] = []
         add = lines.append
         servo_log = interp.servo.log
+        plot, as_json = getattr(args, "plot", None), args.json  # asked once, not per event
         for ev in interp.run(program, preview=interrupt is None):
             if len(servo_log) > listed:  # asked per event: a look at the log's length (hot path)
                 _flush(out, lines)
                 listed = _print_servo(interp, args, listed)
             if type(ev) is MoveBatch:
-                add(batch_json(ev) if args.json else batch_text(ev))
+                add(batch_json(ev) if as_json else batch_text(ev))
             elif isinstance(ev, Move):
                 if interrupt and ev.line == interrupt[0] and ev.program == program.name \
                         and interp.interrupt_program is not None:
                     ev, interrupt = suspend(interp, ev, interrupt[1]), None
-                if getattr(args, "plot", None):
+                if plot:
                     plotted.append(ev)
-                add(move_json(ev) if args.json else _human(ev, profile.diameter_axes))
+                add(move_json(ev) if as_json else _human(ev, profile.diameter_axes))
             elif args.preview_log and isinstance(ev, Sync):
                 _flush(out, lines)
                 print(strict_json.dumps(ev.as_dict()) if args.json else f"{ev.line:5d} sync   {ev.reason}", file=out)

@@ -40,7 +40,8 @@ def expand_corners(interp: "InterpHost", events: Iterator[Event]) -> Iterator[Ev
             pending, held = None, []
             continue
         if isinstance(ev, Move) and ev.kind in ("line", "arc", "rapid", "thread"):
-            mark = _mark(interp, ev)
+            b = interp.block  # a block without ,C/,R marks nothing: said without a call (hot path)
+            mark = None if b is None or not b.comma else _mark(interp, ev)
             if pending is not None:
                 first, kind, value = pending
                 pending = None

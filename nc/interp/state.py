@@ -94,7 +94,7 @@ class Frames:
     def copy(self) -> "Frames":
         """An independent copy (what copy.deepcopy gives, at a tenth of its cost: a lathe cycle's
         contour is interpreted on a copy of the interpreter, issue 16)."""
-        twin = Frames(self.axes, [w.copy() for w in self.work_offsets], self.external.copy(),
+        twin = Frames(self.axes, list(map(dict.copy, self.work_offsets)), self.external.copy(),
                       self.local_shift.copy(), self.set_shift.copy(), self.tool_shift.copy())
         twin._memo = self._memo  # compared by value and never changed: valid for the equal copy too
         return twin
