@@ -122,12 +122,23 @@ def move_dict(m: Move) -> dict:
     return d
 
 
+_NUMS: dict[float, str] = {}  # nonzero float -> its repr ("null" for ±inf)
+
+
 def _num(v) -> str:
     """One number as strict_json.dumps writes it: floats by repr, non-finite as null; anything else
     (a float subclass such as numpy's, None) the general way."""
     t = type(v)
     if t is float:
-        return repr(v) if math.isfinite(v) else "null"
+        if v != 0:  # equal nonzero floats write alike (0.0 and -0.0 do not): a feed, a lead written once
+            text = _NUMS.get(v)
+            if text is None:
+                text = repr(v) if math.isfinite(v) else "null"
+                if len(_NUMS) >= _QUOTED_LIMIT:
+                    _NUMS.clear()
+                _NUMS[v] = text
+            return text
+        return repr(v)
     if t is int:
         return repr(v)
     if v is None:
