@@ -6,8 +6,6 @@ they use is the Interpreter's (see its __init__)."""
 
 from __future__ import annotations
 
-import copy
-
 from collections.abc import Iterator
 
 from nc.alarms import NcAlarm
@@ -56,7 +54,8 @@ class ContourMixin:
         return self.contour_moves(self.contour_blocks(p, q))
 
     def _clone(self):  # -> the same Interpreter class
-        twin = copy.copy(self)
+        twin = object.__new__(type(self))  # copy.copy without its reduce protocol (a plain class)
+        twin.__dict__.update(self.__dict__)
         twin.state = self.state.copy()
         twin.state.cycle = None
         twin.frames = self.frames.copy()
