@@ -65,3 +65,19 @@ def test_line_depths_from_its_ends(p0, p1):
     short = _sample_ds(Seg(p0, p1))
     assert (min(short), max(short), short[0], short[-1]) == (min(full), max(full), full[0], full[-1])
     assert any(b < a for a, b in zip(short, short[1:])) == any(b < a for a, b in zip(full, full[1:]))
+
+
+def test_seg_is_still_a_frozen_dataclass():
+    """Seg's own __init__ (issue 16) keeps what the dataclass gave: defaults, equality, hashing,
+    dataclasses.replace and refused assignment."""
+    import dataclasses
+
+    import pytest
+
+    s = Seg((0.0, 1.0), (2.0, 3.0))
+    assert (s.center, s.cw, s.rapid, s.src) == (None, False, False, None)
+    assert s == Seg(p0=(0.0, 1.0), p1=(2.0, 3.0)) and hash(s) == hash(Seg((0.0, 1.0), (2.0, 3.0)))
+    arc = dataclasses.replace(s, center=(1.0, 1.0), cw=True)
+    assert (arc.p0, arc.p1, arc.center, arc.cw, arc.is_arc) == ((0.0, 1.0), (2.0, 3.0), (1.0, 1.0), True, True)
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        s.p0 = (5.0, 5.0)  # type: ignore[misc]

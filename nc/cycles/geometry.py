@@ -24,6 +24,14 @@ class Seg:
     rapid: bool = False
     src: object = None  # the Move this element came from (feed, line, block, comp)
 
+    def __init__(self, p0: Pt, p1: Pt, center: Pt | None = None, cw: bool = False, rapid: bool = False,
+                 src: object = None) -> None:
+        # the fields written straight into the instance dict: the frozen dataclass's own __init__ goes
+        # through object.__setattr__ per field, a third of the cost of every element (issue 16: cycles and
+        # compensation make thousands); assignment afterwards still raises FrozenInstanceError
+        d = self.__dict__
+        d["p0"], d["p1"], d["center"], d["cw"], d["rapid"], d["src"] = p0, p1, center, cw, rapid, src
+
     @property
     def is_arc(self) -> bool:
         return self.center is not None
