@@ -37,18 +37,22 @@ def _plane_pt(m: Move, key: str) -> Pt:
 
 
 def _seg(m: Move) -> Seg:
-    p0, p1 = _plane_pt(m, "start"), _plane_pt(m, "end")
-    if m.kind == "arc" and m.center is not None:
-        return Seg(p0, p1, _plane_pt(m, "center"), m.dir == "cw", False, m)
-    return Seg(p0, p1, None, False, m.kind == "rapid", m)
+    a1, a2 = m.plane
+    s, e, c = m.start, m.end, m.center
+    if m.kind == "arc" and c is not None:
+        return Seg((s[a1], s[a2]), (e[a1], e[a2]), (c[a1], c[a2]), m.dir == "cw", False, m)
+    return Seg((s[a1], s[a2]), (e[a1], e[a2]), None, False, m.kind == "rapid", m)
 
 
 def _moves_in_plane(m: Move) -> bool:
-    if m.kind not in PLANE_MOVES:
+    kind = m.kind
+    if kind not in PLANE_MOVES:
         return False
-    if m.kind == "arc":
+    if kind == "arc":
         return True
-    return dist(_plane_pt(m, "start"), _plane_pt(m, "end")) > 1e-9
+    a1, a2 = m.plane
+    s, e = m.start, m.end
+    return dist((s[a1], s[a2]), (e[a1], e[a2])) > 1e-9
 
 
 @dataclass

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import ClassVar
 
 EPS = 1e-9
 Pt = tuple[float, float]
@@ -31,10 +32,9 @@ class Seg:
         # compensation make thousands); assignment afterwards still raises FrozenInstanceError
         d = self.__dict__
         d["p0"], d["p1"], d["center"], d["cw"], d["rapid"], d["src"] = p0, p1, center, cw, rapid, src
+        d["is_arc"] = center is not None  # not a field: read often, kept beside them (not a property)
 
-    @property
-    def is_arc(self) -> bool:
-        return self.center is not None
+    is_arc: ClassVar[bool]  # set per instance by __init__: the element is an arc (it has a centre)
 
     @property
     def radius(self) -> float:
