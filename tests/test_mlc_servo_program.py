@@ -12,7 +12,8 @@ import pytest
 
 from fieldbus.link import SimLink
 from hil.runner import BenchRunner
-from hil.session import default_lathe, make_link, sim_slaves
+from hil.bench import default_lathe
+from hil.session import make_link, sim_slaves
 from nc.program import parse_program
 
 WRITE_READ_BRANCH = """\
