@@ -59,6 +59,9 @@ class Contour:
                 ds.extend(p[1] for p in self._arc_extremes(s))
         self.d_min = min(ds)
         self.d_max = max(ds)
+        # an arc's start angle, sweep and radius, found once (crossings and depths ask them per layer)
+        self._arcs = {id(s): (math.atan2(s.p0[1] - s.center[1], s.p0[0] - s.center[0]), s.sweep(), s.radius)
+                      for s in self.segs if s.center is not None}
         # (f low, f high, element) of the elements not vertical in f, for `depth_at`
         self._spans = [(lo, hi, s) for s in self.segs
                        for lo, hi in [(min(s.p0[0], s.p1[0]), max(s.p0[0], s.p1[0]))] if hi - lo >= TOL]
@@ -105,15 +108,21 @@ class Contour:
             raise NcAlarm(0x0246, f"the P–Q contour does not cover the cutting position {f:g}")
         return best
 
-    @staticmethod
-    def _arc_depth(s: Seg, f: float) -> float:
+    def _contains(self, s: Seg, ang: float) -> bool:
+        """`s.contains_angle(ang)` with the arc's start angle and sweep found once."""
+        a0, sw, _ = self._arcs[id(s)]
+        if sw >= 0:
+            return 1e-9 < (ang - a0) % (2 * math.pi) < sw - 1e-9
+        return 1e-9 < (a0 - ang) % (2 * math.pi) < -sw - 1e-9
+
+    def _arc_depth(self, s: Seg, f: float) -> float:
         """Highest point of the arc over f: an arc that bulges past its end point along f covers
         that f twice, on both sides of its centre."""
-        c, r = s.center, s.radius
+        c, r = s.center, self._arcs[id(s)][2]
         assert c is not None
         h = math.sqrt(max(r * r - (f - c[0]) ** 2, 0.0))
         on_arc = [c[1] + sign * h for sign in (1.0, -1.0)
-                  if s.contains_angle(math.atan2(sign * h, f - c[0]))]
+                  if self._contains(s, math.atan2(sign * h, f - c[0]))]
         ends = [p[1] for p in (s.p0, s.p1) if abs(p[0] - f) < 1e-9]
         if on_arc or ends:
             return max(on_arc + ends)
@@ -131,14 +140,14 @@ class Contour:
                 if -1e-12 <= t <= 1 + 1e-12:
                     out.append(s.p0[0] + t * (s.p1[0] - s.p0[0]))
             else:
-                c, r = s.center, s.radius
+                c, r = s.center, self._arcs[id(s)][2]
                 assert c is not None
                 sn = (level - c[1]) / r
                 if abs(sn) > 1:
                     continue
                 for a in (math.asin(sn), math.pi - math.asin(sn)):
                     p = (c[0] + r * math.cos(a), c[1] + r * math.sin(a))
-                    if s.contains_angle(a) or min(math.dist(p, s.p0), math.dist(p, s.p1)) < 1e-9:
+                    if self._contains(s, a) or min(math.dist(p, s.p0), math.dist(p, s.p1)) < 1e-9:
                         out.append(p[0])
         return out
 
