@@ -85,11 +85,22 @@ def eligible(ip: Interpreter) -> bool:
             and ip._call_table("G", 0) is None and ip._call_table("G", 1) is None)
 
 
+_UNSEEN = object()
+
+
 def _shape_of(raw: str, shapes: dict, axes: dict[str, int]) -> _Shape | None:
+    """The shape of a line's letters. `shapes` holds them by letters (tuples) and, for the first
+    few thousand lines looked at, by the line's text too (a repeated line, issue 16)."""
+    shape = shapes.get(raw, _UNSEEN)
+    if shape is not _UNSEEN:
+        return shape  # type: ignore[return-value]
     letters = tuple(c.upper() for c in _LETTER.findall(raw))
     if letters not in shapes:
         shapes[letters] = _shape(letters, axes)
-    return shapes[letters]
+    shape = shapes[letters]
+    if len(shapes) < 8192:
+        shapes[raw] = shape
+    return shape
 
 
 def take(ip: Interpreter, fr: Frame, limit: int) -> MoveBatch | None:
