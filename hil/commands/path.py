@@ -172,8 +172,10 @@ _POINTS: dict[tuple, tuple[str, bool]] = {}  # ((axis, value), …) of floats ->
 _POINTS_LIMIT = 4096  # points remembered: a program comes back to its points (a repeated part, a cycle's passes)
 
 
-def _axes(d: dict[str, float]) -> str:
-    key = tuple(d.items())
+def _axes(d: dict[str, float], key: tuple | None = None) -> str:
+    """The JSON object of a point; `key` is tuple(d.items()) when the caller has it already."""
+    if key is None:
+        key = tuple(d.items())
     hit = _POINTS.get(key)
     # stored for plain floats only; an int or bool equal to a float (5 == 5.0) writes otherwise, so a
     # point with an integral value is taken only after a look at the types
@@ -235,8 +237,9 @@ def move_json(m: Move) -> str:
     start, end = m.start, m.end
     last = _LAST_END
     start_text = last[2] if start is last[0] and tuple(start.items()) == last[1] else _axes(start)
-    end_text = _axes(end)
-    last[0], last[1], last[2] = end, tuple(end.items()), end_text
+    end_items = tuple(end.items())
+    end_text = _axes(end, end_items)
+    last[0], last[1], last[2] = end, end_items, end_text
     text = (f'{head}{start_text}, "end": {end_text}, "work": {_axes(m.work)}, '
             f'"center": {"null" if m.center is None else _axes(m.center)}, '
             f'"dir": {"null" if m.dir is None else _str(m.dir)}, '
