@@ -55,7 +55,7 @@ def _moves_in_plane(m: Move) -> bool:
     return dist((s[a1], s[a2]), (e[a1], e[a2])) > 1e-9
 
 
-@dataclass
+@dataclass(slots=True)
 class _Pending:
     move: Move
     seg: Seg
@@ -140,7 +140,8 @@ class Compensator:
             last = _plane_pt(m_last, "end")
             tv = self._tipv()
             last = (last[0] - tv[0], last[1] - tv[1])
-        res.extend(self._fix_held(p.held, last, True))
+        if p.held:
+            res.extend(self._fix_held(p.held, last, True))
         self.pending = None
         self.out_pos = last
         return res

@@ -11,7 +11,7 @@ from collections.abc import Iterator
 from nc.alarms import NcAlarm
 from nc.interp.corners import expand_corners
 from nc.moves import Event, Move
-from nc.program.blocks import Block, Program
+from nc.program.blocks import Block
 
 
 class ContourMixin:
@@ -42,10 +42,10 @@ class ContourMixin:
         twin = self._clone()
         if start is not None:
             twin.position = dict(start)
-        prog = Program(self.frame.program.name, [b for b in blocks if b.stmt is None])
+        run = [b for b in blocks if b.stmt is None]  # run in order on the twin (no Program needed)
 
         def gen() -> Iterator[Event]:
-            for b in prog.blocks:
+            for b in run:
                 yield from twin._execute(b)
         out = [ev for ev in expand_corners(twin, gen()) if isinstance(ev, Move)]
         return out
