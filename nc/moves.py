@@ -166,3 +166,28 @@ class MoveBatch:
                             plane=self.plane, css=self.css))
             start = dict(end)
         return out
+
+
+@dataclass(slots=True)
+class MoveList:
+    """A lathe cycle's Moves as one event, for a consumer that takes MoveBatch events (`hil path`,
+    issue 16): the thousands of moves of a G71 pass the corner, compensation and preview stages once
+    instead of one by one. Made only of plain Move objects without radius compensation, computed
+    before the first is handed on (a cycle that streams its moves keeps streaming them); a stage that
+    holds state expands it with `moves()`, as it does a MoveBatch."""
+
+    items: list[Move]
+
+    def __len__(self) -> int:
+        return len(self.items)
+
+    @property
+    def line(self) -> int:  # the last move's, as a MoveBatch's
+        return self.items[-1].line
+
+    @property
+    def block(self) -> str:
+        return self.items[-1].block
+
+    def moves(self) -> list[Move]:
+        return self.items

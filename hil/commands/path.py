@@ -337,7 +337,7 @@ DEFAULT_PROFILE = "nc5-lathe-a"  # hil.bench.default_lathe's (tests/test_foundat
 def cmd_path(args: argparse.Namespace) -> int:
     from hil.session import InputError, checked_profile, load_bench, print_alarm
     from nc.interp import Interpreter
-    from nc.moves import Move, MoveBatch, Sync
+    from nc.moves import Move, MoveBatch, MoveList, Sync
     from nc.profiles import make_profile
     from nc.store import ProgramStore
 
@@ -402,6 +402,11 @@ def cmd_path(args: argparse.Namespace) -> int:
                 listed = _print_servo(interp, args, listed)
             if type(ev) is MoveBatch:
                 add(batch_json(ev) if as_json else batch_text(ev))
+            elif type(ev) is MoveList:  # a cycle's moves (bulk only: no interrupt, no plot)
+                if as_json:
+                    lines.extend(map(move_json, ev.items))
+                else:
+                    lines.extend([_human(m, profile.diameter_axes) for m in ev.items])
             elif isinstance(ev, Move):
                 if interrupt and ev.line == interrupt[0] and ev.program == program.name \
                         and interp.interrupt_program is not None:

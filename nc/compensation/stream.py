@@ -25,7 +25,7 @@ from nc.alarms import NcAlarm
 from nc.compensation import offset as geo
 from nc.compensation.nose import tip_vector
 from nc.cycles.geometry import Pt, Seg, dist
-from nc.moves import Busy, Event, Move, MoveBatch, ProgramEnd
+from nc.moves import Busy, Event, Move, MoveBatch, MoveList, ProgramEnd
 
 PLANE_MOVES = ("rapid", "line", "arc", "thread")
 
@@ -294,7 +294,8 @@ def compensate(events: Iterable[Event], profile: object | None = None) -> Iterat
         if comp.pending is None and comp.out_pos is None and (not isinstance(ev, Move) or ev.comp is None):
             yield ev
             continue
-        if type(ev) is MoveBatch:  # plain uncompensated moves (nc.interp.bulk): through whole when idle
+        if type(ev) is MoveBatch or type(ev) is MoveList:  # plain uncompensated moves (nc.interp.bulk, a
+            # cycle's): through whole when idle
             if comp.pending is None and comp.out_pos is None:
                 yield ev
                 continue

@@ -240,7 +240,7 @@ def _g90_g94(host: Any, code: str, block: Block) -> list[Event]:
 
 
 # ---- entry ----------------------------------------------------------------------------------
-def run_cycle(host: Any, code: str, block: Block) -> Iterator[Event]:
+def run_cycle(host: Any, code: str, block: Block) -> Iterator[Event] | list[Event]:
     if code not in CYCLE_CODES:
         raise NcAlarm(0x021D, f"cycle {code} is not supported")
     if code in ("G71", "G72"):
@@ -263,4 +263,6 @@ def run_cycle(host: Any, code: str, block: Block) -> Iterator[Event]:
         events = _mill_hole(host, code, block)
     else:
         events = _lathe_hole(host, code, block)
-    return iter(events)  # the hole, G73 and G74/G75 cycles are generators: lazy for any K, R, P or Q
+    # the hole, G73 and G74/G75 cycles are generators: lazy for any K, R, P or Q; the others' list as it
+    # is (the interpreter hands a computed list on as one event to a consumer that takes them)
+    return events if type(events) is list else iter(events)

@@ -93,7 +93,7 @@ def cycle_runner() -> RunCycle | None:
     return None if _cache is _MISSING else _cache
 
 
-def run_cycle(host: CycleHost, code: str, block: "Block") -> Iterator["Event"]:
+def run_cycle(host: CycleHost, code: str, block: "Block") -> Iterator["Event"] | list["Event"]:
     runner = cycle_runner()
     if runner is None:
         raise NcAlarm(0x021D, f"cycle {code} is not supported in this build (nc.cycles missing)")

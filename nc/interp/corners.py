@@ -11,11 +11,12 @@ corner.  A helical arc (a third axis moving) cannot be trimmed: 0x021D.
 from __future__ import annotations
 
 import math
+from itertools import chain
 from collections.abc import Iterator
 from typing import TYPE_CHECKING
 
 from nc.alarms import NcAlarm
-from nc.moves import Busy, Event, Move, MoveBatch, ProgramEnd
+from nc.moves import Busy, Event, Move, MoveBatch, MoveList, ProgramEnd
 
 if TYPE_CHECKING:  # pragma: no cover
     from nc.interp.host import InterpHost
@@ -32,6 +33,12 @@ def expand_corners(interp: "InterpHost", events: Iterator[Event]) -> Iterator[Ev
         ev = next(events, None)
         if ev is None:
             break
+        if type(ev) is MoveList:  # a cycle's moves: through whole unless a corner waits, then one by one
+            if pending is None:
+                yield ev
+                continue
+            events = chain(ev.moves(), events)
+            continue
         if type(ev) is MoveBatch:  # plain moves (no ,C/,R): through whole unless a corner waits for them
             if pending is None:
                 yield ev

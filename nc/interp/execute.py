@@ -19,7 +19,7 @@ from nc.interp import context
 from nc.interp.gcodes import STOP_PREVIEW
 from nc.interp.records import (INCREMENTAL, MAX_M_PER_BLOCK, M_BEFORE_MOTION, M_END, NO_MOTION_FUNCS,
                                REFUSED_UNDER_G68, TRANSFORM_ARG_FUNCS, _transforms)
-from nc.moves import Aux, Event, Move, ProgramEnd, Sync
+from nc.moves import Aux, Event, Move, MoveList, ProgramEnd, Sync
 from nc.program.blocks import Block, Word
 
 
@@ -155,7 +155,14 @@ def step_nonmodal(ip, run: BlockRun) -> Iterator[Event]:
             if r is not None:
                 yield from _moves(r, run)
         elif fn in ("G70", "G71", "G72", "G73", "G74", "G75", "G76"):
-            yield from context.run_cycle(ip, fn, block)
+            events = context.run_cycle(ip, fn, block)
+            # a computed list of plain uncompensated moves goes on as one event to a consumer that
+            # takes batches (issue 16: a G71's thousands of moves, one by one, were a fifth of `hil path`)
+            if ip.bulk and type(events) is list and len(events) > 1 \
+                    and all([type(e) is Move and e.comp is None for e in events]):
+                yield MoveList(events)
+            else:
+                yield from events
             run.moved = True
             ip._skip_contour(fn, block)
 

@@ -15,7 +15,7 @@ from collections.abc import Iterator
 from typing import TYPE_CHECKING
 
 from nc.interp.records import PreviewRecord
-from nc.moves import Busy, Event, Move, MoveBatch, Sync
+from nc.moves import Busy, Event, Move, MoveBatch, MoveList, Sync
 
 if TYPE_CHECKING:  # pragma: no cover
     from nc.interp.host import InterpHost
@@ -69,8 +69,8 @@ class PreviewWindow:
                 buf.append(ev)
                 if isinstance(ev, Move):
                     moves += 1
-                elif type(ev) is MoveBatch:  # a run of plain moves (nc.interp.bulk) counts as its moves
-                    moves += len(ev)
+                elif type(ev) is MoveBatch or type(ev) is MoveList:  # a run of plain moves (nc.interp.bulk,
+                    moves += len(ev)  # a cycle's) counts as its moves
                 elif isinstance(ev, Sync):
                     syncs += 1
             if not buf:
@@ -84,6 +84,9 @@ class PreviewWindow:
             elif type(ev) is MoveBatch:
                 moves -= len(ev)
                 self.executing = ev  # type: ignore[assignment]  # its .line/.block: the last move's
+            elif type(ev) is MoveList:
+                moves -= len(ev)
+                self.executing = ev.items[-1]
             elif isinstance(ev, Sync):
                 syncs -= 1
             yield ev
