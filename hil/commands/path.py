@@ -237,10 +237,17 @@ def move_json(m: Move) -> str:
     start, end = m.start, m.end
     last = _LAST_END
     start_text = last[2] if start is last[0] and tuple(start.items()) == last[1] else _axes(start)
+    # `_axes` of end and work, its remembered-point hit inline (the usual case: a call less per point)
     end_items = tuple(end.items())
-    end_text = _axes(end, end_items)
+    hit = _POINTS.get(end_items)
+    end_text = hit[0] if hit is not None and (not hit[1] or set(map(type, end.values())) == _FLOATS) \
+        else _axes(end, end_items)
     last[0], last[1], last[2] = end, end_items, end_text
-    text = (f'{head}{start_text}, "end": {end_text}, "work": {_axes(m.work)}, '
+    work = m.work
+    hit = _POINTS.get(work_items := tuple(work.items()))
+    work_text = hit[0] if hit is not None and (not hit[1] or set(map(type, work.values())) == _FLOATS) \
+        else _axes(work, work_items)
+    text = (f'{head}{start_text}, "end": {end_text}, "work": {work_text}, '
             f'"center": {"null" if m.center is None else _axes(m.center)}, '
             f'"dir": {"null" if m.dir is None else _str(m.dir)}, '
             f'"feed": {"null" if (feed := m.feed) is None else _num(feed)}, '
