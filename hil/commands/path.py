@@ -247,15 +247,7 @@ def move_json(m: Move) -> str:
     hit = _POINTS.get(work_items := tuple(work.items()))
     work_text = hit[0] if hit is not None and (not hit[1] or set(map(type, work.values())) == _FLOATS) \
         else _axes(work, work_items)
-    text = (f'{head}{start_text}, "end": {end_text}, "work": {work_text}, '
-            f'"center": {"null" if m.center is None else _axes(m.center)}, '
-            f'"dir": {"null" if m.dir is None else _str(m.dir)}, '
-            f'"feed": {"null" if (feed := m.feed) is None else _num(feed)}, '
-            f'"duration": {"null" if (duration := m.duration) is None else _num(duration)}')
-    if m.per_rev and feed is not None:  # the additive keys of move_dict, in its order
-        text += ', "per_rev": true'
-    if m.exact_stop:
-        text += ', "exact_stop": true'
+    tags = ""
     if m.tags:
         tags = _TAGS.get(m.tags)
         if tags is None:
@@ -264,12 +256,28 @@ def move_json(m: Move) -> str:
                 if len(_TAGS) >= _QUOTED_LIMIT:
                     _TAGS.clear()
                 _TAGS[m.tags] = tags
-        text += tags
-    if m.kind == "thread":
-        text += f', "lead": {_num(m.lead)}, "lead_change": {_num(m.lead_change)}, "start_angle": {_num(m.start_angle)}'
-    if m.comp:
-        text += f', "comp": {_str(m.comp)}, "comp_radius": {_num(m.comp_radius)}, "tip": {_num(m.tip)}'
-    return text + "}"
+    feed = m.feed
+    # one string for the whole line: the additive keys of move_dict in its order, none appended to a
+    # finished line (each append copied the line, issue 16)
+    return (f'{head}{start_text}, "end": {end_text}, "work": {work_text}, '
+            f'"center": {"null" if m.center is None else _axes(m.center)}, '
+            f'"dir": {"null" if m.dir is None else _str(m.dir)}, '
+            f'"feed": {"null" if feed is None else _num(feed)}, '
+            f'"duration": {"null" if (duration := m.duration) is None else _num(duration)}'
+            f'{_PER_REV if m.per_rev and feed is not None else ""}{_EXACT_STOP if m.exact_stop else ""}{tags}'
+            f'{_thread_keys(m) if m.kind == "thread" else ""}{_comp_keys(m) if m.comp else ""}}}')
+
+
+_PER_REV = ', "per_rev": true'
+_EXACT_STOP = ', "exact_stop": true'
+
+
+def _thread_keys(m: Move) -> str:
+    return f', "lead": {_num(m.lead)}, "lead_change": {_num(m.lead_change)}, "start_angle": {_num(m.start_angle)}'
+
+
+def _comp_keys(m: Move) -> str:
+    return f', "comp": {_str(m.comp)}, "comp_radius": {_num(m.comp_radius)}, "tip": {_num(m.tip)}'
 
 
 def _coord(v: float) -> str:
