@@ -2,6 +2,12 @@
 
 In lock-step mode the link advances simulated time by exactly one cycle per exchange, so a run
 is deterministic and faster than real time.
+
+Why one file of ~630 lines: `BenchRunner` is the cycle, and the stop path (quick stop, standstill,
+disable at rest, shutdown) runs inside that same cycle on the same state (masters, PDO images,
+channel, MLC, trace, stop flags); kept together, the order a cycle and a stop do things in can be
+read in one place. What is not that state lives beside it: stretches (stretch.py, stretch_bulk.py),
+signals (stop_signals.py), the MLC bridge (mlc_bridge.py), homing (drive_homing.py), the trace.
 """
 
 from __future__ import annotations
