@@ -173,8 +173,9 @@ def cmd_path(args: argparse.Namespace) -> int:
             if len(servo_log) > listed:  # asked per event: a look at the log's length (hot path)
                 _flush(out, lines)
                 listed = _print_servo(interp, args, listed)
-            if type(ev) is MoveBatch:
-                add(batch_json(ev) if as_json else batch_text(ev))
+            if type(ev) is MoveBatch:  # up to MAX_RUN lines already: written at once, so memory stays
+                add(batch_json(ev) if as_json else batch_text(ev))  # flat (256 batches held 1M lines)
+                _flush(out, lines)
             elif type(ev) is MoveList:  # a cycle's moves (bulk only: no interrupt, no plot)
                 if as_json:
                     lines.extend(map(move_json, ev.items))
