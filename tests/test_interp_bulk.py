@@ -14,7 +14,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from hil.commands.path import _human, batch_text
-from hil.commands.path_json import _coord, _num, batch_json, fmt, move_json
+from hil.path_json import _coord, _num, batch_json, fmt, move_json
 from nc.alarms import NcAlarm
 from nc.interp import Interpreter, bulk
 from nc.moves import Move, MoveBatch

@@ -1,4 +1,4 @@
-"""`hil path --json` writes every move without intermediate dicts (hil.commands.path_json.move_json,
+"""`hil path --json` writes every move without intermediate dicts (hil.path_json.move_json,
 issue 16): the line must be byte for byte what the general way (move_dict +
 strict_json.dumps) writes, for any move, the goldens' seam."""
 
@@ -9,7 +9,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from hil import strict_json
-from hil.commands.path_json import move_dict, move_json
+from hil.path_json import move_dict, move_json
 from nc.moves import Move
 
 number = st.one_of(st.floats(allow_nan=True, allow_infinity=True), st.integers(-10**6, 10**6),
@@ -58,6 +58,6 @@ def test_a_compensated_thread_pass_writes_its_additive_keys() -> None:
                                   2.5e-7, 1.00000005, 0.00015])))
 def test_seven_decimals_is_repr_of_round(v: float) -> None:
     """The 7-decimal number text of a coordinate ('%.7f' stripped) is repr(round(v, 7)) (issue 16)."""
-    from hil.commands.path_json import _seven
+    from hil.path_json import _seven
 
     assert _seven(v) == repr(round(v, 7) + 0.0)

@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 
 from hil import strict_json
 from hil.cli import EXIT_ALARM, EXIT_OK, EXIT_USAGE
-from hil.commands.path_json import batch_json, fmt, move_json
+from hil.path_json import batch_json, fmt, move_json
 from nc.alarms import NcAlarm, internal_error
 
 if TYPE_CHECKING:  # the interpreter and the bench load when the command runs, not at `hil` start-up
