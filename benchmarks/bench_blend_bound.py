@@ -24,113 +24,76 @@ import sys
 from pathlib import Path
 
 import numpy as np
-from scipy.special import fresnel
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 from benchmarks.bench_vs_linuxcnc import START, TOL, cam_polyline, cam_surface, programs  # noqa: E402
+from nc.motion.clothoid import corner_blend  # noqa: E402
+from nc.motion.path import Segment  # noqa: E402
 from tests.motion_helpers import polyline_deviation  # noqa: E402
 
 A_AXIS, J_AXIS = 5000.0, 250_000.0
 SHARE_N = math.sqrt(1.0 - 0.5 ** 2)  # LinuxCNC's BLEND_ACC_RATIO_NORMAL
 
 
-def clothoid_pair(theta: float) -> tuple[float, float]:
-    """(tangent length, deviation from the corner) of a symmetric clothoid pair turning by theta,
-    each clothoid of unit length: both scale with the length L."""
-    # A clothoid of length 1 turning by theta/2: s²/(2A²) = theta/2 at s = 1, so A² = 1/theta.
-    a = math.sqrt(1.0 / theta)
-    k = 1.0 / (a * math.sqrt(math.pi))  # fresnel(t) integrates cos(πt²/2): s = t·A·√π, here s = 1
-    sf, cf = fresnel(k)  # scipy returns (S, C)
-    x, y = a * math.sqrt(math.pi) * cf, a * math.sqrt(math.pi) * sf
-    h = theta / 2.0
-    t = x + y * math.tan(h)  # the pair's middle lies on the corner's axis of symmetry
-    dev = math.hypot(x - t, y) * math.cos(h)  # distance of that middle from each leg
-    return t, dev
+def _lines(points: np.ndarray) -> list[Segment]:
+    pts = points[np.r_[True, np.linalg.norm(np.diff(points, axis=0), axis=1) > 1e-9]]
+    out = []
+    for p, q in zip(pts[:-1], pts[1:]):
+        ln = float(np.linalg.norm(q - p))
+        out.append(Segment(("X", "Y", "Z"), p.astype(float), q.astype(float), ln, "line",
+                           _dir=tuple(((q - p) / ln).tolist())))
+    return out
 
 
 def bound(points: np.ndarray, feed: float, tol: float, share: float) -> float:
-    d = np.diff(points, axis=0)
-    seg = np.linalg.norm(d, axis=1)
-    keep = seg > 1e-9
-    d, seg = d[keep], seg[keep]
-    u = d / seg[:, None]
+    lines = _lines(points)
     acc, jerk = share * A_AXIS, share * J_AXIS
     time = 0.0
-    used = np.zeros(len(seg))  # path each segment gives to the blends at its two ends
-    for i in range(len(seg) - 1):
-        theta = math.acos(max(-1.0, min(1.0, float(u[i] @ u[i + 1]))))
-        if theta < 1e-9:
+    used = np.zeros(len(lines))  # path each line gives to the blends at its two ends
+    for i, (s1, s2) in enumerate(zip(lines[:-1], lines[1:])):
+        b = corner_blend(s1, s2, tol, s1.length, s2.length)
+        if b is None:
             continue
-        t1, dev1 = clothoid_pair(theta)
-        length = min(tol / dev1, 0.5 * min(seg[i], seg[i + 1]) / t1)  # L of each clothoid
-        kmax, dk = theta / length, theta / length ** 2
-        v = min(feed, math.sqrt(acc / kmax), (jerk / dk) ** (1.0 / 3.0))
-        time += 2.0 * length / v  # the pair's path length is 2L
-        used[i] += t1 * length
-        used[i + 1] += t1 * length
-    return time + float(np.sum(np.maximum(seg - used, 0.0))) / feed
+        v = min(feed, math.sqrt(acc / b.kappa_max), (jerk / b.dkappa) ** (1.0 / 3.0))
+        time += b.length / v
+        used[i] += b.tlen
+        used[i + 1] += b.tlen
+    return time + float(np.sum(np.maximum(np.array([s.length for s in lines]) - used, 0.0))) / feed
 
 
 # ---- the filter share on a blended path (decision motion 40 b) -----------------------------------
-def unit_clothoid(theta: float, s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(x, y) at s (0 … 1) of the unit-length clothoid of a pair turning by theta, heading 0 at s = 0."""
-    a = math.sqrt(1.0 / theta)
-    sf, cf = fresnel(s / (a * math.sqrt(math.pi)))
-    return a * math.sqrt(math.pi) * cf, a * math.sqrt(math.pi) * sf
-
-
-def blended_path(points: np.ndarray, tol: float) -> list[tuple]:
-    """The polyline as pieces ("line", length, (start, u)) and ("blend", 2L, geometry): a clothoid
-    pair at every corner, sized as `bound` sizes it."""
-    d = np.diff(points, axis=0)
-    seg = np.linalg.norm(d, axis=1)
-    u = d / seg[:, None]
-    trim = np.zeros((len(seg), 2))
-    blends: list[tuple | None] = []
-    for i in range(len(seg) - 1):
-        theta = math.acos(max(-1.0, min(1.0, float(u[i] @ u[i + 1]))))
-        if theta < 1e-7:
-            blends.append(None)
-            continue
-        t1, dev1 = clothoid_pair(theta)
-        length = min(tol / dev1, 0.5 * min(seg[i], seg[i + 1]) / t1)
-        trim[i, 1] = trim[i + 1, 0] = t1 * length
-        blends.append((theta, length, t1 * length))
-    pieces: list[tuple] = []
-    for i in range(len(seg)):
-        pieces.append(("line", max(seg[i] - trim[i].sum(), 0.0), (points[i] + u[i] * trim[i, 0], u[i])))
-        if i < len(seg) - 1 and blends[i] is not None:
-            theta, length, t = blends[i]
-            u1, u2, vx = u[i], u[i + 1], points[i + 1]
-            n1 = u2 - (u1 @ u2) * u1  # towards the turn, normal to each leg
-            n2 = (u1 @ u2) * u2 - u1
-            pieces.append(("blend", 2.0 * length, (theta, length, vx - u1 * t, u1, n1 / np.linalg.norm(n1),
-                                                   vx + u2 * t, u2, n2 / np.linalg.norm(n2))))
+def blended_path(points: np.ndarray, tol: float) -> list[Segment]:
+    """The polyline as segments: its lines, trimmed, and a clothoid pair (nc.motion.clothoid) at
+    every corner, sized as `bound` sizes it."""
+    lines = _lines(points)
+    trim = np.zeros((len(lines), 2))
+    blends = []
+    for i, (s1, s2) in enumerate(zip(lines[:-1], lines[1:])):
+        b = corner_blend(s1, s2, tol, s1.length, s2.length)
+        blends.append(b)
+        if b is not None:
+            trim[i, 1] = trim[i + 1, 0] = b.tlen
+    pieces: list[Segment] = []
+    for i, s in enumerate(lines):
+        u = np.array(s.tangent(False))
+        ln = max(s.length - trim[i].sum(), 0.0)
+        p = s.start + u * trim[i, 0]
+        pieces.append(Segment(s.axes, p, p + u * ln, ln, "line", _dir=s._dir))
+        if i < len(blends) and blends[i] is not None:
+            pieces.append(blends[i])
     return pieces
 
 
-def sample_path(pieces: list[tuple], s: np.ndarray) -> np.ndarray:
+def sample_path(pieces: list[Segment], s: np.ndarray) -> np.ndarray:
     """Positions at path lengths s (increasing) along `blended_path`'s pieces."""
     out = np.empty((len(s), 3))
     s0 = 0.0
-    for kind, ln, g in pieces:
-        m = (s >= s0) & (s < s0 + ln)
+    for seg in pieces:
+        m = (s >= s0) & (s < s0 + seg.length)
         if m.any():
-            x = s[m] - s0
-            if kind == "line":
-                out[m] = g[0] + x[:, None] * g[1]
-            else:  # the first clothoid from its start, the second back from its end
-                theta, length, q0, u1, n1, q1, u2, n2 = g
-                first = x <= length
-                pts = np.empty((len(x), 3))
-                cx, cy = unit_clothoid(theta, x[first] / length)
-                pts[first] = q0 + (length * cx)[:, None] * u1 + (length * cy)[:, None] * n1
-                cx, cy = unit_clothoid(theta, (2.0 * length - x[~first]) / length)
-                pts[~first] = q1 - (length * cx)[:, None] * u2 + (length * cy)[:, None] * n2
-                out[m] = pts
-        s0 += ln
-    kind, ln, g = pieces[-1]
-    out[s >= s0] = g[0] + ln * g[1]
+            out[m] = seg.points(s[m] - s0)
+        s0 += seg.length
+    out[s >= s0] = pieces[-1].end
     return out
 
 
@@ -157,7 +120,7 @@ def crossfade(v: float, n1: int = 16, n2: int = 16) -> None:
     for prog in (cam_surface(400), cam_polyline(400)):
         pts = np.array([START] + prog.points, dtype=float)
         pieces = blended_path(pts, TOL)
-        n = int(sum(p[1] for p in pieces) / v / 1e-3)
+        n = int(sum(p.length for p in pieces) / v / 1e-3)
         raw = sample_path(pieces, v * 1e-3 * np.arange(n))
         f = _moving(_moving(raw, n1), n2)
         raw_d = np.vstack([np.repeat(raw[:1], d, axis=0), raw[:-d]])

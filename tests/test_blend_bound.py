@@ -8,7 +8,8 @@ import math
 import numpy as np
 import pytest
 
-from benchmarks.bench_blend_bound import SHARE_N, bound, clothoid_pair
+from benchmarks.bench_blend_bound import SHARE_N, bound
+from nc.motion.clothoid import clothoid_pair
 from benchmarks.bench_vs_linuxcnc import START, TOL, chord_circle, contour_90
 
 
@@ -67,7 +68,7 @@ def test_blended_path_is_continuous_and_within_the_tolerance():
     pts = np.array([START] + prog.points, dtype=float)
     pieces = blended_path(pts, TOL)
     ds = 0.001
-    q = sample_path(pieces, ds * np.arange(int(sum(p[1] for p in pieces) / ds)))
+    q = sample_path(pieces, ds * np.arange(int(sum(p.length for p in pieces) / ds)))
     step = np.linalg.norm(np.diff(q, axis=0), axis=1)
     assert step.max() <= ds * (1.0 + 1e-6) and step.min() >= ds * (1.0 - 1e-3)  # no jump, no stall
     u = np.diff(q, axis=0) / step[:, None]
