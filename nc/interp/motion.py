@@ -46,6 +46,8 @@ class MotionMixin:
     def _geometry(self, block: Block, base: dict[str, float] | None = None) -> _Geometry:
         st = self.state
         tr = _transforms(self)
+        if tr is None and base is None and not block.comma and (not st.polar or self.profile.is_lathe):
+            return self._plain_geometry(block)
         work = dict(base) if base is not None else self.work_position()
         if tr is not None:
             work = tr.inverse(self, work)  # incremental moves count in the programmed frame
@@ -63,6 +65,31 @@ class MotionMixin:
             if not math.isfinite(machine[a]) or abs(machine[a]) > 1e9:
                 raise NcAlarm(0x120E, f"{a} target is out of range")
         return _Geometry(work, machine, bool(words), axes)
+
+    def _plain_geometry(self, block: Block) -> _Geometry:
+        """`_geometry` without transforms, polar mode or ,A (every block of a usual program, issue 16):
+        `work_position`, `to_machine` and the range check in one pass over the axes, the origins
+        looked up once (the same dict both would get)."""
+        axes = self.axes
+        origin = self.frames.origins(self.state.wcs, axes)
+        diameter = self.profile.diameter_axes
+        position = self.position
+        work = {}
+        for a in axes:
+            v = position.get(a, 0.0) - origin[a]
+            work[a] = v * 2.0 if a in diameter else v
+        words = self._axis_words(block)
+        for a, (w, inc) in words.items():
+            v = self.distance(w, a)
+            work[a] = work[a] + v if inc else v
+        machine = {}
+        for a in axes:
+            v = work[a]
+            v = (v / 2.0 if a in diameter else v) + origin[a]
+            if not math.isfinite(v) or abs(v) > 1e9:
+                raise NcAlarm(0x120E, f"{a} target is out of range")
+            machine[a] = v
+        return _Geometry(work, machine, bool(words), set(words))
 
     def _polar_geometry(self, block: Block, work: dict[str, float], words) -> _Geometry:
         a1, a2 = PLANES[self.state.plane]
