@@ -50,7 +50,7 @@ def main() -> None:
     args = ap.parse_args()
     bench = default_lathe()  # X, Z and the spindle: 3 drives
     for mode, sim_args in (("lock-step, back to back", ()), ("real-time, paced", ("--realtime",))):
-        with SimProcess(*sim_args, tag="b") as sim:
+        with SimProcess(*sim_args, tag="ecat9") as sim:
             link = EthercatLink.for_bench(bench, sim.iface)
             link.open()
             try:

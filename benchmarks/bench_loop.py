@@ -167,7 +167,7 @@ def ethercat_lockstep(cycles: int = 5000) -> None:
         print(f"EtherCAT lock-step: skipped ({why})")
         return
     bench = default_lathe()
-    with SimProcess(tag="b") as sim:
+    with SimProcess(tag="ecat9") as sim:
         link = EthercatLink.for_bench(bench, sim.iface)
         link.open()
         try:

@@ -96,3 +96,51 @@ def test_watchdog_time_the_master_writes_in_op_takes_effect():
     send(chain, frame)
     s = chain.slaves[0]
     assert s.al_state == E.SAFEOP and s.mem[E.R_AL_STATUS] & E.AL_ERROR and s.al_code == E.AL_SM_WATCHDOG
+
+
+def _rx_by_entries(od, outputs: bytes, rx_map) -> dict[str, int]:
+    """What DriveApp did per frame before its codec: the outputs into their objects entry by entry, then
+    the RxPdo fields read back from the objects."""
+    from virtual_bus.ethercat.app import RX_ATTR
+
+    unpack_generic(outputs, rx_map, od)
+    return {attr: od.value(i, s) for (i, s), attr in RX_ATTR.items() if i in od.objects}
+
+
+def test_drive_codec_moves_the_values_the_entry_by_entry_route_moves():
+    from dataclasses import asdict
+
+    from fieldbus.pdo import TxPdo
+    from virtual_bus.ethercat.app import RX_ATTR, TX_ATTR
+    from virtual_bus.ethercat.pdo_image import DriveCodec
+
+    rng = random.Random(1702)
+    # the ESI default set, a short CSP set (0x6060 and the rest then come from their objects: SDO) and
+    # the wide test mapping above
+    maps = [([(0x6040, 0, 16), (0x607A, 0, 32), (0x60FF, 0, 32), (0x6071, 0, 16), (0x6060, 0, 8), (0x60B8, 0, 16)],
+             [(0x6041, 0, 16), (0x6064, 0, 32), (0x606C, 0, 32), (0x6077, 0, 16), (0x6061, 0, 8), (0x60B9, 0, 16),
+              (0x60BA, 0, 32), (0x60FD, 0, 32)]),
+            ([(0x6040, 0, 16), (0x607A, 0, 32)], [(0x6041, 0, 16), (0x6064, 0, 32)]),
+            (RX, TX)]
+    for rx_map, tx_map in maps:
+        fast_od = build_chain(default_lathe()).slaves[0].od
+        slow_od = build_chain(default_lathe()).slaves[0].od
+        for od in (fast_od, slow_od):
+            od.set(0x6060, 0, 9)  # by SDO: the short set does not carry the mode
+        codec = DriveCodec.compile(rx_map, tx_map, fast_od, RX_ATTR, TX_ATTR)
+        assert codec is not None
+        size = sum(b for *_, b in rx_map) // 8
+        for _ in range(200):
+            raw = bytes(rng.getrandbits(8) for _ in range(size))
+            rx = codec.read_rx(raw, 8)
+            want = _rx_by_entries(slow_od, raw, rx_map)
+            assert {a: v for a, v in asdict(rx).items() if a in want} == want
+            fb = TxPdo(*(rng.randrange(-1 << 31, 1 << 31) for _ in range(10)))
+            for (i, s), attr in TX_ATTR.items():  # DriveApp._publish, then PdoImage.write's packing
+                if i in slow_od.objects:
+                    slow_od.set(i, s, int(getattr(fb, attr)))
+            assert codec.write_tx(fb) == pack_generic(tx_map, slow_od)
+            assert [e.value for o in fast_od.objects.values() for e in o.entries.values()] \
+                == [e.value for o in slow_od.objects.values() for e in o.entries.values()]  # the dictionaries agree
+        if (0x6060, 0, 8) not in rx_map:
+            assert rx.mode == 9  # the mode written by SDO, not the caller's default

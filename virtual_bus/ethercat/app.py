@@ -17,7 +17,7 @@ from virtual_bus.drive_modes import CST, MODE_OBJECTS, check_value
 from virtual_bus.ethercat.coe import ABORT_VALUE_RANGE, ObjectDictionary, SdoAbort
 from virtual_bus.ethercat.device import OBJ_VAR, TYPES, OdEntry, OdObject
 from virtual_bus.ethercat.esc import SlaveApp
-from virtual_bus.ethercat.pdo_image import Images
+from virtual_bus.ethercat.pdo_image import DriveCodec, Images
 from virtual_bus.servo_params import ServoParamError, ServoParams, coe_objects
 
 # (index, subindex) -> RxPdo / TxPdo attribute, from the layouts' entries
@@ -38,6 +38,8 @@ class DriveApp(SlaveApp):
     _tx_entries: tuple[OdEntry, ...] = ()
     _tx_values: Callable[[TxPdo], tuple] = field(default=lambda fb: ())
     _images: Images = field(default_factory=Images)
+    _codec: DriveCodec | None = None  # the mapping in force in one function per direction, see `_codec_for`
+    _codec_maps: tuple[object, object] = (None, None)
 
     def attach(self, od: ObjectDictionary) -> None:
         self.od = od
@@ -102,11 +104,18 @@ class DriveApp(SlaveApp):
         elif index in self._params and self.od is not None:
             self.od.set(index, 0, self.drive.servo_params.read(ServoParams.from_index(index, 0)))
 
+    def _codec_for(self, rx_map, tx_map, od: ObjectDictionary) -> DriveCodec | None:
+        """The compiled codec of the mapping lists the ESC hands over (new ones on every SAFE-OP entry)."""
+        if self._codec_maps[0] is not rx_map or self._codec_maps[1] is not tx_map:
+            self._codec = DriveCodec.compile(rx_map, tx_map, od, RX_ATTR, TX_ATTR)
+            self._codec_maps = (rx_map, tx_map)
+        return self._codec
+
     def cycle(self, outputs: bytes | memoryview, rx_map, tx_map, step: bool, dt: float = 0.0,
               lost: bool = False) -> bytes:
         od = self.od
         assert od is not None
-        images = self._images.get(rx_map, tx_map, od)
+        codec = self._codec_for(rx_map, tx_map, od)
         if step and lost:
             # Out of OP by an error (SM watchdog, sync, AL error): the outputs are not valid any more.
             # The drive takes its communication fault reaction (CiA 402 0x6007 = 2: fault, braking on
@@ -115,18 +124,27 @@ class DriveApp(SlaveApp):
                 self.drive.fault(COMM_FAULT)  # a drive that was not powering its motor has nothing to stop
             self.drive.step(dt)
         elif step:
-            images.unpack(outputs, rx_map, od)
+            if codec is not None:  # the usual frame: outputs into their objects and the RxPdo in one call
+                rx = codec.read_rx(outputs, self.drive.mode)
+            else:
+                self._images.get(rx_map, tx_map, od).unpack(outputs, rx_map, od)
+                rx = self._rx_from_od()
             if self.drive.mode == CST and 0x60E0 in od.objects:  # torque limits may travel in 0x1603
                 self.drive.modes.objects.positive_torque_limit = od.value(0x60E0)
                 self.drive.modes.objects.negative_torque_limit = od.value(0x60E1)
-            rx = RxPdo(mode=self.drive.mode)
-            for attr, e in self._rx_pairs:
-                v = e.value
-                setattr(rx, attr, v if isinstance(v, int) else 0)  # ObjectDictionary.value's rule
             self.drive.apply(rx)
             self.drive.step(dt)
+        if codec is not None:
+            return codec.write_tx(self.drive.feedback())
         self._publish()
-        return images.pack(tx_map, od)
+        return self._images.get(rx_map, tx_map, od).pack(tx_map, od)
+
+    def _rx_from_od(self) -> RxPdo:
+        rx = RxPdo(mode=self.drive.mode)
+        for attr, e in self._rx_pairs:
+            v = e.value
+            setattr(rx, attr, v if isinstance(v, int) else 0)  # ObjectDictionary.value's rule
+        return rx
 
     def new_error(self) -> int:
         """The drive's error code if it changed to a new non-zero value since the last call."""

@@ -93,7 +93,7 @@ class Esc:
         # seen, until the master writes those registers again (issue 17: no per-frame decoding).
         self._sms: dict[int, Sm] = {}
         self._fmmus: list[tuple[int, int, int, int]] | None = None
-        self._plans: dict[tuple[int, int, int], tuple[list, list]] = {}
+        self._plans: dict[tuple[int, int, int], tuple[list, list, memoryview, int]] = {}
         self._wd_ns: int | None = None  # the process-data watchdog time, from 0x0400 and 0x0420
         self.power_on()
 
@@ -370,15 +370,17 @@ class Esc:
         """LRD/LWR/LRW through the FMMUs. Returns the WKC increment. In lock-step the outputs are
         applied and the model advanced before the inputs are copied, so one frame = one cycle."""
         mem = self.mem
-        state = mem[R_AL_STATUS] & 0x0F
+        status = mem[R_AL_STATUS]
+        state = status & 0x0F
         if state != SAFEOP and state != OP:
             return 0
-        plan = self._plans.get((cmd, addr, len(data)))
+        key = (cmd, addr, len(data))
+        plan = self._plans.get(key)
         if plan is None:
-            plan = self._plans[(cmd, addr, len(data))] = self._plan(cmd, addr, len(data))
-        writes, reads = plan
+            plan = self._plans[key] = self._plan(cmd, addr, len(data))
+        writes, reads, outputs, inputs = plan
         inc = 0
-        if writes and not mem[R_AL_STATUS] & AL_ERROR:
+        if writes and not status & AL_ERROR:
             # The ESC takes outputs from SAFE-OP on (the SM is enabled); only OP applies them. After
             # an error (watchdog, sync) the application deactivates the output SM: no write WKC.
             for d0, d1, p0, p1 in writes:
@@ -393,23 +395,23 @@ class Esc:
             self.last_cycle_ns = now
             self.last_output_ns = now
             self.outputs_written += 1
-            s2 = self.sm(2)
-            self._write_inputs(self.app.cycle(memoryview(mem)[s2.start:s2.end], self.rx_map, self.tx_map,
-                                              step=True, dt=dt))
+            got = self.app.cycle(outputs, self.rx_map, self.tx_map, step=True, dt=dt)
+            if got:
+                mem[inputs:inputs + len(got)] = got
         elif reads and state == SAFEOP:
-            s2 = self.sm(2)
-            lost = bool(mem[R_AL_STATUS] & AL_ERROR) and self.outputs_written > 0  # dropped out of OP
-            self._write_inputs(self.app.cycle(memoryview(mem)[s2.start:s2.end], self.rx_map, self.tx_map,
-                                              step=lost, dt=self.cycle_time, lost=lost))
+            lost = bool(status & AL_ERROR) and self.outputs_written > 0  # dropped out of OP
+            self._write_inputs(self.app.cycle(outputs, self.rx_map, self.tx_map, step=lost, dt=self.cycle_time,
+                                              lost=lost))
         if reads:
             for d0, d1, p0, p1 in reads:
                 data[d0:d1] = mem[p0:p1]
             inc += 1
         return 0 if self.wkc_fault else inc
 
-    def _plan(self, cmd: int, addr: int, n: int) -> tuple[list, list]:
+    def _plan(self, cmd: int, addr: int, n: int) -> tuple[list, list, memoryview, int]:
         """Where a logical datagram's bytes go: (datagram slice, physical slice) per FMMU it hits,
-        outputs (written) and inputs (read)."""
+        outputs (written) and inputs (read); then the SM2 area the application reads its outputs from
+        (a view of `mem`) and where SM3, its inputs, starts. Dropped when FMMUs or SMs change."""
         reads, writes = [], []
         for ls, ps, typ, ln in self.fmmus():
             lo, hi = max(addr, ls), min(addr + n, ls + ln)
@@ -420,7 +422,8 @@ class Esc:
                 writes.append(part)
             if typ & 1 and cmd in (LRD, LRW):
                 reads.append(part)
-        return writes, reads
+        s2 = self.sm(2)
+        return writes, reads, memoryview(self.mem)[s2.start:s2.end], self.sm(3).start
 
     # ---- watchdog -------------------------------------------------------------------------
     def watchdog_ns(self) -> int:

@@ -9,7 +9,10 @@ read with each entry's signedness, inputs written as the value masked to the ent
 from __future__ import annotations
 
 import struct
+from collections.abc import Callable
 from dataclasses import dataclass
+
+from fieldbus.pdo import RxPdo, TxPdo
 
 from virtual_bus.ethercat.coe import ObjectDictionary
 from virtual_bus.ethercat.device import VISIBLE_STRING, OdEntry
@@ -94,3 +97,62 @@ class Images:
 
     def pack(self, tx_map: Mapping, od: ObjectDictionary) -> bytes:
         return self.tx.write() if self.tx is not None else pack_generic(tx_map, od)
+
+
+class DriveCodec:
+    """A drive's process data in one generated function per direction (issue 17), for `DriveApp`:
+    `read_rx(data, mode)` stores the outputs in their entries, as `PdoImage.read` does, and returns the
+    `RxPdo` the drive latches (fields the mapping does not carry come from their entries, `mode` where
+    the dictionary has no 0x6060); `write_tx(fb)` stores a `TxPdo` in the entries, as `DriveApp._publish`
+    does, and returns the input image `PdoImage.write` would pack from them. The dictionary ends up as
+    the entry-by-entry route leaves it; only the per-entry loops, lookups and temporaries are gone."""
+
+    def __init__(self, read_rx: Callable[..., RxPdo], write_tx: Callable[[TxPdo], bytes]) -> None:
+        self.read_rx, self.write_tx = read_rx, write_tx
+
+    @classmethod
+    def compile(cls, rx_map: Mapping, tx_map: Mapping, od: ObjectDictionary, rx_attr: dict[tuple[int, int], str],
+                tx_attr: dict[tuple[int, int], str]) -> "DriveCodec | None":
+        """None where either image cannot be compiled (`PdoImage.compile`): the generic route decides."""
+        rx, tx = PdoImage.compile(rx_map, od), PdoImage.compile(tx_map, od)
+        if rx is None or tx is None:
+            return None
+        scope: dict = {"RxPdo": RxPdo, "_unpack": rx.reader.unpack_from, "_pack": tx.writer.pack, "_int": _int}
+        # outputs: v<k> is the k-th mapped value, stored in its entry; a field takes the last value mapped to it
+        lines = ["def read_rx(data, mode):"]
+        names = [f"v{k}" for k in range(len(rx.entries))]
+        if names:
+            lines.append(f"    {', '.join(names)}{',' if len(names) == 1 else ''} = _unpack(data)")
+        fields: dict[str, str] = {}
+        for k, ((index, sub, _), e) in enumerate(zip(rx_map, rx.entries)):
+            scope[f"e{k}"] = e
+            lines.append(f"    e{k}.value = v{k}")
+            if (index, sub) in rx_attr:
+                fields[rx_attr[(index, sub)]] = f"v{k}"
+        for k, ((index, sub), attr) in enumerate(rx_attr.items()):  # not mapped: the entry's value (SDO)
+            obj = od.objects.get(index)
+            if attr not in fields and obj is not None and sub in obj.entries:
+                scope[f"u{k}"] = obj.entries[sub]
+                fields[attr] = f"_int(u{k}.value)"
+        fields.setdefault("mode", "mode")
+        lines.append("    return RxPdo(" + ", ".join(f"{a}={x}" for a, x in fields.items()) + ")")
+        # inputs: every TxPdo field the dictionary has goes to its entry; the mapped ones are packed masked
+        lines.append("def write_tx(fb):")
+        published: dict[tuple[int, int], str] = {}
+        for k, ((index, sub), attr) in enumerate(tx_attr.items()):
+            obj = od.objects.get(index)
+            if obj is not None and sub in obj.entries:
+                scope[f"t{k}"] = obj.entries[sub]
+                lines.append(f"    w{k} = t{k}.value = fb.{attr}")
+                published[(index, sub)] = f"w{k}"
+        packed = []
+        for k, ((index, sub, _), e, mask) in enumerate(zip(tx_map, tx.entries, tx.masks)):
+            scope[f"p{k}"] = e
+            packed.append(f"{published.get((index, sub), f'p{k}.value')} & {mask:#x}")
+        lines.append(f"    return _pack({', '.join(packed)})")
+        exec(compile("\n".join(lines) + "\n", "<drive codec>", "exec"), scope)
+        return cls(scope["read_rx"], scope["write_tx"])
+
+
+def _int(v) -> int:
+    return v if isinstance(v, int) else 0  # ObjectDictionary.value's rule
