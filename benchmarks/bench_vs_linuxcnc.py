@@ -5,7 +5,10 @@ cycles), their ratio, the largest deviation from the programmed polyline, and th
 velocity/acceleration/jerk share of the axis limits (finite differences of the commanded
 positions, as a drive sees them). Asserts nothing.
 
-    python benchmarks/bench_vs_linuxcnc.py [--only NAME] [--keep DIR] [--no-linuxcnc]
+    python benchmarks/bench_vs_linuxcnc.py [--only NAME] [--keep DIR] [--no-linuxcnc] [--filter-off]
+
+--filter-off runs hil on the bench with N1.036 = N1.037 = 0 (no position filter): line-line corners
+then get clothoid blends within N1.053 (decision motion 42).
 
 LinuxCNC is run through the reference runner in ../shared/tools/linuxcnc-time (or $LCNC_TIME_DIR);
 its G64 P<tol> matches N1.053 (benches/mill-3axis.toml: 0.02 mm). Where LinuxCNC or the runner is
@@ -169,12 +172,21 @@ def measure(P: np.ndarray, prog: Program, note: str = "") -> Result:
     return Result((i1 - i0) * 0.001, polyline_deviation(S, [START] + prog.points), *shares(S), note)
 
 
-def run_hil(prog: Program, work: Path) -> Result:
+def filter_off_bench(work: Path) -> Path:
+    """benches/mill-3axis.toml with N1.036 = N1.037 = 0 (the filter off, N1.053 kept)."""
+    text = BENCH.read_text()
+    head, sep, rest = text.partition("[[axes]]")
+    out = work / "mill-3axis-nofilter.toml"
+    out.write_text(head + '[params]\n"N1.036" = 0\n"N1.037" = 0\n\n' + sep + rest)
+    return out
+
+
+def run_hil(prog: Program, work: Path, bench: Path = BENCH) -> Result:
     src = work / (re.sub(r"\W+", "_", prog.name) + ".nc")
     src.write_text(prog.text(lcnc=False))
     trace = src.with_suffix(".csv")
     env = dict(os.environ, PYTHONPATH=str(ROOT))
-    r = subprocess.run([sys.executable, "-m", "hil.cli", "run", "--bench", str(BENCH), "--trace", str(trace),
+    r = subprocess.run([sys.executable, "-m", "hil.cli", "run", "--bench", str(bench), "--trace", str(trace),
                         "--no-progress", str(src)], capture_output=True, text=True, env=env, cwd=ROOT)
     with open(trace) as f:
         rows = list(csv.DictReader(f))
@@ -218,20 +230,22 @@ def main() -> None:
     ap.add_argument("--only", help="run the programs whose name contains this")
     ap.add_argument("--keep", type=Path, help="keep programs, traces and samples in this folder")
     ap.add_argument("--no-linuxcnc", action="store_true")
+    ap.add_argument("--filter-off", action="store_true", help="hil without the position filter (corner blends)")
     args = ap.parse_args()
     skip = "skipped (--no-linuxcnc)" if args.no_linuxcnc else lcnc_available()
     if skip:
         print(f"LinuxCNC column: {skip}")
     work = args.keep or Path(tempfile.mkdtemp(prefix="bench-lcnc-"))
     work.mkdir(parents=True, exist_ok=True)
-    print(f"bench {BENCH.name}, N1.053 = G64 P{TOL} mm; times in simulated 1 ms cycles; shares = peak v/a/j of the limits")
+    bench = filter_off_bench(work) if args.filter_off else BENCH
+    print(f"bench {bench.name}, N1.053 = G64 P{TOL} mm; times in simulated 1 ms cycles; shares = peak v/a/j of the limits")
     print(f"{'program':32s} {'bound':>7s} | {'hil':>7s} {'dev mm':>7s} {'v/a/j':>15s} | {'LinuxCNC':>8s} {'dev mm':>7s} "
           f"{'v/a/j':>15s} | {'hil/LCNC':>8s} {'hil/bound':>9s}")
     try:
         for prog in programs():
             if args.only and args.only not in prog.name:
                 continue
-            h = run_hil(prog, work)
+            h = run_hil(prog, work, bench)
             lc = None if skip else run_lcnc(prog, work)
             ratio = f"{h.time / lc.time:8.3f}" if lc else f"{'-':>8s}"
             lcs = (f"{lc.time:8.3f} {lc.deviation:7.4f} {lc.v:4.2f}/{lc.a:4.2f}/{lc.j:5.1f}" if lc

@@ -230,7 +230,10 @@ class Channel:
         # At rest: the suspended block and what was read ahead leave the planner (look-ahead flushed)
         self._interrupt = None
         stop = dict(zip(pl.axes, pl.position.tolist()))
-        held: list[Event] = [b.move for b in pl.queue]
+        held: list[Event] = []
+        for b in pl.queue:  # a corner blend's block carries its incoming move again (motion decision 42)
+            if not held or b.move is not held[-1]:
+                held.append(b.move)
         held += [e for e in (self._deferred, self.end) if e is not None]
         self._deferred, self.end = None, None
         pl.stop()

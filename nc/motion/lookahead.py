@@ -27,6 +27,9 @@ from nc.motion.limits import MotionConfig
 from nc.motion.path import Segment
 from nc.moves import Move
 
+# Shares of the axis jerk on a corner blend: centripetal v³·(dκ/ds + κ²), tangential profile, and the
+# coupling 3·v·a_t·κ (Limits._blend_limits).
+BLEND_JERK = (0.8, 0.1, 0.1)
 MARGIN = 0.98  # the passes plan with 98 % of the limits ruckig gets, so plans are never borderline
 
 
@@ -76,6 +79,7 @@ class Block:
     tf_cap: float = math.nan
     tf_tcap: float = math.nan
     tf_ok: bool = False
+    trim0: float = 0.0  # path its start gave to a corner blend before it (nc.motion.corner_blends)
 
 
 def change_distance(v0: float, v1: float, a: float, j: float) -> float:
@@ -150,8 +154,9 @@ class Limits:
         self._corner_a = tuple(x * T for x in self._acc)
         self.blend = FilterCorners(cfg, self._acc, self._jerk) if cfg.filtered else None
 
-    def block_limits(self, seg: Segment) -> tuple[float, float, float]:
-        """(speed cap, tangential acceleration, tangential jerk) of a path segment."""
+    def block_limits(self, seg: Segment, short_ok: bool = False) -> tuple[float, float, float]:
+        """(speed cap, tangential acceleration, tangential jerk) of a path segment. `short_ok`: no
+        minimum duration (a line whose both ends are blends has no corner for it to protect)."""
         cfg = self.cfg
         v = a = j = math.inf
         for d, vl, al, jl in zip(seg.direction_cosines(), self._v, self._acc, self._jerk):
@@ -180,8 +185,29 @@ class Limits:
             a = min(a, 0.3 * sc * pj * rc / (3.0 * max(v, 1e-9)))
         if self.blend is not None and seg.kind == "arc":
             v = min(v, self.blend.arc_speed(seg.radius))
-        v = min(v, seg.length / (cfg.min_segment_cycles * self.T))
+        if seg.kind == "blend":
+            v, a, j = self._blend_limits(seg, v, a, j)
+        if not short_ok:
+            v = min(v, seg.length / (cfg.min_segment_cycles * self.T))
         return v, a, j
+
+    def _blend_limits(self, seg: Segment, v: float, a: float, j: float) -> tuple[float, float, float]:
+        """A clothoid pair (nc.motion.clothoid) at speed v: normal acceleration v²·κ ≤ v²·κmax and
+        jerk v³·(dκ/ds + κ²), plus 3·v·a_t·κ from the tangential acceleration, each axis' share of
+        the normal at most `normal_amplitude`. A blend has no tangent or curvature jump, so the corner
+        and curvature shares are its own (as between lines under the filter, decision 38); of the
+        jerk, the centripetal term takes BLEND_JERK first (decision 40 e: the blends' speed is set
+        by it), the tangential profile and the coupling term what is left."""
+        cfg = self.cfg
+        pa = pj = math.inf
+        for m, al, jl in zip(seg.normal_amplitude().tolist(), self._acc, self._jerk):
+            if m > 1e-12:
+                pa, pj = min(pa, al / m), min(pj, jl / m)
+        km, dk = seg.kappa_max, seg.dkappa
+        sa = cfg.share_curvature + cfg.share_corner
+        v = min(v, math.sqrt(sa * pa / km), (BLEND_JERK[0] * pj / (dk + km * km)) ** (1.0 / 3.0))
+        a = min(a, BLEND_JERK[2] * pj / (3.0 * max(v, 1e-9) * km))
+        return v, a, j * BLEND_JERK[1] / cfg.share_tangential
 
     def junction(self, b1: Block, b2: Block) -> float:
         """Highest speed at the junction b1 → b2."""

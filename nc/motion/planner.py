@@ -30,6 +30,7 @@ import numpy as np
 
 from nc.alarm_table import PLANNING_STALL
 from nc.alarms import NcAlarm
+from nc.motion.corner_blends import blend_block
 from nc.motion.limits import MotionConfig
 from nc.motion.lookahead import MARGIN, Block, Limits, backward, change_distance, max_speed_at, reach
 from nc.motion.path import Segment
@@ -145,6 +146,9 @@ class Planner:
         if cfg.filtered:
             self.filter = PositionFilter(*cfg.filter_cycles(), self.position)
         self._path_s = 0.0  # path length pushed so far (junction windows are measured on it)
+        # Half the least tangential acceleration and jerk of any line: the braking `_may_blend` allows for.
+        self._a_lo = 0.5 * cfg.share_tangential * float(self.lim.acc.min())
+        self._j_lo = 0.5 * cfg.share_tangential * float(self.lim.jerk.min())
         # The channel sets `closed` when no move comes before the queue has run out to rest (program
         # end, an M/S/T or preview barrier); a push clears it. _jf: tangential jerk factor of the
         # last path solve (nc.motion.shares).
@@ -168,17 +172,47 @@ class Planner:
             if b.kind == "path" and not b.rapid and not b.move.per_rev:
                 b.vtop = min(b.cap_hard, 1.5 * (self.dry_run_feed if self.dry_run else (b.feed or 0.0)))
         self._update_cap(b)
+        added = 1
         if self.blocks:
             prev = self.blocks[-1]
             prev.vjunc = self.lim.junction(prev, b)
+            if blend is None and self._may_blend(prev):
+                blk = blend_block(self.lim, prev, b, self.cfg.path_tolerance or 0.0)
+                if blk is not None:  # both lines gave path to it: the running lengths follow
+                    prev.s_end -= blk.seg.tlen
+                    blk.s_end = prev.s_end + blk.length
+                    self._path_s = blk.s_end
+                    for x in (prev, blk, b):
+                        self._update_cap(x)
+                    self.blocks.append(blk)
+                    added = 2
+        if blend is None:
+            self._path_s += b.length
+            b.s_end = self._path_s
         self.blocks.append(b)
         self.threads_queued += b.kind == "thread"
-        self._pushed += 1
+        self._pushed += added
         # Blocks pushed since the last pass never had one: the pass must reach past all of them.
-        need = max(self._need + 1, self._pushed)
+        need = max(self._need + added, self._pushed)
         if blend is not None:
             need = max(need, blend.window(self.blocks))
         self._need = need
+
+    def _may_blend(self, prev: Block) -> bool:
+        """Whether the tail may still give path to a corner blend (decision motion 42): a tolerance
+        to blend within, no hold (its ramp runs on across blocks), and no profile that could be
+        caught by the shorter path: nothing planned yet, or the tail further beyond the active
+        block than any stop from its speed needs, at half the least tangential limits."""
+        tol = self.cfg.path_tolerance
+        if tol is None or tol <= 0.0 or self.held or self._stopping:
+            return False
+        if not self._started and self.plan is None:
+            return True
+        head = self.blocks[0]
+        if prev is head:
+            return False
+        room = prev.s_end - prev.length - head.s_end
+        return room >= change_distance(max(head.cap, abs(self.v)), 0.0, self._a_lo, self._j_lo)
 
     def lookahead(self) -> None:
         """Bring the queue's end speeds up to date (the backward pass the pushes owe)."""
