@@ -95,7 +95,7 @@ class Stretcher:
                 n = min(n, pl.filter.span - pl.filter._still)
             self._sampler = stand_stretch
         else:  # to the buffer's end: the planner stays on its block (dropped at the refill, a stepped cycle)
-            n = min(limit, MAX_CYCLES, len(pl._buf_pos) - pl._buf_i)
+            n = min(limit, MAX_CYCLES, pl._block_rows())  # a cruise's buffer spans blocks: this one's rows
             self._sampler = sample_stretch
         if n < 2:
             return False

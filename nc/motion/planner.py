@@ -75,9 +75,18 @@ class _Plan:
     # few cycles at a time and solved again once more than `queued` moves were pushed.
     open: bool = False
     queued: int = 0
+    # A "cruise" (decision motion 42): sampled at once across its blocks; `ends` when its last row is its
+    # last block's last sample (that block is then finished like a path plan's), `carry` the next plan's t0.
+    ends: bool = False
+    carry: float = 0.0
+    last: int = 0  # the offset of its last block from blocks[0] when sampled
 
 
 class Planner:
+    # True: every block of a run starts a new solve, also where the run cruises at its cap (the reference
+    # tests compare the cruise sampling against, decision motion 42)
+    per_block = False
+
     def __init__(self, cfg: MotionConfig, start: dict[str, float] | None = None,
                  spindle_rpm: Callable[[], float] | None = None,
                  spindle_angle: Callable[[], float] | None = None,
@@ -140,6 +149,10 @@ class Planner:
         self._buf_line: list[int] = []
         self._buf_i = 0
         self._buf_state: list[tuple[float, float, float]] = []
+        # A cruise's buffer spans blocks: per row the offset of its block from blocks[0] when sampled (None:
+        # every row in blocks[0]), and how many of those blocks the rows handed out so far finished.
+        self._buf_blk: list[int] | None = None
+        self._buf_popped = 0
         self.solves = 0  # ruckig solves so far (one per block plus one per event)
         # Post-interpolation filter (N1.036/N1.037); None when both times are zero.
         self.filter: PositionFilter | None = None
@@ -370,11 +383,31 @@ class Planner:
             return Setpoint(self.position.copy(), self.line, 0.0, blk)
         i = self._buf_i
         self._buf_i += 1
+        self._take(i)
+        blk = self.blocks[0].move if self.blocks else None
+        return Setpoint(self.position.copy(), self.line, float(self._buf_vel[i]), blk)
+
+    def _block_rows(self) -> int:
+        """Buffer rows left that lie in blocks[0] (a stretch stays within one block: nc.motion.stretch)."""
+        i, n = self._buf_i, 0 if self._buf_pos is None else len(self._buf_pos)
+        blk = self._buf_blk
+        if blk is None:
+            return n - i
+        j = i
+        while j < n and blk[j] == self._buf_popped:
+            j += 1
+        return j - i
+
+    def _take(self, i: int) -> None:
+        """The state after handing out buffer row i: a cruise's blocks before row i's are finished."""
+        if self._buf_blk is not None:
+            k = self._buf_blk[i]
+            while self._buf_popped < k:
+                self._finish_block(keep_plan=True)
+                self._buf_popped += 1
         self.position = self._buf_pos[i]
         self.line = self._buf_line[i]
         self.s, self.v, self.a = self._buf_state[i]
-        blk = self.blocks[0].move if self.blocks else None
-        return Setpoint(self.position.copy(), self.line, float(self._buf_vel[i]), blk)
 
     # ---- threads --------------------------------------------------------------------------
     def _thread_step(self) -> Setpoint:
@@ -534,6 +567,13 @@ class Planner:
                 if self.plan is None:
                     return
             p = self.plan
+            if p.kind == "cruise":
+                if not p.emitted:
+                    self._sample_cruise(p)
+                    if not self._buf_done:
+                        return
+                self._end_plan(p)
+                continue
             if p.open and p.emitted and self._pushes > p.queued and not self.held:
                 self._replan()  # more of the path is known: the jerk factor may rise
                 continue
@@ -588,13 +628,93 @@ class Planner:
             if self.s >= b.length - 1e-12 and abs(self.v) < 1e-9:
                 self._finish_block()
                 continue
+            if not self.per_block:
+                cruise = self._cruise(b, t0)
+                if cruise is not None:
+                    return cruise
             return self._plan_path(b, t0)
         if self._stopping:
             self._flush()
         self._started = False
         return None
 
-    def _spindle_starting(self) -> bool:
+    def _cruising(self, b: Block, v: float) -> bool:
+        """A solve at b's start (or within b) from speed v at zero acceleration would cruise at v to b's end:
+        its run ends there (b's end speed is not below its cap), its cap is v, nothing re-plans it per cycle."""
+        return (b.kind == "path" and b.cap == v and b.vend >= v and not b.move.per_rev and b.move.css is None
+                and "G31" not in b.move.tags)
+
+    def _cruise(self, b: Block, t0: float) -> _Plan | None:
+        """Decision motion 42: at its cap, with zero acceleration, a run whose end speed is the cap solves to
+        constant speed to the end of its block, and so does the next block's solve while the same holds there.
+        Such a chain is sampled across its blocks at once (no solve): positions as the per-block solves give
+        them (tests/test_motion_cruise.py). Only over blocks no push can change any more: a push changes the
+        junction speeds within one filter span behind the queue's new end (FilterCorners.window), and the
+        backward pass carries that back at most one braking distance."""
+        v = self.v
+        if self.held or self._stopping or self.a != 0.0 or v <= 0.0:
+            return None
+        self.lookahead()
+        if not self._cruising(b, v):
+            return None
+        horizon = math.inf  # the end of the last block the chain may take
+        if not self.closed:
+            blend = self.lim.blend
+            # no block's tangential limits are below the lowest axis's (Limits.block_limits)
+            share = self.cfg.share_tangential
+            brake = change_distance(v, 0.0, min(self.lim._acc) * share, min(self.lim._jerk) * share)
+            horizon = self.blocks[-1].s_end - 2.0 * (blend.span_max + brake) if blend is not None else -math.inf
+        return _Plan("cruise", None, math.inf, t0, target=horizon)
+
+    def _sample_cruise(self, p: _Plan) -> None:
+        """Up to CHUNK rows of a cruise: each block as its own solve gives them (a constant-speed profile from
+        s0 at the plan time t0, sampled while t <= duration + 1e-12 cycles, s = s0 + v·t; the next block's t0
+        the time left over, `_end_plan`), and the snap of a block's start to where the last one ended."""
+        T = self.cfg.cycle
+        v = self.v
+        blocks = self.blocks
+        s0, t_next, k, nb = self.s, p.t_next, 0, len(blocks)
+        pos: list[np.ndarray] = []
+        st: list[float] = []
+        offs: list[int] = []
+        lines: list[int] = []
+        rows = 0
+        while True:
+            b = blocks[k]
+            if k and _near(b.seg.start, blocks[k - 1].seg.end):
+                b.seg.start = blocks[k - 1].seg.end.copy()
+            duration = (b.length - s0) / v
+            n = int(math.floor((duration - t_next) / T + 1e-9)) + 1 if t_next <= duration + 1e-12 else 0
+            take = min(n, CHUNK - rows)
+            if take > 0:
+                t = t_next + T * np.arange(take)
+                s = s0 + np.clip(t, 0.0, duration) * v
+                pos.append(b.seg.points(np.clip(s, 0.0, b.length)))
+                st += s.tolist()
+                offs += [k] * take
+                lines += [b.move.line] * take
+                rows += take
+            if take < n:  # the chunk ends within the block: the next plan goes on from its last row
+                p.ends, p.last = False, k
+                break
+            t_next += n * T
+            p.carry = t_next - duration if t_next - duration > 1e-12 else t_next - duration + T
+            p.ends, p.last = True, k
+            if rows >= CHUNK or k + 1 >= nb:
+                break
+            nx = blocks[k + 1]
+            if not self._cruising(nx, v) or nx.s_end > p.target:
+                break
+            k, s0, t_next = k + 1, 0.0, p.carry
+        p.emitted = True
+        self._buf_pos = np.concatenate(pos) if pos else np.empty((0, len(self.axes)))
+        self._buf_vel = np.full(rows, v)
+        self._buf_line = lines
+        self._buf_state = [(x, v, 0.0) for x in st]
+        self._buf_blk = offs
+        self._buf_popped = 0
+        self._buf_i = 0
+
         return self.spindle_command is not None and abs(self.spindle_command()) > 0.0
 
     def _plan_path(self, b: Block, t0: float) -> _Plan | None:
@@ -740,6 +860,7 @@ class Planner:
 
     def _sample(self, p: _Plan, n: int) -> None:
         T = self.cfg.cycle
+        self._buf_blk = None
         t = p.t_next + T * np.arange(n)
         p.t_next = float(t[-1] + T)
         line = self.blocks[0].move.line if self.blocks else self.line
@@ -804,6 +925,18 @@ class Planner:
 
     def _end_plan(self, p: _Plan) -> None:
         T = self.cfg.cycle
+        if p.kind == "cruise":
+            self.plan = None
+            self._carry = T  # ended within a block: the next plan goes on from the last row
+            if p.ends:  # its last block ends here as that block's own path plan would end it
+                while self._buf_popped < p.last:
+                    self._finish_block(keep_plan=True)
+                    self._buf_popped += 1
+                self._carry = p.carry
+                self.position = self.blocks[0].seg.end.copy()
+                self.a = 0.0
+                self._finish_block()
+            return
         self._carry = p.t_next - p.duration
         if self._carry <= 1e-12:
             self._carry += T

@@ -1,7 +1,8 @@
 """The planner's samples handed out a stretch at a time (issue 17: "the runner asks the channel for the next N
 planned samples as arrays").
 
-The planner samples each plan into a buffer (`Planner._buf_pos`, up to 64 cycles, within one block) and
+The planner samples each plan into a buffer (`Planner._buf_pos`, up to 64 cycles, within one block; a
+cruise's across blocks, decision motion 42, of which a stretch takes the rows in the current block) and
 `Planner.step` hands out one row per cycle, through the position filter. `sample_stretch(planner, n)` hands
 out the next rows of that buffer at once — at most to its end, where the planner solves again — filtered by
 `PositionFilter.push_many`, and leaves the planner as that many `step()` calls would. It refuses (None) what
@@ -30,7 +31,7 @@ class Samples:
     positions: np.ndarray  # (cycles, axes), filtered as step() returns them
     lines: list[int]
     path_velocity: np.ndarray
-    move: Move | None  # the same for every row: a buffer lies within one block
+    move: Move | None  # the same for every row: a stretch lies within one block
 
 
 def sample_stretch(pl: Planner, n: int) -> Samples | None:
@@ -45,13 +46,13 @@ def sample_stretch(pl: Planner, n: int) -> Samples | None:
     if mv is not None and (mv.kind == "thread" or "G31" in mv.tags):
         return None
     i = pl._buf_i
-    m = min(n, len(pl._buf_pos) - i)
+    m = min(n, pl._block_rows())
+    if m <= 0:
+        return None  # the next row starts the cruise's next block: step() finishes this one
     j = i + m - 1
     raw = pl._buf_pos[i:i + m]
     pl._buf_i = i + m
-    pl.position = pl._buf_pos[j]
-    pl.line = pl._buf_line[j]
-    pl.s, pl.v, pl.a = pl._buf_state[j]
+    pl._take(j)
     positions = pl.filter.push_many(raw) if pl.filter is not None else np.array(raw, dtype=float)
     pl.output = positions[-1].copy()
     return Samples(positions, list(pl._buf_line[i:i + m]), np.array(pl._buf_vel[i:i + m], dtype=float), mv)
