@@ -117,20 +117,27 @@ def take(ip: Interpreter, fr: Frame, limit: int) -> MoveBatch | None:
     first = raw_at(pc) if raw_at is not None else None
     if first is None:
         return None
-    shapes = ip.__dict__.setdefault("_bulk_shapes", {})  # per interpreter: the axes decide the shapes
     # a line the lane never takes (T0101, M05 …) is refused at once, found by its text when seen before
     known = ip.__dict__.setdefault("_bulk_refused", set())
     if first in known:
         return None
-    axes = {a: j for j, a in enumerate(ip.axes) if len(a) == 1 and a in ip._plain_axes}
+    shapes = ip.__dict__.setdefault("_bulk_shapes", {})  # per interpreter: the axes decide the shapes
+    axes = ip.__dict__.get("_bulk_axes")
+    if axes is None:
+        axes = ip._bulk_axes = {a: j for j, a in enumerate(ip.axes) if len(a) == 1 and a in ip._plain_axes}
     if _shape_of(first, shapes, axes) is None:
-        if len(known) >= 4096:
-            known.clear()
-        known.add(first)
+        _refuse(known, first)
         return None
     if not eligible(ip):
         return None
     room = min(MAX_RUN, len(blocks) - pc, limit - ip._executed)
+    # a refused line or a parsed block within MIN_RUN lines ends the run short: found without reading
+    # the lines before it (a lathe program's G00 between cycle blocks, issue 16)
+    for j in range(1, MIN_RUN):
+        nxt = raw_at(pc + j) if j < room else None
+        if nxt is None or nxt in known:
+            ip._bulk_skip = (blocks, pc, pc + j + 1)
+            return None
     segments: list[tuple[_Shape, int, list[tuple[str, ...]]]] = []  # (shape, first row, groups per row)
     texts: list[str] = []
     shape: _Shape | None = None
@@ -147,6 +154,7 @@ def take(ip: Interpreter, fr: Frame, limit: int) -> MoveBatch | None:
             if m is None:
                 shape = _shape_of(raw, shapes, axes)
                 if shape is None:
+                    _refuse(known, raw)
                     break
                 match = shape.pattern.fullmatch
                 m = match(raw)
@@ -164,6 +172,13 @@ def take(ip: Interpreter, fr: Frame, limit: int) -> MoveBatch | None:
         ip._bulk_skip = (blocks, pc, pc + len(texts) + 1)
         return None
     return _run(ip, fr, segments, texts)
+
+
+def _refuse(known: set[str], raw: str) -> None:
+    """Remember a line the lane never takes (memory flat: a few thousand texts)."""
+    if len(known) >= 4096:
+        known.clear()
+    known.add(raw)
 
 
 def _same_shape(shape: _Shape, part: list[str], rows: list[tuple[str, ...]]) -> int:

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import copy
-
 from dataclasses import dataclass, field
 from typing import ClassVar
 
@@ -60,7 +58,8 @@ class ModalState:
 
     def copy(self) -> "ModalState":
         """An independent copy: every field is a number, flag or string but the groups dict."""
-        st = copy.copy(self)
+        st = object.__new__(type(self))  # copy.copy without its reduce protocol (a twin per lathe cycle)
+        st.__dict__.update(self.__dict__)
         st.groups = dict(self.groups)
         return st
 
