@@ -231,9 +231,12 @@ def realtime_runs(d: str, cam_blocks: int = 1500) -> None:
         res = api.run(program, str(bench) if bench else None, trace=os.path.join(d, "rt.parquet"), realtime=True,
                       check=False)
         r = res.run
-        e, j = r.timing.get("exec", {}), r.timing.get("jitter", {})
-        print(f"real time, {label}, 1 ms ({r.granted}): {r.cycles} cycles, {r.overruns} overruns; cycle work "
+        e, j, b = r.timing.get("exec", {}), r.timing.get("jitter", {}), r.timing.get("between", {})
+        print(f"real time, {label}, 1 ms ({r.granted}): {r.cycles} cycles ({r.stretched / max(1, r.cycles):.0%} in "
+              f"stretches), {r.overruns} overruns; cycle work (wake-up to outputs written) "
               + "  ".join(f"{k} {e[k] * 1e6:.0f} µs" for k in ("p50", "p99", "p99.9", "max") if k in e)
+              + "; between cycles (ahead work, in the slack) "
+              + "  ".join(f"{k} {b[k] * 1e6:.0f} µs" for k in ("p50", "p99", "p99.9", "max") if k in b)
               + "; jitter " + "  ".join(f"{k} {j[k] * 1e6:.1f} µs" for k in ("p50", "p99", "max") if k in j)
               + ("" if r.ok else "  (" + ", ".join(a.code_text for a in r.alarms) + ")"))
 

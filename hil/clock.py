@@ -153,6 +153,11 @@ class RealTimeClock:
         self.exec = TimingStats()
         self.jitter = TimingStats()  # |period - cycle|
         self.latency = TimingStats()  # wake-up lateness against the deadline
+        # Work between one cycle's done() and the next tick() (decision B21): a stretch's planner samples and
+        # drive models computed ahead, the runner's loop; it runs in the period's slack, so a period holds
+        # its cycle's work plus this
+        self.between = TimingStats()
+        self._done_ns: int | None = None
         self.overruns = 0
         self.first_overrun: int | None = None
         self.granted = Granted()
@@ -180,6 +185,8 @@ class RealTimeClock:
     # ---- the cycle ----------------------------------------------------------------------------
     def tick(self) -> CycleTiming:
         now = self.now_ns()
+        if self._done_ns is not None:
+            self.between.add((now - self._done_ns) * 1e-9, self._n + 1)
         overrun = now > self._deadline
         if overrun:
             self.overruns += 1
@@ -201,7 +208,8 @@ class RealTimeClock:
         return CycleTiming(period, late, overrun)
 
     def done(self) -> None:
-        self.exec.add((self.now_ns() - self._start_ns) * 1e-9, self._n)
+        self._done_ns = now = self.now_ns()
+        self.exec.add((now - self._start_ns) * 1e-9, self._n)
 
     def _wait_until(self, deadline: int) -> None:
         spin_ns = int(self.config.busy_wait * 1e9)

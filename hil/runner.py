@@ -252,7 +252,12 @@ class BenchRunner:
                 ch.reset()
             if stretcher is not None and not stopping and stretcher.run(max_cycles - 1 - self.cycle):
                 continue  # it ended before max_cycles: the check below is for a stepped cycle
-            self._exchange()
+            # real time: this cycle's planner refill computed now, in the slack (decision B21)
+            ahead = stretcher.ahead() if stretcher is not None and not stopping else None
+            if ahead is None:
+                self._exchange()
+            else:
+                self._exchange(ahead)
             if self.cycle == max_cycles:  # an alarm like any other: the channel stops along the path
                 self._end_reason = "max_time"
                 ch.raise_alarm(Alarm(MAX_TIME_ALARM, f"run exceeded the bench's max_time of {self.bench.max_time:g} s",
@@ -324,11 +329,11 @@ class BenchRunner:
             ch.skip(latched)
 
     # ---- the cycle ------------------------------------------------------------------------
-    def _exchange(self) -> None:
+    def _exchange(self, step: Callable[[Channel], object] | None = None) -> None:
         self.timing = self.clock.tick()
         if self.timing.overrun:
             self._overrun()
-        self._cycle(self.link.exchange(self.rx))
+        self._cycle(self.link.exchange(self.rx), step)
 
     def _cycle(self, tx: list[TxPdo], step: Callable[[Channel], object] | None = None) -> None:
         """One cycle from its feedback on (a stretch, hil/stretch.py, hands in feedback it computed and, as
@@ -583,6 +588,7 @@ class BenchRunner:
         r.timing = {"jitter": c.jitter.summary(), "exec": c.exec.summary()}
         if isinstance(c, RealTimeClock):
             r.timing["latency"] = c.latency.summary()
+            r.timing["between"] = c.between.summary()  # work in the periods' slack (decision B21)
         if self.channel is not None:
             for a in self.channel.alarms:
                 if a not in r.alarms:

@@ -27,6 +27,7 @@ from __future__ import annotations
 import copy
 import os
 from collections import deque
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -34,7 +35,7 @@ import numpy as np
 from fieldbus.cia402 import State, Target
 from fieldbus.link import SimLink
 from fieldbus.pdo import RxPdo, TxPdo
-from hil.clock import LockStepClock
+from hil.clock import LockStepClock, RealTimeClock
 from hil.stretch_bulk import bulk_cycles, bulk_ok, first_change, outputs_hold
 from mlc.basic import BasicMlc
 from mlc.machine import Mlc
@@ -47,6 +48,9 @@ from virtual_bus.drive_stretch import Stretch, can_stretch, csp_stretch, csv_str
 
 ENV = "DELTAHIL_STRETCH"  # "0": every cycle is stepped (the reference the tests compare against)
 MAX_CYCLES = 64  # the planner's buffers are up to 64 cycles: a stretch never spans two
+# Real time (decision B21): a stretch's planner samples and drive models are computed in the slack of the period
+# before its first cycle, so that work must fit there; RT_CYCLES cycles of it cost ≈ 0.2 ms on the lathe demo
+RT_CYCLES = 16
 MODE_CSP, MODE_CSV = 8, 9
 
 
@@ -60,16 +64,21 @@ class Stretcher:
     def __init__(self, runner: Any, drives: list[Cia402Drive]) -> None:
         self.r = runner
         self.drives = drives
+        # Real time: every cycle of a stretch is paced (its own tick, overrun check, outputs), none at once
+        self.paced = type(runner.clock) is RealTimeClock
+        self.max_cycles = RT_CYCLES if self.paced else MAX_CYCLES
         self.n_axes = len(runner.axes)
         self._sampler = sample_stretch  # the planner's samples of this stretch (stand_stretch while it waits)
         self.stretches = 0  # stretches taken and cycles in them (benchmarks, tests)
         self.cycles = 0
+        self.ahead_used = 0  # real time: refills computed ahead and taken by their cycle
 
     @classmethod
     def for_runner(cls, runner: Any) -> "Stretcher | None":
-        """A stretcher where stretches can be exact: lock-step on the in-process bus with its simulated drives."""
+        """A stretcher where stretches can be exact: the in-process bus with its simulated drives, in lock-step
+        or paced in real time (B21)."""
         link = runner.link
-        if not wanted() or type(link) is not SimLink or type(runner.clock) is not LockStepClock:
+        if not wanted() or type(link) is not SimLink or type(runner.clock) not in (LockStepClock, RealTimeClock):
             return None
         drives = list(link.slaves)
         if len(drives) != len(runner.rx) or any(type(d) is not Cia402Drive for d in drives):
@@ -90,12 +99,12 @@ class Stretcher:
             return False
         pl = ch.planner
         if kind in ("wait", "drain"):  # standing: an M/S/T code waits for its finish, or the filter's tail
-            n = min(limit, MAX_CYCLES)
+            n = min(limit, self.max_cycles)
             if kind == "drain":  # the cycle that begins with the filter settled issues the waiting code: stepped
                 n = min(n, pl.filter.span - pl.filter._still)
             self._sampler = stand_stretch
         else:  # to the buffer's end: the planner stays on its block (dropped at the refill, a stepped cycle)
-            n = min(limit, MAX_CYCLES, pl._block_rows())  # a cruise's buffer spans blocks: this one's rows
+            n = min(limit, self.max_cycles, pl._block_rows())  # a cruise's buffer spans blocks: this one's rows
             self._sampler = sample_stretch
         if n < 2:
             return False
@@ -160,7 +169,7 @@ class Stretcher:
         while k < m:
             # The rest at once once the NC outputs the stretch's state decides are written: by its first cycle,
             # or, from the first, when writing them now leaves every device the gated user scan read as it saw it
-            if (k == 1 and bulk_ok(r)) or (k == 0 and bulk_ok(r) and outputs_hold(r, ch, raw[0])):
+            if not self.paced and ((k == 1 and bulk_ok(r)) or (k == 0 and bulk_ok(r) and outputs_hold(r, ch, raw[0]))):
                 j = first_change(r, ch, outs, k, m, raw)  # the first cycle whose scan would not be skipped
                 if j > k:
                     if j < m:  # the stretch ends before it: that cycle is stepped
@@ -174,7 +183,9 @@ class Stretcher:
                     k = m
                     pl.position = last_raw
                     break
-            r.timing = clock.tick()
+            r.timing = clock.tick()  # real time: the period's wake-up; the work above was in the last one's slack
+            if r.timing.overrun:
+                r._overrun()
             link.time += dt
             link.cycles += 1
             tx = [TxPdo(o.statusword[k], o.position_actual[k], o.velocity_actual[k], o.torque_actual[k],
@@ -199,6 +210,57 @@ class Stretcher:
         self.stretches += 1
         self.cycles += k
         return True
+
+    # ---- real time: the refill of a stepped cycle ahead ----------------------------------------------
+    def ahead(self) -> Callable[[Channel], Setpoint] | None:
+        """Real time (B21): the planner's refill of the next cycle (the stepped cycle at the end of a stretch,
+        where its buffer ran out: ≈ 100 µs of sampling) computed now, in the period's slack, and kept aside;
+        the cycle's step puts it in place when nothing the refill read changed since (the planner's fields and
+        its plan as they were, the channel's inputs), and otherwise leaves the planner to refill itself. Only a
+        refill that continues the same plan in the same block: one that ends a block or starts a plan also
+        changes what the feed and the MLC read before the step. None: the cycle steps as usual."""
+        r = self.r
+        ch = r.channel
+        if not self.paced or ch is None:
+            return None
+        pl = ch.planner
+        p = pl.plan
+        if p is None or p.kind == "cruise" or not pl._buf_done or not pl.blocks or pl.blocks[0].move.per_rev:
+            return None  # per_rev: _check_spindle, which comes before the refill, may re-plan; a cruise's
+            # sampling snaps the next blocks' starts (it changes blocks in place)
+        if self._quiet(r, ch) != "run":
+            return None
+        b0, nb = pl.blocks[0], len(pl.blocks)
+        s0, p0 = dict(pl.__dict__), dict(p.__dict__)
+        for name in _NOT_AHEAD:  # what would end the block or the plan stops the refill before it changes anything
+            setattr(pl, name, _not_ahead)
+        try:
+            pl._refill()
+            ok = pl.plan is p and not pl._buf_done
+        except Exception:  # _NotAhead, or an alarm of the refill: the cycle's own, it raises it there
+            ok = False
+        finally:
+            for name in _NOT_AHEAD:
+                delattr(pl, name)
+        s1, p1 = dict(pl.__dict__), dict(p.__dict__)
+        pl.__dict__.clear()
+        pl.__dict__.update(s0)
+        p.__dict__.clear()
+        p.__dict__.update(p0)
+        if not ok:
+            return None
+        sig = _signature(ch)
+
+        def step(channel: Channel) -> Setpoint:
+            d = pl.__dict__
+            if (_signature(channel) == sig and pl.plan is p and p.__dict__ == p0 and len(pl.blocks) == nb
+                    and pl.blocks[0] is b0 and len(d) == len(s0) and all(d.get(k) is v for k, v in s0.items())):
+                d.update(s1)
+                p.__dict__.update(p1)
+                self.ahead_used += 1
+            return channel.step()
+
+        return step
 
     # ---- conditions ----------------------------------------------------------------------------
     def _quiet(self, r: Any, ch: Channel) -> str | None:
@@ -262,6 +324,8 @@ class Stretcher:
     def _still_quiet(self, r: Any, gate: Any, scans: int, panel: tuple | None, rx0: list[RxPdo],
                      targets: list[list[int]], k: int) -> bool:
         """After cycle k-1 of the stretch: nothing it did changes what cycle k reads or is stepped with."""
+        if r.stop_request is not None:
+            return False  # a signal: the stop path starts at the next cycle, stepped (a paced stretch is 16 ms)
         if gate is not None and gate.scans != scans and (gate.last is None or gate.last.dirty):
             return False  # the user scan ran and wrote: the NC reads it next cycle
         if _panel_state(r.on_cycle) != panel:
@@ -308,6 +372,18 @@ class Stretcher:
             settle_stretch(pl, rpms[:samples], cmds[:samples])
         self._restore_drives(saved_drives)
         return self._step_drives(rx0, targets, cycles)
+
+
+class _NotAhead(Exception):
+    pass
+
+
+def _not_ahead(*args: Any, **kwargs: Any) -> None:
+    raise _NotAhead
+
+
+# Planner methods a refill calls when it ends a block or the plan, re-plans or stalls: a refill ahead stops there
+_NOT_AHEAD = ("_finish_block", "_end_plan", "_replan", "_start_plan", "_no_progress")
 
 
 def _signature(ch: Channel) -> tuple:

@@ -1,0 +1,112 @@
+"""Real-time runs take stretches too (issue 17, decision B21): the planner's samples and the drive models of
+a stretch are computed ahead, in the period's slack, and each period's cycle only takes its share, with its
+own tick (pacing, overrun check, timing). On a fake monotonic clock a `--realtime` run is deterministic, so
+the run with stretches (DELTAHIL_STRETCH=1) and without (0) must give the same trace in every column,
+`period` and `late` included, the same alarms, end record and final positions."""
+
+from __future__ import annotations
+
+import pyarrow.parquet as pq
+import pytest
+
+import hil.clock
+from hil import api
+from hil.bench import RealtimeConfig
+from hil.clock import Granted, RealTimeClock
+from hil.stretch import ENV
+from tests.conftest import ROOT
+
+DEMO = str(ROOT / "examples" / "lathe_demo.nc")
+
+
+class FakeTime:
+    """A monotonic clock that advances 1 µs per read and by what is slept (woken 30 µs late)."""
+
+    def __init__(self) -> None:
+        self.t = 1_000_000_000
+
+    def now(self) -> int:
+        self.t += 1_000
+        return self.t
+
+    def sleep(self, s: float) -> None:
+        self.t += int(round(s * 1e6)) * 1_000 + 30_000
+
+
+class StopAt:
+    """A trace column that asks for a stop in cycle `at`, as a SIGINT's handler does between two cycles."""
+
+    columns = ["stop_asked"]
+
+    def __init__(self, at: int) -> None:
+        self.at = at
+
+    def values(self, runner):
+        if runner.cycle == self.at:
+            runner.request_stop("SIGINT")
+        return [float(runner.stop_request is not None)]
+
+
+def _run(monkeypatch, tmp_path, on: str, stop_at: int | None = None, **kw) -> tuple[dict, api.Result]:
+    monkeypatch.setenv(ENV, on)
+    ft = FakeTime()
+    clocks = []
+
+    def make_clock(cycle, realtime, config=None):
+        assert realtime
+        clk = RealTimeClock(cycle, RealtimeConfig(busy_wait=100e-6, lock_memory=False), now_ns=ft.now,
+                            sleep=ft.sleep)
+        clocks.append(clk)
+        return clk
+
+    monkeypatch.setattr(hil.clock, "make_clock", make_clock)
+    monkeypatch.setattr(hil.clock, "acquire_realtime", lambda config, owner: Granted())  # no SCHED_FIFO in tests
+    if stop_at is not None:
+        from hil.runner import BenchRunner
+
+        real_init = BenchRunner.__init__
+
+        def init(self, *a, **k):
+            real_init(self, *a, **k)
+            if not any(isinstance(src, StopAt) for src in self.trace_sources):
+                self.trace_sources.append(StopAt(stop_at))
+
+        monkeypatch.setattr(BenchRunner, "__init__", init)
+    path = tmp_path / f"rt{on}.parquet"
+    res = api.run(DEMO, trace=str(path), realtime=True, check=False, **kw)
+    assert clocks and type(res.runner.clock) is RealTimeClock
+    table = pq.read_table(path)
+    return {c: table.column(c).to_pylist() for c in table.column_names}, res
+
+
+def _same(a: tuple, b: tuple) -> None:
+    (ca, ra), (cb, rb) = a, b
+    assert list(ca) == list(cb)
+    for c in ca:
+        assert ca[c] == cb[c], f"column {c} differs from row {next(i for i, (x, y) in enumerate(zip(ca[c], cb[c])) if x != y)}"
+    assert [x.code_text for x in ra.alarms] == [x.code_text for x in rb.alarms]
+    assert ra.run.final == rb.run.final and ra.run.cycles == rb.run.cycles
+    assert ra.run.stopped_by == rb.run.stopped_by
+    assert ra.run.stretched == 0
+
+
+@pytest.mark.parametrize("kw", [{}, {"events": ["t=2:feed-hold", "t=2.6:cycle-start", "t=4:set D21002=50"]}],
+                         ids=["plain", "hold-resume-override"])
+def test_a_realtime_run_with_stretches_equals_stepping(monkeypatch, tmp_path, kw):
+    a = _run(monkeypatch, tmp_path, "0", **kw)
+    b = _run(monkeypatch, tmp_path, "1", **kw)
+    _same(a, b)
+    r = b[1].run
+    assert r.ok and r.realtime and r.overruns == 0
+    assert r.stretched > 0.8 * r.cycles  # most cycles come from stretches, each paced on its own
+    assert set(a[0]["period"][1:]) == {0.001}  # every cycle ticked: a 1 ms period on the fake clock
+    assert r.timing["between"]["count"] == r.cycles - 1  # the work between cycles is measured in every period
+
+
+def test_a_stop_inside_a_stretch_is_taken_at_the_next_cycle(monkeypatch, tmp_path):
+    a = _run(monkeypatch, tmp_path, "0", stop_at=5000)
+    b = _run(monkeypatch, tmp_path, "1", stop_at=5000)
+    _same(a, b)
+    cols, res = b
+    assert res.run.stopped_by == "SIGINT" and not res.run.finished
+    assert cols["stop_asked"].index(1.0) == 4999  # asked in cycle 5000; its stop starts in cycle 5001 both ways
