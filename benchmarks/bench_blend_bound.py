@@ -26,9 +26,10 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
-from benchmarks.bench_vs_linuxcnc import START, TOL, cam_polyline, cam_surface, programs  # noqa: E402
+from benchmarks.bench_vs_linuxcnc import START, TOL, Program, cam_polyline, cam_surface, programs  # noqa: E402
 from nc.motion.clothoid import corner_blend  # noqa: E402
 from nc.motion.path import Segment  # noqa: E402
+from nc.motion.smoothing import PositionFilter, smoothstep  # noqa: E402
 from tests.motion_helpers import polyline_deviation  # noqa: E402
 
 A_AXIS, J_AXIS = 5000.0, 250_000.0
@@ -97,11 +98,6 @@ def sample_path(pieces: list[Segment], s: np.ndarray) -> np.ndarray:
     return out
 
 
-def _moving(x: np.ndarray, n: int) -> np.ndarray:
-    c = np.cumsum(np.vstack([np.repeat(x[:1], n, axis=0), x]), axis=0)
-    return (c[n:] - c[:-n]) / n
-
-
 def _shares(q: np.ndarray, pts: np.ndarray) -> str:
     v = np.diff(q, axis=0) / 1e-3
     a = np.diff(v, axis=0) / 1e-3
@@ -109,6 +105,23 @@ def _shares(q: np.ndarray, pts: np.ndarray) -> str:
     lim = np.array([[500.0, 5000.0, 250_000.0]] * 2 + [[300.0, 3000.0, 150_000.0]])
     r = [float((np.abs(x).max(axis=0) / lim[:, k]).max()) for k, x in enumerate((v, a, j))]
     return f"v/a/j {r[0]:.2f}/{r[1]:.2f}/{r[2]:.2f} dev {polyline_deviation(q, pts):.4f}"
+
+
+def share_ramps(n: int, r: int) -> np.ndarray:
+    """λ per cycle: 1, going to 0 at cycle 1000 and back to 1 at cycle 2000, each over a smoothstep of r cycles."""
+    t = np.arange(n)
+    return 1.0 - smoothstep((t - 1000) / r) + smoothstep((t - 2000) / r)
+
+
+def crossfade_run(prog: Program, v: float, lam: np.ndarray | None, n1: int = 16, n2: int = 16) -> tuple[np.ndarray, np.ndarray]:
+    """(raw, out): the program blended (`blended_path`) sampled at a constant v, and that through
+    nc.motion.smoothing.PositionFilter with the share lam per cycle (None: the whole filter)."""
+    pts = np.array([START] + prog.points, dtype=float)
+    pieces = blended_path(pts, TOL)
+    n = int(sum(p.length for p in pieces) / v / 1e-3)
+    raw = sample_path(pieces, v * 1e-3 * np.arange(n))
+    f = PositionFilter(n1, n2, raw[0])
+    return raw, f.push_many(raw, None if lam is None else lam[:n])
 
 
 def crossfade(v: float, n1: int = 16, n2: int = 16) -> None:
@@ -119,19 +132,14 @@ def crossfade(v: float, n1: int = 16, n2: int = 16) -> None:
     d = (n1 + n2 - 2) // 2
     for prog in (cam_surface(400), cam_polyline(400)):
         pts = np.array([START] + prog.points, dtype=float)
-        pieces = blended_path(pts, TOL)
-        n = int(sum(p.length for p in pieces) / v / 1e-3)
-        raw = sample_path(pieces, v * 1e-3 * np.arange(n))
-        f = _moving(_moving(raw, n1), n2)
+        raw, f = crossfade_run(prog, v, None, n1, n2)
+        n = len(raw)
         raw_d = np.vstack([np.repeat(raw[:1], d, axis=0), raw[:-d]])
         inner = slice(64, n - 64)
         print(f"{prog.name}, {v:g} mm/s: blended, no filter {_shares(raw[inner], pts)}; "
               f"the whole filter {_shares(f[inner], pts)}")
-        t = np.arange(n)
         for r in (15, 30, 60):
-            x1, x2 = np.clip((t - 1000) / r, 0.0, 1.0), np.clip((t - 2000) / r, 0.0, 1.0)
-            lam = 1.0 - x1 ** 3 * (10 - 15 * x1 + 6 * x1 * x1) + x2 ** 3 * (10 - 15 * x2 + 6 * x2 * x2)
-            out = raw_d + lam[:, None] * (f - raw_d)
+            out = crossfade_run(prog, v, share_ramps(n, r), n1, n2)[1]
             print(f"  R = {r:2d} ms: ramp down {_shares(out[960:1040 + r], pts)} | λ = 0 "
                   f"{_shares(out[1040 + r:1960], pts)} | ramp up {_shares(out[1960:2040 + r], pts)}")
         print(f"  raw p(t − D) there:  {_shares(raw_d[960:1070], pts)} | {_shares(raw_d[1070:1960], pts)} | "

@@ -24,6 +24,10 @@ class PositionFilter:
         self.n1 = max(1, int(n1))
         self.n2 = max(1, int(n2))
         self.span = self.n1 + self.n2 - 2  # cycles after which a constant input is reproduced exactly
+        # The filter's share λ (decision motion 43): out = p(t − D) + λ·(F(p) − p(t − D)), D the group
+        # delay. Only where D is a whole number of cycles that the first window still holds (n1 + n2
+        # even, n2 ≤ n1: p(t − D) is w1[n1 − 1 − D]); elsewhere λ is ignored and F is output.
+        self.lag: int | None = self.span // 2 if self.span % 2 == 0 and self.n2 <= self.n1 else None
         self.reset(position)
 
     def reset(self, position: np.ndarray) -> None:
@@ -54,7 +58,8 @@ class PositionFilter:
         """Group delay of the filter in cycles (a constant-speed move lags by this much)."""
         return (self.n1 - 1 + self.n2 - 1) / 2.0
 
-    def push(self, x: np.ndarray) -> np.ndarray:
+    def push(self, x: np.ndarray, lam: float = 1.0) -> np.ndarray:
+        """The next output for input row x; lam: the filter's share (1 = the filter's own output)."""
         row = np.asarray(x, dtype=float).tolist()
         same = row == self._last
         if same and self._still >= self.span:
@@ -75,11 +80,16 @@ class PositionFilter:
             # Constant input for a whole window: the exact value, free of summation round-off.
             self.reset(row)
             return np.array(row)
-        self._out = [s / n2 for s in s2]
-        return np.array(self._out)
+        out = [s / n2 for s in s2]
+        if lam != 1.0 and self.lag is not None:
+            d = self._w1[n1 - 1 - self.lag]
+            out = [p + lam * (f - p) for p, f in zip(d, out)]
+        self._out = out
+        return np.array(out)
 
-    def push_many(self, xs: np.ndarray) -> np.ndarray:
-        """push() each row of `xs` (cycles × axes) in turn, the outputs as rows: the same values bit for bit.
+    def push_many(self, xs: np.ndarray, lam: np.ndarray | None = None) -> np.ndarray:
+        """push() each row of `xs` (cycles × axes) in turn (with lam[k] the share of row k; None: 1), the
+        outputs as rows: the same values bit for bit.
         A run of rows that each differ from the one before goes through both moving averages as one
         cumulative sum with the carried sums and windows (numpy's accumulate adds in order, as push
         does); rows equal to the one before (the still count, the snap at rest) go through push."""
@@ -89,16 +99,16 @@ class PositionFilter:
         repeats = np.flatnonzero(np.all(xs[1:] == xs[:-1], axis=1)) + 1  # rows equal to the one before
         while k < m:
             if self.span == 0 or xs[k].tolist() == self._last:
-                out[k] = self.push(xs[k])
+                out[k] = self.push(xs[k], 1.0 if lam is None else float(lam[k]))
                 k += 1
                 continue
             r = int(np.searchsorted(repeats, k, side="right"))
             j = int(repeats[r]) if r < len(repeats) else m  # the run ends before the next repeated row
-            out[k:j] = self._moving(xs[k:j])
+            out[k:j] = self._moving(xs[k:j], None if lam is None else np.asarray(lam[k:j], dtype=float))
             k = j
         return out
 
-    def _moving(self, x: np.ndarray) -> np.ndarray:
+    def _moving(self, x: np.ndarray, lam: np.ndarray | None = None) -> np.ndarray:
         """Rows each unlike the one before: no still count, no snap (see push_many)."""
         n = len(x)
         h1 = np.vstack([np.array(self._w1), x])  # the window's oldest row is what each push subtracts
@@ -107,8 +117,18 @@ class PositionFilter:
         h2 = np.vstack([np.array(self._w2), y1])
         s2 = np.cumsum(np.vstack([self._s2, y1 - h2[:n]]), axis=0)[1:]
         y = s2 / self.n2
+        if lam is not None and self.lag is not None and np.any(lam != 1.0):
+            d = h1[self.n1 + np.arange(n) - self.lag]  # p(t − D) of each row
+            y = np.where((lam == 1.0)[:, None], y, d + lam[:, None] * (y - d))
         self._w1.extend(h1[-self.n1:].tolist())
         self._w2.extend(h2[-self.n2:].tolist())
         self._s1, self._s2 = s1[-1].tolist(), s2[-1].tolist()
         self._last, self._out, self._still = x[-1].tolist(), y[-1].tolist(), 0
         return y
+
+
+def smoothstep(x: np.ndarray) -> np.ndarray:
+    """The quintic smoothstep 10x³ − 15x⁴ + 6x⁵ of x clipped to 0 … 1: a ramp of the filter's share λ
+    with zero first and second derivatives at both ends (decision motion 43)."""
+    x = np.clip(np.asarray(x, dtype=float), 0.0, 1.0)
+    return x ** 3 * (10.0 - 15.0 * x + 6.0 * x * x)
