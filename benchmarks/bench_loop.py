@@ -156,6 +156,7 @@ def ethercat_lockstep(cycles: int = 5000) -> None:
     own work per frame in-process (benchmarks/bench_ecat_slaves.py)."""
     sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
     from benchmarks import bench_ecat_slaves
+    from benchmarks.bench_ethercat import lockstep_placement
     from fieldbus.cia402 import Cia402Master, Target
     from fieldbus.ethercat.link import EthercatLink
     from fieldbus.pdo import RxPdo
@@ -183,26 +184,35 @@ def ethercat_lockstep(cycles: int = 5000) -> None:
                     r.target_position = t.position_actual
                 tx = link.exchange(rx)
             enabled = sum(m.enabled for m in masters)
-            t0, c0, s0 = time.perf_counter(), time.thread_time(), _cpu_of(sim.proc.pid)
-            for _ in range(cycles):
-                for m, r, t in zip(masters, rx, tx):
-                    r.controlword = m.step(t.statusword)
-                tx = link.exchange(rx)
-            wall, cpu, slaves = time.perf_counter() - t0, time.thread_time() - c0, _cpu_of(sim.proc.pid) - s0
+
+            def bus_alone(label: str) -> None:
+                nonlocal tx
+                t0, c0, s0 = time.perf_counter(), time.thread_time(), _cpu_of(sim.proc.pid)
+                for _ in range(cycles):
+                    for m, r, t in zip(masters, rx, tx):
+                        r.controlword = m.step(t.statusword)
+                    tx = link.exchange(rx)
+                wall, cpu, slaves = time.perf_counter() - t0, time.thread_time() - c0, _cpu_of(sim.proc.pid) - s0
+                print(f"EtherCAT lock-step, bus alone ({n} drives, {enabled} enabled, veth + hil sim ethercat, {label}): "
+                      f"{cycles} cycles in {wall:.2f} s wall = {cycles / wall:,.0f} cycles/s; CPU per cycle: master "
+                      f"{cpu / cycles * 1e6:.0f} µs, slaves {slaves / cycles * 1e6:.0f} µs, so "
+                      f"{cycles / (cpu + slaves):,.0f} cycles/s when the two take turns on an otherwise idle machine "
+                      f"(load {os.getloadavg()[0]:.1f})")
+
+            bus_alone("default scheduling")
+            with lockstep_placement([0, sim.proc.pid]) as placed:  # benchmarks/bench_ethercat.py: why
+                bus_alone(placed)
         finally:
             link.close()
-        print(f"EtherCAT lock-step, bus alone ({n} drives, {enabled} enabled, veth + hil sim ethercat): "
-              f"{cycles} cycles in {wall:.2f} s wall = {cycles / wall:,.0f} cycles/s; CPU per cycle: master "
-              f"{cpu / cycles * 1e6:.0f} µs, slaves {slaves / cycles * 1e6:.0f} µs, so {cycles / (cpu + slaves):,.0f} "
-              "cycles/s when the two take turns on an otherwise idle machine")
         runner = BenchRunner(bench, EthercatLink.for_bench(bench, sim.iface), None)
-        t0, c0, s0 = time.perf_counter(), time.thread_time(), _cpu_of(sim.proc.pid)
-        r = runner.run_program(parse_program(PROGRAM, name="bench.nc"))
-        wall, cpu, slaves = time.perf_counter() - t0, time.thread_time() - c0, _cpu_of(sim.proc.pid) - s0
-        print(f"EtherCAT lock-step, bench program ({n} drives): {r.cycles} cycles, {r.sim_time:.2f} s simulated in "
-              f"{wall:.2f} s wall = {r.cycles / wall:,.0f} cycles/s ({r.sim_time / wall:.1f}x real time, "
-              f"{'completed' if r.ok else 'alarm ' + ', '.join(a.code_text for a in r.alarms)}); CPU per cycle: "
-              f"master {cpu / r.cycles * 1e6:.0f} µs, slaves {slaves / r.cycles * 1e6:.0f} µs")
+        with lockstep_placement([0, sim.proc.pid]) as placed:
+            t0, c0, s0 = time.perf_counter(), time.thread_time(), _cpu_of(sim.proc.pid)
+            r = runner.run_program(parse_program(PROGRAM, name="bench.nc"))
+            wall, cpu, slaves = time.perf_counter() - t0, time.thread_time() - c0, _cpu_of(sim.proc.pid) - s0
+        print(f"EtherCAT lock-step, bench program ({n} drives, {placed}; bring-up included): {r.cycles} cycles, "
+              f"{r.sim_time:.2f} s simulated in {wall:.2f} s wall = {r.cycles / wall:,.0f} cycles/s ({r.sim_time / wall:.1f}x "
+              f"real time, {'completed' if r.ok else 'alarm ' + ', '.join(a.code_text for a in r.alarms)}); CPU per "
+              f"cycle: master {cpu / r.cycles * 1e6:.0f} µs, slaves {slaves / r.cycles * 1e6:.0f} µs")
 
 
 def _cpu_of(pid: int) -> float:

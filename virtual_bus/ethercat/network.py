@@ -24,6 +24,7 @@ _U16 = struct.Struct("<H")
 _READS = {APRD, FPRD, BRD}
 _WRITES = {APWR, FPWR, BWR}
 _RW = {APRW, FPRW, BRW}
+_FIXED = {FPRD, FPWR, FPRW, FRMW}
 
 
 @dataclass
@@ -121,36 +122,39 @@ class Chain:
             return None, 0.0
         line = self.reachable()
         now = time.monotonic_ns()
+        count = len(line)
+        wkc = [0] * len(grams)  # working counter increments, added to the frame once every slave has seen it
         for i, s in enumerate(line):
-            s.position, s.chain_len, s.frame_ns = i, len(line), now
+            s.position, s.chain_len, s.frame_ns = i, count, now
             s.check_watchdog(now)
-            self._walk(s, buf, end, grams)
+            # one slave's pass over the frame's datagrams, in order
+            for k, (pos, cmd, logical, _wpos, data) in enumerate(grams):
+                if LRD <= cmd <= LRW:
+                    inc = s.logical(cmd, logical, data)  # the address is not changed on the way
+                else:
+                    adp = _U16.unpack_from(buf, pos + 2)[0]  # auto-increment addresses count down on the way
+                    inc, new_adp = self._datagram(s, cmd, adp, logical >> 16, data)
+                    if new_adp != adp:
+                        _U16.pack_into(buf, pos + 2, new_adp)
+                if inc:
+                    wkc[k] += inc
             s.idle()
-        buf[6] |= 0x02
-        return bytes(buf), delay
-
-    def _walk(self, s: Esc, buf: bytearray, end: int, grams: list) -> None:
-        """One slave's pass over the frame's datagrams, in order."""
-        for pos, cmd, logical, wpos, data in grams:
-            if LRD <= cmd <= LRW:
-                inc = s.logical(cmd, logical, data)  # the address is not changed on the way
-            else:
-                _c, _i, adp, ado, _l = _HEAD.unpack_from(buf, pos)
-                inc, adp = self._datagram(s, cmd, adp, ado, data)
-                _U16.pack_into(buf, pos + 2, adp)
+        for (_pos, _cmd, _logical, wpos, _data), inc in zip(grams, wkc):
             if inc:
                 _U16.pack_into(buf, wpos, (_U16.unpack_from(buf, wpos)[0] + inc) & 0xFFFF)
+        buf[6] |= 0x02
+        return bytes(buf), delay
 
     @staticmethod
     def _datagram(s: Esc, cmd: int, adp: int, ado: int, data: memoryview) -> tuple[int, int]:
         n = len(data)
-        if cmd in (APRD, APWR, APRW, ARMW):
-            addressed = adp == 0
-            new_adp = (adp + 1) & 0xFFFF
-        elif cmd in (FPRD, FPWR, FPRW, FRMW):
+        if cmd in _FIXED:  # first: the FRMW that distributes DC time rides in every cycle's frame
             addressed = adp == _U16.unpack_from(s.mem, R_STATION)[0] \
                 or (bool(s.mem[0x0103] & 0x01) and adp == s.u16(0x0012))
             new_adp = adp
+        elif cmd in (APRD, APWR, APRW, ARMW):
+            addressed = adp == 0
+            new_adp = (adp + 1) & 0xFFFF
         elif cmd in (BRD, BWR, BRW):
             addressed = True
             new_adp = (adp + 1) & 0xFFFF
