@@ -75,11 +75,10 @@ class _Plan:
     # few cycles at a time and solved again once more than `queued` moves were pushed.
     open: bool = False
     queued: int = 0
-    # A "cruise" (decision motion 42): sampled at once across its blocks; `ends` when its last row is its
-    # last block's last sample (that block is then finished like a path plan's), `carry` the next plan's t0.
-    ends: bool = False
+    # A "cruise" (decision motion 42): whole blocks sampled at once; `carry` the next plan's t0 after the last
+    # of them, `last` its offset from blocks[0] when sampled.
     carry: float = 0.0
-    last: int = 0  # the offset of its last block from blocks[0] when sampled
+    last: int = 0
 
 
 class Planner:
@@ -153,6 +152,7 @@ class Planner:
         # every row in blocks[0]), and how many of those blocks the rows handed out so far finished.
         self._buf_blk: list[int] | None = None
         self._buf_popped = 0
+        self._buf_carry: list[float] = []
         self.solves = 0  # ruckig solves so far (one per block plus one per event)
         # Post-interpolation filter (N1.036/N1.037); None when both times are zero.
         self.filter: PositionFilter | None = None
@@ -372,6 +372,10 @@ class Planner:
         self._check_spindle()
         if self.spindle_command is not None:
             self._settle.update(float(self.spindle_rpm()), float(self.spindle_command()))
+        if self._buf_blk is not None and not self._buf_done:
+            k = self._buf_blk[self._buf_i]
+            if k > self._buf_popped and (bad := self._chain_ok(self.plan, k)) <= k:
+                self._break_chain(bad)
         if self._buf_done:
             self._refill()
         if self._buf_done and self.plan is None and self.blocks and self.blocks[0].kind == "thread" \
@@ -648,28 +652,22 @@ class Planner:
         """Decision motion 42: at its cap, with zero acceleration, a run whose end speed is the cap solves to
         constant speed to the end of its block, and so does the next block's solve while the same holds there.
         Such a chain is sampled across its blocks at once (no solve): positions as the per-block solves give
-        them (tests/test_motion_cruise.py). Only over blocks no push can change any more: a push changes the
-        junction speeds within one filter span behind the queue's new end (FilterCorners.window), and the
-        backward pass carries that back at most one braking distance."""
+        them (tests/test_motion_cruise.py). A push may change the junction speeds far back in the queue
+        (FilterCorners.window): once one came, each block of the chain is checked again when its first row is
+        due, when its own solve would run (`_chain_ok`)."""
         v = self.v
         if self.held or self._stopping or self.a != 0.0 or v <= 0.0:
             return None
         self.lookahead()
         if not self._cruising(b, v):
             return None
-        horizon = math.inf  # the end of the last block the chain may take
-        if not self.closed:
-            blend = self.lim.blend
-            # no block's tangential limits are below the lowest axis's (Limits.block_limits)
-            share = self.cfg.share_tangential
-            brake = change_distance(v, 0.0, min(self.lim._acc) * share, min(self.lim._jerk) * share)
-            horizon = self.blocks[-1].s_end - 2.0 * (blend.span_max + brake) if blend is not None else -math.inf
-        return _Plan("cruise", None, math.inf, t0, target=horizon)
+        return _Plan("cruise", None, math.inf, t0, queued=self._pushes)
 
     def _sample_cruise(self, p: _Plan) -> None:
-        """Up to CHUNK rows of a cruise: each block as its own solve gives them (a constant-speed profile from
-        s0 at the plan time t0, sampled while t <= duration + 1e-12 cycles, s = s0 + v·t; the next block's t0
-        the time left over, `_end_plan`), and the snap of a block's start to where the last one ended."""
+        """The rows of a cruise, whole blocks up to at least CHUNK rows: each block as its own solve gives them
+        (a constant-speed profile from s0 at the plan time t0, s = s0 + v·t, sampled a CHUNK at a time while
+        t <= duration + 1e-9 cycles, as `_refill` and `_sample` do; the next block's t0 the time left over, as
+        `_end_plan` carries it), and the snap of a block's start to where the last one ended (`_start_plan`)."""
         T = self.cfg.cycle
         v = self.v
         blocks = self.blocks
@@ -678,32 +676,30 @@ class Planner:
         st: list[float] = []
         offs: list[int] = []
         lines: list[int] = []
+        carries: list[float] = []  # the plan time left over at the end of each block
         rows = 0
         while True:
             b = blocks[k]
             if k and _near(b.seg.start, blocks[k - 1].seg.end):
                 b.seg.start = blocks[k - 1].seg.end.copy()
-            duration = (b.length - s0) / v
-            n = int(math.floor((duration - t_next) / T + 1e-9)) + 1 if t_next <= duration + 1e-12 else 0
-            take = min(n, CHUNK - rows)
-            if take > 0:
-                t = t_next + T * np.arange(take)
+            duration = (b.length - s0) / v  # ruckig's duration of this profile, to the bit
+            while True:
+                n = int(math.floor((duration - t_next) / T + 1e-9)) + 1
+                if not (t_next <= duration + 1e-12 and n > 0):
+                    break
+                n = min(n, CHUNK)
+                t = t_next + T * np.arange(n)
+                t_next = float(t[-1] + T)
                 s = s0 + np.clip(t, 0.0, duration) * v
                 pos.append(b.seg.points(np.clip(s, 0.0, b.length)))
                 st += s.tolist()
-                offs += [k] * take
-                lines += [b.move.line] * take
-                rows += take
-            if take < n:  # the chunk ends within the block: the next plan goes on from its last row
-                p.ends, p.last = False, k
-                break
-            t_next += n * T
+                offs += [k] * n
+                lines += [b.move.line] * n
+                rows += n
             p.carry = t_next - duration if t_next - duration > 1e-12 else t_next - duration + T
-            p.ends, p.last = True, k
-            if rows >= CHUNK or k + 1 >= nb:
-                break
-            nx = blocks[k + 1]
-            if not self._cruising(nx, v) or nx.s_end > p.target:
+            carries.append(p.carry)
+            p.last = k
+            if rows >= CHUNK or k + 1 >= nb or not self._cruising(blocks[k + 1], v):
                 break
             k, s0, t_next = k + 1, 0.0, p.carry
         p.emitted = True
@@ -714,7 +710,35 @@ class Planner:
         self._buf_blk = offs
         self._buf_popped = 0
         self._buf_i = 0
+        self._buf_carry = carries
 
+    def _chain_ok(self, p: _Plan | None, upto: int) -> int:
+        """The first block offset up to `upto` (where a cruise's next row lies) whose own solve would no longer
+        cruise: a push since the chain was sampled changed its end speed (the same check `_cruise` makes, at
+        the cycle the per-block solve would make it); `upto + 1` when all still cruise."""
+        if p is None or p.kind != "cruise" or self._pushes == p.queued:
+            return upto + 1
+        self.lookahead()
+        for k in range(self._buf_popped + 1, upto + 1):
+            if not self._cruising(self.blocks[k - self._buf_popped], self.v):
+                return k
+        return upto + 1
+
+    def _break_chain(self, k: int) -> None:
+        """Block offset k does not cruise any more: the chain ends at the end of block k - 1, as that block's
+        own plan would end there (`_end_plan`); the next refill solves block k."""
+        while self._buf_popped < k - 1:
+            self._finish_block(keep_plan=True)
+            self._buf_popped += 1
+        self._carry = self._buf_carry[k - 1]
+        self.position = self.blocks[0].seg.end.copy()
+        self.a = 0.0
+        self._finish_block()
+        self.plan = None
+        self._buf_pos = None
+        self._buf_blk = None
+
+    def _spindle_starting(self) -> bool:
         return self.spindle_command is not None and abs(self.spindle_command()) > 0.0
 
     def _plan_path(self, b: Block, t0: float) -> _Plan | None:
@@ -925,17 +949,8 @@ class Planner:
 
     def _end_plan(self, p: _Plan) -> None:
         T = self.cfg.cycle
-        if p.kind == "cruise":
-            self.plan = None
-            self._carry = T  # ended within a block: the next plan goes on from the last row
-            if p.ends:  # its last block ends here as that block's own path plan would end it
-                while self._buf_popped < p.last:
-                    self._finish_block(keep_plan=True)
-                    self._buf_popped += 1
-                self._carry = p.carry
-                self.position = self.blocks[0].seg.end.copy()
-                self.a = 0.0
-                self._finish_block()
+        if p.kind == "cruise":  # its last block ends here as that block's own path plan would end it
+            self._break_chain(min(self._chain_ok(p, p.last), p.last + 1))
             return
         self._carry = p.t_next - p.duration
         if self._carry <= 1e-12:
