@@ -129,6 +129,9 @@ class LockStepClock:
         self.jitter.add(0.0, self._n)
         return CycleTiming(self.cycle, 0.0)
 
+    def written(self) -> None:
+        pass  # lock-step: the work per cycle is taken at done() (stretch_bulk adds its cycles' share there)
+
     def done(self) -> None:
         self.exec.add((time.perf_counter_ns() - self._t0) * 1e-9, self._n)
 
@@ -158,6 +161,8 @@ class RealTimeClock:
         # its cycle's work plus this
         self.between = TimingStats()
         self._done_ns: int | None = None
+        self._written = False
+        self._late_period = (0.0, 0.0)  # this cycle's, added to the statistics once its outputs are written
         self.overruns = 0
         self.first_overrun: int | None = None
         self.granted = Granted()
@@ -202,14 +207,24 @@ class RealTimeClock:
         period = (start - self._last_start) * 1e-9 if self._last_start is not None else self.cycle
         self._last_start = start
         self._start_ns = start
-        self.latency.add(late, self._n)
-        self.jitter.add(period - self.cycle, self._n)
+        self._written = False
+        self._late_period = (late, period)
         self._deadline += self.period_ns + self._dc_correction()
         return CycleTiming(period, late, overrun)
 
-    def done(self) -> None:
+    def written(self) -> None:
+        """The cycle's outputs are written (the setpoints the next exchange sends): its work ends here (decision
+        B21); what follows (trace row, panel, progress, statistics) counts as work between cycles."""
         self._done_ns = now = self.now_ns()
+        self._written = True
         self.exec.add((now - self._start_ns) * 1e-9, self._n)
+        late, period = self._late_period
+        self.latency.add(late, self._n)
+        self.jitter.add(period - self.cycle, self._n)
+
+    def done(self) -> None:
+        if not self._written:
+            self.written()
 
     def _wait_until(self, deadline: int) -> None:
         spin_ns = int(self.config.busy_wait * 1e9)

@@ -420,6 +420,7 @@ class BenchRunner:
                     rx.target_position = sc.to_counts(deg)
                 if vel is not None:
                     rx.target_velocity = sc.rpm_to_drive(vel)
+        self.clock.written()  # the outputs the next exchange sends: the end of the cycle's work (decision B21)
         if self.trace is not None:
             self.trace.write(self._row())
             self._row_cycle = self.cycle

@@ -35,7 +35,7 @@ import numpy as np
 from fieldbus.cia402 import State, Target
 from fieldbus.link import SimLink
 from fieldbus.pdo import RxPdo, TxPdo
-from hil.clock import LockStepClock, RealTimeClock
+from hil.clock import CycleTiming, LockStepClock, RealTimeClock
 from hil.stretch_bulk import bulk_cycles, bulk_ok, first_change, outputs_hold
 from mlc.basic import BasicMlc
 from mlc.machine import Mlc
@@ -169,15 +169,18 @@ class Stretcher:
         while k < m:
             # The rest at once once the NC outputs the stretch's state decides are written: by its first cycle,
             # or, from the first, when writing them now leaves every device the gated user scan read as it saw it
-            if not self.paced and ((k == 1 and bulk_ok(r)) or (k == 0 and bulk_ok(r) and outputs_hold(r, ch, raw[0]))):
+            if (k == 1 and self._bulk_ok(r)) or (k == 0 and self._bulk_ok(r) and outputs_hold(r, ch, raw[0])):
                 j = first_change(r, ch, outs, k, m, raw)  # the first cycle whose scan would not be skipped
                 if j > k:
+                    timings = None
+                    if self.paced:  # each cycle paced, with its outputs; the rest of them at once after the last
+                        j, timings = self._pace(r, k, j, positions, targets, panel)
                     if j < m:  # the stretch ends before it: that cycle is stepped
                         outs = self._cut(pl, saved_pl, saved_drives, rx0, targets, j, j)
                         m, last_raw, cut = j, pl.position, True
                         if settle:
                             rpms, cmds = rpms[:k], cmds[:k]
-                    bulk_cycles(r, ch, pl, smp, outs, k, m, raw[m - 1], (rpms, cmds) if settle else None)
+                    bulk_cycles(r, ch, pl, smp, outs, k, m, raw[m - 1], (rpms, cmds) if settle else None, timings)
                     if cut and settle:
                         settle_stretch(pl, rpms, cmds)
                     k = m
@@ -210,6 +213,40 @@ class Stretcher:
         self.stretches += 1
         self.cycles += k
         return True
+
+    # ---- real time -----------------------------------------------------------------------------------
+    def _bulk_ok(self, r: Any) -> bool:
+        """At once (stretch_bulk), or in real time paced with only the outputs per cycle (B21). Not on a bench
+        whose overrun is an alarm: its alarm lands in the cycle after the late tick, which must be stepped."""
+        return bulk_ok(r) and not (self.paced and r.bench.realtime.overrun == "alarm")
+
+    def _pace(self, r: Any, k: int, m: int, positions: np.ndarray, targets: list[list[int]],
+              panel: tuple | None) -> tuple[int, list[CycleTiming]]:
+        """Real time, a bulk stretch (B21): cycles k … m-1 paced one by one, each its tick (the wait for its
+        deadline, the overrun count, its timing) and its outputs, the setpoints of its sample (converted
+        ahead, here in the slack); the rest of those cycles (MLC, counters, trace rows) is done at once after
+        the last one (`bulk_cycles`). Ends after a cycle in which a stop was asked or the panel was pressed,
+        which the next cycle must see. Returns the end (k + the cycles paced) and their timings."""
+        clock, rx = r.clock, r.rx
+        n_axes = self.n_axes
+        org = r.origin.tolist()
+        last = positions[len(targets[0]) - 1].tolist() if n_axes else []
+        # the setpoint each cycle writes: the sample of that cycle (targets[i][c + 1]; the last one converted here)
+        tgt = [targets[i][1:] + [r.scales[i].to_counts(last[i] - org[i])] for i in range(n_axes)]
+        pairs = list(zip(rx[:n_axes], tgt))
+        timings: list[CycleTiming] = []
+        for c in range(k, m):
+            t = clock.tick()
+            timings.append(t)
+            if t.overrun:
+                r._overrun()  # counted: a bench whose overrun is an alarm takes no paced bulk (_bulk_ok)
+            for out, col in pairs:
+                out.target_position = col[c]
+            clock.written()
+            clock.done()
+            if r.stop_request is not None or _panel_state(r.on_cycle) != panel:
+                break
+        return k + len(timings), timings
 
     # ---- real time: the refill of a stepped cycle ahead ----------------------------------------------
     def ahead(self) -> Callable[[Channel], Setpoint] | None:

@@ -22,6 +22,7 @@ from typing import Any
 import numpy as np
 
 from fieldbus.pdo import TxPdo
+from hil.clock import CycleTiming
 from hil.mlc_bridge import drive_status
 from hil.trace_parquet import ParquetTrace
 from mlc.basic import BasicMlc
@@ -157,8 +158,11 @@ def outputs_hold(r: Any, ch: Channel, position: np.ndarray) -> bool:
 
 
 def bulk_cycles(r: Any, ch: Channel, pl: Planner, smp: Samples, outs: list[Stretch], k0: int, m: int,
-                before_last_step: np.ndarray, settle: tuple[list[float], list[float]] | None) -> None:
-    """Cycles k0 … m-1 of the stretch as the runner's cycle would run them one by one (module doc)."""
+                before_last_step: np.ndarray, settle: tuple[list[float], list[float]] | None,
+                timings: list[CycleTiming] | None = None) -> None:
+    """Cycles k0 … m-1 of the stretch as the runner's cycle would run them one by one (module doc). `timings`:
+    real time, the cycles were paced one by one (hil.stretch.Stretcher._pace) with these timings, which the
+    trace rows take; the clock has counted them."""
     t_wall = _time.perf_counter_ns()
     cnt = m - k0
     dt = r.bench.cycle
@@ -219,11 +223,14 @@ def bulk_cycles(r: Any, ch: Channel, pl: Planner, smp: Samples, outs: list[Stret
     if type(mlc) is Mlc and n_axes < len(r.rx):
         mlc.caxis._cycles += cnt  # Mlc.spindle_drive → SpindleAxisSwitch.drive, a spindle staying one
     if r.trace is not None:
-        _rows(r, outs, k0, m, times, first_cycle, row_lines, positions)
+        _rows(r, outs, k0, m, times, first_cycle, row_lines, positions, timings)
     if r.on_cycle is not None:
         r.on_cycle(r)  # the operator panel, with nothing held: the same call every cycle
     if r.progress is not None:
         r.progress.update(r)
+    if timings is not None:
+        r.timing = timings[-1]
+        return
     clock = r.clock
     clock._n += cnt
     clock.jitter.add_repeated(0.0, cnt, first_cycle)
@@ -272,7 +279,7 @@ def _mlc(r: Any, ch: Channel, outs: list[Stretch], k0: int, m: int, before_last_
 
 
 def _rows(r: Any, outs: list[Stretch], k0: int, m: int, times: list[float], first_cycle: int, lines: list[int],
-          positions: np.ndarray) -> None:
+          positions: np.ndarray, timings: list[CycleTiming] | None = None) -> None:
     """The trace rows of cycles k0 … m-1, as BenchRunner._row makes them: the unit conversions over the columns
     in numpy, with the same operations in the same order (IEEE division and product, numpy's float remainder
     is Python's %), back as Python floats."""
@@ -291,9 +298,12 @@ def _rows(r: Any, outs: list[Stretch], k0: int, m: int, times: list[float], firs
         else:  # drive_to_rpm of the command and the feedback, the angle mod 360
             cols += [[sc.drive_to_rpm(r.rx[i].target_velocity)] * cnt, (va / rpc / cpu / sc.lead * 60.0).tolist(),
                      np.remainder(pa / cpu, 360.0).tolist(), tq, out.statusword[k0:m]]
-    period, late = r.timing.period, r.timing.late
-    rows = zip([round(t, 9) for t in times], lines, range(first_cycle, first_cycle + cnt), repeat(period, cnt),
-               repeat(late, cnt), repeat("", cnt), *cols)
+    if timings is None:
+        periods, lates = repeat(r.timing.period, cnt), repeat(r.timing.late, cnt)
+    else:  # real time: each cycle's own
+        periods, lates = [t.period for t in timings], [t.late for t in timings]
+    rows = zip([round(t, 9) for t in times], lines, range(first_cycle, first_cycle + cnt), periods, lates,
+               repeat("", cnt), *cols)
     trace = r.trace
     if type(trace) is ParquetTrace:
         trace.write_many(rows)

@@ -24,6 +24,7 @@ class FakeTime:
 
     def __init__(self) -> None:
         self.t = 1_000_000_000
+        self.on_sleep = None  # called on every sleep (a signal arriving while the pacer waits)
 
     def now(self) -> int:
         self.t += 1_000
@@ -31,6 +32,8 @@ class FakeTime:
 
     def sleep(self, s: float) -> None:
         self.t += int(round(s * 1e6)) * 1_000 + 30_000
+        if self.on_sleep is not None:
+            self.on_sleep()
 
 
 class StopAt:
@@ -47,10 +50,14 @@ class StopAt:
         return [float(runner.stop_request is not None)]
 
 
-def _run(monkeypatch, tmp_path, on: str, stop_at: int | None = None, **kw) -> tuple[dict, api.Result]:
+def _run(monkeypatch, tmp_path, on: str, stop_at: int | None = None, signal_at: int | None = None,
+         **kw) -> tuple[dict, api.Result]:
+    """A real-time run of the lathe demo on a fake clock; `stop_at`: a trace column asks for a stop in that cycle;
+    `signal_at`: a SIGINT's stop is asked while the pacer waits for that cycle (ticks counted by the clock)."""
     monkeypatch.setenv(ENV, on)
     ft = FakeTime()
-    clocks = []
+    clocks: list[RealTimeClock] = []
+    runners: list = []
 
     def make_clock(cycle, realtime, config=None):
         assert realtime
@@ -61,17 +68,23 @@ def _run(monkeypatch, tmp_path, on: str, stop_at: int | None = None, **kw) -> tu
 
     monkeypatch.setattr(hil.clock, "make_clock", make_clock)
     monkeypatch.setattr(hil.clock, "acquire_realtime", lambda config, owner: Granted())  # no SCHED_FIFO in tests
-    if stop_at is not None:
-        from hil.runner import BenchRunner
+    from hil.runner import BenchRunner
 
-        real_init = BenchRunner.__init__
+    real_init = BenchRunner.__init__
 
-        def init(self, *a, **k):
-            real_init(self, *a, **k)
-            if not any(isinstance(src, StopAt) for src in self.trace_sources):
-                self.trace_sources.append(StopAt(stop_at))
+    def init(self, *a, **k):
+        real_init(self, *a, **k)
+        runners.append(self)
+        if stop_at is not None and not any(isinstance(src, StopAt) for src in self.trace_sources):
+            self.trace_sources.append(StopAt(stop_at))
 
-        monkeypatch.setattr(BenchRunner, "__init__", init)
+    monkeypatch.setattr(BenchRunner, "__init__", init)
+    if signal_at is not None:
+        def on_sleep():
+            if clocks[0]._n + 1 == signal_at:
+                runners[0].request_stop("SIGINT")
+
+        ft.on_sleep = on_sleep
     path = tmp_path / f"rt{on}.parquet"
     res = api.run(DEMO, trace=str(path), realtime=True, check=False, **kw)
     assert clocks and type(res.runner.clock) is RealTimeClock
@@ -110,3 +123,14 @@ def test_a_stop_inside_a_stretch_is_taken_at_the_next_cycle(monkeypatch, tmp_pat
     cols, res = b
     assert res.run.stopped_by == "SIGINT" and not res.run.finished
     assert cols["stop_asked"].index(1.0) == 4999  # asked in cycle 5000; its stop starts in cycle 5001 both ways
+
+
+def test_a_signal_while_a_stretch_is_paced_lands_on_the_same_cycle(monkeypatch, tmp_path):
+    """The plain run's stretches are paced with only their outputs per cycle (the rest at once after their last
+    cycle): a SIGINT while the pacer waits for cycle 5000 ends the stretch after that cycle, as stepping does."""
+    a = _run(monkeypatch, tmp_path, "0", signal_at=5000)
+    b = _run(monkeypatch, tmp_path, "1", signal_at=5000)
+    _same(a, b)
+    r = b[1].run
+    assert r.stopped_by == "SIGINT" and not r.finished and r.stretched > 3000
+    assert b[1].runner.trace is not None
