@@ -139,6 +139,9 @@ class Cia402Master:
         state = decode_state(statusword)
         self.cycles_in_state = self.cycles_in_state + 1 if state is self.state else 0
         self.state = state
+        if state is State.OPERATION_ENABLED and self.target is Target.ENABLED:  # the usual cycle, as below
+            self._reset_phase = 0
+            return CW_ENABLE_OPERATION
 
         if state in (State.FAULT, State.FAULT_REACTION_ACTIVE):
             if state is State.FAULT and (self._reset_phase or self.auto_fault_reset):

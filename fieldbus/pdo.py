@@ -9,7 +9,8 @@ from __future__ import annotations
 
 import struct
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
+from operator import attrgetter
 
 
 @dataclass(slots=True)
@@ -39,6 +40,20 @@ class TxPdo:
     touch_probe_status: int = 0  # 0x60B9
     touch_probe_pos1: int = 0  # 0x60BA, counts
     digital_inputs: int = 0  # 0x60FD (bit0 negative limit, bit1 positive limit, bit2 home)
+
+
+_RX_FIELDS = attrgetter(*(f.name for f in fields(RxPdo)))
+_TX_FIELDS = attrgetter(*(f.name for f in fields(TxPdo)))
+
+
+def copy_rx(rx: RxPdo) -> RxPdo:
+    """`copy.copy(rx)` without the copy module's reduce protocol (a cycle's copy of a latched image)."""
+    return RxPdo(*_RX_FIELDS(rx))
+
+
+def copy_tx(tx: TxPdo) -> TxPdo:
+    """`copy.copy(tx)`, as `copy_rx`."""
+    return TxPdo(*_TX_FIELDS(tx))
 
 
 @dataclass(frozen=True, slots=True)

@@ -14,7 +14,6 @@ between processes in tests). The same code configures and runs all of them.
 
 from __future__ import annotations
 
-import copy
 import itertools
 import logging
 import threading
@@ -34,7 +33,7 @@ from fieldbus.canopen.nodes import (FaultEpisode, IoNode, IoNodeConfig, Node, No
                                     interpolation_period)
 from fieldbus.canopen.objects import ASDA_B3_EDS, DIO_EDS, MAX_PDOS, frame_layouts
 from fieldbus.link import BusError, SlaveInfo
-from fieldbus.pdo import ASDA_CSP, ASDA_CSP_CSV, PdoLayout, RxPdo, TxPdo
+from fieldbus.pdo import ASDA_CSP, ASDA_CSP_CSV, PdoLayout, RxPdo, TxPdo, copy_tx
 from nc.alarms import Alarm
 
 log = logging.getLogger("fieldbus.canopen")
@@ -395,7 +394,7 @@ class CanopenLink:
             for n in live:
                 if len(n.received) < len(n.tx_frames):
                     n.tpdo_misses += 1  # keep the last values: the heartbeat decides if the node is gone
-            out = [copy.copy(n.tx) for n in self._nodes]
+            out = [copy_tx(n.tx) for n in self._nodes]
             emcys, self._emcys = self._emcys, []
         self._supervise(emcys)
         return out

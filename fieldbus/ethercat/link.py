@@ -77,7 +77,11 @@ class EthercatLink:
         self._last: list[TxPdo] = []
         self._bad = 0
         self._structs: list[PdoLayout] = []
+        # per drive, decided once at bring-up: the master derives 0x60F4 / reads 0x603F (no PDO carries it)
+        self._derived_fe: list[bool] = []
+        self._derived_ec: list[bool] = []
         self._states: list[str] = []  # per slave as `infos` lists them, refreshed on every bad cycle
+        self._all_op: list[str] = []  # what `_states` reads after a good frame (shared, never changed in place)
         self._failed = False  # a bus alarm was raised and the line was not recovered since
         self._io_out: list[bytes] = []  # per I/O slave: the output image the next frame carries
         self._io_in: list[bytes] = []  # per I/O slave: the input image of the last good frame
@@ -180,6 +184,8 @@ class EthercatLink:
         self._check_aliases()
         layouts = list(self.layouts) or [ASDA_E] * len(self.names)
         self._structs = layouts
+        self._derived_fe = [not layout.carries(0x60F4) for layout in layouts]
+        self._derived_ec = [not layout.carries(0x603F) for layout in layouts]
         errors: list[Alarm] = []
         for s, layout, name in zip(self.drives, layouts, self.names):
             s.config_func = self._mapper(s, layout, name, errors)
@@ -225,6 +231,7 @@ class EthercatLink:
             name, mods = self._io_identity(s)
             self.infos.append(SlaveInfo(len(self.infos), name, "io", s.man, s.id, state_name(s.state), mods))
         self._states = [i.state for i in self.infos]
+        self._all_op = ["OP"] * len(self.infos)
         self._failed = False
         self._io_out = [bytes(len(s.output)) for s in self.io]
         self._io_in = [bytes(s.input) for s in self.io]
@@ -292,36 +299,41 @@ class EthercatLink:
             raise ValueError(f"{len(outputs)} output images for {len(self.drives)} drives")
         for s, layout, rx in zip(self.drives, self._structs, outputs):
             s.output = layout.pack_rx(rx)
-        for s, data in zip(self.io, self._io_out):  # remote I/O outputs the MLC wrote (mlc/remote_io.py)
-            s.output = data
+        if self.io:
+            for s, data in zip(self.io, self._io_out):  # remote I/O outputs the MLC wrote (mlc/remote_io.py)
+                s.output = data
         m.send_processdata()
         wkc = m.receive_processdata(self.receive_timeout_us)
-        self.stats.cycles += 1
+        stats = self.stats
+        stats.cycles += 1
         if wkc == m.expected_wkc:
             self._bad = 0
             if not self._failed:  # the full working counter: every slave exchanged, so every slave is in OP
-                self._states = ["OP"] * len(self.infos)
-            self._last = [layout.unpack_tx(s.input, tx) for s, layout, tx in zip(self.drives, self._structs, self._last)]
+                self._states = self._all_op
+            last = self._last
+            for s, layout, tx in zip(self.drives, self._structs, last):
+                layout.unpack_tx(s.input, tx)
             self._derive(outputs)
-            self._io_in = [bytes(s.input) for s in self.io]
-            if self.dc and self.drift_check_every and not self._failed and self.stats.cycles % self.drift_check_every == 0:
+            if self.io:
+                self._io_in = [bytes(s.input) for s in self.io]
+            if self.dc and self.drift_check_every and not self._failed and stats.cycles % self.drift_check_every == 0:
                 self._check_drift()
-            return list(self._last)
+            return list(last)
         return self._bad_cycle(m, wkc)
 
     def _derive(self, outputs: Sequence[RxPdo]) -> None:
         """What the layout does not carry (no Delta PDO set maps 0x60F4; ASDA_E leaves 0x603F out):
         the following error in CSP is the target just sent less the position reached (the drive's own
         0x60F4 in lock-step), and the error code is read over SDO once when the fault bit rises."""
-        for layout, rx, tx in zip(self._structs, outputs, self._last):
-            if not layout.carries(0x60F4):  # the drive's command follows the actual position until enabled
+        for derive, rx, tx in zip(self._derived_fe, outputs, self._last):
+            if derive:  # the drive's command follows the actual position until enabled
                 live = tx.mode_display == 8 and tx.statusword & 0x6F == 0x27
                 tx.following_error = rx.target_position - tx.position_actual if live else 0
         self._read_error_codes()
 
     def _read_error_codes(self) -> None:
-        for s, layout, tx in zip(self.drives, self._structs, self._last):
-            if not layout.carries(0x603F):
+        for s, derive, tx in zip(self.drives, self._derived_ec, self._last):
+            if derive:
                 if not tx.statusword & SW_FAULT:
                     tx.error_code = 0
                 elif not tx.error_code:

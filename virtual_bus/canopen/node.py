@@ -10,7 +10,6 @@ drive by the interpolation time period (0x60C2) and sends its TPDOs.
 
 from __future__ import annotations
 
-import copy
 import logging
 import struct
 from dataclasses import dataclass
@@ -22,7 +21,7 @@ from canopen.sdo.exceptions import SdoAbortedError
 from fieldbus.canopen.emcy import Emcy, emcy_for_delta
 from fieldbus.canopen.objects import ASDA_B3_EDS, MAX_PDO_BYTES, MAX_PDOS, OBJECT_ATTRS
 from fieldbus.cia402 import State
-from fieldbus.pdo import PdoEntry, PdoLayout, RxPdo
+from fieldbus.pdo import PdoEntry, PdoLayout, RxPdo, copy_rx
 from virtual_bus.drive import Cia402Drive
 from virtual_bus.drive_modes import MODE_OBJECTS, check_value
 from virtual_bus.servo_params import ServoParamError, ServoParams, coe_objects
@@ -66,6 +65,7 @@ class Cia402Slave:
         self._tpdos: list[_Pdo] = []
         self._latched: dict[int, bytes] = {}
         self._dirty = True
+        self._period: float | None = None  # 0x60C2 in seconds, see interpolation_period
         self._fault_reported = 0
         self._add_servo_params()
         self._mode_defaults()
@@ -120,6 +120,7 @@ class Cia402Slave:
         from the EDS, the drive out of any fault (a persisting cause faults it again), no RPDO data."""
         for index in [i for i in self.node.data_store if 0x6000 <= i <= 0x9FFF]:
             del self.node.data_store[index]
+        self._period = None
         d = self.drive
         d.modes.reset()  # the profile modes' objects and the home origin (a real drive forgets it too)
         self._mode_defaults()
@@ -128,7 +129,7 @@ class Cia402Slave:
         d.state = State.SWITCH_ON_DISABLED
         d.mode = self._power_on_mode
         self.rx = RxPdo(mode=d.mode)
-        d.apply(copy.copy(self.rx))
+        d.apply(copy_rx(self.rx))
         self._emcy_queue.clear()
         self._fault_reported = 0
 
@@ -185,6 +186,8 @@ class Cia402Slave:
         code = self.reject_writes.get((index, subindex))
         if code is not None:
             raise SdoAbortedError(code)
+        if index == 0x60C2:
+            self._period = None  # read again at the next SYNC, once the value is stored
         if 0x2000 <= index <= 0x26FF:  # a servo parameter: the drive checks range and access
             try:
                 self.drive.servo_params.sdo_write(index, subindex, data)
@@ -211,7 +214,7 @@ class Cia402Slave:
             setattr(self.rx, attr, od.decode_raw(data))
             # Acyclic (SDO) device control acts at once, a target as well as the controlword: NMT states
             # govern PDOs, not the application (a target written in PRE-OPERATIONAL moved nothing before).
-            self.drive.apply(copy.copy(self.rx))
+            self.drive.apply(copy_rx(self.rx))
 
     def _check_mapping_write(self, index: int, subindex: int, value: int) -> None:
         if index & 0xFF00 in (0x1400, 0x1800) and subindex == 1:
@@ -292,7 +295,9 @@ class Cia402Slave:
     # ---- SYNC ---------------------------------------------------------------------------------
     @property
     def interpolation_period(self) -> float:
-        return self._value(0x60C2, 1) * 10.0 ** self._value(0x60C2, 2)
+        if self._period is None:  # two object reads a SYNC otherwise; dropped when 0x60C2 changes
+            self._period = self._value(0x60C2, 1) * 10.0 ** self._value(0x60C2, 2)
+        return self._period
 
     def on_sync(self) -> None:
         """One SYNC: latched RPDOs act, the drive runs one interpolation period, TPDOs go out."""
@@ -306,7 +311,7 @@ class Cia402Slave:
             for cob, data in self._latched.items():
                 self._rpdos[cob].unpack_rx(data, into=self.rx)
             self._latched.clear()
-            tx = self.drive.exchange(copy.copy(self.rx), dt)
+            tx = self.drive.exchange(copy_rx(self.rx), dt)
         else:
             self.drive.step(dt)
             tx = self.drive.feedback()

@@ -115,12 +115,12 @@ class Chain:
             if not ln & 0x8000 or wpos + 2 > size:
                 break
         self.frames += 1
-        drop, delay = self._fault_step(is_pd)
+        drop, delay = self._fault_step(is_pd) if self.faults else (False, 0.0)
         if is_pd:
             self.pd_frames += 1
         if drop:
             return None, 0.0
-        line = self.reachable()
+        line = self.reachable() if self._left else self.slaves
         now = time.monotonic_ns()
         count = len(line)
         wkc = [0] * len(grams)  # working counter increments, added to the frame once every slave has seen it
