@@ -14,7 +14,7 @@ EPS = 1e-9
 Pt = tuple[float, float]
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, init=False)  # its own __init__ below (no generated one compiled at start-up)
 class Seg:
     """A straight line (``center is None``) or a circular arc from p0 to p1."""
 
@@ -71,9 +71,14 @@ class Seg:
         return (c[0] + r * math.cos(a), c[1] + r * math.sin(a))
 
     def tangent(self, t: float) -> Pt:
-        """Unit direction of travel at parameter t."""
+        """Unit direction of travel at parameter t. A line's is found once and kept beside the fields
+        (compensation asks each element several times, issue 16; the fields never change)."""
         if not self.is_arc:
-            return unit((self.p1[0] - self.p0[0], self.p1[1] - self.p0[1]))
+            d = self.__dict__
+            u = d.get("_direction")
+            if u is None:
+                u = d["_direction"] = unit((self.p1[0] - self.p0[0], self.p1[1] - self.p0[1]))
+            return u
         p = self.point(t)
         c = self.center
         assert c is not None

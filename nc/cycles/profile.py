@@ -52,8 +52,9 @@ class Contour:
             raise NcAlarm(0x0246, "the P–Q contour has no movement")
         self.f_start = self.segs[0].p0[0]
         self.f_end = self.segs[-1].p1[0]
-        self._check(type_one)
-        ds = [d for s in self.segs for d in _sample_ds(s)]
+        samples = [_sample_ds(s) for s in self.segs]  # once: the type I check and the depth range read them
+        self._check(type_one, samples)
+        ds = [d for sd in samples for d in sd]
         for s in self.segs:
             if s.is_arc:
                 ds.extend(p[1] for p in self._arc_extremes(s))
@@ -66,7 +67,7 @@ class Contour:
         self._spans = [(lo, hi, s) for s in self.segs
                        for lo, hi in [(min(s.p0[0], s.p1[0]), max(s.p0[0], s.p1[0]))] if hi - lo >= TOL]
 
-    def _check(self, type_one: bool) -> None:
+    def _check(self, type_one: bool, samples: list[list[float]]) -> None:
         # Monotone along the cutting axis is judged on block end points. An arc may bulge past its end
         # point (the manual's own G72 example 1, E-L23: the R10 arc dips 0.08 mm under X20.): the
         # layers stop at the highest element over each f (`depth_at`), leaving the shadow under the
@@ -74,12 +75,11 @@ class Contour:
         if self.f_end > self.f_start - TOL:
             raise NcAlarm(0x0246, "the P–Q contour does not advance in the cutting direction")
         last_d = self.segs[0].p0[1]
-        for s in self.segs:
+        for s, ds in zip(self.segs, samples):
             if s.p1[0] > s.p0[0] + TOL:
                 raise NcAlarm(0x0246, "the P–Q contour turns back against the cutting direction "
                                       "(it must be monotone along the cutting axis)")
             if type_one:
-                ds = _sample_ds(s)
                 if any(b < a - TOL for a, b in zip([last_d] + ds, ds)):
                     raise NcAlarm(0x0246, "type I roughing needs a monotone contour; program X and Z in the "
                                           "P block for a type II (pocket) contour")

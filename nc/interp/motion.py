@@ -25,16 +25,29 @@ _AXIS_LETTERS: dict[tuple, tuple[tuple[str, str | None], ...]] = {}
 class MotionMixin:
     def _axis_words(self, block: Block) -> dict[str, tuple[Word, bool]]:
         """axis -> (word, incremental) from X/Y/Z/… and the U/V/W/H incremental addresses (A5)."""
+        cached = self.__dict__.get("_axis_pairs")
+        if cached is None or cached[0] is not self.axes or cached[1] is not self.profile:
+            key = (self.axes, self.profile.is_lathe)
+            pairs = _AXIS_LETTERS.get(key)
+            if pairs is None:  # (axis, its incremental letter or None) per axes and machine type, found once
+                incs = {v: k for k, v in reversed(INCREMENTAL.items())}  # the first letter naming an axis
+                pairs = _AXIS_LETTERS[key] = tuple(
+                    (a, (incs.get(a) if incs.get(a) not in self.axes else None) if key[1] else None)
+                    for a in self.axes)
+            letters = frozenset(a for pair in pairs for a in pair if a is not None)
+            cached = self._axis_pairs = (self.axes, self.profile, pairs, letters)
+        # the block's axis words in one pass, the last of a letter winning as `Block.get` finds it (A9)
+        found: dict[str, Word] = {}
+        letters = cached[3]
+        for w in block.words:
+            if w.letter in letters:
+                found[w.letter] = w
         out: dict[str, tuple[Word, bool]] = {}
-        key = (self.axes, self.profile.is_lathe)
-        pairs = _AXIS_LETTERS.get(key)
-        if pairs is None:  # (axis, its incremental letter or None) per axes and machine type, found once
-            incs = {v: k for k, v in reversed(INCREMENTAL.items())}  # the first letter naming an axis
-            pairs = _AXIS_LETTERS[key] = tuple(
-                (a, (incs.get(a) if incs.get(a) not in self.axes else None) if key[1] else None) for a in self.axes)
-        for a, inc_letter in pairs:
-            w_abs = block.get(a)
-            w_inc = block.get(inc_letter) if inc_letter else None
+        if not found:
+            return out
+        for a, inc_letter in cached[2]:
+            w_abs = found.get(a)
+            w_inc = found.get(inc_letter) if inc_letter else None
             if w_abs is not None and w_inc is not None:
                 raise NcAlarm(0x0202, f"{a} and {inc_letter} in one block")
             if w_abs is not None:
