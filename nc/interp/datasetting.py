@@ -52,13 +52,13 @@ def g10(ip: "InterpHost", block: "Block") -> Iterator[Event]:
     if L == 2:
         if P is None or not 0 <= P <= 6:
             raise NcAlarm(0x0243, "G10 L2 P must be 0-6")
-        target = ip.frames.external if P == 0 else ip.frames.work_offsets[P - 1]
+        target = ip.frames.external if P == 0 else ip.frames.writable_offsets()[P - 1]
         _set_axes(ip, target, words)
         return
     if L == 20:
         if P is None or not 1 <= P <= N_EXT_WCS:
             raise NcAlarm(0x0237, f"G10 L20 P must be 1-{N_EXT_WCS}")
-        _set_axes(ip, ip.frames.work_offsets[5 + P], words)
+        _set_axes(ip, ip.frames.writable_offsets()[5 + P], words)
         return
     if L == 21:
         if P is None or not 1 <= P <= 4:

@@ -85,6 +85,7 @@ class Frames:
     tool_shift: dict[str, float] = field(default_factory=dict)
 
     _memo: ClassVar[tuple | None] = None  # (wcs, axes, the five offsets, origins) of the last call
+    _shared: ClassVar[bool] = False  # work_offsets is shared with a copy: `writable_offsets` copies it first
 
     def __post_init__(self) -> None:
         if not self.work_offsets:
@@ -92,11 +93,21 @@ class Frames:
 
     def copy(self) -> "Frames":
         """An independent copy (what copy.deepcopy gives, at a tenth of its cost: a lathe cycle's
-        contour is interpreted on a copy of the interpreter, issue 16)."""
-        twin = Frames(self.axes, list(map(dict.copy, self.work_offsets)), self.external.copy(),
+        contour is interpreted on a copy of the interpreter, issue 16). The 70 work offsets are shared
+        until either side writes one: writers take them from `writable_offsets`."""
+        twin = Frames(self.axes, self.work_offsets, self.external.copy(),
                       self.local_shift.copy(), self.set_shift.copy(), self.tool_shift.copy())
         twin._memo = self._memo  # compared by value and never changed: valid for the equal copy too
+        twin._shared = self._shared = True
         return twin
+
+    def writable_offsets(self) -> list[dict[str, float]]:
+        """`work_offsets` to change in place (G10 L2/L20, #5221…): this frame's own, copied first if
+        a copy shares them."""
+        if self._shared:
+            self.work_offsets = list(map(dict.copy, self.work_offsets))
+            self._shared = False
+        return self.work_offsets
 
     def origins(self, wcs: int, axes: tuple[str, ...]) -> dict[str, float]:
         """`origin` of every axis at once (the interpreter's per-block coordinate conversion). The dict

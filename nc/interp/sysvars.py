@@ -48,7 +48,7 @@ class SystemVariables:
         if wcs is None:
             fr.external[axis] = v
         else:
-            fr.work_offsets[wcs][axis] = v
+            fr.writable_offsets()[wcs][axis] = v
 
     def live(self, n: int) -> bool:
         if self.i.profile.legacy:
