@@ -135,6 +135,15 @@ def _str(s) -> str:
     return q
 
 
+def _all_floats(d: dict) -> bool:
+    """Every value a float (`set(map(type, …)) == _FLOATS` at a third of its cost, for a point that may
+    hash like one with an int)."""
+    for v in d.values():
+        if type(v) is not float:
+            return False
+    return True
+
+
 def move_json(m: Move) -> str:
     """The JSON line of `move_dict(m)`, byte for byte as strict_json.dumps writes it, built as text
     without the intermediate dicts (issue 16: the dicts and the generic encoder were half of `hil
@@ -156,16 +165,51 @@ def move_json(m: Move) -> str:
     start, end = m.start, m.end
     last = _LAST_END
     start_text = last[2] if start is last[0] and tuple(start.items()) == last[1] else _axes(start)
-    # `_axes` of end and work, its remembered-point hit inline (the usual case: a call less per point)
+    # `_axes` of end and work, its remembered-point hit inline (the usual case: a call less per point);
+    # a point with an integral value is taken only when all its values are floats (see `_axes`)
     end_items = tuple(end.items())
     hit = _POINTS.get(end_items)
-    end_text = hit[0] if hit is not None and (not hit[1] or set(map(type, end.values())) == _FLOATS) \
-        else _axes(end, end_items)
+    if hit is not None and hit[1] and not _all_floats(end):
+        hit = None
+    end_text = hit[0] if hit is not None else _axes(end, end_items)
     last[0], last[1], last[2] = end, end_items, end_text
     work = m.work
     hit = _POINTS.get(work_items := tuple(work.items()))
-    work_text = hit[0] if hit is not None and (not hit[1] or set(map(type, work.values())) == _FLOATS) \
-        else _axes(work, work_items)
+    if hit is not None and hit[1] and not _all_floats(work):
+        hit = None
+    work_text = hit[0] if hit is not None else _axes(work, work_items)
+    # the rest of the line of a move without centre, direction, duration or compensation is one of
+    # few (feed, flags, tags, thread keys): remembered by them where equal keys write alike (floats
+    # but 0.0 and -0.0 do, an int as 5 and 5.0 do not)
+    feed, tags = m.feed, m.tags
+    key = None
+    if m.center is None and m.dir is None and m.duration is None and not m.comp and type(tags) is tuple \
+            and (feed is None or type(feed) is float and feed != 0):
+        if m.kind != "thread":
+            key = (feed, bool(m.per_rev), bool(m.exact_stop), tags)
+        elif _plain(lead := m.lead) and _plain(lead_change := m.lead_change) and _plain(angle := m.start_angle):
+            key = (feed, bool(m.per_rev), bool(m.exact_stop), tags, lead, lead_change, angle)
+    tail = _TAILS.get(key) if key is not None else None
+    if tail is None:
+        tail = _tail(m)
+        if key is not None and all(type(t) is str for t in tags):
+            if len(_TAILS) >= _QUOTED_LIMIT:
+                _TAILS.clear()
+            _TAILS[key] = tail
+    # one string for the whole line, none appended to a finished line (each append copied the line)
+    return f'{head}{start_text}, "end": {end_text}, "work": {work_text}{tail}'
+
+
+_TAILS: dict[tuple, str] = {}  # (feed, per_rev, exact_stop, tags[, lead, lead_change, start_angle]) -> tail
+
+
+def _plain(v) -> bool:
+    """None or a float that writes as every float equal to it does (not -0.0)."""
+    return v is None or type(v) is float and (v != 0 or math.copysign(1.0, v) > 0)
+
+
+def _tail(m: Move) -> str:
+    """The line of `move_json(m)` after its work point: the additive keys of move_dict in its order."""
     tags = ""
     if m.tags:
         tags = _TAGS.get(m.tags)
@@ -176,10 +220,7 @@ def move_json(m: Move) -> str:
                     _TAGS.clear()
                 _TAGS[m.tags] = tags
     feed = m.feed
-    # one string for the whole line: the additive keys of move_dict in its order, none appended to a
-    # finished line (each append copied the line, issue 16)
-    return (f'{head}{start_text}, "end": {end_text}, "work": {work_text}, '
-            f'"center": {"null" if m.center is None else _axes(m.center)}, '
+    return (f', "center": {"null" if m.center is None else _axes(m.center)}, '
             f'"dir": {"null" if m.dir is None else _str(m.dir)}, '
             f'"feed": {"null" if feed is None else _num(feed)}, '
             f'"duration": {"null" if (duration := m.duration) is None else _num(duration)}'

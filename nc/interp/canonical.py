@@ -34,6 +34,15 @@ class CanonicalMixin:
         diameter = self.profile.diameter_axes
         spec = tuple((a, origin[a], 2.0 if a in diameter else 1.0) for a in self.axes)
         slow = self.to_work
+        if len(spec) == 2:  # a lathe's X and Z: the loop written out
+            (a1, o1, f1), (a2, o2, f2) = spec
+
+            def convert2(machine: dict[str, float]) -> dict[str, float]:
+                try:
+                    return {a1: (machine[a1] - o1) * f1, a2: (machine[a2] - o2) * f2}
+                except KeyError:
+                    return slow(machine)
+            return convert2
 
         def convert(machine: dict[str, float]) -> dict[str, float]:
             out = {}  # a loop, not a comprehension: no function frame per call (a move each)
