@@ -44,6 +44,8 @@ def runs(tmp: Path, quick: bool) -> Iterator[tuple[str, str, dict]]:
     yield "C-axis drilling", str(ROOT / "examples" / "lathe_face_drilling_c.nc"), {"bench": LATHE_C}
     yield "M96 interrupt", str(ROOT / "examples" / "m96_interrupt.nc"), {"bench": MILL, "events": ["t=1.1:pulse M21019"]}
     yield "CAM 800 blocks", str(cam), {"bench": MILL}
+    # without device columns the mill keeps its basic MLC: stretches cross the cruise's blocks (decision B25)
+    yield "CAM 800 blocks, basic MLC", str(cam), {"bench": MILL, "trace_signals": None}
     if quick:
         return
     yield "lathe demo", demo, {}
@@ -88,7 +90,7 @@ SHORTCUTS: dict[str, Callable[[bool], object]] = {"mlc-on-change": mlc_on_change
 
 def one(program: str, kw: dict, trace: Path, keep: list | None = None) -> tuple:
     """(trace columns, summary) of a run; `keep` receives the run's result (tests/test_stretch_runner.py)."""
-    r = run(program, trace=str(trace), trace_signals=SIGNALS, check=False, **kw)
+    r = run(program, trace=str(trace), check=False, **({"trace_signals": SIGNALS} | kw))
     if keep is not None:
         keep.append(r)
     table = pq.read_table(trace)

@@ -103,6 +103,9 @@ class Stretcher:
             if kind == "drain":  # the cycle that begins with the filter settled issues the waiting code: stepped
                 n = min(n, pl.filter.span - pl.filter._still)
             self._sampler = stand_stretch
+        elif type(r.mlc) is BasicMlc and pl._buf_blk is not None:  # a cruise, across its blocks (nothing reads
+            n = _across(ch, pl, min(limit, self.max_cycles))          # the queue's length in between)
+            self._sampler = _sample_across
         else:  # to the buffer's end: the planner stays on its block (dropped at the refill, a stepped cycle)
             n = min(limit, self.max_cycles, pl._block_rows())  # a cruise's buffer spans blocks: this one's rows
             self._sampler = sample_stretch
@@ -112,6 +115,11 @@ class Stretcher:
         smp = self._sampler(pl, n)
         if smp is None:
             return False
+        if len(smp.positions) < n:  # a cruise's block that would not cruise any more: the stretch ends before it
+            n = len(smp.positions)
+            if n < 2:
+                _restore_planner(pl, saved_pl)
+                return False
         if kind != "wait":  # what the first cycle's feed does before it finds nothing to read (the same after)
             pl.closed = ch.end is not None or ch._deferred is not None or ch._limit_alarm is not None
             if ch.statement_budget is not None:
@@ -146,12 +154,12 @@ class Stretcher:
         dt, link, clock = r.bench.cycle, r.link, r.clock
         fixed = [(d.error_code, d.mode) for d in self.drives]
         probes = [(o.last.touch_probe_status, o.last.touch_probe_pos1, o.last.digital_inputs) for o in outs]
-        positions, lines, vel, mv = smp.positions, smp.lines, smp.path_velocity, smp.move
+        positions, lines, vel, mv, moves = smp.positions, smp.lines, smp.path_velocity, smp.move, smp.moves
         state = {"fell_back": False}
         # The MLC exchange reads the planner's own position (M3x352+i, axis at 0) before the cycle's step: the
         # raw sample of the cycle before, as it stood in stepping (sample_stretch moved it to the last one).
         raw = [saved_pl["pl"]["position"], *pl._buf_pos[pl._buf_i - m:pl._buf_i - 1]] \
-            if self._sampler is sample_stretch else [pl.position] * m
+            if self._sampler is not stand_stretch else [pl.position] * m
         last_raw = pl.position
         k = 0
 
@@ -163,7 +171,7 @@ class Stretcher:
             if settle:
                 rpms.append(float(pl.spindle_rpm()))
                 cmds.append(float(pl.spindle_command()))  # type: ignore[misc]
-            return Setpoint(positions[k], lines[k], float(vel[k]), mv)
+            return Setpoint(positions[k], lines[k], float(vel[k]), mv if moves is None else moves[k])
 
         cut = False
         while k < m:
@@ -456,9 +464,32 @@ def _event_due(r: Any) -> bool:
     return isinstance(oc, EventPlayer) and any(e.fired_cycle == r.cycle + 1 for e in oc.events)
 
 
+def _across(ch: Channel, pl: Planner, n: int) -> int:
+    """How many of the next n cycles a stretch across a cruise's blocks may take: its rows, up to the first
+    cycle whose feed would read the program again (its queue below the planner's depth; it stays full up to
+    there, `Planner.full`); none reads once the program's end, a barrier or a limit alarm was read."""
+    i = pl._buf_i
+    n = min(n, len(pl._buf_pos) - i)
+    if ch.end is not None or ch._deferred is not None or ch._limit_alarm is not None \
+            or (ch.single_block and ch._block_moves):
+        return n
+    left, blk, popped, depth = len(pl.blocks), pl._buf_blk, pl._buf_popped, pl.depth
+    for c in range(1, n):  # cycle c's feed sees the queue its cycle c - 1 left
+        if left - (blk[i + c - 1] - popped) < depth:
+            return c
+    return n
+
+
+def _sample_across(pl: Planner, n: int) -> Samples | None:
+    return sample_stretch(pl, n, across=True)
+
+
 def _save_planner(pl: Planner) -> dict:
-    """What sample_stretch changes: the planner's own fields and its position filter's state."""
+    """What sample_stretch changes: the planner's own fields and its position filter's state (and its queue,
+    of which a stretch across a cruise's blocks finishes some)."""
     saved: dict[str, Any] = {"pl": dict(pl.__dict__)}
+    if pl._buf_blk is not None:
+        saved["blocks"] = list(pl.blocks)
     f = pl.filter
     if f is not None:
         fs = dict(f.__dict__)
@@ -470,6 +501,9 @@ def _save_planner(pl: Planner) -> dict:
 def _restore_planner(pl: Planner, saved: dict) -> None:
     pl.__dict__.clear()
     pl.__dict__.update(saved["pl"])
+    if "blocks" in saved:  # the same deque (the channel's view of the planner holds it)
+        pl.blocks.clear()
+        pl.blocks.extend(saved["blocks"])
     if "f" in saved:
         f = pl.filter
         fs = dict(saved["f"])

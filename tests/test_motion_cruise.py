@@ -1,4 +1,4 @@
-"""Decision motion 42: a block the planner enters at its cap, with zero acceleration, and leaves at its cap
+"""Decision motion 44: a block the planner enters at its cap, with zero acceleration, and leaves at its cap
 is sampled as constant speed without a solve (`Planner._cruise`); `Planner.per_block` solves every block as
 before. Both on benches/mill-3axis.toml: the same setpoints, fewer solves."""
 

@@ -37,10 +37,14 @@ class Stretch:
 
 def can_stretch(drive: Cia402Drive, rx: RxPdo, mode: int = 8) -> bool:
     """The drive runs the plain CSP (mode 8) or CSV (9) path the stretch reproduces. CSV may have its touch
-    probe armed once it latched the index (a spindle's thread sync): a latched probe waits, unchanged."""
+    probe armed once it latched the index (a spindle's thread sync): a latched probe waits, unchanged; or, not
+    latched yet, on a spindle that stands and is commanded to stand (a mill's CAM program without M03): it
+    does not move in the stretch, so no index passes (Cia402Drive._probe)."""
     p = drive.params
     cw = rx.controlword
-    probe_ok = not rx.touch_probe_function & 1 or (mode == 9 and drive._probe_latched)
+    probe_ok = not rx.touch_probe_function & 1 or (mode == 9 and (drive._probe_latched or (
+        p.probe_position is None and rx.target_velocity == 0 and drive._want_cps == 0.0
+        and drive.target_velocity == 0.0 and drive.velocity == 0.0)))
     return (drive.state is State.OPERATION_ENABLED and drive.mode == mode and rx.mode == mode
             and not drive.external_fault and cw == drive._last_cw and cw & 0x8F == ENABLE_HELD
             and (mode == 8 or (p.negative_limit is None and p.positive_limit is None)) and probe_ok)

@@ -75,7 +75,7 @@ class _Plan:
     # few cycles at a time and solved again once more than `queued` moves were pushed.
     open: bool = False
     queued: int = 0
-    # A "cruise" (decision motion 42): whole blocks sampled at once; `carry` the next plan's t0 after the last
+    # A "cruise" (decision motion 44): whole blocks sampled at once; `carry` the next plan's t0 after the last
     # of them, `last` its offset from blocks[0] when sampled.
     carry: float = 0.0
     last: int = 0
@@ -83,7 +83,7 @@ class _Plan:
 
 class Planner:
     # True: every block of a run starts a new solve, also where the run cruises at its cap (the reference
-    # tests compare the cruise sampling against, decision motion 42)
+    # tests compare the cruise sampling against, decision motion 44)
     per_block = False
 
     def __init__(self, cfg: MotionConfig, start: dict[str, float] | None = None,
@@ -402,6 +402,20 @@ class Planner:
             j += 1
         return j - i
 
+    def _cruise_rows(self, n: int) -> int:
+        """Of the next n buffer rows, how many a stretch may take across a cruise's blocks: those before the
+        first block whose own solve would no longer cruise (`_chain_ok`, with the queue as it stands)."""
+        i = self._buf_i
+        m = min(n, 0 if self._buf_pos is None else len(self._buf_pos) - i)
+        blk = self._buf_blk
+        if blk is None or m <= 0:
+            return m
+        last = blk[i + m - 1]
+        if last > self._buf_popped and (bad := self._chain_ok(self.plan, last)) <= last:
+            while m > 0 and blk[i + m - 1] >= bad:
+                m -= 1
+        return m
+
     def _take(self, i: int) -> None:
         """The state after handing out buffer row i: a cruise's blocks before row i's are finished."""
         if self._buf_blk is not None:
@@ -649,7 +663,7 @@ class Planner:
                 and "G31" not in b.move.tags)
 
     def _cruise(self, b: Block, t0: float) -> _Plan | None:
-        """Decision motion 42: at its cap, with zero acceleration, a run whose end speed is the cap solves to
+        """Decision motion 44: at its cap, with zero acceleration, a run whose end speed is the cap solves to
         constant speed to the end of its block, and so does the next block's solve while the same holds there.
         Such a chain is sampled across its blocks at once (no solve): positions as the per-block solves give
         them (tests/test_motion_cruise.py). A push may change the junction speeds far back in the queue

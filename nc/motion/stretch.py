@@ -2,7 +2,8 @@
 planned samples as arrays").
 
 The planner samples each plan into a buffer (`Planner._buf_pos`, up to 64 cycles, within one block; a
-cruise's across blocks, decision motion 42, of which a stretch takes the rows in the current block) and
+cruise's across blocks, decision motion 44, of which a stretch takes the rows in the current block, or with
+`across` in its later blocks too) and
 `Planner.step` hands out one row per cycle, through the position filter. `sample_stretch(planner, n)` hands
 out the next rows of that buffer at once — at most to its end, where the planner solves again — filtered by
 `PositionFilter.push_many`, and leaves the planner as that many `step()` calls would. It refuses (None) what
@@ -31,11 +32,14 @@ class Samples:
     positions: np.ndarray  # (cycles, axes), filtered as step() returns them
     lines: list[int]
     path_velocity: np.ndarray
-    move: Move | None  # the same for every row: a stretch lies within one block
+    move: Move | None  # the move of every row, unless `moves` gives one per row (a cruise's blocks)
+    moves: list[Move] | None = None
 
 
-def sample_stretch(pl: Planner, n: int) -> Samples | None:
-    """The next min(n, rows left in the buffer) setpoints, or None where step() must run (module doc)."""
+def sample_stretch(pl: Planner, n: int, across: bool = False) -> Samples | None:
+    """The next min(n, rows left in the buffer) setpoints, or None where step() must run (module doc).
+    `across`: a cruise's rows in its later blocks too, those blocks finished as step() finishes them (the
+    caller sees to it that nothing reads the queue in between, nor pushes to it)."""
     if n <= 0 or pl._integrate_angle or pl._buf_done:
         return None
     blocks = pl.blocks
@@ -46,16 +50,20 @@ def sample_stretch(pl: Planner, n: int) -> Samples | None:
     if mv is not None and (mv.kind == "thread" or "G31" in mv.tags):
         return None
     i = pl._buf_i
-    m = min(n, pl._block_rows())
+    m = pl._cruise_rows(n) if across else min(n, pl._block_rows())
     if m <= 0:
         return None  # the next row starts the cruise's next block: step() finishes this one
     j = i + m - 1
     raw = pl._buf_pos[i:i + m]
+    moves = None
+    if pl._buf_blk is not None and pl._buf_blk[j] != pl._buf_popped:
+        blocks, off = pl.blocks, pl._buf_popped
+        moves = [blocks[k - off].move for k in pl._buf_blk[i:i + m]]
     pl._buf_i = i + m
     pl._take(j)
     positions = pl.filter.push_many(raw) if pl.filter is not None else np.array(raw, dtype=float)
     pl.output = positions[-1].copy()
-    return Samples(positions, list(pl._buf_line[i:i + m]), np.array(pl._buf_vel[i:i + m], dtype=float), mv)
+    return Samples(positions, list(pl._buf_line[i:i + m]), np.array(pl._buf_vel[i:i + m], dtype=float), mv, moves)
 
 
 def stand_stretch(pl: Planner, n: int) -> Samples | None:
