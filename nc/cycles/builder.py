@@ -101,8 +101,7 @@ class PathBuilder:
 
     def thread(self, p: Pt, lead: float, start_angle: float, tags: tuple[str, ...] = (),
                lead_change: float = 0.0) -> Move:
-        return self._to("thread", p, tags, lead, True, lead=lead, lead_change=lead_change,  # type: ignore[return-value]
-                        start_angle=start_angle)
+        return self._to("thread", p, tags, lead, True, None, None, lead, lead_change, start_angle)  # type: ignore[return-value]
 
     def dwell(self, seconds: float, tags: tuple[str, ...] = ()) -> Move:
         here = dict(self.position)

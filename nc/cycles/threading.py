@@ -114,6 +114,7 @@ def g76(b: PathBuilder, spec: G76Spec, code: str = "G76") -> list[ThreadPass]:
     half = math.tan(math.radians(spec.tool_angle / 2.0))
     passes = g76_depths(spec.height, spec.first, spec.min_step, spec.allowance, spec.finish_passes)
     n_rough = 0
+    rapid = b._to  # `b.rapid` without its call (a G76 makes some sixty moves)
     for i, ps in enumerate(passes):
         left = spec.height - ps.depth  # distance above the root
         side = {0: 1.0, 1: 0.0, 2: -1.0}.get(spec.infeed, 1.0 if i % 2 == 0 else -1.0)
@@ -129,11 +130,11 @@ def g76(b: PathBuilder, spec: G76Spec, code: str = "G76") -> list[ThreadPass]:
         else:
             n_rough += 1
             tags = (code, "rough", str(n_rough))
-        b.rapid((z_start, xa), (code, "approach"))
-        b.rapid((z_start, x0), (code, "infeed"))
+        rapid("rapid", (z_start, xa), (code, "approach"), None, False)
+        rapid("rapid", (z_start, x0), (code, "infeed"), None, False)
         _thread_line(b, (z_start, x0), (ze, x1), spec.lead, 0.0, spec.chamfer, spec.chamfer_angle, s, tags)
-        b.rapid((b.here[0], xa), (code, "retract"))
-        b.rapid((za, xa), (code, "return"))
+        rapid("rapid", (b.here[0], xa), (code, "retract"), None, False)
+        rapid("rapid", (za, xa), (code, "return"), None, False)
     return passes
 
 

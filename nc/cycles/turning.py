@@ -87,7 +87,7 @@ def rough(b: PathBuilder, contour_segs: list[Seg], spec: RoughSpec) -> None:
         emit("rapid", to_plane(q), tags, None, False)
 
     def feed(q: Pt, tags: tuple[str, ...]) -> None:
-        b.feed_to(to_plane(q), tags)
+        emit("line", to_plane(q), tags, b.feed, b.per_rev)  # `b.feed_to` without its default feed
 
     def here() -> Pt:
         return frame.to_fd(b.here)

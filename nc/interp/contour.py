@@ -43,6 +43,9 @@ class ContourMixin:
         if start is not None:
             twin.position = dict(start)
         run = [b for b in blocks if b.stmt is None]  # run in order on the twin (no Program needed)
+        if not any(b.comma or b.comma_expr for b in run):
+            # no ,C/,R/,A: expand_corners would hand every event on as it is (a stage less per move)
+            return [ev for b in run for ev in twin._execute(b) if isinstance(ev, Move)]
 
         def gen() -> Iterator[Event]:
             for b in run:

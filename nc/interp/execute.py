@@ -170,8 +170,10 @@ def step_nonmodal(ip, run: BlockRun) -> Iterator[Event]:
 def step_motion(ip, run: BlockRun) -> Iterator[Event] | None:
     """The modal motion (G0 G1 G2 G3 G32 a modal cycle …) unless a group-0 code or a transform owns
     the block's axis words."""
-    nonmodal = [fn for grp, fn, _ in run.gcodes if grp == 0]
-    if NO_MOTION_FUNCS.isdisjoint(nonmodal) and TRANSFORM_ARG_FUNCS.isdisjoint(run.funcs):
+    for grp, fn, _ in run.gcodes:  # a loop, not a list of the group-0 codes (every block, issue 16)
+        if grp == 0 and fn in NO_MOTION_FUNCS:
+            return None
+    if TRANSFORM_ARG_FUNCS.isdisjoint(run.funcs):
         if _still(ip, run):
             return None
         if ip.macro_modal is None:  # `run.moved` is read only for a modal G66 call: no wrapper per move
