@@ -19,14 +19,14 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from fieldbus.cia402 import SW_INTERNAL_LIMIT, Cia402Master, State, Target
-from fieldbus.link import BusError, BusLink
+from fieldbus.link import BusError, BusLink, SimLink
 from fieldbus.pdo import RxPdo, TxPdo
 from hil.bench import Bench
 from hil.clock import CycleTiming, LockStepClock, RealTimeClock
 from hil import retentive
 from hil.drive_homing import home_axes
 from hil.mlc_bridge import drive_status
-from hil.stretch import Stretcher
+from hil.stretch import Stretcher, wanted as stretch_wanted
 from hil.trace import TraceSource, TraceWriter, trace_columns
 from mlc.basic import BasicMlc
 from nc.alarm_table import MAX_TIME
@@ -132,6 +132,7 @@ class BenchRunner:
         self.retain: str | None = None  # hil run --retain FILE: the retentive # variables (hil/retentive.py)
         self._retained = None  # the variables loaded from it, saved back when the run ends
         self._overrun_alarmed = False
+        self._bus_ahead = False  # real time on the sim bus: a stepped cycle's exchange runs before its tick
 
     def trace_columns(self) -> list[str]:
         extra = [c for src in self.trace_sources for c in src.columns]
@@ -140,6 +141,7 @@ class BenchRunner:
     # ---- public ---------------------------------------------------------------------------
     def run_program(self, program: Program) -> RunResult:
         paced = isinstance(self.clock, RealTimeClock)
+        self._bus_ahead = paced and type(self.link) is SimLink and stretch_wanted()
         if paced:
             _preload(self.bench)
         try:
@@ -330,10 +332,13 @@ class BenchRunner:
 
     # ---- the cycle ------------------------------------------------------------------------
     def _exchange(self, step: Callable[[Channel], object] | None = None) -> None:
+        # Real time on the in-process bus: this cycle's drive models run before its wake-up, in the slack
+        # (decision B21); nothing between here and the tick reads or writes the PDOs or the drives
+        tx = self.link.exchange(self.rx) if self._bus_ahead else None
         self.timing = self.clock.tick()
         if self.timing.overrun:
             self._overrun()
-        self._cycle(self.link.exchange(self.rx), step)
+        self._cycle(tx if tx is not None else self.link.exchange(self.rx), step)
 
     def _cycle(self, tx: list[TxPdo], step: Callable[[Channel], object] | None = None) -> None:
         """One cycle from its feedback on (a stretch, hil/stretch.py, hands in feedback it computed and, as

@@ -98,6 +98,7 @@ class Stretcher:
         if kind is None:
             return False
         pl = ch.planner
+        fill = None
         if kind in ("wait", "drain"):  # standing: an M/S/T code waits for its finish, or the filter's tail
             n = min(limit, self.max_cycles)
             if kind == "drain":  # the cycle that begins with the filter settled issues the waiting code: stepped
@@ -109,11 +110,19 @@ class Stretcher:
         else:  # to the buffer's end: the planner stays on its block (dropped at the refill, a stepped cycle)
             n = min(limit, self.max_cycles, pl._block_rows())  # a cruise's buffer spans blocks: this one's rows
             self._sampler = sample_stretch
+            # real time: where the buffer ran out, the refill the first cycle's step would make, made ahead (B21)
+            fill = self._refill_ahead(r, ch, pl) if self.paced and n == 0 else None
+            if fill is not None:
+                n = min(limit, self.max_cycles, fill[4])
+                self._sampler = _refilled(fill)
         if n < 2:
             return False
         saved_pl = _save_planner(pl)
+        if fill is not None:  # the planner as before the refill: a stretch cut before its first sample steps it
+            saved_pl["plan"] = (fill[0], fill[1])
         smp = self._sampler(pl, n)
         if smp is None:
+            _restore_planner(pl, saved_pl)  # as it was (a refill ahead was put in place before sampling)
             return False
         if len(smp.positions) < n:  # a cruise's block that would not cruise any more: the stretch ends before it
             n = len(smp.positions)
@@ -181,14 +190,20 @@ class Stretcher:
                 j = first_change(r, ch, outs, k, m, raw)  # the first cycle whose scan would not be skipped
                 if j > k:
                     timings = None
-                    if self.paced:  # each cycle paced, with its outputs; the rest of them at once after the last
-                        j, timings = self._pace(r, k, j, positions, targets, panel)
+                    if self.paced:  # each cycle paced, with its outputs; the rest of them at once in the slack
+                        # before the last one (so the next stretch's work ahead has the slack after it to itself)
+                        stop = j - 1 if j - k >= 2 else j
+                        end, timings = self._pace(r, k, stop, positions, targets, panel)
+                        j = end if end < stop else j  # a stop or a press ended it: at once up to there
                     if j < m:  # the stretch ends before it: that cycle is stepped
                         outs = self._cut(pl, saved_pl, saved_drives, rx0, targets, j, j)
                         m, last_raw, cut = j, pl.position, True
                         if settle:
                             rpms, cmds = rpms[:k], cmds[:k]
-                    bulk_cycles(r, ch, pl, smp, outs, k, m, raw[m - 1], (rpms, cmds) if settle else None, timings)
+                    last_row = bulk_cycles(r, ch, pl, smp, outs, k, m, raw[m - 1], (rpms, cmds) if settle else None,
+                                           timings)
+                    if last_row is not None:  # real time: the last cycle, paced after the rest
+                        last_row(self._pace(r, m - 1, m, positions, targets, panel)[1][0])
                     if cut and settle:
                         settle_stretch(pl, rpms, cmds)
                     k = m
@@ -258,42 +273,22 @@ class Stretcher:
 
     # ---- real time: the refill of a stepped cycle ahead ----------------------------------------------
     def ahead(self) -> Callable[[Channel], Setpoint] | None:
-        """Real time (B21): the planner's refill of the next cycle (the stepped cycle at the end of a stretch,
-        where its buffer ran out: ≈ 100 µs of sampling) computed now, in the period's slack, and kept aside;
-        the cycle's step puts it in place when nothing the refill read changed since (the planner's fields and
-        its plan as they were, the channel's inputs), and otherwise leaves the planner to refill itself. Only a
-        refill that continues the same plan in the same block: one that ends a block or starts a plan also
-        changes what the feed and the MLC read before the step. None: the cycle steps as usual."""
+        """Real time (B21): the planner's refill of the next cycle (a stepped cycle where the planner's buffer
+        ran out: ≈ 100 µs of sampling) computed now, in the period's slack, and kept aside; the cycle's step
+        puts it in place when nothing the refill read changed since (the planner's fields and its plan as they
+        were, the channel's inputs), and otherwise leaves the planner to refill itself. None: the cycle steps
+        as usual."""
         r = self.r
         ch = r.channel
         if not self.paced or ch is None:
             return None
         pl = ch.planner
-        p = pl.plan
-        if p is None or p.kind == "cruise" or not pl._buf_done or not pl.blocks or pl.blocks[0].move.per_rev:
-            return None  # per_rev: _check_spindle, which comes before the refill, may re-plan; a cruise's
-            # sampling snaps the next blocks' starts (it changes blocks in place)
-        if self._quiet(r, ch) != "run":
+        fill = self._refill_ahead(r, ch, pl)
+        if fill is None:
             return None
+        p, p0, s1, p1, _ = fill
+        s0 = dict(pl.__dict__)
         b0, nb = pl.blocks[0], len(pl.blocks)
-        s0, p0 = dict(pl.__dict__), dict(p.__dict__)
-        for name in _NOT_AHEAD:  # what would end the block or the plan stops the refill before it changes anything
-            setattr(pl, name, _not_ahead)
-        try:
-            pl._refill()
-            ok = pl.plan is p and not pl._buf_done
-        except Exception:  # _NotAhead, or an alarm of the refill: the cycle's own, it raises it there
-            ok = False
-        finally:
-            for name in _NOT_AHEAD:
-                delattr(pl, name)
-        s1, p1 = dict(pl.__dict__), dict(p.__dict__)
-        pl.__dict__.clear()
-        pl.__dict__.update(s0)
-        p.__dict__.clear()
-        p.__dict__.update(p0)
-        if not ok:
-            return None
         sig = _signature(ch)
 
         def step(channel: Channel) -> Setpoint:
@@ -306,6 +301,37 @@ class Stretcher:
             return channel.step()
 
         return step
+
+    def _refill_ahead(self, r: Any, ch: Channel, pl: Planner) -> tuple | None:
+        """The refill the next channel step would make (its buffer ran out), worked out and put back: (plan, its
+        fields before, the planner's fields after, the plan's fields after, buffer rows in this block), or None.
+        Only a refill that continues the same plan in the same block: one that ends a block or starts a plan
+        also changes what the feed and the MLC read before the step (the planner methods that would do it stop
+        the refill before they change anything)."""
+        p = pl.plan
+        if p is None or p.kind == "cruise" or not pl._buf_done or not pl.blocks or pl.blocks[0].move.per_rev:
+            return None  # per_rev: _check_spindle, which comes before the refill, may re-plan; a cruise's
+            # sampling snaps the next blocks' starts (it changes blocks in place)
+        if self._quiet(r, ch) != "run":
+            return None
+        s0, p0 = dict(pl.__dict__), dict(p.__dict__)
+        for name in _NOT_AHEAD:
+            setattr(pl, name, _not_ahead)
+        try:
+            pl._refill()
+            ok = pl.plan is p and not pl._buf_done
+        except Exception:  # _NotAhead, or an alarm of the refill: the cycle's own, it raises it there
+            ok = False
+        finally:
+            for name in _NOT_AHEAD:
+                delattr(pl, name)
+        rows = pl._block_rows() if ok else 0
+        s1, p1 = dict(pl.__dict__), dict(p.__dict__)
+        pl.__dict__.clear()
+        pl.__dict__.update(s0)
+        p.__dict__.clear()
+        p.__dict__.update(p0)
+        return (p, p0, s1, p1, rows) if ok else None
 
     # ---- conditions ----------------------------------------------------------------------------
     def _quiet(self, r: Any, ch: Channel) -> str | None:
@@ -498,12 +524,28 @@ def _save_planner(pl: Planner) -> dict:
     return saved
 
 
+def _refilled(fill: tuple) -> Callable[[Planner, int], Samples | None]:
+    """sample_stretch after the refill `Stretcher._refill_ahead` worked out (the planner stands where it did)."""
+    p, _, s1, p1, _ = fill
+
+    def sampler(pl: Planner, n: int) -> Samples | None:
+        pl.__dict__.update(s1)
+        p.__dict__.update(p1)
+        return sample_stretch(pl, n)
+
+    return sampler
+
+
 def _restore_planner(pl: Planner, saved: dict) -> None:
     pl.__dict__.clear()
     pl.__dict__.update(saved["pl"])
     if "blocks" in saved:  # the same deque (the channel's view of the planner holds it)
         pl.blocks.clear()
         pl.blocks.extend(saved["blocks"])
+    if "plan" in saved:  # a refill ahead sampled the plan (Stretcher._refill_ahead): its fields as before
+        p, fields = saved["plan"]
+        p.__dict__.clear()
+        p.__dict__.update(fields)
     if "f" in saved:
         f = pl.filter
         fs = dict(saved["f"])

@@ -159,10 +159,11 @@ def outputs_hold(r: Any, ch: Channel, position: np.ndarray) -> bool:
 
 def bulk_cycles(r: Any, ch: Channel, pl: Planner, smp: Samples, outs: list[Stretch], k0: int, m: int,
                 before_last_step: np.ndarray, settle: tuple[list[float], list[float]] | None,
-                timings: list[CycleTiming] | None = None) -> None:
+                timings: list[CycleTiming] | None = None) -> Any:
     """Cycles k0 … m-1 of the stretch as the runner's cycle would run them one by one (module doc). `timings`:
     real time, the cycles were paced one by one (hil.stretch.Stretcher._pace) with these timings, which the
-    trace rows take; the clock has counted them."""
+    trace rows take; the clock has counted them. With one timing fewer than cycles, the last cycle is paced
+    after this (in the slack before it): its trace row is left to the returned `last_row(timing)`."""
     t_wall = _time.perf_counter_ns()
     cnt = m - k0
     dt = r.bench.cycle
@@ -222,19 +223,36 @@ def bulk_cycles(r: Any, ch: Channel, pl: Planner, smp: Samples, outs: list[Stret
     mlc = r.mlc
     if type(mlc) is Mlc and n_axes < len(r.rx):
         mlc.caxis._cycles += cnt  # Mlc.spindle_drive → SpindleAxisSwitch.drive, a spindle staying one
+    deferred = timings is not None and len(timings) == cnt - 1
     if r.trace is not None:
-        _rows(r, outs, k0, m, times, first_cycle, row_lines, positions, timings)
+        if deferred:
+            _rows(r, outs, k0, m - 1, times[:-1], first_cycle, row_lines[:-1], positions, timings)
+        else:
+            _rows(r, outs, k0, m, times, first_cycle, row_lines, positions, timings)
     if r.on_cycle is not None:
         r.on_cycle(r)  # the operator panel, with nothing held: the same call every cycle
     if r.progress is not None:
         r.progress.update(r)
     if timings is not None:
-        r.timing = timings[-1]
-        return
+        if not deferred:
+            r.timing = timings[-1]
+            return None
+
+        def last_row(timing: CycleTiming) -> None:
+            r.timing = timing
+            if r.trace is not None:
+                _rows(r, outs, m - 1, m, times[-1:], first_cycle + cnt - 1, row_lines[-1:], positions, [timing])
+            if r.on_cycle is not None:
+                r.on_cycle(r)  # the last cycle's own call: a press while it waited is taken as stepping takes it
+            if r.progress is not None:
+                r.progress.update(r)
+
+        return last_row
     clock = r.clock
     clock._n += cnt
     clock.jitter.add_repeated(0.0, cnt, first_cycle)
     clock.exec.add_repeated((_time.perf_counter_ns() - t_wall) * 1e-9 / cnt, cnt, first_cycle)
+    return None
 
 
 def _mlc(r: Any, ch: Channel, outs: list[Stretch], k0: int, m: int, before_last_step: np.ndarray) -> None:
