@@ -149,8 +149,8 @@ def move_json(m: Move) -> str:
     without the intermediate dicts (issue 16: the dicts and the generic encoder were half of `hil
     path` on a lathe-cycle program); a move with a field of an unusual type goes the general way.
     Pinned by tests/test_path_json_fast.py (hypothesis)."""
-    if m.start is None or m.end is None or m.work is None or type(m.line) is not int \
-            or type(m.kind) is not str:
+    start, end, work = m.start, m.end, m.work
+    if start is None or end is None or work is None or type(m.line) is not int or type(m.kind) is not str:
         return strict_json.dumps(move_dict(m))
     key = (m.kind, m.line, m.block)
     head = _HEADS.get(key)
@@ -162,7 +162,6 @@ def move_json(m: Move) -> str:
             _HEADS[key] = head
     # a cycle's move starts at the dict its last move ended at: that point's text again (checked by
     # value, so a dict changed in place since is written anew)
-    start, end = m.start, m.end
     last = _LAST_END
     start_text = last[2] if start is last[0] and tuple(start.items()) == last[1] else _axes(start)
     # `_axes` of end and work, its remembered-point hit inline (the usual case: a call less per point);
@@ -173,7 +172,6 @@ def move_json(m: Move) -> str:
         hit = None
     end_text = hit[0] if hit is not None else _axes(end, end_items)
     last[0], last[1], last[2] = end, end_items, end_text
-    work = m.work
     hit = _POINTS.get(work_items := tuple(work.items()))
     if hit is not None and hit[1] and not _all_floats(work):
         hit = None

@@ -92,8 +92,9 @@ class MotionMixin:
             v = position.get(a, 0.0) - origin[a]
             work[a] = v * 2.0 if a in diameter else v
         words = self._axis_words(block)
+        inch = self.state.inch
         for a, (w, inc) in words.items():
-            v = self.distance(w, a)
+            v = w.value if w.has_point and not inch else self.distance(w, a)  # `distance` keeps such a value
             work[a] = work[a] + v if inc else v
         machine = {}
         for a in axes:
@@ -234,9 +235,10 @@ class MotionMixin:
         self.unit_locked = True
         exact = "G09" in funcs
         motion = st.motion
-        if motion == 0 or motion == 1:  # `_move_common`'s fields, positionally (no dict per block)
+        if motion == 0 or motion == 1:  # `_move_common`'s fields, positionally (no dict per block); the
+            # target dicts are this block's own (no stage changes a move's points in place)
             move = Move("rapid" if motion == 0 else "line", block.line, block.text, dict(self.position),
-                        dict(geo.target_machine), dict(geo.target_work), None, None,
+                        geo.target_machine, geo.target_work, None, None,
                         self.feed() if motion == 1 else None, None, st.per_rev if motion == 1 else False,
                         PLANES[st.plane], False, None, 0.0, 0.0, 0.0, self.program_name)
             self.position = dict(geo.target_machine)
