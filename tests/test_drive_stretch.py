@@ -142,6 +142,8 @@ def test_csv_spindle_stretch_equals_exchange_with_its_index_latch(probe):
     want, states = _reference(one, rx1, "target_velocity", speeds)
     rng = np.random.default_rng(probe)
     k = stretched = 0
+    latch = next((j for j, tx in enumerate(want) if tx.touch_probe_status == 3), len(want))
+    before = 0  # cycles stretched before the index latched: an armed probe no longer keeps the spindle stepped
     while k < len(speeds):
         rx2.target_velocity = speeds[k]
         c = min(int(rng.integers(1, 70)), len(speeds) - k)
@@ -154,7 +156,11 @@ def test_csv_spindle_stretch_equals_exchange_with_its_index_latch(probe):
             got = list(zip(*(getattr(s, f) for f in FIELDS)))
             assert got == [tuple(getattr(tx, f) for f in FIELDS) for tx in want[k:k + s.done]]
             assert astuple(s.last) == astuple(want[k + s.done - 1])
+            assert k + s.done <= latch or k > latch  # a stretch never takes the latching cycle
+            before += max(0, min(k + s.done, latch) - k)
             k, stretched = k + s.done, stretched + s.done
         assert _state(many) == states[k - 1]
     assert stretched > 1000 and abs(want[699].velocity_actual - 12000) < 20
     assert (want[-1].touch_probe_status == 3) == bool(probe)
+    if probe:
+        assert before > 0.5 * latch > 5  # the run-up to the first index edge stretches too

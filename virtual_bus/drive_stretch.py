@@ -37,14 +37,12 @@ class Stretch:
 
 def can_stretch(drive: Cia402Drive, rx: RxPdo, mode: int = 8) -> bool:
     """The drive runs the plain CSP (mode 8) or CSV (9) path the stretch reproduces. CSV may have its touch
-    probe armed once it latched the index (a spindle's thread sync): a latched probe waits, unchanged; or, not
-    latched yet, on a spindle that stands and is commanded to stand (a mill's CAM program without M03): it
-    does not move in the stretch, so no index passes (Cia402Drive._probe)."""
+    probe armed on the encoder index (a spindle's thread sync): a latched probe waits, unchanged; one not
+    latched yet (a spindle running up, or standing in a mill's CAM program without M03) latches in the cycle
+    whose sub-steps pass an index edge (Cia402Drive._probe), before which csv_stretch stops."""
     p = drive.params
     cw = rx.controlword
-    probe_ok = not rx.touch_probe_function & 1 or (mode == 9 and (drive._probe_latched or (
-        p.probe_position is None and rx.target_velocity == 0 and drive._want_cps == 0.0
-        and drive.target_velocity == 0.0 and drive.velocity == 0.0)))
+    probe_ok = not rx.touch_probe_function & 1 or (mode == 9 and (drive._probe_latched or p.probe_position is None))
     return (drive.state is State.OPERATION_ENABLED and drive.mode == mode and rx.mode == mode
             and not drive.external_fault and cw == drive._last_cw and cw & 0x8F == ENABLE_HELD
             and (mode == 8 or (p.negative_limit is None and p.positive_limit is None)) and probe_ok)
@@ -126,8 +124,13 @@ def csv_stretch(drive: Cia402Drive, rx: RxPdo, cycles: int, dt: float) -> Stretc
     pa, va, ta, sws = out.position_actual, out.velocity_actual, out.torque_actual, out.statusword
     k_raw, t_pct = units.raw_per_count_per_s(cpr), units.torque_percent  # as in csp_stretch
     inertia, viscous, coulomb, rated = p.inertia, p.viscous, p.coulomb, p.rated_torque
+    # the encoder index armed and not latched yet (Cia402Drive._probe): the stretch ends before the cycle whose
+    # sub-steps pass an index edge, which exchange() latches
+    every = (p.index_pulse_every or cpr) if rx.touch_probe_function & 1 and not drive._probe_latched else 0
+    floor = math.floor
     for _ in range(cycles):
         c_pos, c_vel, c_t, c_tv, cmd = pos, vel, t, tv, command
+        edge = False
         # The velocity-loop lines below repeat csp_stretch's on purpose: a call per sub-step would cost about
         # a third of what the stretch saves.
         for _k in range(n):  # Cia402Drive._step_following, csv
@@ -137,8 +140,13 @@ def csv_stretch(drive: Cia402Drive, rx: RxPdo, cycles: int, dt: float) -> Stretc
                 v_cmd = max(-max_cps, min(max_cps, v_cmd))
             if v_cmd != c_vel:
                 c_vel += (v_cmd - c_vel) * alpha
-            c_pos = c_pos + c_vel * h
+            new_pos = c_pos + c_vel * h
+            if every and floor(c_pos / every) != floor(new_pos / every):
+                edge = True
+            c_pos = new_pos
             c_t += h
+        if edge:
+            break  # the index latches in this cycle: exchange() takes it
         if abs(c_vel) > 1.2 * max_cps:
             break  # overspeed: exchange() takes the fault
         c_acc = (c_vel - vel) / dt
