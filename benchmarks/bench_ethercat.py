@@ -1,8 +1,9 @@
 """EtherCAT over a veth pair: pysoem master + virtual slaves (3 ASDA-class drives).
 
 Prints (asserts nothing):
-  * cycles/s reached back to back (lock-step slaves, one LRW per cycle), with both processes SCHED_FIFO on
-    one CPU (`lockstep_placement`; default scheduling where that is refused),
+  * cycles/s reached back to back (lock-step slaves, one LRW per cycle), with both processes SCHED_FIFO 50 on
+    one CPU as a user places them (hil/placement.py: `hil sim ethercat --cpu N --priority 50`, and the master
+    as `[realtime] lockstep = "fifo"` places `hil run`; decisions E21; what was refused is printed),
   * p50 / p99 / p99.9 cycle-period jitter with the master paced at the bench cycle (real-time
     mode: slaves advance by wall-clock time).
 Needs root (veth pair). Usage: python benchmarks/bench_ethercat.py [--cycles N] [--period-ms P]
@@ -11,10 +12,7 @@ Needs root (veth pair). Usage: python benchmarks/bench_ethercat.py [--cycles N] 
 from __future__ import annotations
 
 import argparse
-import os
 import time
-from collections.abc import Iterator
-from contextlib import contextmanager
 
 import numpy as np
 
@@ -22,38 +20,8 @@ from fieldbus.cia402 import Cia402Master, Target
 from fieldbus.ethercat.link import EthercatLink
 from fieldbus.pdo import RxPdo
 from hil.bench import default_lathe
+from hil.placement import Placed, placement_cpu
 from virtual_bus.ethercat.veth import SimProcess
-
-
-@contextmanager
-def lockstep_placement(pids: list[int], priority: int = 50) -> Iterator[str]:
-    """Master and slaves SCHED_FIFO on one CPU while a lock-step figure is taken; yields what was set.
-
-    Lock-step is a ping-pong: exactly one side has work at any time. On this 2-core VM shared with other
-    jobs, default scheduling leaves each wake-up queued behind the others' time slices (6,100 cycles/s
-    at load 6.6 for 21 + 58 µs of CPU a cycle), and the two on separate CPUs pay an IPI per wake-up (CPU a
-    cycle doubled); SCHED_FIFO on one CPU gives the CPU a cycle of an idle machine (docs/decisions/ethercat.md,
-    E20). Every thread of each process; restored afterwards. Needs root, as the veth pair does."""
-    tids = [int(t) for pid in pids for t in (os.listdir(f"/proc/{pid}/task") if pid else [os.getpid()])]
-    saved = []
-    try:
-        cpu = max(os.sched_getaffinity(0))
-        for tid in tids:
-            saved.append((tid, os.sched_getscheduler(tid), os.sched_getparam(tid), os.sched_getaffinity(tid)))
-            os.sched_setaffinity(tid, {cpu})
-            os.sched_setscheduler(tid, os.SCHED_FIFO, os.sched_param(priority))
-        what = f"SCHED_FIFO {priority}, master and slaves on CPU {cpu}"
-    except OSError as exc:
-        what = f"default scheduling ({exc.strerror or exc})"
-    try:
-        yield what
-    finally:
-        for tid, policy, param, cpus in saved:
-            try:
-                os.sched_setscheduler(tid, policy, param)
-                os.sched_setaffinity(tid, cpus)
-            except OSError:  # the slaves' process may be gone already
-                pass
 
 
 def drive_loop(link: EthercatLink, n: int, period: float | None) -> np.ndarray:
@@ -95,17 +63,23 @@ def main() -> None:
     ap.add_argument("--period-ms", type=float, default=1.0)
     args = ap.parse_args()
     bench = default_lathe()  # X, Z and the spindle: 3 drives
-    for mode, sim_args in (("lock-step, back to back", ()), ("real-time, paced", ("--realtime",))):
+    cpu_n, prio = placement_cpu(bench.realtime), 50
+    placed_sim = ("--cpu", str(cpu_n), "--priority", str(prio))
+    for mode, sim_args in (("lock-step, back to back", placed_sim), ("real-time, paced", ("--realtime",))):
         with SimProcess(*sim_args, tag="ecat9") as sim:
             link = EthercatLink.for_bench(bench, sim.iface)
             link.open()
             try:
-                if not sim_args:
-                    with lockstep_placement([0, sim.proc.pid]) as placed:
+                if sim_args is placed_sim:
+                    master = Placed()
+                    try:
+                        placed = f"master {master.apply(prio, cpu_n).what}, slaves {sim.banner.partition('; ')[2]}"
                         c0 = time.thread_time()
                         s = drive_loop(link, args.cycles, None)
                         cpu = time.thread_time() - c0
                         raw = pysoem_alone(link, args.cycles)
+                    finally:
+                        master.restore()
                     total = s[-1] - s[0]
                     print(f"{mode}: {args.cycles / total:,.0f} cycles/s "
                           f"({total / args.cycles * 1e6:.1f} µs per LRW round trip, 3 drives; {placed}); master CPU "

@@ -150,16 +150,19 @@ def issue17(d: str) -> None:
 
 def ethercat_lockstep(cycles: int = 5000) -> None:
     """Lock-step over EtherCAT: `hil sim ethercat` (the default lathe's 3 drives: X, Z, spindle) in a
-    network namespace behind a veth pair, the pysoem master here. Two figures: the bus alone (the link's
-    exchange, drives enabled, setpoints held), and the bench program run by BenchRunner over that bus
-    (MLC, NC, trace off). Needs root; prints why it is skipped otherwise. First, without root, the slaves'
-    own work per frame in-process (benchmarks/bench_ecat_slaves.py)."""
+    network namespace behind a veth pair, the pysoem master here. The bus alone (the link's exchange,
+    drives enabled, setpoints held) under default scheduling, then placed as a user asks for it (decisions
+    E21): the bench's `[realtime] lockstep = "fifo"` (priority 50) for the master, `hil sim ethercat --cpu N
+    --priority 50` for the slaves; then the bench program run by BenchRunner over that bus with the bench's
+    lock-step clock (hil/placement.py, as `hil run` makes it; MLC, NC, trace off). Each line says what was
+    granted. Needs root; prints why it is skipped otherwise. First, without root, the slaves' own work per
+    frame in-process (benchmarks/bench_ecat_slaves.py)."""
     sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+    from dataclasses import replace
+
     from benchmarks import bench_ecat_slaves
-    from benchmarks.bench_ethercat import lockstep_placement
-    from fieldbus.cia402 import Cia402Master, Target
     from fieldbus.ethercat.link import EthercatLink
-    from fieldbus.pdo import RxPdo
+    from hil.placement import PREFIX, Placed, lockstep_clock, placement_cpu
     from virtual_bus.ethercat.veth import SimProcess, can_create
 
     bench_ecat_slaves.main([])
@@ -168,51 +171,69 @@ def ethercat_lockstep(cycles: int = 5000) -> None:
         print(f"EtherCAT lock-step: skipped ({why})")
         return
     bench = default_lathe()
-    with SimProcess(tag="ecat9") as sim:
-        link = EthercatLink.for_bench(bench, sim.iface)
-        link.open()
-        try:
-            n = len(link.drives)
-            masters = [Cia402Master() for _ in range(n)]
-            rx = [RxPdo(mode=8) for _ in range(n - len(bench.spindles))] + [RxPdo(mode=9) for _ in bench.spindles]
-            tx = link.exchange(rx)
-            for m in masters:
-                m.request(Target.ENABLED)
-            for _ in range(200):  # enable every drive, then hold the position each reports
-                for m, r, t in zip(masters, rx, tx):
-                    r.controlword = m.step(t.statusword)
-                    r.target_position = t.position_actual
-                tx = link.exchange(rx)
-            enabled = sum(m.enabled for m in masters)
-
-            def bus_alone(label: str) -> None:
-                nonlocal tx
-                t0, c0, s0 = time.perf_counter(), time.thread_time(), _cpu_of(sim.proc.pid)
-                for _ in range(cycles):
-                    for m, r, t in zip(masters, rx, tx):
-                        r.controlword = m.step(t.statusword)
-                    tx = link.exchange(rx)
-                wall, cpu, slaves = time.perf_counter() - t0, time.thread_time() - c0, _cpu_of(sim.proc.pid) - s0
-                print(f"EtherCAT lock-step, bus alone ({n} drives, {enabled} enabled, veth + hil sim ethercat, {label}): "
-                      f"{cycles} cycles in {wall:.2f} s wall = {cycles / wall:,.0f} cycles/s; CPU per cycle: master "
-                      f"{cpu / cycles * 1e6:.0f} µs, slaves {slaves / cycles * 1e6:.0f} µs, so "
-                      f"{cycles / (cpu + slaves):,.0f} cycles/s when the two take turns on an otherwise idle machine "
-                      f"(load {os.getloadavg()[0]:.1f})")
-
-            bus_alone("default scheduling")
-            with lockstep_placement([0, sim.proc.pid]) as placed:  # benchmarks/bench_ethercat.py: why
-                bus_alone(placed)
-        finally:
-            link.close()
-        runner = BenchRunner(bench, EthercatLink.for_bench(bench, sim.iface), None)
-        with lockstep_placement([0, sim.proc.pid]) as placed:
+    bench.realtime = replace(bench.realtime, lockstep="fifo", priority=50)
+    placed_sim = ("--cpu", str(placement_cpu(bench.realtime)), "--priority", str(bench.realtime.priority))
+    for sim_args in ((), placed_sim):
+        with SimProcess(*sim_args, tag="ecat9") as sim:
+            slaves_placed = sim.banner.partition("; ")[2] or "default scheduling"
+            if sim_args:
+                master = Placed()
+                label = f"master {master.apply(bench.realtime.priority, placement_cpu(bench.realtime)).what}; slaves {slaves_placed}"
+            else:
+                master, label = None, "default scheduling"
+            try:
+                _bus_alone(bench, sim, cycles, label)
+            finally:
+                if master is not None:
+                    master.restore()
+            if not sim_args:
+                continue
+            runner = BenchRunner(bench, EthercatLink.for_bench(bench, sim.iface), None,
+                                 clock=lockstep_clock(bench.cycle, bench.realtime))
             t0, c0, s0 = time.perf_counter(), time.thread_time(), _cpu_of(sim.proc.pid)
             r = runner.run_program(parse_program(PROGRAM, name="bench.nc"))
             wall, cpu, slaves = time.perf_counter() - t0, time.thread_time() - c0, _cpu_of(sim.proc.pid) - s0
-        print(f"EtherCAT lock-step, bench program ({n} drives, {placed}; bring-up included): {r.cycles} cycles, "
-              f"{r.sim_time:.2f} s simulated in {wall:.2f} s wall = {r.cycles / wall:,.0f} cycles/s ({r.sim_time / wall:.1f}x "
-              f"real time, {'completed' if r.ok else 'alarm ' + ', '.join(a.code_text for a in r.alarms)}); CPU per "
-              f"cycle: master {cpu / r.cycles * 1e6:.0f} µs, slaves {slaves / r.cycles * 1e6:.0f} µs")
+            print(f"EtherCAT lock-step, bench program ({len(bench.axes) + len(bench.spindles)} drives; master {r.granted.removeprefix(PREFIX)}; "
+                  f"slaves {slaves_placed}; bring-up included): {r.cycles} cycles, "
+                  f"{r.sim_time:.2f} s simulated in {wall:.2f} s wall = {r.cycles / wall:,.0f} cycles/s ({r.sim_time / wall:.1f}x "
+                  f"real time, {'completed' if r.ok else 'alarm ' + ', '.join(a.code_text for a in r.alarms)}); CPU per "
+                  f"cycle: master {cpu / r.cycles * 1e6:.0f} µs, slaves {slaves / r.cycles * 1e6:.0f} µs")
+
+
+def _bus_alone(bench, sim, cycles: int, label: str) -> None:
+    """The link's exchange alone: every drive enabled, then `cycles` exchanges holding the position."""
+    from fieldbus.cia402 import Cia402Master, Target
+    from fieldbus.ethercat.link import EthercatLink
+    from fieldbus.pdo import RxPdo
+
+    link = EthercatLink.for_bench(bench, sim.iface)
+    link.open()
+    try:
+        n = len(link.drives)
+        masters = [Cia402Master() for _ in range(n)]
+        rx = [RxPdo(mode=8) for _ in range(n - len(bench.spindles))] + [RxPdo(mode=9) for _ in bench.spindles]
+        tx = link.exchange(rx)
+        for m in masters:
+            m.request(Target.ENABLED)
+        for _ in range(200):  # enable every drive, then hold the position each reports
+            for m, r, t in zip(masters, rx, tx):
+                r.controlword = m.step(t.statusword)
+                r.target_position = t.position_actual
+            tx = link.exchange(rx)
+        enabled = sum(m.enabled for m in masters)
+        t0, c0, s0 = time.perf_counter(), time.thread_time(), _cpu_of(sim.proc.pid)
+        for _ in range(cycles):
+            for m, r, t in zip(masters, rx, tx):
+                r.controlword = m.step(t.statusword)
+            tx = link.exchange(rx)
+        wall, cpu, slaves = time.perf_counter() - t0, time.thread_time() - c0, _cpu_of(sim.proc.pid) - s0
+    finally:
+        link.close()
+    print(f"EtherCAT lock-step, bus alone ({n} drives, {enabled} enabled, veth + hil sim ethercat, {label}): "
+          f"{cycles} cycles in {wall:.2f} s wall = {cycles / wall:,.0f} cycles/s; CPU per cycle: master "
+          f"{cpu / cycles * 1e6:.0f} µs, slaves {slaves / cycles * 1e6:.0f} µs, so "
+          f"{cycles / (cpu + slaves):,.0f} cycles/s when the two take turns on an otherwise idle machine "
+          f"(load {os.getloadavg()[0]:.1f})")
 
 
 def _cpu_of(pid: int) -> float:

@@ -146,6 +146,7 @@ def run(program: str | Path, bench: str | Path | Bench | None = None, *, bus: st
     homing of axes with a bench `homing` table (hil/drive_homing.py; the drives keep their last origin). `retain`: a
     JSON file holding the retentive # variables from run to run (hil/retentive.py)."""
     from hil.clock import make_clock
+    from hil.placement import lockstep_clock
     from hil.progress import Progress
     from hil.remote_io import attach_remote_io
     from hil.run_events import EventPlayer, EventSpecError, parse_events
@@ -180,7 +181,8 @@ def run(program: str | Path, bench: str | Path | Bench | None = None, *, bus: st
     if capture:  # refuse a sim bus or a wrong suffix before anything starts
         _capture_suffix(str(capture), b)
     link = make_link(b)
-    clock = make_clock(b.cycle, realtime, b.realtime)
+    # lock-step: placed on one CPU under SCHED_FIFO when the bench's [realtime] lockstep says so (decisions E21)
+    clock = make_clock(b.cycle, realtime, b.realtime) if realtime else lockstep_clock(b.cycle, b.realtime)
     if progress is True:
         progress = Progress(max((blk.line for blk in prog.blocks), default=1))
     if aux_timeout:  # warn when an M/S/T code waits longer for the MLC's finish (decision T7)

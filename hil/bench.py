@@ -42,6 +42,7 @@ class SpindleConfig:
     station_alias: int | None = None  # as AxisConfig.station_alias
 
 
+LOCKSTEP_PLACEMENTS = ("default", "fifo")  # [realtime] lockstep: scheduled as any process / SCHED_FIFO on one CPU
 FILTER_MS = 16.0  # default N1.036 and N1.037 (ms)
 PATH_DEVIATION = 0.02  # default N1.053 (mm)
 
@@ -88,6 +89,9 @@ class RealtimeConfig:
     busy_wait: float = 0.0002  # s spun on the clock before each deadline instead of sleeping
     overrun: str = "warn"  # "warn" or "alarm"
     lock_memory: bool = True  # mlockall so page faults don't hit the cycle
+    # "fifo": a lock-step run (not only --realtime) takes SCHED_FIFO `priority` on `cpu` too, and `hil sim
+    # ethercat --bench` places its slaves the same, so the two take turns on one CPU (decisions E21)
+    lockstep: str = "default"
 
 
 @dataclass

@@ -18,7 +18,7 @@ from fieldbus.pdo import ASDA_CSP, ASDA_CSP_CSV
 from fieldbus.devices import DEFAULT_MODEL, MODELS
 from fieldbus.units import AxisScaling
 from hil.bench_params import check_param
-from hil.bench import AxisConfig, Bench, ChecksConfig, IoStationConfig, RealtimeConfig, SpindleConfig
+from hil.bench import LOCKSTEP_PLACEMENTS, AxisConfig, Bench, ChecksConfig, IoStationConfig, RealtimeConfig, SpindleConfig
 from hil.drive_homing import DriveHoming
 from hil.toml_fields import BenchFileError, FieldReader, kind_of, read_text_file
 from nc.motion.limits import AxisLimits
@@ -304,8 +304,9 @@ def _realtime(r: FieldReader, d: dict) -> RealtimeConfig:
         busy_wait=(r.number(d, "busy_wait_us", "realtime.busy_wait_us", base.busy_wait * 1e6, minimum=0.0,
                             maximum=100_000.0) or 0.0) / 1e6,
         overrun=r.string(d, "overrun", "realtime.overrun", base.overrun, ("warn", "alarm")) or base.overrun,
-        lock_memory=r.boolean(d, "lock_memory", "realtime.lock_memory", base.lock_memory))
-    r.unknown(d, "realtime.", {"priority", "cpu", "busy_wait_us", "overrun", "lock_memory"})
+        lock_memory=r.boolean(d, "lock_memory", "realtime.lock_memory", base.lock_memory),
+        lockstep=r.string(d, "lockstep", "realtime.lockstep", base.lockstep, LOCKSTEP_PLACEMENTS) or base.lockstep)
+    r.unknown(d, "realtime.", {"priority", "cpu", "busy_wait_us", "overrun", "lock_memory", "lockstep"})
     return rt
 
 

@@ -183,7 +183,10 @@ class BenchRunner:
             self._end_reason = "interrupted"
             raise
         finally:
-            self._shutdown()
+            try:
+                self._shutdown()
+            finally:  # the scheduling given back even when the shutdown fails (a hook raising every cycle)
+                self.clock.stop()
             if self._retained is not None:
                 try:
                     retentive.save(self.retain, self._retained)

@@ -54,6 +54,9 @@ def err(text: str) -> str:
     ('[realtime]\npriority = 120\n', "realtime.priority: must be at most 99, got 120"),
     ('[realtime]\noverrun = "ignore"\n', "realtime.overrun: must be one of 'warn', 'alarm', got 'ignore'"),
     ('[realtime]\ncpu = -1\n', "realtime.cpu: must be at least 0, got -1"),
+    ('[realtime]\nlockstep = "rr"\n', "realtime.lockstep: must be one of 'default', 'fifo', got 'rr'"),
+    ('[realtime]\nlockstep = true\n', "realtime.lockstep: must be a non-empty string, got true"),
+    ('[realtime]\nlock_step = "fifo"\n', "realtime.lock_step: unknown key"),
     ('[checks]\nmax_following_error = { Y = 0.1 }\n', "checks.max_following_error.Y: no axis 'Y' on this bench"),
     ('[checks]\nmax_following_error = -1\n', "checks.max_following_error: must be a positive number"),
     ('[checks]\ncontour_error = "small"\n', "checks.contour_error: must be a number, got 'small'"),
@@ -102,6 +105,9 @@ def test_good_bench_builds_scaling_and_limits():
     assert b.axes[0].start == 10.0 and b.axes[0].scaling.lead == 5.0
     assert b.checks.max_following_error == {"X": 0.02, "Z": 0.02, "C": 0.02}
     assert b.realtime.overrun == "alarm" and b.realtime.busy_wait == pytest.approx(50e-6)
+    assert b.realtime.lockstep == "default"  # a lock-step run is scheduled as any process unless asked
+    placed = parse_bench(GOOD + '[realtime]\nlockstep = "fifo"\ncpu = 1\npriority = 40\n').realtime
+    assert (placed.lockstep, placed.cpu, placed.priority) == ("fifo", 1, 40)
 
 
 @pytest.mark.parametrize("name, axes", [("lathe-2axis", ("X", "Z")), ("mill-3axis", ("X", "Y", "Z")),

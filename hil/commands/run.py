@@ -180,6 +180,8 @@ def print_run(program: str, r, out) -> None:
 
 
 def print_timing(r: RunResult, out=None) -> None:
+    from hil.placement import PREFIX as PLACEMENT
+
     out = out or sys.stdout
     if r.realtime:
         j = r.timing.get("jitter", {})
@@ -190,6 +192,8 @@ def print_timing(r: RunResult, out=None) -> None:
         if lat:
             print("wake latency   " + "  ".join(f"{k} {lat.get(k, 0.0) * 1e6:.1f} µs"
                                             for k in ("p50", "p99", "p99.9", "max")), file=out)
+    elif r.granted.startswith(PLACEMENT):  # [realtime] lockstep = "fifo": what the system granted (decisions E21)
+        print(f"placement      {r.granted[len(PLACEMENT):]}", file=out)
     e = r.timing.get("exec", {})
     if e:
         print("cycle work     " + "  ".join(f"{k} {e.get(k, 0.0) * 1e6:.1f} µs" for k in ("p50", "p99", "max"))

@@ -33,6 +33,11 @@ def _add_ethercat(sims: argparse._SubParsersAction) -> None:
                         "then DI16 + DO16 ones up to N")
     p.add_argument("--realtime", action="store_true",
                    help="advance drive models by wall-clock time between frames instead of one cycle per frame")
+    p.add_argument("--cpu", type=int, metavar="N",
+                   help="run the slaves on CPU N under SCHED_FIFO (lock-step beside `hil run` on the same CPU; "
+                        "default: the bench's [realtime] cpu when its lockstep is \"fifo\")")
+    p.add_argument("--priority", type=int, metavar="P",
+                   help="SCHED_FIFO priority 1-99 of the slaves (default: the bench's [realtime] priority)")
     p.add_argument("--fault", action="append", default=[], metavar="SPEC", help="inject a scripted fault (repeatable)")
     p.add_argument("--duration", type=float, help="stop after this many seconds")
     p.add_argument("--verbose", action="store_true", help="log faults and AL state changes to stderr")
@@ -143,6 +148,20 @@ def ethercat_iface(bus: str | None, iface: str | None) -> str:
     return iface
 
 
+def _place(args: argparse.Namespace, bench) -> tuple[object | None, str]:
+    """SCHED_FIFO on one CPU for the slaves (decisions E21) when --cpu/--priority ask for it, or the bench's
+    [realtime] lockstep = "fifo" in lock-step; (the placement to restore, "; what was granted" for the banner)."""
+    rt = bench.realtime
+    if args.cpu is None and args.priority is None and (rt.lockstep != "fifo" or args.realtime):
+        return None, ""
+    from hil.placement import Placed, placement_cpu
+
+    placed = Placed()
+    cpu = args.cpu if args.cpu is not None else placement_cpu(rt)
+    granted = placed.apply(args.priority or rt.priority, cpu)
+    return placed, "; " + granted.what
+
+
 def cmd_sim_ethercat(args: argparse.Namespace) -> int:
     from virtual_bus.ethercat.faults import parse_fault
     from virtual_bus.ethercat.network import RawSocketLine
@@ -154,6 +173,10 @@ def cmd_sim_ethercat(args: argparse.Namespace) -> int:
         if args.esi:
             bench = with_esi(bench, args.esi)
         faults = [parse_fault(f) for f in args.fault]
+        if args.priority is not None and not 1 <= args.priority <= 99:
+            raise ValueError(f"--priority {args.priority}: a SCHED_FIFO priority from 1 to 99")
+        if args.cpu is not None and args.cpu < 0:
+            raise ValueError(f"--cpu {args.cpu}: a CPU number (0, 1, ...)")
     except (InputError, ValueError) as exc:
         print(f"hil sim ethercat: {exc}", file=sys.stderr)
         return EXIT_USAGE
@@ -167,12 +190,15 @@ def cmd_sim_ethercat(args: argparse.Namespace) -> int:
         return EXIT_USAGE
     signal.signal(signal.SIGTERM, lambda *_: setattr(line, "running", False))
     names = ", ".join(s.name for s in chain.slaves)
-    print(f"hil sim ethercat: {len(chain.slaves)} slaves on {args.iface}: {names}", flush=True)
+    placed, where = _place(args, bench)
+    print(f"hil sim ethercat: {len(chain.slaves)} slaves on {args.iface}: {names}{where}", flush=True)
     try:
         line.serve(args.duration)
     except KeyboardInterrupt:
         pass
     finally:
+        if placed is not None:
+            placed.restore()
         line.close()
         if args.verbose:
             for name, state, code in chain.states():

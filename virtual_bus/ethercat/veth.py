@@ -64,6 +64,7 @@ class SimProcess:
         self.pair: VethPair | None = None
         self.proc: subprocess.Popen | None = None
         self.log = ""
+        self.banner = ""  # its first line: the slaves it serves, and its placement (decisions E21)
 
     @property
     def iface(self) -> str:
@@ -82,6 +83,7 @@ class SimProcess:
             if "slaves on" not in line:
                 self.proc.wait(5)
                 raise RuntimeError(f"hil sim ethercat did not start: {line}{self.proc.stderr.read() if self.proc.stderr else ''}")
+            self.banner = line.strip()
         except BaseException:
             self.__exit__(None, None, None)
             raise
