@@ -107,6 +107,11 @@ class Stretcher:
         elif type(r.mlc) is BasicMlc and pl._buf_blk is not None:  # a cruise, across its blocks (nothing reads
             n = _across(ch, pl, min(limit, self.max_cycles))          # the queue's length in between)
             self._sampler = _sample_across
+        elif pl.plan is None and pl._buf_done and pl.filter is not None and not pl.filter.settled and pl.at_rest:
+            # an exact stop between blocks: the planner stands until its filter settled, the cycle that begins
+            # settled starts the next block (stepped), as "drain" before a code
+            n = min(limit, self.max_cycles, pl.filter.span - pl.filter._still)
+            self._sampler = _stand_queued
         else:  # to the buffer's end: the planner stays on its block (dropped at the refill, a stepped cycle)
             n = min(limit, self.max_cycles, pl._block_rows())  # a cruise's buffer spans blocks: this one's rows
             self._sampler = sample_stretch
@@ -168,7 +173,7 @@ class Stretcher:
         # The MLC exchange reads the planner's own position (M3x352+i, axis at 0) before the cycle's step: the
         # raw sample of the cycle before, as it stood in stepping (sample_stretch moved it to the last one).
         raw = [saved_pl["pl"]["position"], *pl._buf_pos[pl._buf_i - m:pl._buf_i - 1]] \
-            if self._sampler is not stand_stretch else [pl.position] * m
+            if self._sampler not in (stand_stretch, _stand_queued) else [pl.position] * m
         last_raw = pl.position
         k = 0
 
@@ -274,64 +279,82 @@ class Stretcher:
     # ---- real time: the refill of a stepped cycle ahead ----------------------------------------------
     def ahead(self) -> Callable[[Channel], Setpoint] | None:
         """Real time (B21): the planner's refill of the next cycle (a stepped cycle where the planner's buffer
-        ran out: ≈ 100 µs of sampling) computed now, in the period's slack, and kept aside; the cycle's step
-        puts it in place when nothing the refill read changed since (the planner's fields and its plan as they
-        were, the channel's inputs), and otherwise leaves the planner to refill itself. None: the cycle steps
-        as usual."""
+        ran out: ≈ 100 µs of sampling, more with a block's end and the next one's solve) computed now, in the
+        period's slack, and kept aside; the cycle's step puts it in place when nothing the refill read changed
+        since (the planner's fields, its queue and its plan as they were, the channel's inputs), and otherwise
+        leaves the planner to refill itself. None: the cycle steps as usual."""
         r = self.r
         ch = r.channel
         if not self.paced or ch is None:
             return None
         pl = ch.planner
-        fill = self._refill_ahead(r, ch, pl)
+        fill = self._refill_ahead(r, ch, pl, across=True)
         if fill is None:
             return None
-        p, p0, s1, p1, _ = fill
+        p, p0, s1, p1, _, q0, q1 = fill
         s0 = dict(pl.__dict__)
-        b0, nb = pl.blocks[0], len(pl.blocks)
         sig = _signature(ch)
 
         def step(channel: Channel) -> Setpoint:
-            d = pl.__dict__
-            if (_signature(channel) == sig and pl.plan is p and p.__dict__ == p0 and len(pl.blocks) == nb
-                    and pl.blocks[0] is b0 and len(d) == len(s0) and all(d.get(k) is v for k, v in s0.items())):
+            d, q = pl.__dict__, pl.blocks
+            if (_signature(channel) == sig and pl.plan is p and (p is None or p.__dict__ == p0)
+                    and len(q) == len(q0) and all(a is b for a, b in zip(q, q0)) and len(d) == len(s0)
+                    and all(d.get(k) is v for k, v in s0.items())):
                 d.update(s1)
-                p.__dict__.update(p1)
+                if p is not None:
+                    p.__dict__.update(p1)
+                if q1 is not None:  # the refill finished blocks: the queue as it left it (the same deque)
+                    q.clear()
+                    q.extend(q1)
                 self.ahead_used += 1
             return channel.step()
 
         return step
 
-    def _refill_ahead(self, r: Any, ch: Channel, pl: Planner) -> tuple | None:
+    def _refill_ahead(self, r: Any, ch: Channel, pl: Planner, across: bool = False) -> tuple | None:
         """The refill the next channel step would make (its buffer ran out), worked out and put back: (plan, its
-        fields before, the planner's fields after, the plan's fields after, buffer rows in this block), or None.
-        Only a refill that continues the same plan in the same block: one that ends a block or starts a plan
-        also changes what the feed and the MLC read before the step (the planner methods that would do it stop
-        the refill before they change anything)."""
+        fields before, the planner's fields after, the plan's fields after, buffer rows in this block, the queue
+        before and after, None if unchanged), or None. Without `across` only a refill that continues the same
+        plan in the same block (a stretch starting there hands its samples to the MLC scans before the step;
+        ending a block changes what they read); with it also one that ends blocks and solves the next, for a
+        step that puts it in place after the scan. Spindle feedback (feed per revolution, threads) is not read
+        ahead: the refills that would are left to the step."""
         p = pl.plan
-        if p is None or p.kind == "cruise" or not pl._buf_done or not pl.blocks or pl.blocks[0].move.per_rev:
+        if (p is None and not across) or (p is not None and p.kind == "cruise") or not pl._buf_done \
+                or not pl.blocks or pl.blocks[0].move.per_rev:
             return None  # per_rev: _check_spindle, which comes before the refill, may re-plan; a cruise's
             # sampling snaps the next blocks' starts (it changes blocks in place)
         if self._quiet(r, ch) != "run":
             return None
-        s0, p0 = dict(pl.__dict__), dict(p.__dict__)
-        for name in _NOT_AHEAD:
+        s0, p0, q0 = dict(pl.__dict__), dict(p.__dict__) if p is not None else None, list(pl.blocks)
+        guards = ("_no_progress",) if across else _NOT_AHEAD
+        for name in guards:
+            setattr(pl, name, _not_ahead)
+        feedback = {name: s0[name] for name in _SPINDLE_FEEDBACK if s0.get(name) is not None}
+        for name in feedback:
             setattr(pl, name, _not_ahead)
         try:
+            # what the step's feed sets first (it reads nothing in a quiet cycle: Stretcher._quiet)
+            pl.closed = ch.end is not None or ch._deferred is not None or ch._limit_alarm is not None
             pl._refill()
-            ok = pl.plan is p and not pl._buf_done
+            ok = (across or pl.plan is p) and not pl._buf_done
         except Exception:  # _NotAhead, or an alarm of the refill: the cycle's own, it raises it there
             ok = False
         finally:
-            for name in _NOT_AHEAD:
+            for name in guards:
                 delattr(pl, name)
+            pl.__dict__.update(feedback)
         rows = pl._block_rows() if ok else 0
-        s1, p1 = dict(pl.__dict__), dict(p.__dict__)
+        s1, p1, q1 = dict(pl.__dict__), dict(p.__dict__) if p is not None else None, list(pl.blocks)
         pl.__dict__.clear()
         pl.__dict__.update(s0)
-        p.__dict__.clear()
-        p.__dict__.update(p0)
-        return (p, p0, s1, p1, rows) if ok else None
+        if p is not None:
+            p.__dict__.clear()
+            p.__dict__.update(p0)
+        pl.blocks.clear()
+        pl.blocks.extend(q0)
+        changed = len(q1) != len(q0) or any(a is not b for a, b in zip(q1, q0))
+        return (p, p0, s1, p1, rows, q0, q1 if changed else None) if ok else None
 
     # ---- conditions ----------------------------------------------------------------------------
     def _quiet(self, r: Any, ch: Channel) -> str | None:
@@ -455,6 +478,8 @@ def _not_ahead(*args: Any, **kwargs: Any) -> None:
 
 # Planner methods a refill calls when it ends a block or the plan, re-plans or stalls: a refill ahead stops there
 _NOT_AHEAD = ("_finish_block", "_end_plan", "_replan", "_start_plan", "_no_progress")
+# The planner's spindle feedback callbacks: this cycle's feedback, not there yet ahead of it
+_SPINDLE_FEEDBACK = ("spindle_rpm", "spindle_angle", "spindle_index", "spindle_command")
 
 
 def _signature(ch: Channel) -> tuple:
@@ -506,6 +531,10 @@ def _across(ch: Channel, pl: Planner, n: int) -> int:
     return n
 
 
+def _stand_queued(pl: Planner, n: int) -> Samples | None:
+    return stand_stretch(pl, n, queued=True)
+
+
 def _sample_across(pl: Planner, n: int) -> Samples | None:
     return sample_stretch(pl, n, across=True)
 
@@ -526,7 +555,7 @@ def _save_planner(pl: Planner) -> dict:
 
 def _refilled(fill: tuple) -> Callable[[Planner, int], Samples | None]:
     """sample_stretch after the refill `Stretcher._refill_ahead` worked out (the planner stands where it did)."""
-    p, _, s1, p1, _ = fill
+    p, _, s1, p1, *_ = fill
 
     def sampler(pl: Planner, n: int) -> Samples | None:
         pl.__dict__.update(s1)

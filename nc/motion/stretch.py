@@ -66,13 +66,16 @@ def sample_stretch(pl: Planner, n: int, across: bool = False) -> Samples | None:
     return Samples(positions, list(pl._buf_line[i:i + m]), np.array(pl._buf_vel[i:i + m], dtype=float), mv, moves)
 
 
-def stand_stretch(pl: Planner, n: int) -> Samples | None:
+def stand_stretch(pl: Planner, n: int, queued: bool = False) -> Samples | None:
     """`n` setpoints of a planner with nothing to move (no block, no plan: waiting for an M/S/T finish, or the
     filter's tail after the last move), as step() gives them: the position where it stands through the filter.
     None unless step() would change nothing else: it stood so the cycle before (speed 0, no block started, no
     stop to flush, no axis moving on its own) and the filter needs no reset to that position. step()'s solve
-    (which finds nothing) runs once the filter has settled, and leaves the carry at one cycle."""
-    if n <= 0 or pl.blocks or pl.plan is not None or not pl._buf_done or pl._integrate_angle or pl._stopping:
+    (which finds nothing) runs once the filter has settled, and leaves the carry at one cycle. `queued`: blocks
+    wait behind an exact stop (Planner._refill starts nothing before the filter settled); the caller ends the
+    stretch before the cycle that begins with the filter settled, whose solve starts the next block."""
+    if n <= 0 or (pl.blocks and not queued) or pl.plan is not None or not pl._buf_done or pl._integrate_angle \
+            or pl._stopping:
         return None
     if pl.v != 0.0 or pl.a != 0.0 or pl._started or np.any(pl._axis_v):
         return None
