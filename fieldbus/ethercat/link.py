@@ -83,6 +83,9 @@ class EthercatLink:
         self._states: list[str] = []  # per slave as `infos` lists them, refreshed on every bad cycle
         self._all_op: list[str] = []  # what `_states` reads after a good frame (shared, never changed in place)
         self._failed = False  # a bus alarm was raised and the line was not recovered since
+        # status() of the last call, with what it was built from: `_states` (by identity: it is replaced, never
+        # changed in place), `_failed` and whether the master is open
+        self._status: tuple[list[str], bool, bool, LinkStatus] | None = None
         self._io_out: list[bytes] = []  # per I/O slave: the output image the next frame carries
         self._io_in: list[bytes] = []  # per I/O slave: the input image of the last good frame
 
@@ -389,10 +392,17 @@ class EthercatLink:
 
     def status(self) -> LinkStatus:
         """Connected (M30000) while every slave reads OP and no bus alarm stands; per-slave states as
-        last seen (a good working counter means OP; a bad cycle re-reads the AL states)."""
-        ok = self.master is not None and not self._failed and bool(self._states) \
-            and all(st == "OP" for st in self._states)
-        return LinkStatus(ok, [i.name for i in self.infos], [i.kind for i in self.infos], list(self._states))
+        last seen (a good working counter means OP; a bad cycle re-reads the AL states). The runner reads it
+        every cycle and never changes it: the same object comes back until one of those changes (building
+        it was 2.5 µs of a lock-step cycle's CPU)."""
+        states, failed, opened = self._states, self._failed, self.master is not None
+        last = self._status
+        if last is not None and last[0] is states and last[1] == failed and last[2] == opened:
+            return last[3]
+        ok = opened and not failed and bool(states) and all(st == "OP" for st in states)
+        st = LinkStatus(ok, [i.name for i in self.infos], [i.kind for i in self.infos], list(states))
+        self._status = (states, failed, opened, st)
+        return st
 
     # ---- remote I/O slaves (R1-EC class), k-th in connection order = EIO node 501+k ---------------
     def io_bits(self, k: int) -> tuple[int, int]:
