@@ -127,3 +127,15 @@ def test_hil_sim_ethercat_shares_the_cpu_of_a_placed_ethercat_run(tmp_path):
     assert r.granted == f"lock-step placement: SCHED_FIFO prio 20 on CPU {_cpu()}"
     assert probe.seen == {(os.SCHED_FIFO, 20, frozenset({_cpu()}))}
     assert _now() == before
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--priority", "0"], "--priority 0: a SCHED_FIFO priority from 1 to 99"),
+    (["--priority", "100"], "--priority 100: a SCHED_FIFO priority from 1 to 99"),
+    (["--cpu", "-1"], "--cpu -1: a CPU number (0, 1, ...)"),
+])
+def test_hil_sim_ethercat_refuses_a_bad_placement_before_it_serves(args, message):
+    out = subprocess.run([sys.executable, "-m", "hil.cli", "sim", "ethercat", "--bus", "ethercat:lo", *args],
+                         capture_output=True, text=True, timeout=60, env={**os.environ, "PYTHONPATH": str(ROOT)})
+    assert out.returncode == 2
+    assert out.stderr.strip() == f"hil sim ethercat: {message}"
