@@ -14,7 +14,7 @@ from nc.channel import RunState
 from nc.motion import AxisLimits, MotionConfig
 from nc.motion.offline import run
 from nc.motion.planner import Planner
-from tests.motion_helpers import AX, check, lines, polyline_deviation, worst_ratio
+from tests.motion_helpers import AX, arc, check, lines, polyline_deviation, worst_ratio
 
 TOL = 0.02
 LIM = {"X": AxisLimits(500, 5000, 250_000), "Y": AxisLimits(500, 5000, 250_000), "Z": AxisLimits(300, 3000, 150_000)}
@@ -63,13 +63,54 @@ def test_exact_stop_and_rapids_get_no_blend():
     assert 0.5 * TOL < polyline_deviation(st.positions, pts) <= TOL * (1 + 1e-6)
 
 
-def test_the_filter_keeps_its_own_corners():
-    """Under N1.036/N1.037 the corners stay the filter's (decision 40 b: blends need its share gone)."""
+def _filtered(**kw) -> MotionConfig:
+    return _cfg(path_tolerance=TOL, filter_time=0.016, filter_scurve=0.016, min_segment_cycles=0.25, **kw)
+
+
+def test_under_the_filter_a_cam_polyline_is_blended_where_its_share_is_zero():
+    """Decision 45: the bench's 16 + 16 ms filter gives way (λ = 0) on the blended stretch."""
+    prog = cam_polyline(200)
+    pts = [START] + prog.points
+    st = check(lines(pts, prog.feed), _filtered(), START)
+    assert 0.9 * TOL < polyline_deviation(st.positions, pts) <= TOL * (1.0 + 1e-6)
+    assert st.time == pytest.approx(4.538, abs=0.05)  # 5.444 s with the filter's own corners (before)
+
+
+def test_under_the_filter_chords_keep_the_filters_corners():
+    """A blend within half a 0.05 mm chord is slower than the filter's corner (decision 40 a): none is built,
+    and nothing changes (R10 1.555 s, decision 39's figure)."""
+    prog = chord_circle(10.0)
+    pts = [START] + prog.points
+    pl = Planner(_filtered(), dict(zip(AX, START)))
+    for m in lines(pts, prog.feed):
+        pl.push(m)
+    assert all(b.seg.kind == "line" for b in pl.blocks)
+    st = check(lines(pts, prog.feed), _filtered(), START)
+    assert st.time == pytest.approx(1.555, abs=0.003)
+
+
+def test_without_a_whole_cycle_group_delay_the_filter_keeps_its_corners():
     prog = cam_polyline(60)
-    pl = Planner(_cfg(path_tolerance=TOL, filter_time=0.016, filter_scurve=0.016), dict(zip(AX, START)))
+    pl = Planner(_cfg(path_tolerance=TOL, filter_time=0.016, filter_scurve=0.015), dict(zip(AX, START)))
     for m in lines([START] + prog.points, prog.feed):
         pl.push(m)
     assert all(b.seg.kind == "line" for b in pl.blocks)
+
+
+def test_a_reversal_and_an_arc_after_a_blended_stretch_stay_within_the_limits():
+    """Junctions the filter would round, within a blended stretch's reach, are taken as without it."""
+    prog = cam_polyline(200)
+    p = [np.array(x, float) for x in ([START] + prog.points)[:60]]
+    d = (p[-1] - p[-2]) / np.linalg.norm(p[-1] - p[-2])
+    turn = p[-1] - 2.0 * d + np.array([0.3, 0.0, 0.0])  # ≈ 170°
+    e = turn + np.array([2.0, 0.0, 0.0])
+    mv = lines(p + [turn], prog.feed)
+    mv.append(arc(turn, e, (turn[0] + 1.0, turn[1]), "cw", prog.feed, line=200))
+    tail = [e, e + np.array([0.0, 3.0, 0.0]), e + np.array([1.0, 5.0, 0.2])]
+    mv += lines(tail, prog.feed, first_line=201)
+    st = check(mv, _filtered(), START)
+    assert polyline_deviation(st.positions[: int(np.argmax(st.lines >= 60))], p + [turn]) <= TOL * (1.0 + 1e-6)
+    assert np.allclose(st.positions[-1], tail[-1], atol=1e-9)
 
 
 def test_blend_blocks_carry_the_incoming_line_and_shorten_both_lines():

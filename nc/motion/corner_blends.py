@@ -14,6 +14,7 @@ import math
 from nc.motion.clothoid import ClothoidBlend, corner_blend
 from nc.motion.lookahead import Block, Limits, change_distance, reach
 
+MIN_SPEED = 1e-3  # mm/s (and mm/s², mm/s³): below it no blend is built
 KEEP = 1e-6  # mm a line keeps between two blends (a block of zero length would stall nothing, but
 # every pass divides by lengths): its share of the half rule is that much smaller
 
@@ -34,6 +35,8 @@ def blend_block(lim: Limits, prev: Block, b: Block, tol: float) -> Block | None:
     if seg is None:
         return None
     v, a, j = lim.block_limits(seg)
+    if not (v >= MIN_SPEED and a >= MIN_SPEED and j >= MIN_SPEED):
+        return None  # absurd limits (acceleration 1e-50): the planner's own alarm says so, not ruckig
     if not _faster(seg, min(v, prev.feed or 0.0), prev, b):
         return None  # the junction as it is is no slower
     _trim(prev, end=seg)

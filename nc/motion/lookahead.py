@@ -209,8 +209,9 @@ class Limits:
         a = min(a, BLEND_JERK[2] * pj / (3.0 * max(v, 1e-9) * km))
         return v, a, j * BLEND_JERK[1] / cfg.share_tangential
 
-    def junction(self, b1: Block, b2: Block) -> float:
-        """Highest speed at the junction b1 → b2."""
+    def junction(self, b1: Block, b2: Block, raw: bool = False) -> float:
+        """Highest speed at the junction b1 → b2. `raw`: as without the filter (a junction where its
+        share λ is below 1, nc.motion.share_zones); the filter's fields of b1 are then left alone."""
         if b1.kind != "path" or b2.kind != "path" or b1.rapid or b2.rapid or b1.move.exact_stop:
             return 0.0  # G00, G09/G61, dwells, threads and independent rapids stop at their ends
         s1, s2 = b1.seg, b2.seg
@@ -219,7 +220,7 @@ class Limits:
         dv = [p - q for p, q in zip(s2.tangent(False), s1.tangent(True))]
         du = [abs(d) for d in dv]
         cfg = self.cfg
-        if self.blend is not None:
+        if self.blend is not None and not raw:
             b1.dv = tuple(dv)
             b1.du = tuple(du)
             b1.du_n = math.sqrt(sum(d * d for d in du))
@@ -247,7 +248,7 @@ class Limits:
                 m = dk > 1e-12
                 # A curvature jump steps the axis acceleration: in one cycle without the filter,
                 # spread over its first window T1 with it.
-                t = self.blend.t_a if self.blend is not None else self.T
+                t = self.blend.t_a if self.blend is not None and not raw else self.T
                 v = min(v, float(np.min(np.sqrt(0.4 * cfg.share_curvature * self.jerk[m] * t / dk[m]))))
         return max(v, 0.0)
 

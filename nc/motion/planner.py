@@ -35,6 +35,7 @@ from nc.motion.limits import MotionConfig
 from nc.motion.lookahead import MARGIN, Block, Limits, backward, change_distance, max_speed_at, reach
 from nc.motion.path import Segment
 from nc.motion.profile import Piecewise, solve_axes, solve_position, solve_velocity
+from nc.motion.share_zones import ShareZones
 from nc.motion.shares import MAX_FACTOR, jerk_factor
 from nc.motion.smoothing import PositionFilter
 from nc.motion.thread_corners import corner_offset
@@ -160,6 +161,13 @@ class Planner:
             self.filter = PositionFilter(*cfg.filter_cycles(), self.position)
         self._path_s = 0.0  # path length pushed so far (junction windows are measured on it)
         # Half the least tangential acceleration and jerk of any line: the braking `_may_blend` allows for.
+        # Under the filter, where its share λ gives way to blends (nc.motion.share_zones); None without
+        # the filter, or where λ cannot act (PositionFilter.lag).
+        self._zones: ShareZones | None = None
+        if self.filter is not None and self.filter.lag is not None and (cfg.path_tolerance or 0.0) > 0.0:
+            self._zones = ShareZones(cfg.filter_time + cfg.filter_scurve)
+        self._share_s = 0.0
+        self._lam = 1.0
         self._a_lo = 0.5 * cfg.share_tangential * float(self.lim.acc.min())
         self._j_lo = 0.5 * cfg.share_tangential * float(self.lim.jerk.min())
         # The channel sets `closed` when no move comes before the queue has run out to rest (program
@@ -179,8 +187,6 @@ class Planner:
             return
         blend = self.lim.blend
         if blend is not None:
-            self._path_s += b.length
-            b.s_end = self._path_s
             b.vtop = b.cap_hard
             if b.kind == "path" and not b.rapid and not b.move.per_rev:
                 b.vtop = min(b.cap_hard, 1.5 * (self.dry_run_feed if self.dry_run else (b.feed or 0.0)))
@@ -189,19 +195,11 @@ class Planner:
         if self.blocks:
             prev = self.blocks[-1]
             prev.vjunc = self.lim.junction(prev, b)
-            if blend is None and self._may_blend(prev):
-                blk = blend_block(self.lim, prev, b, self.cfg.path_tolerance or 0.0)
-                if blk is not None:  # both lines gave path to it: the running lengths follow
-                    prev.s_end -= blk.seg.tlen
-                    blk.s_end = prev.s_end + blk.length
-                    self._path_s = blk.s_end
-                    for x in (prev, blk, b):
-                        self._update_cap(x)
-                    self.blocks.append(blk)
-                    added = 2
-        if blend is None:
-            self._path_s += b.length
-            b.s_end = self._path_s
+            added += self._corner(prev, b)
+        self._path_s += b.length
+        b.s_end = self._path_s
+        if self._zones is not None:
+            self._zones.block(b.s_end - b.length, b.vtop)
         self.blocks.append(b)
         self.threads_queued += b.kind == "thread"
         self._pushed += added
@@ -210,6 +208,41 @@ class Planner:
         if blend is not None:
             need = max(need, blend.window(self.blocks))
         self._need = need
+
+    def _corner(self, prev: Block, b: Block) -> int:
+        """The junction prev → b (prev.vjunc set): a corner blend between them where one is built
+        (decisions motion 42, 45), or, under the filter, a hard junction where λ < 1 planned raw.
+        Returns the blocks added (the blend: 1)."""
+        zones = self._zones
+        tol = self.cfg.path_tolerance or 0.0
+        if zones is not None and prev.vjunc <= 0.0:
+            zones.stop(prev.s_end)
+            return 0
+        blk = None
+        if zones is not None and zones.inside(prev.s_end, max(prev.vtop, b.vtop)):
+            # λ stays below 1 here: not blended, the junction is taken as without the filter, and
+            # that is what a blend must beat
+            prev.vjunc = min(prev.vjunc, self.lim.junction(prev, b, raw=True))
+        if (self.lim.blend is None or zones is not None) and self._may_blend(prev):
+            if zones is None or zones.blend_allowed(prev.s_end - prev.length, max(prev.vtop, b.vtop), self._now(),
+                                                    abs(self.v) < 1e-12 and self.plan is None):
+                blk = blend_block(self.lim, prev, b, tol)
+        if blk is None:
+            if zones is not None and (prev.du_n > 1e-9 or "arc" in (prev.seg.kind, b.seg.kind)):
+                if zones.hard(prev.s_end, max(prev.vtop, b.vtop)):
+                    prev.vjunc = min(prev.vjunc, self.lim.junction(prev, b, raw=True))
+            return 0
+        # Both lines gave path to it: the running lengths follow.
+        prev.s_end -= blk.seg.tlen
+        blk.s_end = prev.s_end + blk.length
+        self._path_s = blk.s_end
+        if zones is not None:
+            blk.vtop = min(blk.cap_hard, prev.vtop)
+            zones.add_blend(blk.s_end - blk.length, blk.s_end, max(prev.vtop, b.vtop))
+        for x in (prev, blk, b):
+            self._update_cap(x)
+        self.blocks.append(blk)
+        return 1
 
     def _may_blend(self, prev: Block) -> bool:
         """Whether the tail may still give path to a corner blend (decision motion 42): a tolerance
@@ -362,9 +395,57 @@ class Planner:
             # filter settled, so passing it by keeps the stream continuous.
             f.reset(sp.positions)
         else:
-            sp.positions = f.push(sp.positions)
+            sp.positions = f.push(sp.positions, self._share() if self._zones is not None else 1.0)
         self.output = sp.positions
         return sp
+
+    def _now(self) -> float:
+        """Path position (Block.s_end's scale) of the last sample handed out."""
+        if self.blocks:
+            b = self.blocks[0]
+            self._share_s = b.s_end - b.length + (self.s if self._started else 0.0)
+        return self._share_s
+
+    def _share(self) -> float:
+        """The filter's share λ at the present path position (nc.motion.share_zones)."""
+        z = self._zones
+        if z is None or not z.zones:
+            lam = 1.0
+        elif abs(self.v) < 1e-12:
+            # At rest λ holds: the output is still settling there (F(p) ≠ p(t − D)). A plan starts only
+            # once the filter has settled, where λ may change at once (a stop cuts the zones).
+            lam = self._lam
+        else:
+            lam = z.lam(self._now())
+        self._lam = lam
+        return lam
+
+    def share_rows(self, i: int, m: int) -> np.ndarray | None:
+        """λ of buffer rows i … i + m − 1 as step() would take them one by one (`_share` after `_take`), for a
+        stretch's push_many (nc.motion.stretch); None where λ is 1 throughout (no zone left)."""
+        z = self._zones
+        if z is None or not z.zones:
+            return None
+        out = np.empty(m)
+        blk, popped, blocks = self._buf_blk, self._buf_popped, self.blocks
+        for r in range(m):
+            s, v, _ = self._buf_state[i + r]
+            if not z.zones:
+                lam = 1.0
+            elif abs(v) < 1e-12:
+                lam = self._lam
+            else:
+                b = blocks[blk[i + r] - popped] if blk is not None else blocks[0]
+                self._share_s = b.s_end - b.length + s
+                lam = z.lam(self._share_s)
+            self._lam = out[r] = lam
+        return out
+
+    def share_standing(self, n: int) -> np.ndarray | None:
+        """λ of n cycles standing (nc.motion.stretch.stand_stretch): the held one."""
+        if self._zones is None or not self._zones.zones:
+            return None
+        return np.full(n, self._share())
 
     def _step_path(self) -> Setpoint:
         if self._integrate_angle:
@@ -658,9 +739,10 @@ class Planner:
 
     def _cruising(self, b: Block, v: float) -> bool:
         """A solve at b's start (or within b) from speed v at zero acceleration would cruise at v to b's end:
-        its run ends there (b's end speed is not below its cap), its cap is v, nothing re-plans it per cycle."""
+        its run ends there (b's end speed is not below its cap), its cap is v, nothing re-plans it per cycle.
+        Not a corner blend (decision motion 45): measured, its solve does not give a cruise bit for bit."""
         return (b.kind == "path" and b.cap == v and b.vend >= v and not b.move.per_rev and b.move.css is None
-                and "G31" not in b.move.tags)
+                and "G31" not in b.move.tags and b.seg.kind != "blend")
 
     def _cruise(self, b: Block, t0: float) -> _Plan | None:
         """Decision motion 44: at its cap, with zero acceleration, a run whose end speed is the cap solves to
@@ -816,6 +898,8 @@ class Planner:
         if blend is None:
             return None
         start = b.s_end - b.length
+        if self._zones is not None and self._zones.near(start + s - blend.span_max, start + cruise + blend.span_max):
+            return None
         f, unknown = jerk_factor(self.cfg, blend, self.blocks, start + s, start + cruise, self.closed)
         if unknown or f <= self._jf * (1.0 + 1e-9):
             return None
@@ -836,6 +920,8 @@ class Planner:
             return 1.0, False
         dist = self._run_target(cap, True, cruise)[0]
         start = b.s_end - b.length
+        if self._zones is not None and self._zones.near(start + s - blend.span_max, start + dist + blend.span_max):
+            return 1.0, False  # λ < 1 there: the raw path keeps the tangential share (decision motion 45)
         return jerk_factor(self.cfg, blend, self.blocks, start + s, start + dist, self.closed)
 
     def _run_target(self, cap: float, extend: bool = False, cruise_from: float = math.inf,

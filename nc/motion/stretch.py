@@ -59,9 +59,10 @@ def sample_stretch(pl: Planner, n: int, across: bool = False) -> Samples | None:
     if pl._buf_blk is not None and pl._buf_blk[j] != pl._buf_popped:
         blocks, off = pl.blocks, pl._buf_popped
         moves = [blocks[k - off].move for k in pl._buf_blk[i:i + m]]
+    lam = pl.share_rows(i, m)  # the filter's share per row (decision motion 45)
     pl._buf_i = i + m
     pl._take(j)
-    positions = pl.filter.push_many(raw) if pl.filter is not None else np.array(raw, dtype=float)
+    positions = pl.filter.push_many(raw, lam) if pl.filter is not None else np.array(raw, dtype=float)
     pl.output = positions[-1].copy()
     return Samples(positions, list(pl._buf_line[i:i + m]), np.array(pl._buf_vel[i:i + m], dtype=float), mv, moves)
 
@@ -86,9 +87,10 @@ def stand_stretch(pl: Planner, n: int, queued: bool = False) -> Samples | None:
     if f is None:
         positions, solved = raw, True
     else:  # Planner._refill solves (Planner._start_plan) in a step that begins with the filter settled
-        head = f.push_many(raw[:-1])
+        lam = pl.share_standing(n)
+        head = f.push_many(raw[:-1], None if lam is None else lam[:-1])
         solved = f.settled
-        positions = np.vstack([head, f.push_many(raw[-1:])])
+        positions = np.vstack([head, f.push_many(raw[-1:], None if lam is None else lam[-1:])])
     if solved:
         pl._carry = pl.cfg.cycle
     pl.output = positions[-1].copy()
