@@ -9,7 +9,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from hil import strict_json
-from hil.path_json import move_dict, move_json
+from hil.path_json import move_dict, move_json, moves_json
 from nc.moves import Move
 
 number = st.one_of(st.floats(allow_nan=True, allow_infinity=True), st.integers(-10**6, 10**6),
@@ -61,3 +61,22 @@ def test_seven_decimals_is_repr_of_round(v: float) -> None:
     from hil.path_json import _seven
 
     assert _seven(v) == repr(round(v, 7) + 0.0)
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.lists(moves, min_size=1, max_size=6), st.lists(st.booleans(), min_size=6, max_size=6))
+def test_a_list_of_moves_is_each_move_alone(ms: list[Move], chained: list[bool]) -> None:
+    """moves_json (a cycle's MoveList): a move that starts at the dict the move before it ended at, as a
+    cycle's moves do, writes that point as move_json does on its own."""
+    for k in range(1, len(ms)):
+        if chained[k]:
+            ms[k].start = ms[k - 1].end
+    assert moves_json(ms) == [strict_json.dumps(move_dict(m)) for m in ms]
+
+
+def test_a_point_changed_between_two_lists_is_written_anew() -> None:
+    a = Move("rapid", 1, "G0", {"X": 0.0, "Z": 0.0}, {"X": 1.0, "Z": 2.0}, {"X": 2.0, "Z": 2.0})
+    b = Move("line", 2, "G1", a.end, {"X": 3.0, "Z": 2.0}, {"X": 6.0, "Z": 2.0}, feed=0.1)
+    assert moves_json([a]) == [strict_json.dumps(move_dict(a))]
+    a.end["Z"] = 5.0  # in place, after its line was written
+    assert moves_json([b])[0].startswith('{"kind": "line", "line": 2, "block": "G1", "start": {"X": 1.0, "Z": 5.0}')

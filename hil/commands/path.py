@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 
 from hil import strict_json
 from hil.cli import EXIT_ALARM, EXIT_OK, EXIT_USAGE
-from hil.path_json import batch_json, fmt, move_json
+from hil.path_json import batch_json, fmt, move_json, moves_json
 from nc.alarms import NcAlarm, internal_error
 
 if TYPE_CHECKING:  # the interpreter and the bench load when the command runs, not at `hil` start-up
@@ -178,7 +178,7 @@ def cmd_path(args: argparse.Namespace) -> int:
                 _flush(out, lines)
             elif type(ev) is MoveList:  # a cycle's moves (bulk only: no interrupt, no plot)
                 if as_json:
-                    lines.extend(map(move_json, ev.items))
+                    lines.extend(moves_json(ev.items))
                 else:
                     lines.extend([_human(m, profile.diameter_axes) for m in ev.items])
             elif isinstance(ev, Move):
