@@ -170,12 +170,14 @@ def move_json(m: Move) -> str:
     # a point with an integral value is taken only when all its values are floats (see `_axes`)
     end_items = tuple(end.items())
     hit = _POINTS.get(end_items)
-    if hit is not None and hit[1] and not _all_floats(end):
+    if hit is not None and hit[1] and not (type(end_items[0][1]) is float and type(end_items[-1][1]) is float
+                                           and (len(end_items) <= 2 or _all_floats(end))):
         hit = None
     end_text = hit[0] if hit is not None else _axes(end, end_items)
     last[0], last[1], last[2] = end, end_items, end_text
     hit = _POINTS.get(work_items := tuple(work.items()))
-    if hit is not None and hit[1] and not _all_floats(work):
+    if hit is not None and hit[1] and not (type(work_items[0][1]) is float and type(work_items[-1][1]) is float
+                                           and (len(work_items) <= 2 or _all_floats(work))):
         hit = None
     work_text = hit[0] if hit is not None else _axes(work, work_items)
     # the rest of the line of a move without centre, direction, duration or compensation is one of
