@@ -54,7 +54,7 @@ class PathBuilder:
         A line or rapid shorter than float noise is dropped; the position snaps to the exact target."""
         pos = self.position
         a1, a2 = self.plane
-        if center is None and kind != "thread" and abs(p[0] - pos[a1]) < 1e-12 and abs(p[1] - pos[a2]) < 1e-12:
+        if center is None and kind != "thread" and -1e-12 < p[0] - pos[a1] < 1e-12 and -1e-12 < p[1] - pos[a2] < 1e-12:
             pos = self.position = pos.copy()  # the last move's end: snap a copy
             pos[a1], pos[a2] = p
             return None
