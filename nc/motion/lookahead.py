@@ -27,7 +27,7 @@ from nc.motion.limits import MotionConfig
 from nc.motion.path import Segment
 from nc.moves import Move
 
-# Shares of the axis jerk on a corner blend: centripetal v³·(dκ/ds + κ²), tangential profile, and the
+# Shares of the axis jerk on a corner blend: centripetal v³·|(dκ/ds, κ²)|, tangential profile, and the
 # coupling 3·v·a_t·κ (Limits._blend_limits).
 BLEND_JERK = (0.8, 0.1, 0.1)
 MARGIN = 0.98  # the passes plan with 98 % of the limits ruckig gets, so plans are never borderline
@@ -193,8 +193,8 @@ class Limits:
 
     def _blend_limits(self, seg: Segment, v: float, a: float, j: float) -> tuple[float, float, float]:
         """A clothoid pair (nc.motion.clothoid) at speed v: normal acceleration v²·κ ≤ v²·κmax and
-        jerk v³·(dκ/ds + κ²), plus 3·v·a_t·κ from the tangential acceleration, each axis' share of
-        the normal at most `normal_amplitude`. A blend has no tangent or curvature jump, so the corner
+        jerk v³·(dκ/ds·n − κ²·t), of size v³·hypot(dκ/ds, κ²) (n ⊥ t, decision 46), plus 3·v·a_t·κ from
+        the tangential acceleration, each axis' share of the normal at most `normal_amplitude`. A blend has no tangent or curvature jump, so the corner
         and curvature shares are its own (as between lines under the filter, decision 38); of the
         jerk, the centripetal term takes BLEND_JERK first (decision 40 e: the blends' speed is set
         by it), the tangential profile and the coupling term what is left."""
@@ -205,7 +205,7 @@ class Limits:
                 pa, pj = min(pa, al / m), min(pj, jl / m)
         km, dk = seg.kappa_max, seg.dkappa
         sa = cfg.share_curvature + cfg.share_corner
-        v = min(v, math.sqrt(sa * pa / km), (BLEND_JERK[0] * pj / (dk + km * km)) ** (1.0 / 3.0))
+        v = min(v, math.sqrt(sa * pa / km), (BLEND_JERK[0] * pj / math.hypot(dk, km * km)) ** (1.0 / 3.0))
         a = min(a, BLEND_JERK[2] * pj / (3.0 * max(v, 1e-9) * km))
         return v, a, j * BLEND_JERK[1] / cfg.share_tangential
 

@@ -242,6 +242,10 @@ class Planner:
         for x in (prev, blk, b):
             self._update_cap(x)
         self.blocks.append(blk)
+        if self.lim.blend is not None:
+            # The filter's windows walk the queue and their junction history side by side: the junction
+            # prev → blend joins that history now, as any pushed block's does (b's comes with b).
+            self._need = max(self._need, self.lim.blend.window(self.blocks) + 1)
         return 1
 
     def _may_blend(self, prev: Block) -> bool:
