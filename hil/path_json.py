@@ -188,9 +188,9 @@ def move_json(m: Move) -> str:
     if m.center is None and m.dir is None and m.duration is None and not m.comp and type(tags) is tuple \
             and (feed is None or type(feed) is float and feed != 0):
         if m.kind != "thread":
-            key = (feed, bool(m.per_rev), bool(m.exact_stop), tags)
+            key = (feed, not m.per_rev, not m.exact_stop, tags)  # (`not`: their truth, without a call)
         elif _plain(lead := m.lead) and _plain(lead_change := m.lead_change) and _plain(angle := m.start_angle):
-            key = (feed, bool(m.per_rev), bool(m.exact_stop), tags, lead, lead_change, angle)
+            key = (feed, not m.per_rev, not m.exact_stop, tags, lead, lead_change, angle)
     tail = _TAILS.get(key) if key is not None else None
     if tail is None:
         tail = _tail(m)
