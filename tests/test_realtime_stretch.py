@@ -6,6 +6,8 @@ the run with stretches (DELTAHIL_STRETCH=1) and without (0) must give the same t
 
 from __future__ import annotations
 
+import io
+
 import pyarrow.parquet as pq
 import pytest
 
@@ -13,6 +15,7 @@ import hil.clock
 from hil import api
 from hil.bench import RealtimeConfig
 from hil.clock import Granted, RealTimeClock
+from hil.commands.run import print_timing
 from hil.stretch import ENV
 from tests.conftest import ROOT
 
@@ -114,6 +117,12 @@ def test_a_realtime_run_with_stretches_equals_stepping(monkeypatch, tmp_path, kw
     assert r.stretched > 0.8 * r.cycles  # most cycles come from stretches, each paced on its own
     assert set(a[0]["period"][1:]) == {0.001}  # every cycle ticked: a 1 ms period on the fake clock
     assert r.timing["between"]["count"] == r.cycles - 1  # the work between cycles is measured in every period
+    out = io.StringIO()
+    print_timing(r, out)  # `hil run --realtime`'s summary: the slack's work beside the cycle work
+    lines = {ln[:15].strip(): ln[15:] for ln in out.getvalue().splitlines()}
+    b = r.timing["between"]
+    assert lines["between cycles"] == "  ".join(f"{k} {b[k] * 1e6:.1f} µs" for k in ("p50", "p99", "max"))
+    assert "cycle work" in lines and b["max"] > 0
 
 
 def test_a_stop_inside_a_stretch_is_taken_at_the_next_cycle(monkeypatch, tmp_path):

@@ -1,0 +1,67 @@
+"""A Parquet trace's row groups are converted and written by a writer thread (issue 17): the cycle that fills
+a row group only hands it over, so the ≈ 6 ms of a flush does not land in a real-time period's slack. The
+file stays whole and the same; a failure of the writer reaches the run's thread at close."""
+
+from __future__ import annotations
+
+import threading
+
+import pyarrow.parquet as pq
+import pytest
+
+import hil.trace_parquet as tp
+from hil.trace_parquet import ParquetTrace
+
+
+def test_a_full_row_group_is_written_while_the_run_goes_on(tmp_path, monkeypatch):
+    release = threading.Event()
+    writing = threading.Event()
+    real_write = pq.write_table
+    callers: list[str] = []
+
+    def held_write(*a, **k):  # the writer stays inside its first part until the test lets it go
+        callers.append(threading.current_thread().name)
+        writing.set()
+        assert release.wait(10)
+        return real_write(*a, **k)
+
+    w = ParquetTrace(tmp_path / "w.parquet", ["t", "line", "alarm", "X_sw"], row_group=100)
+    monkeypatch.setattr(tp.pq, "write_table", held_write)
+    for k in range(250):  # two row groups handed over, the writer still holding the first
+        w.write([k * 0.001, k // 10, "" if k % 7 else "0x1001", k])
+    assert writing.wait(10)
+    assert not list(w.parts.glob("*.parquet"))  # nothing written yet, and write() returned all the same
+    release.set()
+    w.close({"reason": "completed"})
+    assert callers and threading.main_thread().name not in callers
+    t = pq.read_table(tmp_path / "w.parquet")
+    assert pq.ParquetFile(tmp_path / "w.parquet").metadata.num_row_groups == 3
+    assert t.column("t").to_pylist() == [k * 0.001 for k in range(250)]
+    assert t.column("alarm").to_pylist() == [None if k % 7 else "0x1001" for k in range(250)]
+    assert t.column("X_sw").to_pylist() == list(range(250)) and str(t.schema.field("X_sw").type) == "uint16"
+    assert not w.parts.exists()
+
+
+def test_a_writer_failure_reaches_the_run_at_close(tmp_path, monkeypatch):
+    def full_disk(*a, **k):
+        raise OSError(28, "No space left on device")
+
+    w = ParquetTrace(tmp_path / "f.parquet", ["t", "x"], row_group=10)
+    monkeypatch.setattr(tp.pq, "write_table", full_disk)
+    with pytest.raises(OSError, match="No space left"):  # at the next hand-over or at close, as it comes
+        for k in range(25):
+            w.write([k * 0.001, float(k)])
+        w.close()
+    assert not (tmp_path / "f.parquet").exists()
+
+
+def test_the_switch_interval_is_put_back_after_the_writer(tmp_path):
+    import sys
+
+    before = sys.getswitchinterval()
+    w = ParquetTrace(tmp_path / "s.parquet", ["t"], row_group=5)
+    for k in range(12):
+        w.write([k * 0.001])
+    w.close()
+    assert sys.getswitchinterval() == before
+    assert pq.read_table(tmp_path / "s.parquet").num_rows == 12
