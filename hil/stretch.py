@@ -199,7 +199,8 @@ class Stretcher:
                         # before the last one (so the next stretch's work ahead has the slack after it to itself)
                         stop = j - 1 if j - k >= 2 else j
                         end, timings = self._pace(r, k, stop, positions, targets, panel)
-                        j = end if end < stop else j  # a stop or a press ended it: at once up to there
+                        if end < stop or r.stop_request is not None or _panel_state(r.on_cycle) != panel:
+                            j = end  # a stop or a press ended it (in its last paced cycle too): at once up to there
                     if j < m:  # the stretch ends before it: that cycle is stepped
                         outs = self._cut(pl, saved_pl, saved_drives, rx0, targets, j, j)
                         m, last_raw, cut = j, pl.position, True

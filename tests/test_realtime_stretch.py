@@ -134,12 +134,14 @@ def test_a_stop_inside_a_stretch_is_taken_at_the_next_cycle(monkeypatch, tmp_pat
     assert cols["stop_asked"].index(1.0) == 4999  # asked in cycle 5000; its stop starts in cycle 5001 both ways
 
 
-def test_a_signal_while_a_stretch_is_paced_lands_on_the_same_cycle(monkeypatch, tmp_path):
+@pytest.mark.parametrize("at", [3000, 3001, 5000])
+def test_a_signal_while_a_stretch_is_paced_lands_on_the_same_cycle(monkeypatch, tmp_path, at):
     """The plain run's stretches are paced with only their outputs per cycle (the rest at once after their last
-    cycle): a SIGINT while the pacer waits for cycle 5000 ends the stretch after that cycle, as stepping does."""
-    a = _run(monkeypatch, tmp_path, "0", signal_at=5000)
-    b = _run(monkeypatch, tmp_path, "1", signal_at=5000)
+    cycle): a SIGINT while the pacer waits for a cycle ends the stretch after that cycle, as stepping does.
+    Cycles 3000 and 5000 are the last paced cycle of their stretches (one cycle late before the fix), 3001 is not."""
+    a = _run(monkeypatch, tmp_path, "0", signal_at=at)
+    b = _run(monkeypatch, tmp_path, "1", signal_at=at)
     _same(a, b)
     r = b[1].run
-    assert r.stopped_by == "SIGINT" and not r.finished and r.stretched > 3000
+    assert r.stopped_by == "SIGINT" and not r.finished and r.stretched > 0.9 * at
     assert b[1].runner.trace is not None
