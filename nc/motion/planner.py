@@ -11,12 +11,15 @@ Operator controls (the channel maps the MLC's relays onto them):
   feed_override (0..1.5), rapid_override (0..1; 0 = slow rapid), hold()/resume(), stop(),
   dry_run (feed of every cutting block replaced by `dry_run_feed`).
 
-Why one file of ~800 lines: the planner is one state machine. Its queue, active plan, sample buffer
+Why one class of ~750 lines: the planner is one state machine. Its queue, active plan, sample buffer
 and event flags are read and written by every method below, in an order that the one-setpoint-per-
-cycle guarantee depends on; split across modules, those invariants would be spread over files that
-each see part of the state. The pure parts live beside it: look-ahead passes (lookahead.py), ruckig
-profiles (profile.py), tolerance shares (shares.py), the position filter (smoothing.py), threading
-geometry (threading.py, thread_corners.py) and stretch sampling (stretch.py).
+cycle guarantee depends on. Three groups of its methods that each serve one feature live in mixins
+beside it, on the same state: cruise sampling across blocks (planner_cruise.py, decision motion 44),
+corner blends and the filter's share (planner_corners.py, decisions 42-45) and thread chains
+(planner_thread.py); its records in plan_state.py. The pure parts live beside it too: look-ahead
+passes (lookahead.py), ruckig profiles (profile.py), tolerance shares (shares.py), the position
+filter (smoothing.py), threading geometry (threading.py, thread_corners.py) and stretch sampling
+(stretch.py).
 """
 
 from __future__ import annotations
@@ -24,65 +27,30 @@ from __future__ import annotations
 import math
 from collections import deque
 from collections.abc import Callable
-from dataclasses import dataclass
 
 import numpy as np
 
 from nc.alarm_table import PLANNING_STALL
 from nc.alarms import NcAlarm
-from nc.motion.corner_blends import blend_block
 from nc.motion.limits import MotionConfig
 from nc.motion.lookahead import MARGIN, Block, Limits, backward, change_distance, max_speed_at, reach
 from nc.motion.path import Segment
-from nc.motion.profile import Piecewise, solve_axes, solve_position, solve_velocity
+from nc.motion.plan_state import CHUNK, Setpoint, _near, _Plan
+from nc.motion.planner_corners import CornerShares
+from nc.motion.planner_cruise import CruiseSampling
+from nc.motion.planner_thread import ThreadStepping
+from nc.motion.profile import solve_axes, solve_position, solve_velocity
 from nc.motion.share_zones import ShareZones
 from nc.motion.shares import MAX_FACTOR, jerk_factor
 from nc.motion.smoothing import PositionFilter
-from nc.motion.thread_corners import corner_offset
 from nc.motion import threading as thr
 from nc.moves import Move
 
-CHUNK = 64  # cycles sampled per vectorised step
-OPEN_CHUNK = 4  # ... while the queue cannot tell the jerk factor yet (the channel reads 4 blocks a cycle)
+OPEN_CHUNK = 4  # cycles sampled at a time (CHUNK otherwise) while the queue cannot tell the jerk factor yet (the channel reads 4 blocks a cycle)
 MAX_SOLVES_PER_CYCLE = 1000  # plans one cycle may start and end before a sample is due (decisions B4)
 
 
-def _near(a: np.ndarray, b: np.ndarray) -> bool:
-    """np.allclose(a, b, atol=1e-6) on plain floats: checked at every block start, where numpy's
-    call cost more than the three comparisons (issue 17)."""
-    return all(abs(x - y) <= 1e-6 + 1e-5 * abs(y) for x, y in zip(a.tolist(), b.tolist()))
-
-
-@dataclass
-class Setpoint:
-    positions: np.ndarray  # machine coordinates per axis, in MotionConfig.axes order
-    line: int  # program line of the active move (0 when idle before any move)
-    path_velocity: float  # mm/s along the path
-    move: Move | None
-
-
-@dataclass
-class _Plan:
-    kind: str  # "path" (to the block end), "ramp" (velocity change, may span blocks), "dwell", "indep"
-    pw: Piecewise | None
-    duration: float
-    t_next: float  # plan time of the next sample
-    base: float = 0.0  # plan position at the start of blocks[0] (ramps that cross blocks)
-    target: float = 0.0  # ramp target speed
-    rpm: float = 0.0  # spindle speed the feed-per-rev cap used
-    settled: bool = False  # that speed was the command the spindle had reached
-    emitted: bool = False  # some of its samples went out (the planner state is the last of them)
-    # A path solve whose jerk factor the queue could not tell yet (nc.motion.shares): sampled a
-    # few cycles at a time and solved again once more than `queued` moves were pushed.
-    open: bool = False
-    queued: int = 0
-    # A "cruise" (decision motion 44): whole blocks sampled at once; `carry` the next plan's t0 after the last
-    # of them, `last` its offset from blocks[0] when sampled.
-    carry: float = 0.0
-    last: int = 0
-
-
-class Planner:
+class Planner(CruiseSampling, CornerShares, ThreadStepping):
     # True: every block of a run starts a new solve, also where the run cruises at its cap (the reference
     # tests compare the cruise sampling against, decision motion 44)
     per_block = False
@@ -208,61 +176,6 @@ class Planner:
         if blend is not None:
             need = max(need, blend.window(self.blocks))
         self._need = need
-
-    def _corner(self, prev: Block, b: Block) -> int:
-        """The junction prev → b (prev.vjunc set): a corner blend between them where one is built
-        (decisions motion 42, 45), or, under the filter, a hard junction where λ < 1 planned raw.
-        Returns the blocks added (the blend: 1)."""
-        zones = self._zones
-        tol = self.cfg.path_tolerance or 0.0
-        if zones is not None and prev.vjunc <= 0.0:
-            zones.stop(prev.s_end)
-            return 0
-        blk = None
-        if zones is not None and zones.inside(prev.s_end, max(prev.vtop, b.vtop)):
-            # λ stays below 1 here: not blended, the junction is taken as without the filter, and
-            # that is what a blend must beat
-            prev.vjunc = min(prev.vjunc, self.lim.junction(prev, b, raw=True))
-        if (self.lim.blend is None or zones is not None) and self._may_blend(prev):
-            if zones is None or zones.blend_allowed(prev.s_end - prev.length, max(prev.vtop, b.vtop), self._now(),
-                                                    abs(self.v) < 1e-12 and self.plan is None):
-                blk = blend_block(self.lim, prev, b, tol)
-        if blk is None:
-            if zones is not None and (prev.du_n > 1e-9 or "arc" in (prev.seg.kind, b.seg.kind)):
-                if zones.hard(prev.s_end, max(prev.vtop, b.vtop)):
-                    prev.vjunc = min(prev.vjunc, self.lim.junction(prev, b, raw=True))
-            return 0
-        # Both lines gave path to it: the running lengths follow.
-        prev.s_end -= blk.seg.tlen
-        blk.s_end = prev.s_end + blk.length
-        self._path_s = blk.s_end
-        if zones is not None:
-            blk.vtop = min(blk.cap_hard, prev.vtop)
-            zones.add_blend(blk.s_end - blk.length, blk.s_end, max(prev.vtop, b.vtop))
-        for x in (prev, blk, b):
-            self._update_cap(x)
-        self.blocks.append(blk)
-        if self.lim.blend is not None:
-            # The filter's windows walk the queue and their junction history side by side: the junction
-            # prev → blend joins that history now, as any pushed block's does (b's comes with b).
-            self._need = max(self._need, self.lim.blend.window(self.blocks) + 1)
-        return 1
-
-    def _may_blend(self, prev: Block) -> bool:
-        """Whether the tail may still give path to a corner blend (decision motion 42): a tolerance
-        to blend within, no hold (its ramp runs on across blocks), and no profile that could be
-        caught by the shorter path: nothing planned yet, or the tail further beyond the active
-        block than any stop from its speed needs, at half the least tangential limits."""
-        tol = self.cfg.path_tolerance
-        if tol is None or tol <= 0.0 or self.held or self._stopping:
-            return False
-        if not self._started and self.plan is None:
-            return True
-        head = self.blocks[0]
-        if prev is head:
-            return False
-        room = prev.s_end - prev.length - head.s_end
-        return room >= change_distance(max(head.cap, abs(self.v)), 0.0, self._a_lo, self._j_lo)
 
     def lookahead(self) -> None:
         """Bring the queue's end speeds up to date (the backward pass the pushes owe)."""
@@ -403,54 +316,6 @@ class Planner:
         self.output = sp.positions
         return sp
 
-    def _now(self) -> float:
-        """Path position (Block.s_end's scale) of the last sample handed out."""
-        if self.blocks:
-            b = self.blocks[0]
-            self._share_s = b.s_end - b.length + (self.s if self._started else 0.0)
-        return self._share_s
-
-    def _share(self) -> float:
-        """The filter's share λ at the present path position (nc.motion.share_zones)."""
-        z = self._zones
-        if z is None or not z.zones:
-            lam = 1.0
-        elif abs(self.v) < 1e-12:
-            # At rest λ holds: the output is still settling there (F(p) ≠ p(t − D)). A plan starts only
-            # once the filter has settled, where λ may change at once (a stop cuts the zones).
-            lam = self._lam
-        else:
-            lam = z.lam(self._now())
-        self._lam = lam
-        return lam
-
-    def share_rows(self, i: int, m: int) -> np.ndarray | None:
-        """λ of buffer rows i … i + m − 1 as step() would take them one by one (`_share` after `_take`), for a
-        stretch's push_many (nc.motion.stretch); None where λ is 1 throughout (no zone left)."""
-        z = self._zones
-        if z is None or not z.zones:
-            return None
-        out = np.empty(m)
-        blk, popped, blocks = self._buf_blk, self._buf_popped, self.blocks
-        for r in range(m):
-            s, v, _ = self._buf_state[i + r]
-            if not z.zones:
-                lam = 1.0
-            elif abs(v) < 1e-12:
-                lam = self._lam
-            else:
-                b = blocks[blk[i + r] - popped] if blk is not None else blocks[0]
-                self._share_s = b.s_end - b.length + s
-                lam = z.lam(self._share_s)
-            self._lam = out[r] = lam
-        return out
-
-    def share_standing(self, n: int) -> np.ndarray | None:
-        """λ of n cycles standing (nc.motion.stretch.stand_stretch): the held one."""
-        if self._zones is None or not self._zones.zones:
-            return None
-        return np.full(n, self._share())
-
     def _step_path(self) -> Setpoint:
         if self._integrate_angle:
             self._sim_angle += self.spindle_rpm() * 6.0 * self.cfg.cycle
@@ -475,103 +340,6 @@ class Planner:
         self._take(i)
         blk = self.blocks[0].move if self.blocks else None
         return Setpoint(self.position.copy(), self.line, float(self._buf_vel[i]), blk)
-
-    def _block_rows(self) -> int:
-        """Buffer rows left that lie in blocks[0] (a stretch stays within one block: nc.motion.stretch)."""
-        i, n = self._buf_i, 0 if self._buf_pos is None else len(self._buf_pos)
-        blk = self._buf_blk
-        if blk is None:
-            return n - i
-        j = i
-        while j < n and blk[j] == self._buf_popped:
-            j += 1
-        return j - i
-
-    def _cruise_rows(self, n: int) -> int:
-        """Of the next n buffer rows, how many a stretch may take across a cruise's blocks: those before the
-        first block whose own solve would no longer cruise (`_chain_ok`, with the queue as it stands)."""
-        i = self._buf_i
-        m = min(n, 0 if self._buf_pos is None else len(self._buf_pos) - i)
-        blk = self._buf_blk
-        if blk is None or m <= 0:
-            return m
-        last = blk[i + m - 1]
-        if last > self._buf_popped and (bad := self._chain_ok(self.plan, last)) <= last:
-            while m > 0 and blk[i + m - 1] >= bad:
-                m -= 1
-        return m
-
-    def _take(self, i: int) -> None:
-        """The state after handing out buffer row i: a cruise's blocks before row i's are finished."""
-        if self._buf_blk is not None:
-            k = self._buf_blk[i]
-            while self._buf_popped < k:
-                self._finish_block(keep_plan=True)
-                self._buf_popped += 1
-        self.position = self._buf_pos[i]
-        self.line = self._buf_line[i]
-        self.s, self.v, self.a = self._buf_state[i]
-
-    # ---- threads --------------------------------------------------------------------------
-    def _thread_step(self) -> Setpoint:
-        """One cycle of a spindle-locked thread chain (see nc.motion.threading)."""
-        T = self.cfg.cycle
-        b = self.blocks[0]
-        self._started = True
-        angle = float(self.spindle_angle())
-        st = self._thread
-        if st is None:
-            if self._stopping:
-                self._flush()
-                return Setpoint(self.position.copy(), self.line, 0.0, None)
-            if b.seg is not None and _near(b.seg.start, self.position):
-                b.seg.start = self.position.copy()
-            self.line = b.move.line
-            if self.spindle_command is not None and not self._settle.ready(float(self.spindle_command())):
-                self.spindle_wait = True  # the spindle still changes speed: stand still on the thread's line
-                self._wait_cycles += 1
-                self.v = self.a = 0.0
-                return Setpoint(self.position.copy(), self.line, 0.0, b.move)
-            self.spindle_wait = False
-            self.thread_waits.append((b.move.line, self._wait_cycles))
-            self._wait_cycles = 0
-            st = self._thread = thr.arm(b, angle, float(self.spindle_rpm()), float(self.spindle_index()),
-                                        b.move.line)
-            self.thread_log.append((b.move.line, st.sync_angle, st.ramp_start))
-            self.solves += 1
-        if self._stopping and not st.stopping:
-            if st.v <= 1e-9 and not st.locked:
-                self._flush()
-                return Setpoint(self.position.copy(), self.line, 0.0, None)
-            thr.stop(st, b)
-        while True:
-            last = not (len(self.blocks) > 1 and self.blocks[1].kind == "thread") or st.stopping
-            if not last:
-                thr.add_corner(st, b, self.blocks[1], self.lim.acc, self.lim.jerk)
-            s = thr.advance(st, b, angle, T, last)
-            if s is not None:
-                break
-            if last:
-                self.position = b.seg.end.copy()
-                self._thread = None
-                self.s = self.v = self.a = 0.0
-                self._finish_block()
-                return Setpoint(self.position.copy(), b.move.line, 0.0, b.move)
-            self._finish_block(keep_plan=True)
-            nb = self.blocks[0]
-            thr.next_block(st, b, nb)
-            b = nb
-        self.position = b.seg.points(np.array([s]))[0]
-        if st.corners:  # the chain's corners are rounded within the axes' limits (nc.motion.thread_corners)
-            off = corner_offset(st.corners, st.u_block + s / thr.major_factor(b))
-            if off is not None:
-                self.position = self.position + off
-        self.line = b.move.line
-        self.s, self.v, self.a = s, st.v, 0.0
-        if st.halted:
-            self._flush()
-            self.v = 0.0
-        return Setpoint(self.position.copy(), self.line, st.v, b.move)
 
     # ---- planning -------------------------------------------------------------------------
     def _block(self, move: Move) -> Block | None:
@@ -740,103 +508,6 @@ class Planner:
             self._flush()
         self._started = False
         return None
-
-    def _cruising(self, b: Block, v: float) -> bool:
-        """A solve at b's start (or within b) from speed v at zero acceleration would cruise at v to b's end:
-        its run ends there (b's end speed is not below its cap), its cap is v, nothing re-plans it per cycle.
-        Not a corner blend (decision motion 45): measured, its solve does not give a cruise bit for bit."""
-        return (b.kind == "path" and b.cap == v and b.vend >= v and not b.move.per_rev and b.move.css is None
-                and "G31" not in b.move.tags and b.seg.kind != "blend")
-
-    def _cruise(self, b: Block, t0: float) -> _Plan | None:
-        """Decision motion 44: at its cap, with zero acceleration, a run whose end speed is the cap solves to
-        constant speed to the end of its block, and so does the next block's solve while the same holds there.
-        Such a chain is sampled across its blocks at once (no solve): positions as the per-block solves give
-        them (tests/test_motion_cruise.py). A push may change the junction speeds far back in the queue
-        (FilterCorners.window): once one came, each block of the chain is checked again when its first row is
-        due, when its own solve would run (`_chain_ok`)."""
-        v = self.v
-        if self.held or self._stopping or self.a != 0.0 or v <= 0.0:
-            return None
-        self.lookahead()
-        if not self._cruising(b, v):
-            return None
-        return _Plan("cruise", None, math.inf, t0, queued=self._pushes)
-
-    def _sample_cruise(self, p: _Plan) -> None:
-        """The rows of a cruise, whole blocks up to at least CHUNK rows: each block as its own solve gives them
-        (a constant-speed profile from s0 at the plan time t0, s = s0 + v·t, sampled a CHUNK at a time while
-        t <= duration + 1e-9 cycles, as `_refill` and `_sample` do; the next block's t0 the time left over, as
-        `_end_plan` carries it), and the snap of a block's start to where the last one ended (`_start_plan`)."""
-        T = self.cfg.cycle
-        v = self.v
-        blocks = self.blocks
-        s0, t_next, k, nb = self.s, p.t_next, 0, len(blocks)
-        pos: list[np.ndarray] = []
-        st: list[float] = []
-        offs: list[int] = []
-        lines: list[int] = []
-        carries: list[float] = []  # the plan time left over at the end of each block
-        rows = 0
-        while True:
-            b = blocks[k]
-            if k and _near(b.seg.start, blocks[k - 1].seg.end):
-                b.seg.start = blocks[k - 1].seg.end.copy()
-            duration = (b.length - s0) / v  # ruckig's duration of this profile, to the bit
-            while True:
-                n = int(math.floor((duration - t_next) / T + 1e-9)) + 1
-                if not (t_next <= duration + 1e-12 and n > 0):
-                    break
-                n = min(n, CHUNK)
-                t = t_next + T * np.arange(n)
-                t_next = float(t[-1] + T)
-                s = s0 + np.clip(t, 0.0, duration) * v
-                pos.append(b.seg.points(np.clip(s, 0.0, b.length)))
-                st += s.tolist()
-                offs += [k] * n
-                lines += [b.move.line] * n
-                rows += n
-            p.carry = t_next - duration if t_next - duration > 1e-12 else t_next - duration + T
-            carries.append(p.carry)
-            p.last = k
-            if rows >= CHUNK or k + 1 >= nb or not self._cruising(blocks[k + 1], v):
-                break
-            k, s0, t_next = k + 1, 0.0, p.carry
-        p.emitted = True
-        self._buf_pos = np.concatenate(pos) if pos else np.empty((0, len(self.axes)))
-        self._buf_vel = np.full(rows, v)
-        self._buf_line = lines
-        self._buf_state = [(x, v, 0.0) for x in st]
-        self._buf_blk = offs
-        self._buf_popped = 0
-        self._buf_i = 0
-        self._buf_carry = carries
-
-    def _chain_ok(self, p: _Plan | None, upto: int) -> int:
-        """The first block offset up to `upto` (where a cruise's next row lies) whose own solve would no longer
-        cruise: a push since the chain was sampled changed its end speed (the same check `_cruise` makes, at
-        the cycle the per-block solve would make it); `upto + 1` when all still cruise."""
-        if p is None or p.kind != "cruise" or self._pushes == p.queued:
-            return upto + 1
-        self.lookahead()
-        for k in range(self._buf_popped + 1, upto + 1):
-            if not self._cruising(self.blocks[k - self._buf_popped], self.v):
-                return k
-        return upto + 1
-
-    def _break_chain(self, k: int) -> None:
-        """Block offset k does not cruise any more: the chain ends at the end of block k - 1, as that block's
-        own plan would end there (`_end_plan`); the next refill solves block k."""
-        while self._buf_popped < k - 1:
-            self._finish_block(keep_plan=True)
-            self._buf_popped += 1
-        self._carry = self._buf_carry[k - 1]
-        self.position = self.blocks[0].seg.end.copy()
-        self.a = 0.0
-        self._finish_block()
-        self.plan = None
-        self._buf_pos = None
-        self._buf_blk = None
 
     def _spindle_starting(self) -> bool:
         return self.spindle_command is not None and abs(self.spindle_command()) > 0.0

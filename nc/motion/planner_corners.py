@@ -1,0 +1,116 @@
+"""The planner's corner blends as they are pushed (decisions motion 42, 45) and the position filter's share λ
+along the path (decision motion 43, nc.motion.share_zones). A mixin of `Planner`."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from nc.motion.corner_blends import blend_block
+from nc.motion.lookahead import Block, change_distance
+
+
+class CornerShares:
+    """Methods of `nc.motion.planner.Planner` (its state is the planner's own: see that module's doc)."""
+
+    def _corner(self, prev: Block, b: Block) -> int:
+        """The junction prev → b (prev.vjunc set): a corner blend between them where one is built
+        (decisions motion 42, 45), or, under the filter, a hard junction where λ < 1 planned raw.
+        Returns the blocks added (the blend: 1)."""
+        zones = self._zones
+        tol = self.cfg.path_tolerance or 0.0
+        if zones is not None and prev.vjunc <= 0.0:
+            zones.stop(prev.s_end)
+            return 0
+        blk = None
+        if zones is not None and zones.inside(prev.s_end, max(prev.vtop, b.vtop)):
+            # λ stays below 1 here: not blended, the junction is taken as without the filter, and
+            # that is what a blend must beat
+            prev.vjunc = min(prev.vjunc, self.lim.junction(prev, b, raw=True))
+        if (self.lim.blend is None or zones is not None) and self._may_blend(prev):
+            if zones is None or zones.blend_allowed(prev.s_end - prev.length, max(prev.vtop, b.vtop), self._now(),
+                                                    abs(self.v) < 1e-12 and self.plan is None):
+                blk = blend_block(self.lim, prev, b, tol)
+        if blk is None:
+            if zones is not None and (prev.du_n > 1e-9 or "arc" in (prev.seg.kind, b.seg.kind)):
+                if zones.hard(prev.s_end, max(prev.vtop, b.vtop)):
+                    prev.vjunc = min(prev.vjunc, self.lim.junction(prev, b, raw=True))
+            return 0
+        # Both lines gave path to it: the running lengths follow.
+        prev.s_end -= blk.seg.tlen
+        blk.s_end = prev.s_end + blk.length
+        self._path_s = blk.s_end
+        if zones is not None:
+            blk.vtop = min(blk.cap_hard, prev.vtop)
+            zones.add_blend(blk.s_end - blk.length, blk.s_end, max(prev.vtop, b.vtop))
+        for x in (prev, blk, b):
+            self._update_cap(x)
+        self.blocks.append(blk)
+        if self.lim.blend is not None:
+            # The filter's windows walk the queue and their junction history side by side: the junction
+            # prev → blend joins that history now, as any pushed block's does (b's comes with b).
+            self._need = max(self._need, self.lim.blend.window(self.blocks) + 1)
+        return 1
+
+    def _may_blend(self, prev: Block) -> bool:
+        """Whether the tail may still give path to a corner blend (decision motion 42): a tolerance
+        to blend within, no hold (its ramp runs on across blocks), and no profile that could be
+        caught by the shorter path: nothing planned yet, or the tail further beyond the active
+        block than any stop from its speed needs, at half the least tangential limits."""
+        tol = self.cfg.path_tolerance
+        if tol is None or tol <= 0.0 or self.held or self._stopping:
+            return False
+        if not self._started and self.plan is None:
+            return True
+        head = self.blocks[0]
+        if prev is head:
+            return False
+        room = prev.s_end - prev.length - head.s_end
+        return room >= change_distance(max(head.cap, abs(self.v)), 0.0, self._a_lo, self._j_lo)
+
+    def _now(self) -> float:
+        """Path position (Block.s_end's scale) of the last sample handed out."""
+        if self.blocks:
+            b = self.blocks[0]
+            self._share_s = b.s_end - b.length + (self.s if self._started else 0.0)
+        return self._share_s
+
+    def _share(self) -> float:
+        """The filter's share λ at the present path position (nc.motion.share_zones)."""
+        z = self._zones
+        if z is None or not z.zones:
+            lam = 1.0
+        elif abs(self.v) < 1e-12:
+            # At rest λ holds: the output is still settling there (F(p) ≠ p(t − D)). A plan starts only
+            # once the filter has settled, where λ may change at once (a stop cuts the zones).
+            lam = self._lam
+        else:
+            lam = z.lam(self._now())
+        self._lam = lam
+        return lam
+
+    def share_rows(self, i: int, m: int) -> np.ndarray | None:
+        """λ of buffer rows i … i + m − 1 as step() would take them one by one (`_share` after `_take`), for a
+        stretch's push_many (nc.motion.stretch); None where λ is 1 throughout (no zone left)."""
+        z = self._zones
+        if z is None or not z.zones:
+            return None
+        out = np.empty(m)
+        blk, popped, blocks = self._buf_blk, self._buf_popped, self.blocks
+        for r in range(m):
+            s, v, _ = self._buf_state[i + r]
+            if not z.zones:
+                lam = 1.0
+            elif abs(v) < 1e-12:
+                lam = self._lam
+            else:
+                b = blocks[blk[i + r] - popped] if blk is not None else blocks[0]
+                self._share_s = b.s_end - b.length + s
+                lam = z.lam(self._share_s)
+            self._lam = out[r] = lam
+        return out
+
+    def share_standing(self, n: int) -> np.ndarray | None:
+        """λ of n cycles standing (nc.motion.stretch.stand_stretch): the held one."""
+        if self._zones is None or not self._zones.zones:
+            return None
+        return np.full(n, self._share())

@@ -1,0 +1,148 @@
+"""The planner's cruise sampling (decision motion 44): blocks run at their cap sampled across blocks without a
+solve, and the buffer rows a stretch may take (nc.motion.stretch). A mixin of `Planner`."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from nc.motion.lookahead import Block
+from nc.motion.plan_state import CHUNK, _near, _Plan
+
+
+class CruiseSampling:
+    """Methods of `nc.motion.planner.Planner` (its state is the planner's own: see that module's doc)."""
+
+    def _block_rows(self) -> int:
+        """Buffer rows left that lie in blocks[0] (a stretch stays within one block: nc.motion.stretch)."""
+        i, n = self._buf_i, 0 if self._buf_pos is None else len(self._buf_pos)
+        blk = self._buf_blk
+        if blk is None:
+            return n - i
+        j = i
+        while j < n and blk[j] == self._buf_popped:
+            j += 1
+        return j - i
+
+    def _cruise_rows(self, n: int) -> int:
+        """Of the next n buffer rows, how many a stretch may take across a cruise's blocks: those before the
+        first block whose own solve would no longer cruise (`_chain_ok`, with the queue as it stands)."""
+        i = self._buf_i
+        m = min(n, 0 if self._buf_pos is None else len(self._buf_pos) - i)
+        blk = self._buf_blk
+        if blk is None or m <= 0:
+            return m
+        last = blk[i + m - 1]
+        if last > self._buf_popped and (bad := self._chain_ok(self.plan, last)) <= last:
+            while m > 0 and blk[i + m - 1] >= bad:
+                m -= 1
+        return m
+
+    def _take(self, i: int) -> None:
+        """The state after handing out buffer row i: a cruise's blocks before row i's are finished."""
+        if self._buf_blk is not None:
+            k = self._buf_blk[i]
+            while self._buf_popped < k:
+                self._finish_block(keep_plan=True)
+                self._buf_popped += 1
+        self.position = self._buf_pos[i]
+        self.line = self._buf_line[i]
+        self.s, self.v, self.a = self._buf_state[i]
+
+    def _cruising(self, b: Block, v: float) -> bool:
+        """A solve at b's start (or within b) from speed v at zero acceleration would cruise at v to b's end:
+        its run ends there (b's end speed is not below its cap), its cap is v, nothing re-plans it per cycle.
+        Not a corner blend (decision motion 45): measured, its solve does not give a cruise bit for bit."""
+        return (b.kind == "path" and b.cap == v and b.vend >= v and not b.move.per_rev and b.move.css is None
+                and "G31" not in b.move.tags and b.seg.kind != "blend")
+
+    def _cruise(self, b: Block, t0: float) -> _Plan | None:
+        """Decision motion 44: at its cap, with zero acceleration, a run whose end speed is the cap solves to
+        constant speed to the end of its block, and so does the next block's solve while the same holds there.
+        Such a chain is sampled across its blocks at once (no solve): positions as the per-block solves give
+        them (tests/test_motion_cruise.py). A push may change the junction speeds far back in the queue
+        (FilterCorners.window): once one came, each block of the chain is checked again when its first row is
+        due, when its own solve would run (`_chain_ok`)."""
+        v = self.v
+        if self.held or self._stopping or self.a != 0.0 or v <= 0.0:
+            return None
+        self.lookahead()
+        if not self._cruising(b, v):
+            return None
+        return _Plan("cruise", None, math.inf, t0, queued=self._pushes)
+
+    def _sample_cruise(self, p: _Plan) -> None:
+        """The rows of a cruise, whole blocks up to at least CHUNK rows: each block as its own solve gives them
+        (a constant-speed profile from s0 at the plan time t0, s = s0 + v·t, sampled a CHUNK at a time while
+        t <= duration + 1e-9 cycles, as `_refill` and `_sample` do; the next block's t0 the time left over, as
+        `_end_plan` carries it), and the snap of a block's start to where the last one ended (`_start_plan`)."""
+        T = self.cfg.cycle
+        v = self.v
+        blocks = self.blocks
+        s0, t_next, k, nb = self.s, p.t_next, 0, len(blocks)
+        pos: list[np.ndarray] = []
+        st: list[float] = []
+        offs: list[int] = []
+        lines: list[int] = []
+        carries: list[float] = []  # the plan time left over at the end of each block
+        rows = 0
+        while True:
+            b = blocks[k]
+            if k and _near(b.seg.start, blocks[k - 1].seg.end):
+                b.seg.start = blocks[k - 1].seg.end.copy()
+            duration = (b.length - s0) / v  # ruckig's duration of this profile, to the bit
+            while True:
+                n = int(math.floor((duration - t_next) / T + 1e-9)) + 1
+                if not (t_next <= duration + 1e-12 and n > 0):
+                    break
+                n = min(n, CHUNK)
+                t = t_next + T * np.arange(n)
+                t_next = float(t[-1] + T)
+                s = s0 + np.clip(t, 0.0, duration) * v
+                pos.append(b.seg.points(np.clip(s, 0.0, b.length)))
+                st += s.tolist()
+                offs += [k] * n
+                lines += [b.move.line] * n
+                rows += n
+            p.carry = t_next - duration if t_next - duration > 1e-12 else t_next - duration + T
+            carries.append(p.carry)
+            p.last = k
+            if rows >= CHUNK or k + 1 >= nb or not self._cruising(blocks[k + 1], v):
+                break
+            k, s0, t_next = k + 1, 0.0, p.carry
+        p.emitted = True
+        self._buf_pos = np.concatenate(pos) if pos else np.empty((0, len(self.axes)))
+        self._buf_vel = np.full(rows, v)
+        self._buf_line = lines
+        self._buf_state = [(x, v, 0.0) for x in st]
+        self._buf_blk = offs
+        self._buf_popped = 0
+        self._buf_i = 0
+        self._buf_carry = carries
+
+    def _chain_ok(self, p: _Plan | None, upto: int) -> int:
+        """The first block offset up to `upto` (where a cruise's next row lies) whose own solve would no longer
+        cruise: a push since the chain was sampled changed its end speed (the same check `_cruise` makes, at
+        the cycle the per-block solve would make it); `upto + 1` when all still cruise."""
+        if p is None or p.kind != "cruise" or self._pushes == p.queued:
+            return upto + 1
+        self.lookahead()
+        for k in range(self._buf_popped + 1, upto + 1):
+            if not self._cruising(self.blocks[k - self._buf_popped], self.v):
+                return k
+        return upto + 1
+
+    def _break_chain(self, k: int) -> None:
+        """Block offset k does not cruise any more: the chain ends at the end of block k - 1, as that block's
+        own plan would end there (`_end_plan`); the next refill solves block k."""
+        while self._buf_popped < k - 1:
+            self._finish_block(keep_plan=True)
+            self._buf_popped += 1
+        self._carry = self._buf_carry[k - 1]
+        self.position = self.blocks[0].seg.end.copy()
+        self.a = 0.0
+        self._finish_block()
+        self.plan = None
+        self._buf_pos = None
+        self._buf_blk = None
