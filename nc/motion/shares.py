@@ -71,6 +71,9 @@ def _s_end(b: "Block") -> float:
 
 
 UNKNOWN = (-1.0, -1.0)  # _scan: the queue ends before the reach does
+# Above FilterCorners._boost_ratio's largest value (2: doubling the jerk at most doubles the speed-up) by
+# far more than its rounding: _tolerance_free's bound.
+RATIO_BOUND = 2.001
 
 
 def _scan(fc: "FilterCorners", blocks: Sequence["Block"], pos: float, run_end: float, reach: float,
@@ -176,7 +179,18 @@ def _tolerance_free(fc: "FilterCorners", j: "Block", blocks: Sequence["Block"], 
     elif tcap <= 0.0:
         ok = False
     else:
-        unb, boosted = fc.braking_pair(j.du_n, j.a, j.j)
-        ok = cap * (fc.tol - unb) / tcap + boosted <= fc.tol
+        # boosted = unb × the kernel's speed-up ratio for the doubled jerk, which lies in [1, 2] (a
+        # jerk-limited speed change's acceleration min(2jt, a) ≤ 2·min(jt, a), so its path at most
+        # doubles): the verdict is decided by those bounds for most junctions without the ratio's
+        # kernel sums (a numpy call per new (a, j) pair, i.e. per junction of a curve; issue 17).
+        # Rounding is monotone, so the bounds give the verdict the exact expression gives.
+        unb = fc.braking(j.du_n, j.a)
+        x = cap * (fc.tol - unb) / tcap
+        if x + unb > fc.tol:
+            ok = False
+        elif x + unb * RATIO_BOUND <= fc.tol:
+            ok = True
+        else:
+            ok = x + fc.braking_pair(j.du_n, j.a, j.j)[1] <= fc.tol
     j.tf_cap, j.tf_tcap, j.tf_ok = cap, tcap, ok
     return ok
