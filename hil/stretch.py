@@ -72,6 +72,11 @@ class Stretcher:
         self.stretches = 0  # stretches taken and cycles in them (benchmarks, tests)
         self.cycles = 0
         self.ahead_used = 0  # real time: refills computed ahead and taken by their cycle
+        # real time: the refill the next stretch starts with, worked out in the slack before the last cycle of the
+        # one before, with what it read (the planner's fields, the channel's signature): taken if still the same
+        self._next_fill: tuple | None = None
+        self._early: tuple | None = None
+        self.fills_early = 0
 
     @classmethod
     def for_runner(cls, runner: Any) -> "Stretcher | None":
@@ -92,6 +97,7 @@ class Stretcher:
         """Up to `limit` cycles as one stretch; False when no stretch can start here (step this cycle)."""
         r = self.r
         ch: Channel | None = r.channel
+        self._early, self._next_fill = self._next_fill, None  # the one before's, for this start only
         if limit < 2 or ch is None:
             return False
         kind = self._quiet(r, ch)
@@ -116,7 +122,7 @@ class Stretcher:
             n = min(limit, self.max_cycles, pl._block_rows())  # a cruise's buffer spans blocks: this one's rows
             self._sampler = sample_stretch
             # real time: where the buffer ran out, the refill the first cycle's step would make, made ahead (B21)
-            fill = self._refill_ahead(r, ch, pl) if self.paced and n == 0 else None
+            fill = self._early_fill(r, ch, pl, kind) if self.paced and n == 0 else None
             if fill is not None:
                 n = min(limit, self.max_cycles, fill[4])
                 self._sampler = _refilled(fill)
@@ -209,6 +215,8 @@ class Stretcher:
                     last_row = bulk_cycles(r, ch, pl, smp, outs, k, m, raw[m - 1], (rpms, cmds) if settle else None,
                                            timings)
                     if last_row is not None:  # real time: the last cycle, paced after the rest
+                        if not cut:  # nothing cuts this stretch any more: the next one's refill, worked out here
+                            self._fill_next(r, ch, pl, last_raw)
                         last_row(self._pace(r, m - 1, m, positions, targets, panel)[1][0])
                     if cut and settle:
                         settle_stretch(pl, rpms, cmds)
@@ -276,6 +284,41 @@ class Stretcher:
             if r.stop_request is not None or _panel_state(r.on_cycle) != panel:
                 break
         return k + len(timings), timings
+
+    def _fill_next(self, r: Any, ch: Channel, pl: Planner, last_raw: Any) -> None:
+        """In the slack before a paced stretch's last cycle, with its bulk part (nothing cuts it any more), where
+        it samples its block's buffer to the end: the refill the next stretch will start with (_refill_ahead),
+        worked out on the planner as this stretch leaves it (its position the last raw sample), kept with what
+        it read; so the slack after the last cycle, the next stretch's start, holds that much less. That start
+        takes it only when all of that is still the same (_early_fill), else works the refill out itself."""
+        self._next_fill = None
+        if self._sampler in (stand_stretch, _stand_queued, _sample_across) or not pl._buf_done:
+            return  # standing, or a cruise across blocks: no refill where it ends
+        pos, pl.position = pl.position, last_raw
+        try:
+            before = dict(pl.__dict__)
+            sig = _signature(ch)
+            fill = self._refill_ahead(r, ch, pl)
+        finally:
+            pl.position = pos
+        if fill is not None:
+            self._next_fill = (fill, before, sig)
+
+    def _early_fill(self, r: Any, ch: Channel, pl: Planner, kind: str) -> tuple | None:
+        """The refill ahead of this stretch's start: the one worked out early (_fill_next) when the planner's
+        fields are the very ones it read, its plan's fields and queue as they were and the channel's signature
+        the same; else worked out here (B21)."""
+        early, self._early = self._early, None
+        if early is not None and kind == "run":
+            fill, before, sig = early
+            p, p0, q0 = fill[0], fill[1], fill[5]
+            d, q = pl.__dict__, pl.blocks
+            if (pl.plan is p and (p is None or p.__dict__ == p0) and len(d) == len(before)
+                    and all(d.get(k) is v for k, v in before.items()) and len(q) == len(q0)
+                    and all(a is b for a, b in zip(q, q0)) and _signature(ch) == sig):
+                self.fills_early += 1
+                return fill
+        return self._refill_ahead(r, ch, pl)
 
     # ---- real time: the refill of a stepped cycle ahead ----------------------------------------------
     def ahead(self) -> Callable[[Channel], Setpoint] | None:
