@@ -187,13 +187,16 @@ class FilterCorners:
         last = len(hist)
         prev = hist[-1].cum if last > h0 else self._zero
         du = j_new.du
+        sprev = hist[-1].scum if last > h0 else self._zero
+        dv = j_new.dv
         if self._axes == 3:  # the common case spelt out (this runs once per pushed block)
             cum_j = (prev[0] + du[0], prev[1] + du[1], prev[2] + du[2], prev[3] + j_new.du_n)
+            sj = (sprev[0] + dv[0], sprev[1] + dv[1], sprev[2] + dv[2])
         else:
             cum_j = tuple(p + d for p, d in zip(prev, du + (j_new.du_n,)))
+            sj = tuple(p + d for p, d in zip(sprev, dv))
         j_new.cum = cum_j
-        sprev = hist[-1].scum if last > h0 else self._zero
-        j_new.scum = sj = tuple(p + d for p, d in zip(sprev, j_new.dv))
+        j_new.scum = sj
         hist.append(j_new)
         s_j = j_new.s_end
         span_max = self.span_max
@@ -212,10 +215,14 @@ class FilterCorners:
         if m < h0:
             m = h0
         maxima = self._maxima
-        for q, x in zip(maxima, (j_new.a, j_new.vtop, j_new.length)):
-            _push_max(q, self._seq0 + last, x)
-            _drop_before(q, self._seq0 + m)
         acc_q, top_q, len_q = maxima
+        seq, seq_m = self._seq0 + last, self._seq0 + m
+        for q, x in ((acc_q, j_new.a), (top_q, j_new.vtop), (len_q, j_new.length)):
+            while q and q[-1][1] <= x:  # _push_max and _drop_before inline (once per pushed block)
+                q.pop()
+            q.append((seq, x))
+            while q[0][0] < seq_m:
+                q.popleft()
         tail = blocks[-1]
         t_w = self.t_j
         # J is crossed no faster than either block beside it can run.

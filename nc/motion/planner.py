@@ -39,7 +39,7 @@ from nc.motion.plan_state import CHUNK, Setpoint, _near, _Plan
 from nc.motion.planner_corners import CornerShares
 from nc.motion.planner_cruise import CruiseSampling
 from nc.motion.planner_thread import ThreadStepping
-from nc.motion.profile import solve_axes, solve_position, solve_velocity
+from nc.motion.profile import clip, solve_axes, solve_position, solve_velocity
 from nc.motion.share_zones import ShareZones
 from nc.motion.shares import MAX_FACTOR, jerk_factor
 from nc.motion.smoothing import PositionFilter
@@ -716,7 +716,7 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping):
         b = blocks[0]
         line = b.move.line
         p.emitted = True
-        self._buf_pos = b.seg.points(np.clip(s, 0.0, b.length))
+        self._buf_pos = b.seg.points(clip(s, 0.0, b.length))
         self._buf_vel = v
         self._buf_line = [line] * n
         self._buf_i = 0

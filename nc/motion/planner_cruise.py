@@ -9,6 +9,7 @@ import numpy as np
 
 from nc.motion.lookahead import Block
 from nc.motion.plan_state import CHUNK, _near, _Plan
+from nc.motion.profile import clip
 
 
 class CruiseSampling:
@@ -99,8 +100,8 @@ class CruiseSampling:
                 n = min(n, CHUNK)
                 t = t_next + T * np.arange(n)
                 t_next = float(t[-1] + T)
-                s = s0 + np.clip(t, 0.0, duration) * v
-                pos.append(b.seg.points(np.clip(s, 0.0, b.length)))
+                s = s0 + clip(t, 0.0, duration) * v
+                pos.append(b.seg.points(clip(s, 0.0, b.length)))
                 st += s.tolist()
                 offs += [k] * n
                 lines += [b.move.line] * n

@@ -27,7 +27,7 @@ unknown, unless the channel said none come before a stop: `closed`), leave the s
 from __future__ import annotations
 
 import math
-from bisect import bisect_right
+from bisect import bisect_left, bisect_right
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
@@ -52,9 +52,13 @@ def jerk_factor(cfg: MotionConfig, fc: "FilterCorners", blocks: Sequence["Block"
         return 1.0, False
     t_w = fc.t_j
     v_hi = max(b.vtop for b in (blocks[0], blocks[-1]))
+    # Whether a junction using its whole share (use 1) already makes the factor 1: then _scan may stop at
+    # the first such junction once no block faster than v_hi lies in the reach (every other outcome of
+    # its scan, None included, gives 1.0 too).
+    saturates = (1.0 - pool) / st <= 1.0
     for _ in range(4):  # the reach grows with the fastest block found inside it
         reach = v_hi * t_w
-        got = _scan(fc, blocks, pos, run_end, reach, closed)
+        got = _scan(fc, blocks, pos, run_end, reach, closed, v_hi if saturates else -1.0)
         if got is None:
             return 1.0, False
         if got is UNKNOWN:
@@ -77,9 +81,12 @@ RATIO_BOUND = 2.001
 
 
 def _scan(fc: "FilterCorners", blocks: Sequence["Block"], pos: float, run_end: float, reach: float,
-          closed: bool) -> tuple[float, float] | None:
+          closed: bool, v_stop: float = -1.0) -> tuple[float, float] | None:
     """(largest vjunc / vbud, fastest vtop) over the junctions within `reach` of [pos, run_end];
-    None when an arc is there, UNKNOWN when the queue does not tell what is there."""
+    None when an arc is there, UNKNOWN when the queue does not tell what is there. `v_stop` ≥ 0: the
+    caller's factor is 1 for a use of 1, so once a junction uses 1 and no vtop in the reach exceeds
+    v_stop (no wider scan follows) the rest only needs those vtops (issue 17: 722 of the CAM program's
+    2,303 scans)."""
     seen = 0.0
     hi = run_end + reach
     covered = False
@@ -110,10 +117,11 @@ def _scan(fc: "FilterCorners", blocks: Sequence["Block"], pos: float, run_end: f
     # push, not to the executing block) and drops old ones only in bulk, counted in _seq0.
     # hist is in path order: the junctions past hi are skipped by bisection, not one by one. The
     # loop runs over ~85 junctions per solve on dense CAM paths (issue 17): max()/min() spelt out.
-    for k in range(bisect_right(hist, hi, key=_s_end) - 1, -1, -1):
+    # The junctions before lo by bisection too (hist is in path order): the loop stops at k_lo, and when
+    # k_lo is 0 no junction before lo is left, as when it ran off the front before.
+    k_lo = bisect_left(hist, lo, key=_s_end)
+    for k in range(bisect_right(hist, hi, key=_s_end) - 1, k_lo - 1, -1):
         j = hist[k]
-        if j.s_end < lo:
-            break
         if j.vtop > seen:
             seen = j.vtop
         if j.seg is not None and j.seg.kind == "arc":
@@ -147,9 +155,16 @@ def _scan(fc: "FilterCorners", blocks: Sequence["Block"], pos: float, run_end: f
         r = j.vjunc / vbud
         if r > use:
             use = r if r < 1.0 else 1.0
-    else:
-        if fc._seq0 > 0:
-            return None  # junctions within the reach were dropped already
+            if use == 1.0 and v_stop >= 0.0 and seen <= v_stop:
+                top = seen
+                for q in range(k - 1, k_lo - 1, -1):
+                    x = hist[q].vtop
+                    if x > top:
+                        top = x
+                if top <= v_stop:
+                    return use, top
+    if k_lo == 0 and fc._seq0 > 0:
+        return None  # junctions within the reach were dropped already
     return use, seen
 
 
