@@ -10,6 +10,9 @@ exchange(): RPDOs out, one SYNC, the TPDOs every node sends on that SYNC in; hea
 Interfaces: `virtual` (in-process, lock-step: delivery is pumped, time is simulated, nothing
 sleeps), and any python-can interface in real time (`socketcan` on benches, `udp_multicast`
 between processes in tests). The same code configures and runs all of them.
+
+Why one file of ~500 lines: the node bring-up over SDO, the SYNC exchange and the heartbeat/NMT/EMCY
+watch share the nodes' state and python-canopen's network object; the node records live in nodes.py.
 """
 
 from __future__ import annotations

@@ -6,6 +6,10 @@ cycle, first DC slave the reference clock) → OP, checking the state after ever
 `exchange` is one LRW frame; the working counter is checked every cycle. Short outages (lost
 frames, a slave off the line for a few cycles) are ridden through on the last inputs; longer ones,
 and any AL error, raise `BusError` with the NC5 alarm.
+
+Why one file of ~520 lines: bring-up, the cyclic exchange and the outage riding read and write the same
+slave table, PDO views and working-counter state, in the order the line's state machine needs; the
+pure parts live beside it (PDO mapping in pdo_mapping.py, alarms in alarms.py, images in fieldbus.pdo).
 """
 
 from __future__ import annotations
