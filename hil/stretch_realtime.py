@@ -1,0 +1,163 @@
+"""The stretch runner in real time (decision B21): each cycle of a stretch paced with its own tick, and the
+work of the next cycles (a stepped cycle's refill, the next stretch's) worked out ahead in the periods' slack.
+A mixin of `hil.stretch.Stretcher`, on its state."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+from hil.clock import CycleTiming
+from hil.stretch_state import (_NOT_AHEAD, _SPINDLE_FEEDBACK, _not_ahead, _panel_state, _sample_across,
+                               _signature, _stand_queued)
+from nc.channel import Channel
+from nc.motion.planner import Planner, Setpoint
+from nc.motion.stretch import stand_stretch
+
+
+class RealTimeStretches:
+    """`Stretcher`'s real-time methods."""
+
+    def _pace(self, r: Any, k: int, m: int, positions: np.ndarray, targets: list[list[int]],
+              panel: tuple | None) -> tuple[int, list[CycleTiming]]:
+        """Real time, a bulk stretch (B21): cycles k … m-1 paced one by one, each its tick (the wait for its
+        deadline, the overrun count, its timing) and its outputs, the setpoints of its sample (converted
+        ahead, here in the slack); the rest of those cycles (MLC, counters, trace rows) is done at once after
+        the last one (`bulk_cycles`). Ends after a cycle in which a stop was asked or the panel was pressed,
+        which the next cycle must see. Returns the end (k + the cycles paced) and their timings."""
+        clock, rx = r.clock, r.rx
+        n_axes = self.n_axes
+        org = r.origin.tolist()
+        last = positions[len(targets[0]) - 1].tolist() if n_axes else []
+        # the setpoint each cycle writes: the sample of that cycle (targets[i][c + 1]; the last one converted here)
+        tgt = [targets[i][1:] + [r.scales[i].to_counts(last[i] - org[i])] for i in range(n_axes)]
+        pairs = list(zip(rx[:n_axes], tgt))
+        timings: list[CycleTiming] = []
+        for c in range(k, m):
+            t = clock.tick()
+            timings.append(t)
+            if t.overrun:
+                r._overrun()  # counted: a bench whose overrun is an alarm takes no paced bulk (_bulk_ok)
+            for out, col in pairs:
+                out.target_position = col[c]
+            clock.written()
+            clock.done()
+            if r.stop_request is not None or _panel_state(r.on_cycle) != panel:
+                break
+        return k + len(timings), timings
+
+    def _fill_next(self, r: Any, ch: Channel, pl: Planner, last_raw: Any) -> None:
+        """In the slack before a paced stretch's last cycle, with its bulk part (nothing cuts it any more), where
+        it samples its block's buffer to the end: the refill the next stretch will start with (_refill_ahead),
+        worked out on the planner as this stretch leaves it (its position the last raw sample), kept with what
+        it read; so the slack after the last cycle, the next stretch's start, holds that much less. That start
+        takes it only when all of that is still the same (_early_fill), else works the refill out itself."""
+        self._next_fill = None
+        if self._sampler in (stand_stretch, _stand_queued, _sample_across) or not pl._buf_done:
+            return  # standing, or a cruise across blocks: no refill where it ends
+        pos, pl.position = pl.position, last_raw
+        try:
+            before = dict(pl.__dict__)
+            sig = _signature(ch)
+            fill = self._refill_ahead(r, ch, pl)
+        finally:
+            pl.position = pos
+        if fill is not None:
+            self._next_fill = (fill, before, sig)
+
+    def _early_fill(self, r: Any, ch: Channel, pl: Planner, kind: str) -> tuple | None:
+        """The refill ahead of this stretch's start: the one worked out early (_fill_next) when the planner's
+        fields are the very ones it read, its plan's fields and queue as they were and the channel's signature
+        the same; else worked out here (B21)."""
+        early, self._early = self._early, None
+        if early is not None and kind == "run":
+            fill, before, sig = early
+            p, p0, q0 = fill[0], fill[1], fill[5]
+            d, q = pl.__dict__, pl.blocks
+            if (pl.plan is p and (p is None or p.__dict__ == p0) and len(d) == len(before)
+                    and all(d.get(k) is v for k, v in before.items()) and len(q) == len(q0)
+                    and all(a is b for a, b in zip(q, q0)) and _signature(ch) == sig):
+                self.fills_early += 1
+                return fill
+        return self._refill_ahead(r, ch, pl)
+
+    def ahead(self) -> Callable[[Channel], Setpoint] | None:
+        """Real time (B21): the planner's refill of the next cycle (a stepped cycle where the planner's buffer
+        ran out: ≈ 100 µs of sampling, more with a block's end and the next one's solve) computed now, in the
+        period's slack, and kept aside; the cycle's step puts it in place when nothing the refill read changed
+        since (the planner's fields, its queue and its plan as they were, the channel's inputs), and otherwise
+        leaves the planner to refill itself. None: the cycle steps as usual."""
+        r = self.r
+        ch = r.channel
+        if not self.paced or ch is None:
+            return None
+        pl = ch.planner
+        fill = self._refill_ahead(r, ch, pl, across=True)
+        if fill is None:
+            return None
+        p, p0, s1, p1, _, q0, q1 = fill
+        s0 = dict(pl.__dict__)
+        sig = _signature(ch)
+
+        def step(channel: Channel) -> Setpoint:
+            d, q = pl.__dict__, pl.blocks
+            if (_signature(channel) == sig and pl.plan is p and (p is None or p.__dict__ == p0)
+                    and len(q) == len(q0) and all(a is b for a, b in zip(q, q0)) and len(d) == len(s0)
+                    and all(d.get(k) is v for k, v in s0.items())):
+                d.update(s1)
+                if p is not None:
+                    p.__dict__.update(p1)
+                if q1 is not None:  # the refill finished blocks: the queue as it left it (the same deque)
+                    q.clear()
+                    q.extend(q1)
+                self.ahead_used += 1
+            return channel.step()
+
+        return step
+
+    def _refill_ahead(self, r: Any, ch: Channel, pl: Planner, across: bool = False) -> tuple | None:
+        """The refill the next channel step would make (its buffer ran out), worked out and put back: (plan, its
+        fields before, the planner's fields after, the plan's fields after, buffer rows in this block, the queue
+        before and after, None if unchanged), or None. Without `across` only a refill that continues the same
+        plan in the same block (a stretch starting there hands its samples to the MLC scans before the step;
+        ending a block changes what they read); with it also one that ends blocks and solves the next, for a
+        step that puts it in place after the scan. Spindle feedback (feed per revolution, threads) is not read
+        ahead: the refills that would are left to the step."""
+        p = pl.plan
+        if (p is None and not across) or (p is not None and p.kind == "cruise") or not pl._buf_done \
+                or not pl.blocks or pl.blocks[0].move.per_rev:
+            return None  # per_rev: _check_spindle, which comes before the refill, may re-plan; a cruise's
+            # sampling snaps the next blocks' starts (it changes blocks in place)
+        if self._quiet(r, ch) != "run":
+            return None
+        s0, p0, q0 = dict(pl.__dict__), dict(p.__dict__) if p is not None else None, list(pl.blocks)
+        guards = ("_no_progress",) if across else _NOT_AHEAD
+        for name in guards:
+            setattr(pl, name, _not_ahead)
+        feedback = {name: s0[name] for name in _SPINDLE_FEEDBACK if s0.get(name) is not None}
+        for name in feedback:
+            setattr(pl, name, _not_ahead)
+        try:
+            # what the step's feed sets first (it reads nothing in a quiet cycle: Stretcher._quiet)
+            pl.closed = ch.end is not None or ch._deferred is not None or ch._limit_alarm is not None
+            pl._refill()
+            ok = (across or pl.plan is p) and not pl._buf_done
+        except Exception:  # _NotAhead, or an alarm of the refill: the cycle's own, it raises it there
+            ok = False
+        finally:
+            for name in guards:
+                delattr(pl, name)
+            pl.__dict__.update(feedback)
+        rows = pl._block_rows() if ok else 0
+        s1, p1, q1 = dict(pl.__dict__), dict(p.__dict__) if p is not None else None, list(pl.blocks)
+        pl.__dict__.clear()
+        pl.__dict__.update(s0)
+        if p is not None:
+            p.__dict__.clear()
+            p.__dict__.update(p0)
+        pl.blocks.clear()
+        pl.blocks.extend(q0)
+        changed = len(q1) != len(q0) or any(a is not b for a, b in zip(q1, q0))
+        return (p, p0, s1, p1, rows, q0, q1 if changed else None) if ok else None
