@@ -20,6 +20,7 @@ from __future__ import annotations
 import bisect
 import math
 from collections import deque
+from itertools import islice
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
@@ -335,6 +336,13 @@ class FilterCorners:
             c_bud = max(c, self._refine(hist, h0, last, top, top, budget_a, budget_j)[1])
         depth = self._tolerance(blocks, v_hi) if self.tol is not None else 0
         fast = c >= top_q[0][1]  # no junction of the stretch can run as fast as this cap
+        if fast:
+            # Only the budgets' share falls: the queued junctions hist[m..last] (blocks[-2] back),
+            # without the bookkeeping the caps' backward-pass depth needs below (issue 17).
+            for b in islice(reversed(blocks), 1, last - m + 2):
+                if b.vbud > c_bud:
+                    b.vbud = c_bud
+            return depth
         k = 2
         idx = last
         it = reversed(blocks)
