@@ -91,10 +91,16 @@ def _scan(fc: "FilterCorners", blocks: Sequence["Block"], pos: float, run_end: f
     hi = run_end + reach
     covered = False
     last = blocks[-1]
+    # The queue's s_end up to the first block past hi: a junction within hi has its next block there,
+    # so that prefix answers _tolerance_free as the whole queue does (~45 of ~100 blocks; issue 17).
+    prefix: list[float] = []
+    from_prefix = True
     for b in blocks:
         if b.kind != "path" or b.seg is None:
             covered = True  # dwell, thread, independent rapid: a stop before it ends every window
+            from_prefix = False
             break
+        prefix.append(b.s_end)
         if b.s_end - b.length > hi:
             covered = True
             break
@@ -104,6 +110,7 @@ def _scan(fc: "FilterCorners", blocks: Sequence["Block"], pos: float, run_end: f
             seen = b.vtop
         if b is not last and b.vjunc <= 0.0 and b.s_end >= run_end - 1e-9:
             covered = True  # an exact stop (G09/G61, G00): the filter settles there
+            from_prefix = False
             break
     if not covered and not (closed or last.s_end > hi):
         return UNKNOWN
@@ -133,7 +140,7 @@ def _scan(fc: "FilterCorners", blocks: Sequence["Block"], pos: float, run_end: f
             return None
         if tol is not None:
             if ends is None:
-                ends = [b.s_end for b in blocks]
+                ends = prefix if from_prefix else [b.s_end for b in blocks]
                 i = n_ends = len(ends)
             # _tolerance_free, its cached verdict inline: the next block follows j in the queue,
             # at bisect_right(ends, j.s_end), found by stepping back (j walks back in path order)
