@@ -1,0 +1,86 @@
+"""The CAM program's NC work offline (issue 17): bench_loop's 5,000-block program on benches/mill-3axis.toml
+through the interpreter, channel and planner (`nc.motion.offline.run`), no bus. Prints the CPU a cycle of the
+whole run, of `Planner.push` a block and of the jerk-factor scans (`shares.jerk_factor`) a block, best of 3,
+and a digest of the setpoints (equal digests: the same setpoints bit for bit).
+
+    python benchmarks/cam_planner_parts.py            # the figures
+    python benchmarks/cam_planner_parts.py --profile  # cProfile of one run, by own time
+"""
+
+from __future__ import annotations
+
+import cProfile
+import hashlib
+import pstats
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.append(str(ROOT))  # PYTHONPATH first: a tree it names is measured
+
+import nc.motion.planner as planner_mod  # noqa: E402
+from benchmarks.bench_motion import cam_program  # noqa: E402
+from hil.bench_file import load_bench_file  # noqa: E402
+from nc.interp import Interpreter  # noqa: E402
+from nc.motion.offline import Stream, run  # noqa: E402
+from nc.profiles import make_profile  # noqa: E402
+from nc.program.blocks import parse_program  # noqa: E402
+
+BLOCKS = 5000
+_spent = {"push": 0.0, "jf": 0.0}
+
+
+def _wrap() -> None:
+    """CPU time spent in Planner.push and in the jerk-factor scans (≈ 1 µs a call of wrapper)."""
+    clock = time.process_time
+    push, jerk_factor = planner_mod.Planner.push, planner_mod.jerk_factor
+
+    def timed_push(self, move):
+        t = clock()
+        push(self, move)
+        _spent["push"] += clock() - t
+
+    def timed_jf(*args):
+        t = clock()
+        out = jerk_factor(*args)
+        _spent["jf"] += clock() - t
+        return out
+
+    planner_mod.Planner.push = timed_push
+    planner_mod.jerk_factor = timed_jf
+
+
+def main() -> None:
+    prog = parse_program(cam_program(BLOCKS), name="cam.nc")
+    motion = load_bench_file(ROOT / "benches" / "mill-3axis.toml").motion_config()
+
+    def once() -> Stream:
+        events = Interpreter(make_profile("nc5-mill", ("X", "Y", "Z"))).run(prog)
+        return run(events, motion, {"X": 0.0, "Y": 0.0, "Z": 100.0})
+
+    once()  # first-use imports and calculators
+    if "--profile" in sys.argv:
+        prof = cProfile.Profile()
+        prof.enable()
+        once()
+        prof.disable()
+        pstats.Stats(prof).sort_stats("tottime").print_stats(30)
+        return
+    _wrap()
+    best = None
+    for _ in range(3):
+        _spent["push"] = _spent["jf"] = 0.0
+        t = time.process_time()
+        st = once()
+        got = (time.process_time() - t, _spent["push"], _spent["jf"])
+        best = got if best is None or got[0] < best[0] else best
+    cycles = len(st.positions) - 1
+    digest = hashlib.sha1(st.positions.tobytes()).hexdigest()[:12]
+    print(f"CAM {BLOCKS} blocks offline, {cycles} cycles: run {best[0] / cycles * 1e6:.1f} µs a cycle, "
+          f"Planner.push {best[1] / BLOCKS * 1e6:.1f} µs a block, jerk-factor scans {best[2] / BLOCKS * 1e6:.1f} µs "
+          f"a block (CPU, best of 3); setpoints {digest}")
+
+
+if __name__ == "__main__":
+    main()
