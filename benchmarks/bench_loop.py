@@ -257,10 +257,25 @@ def realtime_runs(d: str, cam_blocks: int = 1500) -> None:
 
     cam = Path(d) / f"cam{cam_blocks}.nc"
     cam.write_text(cam_program(cam_blocks))
-    for label, program, bench in (("lathe demo, lathe MLC", root / "examples" / "lathe_demo.nc", None),
-                                  (f"CAM {cam_blocks:,} blocks, mill-3axis", cam, root / "benches" / "mill-3axis.toml")):
-        res = api.run(program, str(bench) if bench else None, trace=os.path.join(d, "rt.parquet"), realtime=True,
-                      check=False)
+    runs = [(label + how, program, bench, on)
+            for label, program, bench in (("lathe demo, lathe MLC", root / "examples" / "lathe_demo.nc", None),
+                                          (f"CAM {cam_blocks:,} blocks, mill-3axis", cam,
+                                           root / "benches" / "mill-3axis.toml"))
+            for how, on in ((" (default: stepped)", None), (" (DELTAHIL_STRETCH=1: stretches, B21)", "1"))]
+    saved = os.environ.get("DELTAHIL_STRETCH")
+    for label, program, bench, on in runs:
+        if on is None:
+            os.environ.pop("DELTAHIL_STRETCH", None)
+        else:
+            os.environ["DELTAHIL_STRETCH"] = on
+        try:
+            res = api.run(program, str(bench) if bench else None, trace=os.path.join(d, "rt.parquet"), realtime=True,
+                          check=False)
+        finally:
+            if saved is None:
+                os.environ.pop("DELTAHIL_STRETCH", None)
+            else:
+                os.environ["DELTAHIL_STRETCH"] = saved
         r = res.run
         e, j, b = r.timing.get("exec", {}), r.timing.get("jitter", {}), r.timing.get("between", {})
         print(f"real time, {label}, 1 ms ({r.granted}): {r.cycles} cycles ({r.stretched / max(1, r.cycles):.0%} in "

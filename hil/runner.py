@@ -141,7 +141,7 @@ class BenchRunner:
     # ---- public ---------------------------------------------------------------------------
     def run_program(self, program: Program) -> RunResult:
         paced = isinstance(self.clock, RealTimeClock)
-        self._bus_ahead = paced and type(self.link) is SimLink and stretch_wanted()
+        self._bus_ahead = paced and type(self.link) is SimLink and stretch_wanted(realtime=True)
         if paced:
             _preload(self.bench)
         try:
