@@ -9,10 +9,12 @@ EtherCAT lock-step prints the virtual slaves' CPU per frame in-process, then (ro
 and of a bench program, with the CPU each side spent;
 `hil run --realtime` of the lathe demo and a CAM program prints p50/p99/max cycle work at 1 ms.
 
-Usage: python benchmarks/bench_loop.py [PACER_SECONDS] [--stages-only | --ethercat-only | --realtime-only]"""
+Usage: python benchmarks/bench_loop.py [PACER_SECONDS] [--stages-only | --ethercat-only | --realtime-only [--repeat N]]
+(--help lists the options and runs nothing)"""
 
 from __future__ import annotations
 
+import argparse
 import os
 import sys
 import tempfile
@@ -245,7 +247,7 @@ def _cpu_of(pid: int) -> float:
         return 0.0
 
 
-def realtime_runs(d: str, cam_blocks: int = 1500) -> None:
+def realtime_runs(d: str, cam_blocks: int = 1500, cam: bool = True) -> None:
     """`hil run --realtime` at the bench's 1 ms cycle, as a user runs it (hil.api.run: the bench's MLC,
     a Parquet trace): cycle work p50/p99/max for the lathe demo (lathe MLC) and a CAM program on
     benches/mill-3axis.toml. Figures, not a test: the machine's other load sets the tail."""
@@ -255,12 +257,13 @@ def realtime_runs(d: str, cam_blocks: int = 1500) -> None:
     sys.path.insert(0, str(root))
     from benchmarks.bench_motion import cam_program
 
-    cam = Path(d) / f"cam{cam_blocks}.nc"
-    cam.write_text(cam_program(cam_blocks))
+    programs = [("lathe demo, lathe MLC", root / "examples" / "lathe_demo.nc", None)]
+    if cam:
+        path = Path(d) / f"cam{cam_blocks}.nc"
+        path.write_text(cam_program(cam_blocks))
+        programs.append((f"CAM {cam_blocks:,} blocks, mill-3axis", path, root / "benches" / "mill-3axis.toml"))
     runs = [(label + how, program, bench, on)
-            for label, program, bench in (("lathe demo, lathe MLC", root / "examples" / "lathe_demo.nc", None),
-                                          (f"CAM {cam_blocks:,} blocks, mill-3axis", cam,
-                                           root / "benches" / "mill-3axis.toml"))
+            for label, program, bench in programs
             for how, on in ((" (default: stepped)", None), (" (DELTAHIL_STRETCH=1: stretches, B21)", "1"))]
     saved = os.environ.get("DELTAHIL_STRETCH")
     for label, program, bench, on in runs:
@@ -302,22 +305,39 @@ def realtime(seconds: float) -> None:
     print(f"  overruns {clk.overruns}")
 
 
-if __name__ == "__main__":
-    args = [a for a in sys.argv[1:] if not a.startswith("--")]
+def main(argv: list[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("pacer_seconds", nargs="?", type=float, default=5.0,
+                        help="seconds of the bare real-time pacer run at the end (default 5)")
+    only = parser.add_mutually_exclusive_group()
+    only.add_argument("--stages-only", action="store_true", help="only the issue-17 stage split (lathe demo, CAM)")
+    only.add_argument("--ethercat-only", action="store_true", help="only EtherCAT lock-step (root: veth + hil sim)")
+    only.add_argument("--realtime-only", action="store_true",
+                      help="only `hil run --realtime` of the lathe demo and the CAM program, stepped and stretched")
+    parser.add_argument("--repeat", type=int, default=1, metavar="N",
+                        help="with --realtime-only: N alternating rounds of the runs (overruns move with the load)")
+    parser.add_argument("--lathe-only", action="store_true", help="with --realtime-only: the lathe demo only")
+    args = parser.parse_args(argv)
     with tempfile.TemporaryDirectory() as d:
-        if "--ethercat-only" in sys.argv:
+        if args.ethercat_only:
             ethercat_lockstep()
-            sys.exit(0)
-        if "--realtime-only" in sys.argv:
-            realtime_runs(d)
-            sys.exit(0)
+            return
+        if args.realtime_only:
+            for _ in range(args.repeat):
+                realtime_runs(d, cam=not args.lathe_only)
+            return
         issue17(d)
-        if "--stages-only" in sys.argv:
-            sys.exit(0)
+        if args.stages_only:
+            return
         ethercat_lockstep()
         realtime_runs(d)
         lockstep(None)
         lockstep(os.path.join(d, "t.csv"))
         lockstep(os.path.join(d, "t.parquet"))
     cam_work()
-    realtime(float(args[0]) if args else 5.0)
+    realtime(args.pacer_seconds)
+
+
+if __name__ == "__main__":
+    main()
