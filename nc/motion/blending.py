@@ -36,9 +36,6 @@ if TYPE_CHECKING:
     from nc.motion.lookahead import Block
 
 
-def _s_end(b: "Block") -> float:
-    return b.s_end
-
 
 def _push_max(q: deque[tuple[int, float]], seq: int, value: float) -> None:
     """Append to a sliding maximum (a deque of decreasing values; the front is the maximum)."""
@@ -82,6 +79,7 @@ class FilterCorners:
         self._zero = (0.0,) * (self._axes + 1)
         # Junctions still inside some filter window, executed or not (for the sums).
         self._hist: list[Block] = []
+        self._hist_s: list[float] = []  # their s_end, side by side: bisected without a key (issue 17)
         self._clear()
         # The longest any window can be: no path speed or acceleration exceeds the norm of the
         # axis limits (a path direction can use every axis at once).
@@ -92,11 +90,15 @@ class FilterCorners:
 
     def _clear(self) -> None:
         self._hist.clear()
+        self._hist_s.clear()
         self._h0 = 0  # first entry of _hist still within reach of a window
         self._m = 0  # where the last search for the first junction taken ended
         self._seq0 = 0  # junctions dropped from the front of _hist so far
         self._lim_s = -math.inf  # path position of the newest junction the tolerance limits
         self._arc_s = -math.inf  # path position where the newest arc block ends
+        # The last window's budget share, for the next one: (J's block, sequence number of the
+        # stretch's first junction, c_bud). Every queued junction of that stretch has vbud <= c_bud.
+        self._bud: tuple["Block", int, float] | None = None
         # Sliding maxima over _hist[_m:] as (sequence number, value) of the blocks' tangential
         # acceleration, vtop and length.
         self._maxima: tuple[deque[tuple[int, float]], ...] = (deque(), deque(), deque())
@@ -200,11 +202,14 @@ class FilterCorners:
         j_new.scum = sj
         hist.append(j_new)
         s_j = j_new.s_end
+        hist_s = self._hist_s
+        hist_s.append(s_j)
         span_max = self.span_max
-        while s_j - hist[h0].s_end > span_max:
+        while s_j - hist_s[h0] > span_max:
             h0 += 1
         if h0 > 4096:
             del hist[:h0]
+            del hist_s[:h0]
             self._seq0 += h0
             self._m -= h0
             last -= h0  # J's index, and its sequence number seq0 + last, stay the same
@@ -336,9 +341,17 @@ class FilterCorners:
             c_bud = max(c, self._refine(hist, h0, last, top, top, budget_a, budget_j)[1])
         depth = self._tolerance(blocks, v_hi) if self.tol is not None else 0
         fast = c >= top_q[0][1]  # no junction of the stretch can run as fast as this cap
+        seq_m = self._seq0 + m
+        bud, self._bud = self._bud, (j_new, seq_m, c_bud)
         if fast:
             # Only the budgets' share falls: the queued junctions hist[m..last] (blocks[-2] back),
             # without the bookkeeping the caps' backward-pass depth needs below (issue 17).
+            if bud is not None and seq_m >= bud[1] and c_bud >= bud[2] and len(blocks) > 2 and blocks[-3] is bud[0]:
+                # The last window's stretch holds all of this one's junctions but J, at vbud <= its share
+                # <= this one's: only J's can fall (issue 17, no walk over the stretch per push).
+                if j_new.vbud > c_bud:
+                    j_new.vbud = c_bud
+                return depth
             for b in islice(reversed(blocks), 1, last - m + 2):
                 if b.vbud > c_bud:
                     b.vbud = c_bud
@@ -439,7 +452,7 @@ class FilterCorners:
         # within reach (whose caps would have to be lifted), nothing near J changes: the common
         # case on gentle curves, O(log n).
         if self._lim_s < s_j - 3.0 * h:
-            k = bisect.bisect_left(hist, s_j - 2.0 * h - 1e-12, h0, last + 1, key=_s_end)
+            k = bisect.bisect_left(self._hist_s, s_j - 2.0 * h - 1e-12, h0, last + 1)
             axes = self._axes
             sum_n = hist[last].cum[axes] - (hist[k - 1].cum[axes] if k > h0 else 0.0)
             if vt * self.kd.g0 * sum_n + self.braking(sum_n, self.amax) <= self.tol:
@@ -454,7 +467,7 @@ class FilterCorners:
             lo -= 1
         h = vt * half
         seg = hist[lo:]
-        s = np.fromiter((b.s_end for b in seg), float, len(seg))
+        s = np.array(self._hist_s[lo:])
         du = np.array([b.dv for b in seg], dtype=float)
         vb = np.fromiter((b.vbase for b in seg), float, len(seg))
         ev = np.nonzero(s >= s_j - h - 1e-12)[0]

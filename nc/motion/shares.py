@@ -70,9 +70,6 @@ def jerk_factor(cfg: MotionConfig, fc: "FilterCorners", blocks: Sequence["Block"
     return 1.0, False
 
 
-def _s_end(b: "Block") -> float:
-    return b.s_end
-
 
 UNKNOWN = (-1.0, -1.0)  # _scan: the queue ends before the reach does
 # Above FilterCorners._boost_ratio's largest value (2: doubling the jerk at most doubles the speed-up) by
@@ -126,8 +123,9 @@ def _scan(fc: "FilterCorners", blocks: Sequence["Block"], pos: float, run_end: f
     # loop runs over ~85 junctions per solve on dense CAM paths (issue 17): max()/min() spelt out.
     # The junctions before lo by bisection too (hist is in path order): the loop stops at k_lo, and when
     # k_lo is 0 no junction before lo is left, as when it ran off the front before.
-    k_lo = bisect_left(hist, lo, key=_s_end)
-    for k in range(bisect_right(hist, hi, key=_s_end) - 1, k_lo - 1, -1):
+    hist_s = fc._hist_s  # hist's s_end, a plain list: bisected without a key
+    k_lo = bisect_left(hist_s, lo)
+    for k in range(bisect_right(hist_s, hi) - 1, k_lo - 1, -1):
         j = hist[k]
         if j.vtop > seen:
             seen = j.vtop
