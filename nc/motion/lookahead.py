@@ -27,9 +27,11 @@ from nc.motion.limits import MotionConfig
 from nc.motion.path import Segment
 from nc.moves import Move
 
-# Shares of the axis jerk on a corner blend: centripetal v³·|(dκ/ds, κ²)|, tangential profile, and the
-# coupling 3·v·a_t·κ (Limits._blend_limits).
-BLEND_JERK = (0.8, 0.1, 0.1)
+# A corner blend's jerk (Limits._blend_limits, decision motion 47): its cap keeps v³·|(dκ/ds, κ²)| within
+# BLEND_CAP of the axis jerk; its normal part v³·dκ/ds + 3·v·a_t·κ and its tangential part j_t + v³·κ² are
+# orthogonal, so they share the axis jerk in quadrature: BLEND_NORMAL and √(1 − BLEND_NORMAL²).
+BLEND_CAP = 0.8
+BLEND_NORMAL = 0.9
 MARGIN = 0.98  # the passes plan with 98 % of the limits ruckig gets, so plans are never borderline
 
 
@@ -192,12 +194,16 @@ class Limits:
         return v, a, j
 
     def _blend_limits(self, seg: Segment, v: float, a: float, j: float) -> tuple[float, float, float]:
-        """A clothoid pair (nc.motion.clothoid) at speed v: normal acceleration v²·κ ≤ v²·κmax and
-        jerk v³·(dκ/ds·n − κ²·t), of size v³·hypot(dκ/ds, κ²) (n ⊥ t, decision 46), plus 3·v·a_t·κ from
-        the tangential acceleration, each axis' share of the normal at most `normal_amplitude`. A blend has no tangent or curvature jump, so the corner
-        and curvature shares are its own (as between lines under the filter, decision 38); of the
-        jerk, the centripetal term takes BLEND_JERK first (decision 40 e: the blends' speed is set
-        by it), the tangential profile and the coupling term what is left."""
+        """A clothoid pair (nc.motion.clothoid) at speed v ≤ its cap with tangential acceleration a_t and
+        jerk j_t: normal acceleration v²·κ ≤ v²·κmax; jerk (j_t − v³·κ²)·t + (v³·dκ/ds + 3·v·a_t·κ)·n
+        (a planar curve). t and n span the blend's plane, so each axis' component is at most the size of
+        that vector times the axis' share of the plane (`normal_amplitude`), and the size is the hypot of
+        the two parts: the normal part within BLEND_NORMAL of the axis jerk, the tangential part within
+        √(1 − BLEND_NORMAL²) (decision motion 47; decisions 42/46 added the parts). The cap keeps
+        v³·hypot(dκ/ds, κ²) within BLEND_CAP (decision 46) and leaves each part some room; a_t and j_t
+        are what the parts leave at the cap (both only grow as the speed falls below it). A blend has no
+        tangent or curvature jump, so the corner and curvature shares of the acceleration are its own (as
+        between lines under the filter, decision 38)."""
         cfg = self.cfg
         pa = pj = math.inf
         for m, al, jl in zip(seg.normal_amplitude().tolist(), self._acc, self._jerk):
@@ -205,9 +211,13 @@ class Limits:
                 pa, pj = min(pa, al / m), min(pj, jl / m)
         km, dk = seg.kappa_max, seg.dkappa
         sa = cfg.share_curvature + cfg.share_corner
-        v = min(v, math.sqrt(sa * pa / km), (BLEND_JERK[0] * pj / math.hypot(dk, km * km)) ** (1.0 / 3.0))
-        a = min(a, BLEND_JERK[2] * pj / (3.0 * max(v, 1e-9) * km))
-        return v, a, j * BLEND_JERK[1] / cfg.share_tangential
+        cn = BLEND_NORMAL
+        ct = math.sqrt(1.0 - cn * cn)
+        v = min(v, math.sqrt(sa * pa / km), (BLEND_CAP * pj / math.hypot(dk, km * km)) ** (1.0 / 3.0),
+                (0.98 * cn * pj / dk) ** (1.0 / 3.0), (0.9 * ct * pj / (km * km)) ** (1.0 / 3.0))
+        v3 = v * v * v
+        a = min(a, (cn * pj - v3 * dk) / (3.0 * max(v, 1e-9) * km))
+        return v, a, min(j, ct * pj - v3 * km * km)
 
     def junction(self, b1: Block, b2: Block, raw: bool = False) -> float:
         """Highest speed at the junction b1 → b2. `raw`: as without the filter (a junction where its
