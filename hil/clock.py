@@ -226,6 +226,10 @@ class RealTimeClock:
         if not self._written:
             self.written()
 
+    def left_ns(self) -> int:
+        """ns until the next cycle's deadline (negative: it is missed); work in the slack asks before it starts."""
+        return self._deadline - self.now_ns()
+
     def _wait_until(self, deadline: int) -> None:
         spin_ns = int(self.config.busy_wait * 1e9)
         remaining = deadline - self.now_ns()

@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import copy
 import os
+from collections.abc import Iterator
 from typing import Any
 
 import numpy as np
@@ -38,7 +39,7 @@ from fieldbus.link import SimLink
 from fieldbus.pdo import RxPdo, TxPdo
 from hil.clock import LockStepClock, RealTimeClock
 from hil.stretch_bulk import bulk_cycles, bulk_ok, first_change, outputs_hold
-from hil.stretch_realtime import RealTimeStretches
+from hil.stretch_realtime import RealTimeStretches, _fed
 from hil.stretch_state import (_across, _event_due, _panel_state, _refilled, _restore_planner, _sample_across,
                                _save_planner, _signature, _stand_queued)
 from mlc.basic import BasicMlc
@@ -84,6 +85,12 @@ class Stretcher(RealTimeStretches):
         self._next_fill: tuple | None = None
         self._early: tuple | None = None
         self.fills_early = 0
+        # real time (B22): the next start worked out a part a slack while this stretch's cycles are paced (_prepare,
+        # a generator the pacing advances), and the start it made, taken when all it read is still the same
+        self._prep: Iterator[None] | None = None
+        self._spec: Any = None
+        self._taken: Any = None
+        self.specs_used = 0
 
     @classmethod
     def for_runner(cls, runner: Any) -> "Stretcher | None":
@@ -105,6 +112,7 @@ class Stretcher(RealTimeStretches):
         r = self.r
         ch: Channel | None = r.channel
         self._early, self._next_fill = self._next_fill, None  # the one before's, for this start only
+        self._taken, self._spec, self._prep = self._spec, None, None  # B22: the one before's, this start's only
         if limit < 2 or ch is None:
             return False
         kind = self._quiet(r, ch)
@@ -128,6 +136,10 @@ class Stretcher(RealTimeStretches):
         else:  # to the buffer's end: the planner stays on its block (dropped at the refill, a stepped cycle)
             n = min(limit, self.max_cycles, pl._block_rows())  # a cruise's buffer spans blocks: this one's rows
             self._sampler = sample_stretch
+            if self.paced:  # real time: this start worked out in the slacks of the stretch before (B22)
+                started = self._spec_start(r, ch, pl, kind, limit)
+                if started is not None:
+                    return started
             # real time: where the buffer ran out, the refill the first cycle's step would make, made ahead (B21)
             fill = self._early_fill(r, ch, pl, kind) if self.paced and n == 0 else None
             if fill is not None:
@@ -147,14 +159,19 @@ class Stretcher(RealTimeStretches):
             if n < 2:
                 _restore_planner(pl, saved_pl)
                 return False
-        if kind != "wait":  # what the first cycle's feed does before it finds nothing to read (the same after)
-            pl.closed = ch.end is not None or ch._deferred is not None or ch._limit_alarm is not None
-            if ch.statement_budget is not None:
-                ch.statement_budget.new_cycle()
+        if kind != "wait":
+            _fed(ch, pl)
         rx0 = [copy.copy(rx) for rx in r.rx]  # what the drives are stepped with (the runner's change per cycle)
         saved_drives = [dict(d.__dict__) for d in self.drives]
         targets = self._targets(smp, rx0, n)
         outs = self._step_drives(rx0, targets, n)
+        return self._launch(r, ch, pl, smp, n, (saved_pl, saved_drives, rx0, targets), outs)
+
+    def _launch(self, r: Any, ch: Channel, pl: Planner, smp: Samples, n: int, saved: tuple,
+                outs: list[Stretch]) -> bool:
+        """The stretch's n sampled cycles with the drives stepped over them (`outs`): shortened to the first
+        cycle a drive or the bench's overspeed check would fault in, then played."""
+        saved_pl, saved_drives, rx0, targets = saved
         m = min(o.done for o in outs)
         for i in range(self.n_axes):  # the bench's overspeed check (App. A 0x0602) fires in that cycle
             over = np.flatnonzero(np.abs(np.asarray(outs[i].velocity_actual[:m])) > r._overspeed[i])
@@ -166,7 +183,7 @@ class Stretcher(RealTimeStretches):
             return False
         if m < n:
             outs = self._cut(pl, saved_pl, saved_drives, rx0, targets, m, m)
-        return self._play(r, ch, pl, smp, outs, m, (saved_pl, saved_drives, rx0, targets))
+        return self._play(r, ch, pl, smp, outs, m, saved)
 
     def _play(self, r: Any, ch: Channel, pl: Planner, smp: Samples, outs: list[Stretch], m: int,
               saved: tuple) -> bool:
@@ -211,9 +228,12 @@ class Stretcher(RealTimeStretches):
                     if self.paced:  # each cycle paced, with its outputs; the rest of them at once in the slack
                         # before the last one (so the next stretch's work ahead has the slack after it to itself)
                         stop = j - 1 if j - k >= 2 else j
+                        # the next stretch's start worked out in these cycles' slacks, a part a slack (B22)
+                        self._prep = self._prepare(r, ch, pl, last_raw, positions, m) if j == m else None
                         end, timings = self._pace(r, k, stop, positions, targets, panel)
                         if end < stop or r.stop_request is not None or _panel_state(r.on_cycle) != panel:
                             j = end  # a stop or a press ended it (in its last paced cycle too): at once up to there
+                            self._prep = self._spec = None
                     if j < m:  # the stretch ends before it: that cycle is stepped
                         outs = self._cut(pl, saved_pl, saved_drives, rx0, targets, j, j)
                         m, last_raw, cut = j, pl.position, True
@@ -222,8 +242,8 @@ class Stretcher(RealTimeStretches):
                     last_row = bulk_cycles(r, ch, pl, smp, outs, k, m, raw[m - 1], (rpms, cmds) if settle else None,
                                            timings)
                     if last_row is not None:  # real time: the last cycle, paced after the rest
-                        if not cut:  # nothing cuts this stretch any more: the next one's refill, worked out here
-                            self._fill_next(r, ch, pl, last_raw)
+                        if not cut and self._spec is None:  # nothing cuts this stretch any more: the next
+                            self._fill_next(r, ch, pl, last_raw)  # one's refill, unless its start is worked out
                         last_row(self._pace(r, m - 1, m, positions, targets, panel)[1][0])
                     if cut and settle:
                         settle_stretch(pl, rpms, cmds)

@@ -4,17 +4,52 @@ A mixin of `hil.stretch.Stretcher`, on its state."""
 
 from __future__ import annotations
 
-from collections.abc import Callable
+import copy
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
+from fieldbus.pdo import RxPdo
 from hil.clock import CycleTiming
-from hil.stretch_state import (_NOT_AHEAD, _SPINDLE_FEEDBACK, _not_ahead, _panel_state, _sample_across,
-                               _signature, _stand_queued)
+from hil.stretch_state import (_NOT_AHEAD, _SPINDLE_FEEDBACK, _not_ahead, _panel_state, _refilled, _restore_planner,
+                               _sample_across, _save_planner, _signature, _stand_queued)
 from nc.channel import Channel
 from nc.motion.planner import Planner, Setpoint
-from nc.motion.stretch import stand_stretch
+from nc.motion.stretch import Samples, sample_stretch, stand_stretch
+from virtual_bus.drive_stretch import Stretch, csp_stretch, csv_stretch
+
+# A part of the next start (B22) runs in a paced cycle's slack only while this much of the period is left: the
+# largest part (a refill, or the planner samples) is ≈ 0.2-0.3 ms of CPU on the 2-vCPU VM
+PREP_LEFT_NS = 600_000
+
+
+def _fed(ch: Channel, pl: Planner) -> None:
+    """What a stretch's first cycle's feed does before it finds nothing to read (the same in its later cycles)."""
+    pl.closed = ch.end is not None or ch._deferred is not None or ch._limit_alarm is not None
+    if ch.statement_budget is not None:
+        ch.statement_budget.new_cycle()
+
+
+@dataclass
+class _Start:
+    """A stretch start worked out ahead (B22), with what it read: the planner (its fields, filter, queue and plan
+    as they were), the channel's signature, the drives' fields and the RxPdos it assumed the last cycle leaves."""
+
+    n: int
+    sig: tuple
+    blocks: list
+    plan_fields: dict | None
+    saved_pl: dict  # _save_planner before (with a refill's plan as before): what a cut restores
+    after_pl: dict  # _save_planner after the samples (with a refill's plan as after)
+    fill: tuple | None
+    smp: Samples
+    rx0: list[RxPdo]
+    targets: list[list[int]]
+    saved_drives: list[dict]
+    drives_after: list[dict]
+    outs: list[Stretch]
 
 
 class RealTimeStretches:
@@ -44,6 +79,11 @@ class RealTimeStretches:
                 out.target_position = col[c]
             clock.written()
             clock.done()
+            if self._prep is not None and c < m - 1 and clock.left_ns() > PREP_LEFT_NS:
+                try:  # a part of the next stretch's start in this slack (B22)
+                    next(self._prep)
+                except StopIteration:
+                    self._prep = None
             if r.stop_request is not None or _panel_state(r.on_cycle) != panel:
                 break
         return k + len(timings), timings
@@ -161,3 +201,109 @@ class RealTimeStretches:
         pl.blocks.extend(q0)
         changed = len(q1) != len(q0) or any(a is not b for a, b in zip(q1, q0))
         return (p, p0, s1, p1, rows, q0, q1 if changed else None) if ok else None
+
+    # ---- the next start, a part a slack (B22) ----------------------------------------------------------
+    def _prepare(self, r: Any, ch: Channel, pl: Planner, last_raw: Any, positions: np.ndarray,
+                 m: int) -> Iterator[None]:
+        """The start the next stretch would make where this one (m cycles, not cut) ends, worked out in the
+        slacks of its paced cycles, one part a slack: the refill where its buffer runs out, the planner's
+        samples, each drive's model. Each part leaves the planner and the drives as it found them; the
+        result is `self._spec`, which the next start takes when all it read is still the same (_spec_start)."""
+        here = pl.position
+        pl.position = last_raw  # as this stretch leaves it
+        try:
+            before = _save_planner(pl)
+            blocks, p0 = list(pl.blocks), dict(pl.plan.__dict__) if pl.plan is not None else None
+            sig = _signature(ch)
+            rows = pl._block_rows()
+            fill = self._refill_ahead(r, ch, pl) if rows == 0 else None
+        finally:
+            pl.position = here
+        if rows == 0 and fill is None:
+            return
+        n = min(self.max_cycles, fill[4] if fill is not None else rows)
+        if n < 2:
+            return
+        if fill is not None:
+            yield
+        saved_pl = dict(before)
+        if fill is not None:
+            saved_pl["plan"] = (fill[0], fill[1])
+        _restore_planner(pl, saved_pl)  # the planner as at the first part (its position this stretch's end)
+        try:
+            smp = (_refilled(fill) if fill is not None else sample_stretch)(pl, n)
+            if smp is not None:
+                after = _save_planner(pl)
+                if fill is not None:
+                    after["plan"] = (fill[0], dict(fill[0].__dict__))
+        finally:
+            _restore_planner(pl, saved_pl)
+            pl.position = here
+        if smp is None or len(smp.positions) < 2:
+            return
+        n = len(smp.positions)
+        yield
+        org, last = r.origin.tolist(), positions[m - 1].tolist()
+        rx0 = [copy.copy(rx) for rx in r.rx]
+        for i in range(self.n_axes):  # the setpoint this stretch's last cycle writes
+            rx0[i].target_position = r.scales[i].to_counts(last[i] - org[i])
+        targets = self._targets(smp, rx0, n)
+        saved_drives, drives_after, outs = [], [], []
+        dt = r.bench.cycle
+        for i, (d, rx) in enumerate(zip(self.drives, rx0)):
+            if i:
+                yield
+            s0 = dict(d.__dict__)
+            outs.append(csp_stretch(d, rx, targets[i][:n], dt) if i < self.n_axes else csv_stretch(d, rx, n, dt))
+            drives_after.append(dict(d.__dict__))
+            d.__dict__.clear()
+            d.__dict__.update(s0)
+            saved_drives.append(s0)
+        self._spec = _Start(n, sig, blocks, p0, saved_pl, after, fill, smp, rx0, targets, saved_drives,
+                            drives_after, outs)
+
+    def _spec_start(self, r: Any, ch: Channel, pl: Planner, kind: str, limit: int) -> bool | None:
+        """The start worked out ahead (_prepare), taken when the planner, the channel, the drives and the
+        RxPdos are as it read them (the same objects; the filter's windows the same rows); None: work it out."""
+        spec, self._taken = self._taken, None
+        if spec is None or kind != "run" or spec.n > limit or not self._same(spec, r, ch, pl):
+            return None
+        _restore_planner(pl, spec.after_pl)  # the planner as its samples left it
+        if spec.fill is not None:
+            self._sampler = _refilled(spec.fill)  # a cut samples again from before the refill
+            self.fills_early += 1
+        _fed(ch, pl)
+        for d, after in zip(self.drives, spec.drives_after):
+            d.__dict__.clear()
+            d.__dict__.update(after)
+        self.specs_used += 1
+        return self._launch(r, ch, pl, spec.smp, spec.n, (spec.saved_pl, spec.saved_drives, spec.rx0, spec.targets),
+                            spec.outs)
+
+    def _same(self, spec: _Start, r: Any, ch: Channel, pl: Planner) -> bool:
+        if _signature(ch) != spec.sig:
+            return False
+        d, a = pl.__dict__, spec.saved_pl["pl"]
+        if len(d) != len(a) or any(d.get(k) is not v for k, v in a.items()):
+            return False
+        q = pl.blocks
+        if len(q) != len(spec.blocks) or any(x is not y for x, y in zip(q, spec.blocks)):
+            return False
+        if pl.plan is not None and pl.plan.__dict__ != spec.plan_fields:
+            return False
+        z = spec.saved_pl.get("zones")
+        if z is not None and (len(z) != len(pl._zones.zones) or any(x is not y for x, y in zip(z, pl._zones.zones))):
+            return False
+        f = pl.filter
+        if f is not None:
+            fd, fs = f.__dict__, spec.saved_pl["f"]
+            if len(fd) != len(fs) or any(
+                    (len(v) != len(fs[k]) or any(x is not y for x, y in zip(v, fs[k])))
+                    if k in ("_w1", "_w2") else v is not fs[k] for k, v in fd.items()):
+                return False
+        for drv, s0 in zip(self.drives, spec.saved_drives):
+            dd = drv.__dict__
+            if len(dd) != len(s0) or any(k != "_rx" and dd.get(k) is not v for k, v in s0.items()):
+                return False
+            s0["_rx"] = dd["_rx"]  # what a cut restores, as run() saves it
+        return all(a == b for a, b in zip(r.rx, spec.rx0))

@@ -79,11 +79,13 @@ def _sample_across(pl: Planner, n: int) -> Samples | None:
 
 
 def _save_planner(pl: Planner) -> dict:
-    """What sample_stretch changes: the planner's own fields and its position filter's state (and its queue,
-    of which a stretch across a cruise's blocks finishes some)."""
+    """What sample_stretch changes: the planner's own fields, its position filter's state and share zones (and
+    its queue, of which a stretch across a cruise's blocks finishes some)."""
     saved: dict[str, Any] = {"pl": dict(pl.__dict__)}
     if pl._buf_blk is not None:
         saved["blocks"] = list(pl.blocks)
+    if pl._zones is not None:  # the filter's share zones: sampling drops those it passed (ShareZones.lam)
+        saved["zones"] = list(pl._zones.zones)
     f = pl.filter
     if f is not None:
         fs = dict(f.__dict__)
@@ -114,6 +116,10 @@ def _restore_planner(pl: Planner, saved: dict) -> None:
         p, fields = saved["plan"]
         p.__dict__.clear()
         p.__dict__.update(fields)
+    if "zones" in saved:  # the same deque, as it was
+        zones = pl._zones.zones
+        zones.clear()
+        zones.extend(saved["zones"])
     if "f" in saved:
         f = pl.filter
         fs = dict(saved["f"])

@@ -16,7 +16,7 @@ from hil import api
 from hil.bench import RealtimeConfig
 from hil.clock import Granted, RealTimeClock
 from hil.commands.run import print_timing
-from hil.stretch import ENV
+from hil.stretch import ENV, Stretcher
 from tests.conftest import ROOT
 
 DEMO = str(ROOT / "examples" / "lathe_demo.nc")
@@ -109,10 +109,23 @@ def _same(a: tuple, b: tuple) -> None:
 @pytest.mark.parametrize("kw", [{}, {"events": ["t=2:feed-hold", "t=2.6:cycle-start", "t=4:set D21002=50"]}],
                          ids=["plain", "hold-resume-override"])
 def test_a_realtime_run_with_stretches_equals_stepping(monkeypatch, tmp_path, kw):
+    taken: list[bool] = []  # B22: stretch starts worked out in the slacks of the stretch before, and taken
+    spec_start = Stretcher._spec_start
+
+    def spy(self, *args):
+        had = self._taken is not None
+        started = spec_start(self, *args)
+        if had:
+            taken.append(started is not None)
+        return started
+
+    monkeypatch.setattr(Stretcher, "_spec_start", spy)
     a = _run(monkeypatch, tmp_path, "0", **kw)
     b = _run(monkeypatch, tmp_path, "1", **kw)
     _same(a, b)
     r = b[1].run
+    if not kw:  # (--at events are read cycle by cycle: no paced bulk, stretches start as in B21)
+        assert len(taken) > 500 and sum(taken) > 0.9 * len(taken)  # most starts were worked out ahead and taken
     assert r.ok and r.realtime and r.overruns == 0
     assert r.stretched > 0.8 * r.cycles  # most cycles come from stretches, each paced on its own
     assert set(a[0]["period"][1:]) == {0.001}  # every cycle ticked: a 1 ms period on the fake clock
@@ -123,6 +136,17 @@ def test_a_realtime_run_with_stretches_equals_stepping(monkeypatch, tmp_path, kw
     b = r.timing["between"]
     assert lines["between cycles"] == "  ".join(f"{k} {b[k] * 1e6:.1f} µs" for k in ("p50", "p99", "max"))
     assert "cycle work" in lines and b["max"] > 0
+
+
+def test_starts_worked_out_ahead_and_dropped_leave_the_run_as_stepping(monkeypatch, tmp_path):
+    """B22: every start worked out in the slacks before it is dropped (as when what it read changed): the planner
+    and the drives were left as found (the filter's share zones too, which sampling pops), so the run still
+    equals stepping. Failed before the zones were saved with the planner: Z_cmd from cycle 1161 on."""
+    monkeypatch.setattr(Stretcher, "_same", lambda self, *args: False)
+    a = _run(monkeypatch, tmp_path, "0")
+    b = _run(monkeypatch, tmp_path, "1")
+    _same(a, b)
+    assert b[1].run.stretched > 0.8 * b[1].run.cycles
 
 
 def test_a_stop_inside_a_stretch_is_taken_at_the_next_cycle(monkeypatch, tmp_path):
