@@ -6,8 +6,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from benchmarks.bench_spline_bound import LAM, START, bound, best_fit, evaluate, fit
+from benchmarks.bench_spline_bound import START, best_fit, bound, evaluate
 from benchmarks.bench_vs_linuxcnc import cam_polyline, cam_surface
+from nc.motion.spline_runs import LAM, fit_curve, samples
 from tests.motion_helpers import polyline_deviation
 
 
@@ -41,8 +42,7 @@ def test_a_fitted_run_holds_the_feed_where_corner_blends_cannot(make, most):
 def test_the_fit_is_local_a_few_segments_ahead_fix_it():
     """What a streaming planner needs: the fit over a span no longer changes once 6 more segments are known."""
     pts = np.array([START] + cam_polyline(200).points, dtype=float)
-    full, _, cum = fit(pts, LAM)
-    part, _, _ = fit(pts[:101], LAM)
+    full, part, cum = fit_curve(pts, LAM), fit_curve(pts[:101], LAM), samples(pts)[2]
     uu = np.linspace(0.0, cum[94], 4000)
     assert max(np.abs(full[a](uu) - part[a](uu)).max() for a in range(3)) < 1e-6
     # and the derivatives the speed is planned on

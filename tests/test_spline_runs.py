@@ -1,0 +1,75 @@
+"""nc.motion.spline_runs (decision motion 49): a CAM run fitted within N1.053 by one C2 curve, cut into
+spans at the vertices; each span read off its own points, and its limits against every axis' own."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from benchmarks.bench_vs_linuxcnc import START, cam_polyline, cam_surface
+from nc.motion.spline_runs import fit_run, span_limits, spans
+from tests.motion_helpers import polyline_deviation
+
+AXES = ("X", "Y", "Z")
+VEL = np.array([500.0, 500.0, 300.0])
+ACC = np.array([5000.0, 5000.0, 3000.0])
+JERK = np.array([250_000.0, 250_000.0, 150_000.0])
+
+
+def _spans(make, n: int = 50):
+    pts = np.array([START] + make(n).points, dtype=float)
+    spl, cum = fit_run(pts, 0.02)
+    return pts, spans(spl, cum, AXES)
+
+
+@pytest.mark.parametrize("make", [cam_polyline, cam_surface])
+def test_spans_join_in_position_tangent_and_curvature_within_the_tolerance(make):
+    pts, sp = _spans(make)
+    assert len(sp) == len(pts) - 1 and all(s.kind == "spline" for s in sp)
+    assert np.allclose(sp[0].start, pts[0], atol=1e-4) and np.allclose(sp[-1].end, pts[-1], atol=1e-4)
+    for a, b in zip(sp[:-1], sp[1:]):
+        assert np.allclose(a.end, b.start, atol=1e-9)
+        assert np.allclose(a.unit_tangent(True), b.unit_tangent(False), atol=1e-7)
+        assert np.allclose(a.curvature_vector(True), b.curvature_vector(False), atol=1e-5)
+    every = np.vstack([s.points(np.linspace(0.0, s.length, 300)) for s in sp])
+    assert 0.015 < polyline_deviation(every, pts) <= 0.02
+
+
+def test_a_span_is_parametrised_by_its_arc_length_and_its_derivatives_are_its_own():
+    _, sp = _spans(cam_surface)
+    for s in sp[5:45:8]:
+        ss = np.linspace(0.0, s.length, 4001)
+        p, rs, rss, rsss = s.derivatives(ss)
+        h = ss[1] - ss[0]
+        step = np.linalg.norm(np.diff(p, axis=0), axis=1) / h
+        assert np.abs(step - 1.0).max() < 1e-5  # unit speed in s: the planner's v is the path speed
+        assert np.allclose(np.linalg.norm(rs, axis=1), 1.0, atol=1e-9)
+        fd2 = np.diff(p, 2, axis=0) / h ** 2
+        assert np.abs(fd2 - rss[1:-1]).max() < 1e-3 * max(1.0, np.abs(rss).max())
+        # r''' jumps at the pieces' knots: compare its integral with r'' (trapezoid)
+        integ = np.cumsum(0.5 * (rsss[1:] + rsss[:-1]) * h, axis=0)
+        assert np.abs(integ - (rss[1:] - rss[0])).max() < 1e-4 * max(1.0, np.abs(rss).max())  # 3e-5; a term off: 2-9e-4
+        assert np.all(np.abs(rsss).max(axis=0) <= s.jerk_bound + 1e-9)
+        assert np.all(np.abs(rss).max(axis=0) <= s.acc_bound + 1e-9)
+
+
+@pytest.mark.parametrize("make", [cam_polyline, cam_surface])
+def test_span_limits_keep_every_axis_within_its_limits(make):
+    """At the cap and below it, with a_t = ±a and j_t = ±j: acceleration a_t·r' + v²·r'' and jerk
+    j_t·r' + 3·v·a_t·r'' + v³·r''' on every axis within its limit, read off the span's own derivatives."""
+    _, sp = _spans(make)
+    worst = 0.0
+    for s in sp:
+        v, a, j = span_limits(s, VEL, ACC, JERK)
+        assert v > 0.0 and a > 0.0 and j > 0.0
+        _, rs, rss, rsss = s.derivatives(np.linspace(0.0, s.length, 400))
+        for f in (1.0, 0.6):
+            u = f * v
+            assert np.all(np.abs(u * rs) <= VEL * (1.0 + 1e-9))
+            for sa in (-1.0, 1.0):
+                assert np.all(np.abs(sa * a * rs + u * u * rss) <= ACC * (1.0 + 1e-9))
+                for sj in (-1.0, 1.0):
+                    jx = np.abs(sj * j * rs + 3.0 * u * sa * a * rss + u ** 3 * rsss).max(axis=0)
+                    assert np.all(jx <= JERK * (1.0 + 1e-9)), (jx / JERK)
+                    worst = max(worst, float(np.max(jx / JERK)))
+    assert worst > 0.7  # the budget is used
