@@ -109,9 +109,10 @@ def staged(label: str, program: Path, bench_file: Path | None, trace: str | None
 
     nc = _Stage(Channel.step)
     stages["NC"].append(nc)
-    # a stretch's planner samples count as NC, its drive models as bus + drives (hil/stretch.py)
-    patched = {name: _Stage(getattr(stretch, name)) for name in ("sample_stretch", "csp_stretch", "csv_stretch")}
-    stages["NC"].append(patched["sample_stretch"])
+    # a stretch's planner samples and feeds count as NC, its drive models as bus + drives (hil/stretch.py)
+    patched = {name: _Stage(getattr(stretch, name))
+               for name in ("sample_stretch", "sample_reading", "csp_stretch", "csv_stretch")}
+    stages["NC"] += [patched["sample_stretch"], patched["sample_reading"]]  # sample_reading: the feeds inside (B26)
     stages["bus + drives"] += [patched["csp_stretch"], patched["csv_stretch"]]
     BenchRunner.run_program = timed_run
     Channel.step = lambda self: nc(self)

@@ -39,6 +39,7 @@ from fieldbus.link import SimLink
 from fieldbus.pdo import RxPdo, TxPdo
 from hil.clock import LockStepClock, RealTimeClock
 from hil.stretch_bulk import bulk_cycles, bulk_ok, first_change, outputs_hold
+from hil.stretch_reads import may_read, sample_reading
 from hil.stretch_realtime import RealTimeStretches, _fed
 from hil.stretch_state import (_across, _event_due, _panel_state, _refilled, _restore_planner, _sample_across,
                                _save_planner, _signature, _stand_queued)
@@ -52,6 +53,7 @@ from virtual_bus.drive import Cia402Drive
 from virtual_bus.drive_stretch import Stretch, can_stretch, csp_stretch, csv_stretch
 
 ENV = "DELTAHIL_STRETCH"  # "0": every cycle is stepped (the reference the tests compare against)
+ENV_READS = "DELTAHIL_STRETCH_READS"  # "0": stretches end before a cycle whose feed reads (B25, benchmarks)
 MAX_CYCLES = 64  # the planner's buffers are up to 64 cycles: a stretch never spans two
 # Real time (decision B21): a stretch's planner samples and drive models are computed in the slack of the period
 # before its first cycle, so that work must fit there; RT_CYCLES cycles of it cost ≈ 0.2 ms on the lathe demo
@@ -91,6 +93,11 @@ class Stretcher(RealTimeStretches):
         self._spec: Any = None
         self._taken: Any = None
         self.specs_used = 0
+        # B26: feeds of the channel run inside stretches (reads_ok False: stretches end before them, as in B25)
+        self.reads_ok = os.environ.get(ENV_READS) != "0"
+        self.feeds = 0
+        self._fed0 = False
+        self._reads_from = 0
 
     @classmethod
     def for_runner(cls, runner: Any) -> "Stretcher | None":
@@ -120,6 +127,7 @@ class Stretcher(RealTimeStretches):
             return False
         pl = ch.planner
         fill = None
+        self._reads_from = 0  # B26: the first cycle whose feed the stretch runs (0: none)
         if kind in ("wait", "drain"):  # standing: an M/S/T code waits for its finish, or the filter's tail
             n = min(limit, self.max_cycles)
             if kind == "drain":  # the cycle that begins with the filter settled issues the waiting code: stepped
@@ -128,6 +136,11 @@ class Stretcher(RealTimeStretches):
         elif type(r.mlc) is BasicMlc and pl._buf_blk is not None:  # a cruise, across its blocks (nothing reads
             n = _across(ch, pl, min(limit, self.max_cycles))          # the queue's length in between)
             self._sampler = _sample_across
+            # B26: past the cycle whose feed reads, the feeds run inside the stretch (hil/stretch_reads.py): the
+            # stretch's length from the rows as they stand, the reads once nothing can cut it any more
+            rows = min(limit, self.max_cycles, len(pl._buf_pos) - pl._buf_i)
+            if n >= 2 and rows > n and self.reads_ok and not self.paced and bulk_ok(r) and may_read(ch, pl):
+                self._reads_from, n = n, rows
         elif pl.plan is None and pl._buf_done and pl.filter is not None and not pl.filter.settled and pl.at_rest:
             # an exact stop between blocks: the planner stands until its filter settled, the cycle that begins
             # settled starts the next block (stepped), as "drain" before a code
@@ -183,6 +196,22 @@ class Stretcher(RealTimeStretches):
             return False
         if m < n:
             outs = self._cut(pl, saved_pl, saved_drives, rx0, targets, m, m)
+        reads_from = self._reads_from
+        if reads_from and m > reads_from:  # B26: the rows again, with the feeds of the cycles that read
+            if first_change(r, ch, outs, 0, m, []) < m:  # the bulk part would cut it after a read: not here
+                outs = self._cut(pl, saved_pl, saved_drives, rx0, targets, reads_from, reads_from)
+                m = reads_from
+            else:
+                expect = smp.positions
+                _restore_planner(pl, saved_pl)
+                smp, feeds = sample_reading(ch, pl, m, expect)  # type: ignore[assignment]
+                self.feeds += feeds
+                if len(smp.positions) < m:
+                    m = len(smp.positions)
+                    self._restore_drives(saved_drives)
+                    outs = self._step_drives(rx0, targets, m)
+                pl.closed = False  # what the feed of the stretch's last reading cycle left, and the ones after
+        self._fed0, ch._fed = ch._fed, False  # a feed a stretch before ran for this first cycle (B26)
         return self._play(r, ch, pl, smp, outs, m, saved)
 
     def _play(self, r: Any, ch: Channel, pl: Planner, smp: Samples, outs: list[Stretch], m: int,
@@ -211,6 +240,7 @@ class Stretcher(RealTimeStretches):
             if _signature(channel) != sig:  # the scan changed what the channel reads: its own step (B20)
                 self._cut(pl, saved_pl, saved_drives, rx0, targets, k, k + 1, rpms, cmds)
                 state["fell_back"] = True
+                channel._fed = self._fed0 and k == 0
                 return channel.step()
             if settle:
                 rpms.append(float(pl.spindle_rpm()))

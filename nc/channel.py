@@ -87,6 +87,10 @@ class Channel:
     # the interpreter's macro statement budget, opened anew every cycle (nc.budget, decisions B2)
     statement_budget: StatementBudget | None = None
     emergency: bool = False  # an E-stop froze the setpoints: the bench must brake with the drives
+    # this cycle's feed ran already, inside a stretch that ended before the cycle's step (hil/stretch_reads.py)
+    _fed: bool = False
+    # a move read ahead of the feed whose soft limits were checked then, as the feed checks it when it reads it
+    _checked: Move | None = None
 
     def load(self, events: Iterator[Event]) -> None:
         self.events = events
@@ -151,6 +155,7 @@ class Channel:
         self._skip_move = None
         self._interrupt, self._m96_running = None, False  # a reset ends an interrupt program too
         self.events = None
+        self._fed = False
         self.state = RunState.RESETTING if not self.planner.idle else RunState.IDLE
 
     # ---- MLC side ---------------------------------------------------------------------
@@ -268,7 +273,8 @@ class Channel:
     def step(self) -> Setpoint:
         if self._interrupt is not None:
             self._interrupt_step()
-        if self.state is RunState.RUNNING and self._interrupt is None:
+        fed, self._fed = self._fed, False
+        if self.state is RunState.RUNNING and self._interrupt is None and not fed:
             self._feed_planner()
         try:
             sp = self.planner.step()
@@ -336,7 +342,8 @@ class Channel:
             if isinstance(ev, Busy):
                 return  # the statement budget is spent: the interpreter reads on next cycle
             if isinstance(ev, Move):
-                if self.soft_limits is not None and (crossing := self.soft_limits.check(ev)) is not None:
+                if self.soft_limits is not None and ev is not self._checked \
+                        and (crossing := self.soft_limits.check(ev)) is not None:
                     self._limit_alarm = crossing
                     continue
                 if "G31" in ev.tags:
