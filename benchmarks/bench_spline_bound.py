@@ -17,11 +17,18 @@ over the spans with `span_limits`' budget.
 from __future__ import annotations
 
 import argparse
+import dataclasses
+from unittest import mock
 
 import numpy as np
 
-from benchmarks.bench_vs_linuxcnc import START, Program, cam_polyline, cam_surface
+from benchmarks.bench_vs_linuxcnc import BENCH, START, Program, cam_polyline, cam_surface, measure
+from hil.bench_file import load_bench_file
+from nc.motion.lookahead import Block
+from nc.motion.offline import Stream, run
+from nc.motion.planner import Planner
 from nc.motion.spline_runs import LAM, FitError, fit_run, polyline_distance, span_limits, spans
+from nc.moves import Move
 
 ACC = np.array([5000.0, 5000.0, 3000.0])  # benches/mill-3axis.toml
 JERK = np.array([250_000.0, 250_000.0, 150_000.0])
@@ -77,15 +84,49 @@ def bound(prog: Program, tol: float, share: float, a_t: float) -> dict[str, floa
             "length": float(np.sum(ds))}
 
 
+def through_planner(prog: Program, tol: float) -> Stream:
+    """The fitted spans run through today's planner (decision 50), one block a programmed line in place of
+    the line, with `span_limits`; the bench's limits, its filter off (on a blended or fitted stretch the
+    filter's share is 0 and the output is the raw path delayed, decision 45). An experiment: Planner._block
+    is patched for the run, the planner has no hook for spans yet."""
+    cfg = load_bench_file(BENCH).motion_config()
+    cfg = dataclasses.replace(cfg, filter_time=0.0, filter_scurve=0.0)
+    pts = np.array([START] + prog.points, dtype=float)
+    cut = spans(*fit_run(pts, tol), cfg.axes)
+    lims = [np.array([getattr(cfg.limit(a), f) for a in cfg.axes])
+            for f in ("max_velocity", "max_acceleration", "max_jerk")]
+    line_block = Planner._block
+
+    def span_block(self: Planner, move: Move) -> Block | None:
+        b = line_block(self, move)
+        if b is None:
+            return None
+        sp = cut[move.line - 1]
+        return Block(move, "path", sp, sp.length, *span_limits(sp, *lims), b.feed)
+
+    moves = [Move("line", k, "", dict(zip("XYZ", pts[k - 1])), dict(zip("XYZ", pts[k])), dict(zip("XYZ", pts[k])),
+                  feed=prog.feed, plane=("X", "Y")) for k in range(1, len(pts))]
+    with mock.patch.object(Planner, "_block", span_block):
+        return run(moves, cfg, dict(zip("XYZ", START)))
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--n", type=int, default=400)
     ap.add_argument("--tol", type=float, default=0.02)
     ap.add_argument("--share", type=float, default=0.8)
     ap.add_argument("--at", type=float, default=1000.0, help="tangential acceleration of speed changes, mm/s²")
+    ap.add_argument("--planner", action="store_true", help="run the spans through the planner (filter off)")
     args = ap.parse_args()
     for make in (cam_polyline, cam_surface):
         prog = make(args.n)
+        if args.planner:
+            st = through_planner(prog, args.tol)
+            r = measure(st.positions, prog)
+            print(f"{prog.name:38s} feed-limited {prog.feed_limited():7.3f} s | spans through the planner "
+                  f"{st.time:7.3f} s ({st.time / prog.feed_limited():.3f}×), {st.state.value}, dev {r.deviation:.4f} mm, "
+                  f"v/a/j {r.v:.2f}/{r.a:.2f}/{r.j:.2f}")
+            continue
         try:
             r = bound(prog, args.tol, args.share, args.at)
         except FitError as e:

@@ -20,7 +20,7 @@ from scipy.interpolate import BSpline, PPoly, make_smoothing_spline
 from nc.motion.path import Segment
 
 PER_SEG = 4  # polyline samples a segment the fit is made to
-LAM = 0.01  # the smoothing spline's λ (mm³): the weights then hold it to the tolerance locally
+LAM = 0.1  # the smoothing spline's λ (mm³): the weights then hold it to the tolerance locally (decision 50)
 NODES = 9  # arc-length table nodes a polynomial piece
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(5)
 
@@ -183,9 +183,9 @@ def spans(spl: list[BSpline], cum: np.ndarray, axes: tuple[str, ...], margin: fl
     return out
 
 
-# Of each axis' limits on a span: the curvature term v²·r'' takes ≤ 0.6 of the acceleration, v³·r''' ≤ 0.8
-# of the jerk and the coupling 3·v·a_t·r'' ≤ 0.1; the tangential profile gets what is left (decision 49).
-SPAN_ACC, SPAN_JERK, SPAN_COUPLING = 0.6, 0.8, 0.1
+# Of each axis' limits on a span: the curvature term v²·r'' takes ≤ 0.6 of the acceleration, v³·r''' ≤ 0.75
+# of the jerk and the coupling 3·v·a_t·r'' ≤ 0.15; the tangential profile gets what is left (decisions 49, 50).
+SPAN_ACC, SPAN_JERK, SPAN_COUPLING = 0.6, 0.75, 0.15
 
 
 def span_limits(sp: SplineSpan, vel: np.ndarray, acc: np.ndarray, jerk: np.ndarray) -> tuple[float, float, float]:
