@@ -40,7 +40,7 @@ from fieldbus.pdo import RxPdo, TxPdo
 from hil.clock import LockStepClock, RealTimeClock
 from hil.stretch_bulk import bulk_cycles, bulk_ok, first_change, outputs_hold
 from hil.stretch_reads import may_read, sample_reading
-from hil.stretch_realtime import RealTimeStretches, _fed
+from hil.stretch_realtime import FIRST_CHANGE_NS, RealTimeStretches, _fed
 from hil.stretch_state import (_across, _event_due, _panel_state, _refilled, _restore_planner, _sample_across,
                                _save_planner, _signature, _stand_queued)
 from mlc.basic import BasicMlc
@@ -92,6 +92,8 @@ class Stretcher(RealTimeStretches):
         self._prep: Iterator[None] | None = None
         self._spec: Any = None
         self._taken: Any = None
+        self._cut_outs: tuple[int, list[Stretch]] | None = None  # a cut made in a paced cycle's slack (B22)
+        self._fc_ns = FIRST_CHANGE_NS  # first_change's CPU a cycle where it works the drive status out (B22)
         self.specs_used = 0
         # B26: feeds of the channel run inside stretches (reads_ok False: stretches end before them, as in B25)
         self.reads_ok = os.environ.get(ENV_READS) != "0"
@@ -150,7 +152,7 @@ class Stretcher(RealTimeStretches):
             n = min(limit, self.max_cycles, pl._block_rows())  # a cruise's buffer spans blocks: this one's rows
             self._sampler = sample_stretch
             if self.paced:  # real time: this start worked out in the slacks of the stretch before (B22)
-                started = self._spec_start(r, ch, pl, kind, limit)
+                started = self._spec_start(r, ch, pl, kind, limit, False)
                 if started is not None:
                     return started
             # real time: where the buffer ran out, the refill the first cycle's step would make, made ahead (B21)
@@ -158,6 +160,10 @@ class Stretcher(RealTimeStretches):
             if fill is not None:
                 n = min(limit, self.max_cycles, fill[4])
                 self._sampler = _refilled(fill)
+        if self.paced and fill is None and self._sampler in (stand_stretch, _stand_queued):  # standing (B22)
+            started = self._spec_start(r, ch, pl, kind, n, True)
+            if started is not None:
+                return started
         if n < 2:
             return False
         saved_pl = _save_planner(pl)
@@ -252,20 +258,26 @@ class Stretcher(RealTimeStretches):
             # The rest at once once the NC outputs the stretch's state decides are written: by its first cycle,
             # or, from the first, when writing them now leaves every device the gated user scan read as it saw it
             if (k == 1 and self._bulk_ok(r)) or (k == 0 and self._bulk_ok(r) and outputs_hold(r, ch, raw[0])):
-                j = first_change(r, ch, outs, k, m, raw)  # the first cycle whose scan would not be skipped
+                # the first cycle whose scan would not be skipped (real time: within what the slack has time for)
+                j = self._first_change(r, ch, outs, k, m, raw) if self.paced else first_change(r, ch, outs, k, m, raw)
                 if j > k:
                     timings = None
                     if self.paced:  # each cycle paced, with its outputs; the rest of them at once in the slack
                         # before the last one (so the next stretch's work ahead has the slack after it to itself)
                         stop = j - 1 if j - k >= 2 else j
-                        # the next stretch's start worked out in these cycles' slacks, a part a slack (B22)
-                        self._prep = self._prepare(r, ch, pl, last_raw, positions, m) if j == m else None
+                        # the next stretch's start worked out in these cycles' slacks, a part a slack
+                        # (B22), or the cut where it ends early
+                        self._cut_outs = None
+                        self._prep = self._prepare(r, ch, pl, last_raw, positions, m) if j == m else \
+                            self._cut_ahead(pl, saved_pl, saved_drives, rx0, targets, j)
                         end, timings = self._pace(r, k, stop, positions, targets, panel)
                         if end < stop or r.stop_request is not None or _panel_state(r.on_cycle) != panel:
                             j = end  # a stop or a press ended it (in its last paced cycle too): at once up to there
-                            self._prep = self._spec = None
-                    if j < m:  # the stretch ends before it: that cycle is stepped
-                        outs = self._cut(pl, saved_pl, saved_drives, rx0, targets, j, j)
+                            self._prep = self._spec = self._cut_outs = None
+                    if j < m:  # the stretch ends before it: that cycle is stepped (real time: cut in a slack)
+                        done = self._cut_outs
+                        outs = done[1] if done is not None and done[0] == j else \
+                            self._cut(pl, saved_pl, saved_drives, rx0, targets, j, j)
                         m, last_raw, cut = j, pl.position, True
                         if settle:
                             rpms, cmds = rpms[:k], cmds[:k]

@@ -13,9 +13,11 @@ import numpy as np
 
 from fieldbus.pdo import RxPdo
 from hil.clock import CycleTiming
+from hil.stretch_bulk import first_change, written_devices
 from hil.stretch_state import (_NOT_AHEAD, _SPINDLE_FEEDBACK, _not_ahead, _panel_state, _refilled, _restore_planner,
                                _sample_across, _save_planner, _signature, _stand_queued)
-from nc.channel import Channel
+from mlc.basic import BasicMlc
+from nc.channel import Channel, RunState
 from nc.motion.planner import Planner, Setpoint
 from nc.motion.stretch import Samples, sample_stretch, stand_stretch
 from virtual_bus.drive_stretch import Stretch, csp_stretch, csv_stretch
@@ -23,6 +25,11 @@ from virtual_bus.drive_stretch import Stretch, csp_stretch, csv_stretch
 # A part of the next start (B22) runs in a paced cycle's slack only while this much of the period is left: the
 # largest part (a refill, or the planner samples) is ≈ 0.2-0.3 ms of CPU on the 2-vCPU VM
 PREP_LEFT_NS = 600_000
+# first_change where the gated user scan read drive status devices: its first guess of ns a cycle (measured after),
+# and the part of the period left after it for the first paced cycle's wake-up (B22)
+FIRST_CHANGE_NS = 40_000
+FIRST_CHANGE_MARGIN_NS = 150_000
+_WRITTEN: dict[int, set] = {}
 
 
 def _fed(ch: Channel, pl: Planner) -> None:
@@ -37,7 +44,9 @@ class _Start:
     """A stretch start worked out ahead (B22), with what it read: the planner (its fields, filter, queue and plan
     as they were), the channel's signature, the drives' fields and the RxPdos it assumed the last cycle leaves."""
 
-    n: int
+    asked: int  # the cycles Stretcher.run asks for (with a refill: as many as it buffered)
+    n: int  # the cycles sampled, fewer where a drive's stretch ends early
+    sampler: Callable  # sample_stretch (after a refill: with `fill`), stand_stretch or _stand_queued
     sig: tuple
     blocks: list
     plan_fields: dict | None
@@ -208,20 +217,31 @@ class RealTimeStretches:
         """The start the next stretch would make where this one (m cycles, not cut) ends, worked out in the
         slacks of its paced cycles, one part a slack: the refill where its buffer runs out, the planner's
         samples, each drive's model. Each part leaves the planner and the drives as it found them; the
-        result is `self._spec`, which the next start takes when all it read is still the same (_spec_start)."""
+        result is `self._spec`, which the next start takes when all it read is still the same (_spec_start).
+        A standing stretch (an M/S/T code's wait, a filter's tail) prepares another as long as Stretcher.run's
+        would be (its filter's tail as this one leaves it)."""
         here = pl.position
         pl.position = last_raw  # as this stretch leaves it
+        sampler: Callable = self._sampler
+        standing = sampler in (stand_stretch, _stand_queued)
+        if not standing:
+            sampler = sample_stretch
         try:
             before = _save_planner(pl)
             blocks, p0 = list(pl.blocks), dict(pl.plan.__dict__) if pl.plan is not None else None
             sig = _signature(ch)
-            rows = pl._block_rows()
-            fill = self._refill_ahead(r, ch, pl) if rows == 0 else None
+            rows = pl._block_rows() if not standing else 0
+            fill = self._refill_ahead(r, ch, pl) if rows == 0 and not standing else None
         finally:
             pl.position = here
-        if rows == 0 and fill is None:
+        if standing:
+            f = pl.filter
+            wait = sampler is stand_stretch and ch.state is RunState.WAIT_AUX
+            n = self.max_cycles if wait else min(self.max_cycles, f.span - f._still) if f is not None else 0
+        elif rows == 0 and fill is None:
             return
-        n = min(self.max_cycles, fill[4] if fill is not None else rows)
+        else:
+            n = min(self.max_cycles, fill[4] if fill is not None else rows)
         if n < 2:
             return
         if fill is not None:
@@ -229,50 +249,62 @@ class RealTimeStretches:
         saved_pl = dict(before)
         if fill is not None:
             saved_pl["plan"] = (fill[0], fill[1])
-        _restore_planner(pl, saved_pl)  # the planner as at the first part (its position this stretch's end)
-        try:
-            smp = (_refilled(fill) if fill is not None else sample_stretch)(pl, n)
-            if smp is not None:
-                after = _save_planner(pl)
-                if fill is not None:
-                    after["plan"] = (fill[0], dict(fill[0].__dict__))
-        finally:
-            _restore_planner(pl, saved_pl)
-            pl.position = here
-        if smp is None or len(smp.positions) < 2:
-            return
-        n = len(smp.positions)
-        yield
-        org, last = r.origin.tolist(), positions[m - 1].tolist()
-        rx0 = [copy.copy(rx) for rx in r.rx]
-        for i in range(self.n_axes):  # the setpoint this stretch's last cycle writes
-            rx0[i].target_position = r.scales[i].to_counts(last[i] - org[i])
-        targets = self._targets(smp, rx0, n)
-        saved_drives, drives_after, outs = [], [], []
-        dt = r.bench.cycle
-        for i, (d, rx) in enumerate(zip(self.drives, rx0)):
-            if i:
-                yield
-            s0 = dict(d.__dict__)
-            outs.append(csp_stretch(d, rx, targets[i][:n], dt) if i < self.n_axes else csv_stretch(d, rx, n, dt))
-            drives_after.append(dict(d.__dict__))
-            d.__dict__.clear()
-            d.__dict__.update(s0)
-            saved_drives.append(s0)
-        self._spec = _Start(n, sig, blocks, p0, saved_pl, after, fill, smp, rx0, targets, saved_drives,
-                            drives_after, outs)
+        asked = n  # the cycles Stretcher.run would ask for; fewer where a drive's stretch ends early (below)
+        while True:
+            _restore_planner(pl, saved_pl)  # the planner as at the first part (its position this stretch's end)
+            try:
+                smp = (_refilled(fill) if fill is not None else sampler)(pl, n)
+                if smp is not None:
+                    after = _save_planner(pl)
+                    if fill is not None:
+                        after["plan"] = (fill[0], dict(fill[0].__dict__))
+            finally:
+                _restore_planner(pl, saved_pl)
+                pl.position = here
+            if smp is None or len(smp.positions) < 2:
+                return
+            n = len(smp.positions)
+            yield
+            org, last = r.origin.tolist(), positions[m - 1].tolist()
+            rx0 = [copy.copy(rx) for rx in r.rx]
+            for i in range(self.n_axes):  # the setpoint this stretch's last cycle writes
+                rx0[i].target_position = r.scales[i].to_counts(last[i] - org[i])
+            targets = self._targets(smp, rx0, n)
+            saved_drives, drives_after, outs = [], [], []
+            dt = r.bench.cycle
+            for i, (d, rx) in enumerate(zip(self.drives, rx0)):
+                if i:
+                    yield
+                s0 = dict(d.__dict__)
+                outs.append(csp_stretch(d, rx, targets[i][:n], dt) if i < self.n_axes else csv_stretch(d, rx, n, dt))
+                drives_after.append(dict(d.__dict__))
+                d.__dict__.clear()
+                d.__dict__.update(s0)
+                saved_drives.append(s0)
+            done = min(o.done for o in outs)
+            if done >= n:
+                break
+            if done < 2:  # a drive would fault or latch an index at once: that start steps its cycle
+                return
+            n = done  # the start as Stretcher._launch would cut it (a spindle's index pulse): taken again shorter
+            yield
+        self._spec = _Start(asked, n, sampler, sig, blocks, p0, saved_pl, after, fill, smp, rx0, targets,
+                            saved_drives, drives_after, outs)
 
-    def _spec_start(self, r: Any, ch: Channel, pl: Planner, kind: str, limit: int) -> bool | None:
-        """The start worked out ahead (_prepare), taken when the planner, the channel, the drives and the
-        RxPdos are as it read them (the same objects; the filter's windows the same rows); None: work it out."""
+    def _spec_start(self, r: Any, ch: Channel, pl: Planner, kind: str, n: int, exact: bool) -> bool | None:
+        """The start worked out ahead (_prepare), taken when it sampled with this start's sampler as many cycles
+        (`exact`; else at most n), and the planner, the channel, the drives and the RxPdos are as it read them
+        (the same objects; the filter's windows the same rows); None: work it out."""
         spec, self._taken = self._taken, None
-        if spec is None or kind != "run" or spec.n > limit or not self._same(spec, r, ch, pl):
+        if spec is None or spec.sampler is not self._sampler or (spec.asked != n if exact else spec.asked > n) \
+                or not self._same(spec, r, ch, pl):
             return None
         _restore_planner(pl, spec.after_pl)  # the planner as its samples left it
         if spec.fill is not None:
             self._sampler = _refilled(spec.fill)  # a cut samples again from before the refill
             self.fills_early += 1
-        _fed(ch, pl)
+        if kind != "wait":  # as Stretcher.run
+            _fed(ch, pl)
         for d, after in zip(self.drives, spec.drives_after):
             d.__dict__.clear()
             d.__dict__.update(after)
@@ -307,3 +339,33 @@ class RealTimeStretches:
                 return False
             s0["_rx"] = dd["_rx"]  # what a cut restores, as run() saves it
         return all(a == b for a, b in zip(r.rx, spec.rx0))
+
+    def _cut_ahead(self, pl: Planner, saved_pl: dict, saved_drives: list[dict], rx0: list[RxPdo],
+                   targets: list[list[int]], j: int) -> Iterator[None]:
+        """A stretch that ends before cycle j, cut in a paced cycle's slack (not in the bulk part's), B22."""
+        self._cut_outs = (j, self._cut(pl, saved_pl, saved_drives, rx0, targets, j, j))
+        yield
+
+    def _first_change(self, r: Any, ch: Channel, outs: list[Stretch], k: int, m: int, raw: list) -> int:
+        """`first_change` in real time (B22): where it works the drive status out cycle by cycle (the gated user
+        scan read devices it writes, or waits for a timer: ≈ 30-40 µs a cycle), over as many cycles as this
+        slack has time for; a stretch with no change among them ends after them (the next cycle is stepped,
+        which is always exact)."""
+        mlc = r.mlc
+        if type(mlc) is BasicMlc:
+            return first_change(r, ch, outs, k, m, raw)
+        rec = mlc.gate.last
+        x = mlc.link.x
+        devices = _WRITTEN.get(x)
+        if devices is None:
+            devices = _WRITTEN[x] = written_devices(x)  # the devices first_change works out cycle by cycle
+        if not rec.timers and not any(key in devices for key in rec.reads):
+            return first_change(r, ch, outs, k, m, raw)  # nothing worked out cycle by cycle: a few µs
+        clock = r.clock
+        left = clock.left_ns() - FIRST_CHANGE_MARGIN_NS
+        e = m if self._fc_ns * (m - k) <= left else min(m, k + max(2, left // self._fc_ns))
+        t0 = clock.now_ns()
+        j = first_change(r, ch, outs, k, e, raw)
+        # the next guess: this call's cost a cycle, or a tenth less than the last guess when that was higher
+        self._fc_ns = max(20_000, (clock.now_ns() - t0) // max(1, min(j + 1, e) - k), self._fc_ns * 9 // 10)
+        return j
