@@ -124,7 +124,8 @@ def main() -> None:
             st = through_planner(prog, args.tol)
             r = measure(st.positions, prog)
             print(f"{prog.name:38s} feed-limited {prog.feed_limited():7.3f} s | spans through the planner "
-                  f"{st.time:7.3f} s ({st.time / prog.feed_limited():.3f}×), {st.state.value}, dev {r.deviation:.4f} mm, "
+                  f"{st.time:7.3f} s ({st.time / prog.feed_limited():.3f}×), {st.state.value}, "
+                  f"dev {r.deviation:.4f} mm, "
                   f"v/a/j {r.v:.2f}/{r.a:.2f}/{r.j:.2f}")
             continue
         try:

@@ -3,11 +3,11 @@
 Corner blends sized by the half rule hold CAM programs of 0.78 mm segments near 1.15-1.22x their
 feed-limited time, whatever their speed planning (decision 47); one C2 curve fitted to the run lets the feed
 hold (decision 48: 1.010-1.025x as a bound). This module holds that fit and its pieces as path segments:
-`fit_run` fits cubic smoothing splines x(u), y(u), z(u) (u the polyline's chord length) within the
-tolerance, `spans` cuts the curve at the polyline's vertices into `SplineSpan`s (a `Segment` of kind
-"spline", parametrised by its own arc length), and `span_limits` gives a span's speed cap and tangential
-acceleration and jerk from its per-axis curvature and jerk bounds. The planner does not use them yet:
-`benchmarks/bench_spline_bound.py` does.
+`fit_run` fits smoothing splines x(u), y(u), z(u) (u the polyline's chord length; quintic, the penalty on
+r''', decision 51) within the tolerance, `spans` cuts the curve at the polyline's vertices into
+`SplineSpan`s (a `Segment` of kind "spline", parametrised by its own arc length), and `span_limits`
+gives a span's speed cap and tangential acceleration and jerk from its per-axis curvature and jerk bounds.
+The planner does not use them yet: `benchmarks/bench_spline_bound.py` does (decision 50).
 """
 
 from __future__ import annotations
@@ -15,12 +15,15 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+import scipy.sparse as sps
 from scipy.interpolate import BSpline, PPoly, make_smoothing_spline
+from scipy.sparse.linalg import spsolve
 
 from nc.motion.path import Segment
 
 PER_SEG = 4  # polyline samples a segment the fit is made to
-LAM = 0.1  # the smoothing spline's λ (mm³): the weights then hold it to the tolerance locally (decision 50)
+DEGREE = 5  # quintic, its r''' continuous (decision 51); 3: decisions 48-50's cubic smoothing spline
+LAM = 0.01  # λ of the penalty ∫r'''² (mm⁵; of ∫r''² at DEGREE 3: 0.1 mm³); the weights then hold N1.053
 NODES = 9  # arc-length table nodes a polynomial piece
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(5)
 
@@ -55,17 +58,44 @@ def polyline_distance(curve: np.ndarray, cu: np.ndarray, pts: np.ndarray, cum: n
     return best
 
 
-def fit_curve(pts: np.ndarray, lam: float = LAM, w: np.ndarray | None = None) -> list[BSpline]:
-    """Cubic smoothing splines of the polyline's samples, one an axis, start and end pinned."""
+def fit_curve(pts: np.ndarray, lam: float = LAM, w: np.ndarray | None = None, degree: int = DEGREE) -> list[BSpline]:
+    """Smoothing splines of the polyline's samples, one an axis, start and end pinned: quintic with the
+    penalty ∫r'''², or cubic with ∫r''² (`degree` 3, scipy's make_smoothing_spline)."""
     u, p, _ = samples(pts)
     w = np.ones(len(u)) if w is None else w.copy()
     w[0] = w[-1] = 1e6
+    if degree == 5:
+        return quintic(u, p, w, lam)
     return [make_smoothing_spline(u, p[:, k], w=w, lam=lam) for k in range(pts.shape[1])]
 
 
-def fit_run(pts: np.ndarray, tol: float, lam: float = LAM, rounds: int = 60,
-            step: float = 0.005) -> tuple[list[BSpline], np.ndarray]:
-    """A fit within tol (checked every `step` mm of chord length), smoothed locally as much as it allows:
+def quintic(x: np.ndarray, y: np.ndarray, w: np.ndarray, lam: float, k: int = 5, pen: int = 3) -> list[BSpline]:
+    """Penalised B-splines of degree k with knots at x: Σ w·(y − f)² + λ·∫(f^(pen))² least
+    (y: samples × axes), one banded sparse solve."""
+    t = np.concatenate([[x[0]] * k, x, [x[-1]] * k])
+    n = len(t) - k - 1
+    gx, gw = np.polynomial.legendre.leggauss(4)
+    h = np.diff(x) / 2.0
+    at = (x[:-1, None] + h[:, None] * (gx[None, :] + 1.0)).ravel()
+    m = sps.identity(n, format="csr")
+    tt, kk = t, k
+    for _ in range(pen):  # the coefficients of the derivative's B-splines
+        nn = m.shape[0]
+        den = tt[kk + 1: kk + nn] - tt[1: nn]
+        den = np.where(den > 0.0, den, np.inf)
+        m = sps.diags([-kk / den, kk / den], [0, 1], shape=(nn - 1, nn), format="csr") @ m
+        tt, kk = tt[1:-1], kk - 1
+    dk = BSpline.design_matrix(at, tt, kk) @ m
+    b = BSpline.design_matrix(x, t, k)
+    a = (b.T @ sps.diags(w) @ b + lam * (dk.T @ sps.diags((h[:, None] * gw[None, :]).ravel()) @ dk)).tocsc()
+    c = spsolve(a, b.T @ (w[:, None] * y))
+    return [BSpline(t, c[:, j], k) for j in range(y.shape[1])]
+
+
+def fit_run(pts: np.ndarray, tol: float, lam: float = LAM, rounds: int = 60, step: float = 0.005,
+            degree: int = DEGREE) -> tuple[list[BSpline], np.ndarray]:
+    """A fit within tol (checked every `step` mm of chord length, and 40 times finer within a step of
+    where it comes within 0.9·tol), smoothed locally as much as it allows:
     the samples' weights grow (× (dev / 0.9·tol)³, never shrink) where the curve strays beyond 0.9·tol.
     Returns the splines and the vertices' chord lengths."""
     pts = np.asarray(pts, dtype=float)
@@ -74,8 +104,13 @@ def fit_run(pts: np.ndarray, tol: float, lam: float = LAM, rounds: int = 60,
     uu = np.append(np.arange(0.0, cum[-1], step), cum[-1])
     j = np.clip(np.searchsorted(u, uu), 0, len(u) - 1)
     for _ in range(rounds):
-        spl = fit_curve(pts, lam, w)
+        spl = fit_curve(pts, lam, w, degree)
         dist = polyline_distance(np.stack([s(uu) for s in spl], axis=1), uu, pts, cum)
+        near = np.flatnonzero(dist > 0.9 * tol)
+        if len(near):  # the distance peaks sharply near a vertex: 40 points a step around the close ones
+            uf = np.clip((uu[near][:, None] + np.linspace(-step, step, 41)[None, :]).ravel(), 0.0, cum[-1])
+            df = polyline_distance(np.stack([s(uf) for s in spl], axis=1), uf, pts, cum)
+            dist[near] = np.maximum(dist[near], df.reshape(len(near), 41).max(axis=1))
         if dist.max() <= tol:
             return spl, cum
         dev = np.zeros(len(u))  # each sample: the largest distance next to it
@@ -90,7 +125,7 @@ class SplineSpan(Segment):
     """The fitted curve between two vertices: polynomial pieces r(w) = Σ c_k·w^(3−k) (w from each piece's
     start, `brk` its chord-length breakpoints from the span's start), evaluated by arc length s."""
 
-    coef: np.ndarray = field(default_factory=lambda: np.zeros((0, 4, 0)))  # pieces × 4 × axes
+    coef: np.ndarray = field(default_factory=lambda: np.zeros((0, 4, 0)))  # pieces × (degree + 1) × axes
     brk: np.ndarray = field(default_factory=lambda: np.zeros(0))
     s_tab: np.ndarray = field(default_factory=lambda: np.zeros((0, NODES)))  # arc length at the nodes
     acc_bound: np.ndarray = field(default_factory=lambda: np.zeros(0))  # max |d²r/ds²| per axis
@@ -98,12 +133,18 @@ class SplineSpan(Segment):
     dir_bound: np.ndarray = field(default_factory=lambda: np.zeros(0))  # max |dr/ds| per axis
 
     def _derivs(self, piece: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, ...]:
-        c = self.coef[piece]  # n × 4 × axes
+        """r and its first three derivatives in w (Horner on the pieces' coefficients, highest first)."""
+        c = self.coef[piece]  # n × (degree + 1) × axes
         w = w[:, None]
-        r = ((c[:, 0] * w + c[:, 1]) * w + c[:, 2]) * w + c[:, 3]
-        d1 = (3.0 * c[:, 0] * w + 2.0 * c[:, 1]) * w + c[:, 2]
-        d2 = 6.0 * c[:, 0] * w + 2.0 * c[:, 1]
-        return r, d1, d2, 6.0 * c[:, 0]
+        k = c.shape[1] - 1
+        out = []
+        for d in range(4):
+            acc = np.zeros((len(c), c.shape[2]))
+            for i in range(k - d + 1):  # coefficient of w^(k-i) differentiated d times
+                f = float(np.prod(np.arange(k - i - d + 1, k - i + 1))) if d else 1.0
+                acc = acc * w + f * c[:, i]
+            out.append(acc)
+        return tuple(out)
 
     def _arc(self, piece: np.ndarray, w0: np.ndarray, w1: np.ndarray) -> np.ndarray:
         """Arc length from w0 to w1 within each piece (5-point Gauss-Legendre)."""
@@ -157,7 +198,7 @@ def spans(spl: list[BSpline], cum: np.ndarray, axes: tuple[str, ...], margin: fl
     x = pp[0].x
     keep = np.diff(x) > 0.0
     starts = x[:-1][keep]
-    coef = np.stack([p.c[:, keep] for p in pp], axis=-1).transpose(1, 0, 2)  # pieces × 4 × axes
+    coef = np.stack([p.c[:, keep] for p in pp], axis=-1).transpose(1, 0, 2)  # pieces × (degree + 1) × axes
     first = np.searchsorted(starts, cum[:-1] - 1e-9 * max(cum[-1], 1.0))
     out = []
     for i in range(len(cum) - 1):
