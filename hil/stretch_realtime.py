@@ -220,9 +220,11 @@ class RealTimeStretches:
         result is `self._spec`, which the next start takes when all it read is still the same (_spec_start).
         A standing stretch (an M/S/T code's wait, a filter's tail) prepares another as long as Stretcher.run's
         would be (its filter's tail as this one leaves it)."""
+        sampler: Callable = self._sampler
+        if sampler is _sample_across:
+            return  # a cruise across its blocks: the next start samples across too, which is not worked out ahead
         here = pl.position
         pl.position = last_raw  # as this stretch leaves it
-        sampler: Callable = self._sampler
         standing = sampler in (stand_stretch, _stand_queued)
         if not standing:
             sampler = sample_stretch
