@@ -106,29 +106,36 @@ def staged(label: str, program: Path, bench_file: Path | None, trace: str | None
             holder["wall"], holder["cpu"] = time.perf_counter() - t0, time.thread_time() - c0
 
     import hil.stretch as stretch
+    import hil.stretch_pass as spass
 
     nc = _Stage(Channel.step)
     stages["NC"].append(nc)
-    # a stretch's planner samples and feeds count as NC, its drive models as bus + drives (hil/stretch.py)
-    patched = {name: _Stage(getattr(stretch, name))
-               for name in ("sample_stretch", "sample_reading", "csp_stretch", "csv_stretch")}
-    stages["NC"] += [patched["sample_stretch"], patched["sample_reading"]]  # sample_reading: the feeds inside (B26)
-    stages["bus + drives"] += [patched["csp_stretch"], patched["csv_stretch"]]
+    # a stretch's planner samples count as NC, its drive models as bus + drives (hil/stretch.py); a stretch that
+    # runs the NC's steps (B27, hil/stretch_pass.py: Pass.run) counts as NC but for the drive models it steps
+    patched = {(mod, name): _Stage(getattr(mod, name)) for mod, name in
+               ((stretch, "sample_stretch"), (stretch, "csp_stretch"), (stretch, "csv_stretch"),
+                (spass, "csp_stretch"), (spass, "csv_stretch"))}
+    in_pass = [patched[(spass, "csp_stretch")], patched[(spass, "csv_stretch")]]
+    pass_run = _Stage(spass.Pass.run)
+    stages["NC"] += [patched[(stretch, "sample_stretch")], pass_run]
+    stages["bus + drives"] += [st for (mod, name), st in patched.items() if name != "sample_stretch"]
     BenchRunner.run_program = timed_run
     Channel.step = lambda self: nc(self)
-    for name, st in patched.items():
-        setattr(stretch, name, st)
+    spass.Pass.run = lambda self, n: pass_run(self, n)
+    for (mod, name), st in patched.items():
+        setattr(mod, name, st)
     try:
         t0 = time.perf_counter()
         res = api.run(program, str(bench_file) if bench_file else None, trace=trace)
         total = time.perf_counter() - t0
     finally:
-        BenchRunner.run_program, Channel.step = original, nc.fn
-        for name, st in patched.items():
-            setattr(stretch, name, st.fn)
+        BenchRunner.run_program, Channel.step, spass.Pass.run = original, nc.fn, pass_run.fn
+        for (mod, name), st in patched.items():
+            setattr(mod, name, st.fn)
     r, wall, cpu = res.run, holder["wall"], holder["cpu"]
     n = max(1, r.cycles)
     parts = {k: sum(st.seconds for st in v) for k, v in stages.items()}
+    parts["NC"] -= sum(st.seconds for st in in_pass)  # Pass.run's drive models, counted as bus + drives
     parts["rest"] = cpu - sum(parts.values())
     print(f"{label}: {r.cycles} cycles, {r.sim_time:.2f} s simulated; the cycles took {cpu:.2f} s CPU = "
           f"{r.sim_time / cpu:.1f}x real time ({wall:.2f} s wall = {r.sim_time / wall:.1f}x); whole run incl. "

@@ -21,7 +21,8 @@ Ending early restores the planner and the drives as they were and takes the shor
 parts are deterministic, so its cycles are the same). `DELTAHIL_STRETCH=0` turns stretches off: tests
 compare both runs column by column.
 
-Its real-time part (decision B21: pacing, work ahead in the slack) is hil/stretch_realtime.py, a mixin on
+With the basic MLC in lock-step a stretch runs the NC's steps itself, feeds and solves included (decisions
+B26/B27, hil/stretch_pass.py). Its real-time part (decision B21: pacing, work ahead in the slack) is hil/stretch_realtime.py, a mixin on
 the same state; the planner saved and restored around a stretch, and the channel's signature, hil/stretch_state.py.
 """
 
@@ -39,7 +40,8 @@ from fieldbus.link import SimLink
 from fieldbus.pdo import RxPdo, TxPdo
 from hil.clock import LockStepClock, RealTimeClock
 from hil.stretch_bulk import bulk_cycles, bulk_ok, first_change, outputs_hold
-from hil.stretch_reads import may_read, sample_reading
+from hil.stretch_pass import Pass, _save as _save_nc, no_reads
+from hil.stretch_reads import may_read
 from hil.stretch_realtime import FIRST_CHANGE_NS, RealTimeStretches, _fed
 from hil.stretch_state import (_across, _event_due, _panel_state, _refilled, _restore_planner, _sample_across,
                                _save_planner, _signature, _stand_queued)
@@ -53,7 +55,7 @@ from virtual_bus.drive import Cia402Drive
 from virtual_bus.drive_stretch import Stretch, can_stretch, csp_stretch, csv_stretch
 
 ENV = "DELTAHIL_STRETCH"  # "0": every cycle is stepped (the reference the tests compare against)
-ENV_READS = "DELTAHIL_STRETCH_READS"  # "0": stretches end before a cycle whose feed reads (B25, benchmarks)
+ENV_READS = "DELTAHIL_STRETCH_READS"  # "0": no feeds or solves inside stretches (B25's, benchmarks compare)
 MAX_CYCLES = 64  # the planner's buffers are up to 64 cycles: a stretch never spans two
 # Real time (decision B21): a stretch's planner samples and drive models are computed in the slack of the period
 # before its first cycle, so that work must fit there; RT_CYCLES cycles of it cost ≈ 0.2 ms on the lathe demo
@@ -95,11 +97,10 @@ class Stretcher(RealTimeStretches):
         self._cut_outs: tuple[int, list[Stretch]] | None = None  # a cut made in a paced cycle's slack (B22)
         self._fc_ns = FIRST_CHANGE_NS  # first_change's CPU a cycle where it works the drive status out (B22)
         self.specs_used = 0
-        # B26: feeds of the channel run inside stretches (reads_ok False: stretches end before them, as in B25)
+        # B26/B27: the channel's feeds and the planner's steps run inside stretches (reads_ok False: B25's stretches)
         self.reads_ok = os.environ.get(ENV_READS) != "0"
         self.feeds = 0
         self._fed0 = False
-        self._reads_from = 0
 
     @classmethod
     def for_runner(cls, runner: Any) -> "Stretcher | None":
@@ -128,8 +129,10 @@ class Stretcher(RealTimeStretches):
         if kind is None:
             return False
         pl = ch.planner
+        if kind == "run" and self.reads_ok and not self.paced and type(r.mlc) is BasicMlc and self._bulk_ok(r) \
+                and (may_read(ch, pl) or (no_reads(ch) and not ch.alarms and not pl.held)):
+            return self._run_pass(r, ch, pl, limit)  # B27: the NC's steps inside the stretch
         fill = None
-        self._reads_from = 0  # B26: the first cycle whose feed the stretch runs (0: none)
         if kind in ("wait", "drain"):  # standing: an M/S/T code waits for its finish, or the filter's tail
             n = min(limit, self.max_cycles)
             if kind == "drain":  # the cycle that begins with the filter settled issues the waiting code: stepped
@@ -138,11 +141,6 @@ class Stretcher(RealTimeStretches):
         elif type(r.mlc) is BasicMlc and pl._buf_blk is not None:  # a cruise, across its blocks (nothing reads
             n = _across(ch, pl, min(limit, self.max_cycles))          # the queue's length in between)
             self._sampler = _sample_across
-            # B26: past the cycle whose feed reads, the feeds run inside the stretch (hil/stretch_reads.py): the
-            # stretch's length from the rows as they stand, the reads once nothing can cut it any more
-            rows = min(limit, self.max_cycles, len(pl._buf_pos) - pl._buf_i)
-            if n >= 2 and rows > n and self.reads_ok and not self.paced and bulk_ok(r) and may_read(ch, pl):
-                self._reads_from, n = n, rows
         elif pl.plan is None and pl._buf_done and pl.filter is not None and not pl.filter.settled and pl.at_rest:
             # an exact stop between blocks: the planner stands until its filter settled, the cycle that begins
             # settled starts the next block (stepped), as "drain" before a code
@@ -186,6 +184,27 @@ class Stretcher(RealTimeStretches):
         outs = self._step_drives(rx0, targets, n)
         return self._launch(r, ch, pl, smp, n, (saved_pl, saved_drives, rx0, targets), outs)
 
+    def _run_pass(self, r: Any, ch: Channel, pl: Planner, limit: int) -> bool:
+        """A stretch whose NC steps inside it (B27, hil/stretch_pass.py), played at once."""
+        n = first_change(r, ch, [], 0, min(limit, self.max_cycles), [])  # the basic MLC: an AuxWatch warning due
+        if n < 2:
+            return False
+        self._fed0, ch._fed = ch._fed, False  # a feed a stretch before ran for this first cycle (B26)
+        _fed(ch, pl)
+        saved_pl = _save_nc(pl)
+        rx0 = [copy.copy(rx) for rx in r.rx]  # what the drives are stepped with (the runner's change per cycle)
+        saved_drives = [dict(d.__dict__) for d in self.drives]
+        ps = Pass(self, ch, pl, rx0, saved_drives)
+        m = ps.run(n)
+        self.feeds += ps.feeds
+        if m < 2:  # (no feed ran: feeds come from the third cycle on)
+            _restore_planner(pl, saved_pl)
+            self._restore_drives(saved_drives)
+            ch._fed = self._fed0
+            return False
+        self._sampler = sample_stretch
+        return self._play(r, ch, pl, ps.samples(), ps.outs, m, (saved_pl, saved_drives, rx0, ps.targets))
+
     def _launch(self, r: Any, ch: Channel, pl: Planner, smp: Samples, n: int, saved: tuple,
                 outs: list[Stretch]) -> bool:
         """The stretch's n sampled cycles with the drives stepped over them (`outs`): shortened to the first
@@ -202,21 +221,6 @@ class Stretcher(RealTimeStretches):
             return False
         if m < n:
             outs = self._cut(pl, saved_pl, saved_drives, rx0, targets, m, m)
-        reads_from = self._reads_from
-        if reads_from and m > reads_from:  # B26: the rows again, with the feeds of the cycles that read
-            if first_change(r, ch, outs, 0, m, []) < m:  # the bulk part would cut it after a read: not here
-                outs = self._cut(pl, saved_pl, saved_drives, rx0, targets, reads_from, reads_from)
-                m = reads_from
-            else:
-                expect = smp.positions
-                _restore_planner(pl, saved_pl)
-                smp, feeds = sample_reading(ch, pl, m, expect)  # type: ignore[assignment]
-                self.feeds += feeds
-                if len(smp.positions) < m:
-                    m = len(smp.positions)
-                    self._restore_drives(saved_drives)
-                    outs = self._step_drives(rx0, targets, m)
-                pl.closed = False  # what the feed of the stretch's last reading cycle left, and the ones after
         self._fed0, ch._fed = ch._fed, False  # a feed a stretch before ran for this first cycle (B26)
         return self._play(r, ch, pl, smp, outs, m, saved)
 
@@ -237,8 +241,11 @@ class Stretcher(RealTimeStretches):
         state = {"fell_back": False}
         # The MLC exchange reads the planner's own position (M3x352+i, axis at 0) before the cycle's step: the
         # raw sample of the cycle before, as it stood in stepping (sample_stretch moved it to the last one).
-        raw = [saved_pl["pl"]["position"], *pl._buf_pos[pl._buf_i - m:pl._buf_i - 1]] \
-            if self._sampler not in (stand_stretch, _stand_queued) else [pl.position] * m
+        if smp.raw is not None:  # a stretch over the planner's steps (B27): the rows it took
+            raw = [saved_pl["pl"]["position"], *smp.raw[:m - 1]]
+        else:
+            raw = [saved_pl["pl"]["position"], *pl._buf_pos[pl._buf_i - m:pl._buf_i - 1]] \
+                if self._sampler not in (stand_stretch, _stand_queued) else [pl.position] * m
         last_raw = pl.position
         k = 0
 

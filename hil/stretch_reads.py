@@ -1,36 +1,23 @@
-"""The channel's feed inside a stretch across a cruise's blocks (issue 17, decision bench B26).
+"""The channel's reads inside a stretch (issue 17, decisions bench B26/B27): its event stream read ahead.
 
-A CAM program's queue refills 8 blocks at a time, 4 a cycle: a stretch across a cruise's blocks (B25) ended
-before every cycle whose feed reads the program, and that cycle was stepped. Here the stretch runs those feeds
-itself, at the cycle stepping would, in stepping's order: the planner's rows up to that cycle
-(`sample_stretch(..., across=True)`, whose chain checks see the queue as that cycle's step sees it), then the
-channel's own feed (`Channel._feed_planner`: the interpreter and `Planner.push` of the blocks read), then the
-rows after it, checked against the queue with those pushes. A push may change what a later row would be (a
-block of the chain that no longer cruises, a filter share λ): the stretch ends before the first row that
-differs from what the drives were stepped with (the rows sampled before the reads), as B20 ends a stretch.
-
-A push cannot be taken back, so the reads run only where nothing cuts the stretch after them: the stretch's
-length is decided first (the rows as they stand, the drive models, the bench's checks), the stretch runs at once
-(bulk, the basic MLC, lock-step), and a read happens only when the events it takes are plain moves
-(`Ahead.peek`: no M/S/T code, sync, end, alarm, G31, thread, feed per revolution, G96, soft-limit crossing or
-macro statement). Otherwise the stretch ends before that cycle. The events peeked stay in `Ahead`, which the
-channel reads them from in order, with the statement budget as generating them left it (the interpreter
-already runs ahead of the machine: its preview window, nc/interp/preview.py, reads by events, not cycles).
+A stretch that runs the NC's steps itself (hil/stretch_pass.py) runs the channel's feed at the cycles stepping
+reads the program in (a CAM program's queue refills 8 blocks at a time, 4 a cycle). A feed's push cannot be
+taken back, so a feed runs there only when the events it takes are plain moves (`Ahead.peek`: line, arc or
+rapid, no G31, feed per revolution or G96, inside the soft limits, generated without a macro statement) and the
+channel's state lets it only read and push (`may_read`); otherwise the stretch ends before that cycle. The events
+peeked stay in `Ahead`, which the channel reads them from in order, with the statement budget as generating them
+left it (the interpreter already runs ahead of the machine: its preview window, nc/interp/preview.py, reads by
+events, not cycles).
 """
 
 from __future__ import annotations
 
 from collections import deque
 from collections.abc import Iterator
-from typing import Any
 
-import numpy as np
-
-from nc.channel import READS_PER_CYCLE, Channel, RunState
+from nc.channel import Channel, RunState
 from nc.moves import Event, Move
 from nc.motion.planner import Planner
-from nc.motion.stretch import Samples, sample_stretch
-from hil.stretch_state import _across, _restore_planner, _save_planner
 
 PLAIN_KINDS = ("line", "arc", "rapid")
 
@@ -117,51 +104,3 @@ def may_read(ch: Channel, pl: Planner) -> bool:
             and ch._limit_alarm is None and ch._interrupt is None and not ch.single_block and not ch.alarms
             and not ch.skip_armed and ch._skip_move is None and (budget is None or not budget.spent)
             and not pl.held and pl.threads_queued == 0)
-
-
-def sample_reading(ch: Channel, pl: Planner, n: int, expect: np.ndarray) -> tuple[Samples | None, int]:
-    """Up to n rows of a cruise across its blocks from where the planner stands, with the feeds of the cycles
-    that read (module doc), each row equal to `expect` (what the drives were stepped with); fewer where a row
-    would differ, a block stops cruising, or a feed would read something else than plain moves. Also how many
-    feeds ran; where the stretch ends right after one, the channel's next step skips its feed (`Channel._fed`)."""
-    parts: list[Samples] = []
-    rows, feeds, fed_at = 0, 0, -1
-    src = ahead(ch)
-    while rows < n:
-        seg = _across(ch, pl, n - rows) if pl.full else 0
-        if seg == 0:  # this cycle's feed reads
-            if not rows or not may_read(ch, pl) or not src.peek(READS_PER_CYCLE):
-                break  # (the first cycle's feed reads nothing: Stretcher._quiet)
-            ch._feed_planner()  # plain moves only: it pushes them, nothing else changes
-            feeds, fed_at = feeds + 1, rows
-            seg = _across(ch, pl, n - rows) if pl.full else 1  # still filling: the next cycle reads again
-        saved = _save_planner(pl)
-        smp = sample_stretch(pl, seg, across=True)
-        if smp is None:
-            break
-        got = len(smp.positions)
-        want = expect[rows:rows + got]
-        if not np.array_equal(smp.positions, want):
-            bad = int(np.flatnonzero(np.any(smp.positions != want, axis=1))[0])
-            _restore_planner(pl, saved)
-            if bad:
-                parts.append(sample_stretch(pl, bad, across=True))  # type: ignore[arg-type]
-                rows += bad
-            break
-        parts.append(smp)
-        rows += got
-        if got < seg:
-            break
-    if fed_at == rows:  # the stretch ends before the cycle whose feed it ran: that cycle's step must not read again
-        ch._fed = True
-    return (_joined(parts) if parts else None), feeds
-
-
-def _joined(parts: list[Samples]) -> Samples:
-    if len(parts) == 1:
-        return parts[0]
-    moves: list[Any] = []
-    for p in parts:
-        moves += p.moves if p.moves is not None else [p.move] * len(p.positions)
-    return Samples(np.concatenate([p.positions for p in parts]), [ln for p in parts for ln in p.lines],
-                   np.concatenate([p.path_velocity for p in parts]), parts[0].move, moves)

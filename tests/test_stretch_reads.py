@@ -1,14 +1,14 @@
-"""The channel's feed inside stretches across a cruise's blocks (issue 17, decision bench B26): the CAM program's
-queue refills 4 blocks a cycle, and those cycles now run inside the stretch. The trace equals cycle-by-cycle
-stepping's column by column, also where the program reads something else than plain moves in between (an M
-code, a macro statement, a dwell, a soft-limit crossing, the program's end), where a stretch must end before
-the cycle that reads it."""
+"""The NC's steps inside stretches (issue 17, decisions bench B26/B27): the CAM program's queue refills 4 blocks
+a cycle and its blocks are solved where its speed dips, and those cycles now run inside the stretch (the channel's
+feed, the planner's block ends and solves). The trace equals cycle-by-cycle stepping's column by column, also
+where the program reads something else than plain moves in between (an M code, a macro statement, a dwell, a
+soft-limit crossing, the program's end), where a stretch must end before the cycle that reads it."""
 
 from __future__ import annotations
 
 import pytest
 
-import hil.stretch
+import hil.stretch_pass
 from benchmarks.bench_motion import cam_program
 from benchmarks.trace_ab import compare, one
 from hil.stretch import ENV, ENV_READS
@@ -28,15 +28,16 @@ def _program(blocks: int, inserts: dict[int, str]) -> str:
 def _both(monkeypatch, tmp_path, text: str) -> tuple[list, list, dict]:
     prog = tmp_path / "cam.nc"
     prog.write_text(text)
-    counts = {"feeds": 0}
-    real = hil.stretch.sample_reading
+    counts = {"feeds": 0, "passes": 0}
+    real = hil.stretch_pass.Pass.run
 
-    def counted(ch, pl, n, expect):
-        smp, feeds = real(ch, pl, n, expect)
-        counts["feeds"] += feeds
-        return smp, feeds
+    def counted(self, n):
+        m = real(self, n)
+        counts["feeds"] += self.feeds
+        counts["passes"] += 1
+        return m
 
-    monkeypatch.setattr(hil.stretch, "sample_reading", counted)
+    monkeypatch.setattr(hil.stretch_pass.Pass, "run", counted)
     out, kept = [], []
     for on in ("0", "1"):
         monkeypatch.setenv(ENV, on)
@@ -48,16 +49,16 @@ def test_feeds_inside_stretches_equal_stepping(monkeypatch, tmp_path):
     out, (stepped, stretched), counts = _both(monkeypatch, tmp_path, cam_program(2000))
     assert compare(out[0], out[1]) == []
     assert stepped.run.stretched == 0 and stretched.run.ok
-    assert counts["feeds"] > 200  # ≈ one cycle in six reads the program
-    # B25 alone (stretches end before every reading cycle): 48 % of this run; with the feeds inside 60 %
-    assert stretched.run.stretched > 0.55 * stretched.run.cycles, (stretched.run.stretched, stretched.run.cycles)
+    assert counts["feeds"] > 400  # ≈ one cycle in four reads the program
+    # B25 alone (stretches end before every reading cycle and every solve): 48 % of this run; now 94 %
+    assert stretched.run.stretched > 0.9 * stretched.run.cycles, (stretched.run.stretched, stretched.run.cycles)
 
 
 def test_reads_off_ends_stretches_before_reading_cycles(monkeypatch, tmp_path):
     monkeypatch.setenv(ENV_READS, "0")
     out, (_, stretched), counts = _both(monkeypatch, tmp_path, cam_program(2000))
     assert compare(out[0], out[1]) == []
-    assert counts["feeds"] == 0 and stretched.run.stretched < 0.5 * stretched.run.cycles
+    assert counts["passes"] == 0 and stretched.run.stretched < 0.5 * stretched.run.cycles
 
 
 @pytest.mark.parametrize("inserts, alarm", [
@@ -84,3 +85,43 @@ def test_macro_loop_spending_its_budget(monkeypatch, tmp_path):
     budget = stretched.runner._interp.budget
     assert budget.held_cycles > 0  # the budget was spent: Busy was handed out
     assert budget.held_cycles == stepped.runner._interp.budget.held_cycles
+
+
+@pytest.mark.parametrize("what", ["following error", "overspeed"])
+def test_a_drive_fault_inside_a_pass_lands_on_its_cycle(monkeypatch, tmp_path, what):
+    """A drive fault in the middle of a stretch that runs the NC's steps (B27): the stretch ends before that
+    cycle; the planner goes back to its last save after a feed and steps again up to there, the drives from the
+    start. The rows, the alarm and where the axes stop are the stepped run's."""
+    from dataclasses import replace
+
+    import pyarrow.parquet as pq
+
+    from fieldbus.link import SimLink
+    from hil.bench_file import load_bench_file
+    from hil.runner import BenchRunner
+    from hil.session import sim_slaves
+    from hil.trace import open_trace
+    from nc.program import parse_program
+
+    text = cam_program(1200).replace("M30", "G01 Z90. F6000\nM30")  # Z moves after the CAM blocks only
+    backs = []
+    real = hil.stretch_pass.Pass._back
+    monkeypatch.setattr(hil.stretch_pass.Pass, "_back", lambda self, mark, stop: backs.append(stop) or real(self, mark, stop))
+    runs = []
+    for on in ("0", "1"):
+        monkeypatch.setenv(ENV, on)
+        bench = load_bench_file(ROOT / "benches" / "mill-3axis.toml")
+        drives = sim_slaves(bench)
+        p = drives[2].params  # Z: its window shrunk, or its position loop's sign flipped (a runaway: 0x0602)
+        drives[2].params = replace(p, following_error_window=6000) if what == "following error" \
+            else replace(p, kp=-abs(p.kp))
+        runner = BenchRunner(bench, SimLink(drives, bench.cycle))
+        runner.trace = open_trace(tmp_path / f"{on}.parquet", runner.trace_columns())
+        result = runner.run_program(parse_program(text))
+        table = pq.read_table(tmp_path / f"{on}.parquet")
+        runs.append(({c: table.column(c).to_pylist() for c in table.column_names if c not in ("period", "late")},
+                     result))
+    (ra, a), (rb, b) = runs
+    assert ra == rb
+    assert [(x.code, x.axis) for x in a.alarms] == [(x.code, x.axis) for x in b.alarms] and a.alarms
+    assert backs and b.stretched > 0.6 * b.cycles and a.final == b.final

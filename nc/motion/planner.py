@@ -322,12 +322,7 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping):
         self._check_spindle()
         if self.spindle_command is not None:
             self._settle.update(float(self.spindle_rpm()), float(self.spindle_command()))
-        if self._buf_blk is not None and not self._buf_done:
-            k = self._buf_blk[self._buf_i]
-            if k > self._buf_popped and (bad := self._chain_ok(self.plan, k)) <= k:
-                self._break_chain(bad)
-        if self._buf_done:
-            self._refill()
+        self._before_take()
         if self._buf_done and self.plan is None and self.blocks and self.blocks[0].kind == "thread" \
                 and (self._thread is not None or self._settled):
             return self._thread_step()

@@ -26,6 +26,16 @@ class CruiseSampling:
             j += 1
         return j - i
 
+    def _before_take(self) -> None:
+        """What a step does before it takes its row: a cruise's next block checked again where a push came since
+        (`_chain_ok`), the refill where the buffer ran out (a stretch makes these steps too, hil/stretch_pass.py)."""
+        if self._buf_blk is not None and not self._buf_done:
+            k = self._buf_blk[self._buf_i]
+            if k > self._buf_popped and (bad := self._chain_ok(self.plan, k)) <= k:
+                self._break_chain(bad)
+        if self._buf_done:
+            self._refill()
+
     def _cruise_rows(self, n: int) -> int:
         """Of the next n buffer rows, how many a stretch may take across a cruise's blocks: those before the
         first block whose own solve would no longer cruise (`_chain_ok`, with the queue as it stands)."""

@@ -34,12 +34,26 @@ class Samples:
     path_velocity: np.ndarray
     move: Move | None  # the move of every row, unless `moves` gives one per row (a cruise's blocks)
     moves: list[Move] | None = None
+    raw: np.ndarray | None = None  # the rows before the filter, where they span buffers (hil/stretch_pass.py)
 
 
 def sample_stretch(pl: Planner, n: int, across: bool = False) -> Samples | None:
     """The next min(n, rows left in the buffer) setpoints, or None where step() must run (module doc).
     `across`: a cruise's rows in its later blocks too, those blocks finished as step() finishes them (the
     caller sees to it that nothing reads the queue in between, nor pushes to it)."""
+    rows = take_rows(pl, n, across)
+    if rows is None:
+        return None
+    raw, lam, smp = rows
+    smp.positions = pl.filter.push_many(raw, lam) if pl.filter is not None else np.array(raw, dtype=float)
+    pl.output = smp.positions[-1].copy()
+    return smp
+
+
+def take_rows(pl: Planner, n: int, across: bool = False) -> tuple[np.ndarray, np.ndarray | None, Samples] | None:
+    """sample_stretch's planner part: the rows taken (the planner left as after their steps), their filter
+    shares λ (None: 1 throughout) and their Samples, whose positions are the raw rows until the caller filters
+    them (hil/stretch_pass.py filters the rows of several takes at once)."""
     if n <= 0 or pl._integrate_angle or pl._buf_done:
         return None
     blocks = pl.blocks
@@ -62,9 +76,8 @@ def sample_stretch(pl: Planner, n: int, across: bool = False) -> Samples | None:
     lam = pl.share_rows(i, m)  # the filter's share per row (decision motion 45)
     pl._buf_i = i + m
     pl._take(j)
-    positions = pl.filter.push_many(raw, lam) if pl.filter is not None else np.array(raw, dtype=float)
-    pl.output = positions[-1].copy()
-    return Samples(positions, list(pl._buf_line[i:i + m]), np.array(pl._buf_vel[i:i + m], dtype=float), mv, moves)
+    return raw, lam, Samples(raw, list(pl._buf_line[i:i + m]), np.array(pl._buf_vel[i:i + m], dtype=float), mv,
+                             moves)
 
 
 def stand_stretch(pl: Planner, n: int, queued: bool = False) -> Samples | None:

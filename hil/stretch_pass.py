@@ -1,0 +1,237 @@
+"""A stretch whose NC steps inside it (issue 17, decision bench B27): block ends, solves and feeds included.
+
+A CAM program's blocks last a cycle or two; where its speed dips below the cap (the 0.0001 mm rounding of its
+points makes junctions slower) every block is solved, and the stretches of B20/B25 (at most to the end of the
+planner's buffer, or across a cruise's blocks) stay shorter than two cycles, so those cycles were stepped: the
+runner's cycle, the bus and the drive models one cycle at a time around the NC's work. Here the stretch runs the
+NC's steps itself, in stepping's order, cycle by cycle where they do more than hand out a buffered row:
+- the channel's feed where it reads (only plain moves, `hil.stretch_reads.Ahead`, as B26);
+- the planner's step: a cruise's next block checked (`_chain_ok`/`_break_chain`), the refill where the buffer ran
+  out (`Planner._refill`: block ends, solves, samples), then its rows at once (`sample_stretch`, to the next cycle
+  whose feed may read or whose step refills), filtered as step() filters them.
+What cannot be taken back is a feed's push, so the drive models are stepped a part at a time, over the cycles up to
+each reading cycle before its feed runs (`csp_stretch` carries its state from one call to the next); a drive
+fault or the bench's overspeed check found there ends the stretch before its cycle, the planner put back to the
+last save after a feed and its steps made again (they are deterministic; everything but a push is saved:
+the planner's fields, queue, filter, share zones and plan). The stretch ends before a cycle whose step would
+stand (no row after the refill), raise, or start a block a stretch does not sample (feed per revolution, G96,
+thread, G31, dwell): that cycle is stepped from the planner as it was before it. Taken only where nothing cuts the
+stretch after a feed: lock-step, the basic MLC, the bulk part from the first cycle (as B26).
+"""
+
+from __future__ import annotations
+
+import copy
+from typing import Any
+
+import numpy as np
+
+from hil.stretch_reads import ahead, may_read
+from hil.stretch_state import _across, _restore_planner, _save_planner
+from nc.alarms import NcAlarm
+from nc.channel import READS_PER_CYCLE, Channel
+from nc.motion.planner import Planner
+from nc.motion.stretch import Samples, take_rows
+from virtual_bus.drive_stretch import Stretch, csp_stretch, csv_stretch
+
+PLAN_KINDS = ("path", "ramp", "cruise")
+FEW = 12  # rows below which the filter takes them one by one (Pass._flush)
+
+
+def _save(pl: Planner) -> dict:
+    """Everything a planner step but a push changes (module doc)."""
+    saved = _save_planner(pl)
+    saved["blocks"] = list(pl.blocks)
+    if pl.plan is not None:
+        saved["plan"] = (pl.plan, dict(pl.plan.__dict__))
+    return saved
+
+
+def _feed_due(pl: Planner) -> bool:
+    """The next cycle's feed reads (`not Planner.full` without its side effect, which that feed has)."""
+    n = len(pl.blocks)
+    return n < pl.depth or (pl._filling and n < pl.depth + pl._batch)
+
+
+def no_reads(ch: Channel) -> bool:
+    """The channel's feed reads nothing while the planner moves: the program's end, a barrier or a limit alarm was
+    read, or a single block waits (Channel._feed_planner)."""
+    return ch.end is not None or ch._deferred is not None or ch._limit_alarm is not None \
+        or (ch.single_block and bool(ch._block_moves))
+
+
+def _steps(ch: Channel, pl: Planner, limit: int, reads: bool) -> tuple[np.ndarray, np.ndarray | None, Samples] | None:
+    """One planner step as Planner._step_path makes it before its take, then the rows that follow it with no feed
+    or refill between (at least one, at most `limit`), as `take_rows` hands them out (not filtered yet); None
+    where the step cannot be taken here (module doc: the caller puts the planner back)."""
+    pl._before_take()
+    p = pl.plan
+    if pl._buf_done or p is None or p.kind not in PLAN_KINDS or not pl.blocks or pl.blocks[0].move.css is not None:
+        return None
+    cruise = pl._buf_blk is not None
+    if reads and _feed_due(pl):
+        limit = 1  # the next cycle reads: a feed comes between
+    elif cruise:
+        limit = _across(ch, pl, limit)
+    return take_rows(pl, limit, across=cruise)
+
+
+class Pass:
+    """The NC pass of one stretch and its drive models, a part at a time (module doc)."""
+
+    def __init__(self, st: Any, ch: Channel, pl: Planner, rx0: list, saved_drives: list[dict]) -> None:
+        self.st, self.ch, self.pl = st, ch, pl
+        self.rx0, self.saved_drives = rx0, saved_drives
+        self.parts: list[Samples] = []  # positions filtered up to `filtered` rows, the rest raw
+        self.pending: list[tuple[np.ndarray, np.ndarray | None]] = []  # (raw rows, λ) not filtered yet
+        self.raws: list[np.ndarray] = []  # every part's raw rows
+        self.filtered = 0
+        self.rows = 0
+        self.outs: list[Stretch] = [Stretch() for _ in rx0]
+        self.driven = 0  # cycles the drives were stepped through
+        self.targets: list[list[int]] = [[rx.target_position] for rx in rx0[:st.n_axes]]
+        self.feeds = 0
+        self.reads = not no_reads(ch)  # (constant over the stretch: its feeds read plain moves only)
+
+    def run(self, n: int) -> int:
+        """The stretch's cycles, at most n: how many (the planner after that many steps, `outs` over them)."""
+        ch, pl = self.ch, self.pl
+        src = ahead(ch)
+        fed_at = -1
+        mark = (0, _save(pl), 0)  # (rows, the planner then, parts then): where a drive fault puts it back
+        while self.rows < n:
+            if self.rows and self.reads and _feed_due(pl):  # this cycle's feed reads: the drives up to it first
+                stop = self._drive(self.rows + 1)
+                if stop is not None:
+                    return self._back(mark, stop)
+                if self.rows < 2 or not may_read(ch, pl) or not src.peek(READS_PER_CYCLE):
+                    break
+                ch._feed_planner()  # plain moves only: it pushes them, nothing else changes
+                self.feeds, fed_at = self.feeds + 1, self.rows
+                mark = (self.rows, _save(pl), len(self.parts))
+            if not self._group(n - self.rows):
+                break
+        if fed_at == self.rows:  # the stretch ends before the cycle whose feed it ran: its step must not read
+            ch._fed = True
+        if self.driven > self.rows:  # stepped up to a reading cycle the stretch then ends before: again to here
+            self._redrive()
+            return self.rows
+        stop = self._drive(self.rows)
+        return self.rows if stop is None else self._back(mark, stop)
+
+    def _group(self, limit: int) -> bool:
+        pl = self.pl
+        if pl._buf_done and pl.at_rest:
+            self._flush()  # a refill at rest reads whether the filter settled
+        # what a step that cannot be taken here changed is put back; a buffered row of a solved plan changes
+        # nothing before take_rows accepts it
+        saved = _save(pl) if pl._buf_done or pl._buf_blk is not None else None
+        try:
+            got = _steps(self.ch, pl, limit, self.reads)
+        except NcAlarm:  # the step raises: stepping raises it in its own cycle
+            got = None
+        if got is None:
+            if saved is not None:
+                _restore_planner(pl, saved)
+            return False
+        raw, lam, smp = got
+        self.parts.append(smp)
+        self.raws.append(raw)
+        self.pending.append((raw, lam))
+        self.rows += len(raw)
+        return True
+
+    def _flush(self) -> None:
+        """The rows taken since the last flush through the position filter at once (push_many gives what step()'s
+        push gives row by row), and the drives' targets from them."""
+        if not self.pending:
+            return
+        pl = self.pl
+        raws = [r for r, _ in self.pending]
+        raw = raws[0] if len(raws) == 1 else np.concatenate(raws)
+        lams = [lm for _, lm in self.pending]
+        lam = None if all(lm is None for lm in lams) else \
+            np.concatenate([np.ones(len(r)) if lm is None else lm for r, lm in self.pending])
+        self.pending = []
+        f = pl.filter
+        if f is None:
+            pos = np.array(raw, dtype=float)
+        elif len(raw) < FEW:  # push_many's numpy costs ≈ 35 µs whatever the rows; push ≈ 2.6 µs a row, the same bits
+            pos = np.array([f.push(x, 1.0 if lam is None else float(lam[k])) for k, x in enumerate(raw)])
+        else:
+            pos = f.push_many(raw, lam)
+        pl.output = pos[-1].copy()
+        k = 0
+        for smp in self.parts:
+            if k >= self.filtered:
+                smp.positions = pos[k - self.filtered:k - self.filtered + len(smp.lines)]
+            k += len(smp.lines)
+        self.filtered = k
+        sc, org = self.st.r.scales, self.st.r.origin.tolist()
+        for i, t in enumerate(self.targets):
+            c, o = sc[i], org[i]
+            t += [c.to_counts(x - o) for x in pos[:, i].tolist()]
+
+    def _drive(self, upto: int) -> int | None:
+        """The drive models over cycles driven … upto-1 (cycle k steps to the setpoint of cycle k-1); the first
+        cycle a drive or the bench's overspeed check would fault in, else None."""
+        self._flush()
+        if upto <= self.driven:
+            return None
+        a, dt, r = self.driven, self.st.r.bench.cycle, self.st.r
+        for i, (d, rx, out) in enumerate(zip(self.st.drives, self.rx0, self.outs)):
+            part = csp_stretch(d, rx, self.targets[i][a:upto], dt) if i < self.st.n_axes \
+                else csv_stretch(d, rx, upto - a, dt)
+            _extend(out, part)
+        self.driven = upto
+        m = min(o.done for o in self.outs)
+        for i in range(self.st.n_axes):
+            over = np.flatnonzero(np.abs(np.asarray(self.outs[i].velocity_actual[a:m])) > r._overspeed[i])
+            if over.size:
+                m = a + int(over[0])
+        return m if m < upto else None
+
+    def _back(self, mark: tuple, stop: int) -> int:
+        """A drive faults in cycle `stop`: the stretch ends before it. The planner from the last save (after a
+        feed, or the start), its steps made again up to there; the drives stepped again from the start."""
+        rows, saved, nparts = mark
+        pl = self.pl
+        _restore_planner(pl, saved)  # (a mark is taken after a feed, whose drive check flushed the filter)
+        del self.parts[nparts:]
+        del self.raws[nparts:]
+        self.pending = []
+        self.rows = self.filtered = rows
+        for t in self.targets:
+            del t[rows + 1:]
+        while self.rows < stop and self._group(stop - self.rows):
+            pass
+        self._redrive()
+        return self.rows
+
+    def _redrive(self) -> None:
+        """The drives from the start again, over the stretch's cycles as they now are."""
+        self.st._restore_drives(self.saved_drives)
+        self.outs = [Stretch() for _ in self.rx0]
+        self.driven = 0
+        self._drive(self.rows)
+
+    def samples(self) -> Samples:
+        """The stretch's rows (filtered), with their raw positions (`Samples.raw`)."""
+        self._flush()
+        parts = self.parts
+        moves: list[Any] = []
+        for p in parts:
+            moves += p.moves if p.moves is not None else [p.move] * len(p.lines)
+        return Samples(np.concatenate([p.positions for p in parts]), [ln for p in parts for ln in p.lines],
+                       np.concatenate([p.path_velocity for p in parts]), parts[0].move, moves, np.concatenate(self.raws))
+
+
+def _extend(out: Stretch, part: Stretch) -> None:
+    out.done += part.done
+    out.position_actual += part.position_actual
+    out.velocity_actual += part.velocity_actual
+    out.torque_actual += part.torque_actual
+    out.following_error += part.following_error
+    out.statusword += part.statusword
+    if part.last is not None:
+        out.last = part.last
