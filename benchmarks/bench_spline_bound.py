@@ -121,7 +121,10 @@ def main() -> None:
     for make in (cam_polyline, cam_surface):
         prog = make(args.n)
         if args.planner:
-            st = through_planner(prog, args.tol)
+            try:
+                st = through_planner(prog, args.tol)
+            except FitError as e:
+                raise SystemExit(f"{prog.name}: {e}") from None
             r = measure(st.positions, prog)
             print(f"{prog.name:38s} feed-limited {prog.feed_limited():7.3f} s | spans through the planner "
                   f"{st.time:7.3f} s ({st.time / prog.feed_limited():.3f}×), {st.state.value}, "

@@ -116,7 +116,8 @@ def fit_run(pts: np.ndarray, tol: float, lam: float = LAM, rounds: int = 60, ste
         dev = np.zeros(len(u))  # each sample: the largest distance next to it
         np.maximum.at(dev, j, dist)
         np.maximum.at(dev, np.maximum(j - 1, 0), dist)
-        w = w * np.clip(dev / (0.9 * tol), 1.0, 10.0) ** 3
+        # bounded: no overflow where tol cannot be met
+        w = np.minimum(w * np.clip(dev / (0.9 * tol), 1.0, 10.0) ** 3, 1e9)
     raise FitError(f"no fit within {tol} mm in {rounds} rounds (λ {lam:g})")
 
 
