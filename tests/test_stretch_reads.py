@@ -125,3 +125,17 @@ def test_a_drive_fault_inside_a_pass_lands_on_its_cycle(monkeypatch, tmp_path, w
     assert ra == rb
     assert [(x.code, x.axis) for x in a.alarms] == [(x.code, x.axis) for x in b.alarms] and a.alarms
     assert backs and b.stretched > 0.6 * b.cycles and a.final == b.final
+
+
+@pytest.mark.parametrize("name", ["polyline", "surface", "mixed", "contour"])
+def test_blends_arcs_and_exact_stops_inside_passes_equal_stepping(monkeypatch, tmp_path, name):
+    """benchmarks/bench_vs_linuxcnc's programs on the mill: corner blends under the filter (its share λ below 1,
+    decision motion 45), chord arcs, 90° corners with exact stops; the passes take their solves and block ends."""
+    from benchmarks.bench_vs_linuxcnc import cam_polyline, cam_surface, contour_90, mixed
+
+    prog = {"polyline": lambda: cam_polyline(300), "surface": lambda: cam_surface(300), "mixed": mixed,
+            "contour": lambda: contour_90(60.0)}[name]()
+    out, (stepped, stretched), counts = _both(monkeypatch, tmp_path, prog.text(False))
+    assert compare(out[0], out[1]) == []
+    assert stretched.run.ok and counts["passes"] > 0
+    assert stretched.run.stretched > 0.9 * stretched.run.cycles, (stretched.run.stretched, stretched.run.cycles)
