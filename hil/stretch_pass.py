@@ -21,7 +21,6 @@ stretch after a feed: lock-step, the basic MLC, the bulk part from the first cyc
 
 from __future__ import annotations
 
-import copy
 from typing import Any
 
 import numpy as np
