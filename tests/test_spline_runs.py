@@ -40,6 +40,7 @@ def test_a_span_is_parametrised_by_its_arc_length_and_its_derivatives_are_its_ow
     for s in sp[5:45:8]:
         ss = np.linspace(0.0, s.length, 4001)
         p, rs, rss, rsss = s.derivatives(ss)
+        assert np.abs(s.points(ss) - p).max() < 1e-9  # the pieces' polynomials in s against the Newton steps
         h = ss[1] - ss[0]
         step = np.linalg.norm(np.diff(p, axis=0), axis=1) / h
         assert np.abs(step - 1.0).max() < 1e-5  # unit speed in s: the planner's v is the path speed

@@ -25,6 +25,7 @@ PER_SEG = 4  # polyline samples a segment the fit is made to
 DEGREE = 5  # quintic, its r''' continuous (decision 51); 3: decisions 48-50's cubic smoothing spline
 LAM = 0.01  # λ of the penalty ∫r'''² (mm⁵; of ∫r''² at DEGREE 3: 0.1 mm³); the weights then hold N1.053
 NODES = 9  # arc-length table nodes a polynomial piece
+CHEB = 9  # degree of a piece's position as a polynomial in its path length
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(5)
 
 
@@ -132,6 +133,9 @@ class SplineSpan(Segment):
     acc_bound: np.ndarray = field(default_factory=lambda: np.zeros(0))  # max |d²r/ds²| per axis
     jerk_bound: np.ndarray = field(default_factory=lambda: np.zeros(0))  # max |d³r/ds³| per axis
     dir_bound: np.ndarray = field(default_factory=lambda: np.zeros(0))  # max |dr/ds| per axis
+    # r(s) itself on each piece: polynomials in x = (2·s − s_a − s_b)/(s_b − s_a), highest power first,
+    # interpolated at Chebyshev nodes when cut (`spans`), so that points() needs no Newton steps
+    s_poly: np.ndarray = field(default_factory=lambda: np.zeros((0, CHEB + 1, 0)))
 
     def _derivs(self, piece: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, ...]:
         """r and its first three derivatives in w (Horner on the pieces' coefficients, highest first)."""
@@ -180,7 +184,18 @@ class SplineSpan(Segment):
         return r, rs, rss, rsss
 
     def points(self, s: np.ndarray) -> np.ndarray:
-        return self.derivatives(s)[0]
+        """Positions at path lengths s from the pieces' polynomials in s (within 1e-9 mm of derivatives())."""
+        s = np.clip(np.asarray(s, dtype=float), 0.0, self.length)
+        if not len(self.s_poly):
+            return self.derivatives(s)[0]
+        sa, sb = self.s_tab[:, 0], self.s_tab[:, -1]
+        piece = np.clip(np.searchsorted(sa, s, side="right") - 1, 0, len(sa) - 1)
+        x = ((2.0 * s - sa[piece] - sb[piece]) / (sb[piece] - sa[piece]))[:, None]
+        c = self.s_poly[piece]
+        out = c[:, 0]
+        for i in range(1, c.shape[1]):
+            out = out * x + c[:, i]
+        return out
 
     def unit_tangent(self, at_end: bool) -> np.ndarray:
         return self.derivatives(np.array([self.length if at_end else 0.0]))[1][0]
@@ -215,6 +230,7 @@ def spans(spl: list[BSpline], cum: np.ndarray, axes: tuple[str, ...], margin: fl
         off = np.concatenate([[0.0], np.cumsum(tab[:, -1])[:-1]])
         sp.s_tab = tab + off[:, None]
         sp.length = float(off[-1] + tab[-1, -1])
+        sp.s_poly = _in_s(sp)
         ends = sp.derivatives(np.array([0.0, sp.length]))[0]
         sp.start, sp.end = ends[0], ends[1]
         _, rs, rss, rsss = sp.derivatives(np.linspace(0.0, sp.length, 33 * len(c)))
@@ -223,6 +239,16 @@ def spans(spl: list[BSpline], cum: np.ndarray, axes: tuple[str, ...], margin: fl
         sp.jerk_bound = np.abs(rsss).max(axis=0) * margin
         out.append(sp)
     return out
+
+
+def _in_s(sp: SplineSpan) -> np.ndarray:
+    """Each piece's r(s) as a polynomial of degree CHEB in its normalised path length (Chebyshev nodes)."""
+    sa, sb = sp.s_tab[:, 0], sp.s_tab[:, -1]
+    x = np.cos(np.pi * (np.arange(CHEB + 1) + 0.5) / (CHEB + 1))
+    s = (0.5 * (sa[:, None] + sb[:, None]) + 0.5 * (sb - sa)[:, None] * x[None, :]).ravel()
+    r = sp.derivatives(s)[0].reshape(len(sa), CHEB + 1, -1)
+    v = np.vander(x, CHEB + 1)  # highest power first
+    return np.stack([np.linalg.solve(v, r[i]) for i in range(len(sa))])
 
 
 # Of each axis' limits on a span: the curvature term v²·r'' takes ≤ 0.6 of the acceleration, v³·r''' ≤ 0.75
