@@ -80,7 +80,8 @@ def test_under_the_filter_a_cam_polyline_is_blended_where_its_share_is_zero():
 
 def test_under_the_filter_chords_keep_the_filters_corners():
     """A blend within half a 0.05 mm chord is slower than the filter's corner (decision 40 a): none is built,
-    and nothing changes (R10 1.555 s, decision 39's figure)."""
+    and nothing changes (R10 1.555 s, decision 39's figure; 1.516 s since the filter shapes the start, the speed-up
+    out of the lead-in's corner and the stop, decision 52)."""
     prog = chord_circle(10.0)
     pts = [START] + prog.points
     pl = Planner(_filtered(), dict(zip(AX, START)))
@@ -88,7 +89,7 @@ def test_under_the_filter_chords_keep_the_filters_corners():
         pl.push(m)
     assert all(b.seg.kind == "line" for b in pl.blocks)
     st = check(lines(pts, prog.feed), _filtered(), START)
-    assert st.time == pytest.approx(1.555, abs=0.003)
+    assert st.time == pytest.approx(1.516, abs=0.003)
 
 
 def test_without_a_whole_cycle_group_delay_the_filter_keeps_its_corners():

@@ -36,6 +36,7 @@ from nc.motion.limits import MotionConfig
 from nc.motion.lookahead import MARGIN, Block, Limits, backward, change_distance, max_speed_at, reach
 from nc.motion.path import Segment
 from nc.motion.plan_state import CHUNK, Setpoint, _near, _Plan
+from nc.motion.filter_ramps import FilterStops
 from nc.motion.planner_corners import CornerShares
 from nc.motion.planner_cruise import CruiseSampling
 from nc.motion.planner_thread import ThreadStepping
@@ -50,7 +51,7 @@ OPEN_CHUNK = 4  # cycles sampled at a time (CHUNK otherwise) while the queue can
 MAX_SOLVES_PER_CYCLE = 1000  # plans one cycle may start and end before a sample is due (decisions B4)
 
 
-class Planner(CruiseSampling, CornerShares, ThreadStepping):
+class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops):
     # True: every block of a run starts a new solve, also where the run cruises at its cap (the reference
     # tests compare the cruise sampling against, decision motion 44)
     per_block = False
@@ -145,6 +146,7 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping):
         self._jf = 1.0
         self._pushes = 0  # moves pushed so far (an open plan re-solves when more came)
         self.output = self.position.copy()  # the last setpoint handed out (filtered)
+        self._init_filter_stops()
 
     # ---- queue ----------------------------------------------------------------------------
     def push(self, move: Move) -> None:
@@ -382,6 +384,8 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping):
             return
         if self.plan is not None and self.plan.kind == "dwell":
             return  # a dwell holds position anyway; the next plan sees the new settings
+        if self._deferred():
+            return  # a filter stop or start runs as checked (nc.motion.filter_ramps); then the new settings
         self._buf_pos = None
         self._buf_i = 0
         self.plan = None
@@ -494,7 +498,7 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping):
             if self.s >= b.length - 1e-12 and abs(self.v) < 1e-9:
                 self._finish_block()
                 continue
-            if not self.per_block:
+            if not self.per_block and not self._deferred():
                 cruise = self._cruise(b, t0)
                 if cruise is not None:
                     return cruise
@@ -515,6 +519,8 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping):
             raise NcAlarm(0x1001, "feed per revolution with the spindle stopped (S0)", line=b.move.line,
                           block=b.move.block, program=b.move.program)
         self.solves += 1
+        if self.filter is not None and (fr := self._filter_ramp(b, s, v, a, cap, t0)) is not None:
+            return fr
         if self.held or cap <= 1e-9:
             if abs(v) < 1e-9 and abs(a) < 1e-9:
                 if self._stopping:
@@ -683,7 +689,7 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping):
         if more and s[0] > blocks[0].length + 1e-12:
             # A ramp that catches up with the cap also re-solves at the boundary: it must not
             # carry its speed into blocks that need less (a hold's ramp to rest runs on).
-            if p.kind == "path" or (p.kind == "ramp" and not self.held):
+            if p.kind == "path" or (p.kind == "ramp" and not self.held and p is not self._fr_plan):
                 # The next sample lies in the next block: re-solve there from the last emitted
                 # state (once per block), now that more of the queue may be known.
                 length = blocks[0].length
@@ -762,7 +768,10 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping):
 
     def _finish_block(self, keep_plan: bool = False) -> None:
         if self.blocks:
-            self.threads_queued -= self.blocks.popleft().kind == "thread"
+            done = self.blocks.popleft()
+            self.threads_queued -= done.kind == "thread"
+            if done.seg is not None:
+                self._seg_hist.append(done.seg)
         self._started = False
         if not keep_plan:
             self.s = 0.0

@@ -42,11 +42,18 @@ class PositionFilter:
         self._out = x
         self._last = x  # rows are never changed in place: the windows share them
         self._still = self.span
+        # The last three outputs (nc.motion.filter_ramps joins a candidate's outputs to them: finite differences)
+        self._recent: deque[list[float]] = deque([x] * 3, maxlen=3)
 
     @property
     def output(self) -> np.ndarray:
         """The last output."""
         return np.array(self._out)
+
+    @property
+    def recent(self) -> np.ndarray:
+        """The last three outputs, oldest first (as the stream had them: rows before the first are the start)."""
+        return np.array(self._recent)
 
     @property
     def settled(self) -> bool:
@@ -63,6 +70,7 @@ class PositionFilter:
         row = np.asarray(x, dtype=float).tolist()
         same = row == self._last
         if same and self._still >= self.span:
+            self._recent.append(self._out)
             return np.array(self._out)
         if same:
             self._still += 1
@@ -78,13 +86,17 @@ class PositionFilter:
         self._w2.append(y1)
         if self._still >= self.span:
             # Constant input for a whole window: the exact value, free of summation round-off.
+            recent = self._recent
             self.reset(row)
+            recent.append(row)
+            self._recent = recent
             return np.array(row)
         out = [s / n2 for s in s2]
         if lam != 1.0 and self.lag is not None:
             d = self._w1[n1 - 1 - self.lag]
             out = [p + lam * (f - p) for p, f in zip(d, out)]
         self._out = out
+        self._recent.append(out)
         return np.array(out)
 
     def push_many(self, xs: np.ndarray, lam: np.ndarray | None = None) -> np.ndarray:
@@ -124,6 +136,7 @@ class PositionFilter:
         self._w2.extend(h2[-self.n2:].tolist())
         self._s1, self._s2 = s1[-1].tolist(), s2[-1].tolist()
         self._last, self._out, self._still = x[-1].tolist(), y[-1].tolist(), 0
+        self._recent.extend(y[-3:].tolist())
         return y
 
 
