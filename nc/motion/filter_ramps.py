@@ -22,7 +22,6 @@ from __future__ import annotations
 
 import copy
 import math
-from collections import deque
 
 import numpy as np
 
@@ -103,7 +102,7 @@ class FilterStops:
     def _init_filter_stops(self) -> None:
         self._fs_tail: Block | None = None  # the queue's last block while a filter stop runs to it
         self._fs_limits = (0.0, 0.0, 0.0)  # its acceleration, jerk and top speed
-        self._seg_hist: deque = deque(maxlen=HISTORY)
+        self._seg_hist: tuple = ()  # rebound, never changed in place (hil.stretch_state copies the planner shallowly)
         self._fr_plan: _Plan | None = None  # the filter start being executed
 
     def _filter_ramp(self, b: Block, s: float, v: float, a: float, cap: float, t0: float) -> _Plan | None:

@@ -36,7 +36,7 @@ from nc.motion.limits import MotionConfig
 from nc.motion.lookahead import MARGIN, Block, Limits, backward, change_distance, max_speed_at, reach
 from nc.motion.path import Segment
 from nc.motion.plan_state import CHUNK, Setpoint, _near, _Plan
-from nc.motion.filter_ramps import FilterStops
+from nc.motion.filter_ramps import HISTORY, FilterStops
 from nc.motion.planner_corners import CornerShares
 from nc.motion.planner_cruise import CruiseSampling
 from nc.motion.planner_thread import ThreadStepping
@@ -771,7 +771,7 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops):
             done = self.blocks.popleft()
             self.threads_queued -= done.kind == "thread"
             if done.seg is not None:
-                self._seg_hist.append(done.seg)
+                self._seg_hist = self._seg_hist[1 - HISTORY:] + (done.seg,)
         self._started = False
         if not keep_plan:
             self.s = 0.0

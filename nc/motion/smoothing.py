@@ -42,8 +42,9 @@ class PositionFilter:
         self._out = x
         self._last = x  # rows are never changed in place: the windows share them
         self._still = self.span
-        # The last three outputs (nc.motion.filter_ramps joins a candidate's outputs to them: finite differences)
-        self._recent: deque[list[float]] = deque([x] * 3, maxlen=3)
+        # The last three outputs (nc.motion.filter_ramps joins a candidate's outputs to them: finite differences);
+        # a tuple rebound, never changed in place, so a shallow copy of the state keeps it (hil.stretch_state)
+        self._recent: tuple[list[float], ...] = (x, x, x)
 
     @property
     def output(self) -> np.ndarray:
@@ -70,7 +71,7 @@ class PositionFilter:
         row = np.asarray(x, dtype=float).tolist()
         same = row == self._last
         if same and self._still >= self.span:
-            self._recent.append(self._out)
+            self._recent = (self._recent[1], self._recent[2], self._out)
             return np.array(self._out)
         if same:
             self._still += 1
@@ -88,15 +89,14 @@ class PositionFilter:
             # Constant input for a whole window: the exact value, free of summation round-off.
             recent = self._recent
             self.reset(row)
-            recent.append(row)
-            self._recent = recent
+            self._recent = (recent[1], recent[2], row)
             return np.array(row)
         out = [s / n2 for s in s2]
         if lam != 1.0 and self.lag is not None:
             d = self._w1[n1 - 1 - self.lag]
             out = [p + lam * (f - p) for p, f in zip(d, out)]
         self._out = out
-        self._recent.append(out)
+        self._recent = (self._recent[1], self._recent[2], out)
         return np.array(out)
 
     def push_many(self, xs: np.ndarray, lam: np.ndarray | None = None) -> np.ndarray:
@@ -136,7 +136,7 @@ class PositionFilter:
         self._w2.extend(h2[-self.n2:].tolist())
         self._s1, self._s2 = s1[-1].tolist(), s2[-1].tolist()
         self._last, self._out, self._still = x[-1].tolist(), y[-1].tolist(), 0
-        self._recent.extend(y[-3:].tolist())
+        self._recent = (self._recent + tuple(y[-3:].tolist()))[-3:]
         return y
 
 
