@@ -120,8 +120,10 @@ class Pass:
 
     def _group(self, limit: int) -> bool:
         pl = self.pl
-        if pl._buf_done and pl.at_rest:
-            self._flush()  # a refill at rest reads whether the filter settled
+        if pl._buf_done:
+            # a refill reads the filter: at rest whether it settled, and a solve its state (a filter start or stop
+            # is checked on a copy of it, decision motion 52)
+            self._flush()
         # what a step that cannot be taken here changed is put back; a buffered row of a solved plan changes
         # nothing before take_rows accepts it
         saved = _save(pl) if pl._buf_done or pl._buf_blk is not None else None

@@ -1,21 +1,24 @@
-"""Stops the position filter shapes (issue 18, decision motion 52). A mixin of `Planner`.
+"""Starts, speed-ups and stops the position filter shapes (issue 18, decision motion 52). A mixin of `Planner`.
 
 Under the two moving averages of N1.036/N1.037 a velocity step Δv of the raw interpolation leaves the
-filter as an acceleration of at most Δv/T1 and a jerk of at most Δv/(T1·T2) per axis (smoothing.py).
-At F3000 (50 mm/s) on a 16 + 16 ms filter that is 3 125 mm/s² and 195 000 mm/s³: within the bench's
-axis limits without any ramp of the planner's own. The planner's jerk-limited braking before a stop
-is then paid twice, once by its own ramp and once by the filter's settling.
+filter as an acceleration of at most Δv/T1 and a jerk of at most Δv/(T1·T2) per axis where the axis
+velocity changes monotonically over the window (smoothing.py). At F3000 (50 mm/s) on a 16 + 16 ms filter
+that is 3 125 mm/s² and 195 000 mm/s³: within the bench's axis limits without any ramp of the planner's
+own, whose jerk-limited ramps were paid on top of the filter's lag and settling.
 
-A *filter stop* brakes the raw profile to the program's end (or any stop the channel announced,
-`Planner.closed`) with limits far above the axis limits, so the filter alone shapes the stop. It is
-taken only where it is proven safe: the whole rest of the motion is known (the queue ends at rest and
-nothing more comes before it), the candidate profile is sampled to its end, run through a copy of the
-filter with the cycles it needs to settle, and every output cycle is checked as `hil check --limits`
+- A *filter start*: from zero acceleration below the block's cap (from rest, or at the speed a slow
+  junction was crossed at, after waiting a few cycles there), a ramp to the cap with limits far above the
+  axis limits, then a cruise at the cap while the filter still mixes the ramp into its output, as one
+  plan across blocks that all allow the cap.
+- A *filter stop*: to the end of the queue when nothing more comes before it (`Planner.closed`), one
+  solve with those limits.
+
+Each is taken only where it is checked safe: the candidate is sampled (a stop to rest), run through a
+copy of the filter from its present state, and every output cycle is checked as `hil check --limits`
 checks it (finite-difference velocity, acceleration and jerk per axis, joined to the outputs already
-handed out) and against N1.053 (distance to the programmed path of the blocks the outputs lie on).
-Otherwise the planner brakes as before. Once taken, the stop is kept (its re-solves at block
-boundaries, a hold or an override in it use the same limits): the state it leaves cannot brake
-with the ordinary limits any more.
+handed out) and against N1.053 (distance to the programmed path, and to the corners it passes).
+Otherwise the planner plans as before. What was checked is what runs: a re-plan (hold, reset,
+override) waits until it is over, and a stop's re-solves at block boundaries keep its limits.
 """
 
 from __future__ import annotations
@@ -37,10 +40,10 @@ HISTORY = 64  # finished segments kept for the deviation check (the outputs lag 
 # A vertex whose tangent turns more than this is a corner: N1.053 bounds how far the output stays from it (below,
 # the polyline distance alone: between a chord polygon's vertices it differs by less than 0.1 % of N1.053)
 CORNER = 0.1
-MAX_ROWS = 400
+MAX_ROWS = 400  # raw cycles a checked plan may span (the check samples all of them)
 # Cycles a start from a slow junction must gain over the planner's own ramp to be taken: its
 # plan is cut at every block (no cruise chain, decision 44), which costs a dense program its stretches
-GAIN = 3.0  # raw cycles a checked stop may span (the check samples all of them)
+GAIN = 3.0
 
 
 def polyline_distance(q: np.ndarray, pts: np.ndarray) -> np.ndarray:
