@@ -226,14 +226,20 @@ class Limits:
             return 0.0  # G00, G09/G61, dwells, threads and independent rapids stop at their ends
         s1, s2 = b1.seg, b2.seg
         assert s1 is not None and s2 is not None
-        v = min(b1.cap_hard, b2.cap_hard)
-        dv = [p - q for p, q in zip(s2.tangent(False), s1.tangent(True))]
-        du = [abs(d) for d in dv]
+        v = b2.cap_hard if b2.cap_hard < b1.cap_hard else b1.cap_hard  # min(), as min() picks
+        t2, t1 = s2.tangent(False), s1.tangent(True)
+        if len(t1) == 3:  # the common case spelt out (once per pushed block, issue 17)
+            d0, d1, d2 = t2[0] - t1[0], t2[1] - t1[1], t2[2] - t1[2]
+            dv = (d0, d1, d2)
+            du = (abs(d0), abs(d1), abs(d2))
+        else:
+            dv = tuple([p - q for p, q in zip(t2, t1)])
+            du = tuple([abs(d) for d in dv])
         cfg = self.cfg
         if self.blend is not None and not raw:
-            b1.dv = tuple(dv)
-            b1.du = tuple(du)
-            b1.du_n = math.sqrt(sum(d * d for d in du))
+            b1.dv = dv
+            b1.du = du
+            b1.du_n = math.sqrt(sum([d * d for d in du]))
             if b1.du_n > 1e-9:
                 lines = s1.kind == "line" and s2.kind == "line"
                 b1.vbud = self.blend.corner_budget(du, lines)

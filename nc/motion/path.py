@@ -11,7 +11,7 @@ from nc.interp.arcs import sweep
 from nc.moves import Move
 
 
-@dataclass
+@dataclass(slots=True)  # one per block (issue 17: slots make its construction and reads cheaper)
 class Segment:
     """A line or a helical arc through the channel axes, parametrised by path length."""
 
@@ -31,17 +31,23 @@ class Segment:
     # A line's unit direction as plain floats, computed once: the look-ahead reads it per
     # junction and per block, where numpy calls on 3-element arrays cost more than the math.
     _dir: tuple[float, ...] | None = None
+    _cos: tuple[float, ...] | None = None  # |_dir|: the direction cosines, for the block limits
 
     @classmethod
     def of(cls, move: Move, axes: tuple[str, ...]) -> "Segment":
-        ls = [float(move.start.get(a, 0.0)) for a in axes]
-        le = [float(move.end.get(a, 0.0)) for a in axes]
-        s = np.array(ls, dtype=float)
-        e = np.array(le, dtype=float)
+        start, end = move.start, move.end
+        ls = [float(start.get(a, 0.0)) for a in axes]
+        le = [float(end.get(a, 0.0)) for a in axes]
+        # Python floats make float64 arrays: no dtype argument to parse (issue 17, once per block)
+        s = np.array(ls)
+        e = np.array(le)
         if move.kind != "arc" or move.center is None:
             length = math.dist(ls, le)
-            d = tuple((q - p) / length for p, q in zip(ls, le)) if length > 0.0 else (0.0,) * len(axes)
-            return cls(axes, s, e, length, "line", _dir=d)
+            if length > 0.0:
+                d = tuple([(q - p) / length for p, q in zip(ls, le)])
+                return cls(axes, s, e, length, "line", _dir=d, _cos=tuple([abs(x) for x in d]))
+            d = (0.0,) * len(axes)
+            return cls(axes, s, e, length, "line", _dir=d, _cos=d)
         p1, p2 = move.plane
         i1, i2 = axes.index(p1), axes.index(p2)
         c = (move.center[p1], move.center[p2])
@@ -90,8 +96,8 @@ class Segment:
 
     def direction_cosines(self) -> tuple[float, ...]:
         """max_direction_cosines as plain floats."""
-        if self._dir is not None:
-            return tuple(abs(x) for x in self._dir)
+        if self._cos is not None:
+            return self._cos
         return tuple(self.max_direction_cosines().tolist())
 
     def curvature_vector(self, at_end: bool) -> np.ndarray:
