@@ -69,6 +69,9 @@ class FilterCorners:
         lines = (sc + cfg.share_curvature) / sc if sc > 0.0 else 1.0
         self.budget_al = tuple(x * lines for x in self.budget_a)
         self.budget_jl = tuple(x * lines for x in self.budget_j)
+        # per axis the smaller of the two (window's cap from the unsigned sums), between lines and not
+        self._bmin = (tuple(a if a < j else j for a, j in zip(self.budget_al, self.budget_jl)),
+                      tuple(a if a < j else j for a, j in zip(self.budget_a, self.budget_j)))
         self.tol = cfg.path_tolerance
         self.kd = KernelDeviation(n1, n2, cfg.cycle)
         self._boost: dict[tuple[float, float], float] = {}  # braking's growth per (a, j)
@@ -248,21 +251,41 @@ class FilterCorners:
         axes = self._axes
         zero = self._zero
         rng = range(axes)
+        bmin = self._bmin[0 if lines else 1]
+        inf = math.inf
+        if axes == 3:
+            bm0, bm1, bm2 = bmin
+            cj0, cj1, cj2 = cum_j[0], cum_j[1], cum_j[2]
 
         def cap(m: int) -> float:
             """Cap from the junctions hist[m..last] (inf when there are none): per axis, the
             acceleration budget over the largest signed sum of any run of them that ends at J,
             the jerk budget over the smaller of their unsigned sum and twice that."""
             if m > last:
-                return math.inf
+                return inf
             base = hist[m - 1].cum if m > h0 else zero
-            c = math.inf  # first from the unsigned sums: a lower bound of the signed cap
-            for i in rng:
-                si = cum_j[i] - base[i]
+            c = inf  # first from the unsigned sums: a lower bound of the signed cap
+            if axes == 3:  # spelt out: ~3 calls a push (issue 17)
+                si = cj0 - base[0]
                 if si > 1e-12:
-                    x = (budget_a[i] if budget_a[i] < budget_j[i] else budget_j[i]) / si
+                    c = bm0 / si
+                si = cj1 - base[1]
+                if si > 1e-12:
+                    x = bm1 / si
                     if x < c:
                         c = x
+                si = cj2 - base[2]
+                if si > 1e-12:
+                    x = bm2 / si
+                    if x < c:
+                        c = x
+            else:
+                for i in rng:
+                    si = cum_j[i] - base[i]
+                    if si > 1e-12:
+                        x = bmin[i] / si
+                        if x < c:
+                            c = x
             if c >= v_hi:
                 return c  # no junction of the stretch runs as fast: the signed sums change nothing
             smax = [0.0] * axes
@@ -296,7 +319,7 @@ class FilterCorners:
             plus what the acceleration adds going back, nor than the highest speed anywhere in
             the stretch (a block between junctions ≤ c reaches √(c² + 2·A·L)) allows in T."""
             c = cap(k + 1)
-            d = s_j - hist[k].s_end
+            d = s_j - hist_s[k]
             if (c if c < top else top) * t_w + pad < d:
                 return False
             return (c * c + two_al) * t_w2 >= d * d and v_hi * t_w >= d
@@ -455,7 +478,8 @@ class FilterCorners:
             k = bisect.bisect_left(self._hist_s, s_j - 2.0 * h - 1e-12, h0, last + 1)
             axes = self._axes
             sum_n = hist[last].cum[axes] - (hist[k - 1].cum[axes] if k > h0 else 0.0)
-            if vt * self.kd.g0 * sum_n + self.braking(sum_n, self.amax) <= self.tol:
+            # the braking term inline (`braking` without a jerk)
+            if vt * self.kd.g0 * sum_n + sum_n * self.amax * self.t2sum / 192.0 <= self.tol:
                 return 0
         lo = last
         while lo > h0:
@@ -471,29 +495,35 @@ class FilterCorners:
         du = np.array([b.dv for b in seg], dtype=float)
         vb = np.fromiter((b.vbase for b in seg), float, len(seg))
         ev = np.nonzero(s >= s_j - h - 1e-12)[0]
-        room = np.empty(len(ev))
-        for r, i in enumerate(ev):
+        # The loops below run over Python lists, not numpy scalars (issue 17: ~70 junctions a call)
+        ev_l = ev.tolist()
+        nseg = len(seg)
+        tol = self.tol
+        room = np.empty(len(ev_l))
+        for r, i in enumerate(ev_l):
             b = seg[i]
-            nx = seg[i + 1] if i + 1 < len(seg) else blocks[-1]
-            room[r] = self.tol - self.braking(b.du_n, b.a if b.a > nx.a else nx.a)
+            nx = seg[i + 1] if i + 1 < nseg else blocks[-1]
+            room[r] = tol - self.braking(b.du_n, b.a if b.a > nx.a else nx.a)
         near = s >= s_j - 2.0 * h - 1e-12
         caps = self.kd.caps(s[ev], room, vt, s[near], du[near], vb[near])
-        for r, i in enumerate(ev):
-            seg[i].ctol = float(caps[r])
-            if caps[r] < vt * (1.0 - 1e-9) and seg[i].s_end > self._lim_s:
-                self._lim_s = seg[i].s_end
-        ctol = np.fromiter((b.ctol for b in seg), float, len(seg))
+        lim = vt * (1.0 - 1e-9)
+        for i, c in zip(ev_l, caps.tolist()):
+            b = seg[i]
+            b.ctol = c
+            if c < lim and b.s_end > self._lim_s:
+                self._lim_s = b.s_end
+        ctol = np.fromiter((b.ctol for b in seg), float, nseg)
         reach = np.minimum(ctol, vt) * half + 1e-12
         upd = np.nonzero(near)[0]
         held = np.abs(s[upd][:, None] - s[None, :]) <= reach[None, :]
         vtol = np.where(held, ctol[None, :], math.inf).min(axis=1)
         depth = 0
         n = len(blocks)
-        for r, i in enumerate(upd):
+        for i, vt_i in zip(upd.tolist(), vtol.tolist()):
             b = seg[i]
-            b.vtol = float(vtol[r])
-            k = len(seg) - i + 1  # seg[-1] is blocks[-2]
-            v = b.vbase if b.vbase < b.vtol else b.vtol
+            b.vtol = vt_i
+            k = nseg - i + 1  # seg[-1] is blocks[-2]
+            v = b.vbase if b.vbase < vt_i else vt_i
             if k <= n and abs(v - b.vjunc) > 1e-9 * max(v, 1.0):
                 b.vjunc = v
                 if k > depth:
