@@ -89,3 +89,23 @@ def test_a_reset_at_the_end_waits_for_the_filter_stop():
     assert np.allclose(st.positions[-1], [10.0, 0.0, 100.0], atol=1e-9)
     assert max(worst_ratio(st, cfg).values()) <= TOL
     assert polyline_deviation(st.positions, [START] + prog.points) <= cfg.path_tolerance
+
+
+def test_stretches_give_the_stepped_trace_where_the_filter_shapes_the_motion(monkeypatch, tmp_path):
+    """`hil run` of the R5 chord circle with its lead-in (a filter start, a speed-up out of the 90° corner after
+    a wait, a filter stop): with stretches (decisions bench B20-B27, the NC's steps run inside them) the trace
+    equals cycle-by-cycle stepping's, column by column. The checks read the filter's state, which a stretch
+    filters a part at a time (it must be current at every refill)."""
+    from benchmarks.bench_vs_linuxcnc import chord_circle
+    from benchmarks.trace_ab import compare, one
+    from hil.stretch import ENV
+
+    prog = tmp_path / "r5.nc"
+    prog.write_text(chord_circle(5.0).text(lcnc=False))
+    out, kept = [], []
+    for on in ("0", "1"):
+        monkeypatch.setenv(ENV, on)
+        out.append(one(str(prog), {"bench": str(BENCH), "trace_signals": None}, tmp_path / f"{on}.parquet", kept))
+    assert compare(out[0], out[1]) == []
+    assert kept[0].run.stretched == 0 and kept[1].run.stretched > 0.3 * kept[1].run.cycles, kept[1].run.stretched
+    assert kept[1].run.ok
