@@ -5,6 +5,12 @@ and a digest of the setpoints (equal digests: the same setpoints bit for bit).
 
     python benchmarks/cam_planner_parts.py            # the figures
     python benchmarks/cam_planner_parts.py --profile  # cProfile of one run, by own time
+    python benchmarks/cam_planner_parts.py --opcodes [N]  # Python opcodes a block, first N blocks (1500)
+
+`--opcodes` counts the bytecode instructions the interpreter executes (sys.settrace with per-opcode
+events), in `Planner.push` and its callees and in the whole run: a figure that does not move with the
+machine's load (CPU time on the shared 2-vCPU VM moves by ±20 %), though it does not see the cost of
+one instruction (numpy calls, cache misses).
 """
 
 from __future__ import annotations
@@ -51,7 +57,40 @@ def _wrap() -> None:
     planner_mod.jerk_factor = timed_jf
 
 
+def opcodes(n: int) -> None:
+    """Python opcodes a block of one offline run of the program's first n blocks."""
+    prog = parse_program(cam_program(n), name="cam.nc")
+    motion = load_bench_file(ROOT / "benches" / "mill-3axis.toml").motion_config()
+    events = Interpreter(make_profile("nc5-mill", ("X", "Y", "Z"))).run(prog)
+    push_code = planner_mod.Planner.push.__code__
+    count = {"all": 0, "push": 0}
+    depth = [0]  # Planner.push frames open (its callees' opcodes count as the push's)
+
+    def tracer(frame, event, arg):
+        frame.f_trace_opcodes = True
+        if event == "opcode":
+            count["all"] += 1
+            if depth[0]:
+                count["push"] += 1
+        elif frame.f_code is push_code:
+            depth[0] += 1 if event == "call" else -1 if event == "return" else 0
+        return tracer
+
+    sys.settrace(tracer)
+    try:
+        st = run(events, motion, {"X": 0.0, "Y": 0.0, "Z": 100.0})
+    finally:
+        sys.settrace(None)
+    digest = hashlib.sha1(st.positions.tobytes()).hexdigest()[:12]
+    print(f"CAM {n} blocks offline, {len(st.positions) - 1} cycles: Python opcodes a block: Planner.push "
+          f"{count['push'] / n:.0f}, the whole run {count['all'] / n:.0f}; setpoints {digest}")
+
+
 def main() -> None:
+    if "--opcodes" in sys.argv:
+        i = sys.argv.index("--opcodes")
+        opcodes(int(sys.argv[i + 1]) if len(sys.argv) > i + 1 else 1500)
+        return
     prog = parse_program(cam_program(BLOCKS), name="cam.nc")
     motion = load_bench_file(ROOT / "benches" / "mill-3axis.toml").motion_config()
 
