@@ -42,7 +42,7 @@ from hil.clock import LockStepClock, RealTimeClock
 from hil.stretch_bulk import bulk_cycles, bulk_ok, first_change, outputs_hold
 from hil.stretch_pass import Pass, _save as _save_nc, no_reads
 from hil.stretch_reads import may_read
-from hil.stretch_realtime import FIRST_CHANGE_NS, RealTimeStretches, _fed
+from hil.stretch_realtime import COLD_CYCLES, FIRST_CHANGE_NS, RealTimeStretches, _fed
 from hil.stretch_state import (_across, _event_due, _panel_state, _refilled, _restore_planner, _sample_across,
                                _save_planner, _signature, _stand_queued)
 from mlc.basic import BasicMlc
@@ -162,6 +162,8 @@ class Stretcher(RealTimeStretches):
             started = self._spec_start(r, ch, pl, kind, n, True)
             if started is not None:
                 return started
+        if self.paced:  # real time, a start nothing prepared: a short one, the next prepared in its slacks (B23)
+            n = min(n, COLD_CYCLES)
         if n < 2:
             return False
         saved_pl = _save_planner(pl)

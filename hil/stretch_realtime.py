@@ -29,6 +29,10 @@ PREP_LEFT_NS = 600_000
 # and the part of the period left after it for the first paced cycle's wake-up (B22)
 FIRST_CHANGE_NS = 40_000
 FIRST_CHANGE_MARGIN_NS = 150_000
+# A start nothing prepared (after a stepped cycle: a block's end, a dropped or cut start) samples and models only
+# this many cycles in its slack (B23): its work there scales with the cycles (≈ 25 µs a cycle on the 2-vCPU VM), and
+# its paced slacks still have room for the next start's parts (4-5); 4 left too few, so nothing was prepared
+COLD_CYCLES = 8
 _WRITTEN: dict[int, set] = {}
 
 

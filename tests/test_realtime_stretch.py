@@ -16,7 +16,8 @@ from hil import api
 from hil.bench import RealtimeConfig
 from hil.clock import Granted, RealTimeClock
 from hil.commands.run import print_timing
-from hil.stretch import ENV, Stretcher
+from hil.stretch import ENV, RT_CYCLES, Stretcher
+from hil.stretch_realtime import COLD_CYCLES
 from tests.conftest import ROOT
 
 DEMO = str(ROOT / "examples" / "lathe_demo.nc")
@@ -120,12 +121,14 @@ def test_a_realtime_run_with_stretches_equals_stepping(monkeypatch, tmp_path, kw
         return started
 
     monkeypatch.setattr(Stretcher, "_spec_start", spy)
+    lengths = _stretch_lengths(monkeypatch)
     a = _run(monkeypatch, tmp_path, "0", **kw)
     b = _run(monkeypatch, tmp_path, "1", **kw)
     _same(a, b)
     r = b[1].run
     if not kw:  # (--at events are read cycle by cycle: no paced bulk, stretches start as in B21)
         assert len(taken) > 500 and sum(taken) > 0.9 * len(taken)  # most starts were worked out ahead and taken
+        assert max(lengths) == RT_CYCLES  # the prepared ones; a cold start takes COLD_CYCLES (B23)
     assert r.ok and r.realtime and r.overruns == 0
     assert r.stretched > 0.8 * r.cycles  # most cycles come from stretches, each paced on its own
     assert set(a[0]["period"][1:]) == {0.001}  # every cycle ticked: a 1 ms period on the fake clock
@@ -143,10 +146,29 @@ def test_starts_worked_out_ahead_and_dropped_leave_the_run_as_stepping(monkeypat
     and the drives were left as found (the filter's share zones too, which sampling pops), so the run still
     equals stepping. Failed before the zones were saved with the planner: Z_cmd from cycle 1161 on."""
     monkeypatch.setattr(Stretcher, "_same", lambda self, *args: False)
+    lengths = _stretch_lengths(monkeypatch)
     a = _run(monkeypatch, tmp_path, "0")
     b = _run(monkeypatch, tmp_path, "1")
     _same(a, b)
     assert b[1].run.stretched > 0.8 * b[1].run.cycles
+    # B23: a start nothing prepared works out only COLD_CYCLES cycles in its slack (here: every start)
+    assert max(lengths) == COLD_CYCLES and sum(lengths) == b[1].run.stretched
+
+
+def _stretch_lengths(monkeypatch) -> list[int]:
+    """The cycles of each stretch Stretcher.run takes (filled as the runs go)."""
+    lengths: list[int] = []
+    run = Stretcher.run
+
+    def spy(self, limit):
+        c0 = self.cycles
+        started = run(self, limit)
+        if started:
+            lengths.append(self.cycles - c0)
+        return started
+
+    monkeypatch.setattr(Stretcher, "run", spy)
+    return lengths
 
 
 def test_a_stop_inside_a_stretch_is_taken_at_the_next_cycle(monkeypatch, tmp_path):
