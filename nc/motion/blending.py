@@ -9,6 +9,11 @@ sums (safe, cheap: the search for the stretch below), then raised to what the si
 allow at the speed the windows are crossed (`_refine`). The deviation from the path is the kernel
 model of nc.motion.deviation, evaluated per junction (`_tolerance`).
 
+Why this file is over 500 lines: it is one class whose `window` runs on every push of a dense program;
+its 3-axis sums and sliding maxima are spelt out inline (issue 17: calls and numpy on 3-element arrays
+cost more than the arithmetic), and splitting the class would put its shared per-push state behind
+attribute hops on that path.
+
 Every new junction J caps the junctions within one window behind it (J included) by
 budget / (sum over that stretch). For any time window W, the fastest junction m of W lies within
 one window behind W's last junction, whose cap was computed over a sum that holds all of W, so
