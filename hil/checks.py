@@ -15,16 +15,15 @@ import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
 
 from hil.bench import FILTER_MS, Bench, ChecksConfig
+from hil.contour_distance import FEED_KINDS, contour_distances
 from hil.trace import axes_of, spindles_of
 from hil.trace_read import TraceFile
 from nc.alarms import NcAlarm
 from nc.interp import Interpreter
-from nc.motion.path import Segment
 from nc.moves import Move
 from nc.profiles import make_profile
 from nc.program import Program
 
-FEED_KINDS = ("line", "arc", "thread")
 # How many cycles the actual position may trail the interpolator's line: the drive's following
 # lag and the bus latency (a few cycles at a 1 ms cycle), plus the position filter's span
 # (default 16+16 ms at 1 ms when the bench is not known).
@@ -171,68 +170,6 @@ def check_following_error(cols: _Cols, axis: str, limit: float, unit: str = "mm"
                        **cols.where(i))
 
 
-def _move_points(m: Move, axes: tuple[str, ...]) -> np.ndarray | None:
-    """The points of one move's polyline (arcs to 0.1 µm chord error); None for a dwell."""
-    if m.kind == "dwell":
-        return None
-    seg = Segment.of(m, axes)
-    n = 1
-    if seg.kind == "arc" and seg.radius > 0:
-        step = math.sqrt(8 * 1e-4 / seg.radius)
-        n = int(min(20_000, max(4, math.ceil(abs(seg.theta) * (1 + abs(m.turns)) / step))))
-    return seg.points(np.linspace(0.0, seg.length, n + 1)) if seg.length > 0 else np.vstack([seg.start, seg.end])
-
-
-def _polyline(moves: list[Move], axes: list[str],
-              cache: dict[int, np.ndarray | None] | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Segment end points (A, B) approximating each move; arcs to 0.1 µm chord error. `cache` (keyed
-    by id(move)) keeps each move's points across calls: the contour check asks for the same
-    neighbouring moves run after run (a quarter of a chord-circle command went into rebuilding them)."""
-    a_list, b_list = [], []
-    key = tuple(axes)
-    for m in moves:
-        if cache is None:
-            pts = _move_points(m, key)
-        elif id(m) in cache:
-            pts = cache[id(m)]
-        else:
-            pts = cache[id(m)] = _move_points(m, key)
-        if pts is None:
-            continue
-        a_list.append(pts[:-1])
-        b_list.append(pts[1:])
-    if not a_list:
-        return np.zeros((0, len(axes))), np.zeros((0, len(axes)))
-    return np.vstack(a_list), np.vstack(b_list)
-
-
-def distance_to_polyline(p: np.ndarray, a: np.ndarray, b: np.ndarray, chunk: int = 512) -> np.ndarray:
-    """Distance from each point (P × k) to the nearest of the segments a→b (S × k)."""
-    out = np.empty(len(p))
-    ab = b - a
-    ab2 = np.einsum("ij,ij->i", ab, ab)
-    ab2 = np.where(ab2 > 0, ab2, 1.0)
-    for s in range(0, len(p), chunk):
-        q = p[s:s + chunk]
-        ap = q[:, None, :] - a[None, :, :]
-        u = np.clip(np.einsum("psk,sk->ps", ap, ab) / ab2, 0.0, 1.0)
-        d = ap - u[..., None] * ab[None, :, :]
-        out[s:s + chunk] = np.sqrt(np.min(np.einsum("psk,psk->ps", d, d), axis=1))
-    return out
-
-
-def _distance_to_boxes(p: np.ndarray, rapids: list[Move], axes: list[str]) -> np.ndarray:
-    """Distance to the nearest axis-aligned box spanned by a rapid's start and end: with
-    independent rapids each axis runs on its own, so the path is somewhere inside that box."""
-    out = np.full(len(p), np.inf)
-    for m in rapids:
-        seg = Segment.of(m, tuple(axes))
-        lo, hi = np.minimum(seg.start, seg.end), np.maximum(seg.start, seg.end)
-        gap = np.maximum(np.maximum(lo - p, p - hi), 0.0)
-        out = np.minimum(out, np.sqrt(np.einsum("ij,ij->i", gap, gap)))
-    return out
-
-
 def check_contour(cols: _Cols, axes: list[str], moves: list[Move], limit: float,
                   lag_cycles: int = LAG_CYCLES, independent_rapids: bool = False) -> CheckResult:
     """Distance of the actual position from the programmed path, on cycles executing a feed move.
@@ -244,34 +181,11 @@ def check_contour(cols: _Cols, axes: list[str], moves: list[Move], limit: float,
     run (on 0.05 mm CAM blocks that is a dozen blocks back), and their neighbours, because a
     move's corner may be blended."""
     mv_axes = [a for a in axes if any(a in m.end for m in moves)]
-    # A canned cycle's one line holds rapids as well as feeds (G71 retracts, G76 returns): every
-    # move of a line is a candidate, but only lines holding a feed move are judged.
-    by_line: dict[int, set[int]] = defaultdict(set)
-    for i, m in enumerate(moves):
-        by_line[m.line].update(j for j in (i - 1, i, i + 1) if 0 <= j < len(moves))
-    judged = {m.line for m in moves if m.kind in FEED_KINDS}
-    if not judged:
+    if not any(m.kind in FEED_KINDS for m in moves):
         return CheckResult("contour error", True, 0.0, limit, "mm", detail="no feed moves in the program")
     line = cols["line"]
     act = np.column_stack([cols[f"{a}_act"] for a in mv_axes]) if mv_axes else np.zeros((len(line), 0))
-    dist = np.zeros(len(line))
-    points: dict[int, np.ndarray | None] = {}  # each move's polyline, built once (see _polyline)
-    # Runs of cycles on one line (a line met again later, in a loop, starts a new run).
-    starts = np.flatnonzero(np.diff(line, prepend=np.nan) != 0) if len(line) else np.zeros(0, int)
-    ends = np.append(starts[1:], len(line))
-    for r0, r1 in zip(starts.tolist(), ends.tolist()):
-        if int(line[r0]) not in judged:
-            continue
-        idx: set[int] = set()
-        for ln in np.unique(line[max(0, r0 - lag_cycles):r1]).tolist():
-            idx |= by_line.get(int(ln), set())
-        cand = [moves[j] for j in sorted(idx)]
-        boxes = [m for m in cand if independent_rapids and m.kind == "rapid"]
-        a, b = _polyline([m for m in cand if not (independent_rapids and m.kind == "rapid")], mv_axes, points)
-        d = distance_to_polyline(act[r0:r1], a, b) if len(a) else np.full(r1 - r0, np.inf)
-        if boxes:
-            d = np.minimum(d, _distance_to_boxes(act[r0:r1], boxes, mv_axes))
-        dist[r0:r1] = d
+    dist = contour_distances(act, line, moves, mv_axes, lag_cycles, independent_rapids)
     i = int(np.argmax(dist))
     over = np.flatnonzero(dist > limit)
     detail = f"{over.size} cycles over, first at cycle {cols.where(int(over[0]))['cycle']}" if over.size else ""

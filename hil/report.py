@@ -18,7 +18,8 @@ import numpy as np
 
 from hil.atomic_dir import atomic_dir
 from hil.bench import Bench
-from hil.checks import CheckResult, _polyline
+from hil.checks import CheckResult
+from hil.contour_distance import polyline
 from hil.figures import subplots
 from hil.trace import axes_of, spindles_of, trace_columns
 from hil.trace_read import TraceFile
@@ -110,7 +111,7 @@ def trace_figures(trace: str | Path | TraceFile, bench: Bench | None = None,
         if moves:
             names = [a for a in axes if any(a in m.end for m in moves)]
             if h in names and v in names:
-                a, b = _polyline([m for m in moves if m.kind != "dwell"], names)
+                a, b = polyline([m for m in moves if m.kind != "dwell"], names)
                 ih, iv = names.index(h), names.index(v)
                 pts = np.vstack([a, b[-1:]]) if len(a) else a
                 if len(pts):

@@ -1,0 +1,136 @@
+"""The contour check over all cycles at once (hil/contour_distance.py) gives each cycle the distance a
+plain per-cycle reading of its rule gives: the nearest candidate move's path, the candidates being the
+moves of every line seen within the lag before the cycle's run of cycles, and their neighbours."""
+
+import math
+
+import numpy as np
+import pytest
+
+from hil.checks import _Cols, check_contour
+from hil.contour_distance import contour_distances
+from nc.motion.path import Segment
+from nc.moves import Move
+from tests.test_bench_checks import base, write
+
+LAG = 6
+
+
+def zigzag(n: int, arcs: bool = True) -> list[Move]:
+    """n short lines (0.1–0.3 mm, turning), a quarter arc after every 40th, a dwell and a rapid."""
+    rng = np.random.default_rng(7)
+    moves, p, heading = [], (0.0, 0.0), 0.0
+    for k in range(n):
+        heading += rng.normal(0.0, 0.6)
+        q = (p[0] + rng.uniform(0.1, 0.3) * math.cos(heading), p[1] + rng.uniform(0.1, 0.3) * math.sin(heading))
+        moves.append(Move("line", k + 1, "G01", {"X": p[0], "Z": p[1]}, {"X": q[0], "Z": q[1]}, {}, feed=600.0))
+        p = q
+        if arcs and k % 40 == 39:
+            c = (p[0] + 0.5, p[1])
+            q = (c[0], c[1] + 0.5)
+            moves.append(Move("arc", k + 1, "G02", {"X": p[0], "Z": p[1]}, {"X": q[0], "Z": q[1]}, {}, feed=600.0,
+                              center={"X": c[0], "Z": c[1]}, dir="cw", plane=("Z", "X")))
+            p = q
+    moves.append(Move("dwell", n + 1, "G04", {"X": p[0], "Z": p[1]}, {"X": p[0], "Z": p[1]}, {}))
+    moves.append(Move("rapid", n + 2, "G00", {"X": p[0], "Z": p[1]}, {"X": p[0] + 5.0, "Z": p[1] + 3.0}, {}))
+    return moves
+
+
+def seg_distance(p, a, b) -> float:
+    ab = [y - x for x, y in zip(a, b)]
+    ab2 = sum(v * v for v in ab) or 1.0
+    u = min(1.0, max(0.0, sum((pi - ai) * v for pi, ai, v in zip(p, a, ab)) / ab2))
+    return math.dist(p, [ai + u * v for ai, v in zip(a, ab)])
+
+
+def move_segments(m: Move):
+    """A move's path as chords: a line's one, an arc's 2,000 (the check's own are within 0.1 µm)."""
+    if m.kind == "dwell":
+        return []
+    seg = Segment.of(m, ("X", "Z"))
+    pts = seg.points(np.linspace(0.0, seg.length, 2 if m.kind != "arc" else 2001)).tolist()
+    return list(zip(pts[:-1], pts[1:]))
+
+
+def reference(act, line, moves, lag):
+    """Each cycle by the rule, in plain Python."""
+    by_line: dict[int, set[int]] = {}
+    for i, m in enumerate(moves):
+        by_line.setdefault(m.line, set()).update(j for j in (i - 1, i, i + 1) if 0 <= j < len(moves))
+    judged = {m.line for m in moves if m.kind in ("line", "arc", "thread")}
+    segs = [move_segments(m) for m in moves]
+    out = np.zeros(len(line))
+    r0 = 0
+    for i in range(len(line)):
+        if i and line[i] != line[i - 1]:
+            r0 = i
+        if int(line[i]) not in judged:
+            continue
+        r1 = i
+        while r1 < len(line) and line[r1] == line[i]:
+            r1 += 1
+        cand = set().union(*(by_line.get(int(ln), set()) for ln in set(line[max(0, r0 - lag):r1].tolist())))
+        out[i] = min((seg_distance(act[i], a, b) for j in cand for a, b in segs[j]), default=math.inf)
+    return out
+
+
+def trace_along(moves, seed: int = 3):
+    """1–3 cycles a line (a CAM program's pace), the line met again in a loop near the end, each
+    actual position off the path by up to 5 µm and trailing the line column by 5 cycles (the filter
+    and the drive's lag: its candidates come from the lines of the window before its run)."""
+    rng = np.random.default_rng(seed)
+    feeds = [m for m in moves if m.kind in ("line", "arc")]
+    order = feeds + feeds[100:110]
+    line, act = [], []
+    for m in order:
+        seg = Segment.of(m, ("X", "Z"))
+        for p in seg.points(np.linspace(0.0, seg.length, int(rng.integers(1, 4)), endpoint=False)):
+            line.append(m.line)
+            act.append(p + rng.uniform(-5e-3, 5e-3, 2))
+    act = act[:1] * 5 + act[:-5]
+    last = moves[-1]
+    line += [last.line] * 5
+    act += [[last.start["X"] + 2.0, last.start["Z"] + 2.0]] * 5
+    return np.array(act), np.array(line, dtype=np.int64)
+
+
+@pytest.mark.parametrize("arcs, within", [(False, 1e-15), (True, 1.01e-4)])
+def test_every_cycle_has_the_distance_its_rule_gives(arcs, within):
+    """Lines to the last bits; arcs within the check's chord error (1e-4 mm, the reference's ≈ 0)."""
+    moves = zigzag(300, arcs)
+    act, line = trace_along(moves)
+    got = contour_distances(act, line, moves, ["X", "Z"], LAG, False)
+    want = reference(act, line, moves, LAG)
+    assert np.all(np.isfinite(got[:-5])) and np.all(got[-5:] == 0.0)  # the rapid's line is not judged
+    assert np.max(np.abs(got - want)) <= within
+    assert 0.002 < float(np.max(got)) < 0.0071
+
+
+def test_the_worst_cycle_is_named_with_its_line(tmp_path):
+    moves = zigzag(120)
+    act, line = trace_along(moves)
+    act = act[:-5]
+    line = line[:-5]
+    k = 200
+    act[k] = act[k] + 0.3  # 0.3 mm off in X and Z
+    d = base(len(line))
+    d["line"], d["X_act"], d["Z_act"] = line, act[:, 0].copy(), act[:, 1].copy()
+    r = check_contour(_Cols(write(tmp_path, d)), ["X", "Z"], moves, 0.05, LAG)
+    assert not r.ok and r.cycle == k + 1 and r.line == int(line[k])
+    assert r.value == pytest.approx(reference(act, line, moves, LAG)[k], abs=1e-12)
+    assert "1 cycles over, first at cycle" in r.detail
+
+
+def test_independent_rapids_are_judged_against_their_box():
+    moves = zigzag(60)
+    rapid = Move("rapid", 30, "G00", moves[29].end, {"X": moves[29].end["X"] + 4.0, "Z": moves[29].end["Z"] + 4.0}, {})
+    moves.insert(30, rapid)
+    act, line = trace_along(moves)
+    i = int(np.flatnonzero(line == 30)[0])
+    act[i] = [rapid.start["X"] + 4.0, rapid.start["Z"]]  # the box's corner: off the straight rapid by 2.8 mm
+    straight = contour_distances(act, line, moves, ["X", "Z"], LAG, False)
+    boxed = contour_distances(act, line, moves, ["X", "Z"], LAG, True)
+    assert straight[i] == pytest.approx(math.sqrt(8.0), rel=1e-9)
+    assert boxed[i] == 0.0
+    others = np.arange(len(line)) != i
+    assert np.all(boxed[others] <= straight[others])
