@@ -67,6 +67,7 @@ def _listing(profile_name: str, text: str, lane: bool, json: bool) -> tuple[list
     profile = make_profile(profile_name, None, {}, ())
     ip = Interpreter(profile)
     ip.bulk = lane
+    ip.lean = lane  # the reference runs every block through the general path (not nc.interp.lean either)
     out: list[str] = []
     alarm = None
     try:

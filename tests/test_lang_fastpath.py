@@ -65,6 +65,7 @@ def _axis_block(axes):
 
 def _events(profile, text, fast: bool):
     with pytest.MonkeyPatch.context() as m:
+        m.setattr(Interpreter, "lean", False)  # the `_axis_block` path, not the lane before it (nc.interp.lean)
         if not fast:
             m.setattr(Interpreter, "_axis_block", lambda self, block: False)
         interp = Interpreter(profile)

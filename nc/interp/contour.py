@@ -66,4 +66,5 @@ class ContourMixin:
         twin.macro_modal = None
         twin.stack = list(self.stack)
         twin.on_statement = None
+        twin._lean = None  # the lane holds the interpreter it runs for (nc.interp.lean)
         return twin

@@ -15,6 +15,7 @@ from nc.alarm_table import ENDLESS_LOOP
 from nc.alarms import NcAlarm
 from nc.budget import StatementBudget
 from nc.interp.corners import expand_corners
+from nc.interp.lean import NOTHING, LeanLane
 from nc.interp.servo import ServoPort
 from nc.interp.state import Frames, ModalState
 from nc.interp.sysvars import SystemVariables
@@ -44,6 +45,10 @@ def _located(exc: Exception, block: Block, program: str) -> NcAlarm:
 
 
 class Interpreter(ExecuteMixin, ReadingMixin, ModalMixin, MotionMixin, NonModalMixin, ControlMixin, CallsMixin, ContourMixin, CanonicalMixin):
+    # True: plain motion lines in the plain state run straight from their text (nc.interp.lean, issue 17);
+    # False runs every block through `_execute` (tests compare the two)
+    lean = True
+
     def __init__(self, profile: Profile, start: dict[str, float] | None = None,
                  store: ProgramStore | None = None) -> None:
         self.profile = profile
@@ -95,6 +100,7 @@ class Interpreter(ExecuteMixin, ReadingMixin, ModalMixin, MotionMixin, NonModalM
         self.bulk = False
         self.corner_pending = False  # a ,C/,R block waits for its motion block (set by expand_corners)
         self._bulk_skip: tuple | None = None  # (blocks, first, end): a run nc.interp.bulk found too short
+        self._lean: LeanLane | None = None  # plain motion lines run from their text (nc.interp.lean)
 
     # ---- public ---------------------------------------------------------------------------
 
@@ -135,6 +141,10 @@ class Interpreter(ExecuteMixin, ReadingMixin, ModalMixin, MotionMixin, NonModalM
         bulk = None
         if self.bulk:  # a consumer that takes MoveBatch events (`hil path`)
             from nc.interp import bulk
+        lean = self._lean
+        if lean is None:
+            lean = self._lean = LeanLane(self)
+        take, nothing = lean.take, NOTHING
         cur = None  # the frame `blocks`, `count`, `parsed` and `name` are of (read again when it changes)
         while self.stack:
             if budget is not None and budget.spent:
@@ -151,6 +161,7 @@ class Interpreter(ExecuteMixin, ReadingMixin, ModalMixin, MotionMixin, NonModalM
                 # a BlockList's parsed items by index (None: a plain line, read when reached); a list of blocks
                 # has no plain lines
                 parsed = getattr(blocks, "parsed", None) or blocks.__getitem__
+                raw_at = getattr(blocks, "raw", None) if self.lean else None  # a plain line's text (BlockList)
             pc = fr.pc
             if pc >= count:
                 if len(self.stack) == 1:
@@ -163,6 +174,12 @@ class Interpreter(ExecuteMixin, ReadingMixin, ModalMixin, MotionMixin, NonModalM
                     if len(batch):  # a run of plain G0/G1 blocks read in one pass (nc.interp.bulk); one
                         yield batch  # that moved nothing (`G1 F100` lines) is no event, as block by block
                     last = self.block
+                    continue
+                # a plain motion line in the plain state, run from its text (nc.interp.lean, issue 17)
+                if raw_at is not None and (ev := take(fr, pc, raw_at(pc), limit)) is not None:
+                    last = self.block
+                    if ev is not nothing:
+                        yield ev  # type: ignore[misc]
                     continue
                 block = blocks[pc]
             last = block

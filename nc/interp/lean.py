@@ -1,0 +1,207 @@
+"""The lean lane (issue 17): one plain motion line run straight from its text, for the channel.
+
+A CAM program is thousands of lines such as ``X12.5 Y-3.25`` or ``G1 X.. Y.. F1200``. Block by
+block, each line is parsed into a Block of Words, read and checked (`_execute`, `_read_run`), and
+its move built by `_motion` -> `_geometry` -> `_plain_geometry` -> `_axis_words` through two
+generator layers. Here a line whose letters are one of a few shapes (an optional N, at most one
+G00/G01, at most one F, axis words of the profile each once) is matched by one compiled pattern
+and its Move built in one call, while the modal state is the plain one (`_eligible`: G90, mm, no
+radius compensation, no canned cycle, no transforms, no G16, no G66, no code call on G00/G01,
+no ,A or G2.4 waiting for its partner, no corner waiting for its motion block).
+
+The Move, the state it leaves (position, last target, F, group 01, `unit_locked`, the block
+counter, `block`, `program_name`) and the alarms are those of the general path: any line it
+would refuse or treat otherwise (F < 0, a cutting move without F, a target out of range, the
+`max blocks` limit, a word without a decimal point) is left to it untouched, and it raises the
+alarm at the same block. Unlike nc.interp.bulk (runs of lines as one `MoveBatch` for `hil path`),
+it yields Move by Move, so the channel's look-ahead, statement budget, M96 and the preview window
+see the same events at the same moments. tests/test_interp_lean.py compares both paths.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from typing import TYPE_CHECKING
+
+from nc.interp.gcodes import lookup
+from nc.interp.records import _transforms
+from nc.interp.state import PLANES
+from nc.moves import Move
+from nc.program.syntax import Block, Word
+
+if TYPE_CHECKING:  # pragma: no cover
+    from nc.interp.interpreter import Interpreter
+    from nc.interp.records import Frame
+
+_NUM = r"([+-]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+))[ \t]*"  # a number as nc.program.parser reads one
+_LETTER = re.compile(r"[A-Za-z]")
+_G_MOTION = {"0": 0, "00": 0, "000": 0, "1": 1, "01": 1, "001": 1}  # G00 / G01 as programs write them
+NOTHING = object()  # `take`: the line ran and moved nothing (`G1 F100`): no event, as block by block
+
+
+class _Shape:
+    """The letters of a line in order and what each is: one compiled pattern reads a line of that
+    shape (a CAM run is mostly one shape)."""
+
+    __slots__ = ("match", "letters", "n", "g", "f", "axes")
+
+    def __init__(self, letters: tuple[str, ...], n: bool, g: int | None, f: int | None,
+                 axes: tuple[tuple[str, int], ...]) -> None:
+        body = r"[ \t]*" + "".join((r"[Nn]([0-9]+)[ \t]*" if c == "N" else f"[{c}{c.lower()}]" + _NUM)
+                                    for c in letters)
+        self.match = re.compile(body).fullmatch
+        self.letters, self.n, self.g, self.f, self.axes = letters, n, g, f, axes
+
+
+class LeanLane:
+    """The lane of one interpreter (its axes and code-call tables decide the shapes it takes)."""
+
+    __slots__ = ("ip", "shapes", "last", "axes", "diameter", "g_codes", "tables", "g_ok")
+
+    def __init__(self, ip: "Interpreter") -> None:
+        self.ip = ip
+        self.shapes: dict[tuple[str, ...], _Shape | None] = {}
+        self.last: _Shape | None = None  # the shape of the last line taken: tried first
+        self.axes = tuple(a for a in ip.axes if len(a) == 1 and a in ip._plain_axes)
+        self.diameter = ip.profile.diameter_axes
+        # a G word is taken when G00/G01 are group-01 motion codes no macro is called for (`_g_ok`)
+        self.g_codes = lookup(ip.profile, 0.0) == (1, "G00") and lookup(ip.profile, 1.0) == (1, "G01")
+        self.tables: object = None  # the code-call tables `g_ok` was found with
+        self.g_ok = False
+
+    def _g_ok(self) -> bool:
+        """Whether a G00/G01 word may be taken: no macro is called for either, by the tables in force
+        (built again after `params_changed`)."""
+        ip = self.ip
+        if ip._call_tables is None or ip._call_tables is not self.tables:
+            self.g_ok = self.g_codes and ip._call_table("G", 0) is None and ip._call_table("G", 1) is None
+            self.tables = ip._call_tables
+        return self.g_ok
+
+    def _shape(self, letters: tuple[str, ...]) -> _Shape | None:
+        """The shape of a line with these letters, None if the lane does not take it: each letter once
+        (a repeated one is for the general path: last wins, or 0x0202 for two G), N only first."""
+        if len(set(letters)) != len(letters):
+            return None
+        g = f = None
+        axes = []
+        for k, c in enumerate(letters):
+            if c == "N":
+                if k:
+                    return None
+            elif c == "G":
+                if not self.g_codes:
+                    return None
+                g = k
+            elif c == "F":
+                f = k
+            elif c in self.axes:
+                axes.append((c, k))
+            else:
+                return None
+        return _Shape(letters, bool(letters) and letters[0] == "N", g, f, tuple(axes))
+
+    def _eligible(self) -> bool:
+        """The modal state in which such a line does nothing but set F / G00-G01 and move."""
+        ip = self.ip
+        st = ip.state
+        return (st.absolute and not st.inch and st.comp == 40 and st.cycle is None and st.motion in (0, 1)
+                and not st.polar and ip.macro_modal is None and ip._three_point is None
+                and ip._angle_pending is None and not ip.corner_pending and _transforms(ip) is None)
+
+    def take(self, fr: "Frame", pc: int, raw: str, limit: int) -> object:
+        """Run the plain line `raw` at `fr.pc == pc`: its Move, NOTHING when it moved nothing, or None
+        (nothing done) when the general path must run it."""
+        ip = self.ip
+        if ip._executed >= limit or not self._eligible():
+            return None
+        shape = self.last
+        m = shape.match(raw) if shape is not None else None
+        if m is None:
+            letters = tuple(c.upper() for c in _LETTER.findall(raw))
+            if letters not in self.shapes:
+                self.shapes[letters] = self._shape(letters)
+            shape = self.shapes[letters]
+            if shape is None:
+                return None
+            m = shape.match(raw)
+            if m is None:
+                return None
+            self.last = shape
+        vals = m.groups()
+        st = ip.state
+        motion = st.motion
+        if shape.g is not None:
+            motion = _G_MOTION.get(vals[shape.g])
+            if motion is None or not self._g_ok():
+                return None
+        feed = st.feed
+        if shape.f is not None:
+            feed = float(vals[shape.f])
+            if feed < 0:
+                return None  # 0x0223 from the general path
+        # ---- the target: `_plain_geometry`'s arithmetic, step for step
+        axes = ip.axes
+        origin = ip.frames.origins(st.wcs, axes)
+        diameter = self.diameter
+        position = ip.position
+        work = {}
+        for a in axes:
+            v = position.get(a, 0.0) - origin[a]
+            work[a] = v * 2.0 if a in diameter else v
+        for a, k in shape.axes:
+            text = vals[k]
+            if "." in text:
+                work[a] = float(text)
+            else:  # the decimal-point rule (N8.018 Bit10, decisions A4)
+                work[a] = ip.distance(Word(a, float(text), a + text, False), a)
+        moved = bool(shape.axes)
+        if moved:
+            if motion == 1:
+                if feed is None or feed == 0.0:
+                    return None  # N1.042's default F, or 0x1001: the general path
+                mfeed = feed * 1.0
+            machine = {}
+            for a in axes:
+                v = work[a]
+                v = (v / 2.0 if a in diameter else v) + origin[a]
+                if not math.isfinite(v) or abs(v) > 1e9:
+                    return None  # 0x120E from the general path
+                machine[a] = v
+        # ---- committed: the state the general path leaves
+        fr.pc = pc + 1
+        ip._executed += 1
+        ip.program_name = fr.program.name
+        ip.block = _block(fr, pc, raw, shape, vals)
+        if shape.g is not None:
+            st.groups[1] = float(vals[shape.g])
+            st.motion = motion
+        if shape.f is not None:
+            st.feed = feed
+        if not moved:
+            return NOTHING
+        ip.unit_locked = True
+        if motion == 0:
+            mv = Move("rapid", ip.block.line, raw, dict(position), machine, work, None, None, None, None, False,
+                      PLANES[st.plane], st.exact_stop_modal, None, 0.0, 0.0, 0.0, ip.program_name)
+        else:
+            mv = Move("line", ip.block.line, raw, dict(position), machine, work, None, None, mfeed, None,
+                      st.per_rev, PLANES[st.plane], st.exact_stop_modal, None, 0.0, 0.0, 0.0, ip.program_name)
+        if st.css:
+            mv.css = st.surface_speed
+        ip.position = dict(machine)
+        ip.last_target = dict(work)
+        return mv
+
+
+def _block(fr: "Frame", pc: int, raw: str, shape: _Shape, vals: tuple[str, ...]) -> Block:
+    """The Block the parser reads from `raw` (`_plain_block`), from the shape's groups."""
+    blk = Block(fr.program.blocks.line(pc), raw)
+    words = blk.words
+    for c, v in zip(shape.letters, vals):
+        if c == "N":
+            blk.n = int(v)
+        else:
+            words.append(Word(c, float(v), c + v, "." in v))
+    return blk
