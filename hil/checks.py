@@ -20,7 +20,7 @@ from hil.trace import axes_of, spindles_of
 from hil.trace_read import TraceFile
 from nc.alarms import NcAlarm
 from nc.interp import Interpreter
-from nc.moves import Move
+from nc.moves import Move, MoveBatch, MoveList
 from nc.profiles import make_profile
 from nc.program import Program
 
@@ -94,7 +94,18 @@ def program_moves(program: Program, bench: Bench) -> list[Move]:
     """The programmed path in machine coordinates, from the axes' power-on positions."""
     profile = make_profile(bench.profile, bench.axis_names, bench.params)
     interp = Interpreter(profile, {a.name: a.start for a in bench.axes})
-    return [ev for ev in interp.run(program) if isinstance(ev, Move)]
+    # runs of plain G0/G1 blocks read in bulk (issue 16's MoveBatch, a cycle's MoveList): the same
+    # Move objects, a third of the interpreter's time on a 5,000-block CAM program (issue 17)
+    interp.bulk = True
+    out: list[Move] = []
+    for ev in interp.run(program):
+        if type(ev) is MoveBatch:
+            out += ev.moves()
+        elif type(ev) is MoveList:
+            out += ev.items
+        elif isinstance(ev, Move):
+            out.append(ev)
+    return out
 
 
 def offline_moves(program: Program, bench: Bench) -> tuple[list[Move] | None, str]:

@@ -134,3 +134,25 @@ def test_independent_rapids_are_judged_against_their_box():
     assert boxed[i] == 0.0
     others = np.arange(len(line)) != i
     assert np.all(boxed[others] <= straight[others])
+
+
+@pytest.mark.parametrize("program, bench", [("examples/lathe_part_g71_g70_g76.nc", None),
+                                            ("cam", "benches/mill-3axis.toml")])
+def test_the_programmed_path_read_in_bulk_is_the_moves_one_by_one(tmp_path, program, bench):
+    """program_moves reads plain G0/G1 runs and a cycle's moves in bulk: the same Moves as one by one."""
+    from benchmarks.bench_motion import cam_program
+    from hil import api
+    from hil.checks import program_moves
+    from hil.session import load_program
+    from nc.interp import Interpreter
+    from nc.profiles import make_profile
+
+    if program == "cam":
+        program = tmp_path / "cam.nc"
+        program.write_text(cam_program(400).replace("M30", "G02 I5 J0\nG01 X1\nM30"))
+    b = api._bench(bench, None, None)
+    got = program_moves(load_program(str(program), []), b)
+    interp = Interpreter(make_profile(b.profile, b.axis_names, b.params), {a.name: a.start for a in b.axes})
+    want = [ev for ev in interp.run(load_program(str(program), [])) if isinstance(ev, Move)]
+    assert len(got) > 100 and got == want
+    assert any(m.kind == "arc" for m in got)
