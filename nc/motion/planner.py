@@ -41,6 +41,7 @@ from nc.motion.planner_corners import CornerShares
 from nc.motion.planner_cruise import CruiseSampling
 from nc.motion.planner_thread import ThreadStepping
 from nc.motion.profile import clip, solve_axes, solve_position, solve_velocity
+from nc.motion.sample_rows import few_rows
 from nc.motion.share_zones import ShareZones
 from nc.motion.shares import MAX_FACTOR, jerk_factor
 from nc.motion.smoothing import PositionFilter
@@ -661,6 +662,8 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops):
     def _sample(self, p: _Plan, n: int) -> None:
         T = self.cfg.cycle
         self._buf_blk = None
+        if (p.kind == "path" or p.kind == "ramp") and few_rows(self, p, n):
+            return  # the same rows on plain floats (nc.motion.sample_rows)
         t = p.t_next + T * np.arange(n)
         p.t_next = float(t[-1] + T)
         line = self.blocks[0].move.line if self.blocks else self.line

@@ -9,6 +9,7 @@ Never pass intermediate positions to ruckig: the community build sends those to 
 
 from __future__ import annotations
 
+from bisect import bisect_right
 from dataclasses import dataclass
 
 import numpy as np
@@ -46,6 +47,7 @@ class Piecewise:
     duration: float
     p_max: float = np.inf  # highest position of DoF 0 anywhere on the profile (ruckig's extrema)
     _vmin: tuple[tuple[int, float], float] | None = None  # v_min's last answer, with (dof, duration)
+    _lists: tuple | None = None  # DoF 0's phases as plain lists, for `at` (with the duration they were made for)
 
     @classmethod
     def of(cls, traj: Trajectory) -> "Piecewise":
@@ -87,6 +89,25 @@ class Piecewise:
                         low = x
         self._vmin = (key, low)
         return low
+
+    def at(self, t: float) -> tuple[float, float, float]:
+        """sample(np.array([t])) of DoF 0 on plain floats: the same operations in the same order, so the same
+        bits (numpy's maximum/minimum keep their first operand on a tie, searchsorted is bisect_right), without
+        ~25 numpy calls on 1-element arrays (issue 17: the planner samples a block's one or two rows at a time)."""
+        c = self._lists
+        dur = self.duration
+        if c is None or c[0] != dur:  # the ramp fallback stretches duration and t0 after the solve
+            c = self._lists = (dur, self.t0[0].tolist(), self.p[0].tolist(), self.v[0].tolist(),
+                               self.a[0].tolist(), self.j[0].tolist())
+        _, t0, p, v, a, j = c
+        t = 0.0 if 0.0 >= t else t
+        t = dur if dur <= t else t
+        k = bisect_right(t0, t) - 1
+        if k < 0:
+            k = 0
+        dt = t - t0[k]
+        jk, ak, vk = j[k], a[k], v[k]
+        return (p[k] + dt * (vk + dt * (ak / 2.0 + dt * jk / 6.0)), vk + dt * (ak + dt * jk / 2.0), ak + dt * jk)
 
     def sample(self, t: np.ndarray, dof: int = 0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(position, velocity, acceleration) of one DoF at times t (clamped to [0, duration])."""

@@ -1,0 +1,90 @@
+"""A solved plan's next rows on plain floats where only a few are kept (issue 17, session 11).
+
+On a dense CAM program a block lasts a cycle or two: `Planner._sample` samples up to CHUNK (64) cycles of the
+plan with numpy, keeps the one or two that lie in the current block (or only reads the first, to see that it lies
+in the next block and re-solve there) and drops the rest, and its ~40 numpy calls on tiny arrays cost more than
+the arithmetic. `few_rows` makes the same decisions from the rows it needs only: the first, and those
+`np.searchsorted(s, length + 1e-12, side="right")` probes (its binary search, replayed on rows computed on demand:
+numpy's loop is the same bisection as `bisect_right`), and the rows kept. Each row is `Piecewise.at`, the same
+operations in the same order as `Piecewise.sample`, and a line's points the same `start + u·(end − start)`, so
+the buffer holds the same bits. Where more than FEW rows are kept, an arc's points, or a ramp runs on into the
+next block, it leaves the planner untouched and `_sample` runs as before.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from nc.motion.plan_state import _Plan
+
+if TYPE_CHECKING:
+    from nc.motion.planner import Planner
+
+FEW = 6  # rows kept up to which plain floats beat numpy (a row ≈ 1 µs, numpy's sample ≈ 25 µs a call)
+
+
+def few_rows(pl: "Planner", p: _Plan, n: int) -> bool:
+    """`Planner._sample(p, n)` for a path or ramp plan, when it keeps at most FEW rows or re-solves at the next
+    block; False (nothing changed) where `_sample` must run."""
+    T = pl.cfg.cycle
+    t_next, base, pw = p.t_next, p.base, p.pw
+    blocks = pl.blocks
+    b = blocks[0]
+    length = b.length
+    rows: dict[int, tuple[float, float, float]] = {}
+
+    def row(i: int) -> tuple[float, float, float]:
+        r = rows.get(i)
+        if r is None:
+            s, v, a = pw.at(t_next + T * i)  # t = p.t_next + T * np.arange(n)
+            r = rows[i] = (s - base, v, a)
+        return r
+
+    more = len(blocks) > 1 and blocks[1].kind == "path"
+    if more and row(0)[0] > length + 1e-12:
+        if not (p.kind == "path" or (p.kind == "ramp" and not pl.held and p is not pl._fr_plan)):
+            return False  # a ramp runs on into the next block without a solve: _sample's loop
+        # _sample's re-solve at the block boundary, from the last emitted state
+        p.t_next = (t_next + T * (n - 1)) + T
+        s_last = pl.s
+        pl._finish_block(keep_plan=True)
+        pl.s = s_last - length
+        pl.plan = None
+        pl._carry = T if p.emitted else t_next
+        pl._buf_pos = None
+        return True
+    keep = n
+    if more:
+        x = length + 1e-12
+        lo, hi = 0, n
+        while lo < hi:
+            mid = (lo + hi) >> 1
+            if x < row(mid)[0]:
+                hi = mid
+            else:
+                lo = mid + 1
+        if 0 < lo < n:
+            keep = lo
+    seg = b.seg
+    if keep > FEW or seg.kind != "line" or seg.length <= 0.0:
+        return False
+    p.t_next = t_next + T * keep if keep < n else (t_next + T * (n - 1)) + T
+    got = [row(i) for i in range(keep)]
+    # seg.points(clip(s, 0.0, b.length)) of a line, per element
+    start = seg.start.tolist()
+    d = (seg.end - seg.start).tolist()
+    seg_len = seg.length
+    pos = []
+    for s, _, _ in got:
+        s = 0.0 if 0.0 >= s else s
+        u = (length if length <= s else s) / seg_len
+        pos.append([q + u * e for q, e in zip(start, d)])
+    p.emitted = True
+    pl._buf_pos = np.array(pos)
+    pl._buf_vel = np.array([r[1] for r in got])
+    pl._buf_line = [b.move.line] * keep
+    pl._buf_i = 0
+    pl._buf_state = got
+    return True
