@@ -76,14 +76,23 @@ class TimingStats:
         if v[i] > self.max:
             self.max, self.max_at = float(v[i]), first_cycle + i
 
-    def percentile(self, q: float) -> float:
+    def percentile(self, q: float, nz: tuple[np.ndarray, np.ndarray] | None = None) -> float:
+        """`nz`: the histogram's non-empty bins and their cumulative counts (`_nonzero`), when the caller asks for
+        several: the first bin whose cumulative count reaches the rank is one of them (a bin adds to the sum only
+        where it holds something), and a cumulative sum over all 500,001 bins costs milliseconds."""
         if self.count == 0:
             return 0.0
-        k = int(np.searchsorted(np.cumsum(self.hist), q / 100.0 * self.count, side="left"))
+        bins, cum = self._nonzero() if nz is None else nz
+        k = int(bins[int(np.searchsorted(cum, q / 100.0 * self.count, side="left"))]) if q > 0 else 0
         return min((k + 0.5) * self.BIN, self.max) if k < self.NBINS else self.max
 
+    def _nonzero(self) -> tuple[np.ndarray, np.ndarray]:
+        bins = np.flatnonzero(self.hist)
+        return bins, np.cumsum(self.hist[bins])
+
     def summary(self) -> dict[str, float]:
-        return {"p50": self.percentile(50), "p99": self.percentile(99), "p99.9": self.percentile(99.9),
+        nz = self._nonzero() if self.count else None
+        return {"p50": self.percentile(50, nz), "p99": self.percentile(99, nz), "p99.9": self.percentile(99.9, nz),
                 "max": self.max, "count": float(self.count)}
 
 
