@@ -12,12 +12,19 @@ The fit and its spans are nc.motion.spline_runs' (decision 49); "span caps" is Î
 over the spans with `span_limits`' budget.
 
     python benchmarks/bench_spline_bound.py [--n 400] [--share 0.8] [--tol 0.02]
+    python benchmarks/bench_spline_bound.py --cost [--n 400] [--window 40] [--every 20]
+
+--cost times what a streaming planner pays (decision 53): `fit_run` and `spans` on windows of `--window`
+segments taken every `--every` segments, CPU time (time.process_time) a segment of the windows, best of 3,
+split by part, with the fit's rounds a window and the load.
 """
 
 from __future__ import annotations
 
 import argparse
 import dataclasses
+import os
+import time
 from unittest import mock
 
 import numpy as np
@@ -27,7 +34,7 @@ from hil.bench_file import load_bench_file
 from nc.motion.lookahead import Block
 from nc.motion.offline import Stream, run
 from nc.motion.planner import Planner
-from nc.motion.spline_runs import LAM, FitError, fit_run, polyline_distance, span_limits, spans
+from nc.motion.spline_runs import LAM, Cost, FitError, fit_run, polyline_distance, span_limits, spans
 from nc.moves import Move
 
 ACC = np.array([5000.0, 5000.0, 3000.0])  # benches/mill-3axis.toml
@@ -110,6 +117,31 @@ def through_planner(prog: Program, tol: float) -> Stream:
         return run(moves, cfg, dict(zip("XYZ", START)))
 
 
+def cost(prog: Program, tol: float, window: int, every: int, repeat: int = 3) -> dict[str, float]:
+    """CPU ms a segment of fit_run's and spans' parts on windows of the program, the best of `repeat` runs,
+    and the fit's rounds a window."""
+    pts = np.array([START] + prog.points, dtype=float)
+    wins = [pts[k:k + window + 1] for k in range(0, len(pts) - window, every)]
+    best: dict[str, float] = {}
+    for _ in range(repeat):
+        fc, sc = Cost(parts={}), Cost(parts={})
+        t0 = time.process_time()
+        fits = [fit_run(w, tol, cost=fc) for w in wins]
+        t1 = time.process_time()
+        for f in fits:
+            spans(*f, ("X", "Y", "Z"), cost=sc)
+        t2 = time.process_time()
+        run = {"fit": t1 - t0, "spans": t2 - t1, **{f"fit {k}": v for k, v in fc.parts.items()},
+               **{f"spans {k}": v for k, v in sc.parts.items()}}
+        if not best or run["fit"] + run["spans"] < best["fit"] + best["spans"]:
+            best = run
+    segs = window * len(wins)
+    out = {k: 1e3 * v / segs for k, v in best.items()}
+    out["rounds"] = fc.rounds / len(wins)
+    out["windows"] = len(wins)
+    return out
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--n", type=int, default=400)
@@ -117,9 +149,22 @@ def main() -> None:
     ap.add_argument("--share", type=float, default=0.8)
     ap.add_argument("--at", type=float, default=1000.0, help="tangential acceleration of speed changes, mm/sÂ²")
     ap.add_argument("--planner", action="store_true", help="run the spans through the planner (filter off)")
+    ap.add_argument("--cost", action="store_true", help="CPU time of the fit and the spans on streaming windows")
+    ap.add_argument("--window", type=int, default=40, help="--cost: segments a window")
+    ap.add_argument("--every", type=int, default=20, help="--cost: segments between windows' starts")
     args = ap.parse_args()
     for make in (cam_polyline, cam_surface):
         prog = make(args.n)
+        if args.cost:
+            try:
+                c = cost(prog, args.tol, args.window, args.every)
+            except FitError as e:
+                raise SystemExit(f"{prog.name}: {e}") from None
+            parts = ", ".join(f"{k} {v:.4f}" for k, v in c.items() if k.count(" "))
+            print(f"{prog.name:38s} {c['windows']:.0f} windows of {args.window}: fit {c['fit']:.4f} + spans "
+                  f"{c['spans']:.4f} = {c['fit'] + c['spans']:.4f} ms CPU a segment, {c['rounds']:.2f} rounds "
+                  f"a window | {parts} | load {os.getloadavg()[0]:.1f}")
+            continue
         if args.planner:
             try:
                 st = through_planner(prog, args.tol)

@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 
 from benchmarks.bench_vs_linuxcnc import START, cam_polyline, cam_surface
-from nc.motion.spline_runs import fit_run, span_limits, spans
+from nc.motion.spline_runs import Cost, fit_run, span_limits, spans
+from tests import spline_slow as slow
 from tests.motion_helpers import polyline_deviation
 
 AXES = ("X", "Y", "Z")
@@ -87,3 +88,49 @@ def test_the_quintic_fit_lets_the_spans_run_faster_than_the_cubic():
         cut = spans(*fit_run(pts, 0.02, lam=lam, degree=degree), AXES)
         t[degree] = sum(s.length / min(span_limits(s, VEL, ACC, JERK)[0], feed) for s in cut) / bound
     assert t[5] <= 1.005 < 1.01 <= t[3], t
+
+
+def _window(make, at: int = 100, n: int = 40) -> np.ndarray:
+    """A streaming planner's window: `n` segments of a CAM program from vertex `at` on."""
+    return np.array([START] + make(at + n + 1).points, dtype=float)[at:at + n + 1]
+
+
+@pytest.mark.parametrize("make", [cam_polyline, cam_surface])
+def test_the_fast_fit_is_the_slow_one_within_its_finer_look(make):
+    """Decision 53: the banded solve, the check's exact distances only where they can reach 0.9·tol and its
+    finer look only where the nearest segment changes give the slow reference's curve (one sparse solve a
+    round, every fine point; tests/spline_slow.py) within 1e-5 mm (2e-6 on these windows, the finer look's
+    points between a step's ends no longer read where the distance is smooth) in as many rounds, and the
+    curve keeps N1.053 read 20 times finer than the check."""
+    pts = _window(make)
+    cost = Cost(parts={})
+    spl, cum = fit_run(pts, 0.02, cost=cost)
+    ref, _, rounds = slow.fit_run(pts, 0.02)
+    assert cost.rounds == rounds > 1
+    uu = np.linspace(0.0, cum[-1], 20_000)
+    assert max(np.abs(a(uu) - b(uu)).max() for a, b in zip(spl, ref)) < 1e-5
+    curve = np.stack([s(uu) for s in spl], axis=1)
+    assert 0.015 < polyline_deviation(curve, pts) <= 0.02
+    assert set(cost.parts) == {"setup", "solve", "check", "weights"}
+
+
+@pytest.mark.parametrize("make", [cam_polyline, cam_surface])
+def test_the_spans_cut_at_once_are_the_spans_cut_one_by_one(make):
+    """Decision 53: every piece of the run in one batch, the same arithmetic: lengths, arc-length tables,
+    points (through r(s)'s polynomials and through Newton steps), ends and bounds as the spans cut one by one
+    (tests/spline_slow.py) to 1e-12."""
+    spl, cum = fit_run(_window(make), 0.02)
+    fast, ref = spans(spl, cum, AXES), slow.spans(spl, cum)
+    assert len(fast) == len(ref) == len(cum) - 1
+    for f, r in zip(fast, ref):
+        assert f.length == pytest.approx(r.length, abs=1e-12)
+        assert np.allclose(f.s_tab, r.s_tab, rtol=0.0, atol=1e-12)
+        ss = np.linspace(0.0, r.length, 97)
+        for a, b in zip(f.derivatives(ss), r.derivatives(ss)):
+            assert np.abs(a - b).max() <= 1e-12 * max(1.0, np.abs(b).max())
+        p = r.derivatives(np.array([0.0, r.length]))[0]
+        assert np.abs(f.start - p[0]).max() < 1e-12 and np.abs(f.end - p[1]).max() < 1e-12
+        assert np.abs(f.points(ss) - r.derivatives(ss)[0]).max() < 1e-9
+        assert np.allclose(f.s_poly, r.s_poly(), rtol=1e-12, atol=1e-12)
+        for a, b in zip((f.dir_bound, f.acc_bound, f.jerk_bound), r.bounds()):
+            assert np.allclose(a, b, rtol=1e-12, atol=0.0)

@@ -1,0 +1,297 @@
+"""The smoothing-spline fit of a CAM run within N1.053 (decisions motion 48, 49, 51; its cost: 53).
+
+`fit_run` fits x(u), y(u), z(u) (u the polyline's chord length) by a quintic penalised B-spline with knots at
+PER_SEG samples a segment, the penalty λ·∫r'''², reweighted until every point of the curve is within the
+tolerance. Everything that depends on the knots only (the samples' B-spline rows, the penalty's band, the
+check grid's B-spline rows and its nearest segments) is built once a run (`_Problem`); a round then costs
+one weighted band (np.bincount), one banded Cholesky solve (scipy.linalg.solveh_banded) and a sparse
+product for the curve on the grid (decision 53). nc.motion.spline_runs re-exports these names.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse as sps
+from scipy.interpolate import BSpline, make_smoothing_spline
+from scipy.linalg import solveh_banded
+
+PER_SEG = 4  # polyline samples a segment the fit is made to
+DEGREE = 5  # quintic, its r''' continuous (decision 51); 3: decisions 48-50's cubic smoothing spline
+LAM = 0.01  # λ of the penalty ∫r'''² (mm⁵; of ∫r''² at DEGREE 3: 0.1 mm³); the weights then hold N1.053
+FINE = 20  # the check's finer look: FINE points a grid step (decision 51: 40 over the two steps around)
+_OFFSETS = (-2, -1, 0, 1, 2)  # the segments a curve point is measured against, around its own
+
+
+class FitError(RuntimeError):
+    """No fit within the tolerance."""
+
+
+@dataclass
+class Cost:
+    """CPU seconds by part, when asked for (`benchmarks/bench_spline_bound.py --cost`); the default
+    times nothing."""
+
+    parts: dict[str, float] | None = None  # None: not timed
+    rounds: int = 0
+
+    def lap(self, part: str, since: float) -> float:
+        """Charge the time since `since` to `part` and return now (0.0 when not timing)."""
+        if self.parts is None:
+            return 0.0
+        now = time.process_time()
+        if part:
+            self.parts[part] = self.parts.get(part, 0.0) + now - since
+        return now
+
+
+def samples(pts: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(chord-length parameter, points) of PER_SEG samples a segment, vertices included, and the
+    vertices' chord lengths."""
+    seg = np.linalg.norm(np.diff(pts, axis=0), axis=1)
+    cum = np.concatenate([[0.0], np.cumsum(seg)])
+    f = np.arange(PER_SEG) / PER_SEG
+    idx = np.repeat(np.arange(len(seg)), PER_SEG)
+    ff = np.tile(f, len(seg))
+    u = cum[idx] + ff * seg[idx]
+    p = pts[idx] + ff[:, None] * (pts[idx + 1] - pts[idx])
+    return np.append(u, cum[-1]), np.vstack([p, pts[-1]]), cum
+
+
+@dataclass
+class _Near:
+    """The segments within two of the one each chord parameter falls in, fixed while only the curve moves."""
+
+    seg: np.ndarray  # offsets × points: segment indices
+    a: np.ndarray  # offsets × points × axes: segment starts
+    d: np.ndarray  # segment vectors
+    dd: np.ndarray  # offsets × points: their squared lengths
+
+    @classmethod
+    def of(cls, cu: np.ndarray, pts: np.ndarray, cum: np.ndarray) -> "_Near":
+        k = np.clip(np.searchsorted(cum, cu) - 1, 0, len(pts) - 2)
+        i = np.clip(k[None, :] + np.array(_OFFSETS)[:, None], 0, len(pts) - 2)
+        a, d = pts[i], pts[i + 1] - pts[i]
+        return cls(i, a, d, np.maximum(np.einsum("oij,oij->oi", d, d), 1e-30))
+
+    def __getitem__(self, at: np.ndarray) -> "_Near":
+        return _Near(self.seg[:, at], self.a[:, at], self.d[:, at], self.dd[:, at])
+
+    def own(self, curve: np.ndarray, at: np.ndarray | slice = slice(None)) -> np.ndarray:
+        """Each point's distance from the segment its grid point `at` falls in: its distance from the
+        polyline or more."""
+        mid = len(_OFFSETS) // 2
+        ca = curve - self.a[mid][at]
+        d = self.d[mid][at]
+        t = np.clip(np.einsum("ij,ij->i", ca, d) / self.dd[mid][at], 0.0, 1.0)
+        r = ca - t[:, None] * d
+        return np.sqrt(np.einsum("ij,ij->i", r, r))
+
+    def distance(self, curve: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Each point's distance from the polyline and its nearest segment."""
+        best = np.full(len(curve), np.inf)
+        seg = self.seg[0].copy()
+        for i, a, d, dd in zip(self.seg, self.a, self.d, self.dd):
+            ca = curve - a
+            t = np.clip(np.einsum("ij,ij->i", ca, d) / dd, 0.0, 1.0)
+            r = ca - t[:, None] * d
+            q = np.einsum("ij,ij->i", r, r)
+            closer = q < best
+            seg[closer] = i[closer]
+            best = np.minimum(best, q)
+        return np.sqrt(best), seg
+
+
+@dataclass
+class _Check:
+    """The distance of a fitted curve from the polyline where it can matter for the reweighting: on a grid of
+    chord-length steps, exactly wherever it may exceed 0.9·tol, and finer (FINE points a step) in every step
+    next to such a point where the nearest segment changes, where the distance peaks (decisions 51, 53)."""
+
+    uu: np.ndarray
+    near: _Near
+    pts: np.ndarray
+    cum: np.ndarray
+    tol: float
+
+    def distance(self, curve: np.ndarray, evaluate) -> np.ndarray:
+        """`curve` on the grid; `evaluate(u)` the curve at other chord lengths."""
+        lim = 0.9 * self.tol
+        dist = self.near.own(curve)
+        seg = self.near.seg[len(_OFFSETS) // 2].copy()
+        over = dist > lim  # the others are within lim whatever their nearest segment: no weight changes there
+        over[1:] |= over[:-1]
+        over[:-1] |= over[1:]
+        at = np.flatnonzero(over)
+        dist[at], seg[at] = self.near[at].distance(curve[at])
+        close = np.flatnonzero(dist > lim)
+        if not len(close):
+            return dist
+        last = len(self.uu) - 2  # the last step
+        steps = np.unique(np.concatenate([close - 1, close]).clip(0, last))
+        steps = steps[seg[steps] != seg[steps + 1]]
+        fine = np.zeros(last + 1)
+        if len(steps):
+            frac = np.arange(1, FINE) / FINE
+            h = np.diff(self.uu)[steps]
+            uf = (self.uu[steps][:, None] + h[:, None] * frac[None, :]).ravel()
+            cf = evaluate(uf)
+            at = np.repeat(steps, FINE - 1)
+            df = self.near.own(cf, at)
+            # a fine point counts only above both ends of its step (each close point's window holds them)
+            look = np.flatnonzero(df > np.maximum(dist[at], dist[at + 1]))
+            df[look] = polyline_distance(cf[look], uf[look], self.pts, self.cum)
+            fine[steps] = df.reshape(len(steps), FINE - 1).max(axis=1)
+        lo, hi = np.maximum(close - 1, 0), np.minimum(close + 1, last + 1)
+        around = np.maximum.reduce([dist[lo], dist[hi], fine[lo], fine[np.minimum(close, last)]])
+        dist[close] = np.maximum(dist[close], around)
+        return dist
+
+
+def polyline_distance(curve: np.ndarray, cu: np.ndarray, pts: np.ndarray, cum: np.ndarray) -> np.ndarray:
+    """Distance of each curve point (at chord parameter cu) from the polyline, over the segments within
+    two of the one its parameter falls in."""
+    return _Near.of(cu, pts, cum).distance(curve)[0]
+
+
+def fit_curve(pts: np.ndarray, lam: float = LAM, w: np.ndarray | None = None, degree: int = DEGREE) -> list[BSpline]:
+    """Smoothing splines of the polyline's samples, one an axis, start and end pinned: quintic with the
+    penalty ∫r'''², or cubic with ∫r''² (`degree` 3, scipy's make_smoothing_spline)."""
+    u, p, _ = samples(pts)
+    w = np.ones(len(u)) if w is None else w.copy()
+    w[0] = w[-1] = 1e6
+    if degree == 5:
+        return quintic(u, p, w, lam)
+    return [make_smoothing_spline(u, p[:, k], w=w, lam=lam) for k in range(pts.shape[1])]
+
+
+def _rows(m: sps.csr_array, width: int) -> tuple[np.ndarray, np.ndarray]:
+    """A sparse matrix whose rows hold `width` consecutive columns each: (first column, values) a row."""
+    m = sps.csr_array(m)
+    m.sum_duplicates()
+    first = np.full(m.shape[0], m.shape[1] - width)
+    vals = np.zeros((m.shape[0], width))
+    nnz = np.diff(m.indptr)
+    row = np.repeat(np.arange(m.shape[0]), nnz)
+    np.minimum.at(first, row, m.indices)
+    first = np.clip(first, 0, m.shape[1] - width)
+    vals[row, m.indices - first[row]] = m.data
+    return first, vals
+
+
+@dataclass
+class _Band:
+    """Σ_rows q·v vᵀ of rows v with `width` consecutive entries, as the upper band of scipy's solveh_banded:
+    fixed indices, one np.bincount for new row weights q."""
+
+    n: int
+    width: int
+    idx: np.ndarray  # rows × pairs: flat index into the (width × n) band
+    prod: np.ndarray  # rows × pairs: v_a·v_b
+
+    @classmethod
+    def of(cls, first: np.ndarray, vals: np.ndarray, n: int) -> "_Band":
+        width = vals.shape[1]
+        ia, ib = np.triu_indices(width)
+        idx = (width - 1 + ia - ib)[None, :] * n + first[:, None] + ib[None, :]
+        return cls(n, width, idx, vals[:, ia] * vals[:, ib])
+
+    def band(self, q: np.ndarray) -> np.ndarray:
+        flat = np.bincount(self.idx.ravel(), (q[:, None] * self.prod).ravel(), minlength=self.width * self.n)
+        return flat.reshape(self.width, self.n)
+
+
+def penalty_parts(x: np.ndarray, k: int = 5, pen: int = 3) -> tuple[np.ndarray, sps.csr_array, sps.csr_array,
+                                                                   np.ndarray]:
+    """Knots t (at x, ends k + 1 fold), the samples' B-spline rows, the pen-th derivative's rows at 4
+    Gauss-Legendre points a knot interval and those points' quadrature weights: ∫(f^(pen))² = cᵀ·dkᵀ·Q·dk·c."""
+    t = np.concatenate([[x[0]] * k, x, [x[-1]] * k])
+    n = len(t) - k - 1
+    gx, gw = np.polynomial.legendre.leggauss(4)
+    h = np.diff(x) / 2.0
+    at = (x[:-1, None] + h[:, None] * (gx[None, :] + 1.0)).ravel()
+    m = sps.identity(n, format="csr")
+    tt, kk = t, k
+    for _ in range(pen):  # the coefficients of the derivative's B-splines
+        nn = m.shape[0]
+        den = tt[kk + 1: kk + nn] - tt[1: nn]
+        den = np.where(den > 0.0, den, np.inf)
+        m = sps.diags([-kk / den, kk / den], [0, 1], shape=(nn - 1, nn), format="csr") @ m
+        tt, kk = tt[1:-1], kk - 1
+    dk = sps.csr_array(BSpline.design_matrix(at, tt, kk) @ m)
+    return t, BSpline.design_matrix(x, t, k), dk, (h[:, None] * gw[None, :]).ravel()
+
+
+@dataclass
+class _Problem:
+    """The penalised B-splines of degree k with knots at x (decision 51), all that depends on x alone:
+    Σ w·(y − f)² + λ·∫(f^(pen))² least for any weights w, one banded Cholesky solve."""
+
+    t: np.ndarray
+    k: int
+    design: sps.csr_array  # samples × coefficients
+    fit: _Band  # the samples' part of the normal matrix
+    pen: np.ndarray  # λ·∫(f^(pen))², banded
+
+    @classmethod
+    def of(cls, x: np.ndarray, lam: float, k: int = 5, pen: int = 3) -> "_Problem":
+        t, b, dk, gq = penalty_parts(x, k, pen)
+        n = b.shape[1]
+        return cls(t, k, b, _Band.of(*_rows(b, k + 1), n), lam * _Band.of(*_rows(dk, k + 1), n).band(gq))
+
+    def solve(self, y: np.ndarray, w: np.ndarray) -> np.ndarray:
+        """The coefficients (coefficients × axes) for samples y (samples × axes) with weights w."""
+        rhs = self.design.T @ (w[:, None] * y)
+        return solveh_banded(self.fit.band(w) + self.pen, rhs, check_finite=False)
+
+
+def quintic(x: np.ndarray, y: np.ndarray, w: np.ndarray, lam: float, k: int = 5, pen: int = 3) -> list[BSpline]:
+    """Penalised B-splines of degree k with knots at x: Σ w·(y − f)² + λ·∫(f^(pen))² least
+    (y: samples × axes), one banded solve."""
+    prob = _Problem.of(x, lam, k, pen)
+    c = prob.solve(y, w)
+    return [BSpline(prob.t, c[:, j], k) for j in range(y.shape[1])]
+
+
+def fit_run(pts: np.ndarray, tol: float, lam: float = LAM, rounds: int = 60, step: float = 0.005,
+            degree: int = DEGREE, cost: Cost | None = None) -> tuple[list[BSpline], np.ndarray]:
+    """A fit within tol (checked every `step` mm of chord length, and FINE times finer within a step of
+    where it comes within 0.9·tol), smoothed locally as much as it allows:
+    the samples' weights grow (× (dev / 0.9·tol)³, never shrink) where the curve strays beyond 0.9·tol.
+    Returns the splines and the vertices' chord lengths; `cost` gets the CPU time by part if given."""
+    cost = cost or Cost()
+    tc = cost.lap("", 0.0)
+    pts = np.asarray(pts, dtype=float)
+    u, p, cum = samples(pts)
+    w = np.ones(len(u))
+    uu = np.append(np.arange(0.0, cum[-1], step), cum[-1])
+    j = np.clip(np.searchsorted(u, uu), 0, len(u) - 1)
+    check = _Check(uu, _Near.of(uu, pts, cum), pts, cum, tol)
+    if degree == 5:
+        prob = _Problem.of(u, lam)
+        grid = BSpline.design_matrix(uu, prob.t, prob.k)
+    tc = cost.lap("setup", tc)
+    for _ in range(rounds):
+        cost.rounds += 1
+        w[0] = w[-1] = 1e6  # start and end pinned
+        if degree == 5:
+            c = prob.solve(p, w)
+            spl = [BSpline(prob.t, c[:, a], prob.k) for a in range(p.shape[1])]
+            tc = cost.lap("solve", tc)
+            dist = check.distance(grid @ c, BSpline(prob.t, c, prob.k))
+        else:
+            spl = fit_curve(pts, lam, w, degree)
+            dist = check.distance(np.stack([s(uu) for s in spl], axis=1),
+                                  lambda uf: np.stack([s(uf) for s in spl], axis=1))
+        tc = cost.lap("check", tc)
+        if dist.max() <= tol:
+            return spl, cum
+        dev = np.zeros(len(u))  # each sample: the largest distance next to it
+        np.maximum.at(dev, j, dist)
+        np.maximum.at(dev, np.maximum(j - 1, 0), dist)
+        # bounded: no overflow where tol cannot be met
+        w = np.minimum(w * np.clip(dev / (0.9 * tol), 1.0, 10.0) ** 3, 1e9)
+        tc = cost.lap("weights", tc)
+    raise FitError(f"no fit within {tol} mm in {rounds} rounds (λ {lam:g})")
