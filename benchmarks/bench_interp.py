@@ -12,6 +12,11 @@ user runs it):
 Prints seconds (wall and CPU), peak MB and the ratio rs274 time / ours (1.0 = as fast as rs274), by
 wall clock and by CPU time (the steadier figure on a shared machine). Figures, never a
 pass/fail. rs274 comes with the Debian package linuxcnc-uspace; without it the ratio is skipped.
+
+  block  the interpreter's cost a block as the channel pays it (issue 17): `Interpreter.run` in process,
+         Move by Move (no bulk lane), on benchmarks/bench_motion.cam_program (--per-block lines of
+         `X.. Y..`, the bench_loop CAM program), CPU best of --repeat (at least 3), with the general
+         path alone (`Interpreter.lean = False`) beside it; rs274 -g on the same lines, CPU / blocks.
 """
 
 from __future__ import annotations
@@ -83,10 +88,50 @@ def timed(cmd: list[str], env: dict | None = None, cwd: str | None = None) -> tu
     return dt, usage.ru_maxrss / 1024.0, lines, usage.ru_utime + usage.ru_stime
 
 
+def _motion_cam(n: int) -> tuple[str, str]:
+    from bench_motion import cam_program as motion_cam  # the bench_loop CAM program (this folder)
+
+    text = motion_cam(n)
+    return text, "%\n" + text + "%\n"
+
+
+# The child that times `Interpreter.run` in the tree under test (PYTHONPATH): µs a block, CPU, best of N;
+# the general path alone too where the tree has the lean lane. Prints "lean general" (general: nan).
+_PER_BLOCK = """
+import sys, time
+from nc.interp import Interpreter
+from nc.profiles import make_profile
+from nc.program.blocks import parse_program
+text, repeat = open(sys.argv[1]).read(), int(sys.argv[2])
+prog = parse_program(text)
+n = len(prog.blocks)
+def best(lean):
+    out = []
+    for _ in range(repeat):
+        ip = Interpreter(make_profile("nc5-mill", ("X", "Y", "Z")))
+        if lean is not None:
+            ip.lean = lean
+        t0 = time.process_time()
+        for ev in ip.run(prog):
+            pass
+        out.append(time.process_time() - t0)
+    return min(out) / n * 1e6
+lean = hasattr(Interpreter, "lean")
+print(best(None), best(False) if lean else float("nan"))
+"""
+
+
+def per_block(path: Path, tree: str, env: dict, repeat: int) -> tuple[float, float]:
+    """µs a block of `Interpreter.run` on the program at `path` in `tree` (lean lane, general path)."""
+    out = subprocess.run([sys.executable, "-c", _PER_BLOCK, str(path), str(max(3, repeat))], env=env, cwd=tree,
+                         capture_output=True, text=True, check=True).stdout.split()
+    return float(out[0]), float(out[1])
+
+
 def write_case(name: str, folder: str, blocks: int, passes: int, parts: int) -> None:
     """The case's two program files, ours (.nc) and rs274's (.ngc), in `folder`."""
     ours, theirs = {"cam": lambda: (cam_program(blocks),) * 2, "macro": lambda: macro_program(passes),
-                    "lathe": lambda: lathe_program(parts)}[name]()
+                    "lathe": lambda: lathe_program(parts), "block": lambda: _motion_cam(blocks)}[name]()
     (Path(folder) / f"{name}.nc").write_text(ours)
     (Path(folder) / f"{name}.ngc").write_text(theirs)
 
@@ -101,7 +146,8 @@ def main() -> int:
     ap.add_argument("--passes", type=int, default=5000, help="macro WHILE passes (default 5000)")
     ap.add_argument("--parts", type=int, default=200, help="lathe parts, each G71/G70/G76 (default 200)")
     ap.add_argument("--repeat", type=int, default=1, help="best of N runs")
-    ap.add_argument("--only", choices=("cam", "macro", "lathe"), action="append")
+    ap.add_argument("--per-block", type=int, default=5000, help="lines of the per-block case (default 5000)")
+    ap.add_argument("--only", choices=("cam", "macro", "lathe", "block"), action="append")
     ap.add_argument("--json", action="store_true")
     ap.add_argument("--tree", default=str(ROOT), help="run `hil` from this source tree (e.g. another checkout, "
                                                       "for before/after figures)")
@@ -114,13 +160,24 @@ def main() -> int:
     rows = []
     with tempfile.TemporaryDirectory() as d:
         profiles = {"cam": "nc5-mill", "macro": "nc5-mill", "lathe": "nc5-lathe-a"}
-        for name in ("cam", "macro", "lathe"):
+        for name in ("cam", "macro", "lathe", "block"):
             if args.only and name not in args.only:
                 continue
             # written by another process: a child's peak RSS (wait4) counts the pages its parent had at
             # the fork, and a parent that had built a 1M-block text would add ~150 MB to both columns
-            subprocess.run([sys.executable, __file__, "--write", name, d, str(args.blocks), str(args.passes),
+            subprocess.run([sys.executable, __file__, "--write", name, d,
+                            str(args.per_block if name == "block" else args.blocks), str(args.passes),
                             str(args.parts)], check=True)
+            if name == "block":
+                lean, general = per_block(Path(d) / "block.nc", args.tree, env, args.repeat)
+                row = {"case": name, "blocks": args.per_block, "interp_us_block": round(lean, 2),
+                       "general_us_block": round(general, 2)}
+                if rs274:
+                    ref = min((timed([rs274, "-g", str(Path(d) / "block.ngc")]) for _ in range(max(3, args.repeat))),
+                              key=lambda r: r[3])
+                    row["rs274_us_block"] = round(ref[3] / args.per_block * 1e6, 2)
+                rows.append(row)
+                continue
             # more blocks than the endless-loop guard allows (decisions P5: "max blocks", 1,000,000 executed
             # blocks) need the guard raised, as a user running such a program does
             guard = ["--param", f"max blocks={2 * args.blocks}"] if name == "cam" and args.blocks > 900_000 else []
@@ -144,6 +201,11 @@ def main() -> int:
     print(f"{'case':6s} {'hil path s':>10s} {'cpu s':>6s} {'peak MB':>8s} {'rs274 -g s':>10s} {'cpu s':>6s} "
           f"{'peak MB':>8s} {'rs274/ours':>10s} {'(cpu)':>6s}")
     for r in rows:
+        if r["case"] == "block":
+            print(f"block  {r['blocks']} `X Y` lines (bench_motion.cam_program), CPU µs a block: Interpreter.run "
+                  f"{r['interp_us_block']:.2f} (general path alone {r['general_us_block']:.2f}); rs274 -g "
+                  f"{r.get('rs274_us_block', nan):.2f} (whole command)")
+            continue
         print(f"{r['case']:6s} {r['hil_s']:10.2f} {r['hil_cpu_s']:6.2f} {r['hil_peak_mb']:8.0f} "
               f"{r.get('rs274_s', nan):10.2f} {r.get('rs274_cpu_s', nan):6.2f} {r.get('rs274_peak_mb', nan):8.0f} "
               f"{r.get('ratio', nan):10.3f} {r.get('cpu_ratio', nan) or nan:6.3f}")
