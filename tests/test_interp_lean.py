@@ -7,15 +7,16 @@ and a lathe profile, with and without a channel's statement budget."""
 from __future__ import annotations
 
 import pytest
-from hypothesis import given, settings
+from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 from nc.alarms import NcAlarm
 from nc.budget import StatementBudget
 from nc.interp import Interpreter
+from nc.interp.lean import LineBlock
 from nc.moves import Busy, Move
 from nc.profiles import make_profile
-from nc.program.blocks import parse_program
+from nc.program.blocks import parse_block, parse_program
 from nc.store import ProgramStore
 from tests.test_interp_bulk import plain
 
@@ -166,3 +167,22 @@ def test_modal_cases_run_the_same_in_the_lean_lane(profile: str, text: str) -> N
     for stop in range(1, text.count("\n")):  # the state after each line (the last block read, its N)
         cut = "\n".join(text.split("\n")[:stop]) + "\n"
         assert _run(profile, cut, True) == _run(profile, cut, False)
+
+
+@settings(max_examples=200, deadline=None)
+@given(line=plain(("X", "Y", "Z")))
+def test_the_block_of_a_lane_line_is_the_parsers_block(line: str) -> None:
+    """`Interpreter.block` after a line the lane ran reads as the parser's block: words, N, text, equal
+    and printed the same; a line the lane does not take (a repeated letter, F < 0) is the parser's."""
+    assume(line.strip())  # a blank line is no block
+    ip = Interpreter(make_profile("nc5-mill"))
+    try:
+        list(ip.run(parse_program(f"G90 G1 F100\n{line}\n")))
+    except NcAlarm:  # F-5 and the like: the general path raised it
+        assert not isinstance(ip.block, LineBlock)
+    parsed = parse_block(2, line)
+    if isinstance(ip.block, LineBlock):
+        assert ip.block == parsed and parsed == ip.block and repr(ip.block) == repr(parsed)
+        assert (ip.block.words, ip.block.n, ip.block.text) == (parsed.words, parsed.n, parsed.text)
+    else:
+        assert ip.block == parsed

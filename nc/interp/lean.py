@@ -173,7 +173,7 @@ class LeanLane:
         fr.pc = pc + 1
         ip._executed += 1
         ip.program_name = fr.program.name
-        ip.block = _block(fr, pc, raw, shape, vals)
+        ip.block = LineBlock(fr.program.blocks.line(pc), raw, shape, vals)
         if shape.g is not None:
             st.groups[1] = float(vals[shape.g])
             st.motion = motion
@@ -195,13 +195,69 @@ class LeanLane:
         return mv
 
 
-def _block(fr: "Frame", pc: int, raw: str, shape: _Shape, vals: tuple[str, ...]) -> Block:
-    """The Block the parser reads from `raw` (`_plain_block`), from the shape's groups."""
-    blk = Block(fr.program.blocks.line(pc), raw)
-    words = blk.words
-    for c, v in zip(shape.letters, vals):
-        if c == "N":
-            blk.n = int(v)
-        else:
-            words.append(Word(c, float(v), c + v, "." in v))
-    return blk
+_WORDS = Block.__dict__["words"]  # Block's slots: LineBlock fills them when first read
+_N = Block.__dict__["n"]
+
+
+class LineBlock(Block):
+    """The Block of a line the lane ran: its words (and N) are made from the matched text when first
+    read, as `_plain_block` makes them. What the lane's callers read of `Interpreter.block` (line,
+    text, the empty comma: nc.interp.corners, alarms, M96) needs none, and making them was a fifth
+    of the lane's time. Equal to, and printed as, the Block the parser makes of the line."""
+
+    __slots__ = ("_match",)  # (shape, groups) until the words are made, then None
+
+    def __init__(self, line: int, text: str, shape: _Shape, vals: tuple[str, ...]) -> None:
+        self.line, self.text, self.skip, self.comment, self.stmt = line, text, False, "", None
+        self.comma, self.comma_expr = {}, {}
+        self._match = (shape, vals)
+
+    def _read(self) -> None:
+        shape, vals = self._match
+        self._match = None
+        words = []
+        n = None
+        for c, v in zip(shape.letters, vals):
+            if c == "N":
+                n = int(v)
+            else:
+                words.append(Word(c, float(v), c + v, "." in v))
+        _WORDS.__set__(self, words)
+        _N.__set__(self, n)
+
+    @property  # type: ignore[override]
+    def words(self) -> list[Word]:
+        if self._match is not None:
+            self._read()
+        return _WORDS.__get__(self)
+
+    @words.setter
+    def words(self, value: list[Word]) -> None:
+        if self._match is not None:
+            self._read()  # N as read
+        _WORDS.__set__(self, value)
+
+    @property  # type: ignore[override]
+    def n(self) -> int | None:
+        if self._match is not None:
+            self._read()
+        return _N.__get__(self)
+
+    @n.setter
+    def n(self, value: int | None) -> None:
+        if self._match is not None:
+            self._read()
+        _N.__set__(self, value)
+
+    def plain(self) -> Block:
+        """The same block as a Block."""
+        return Block(self.line, self.text, self.words, self.n, self.skip, self.comma, self.comment, self.stmt,
+                     self.comma_expr)
+
+    def __eq__(self, other: object) -> bool:
+        return self.plain() == (other.plain() if isinstance(other, LineBlock) else other)
+
+    __hash__ = None  # type: ignore[assignment]  # as Block's
+
+    def __repr__(self) -> str:
+        return repr(self.plain())
