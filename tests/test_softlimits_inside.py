@@ -1,0 +1,66 @@
+"""`SoftLimits.check`'s quick answer for a line inside both segments (`_inside`, issue 17) never hides
+an alarm: on random lines, arcs, limits (bench, G10 L21 P1-P4, a diameter axis, a disabled axis) the
+alarm is the one the full check over the path ranges gives, and a move that crosses is refused."""
+
+from __future__ import annotations
+
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from nc.moves import Move
+from nc.softlimits import SoftLimits
+
+AXES = ("X", "Y", "Z")
+value = st.one_of(st.floats(-400, 400), st.sampled_from([0.0, -0.0, 300.0, -300.0, 300.0 + 1e-9, 150.0]))
+limit = st.one_of(st.none(), st.floats(-350, 350))
+
+
+@st.composite
+def limits(draw) -> SoftLimits:
+    first = {a: tuple(sorted((draw(st.floats(-350, 350)), draw(st.floats(-350, 350)))))
+             for a in draw(st.lists(st.sampled_from(AXES), unique=True))}
+    params = {f"soft limit {p} {a}": v for p in (1, 2, 3, 4) for a in AXES if (v := draw(limit)) is not None}
+    sl = SoftLimits(first, params, draw(st.sampled_from([(), ("X",)])))
+    sl.disabled = set(draw(st.lists(st.sampled_from(AXES), unique=True, max_size=1)))
+    return sl
+
+
+@st.composite
+def moves(draw) -> Move:
+    start = {a: draw(value) for a in AXES}
+    end_axes = draw(st.sampled_from([AXES, AXES, ("X", "Z")]))
+    end = {a: draw(value) for a in end_axes}
+    kind = draw(st.sampled_from(["line", "rapid", "arc", "thread"]))
+    centre = {a: draw(value) for a in AXES} if kind == "arc" else None
+    return Move(kind, 7, "G1 X1.", start, end, dict(end), centre, "cw" if draw(st.booleans()) else "ccw",
+                plane=("X", "Y"))
+
+
+def _full(sl: SoftLimits, mv: Move):
+    """`check` without the quick answer."""
+    sl._inside = lambda move: False  # type: ignore[method-assign]
+    try:
+        return sl.check(mv)
+    finally:
+        del sl._inside
+
+
+@settings(max_examples=600, deadline=None)
+@given(sl=limits(), mv=moves())
+def test_the_quick_answer_gives_the_full_checks_alarm(sl: SoftLimits, mv: Move) -> None:
+    quick = sl.check(mv)
+    full = _full(sl, mv)
+    assert (quick is None) == (full is None)
+    if full is not None:
+        assert (quick.code, quick.message, quick.axis) == (full.code, full.message, full.axis)
+
+
+def test_a_line_past_a_g10_l21_limit_is_refused_and_one_inside_passes() -> None:
+    sl = SoftLimits({"X": (-300.0, 300.0)}, {"soft limit 3 Y": 50.0}, ())
+    inside = Move("line", 3, "X1. Y2.", {"X": 0.0, "Y": 0.0}, {"X": 299.0, "Y": 49.0}, {"X": 299.0, "Y": 49.0})
+    past = Move("line", 4, "Y60.", {"X": 0.0, "Y": 0.0}, {"X": 0.0, "Y": 60.0}, {"X": 0.0, "Y": 60.0})
+    assert sl.check(inside) is None
+    alarm = sl.check(past)
+    assert alarm is not None and (alarm.code, alarm.axis, alarm.line) == (0x0A03, "Y", 4)
+    sl.params = {"soft limit 3 Y": 70.0}  # G10 L21 P3 changed: read again
+    assert sl.check(past) is None
