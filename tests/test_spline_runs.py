@@ -117,8 +117,9 @@ def test_the_fast_fit_is_the_slow_one_within_its_finer_look(make):
 @pytest.mark.parametrize("make", [cam_polyline, cam_surface])
 def test_the_spans_cut_at_once_are_the_spans_cut_one_by_one(make):
     """Decision 53: every piece of the run in one batch, the same arithmetic: lengths, arc-length tables,
-    points (through r(s)'s polynomials and through Newton steps), ends and bounds as the spans cut one by one
-    (tests/spline_slow.py) to 1e-12."""
+    points (through r(s)'s polynomials and through Newton steps) and r(s)'s polynomials as the spans cut one
+    by one (tests/spline_slow.py) to 1e-12; the ends and the bounds, read where each piece's w(s) polynomial
+    puts the samples instead of Newton steps, to 1e-10 (4e-12 relative, 2e-12 mm here)."""
     spl, cum = fit_run(_window(make), 0.02)
     fast, ref = spans(spl, cum, AXES), slow.spans(spl, cum)
     assert len(fast) == len(ref) == len(cum) - 1
@@ -129,8 +130,8 @@ def test_the_spans_cut_at_once_are_the_spans_cut_one_by_one(make):
         for a, b in zip(f.derivatives(ss), r.derivatives(ss)):
             assert np.abs(a - b).max() <= 1e-12 * max(1.0, np.abs(b).max())
         p = r.derivatives(np.array([0.0, r.length]))[0]
-        assert np.abs(f.start - p[0]).max() < 1e-12 and np.abs(f.end - p[1]).max() < 1e-12
+        assert np.abs(f.start - p[0]).max() < 1e-10 and np.abs(f.end - p[1]).max() < 1e-10
         assert np.abs(f.points(ss) - r.derivatives(ss)[0]).max() < 1e-9
         assert np.allclose(f.s_poly, r.s_poly(), rtol=1e-12, atol=1e-12)
         for a, b in zip((f.dir_bound, f.acc_bound, f.jerk_bound), r.bounds()):
-            assert np.allclose(a, b, rtol=1e-12, atol=0.0)
+            assert np.allclose(a, b, rtol=1e-10, atol=0.0)

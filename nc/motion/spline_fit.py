@@ -61,47 +61,37 @@ def samples(pts: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 
 @dataclass
-class _Near:
-    """The segments within two of the one each chord parameter falls in, fixed while only the curve moves."""
+class _Segs:
+    """The polyline's segments: starts, vectors and squared lengths."""
 
-    seg: np.ndarray  # offsets × points: segment indices
-    a: np.ndarray  # offsets × points × axes: segment starts
-    d: np.ndarray  # segment vectors
-    dd: np.ndarray  # offsets × points: their squared lengths
+    a: np.ndarray
+    d: np.ndarray
+    dd: np.ndarray
 
     @classmethod
-    def of(cls, cu: np.ndarray, pts: np.ndarray, cum: np.ndarray) -> "_Near":
-        k = np.clip(np.searchsorted(cum, cu) - 1, 0, len(pts) - 2)
-        i = np.clip(k[None, :] + np.array(_OFFSETS)[:, None], 0, len(pts) - 2)
-        a, d = pts[i], pts[i + 1] - pts[i]
-        return cls(i, a, d, np.maximum(np.einsum("oij,oij->oi", d, d), 1e-30))
+    def of(cls, pts: np.ndarray) -> "_Segs":
+        d = np.diff(pts, axis=0)
+        return cls(pts[:-1], d, np.maximum(np.einsum("ij,ij->i", d, d), 1e-30))
 
-    def __getitem__(self, at: np.ndarray) -> "_Near":
-        return _Near(self.seg[:, at], self.a[:, at], self.d[:, at], self.dd[:, at])
+    def to(self, curve: np.ndarray, i: np.ndarray) -> np.ndarray:
+        """Squared distance of points (points × axes) from segments i (one a point, or candidates × points)."""
+        pa = curve - self.a[i]
+        d = self.d[i]
+        t = np.clip(np.einsum("...j,...j->...", pa, d) / self.dd[i], 0.0, 1.0)
+        r = pa - t[..., None] * d
+        return np.einsum("...j,...j->...", r, r)
 
-    def own(self, curve: np.ndarray, at: np.ndarray | slice = slice(None)) -> np.ndarray:
-        """Each point's distance from the segment its grid point `at` falls in: its distance from the
-        polyline or more."""
-        mid = len(_OFFSETS) // 2
-        ca = curve - self.a[mid][at]
-        d = self.d[mid][at]
-        t = np.clip(np.einsum("ij,ij->i", ca, d) / self.dd[mid][at], 0.0, 1.0)
-        r = ca - t[:, None] * d
-        return np.sqrt(np.einsum("ij,ij->i", r, r))
+    def distance(self, curve: np.ndarray, k: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Each point's distance from the segments within two of its own (k) and the nearest of them."""
+        i = np.clip(k[None, :] + np.array(_OFFSETS)[:, None], 0, len(self.a) - 1)
+        q = self.to(curve[None, :, :], i)
+        near = np.argmin(q, axis=0)  # the first of equals, as a running minimum over the offsets
+        cols = np.arange(len(k))
+        return np.sqrt(q[near, cols]), i[near, cols]
 
-    def distance(self, curve: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Each point's distance from the polyline and its nearest segment."""
-        best = np.full(len(curve), np.inf)
-        seg = self.seg[0].copy()
-        for i, a, d, dd in zip(self.seg, self.a, self.d, self.dd):
-            ca = curve - a
-            t = np.clip(np.einsum("ij,ij->i", ca, d) / dd, 0.0, 1.0)
-            r = ca - t[:, None] * d
-            q = np.einsum("ij,ij->i", r, r)
-            closer = q < best
-            seg[closer] = i[closer]
-            best = np.minimum(best, q)
-        return np.sqrt(best), seg
+
+def _segment_of(cu: np.ndarray, cum: np.ndarray) -> np.ndarray:
+    return np.clip(np.searchsorted(cum, cu) - 1, 0, len(cum) - 2)
 
 
 @dataclass
@@ -111,27 +101,42 @@ class _Check:
     next to such a point where the nearest segment changes, where the distance peaks (decisions 51, 53)."""
 
     uu: np.ndarray
-    near: _Near
-    pts: np.ndarray
+    segs: _Segs
     cum: np.ndarray
     tol: float
+    k: np.ndarray  # each grid point's own segment
+    own: tuple[np.ndarray, np.ndarray, np.ndarray]  # that segment's start and vector (axes × points), 1/|d|²
+
+    @classmethod
+    def of(cls, uu: np.ndarray, pts: np.ndarray, cum: np.ndarray, tol: float) -> "_Check":
+        segs, k = _Segs.of(pts), _segment_of(uu, cum)
+        own = (np.ascontiguousarray(segs.a[k].T), np.ascontiguousarray(segs.d[k].T), 1.0 / segs.dd[k])
+        return cls(uu, segs, cum, tol, k, own)
 
     def distance(self, curve: np.ndarray, evaluate) -> np.ndarray:
-        """`curve` on the grid; `evaluate(u)` the curve at other chord lengths."""
+        """`curve` on the grid (axes × points); `evaluate(u)` the curve at other chord lengths (points × axes)."""
         lim = 0.9 * self.tol
-        dist = self.near.own(curve)
-        seg = self.near.seg[len(_OFFSETS) // 2].copy()
+        a, d, inv = self.own  # each point against its own segment first: an upper bound of its distance
+        pa = curve - a
+        t = np.clip(np.einsum("ij,ij->j", pa, d) * inv, 0.0, 1.0)
+        pa -= t * d
+        dist = np.sqrt(np.einsum("ij,ij->j", pa, pa))
+        seg = self.k.copy()
         over = dist > lim  # the others are within lim whatever their nearest segment: no weight changes there
         over[1:] |= over[:-1]
         over[:-1] |= over[1:]
         at = np.flatnonzero(over)
-        dist[at], seg[at] = self.near[at].distance(curve[at])
+        if not len(at):
+            return dist
+        dist[at], seg[at] = self.segs.distance(curve[:, at].T, self.k[at])
         close = np.flatnonzero(dist > lim)
         if not len(close):
             return dist
         last = len(self.uu) - 2  # the last step
-        steps = np.unique(np.concatenate([close - 1, close]).clip(0, last))
-        steps = steps[seg[steps] != seg[steps + 1]]
+        side = np.zeros(last + 1, dtype=bool)
+        side[np.maximum(close - 1, 0)] = True
+        side[np.minimum(close, last)] = True
+        steps = np.flatnonzero(side & (seg[:-1] != seg[1:]))
         fine = np.zeros(last + 1)
         if len(steps):
             frac = np.arange(1, FINE) / FINE
@@ -139,10 +144,11 @@ class _Check:
             uf = (self.uu[steps][:, None] + h[:, None] * frac[None, :]).ravel()
             cf = evaluate(uf)
             at = np.repeat(steps, FINE - 1)
-            df = self.near.own(cf, at)
-            # a fine point counts only above both ends of its step (each close point's window holds them)
+            # the nearer of the step's ends' nearest segments bounds a fine point's distance; it counts
+            # only above both of the step's ends (each close point's window holds them)
+            df = np.sqrt(np.minimum(self.segs.to(cf, seg[at]), self.segs.to(cf, seg[at + 1])))
             look = np.flatnonzero(df > np.maximum(dist[at], dist[at + 1]))
-            df[look] = polyline_distance(cf[look], uf[look], self.pts, self.cum)
+            df[look] = self.segs.distance(cf[look], _segment_of(uf[look], self.cum))[0]
             fine[steps] = df.reshape(len(steps), FINE - 1).max(axis=1)
         lo, hi = np.maximum(close - 1, 0), np.minimum(close + 1, last + 1)
         around = np.maximum.reduce([dist[lo], dist[hi], fine[lo], fine[np.minimum(close, last)]])
@@ -153,7 +159,7 @@ class _Check:
 def polyline_distance(curve: np.ndarray, cu: np.ndarray, pts: np.ndarray, cum: np.ndarray) -> np.ndarray:
     """Distance of each curve point (at chord parameter cu) from the polyline, over the segments within
     two of the one its parameter falls in."""
-    return _Near.of(cu, pts, cum).distance(curve)[0]
+    return _Segs.of(pts).distance(curve, _segment_of(cu, cum))[0]
 
 
 def fit_curve(pts: np.ndarray, lam: float = LAM, w: np.ndarray | None = None, degree: int = DEGREE) -> list[BSpline]:
@@ -268,10 +274,10 @@ def fit_run(pts: np.ndarray, tol: float, lam: float = LAM, rounds: int = 60, ste
     w = np.ones(len(u))
     uu = np.append(np.arange(0.0, cum[-1], step), cum[-1])
     j = np.clip(np.searchsorted(u, uu), 0, len(u) - 1)
-    check = _Check(uu, _Near.of(uu, pts, cum), pts, cum, tol)
+    check = _Check.of(uu, pts, cum, tol)
     if degree == 5:
         prob = _Problem.of(u, lam)
-        grid = BSpline.design_matrix(uu, prob.t, prob.k)
+        grid = BSpline.design_matrix(uu, prob.t, prob.k, extrapolate=True)  # no bounds check in Python
     tc = cost.lap("setup", tc)
     for _ in range(rounds):
         cost.rounds += 1
@@ -280,10 +286,10 @@ def fit_run(pts: np.ndarray, tol: float, lam: float = LAM, rounds: int = 60, ste
             c = prob.solve(p, w)
             spl = [BSpline(prob.t, c[:, a], prob.k) for a in range(p.shape[1])]
             tc = cost.lap("solve", tc)
-            dist = check.distance(grid @ c, BSpline(prob.t, c, prob.k))
+            dist = check.distance((grid @ c).T, BSpline(prob.t, c, prob.k))
         else:
             spl = fit_curve(pts, lam, w, degree)
-            dist = check.distance(np.stack([s(uu) for s in spl], axis=1),
+            dist = check.distance(np.stack([s(uu) for s in spl]),
                                   lambda uf: np.stack([s(uf) for s in spl], axis=1))
         tc = cost.lap("check", tc)
         if dist.max() <= tol:

@@ -121,14 +121,25 @@ def _by_arc(c: np.ndarray, width: np.ndarray, tab: np.ndarray, node: np.ndarray,
     polynomials c (n × (degree + 1) × axes) of chord length `width`, arc-length table `tab` (NODES a
     piece), s at or past the table's `node`."""
     cs = _soa(c)
+    return _in_s(cs, _newton(cs, width, tab, node, s))
+
+
+def _newton(cs: tuple[np.ndarray, ...], width: np.ndarray, tab: np.ndarray, node: np.ndarray,
+            s: np.ndarray) -> np.ndarray:
+    """The chord parameter w at path length s of each piece (`_by_arc`'s), by three Newton steps on its arc
+    length from the table's node."""
     h = width / (NODES - 1)
     w0 = node * h
     s0 = tab[np.arange(len(s)), node]
     w = w0 + (s - s0) / np.maximum(_speed(cs[1], w0), 1e-12)
-    for _ in range(3):  # Newton on the arc length from the node
+    for _ in range(3):
         w = np.clip(w, 0.0, width)
         w = w - (s0 + _arc(cs[1], w0, w) - s) / _speed(cs[1], w)
-    w = np.clip(w, 0.0, width)
+    return np.clip(w, 0.0, width)
+
+
+def _in_s(cs: tuple[np.ndarray, ...], w: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Position and its first three derivatives in path length (each n × axes) at chord parameters w."""
     r, d1, d2, d3 = (_poly(cd, w) for cd in cs)
     sig2 = np.einsum("ij,ij->j", d1, d1)
     sig = np.sqrt(sig2)
@@ -186,8 +197,13 @@ def spans(spl: list[BSpline], cum: np.ndarray, axes: tuple[str, ...], margin: fl
     sc = (0.5 * (sa[:, None] + sb[:, None]) + 0.5 * (sb - sa)[:, None] * _CHEB_X[None, :]).ravel()
     pc = np.repeat(np.arange(n), CHEB + 1)
     node = np.maximum((s_tab[pc, :NODES - 1] <= sc[:, None]).sum(axis=1) - 1, 0)
-    r = _by_arc(coef[pc], width[pc], s_tab[pc], node, sc)[0].reshape(n, CHEB + 1, -1)
-    s_poly = np.linalg.solve(np.broadcast_to(_CHEB_V, (n, CHEB + 1, CHEB + 1)), r)
+    cs = _soa(coef[pc])
+    wc = _newton(cs, width[pc], s_tab[pc], node, sc)
+    r = _in_s(cs, wc)[0].reshape(n, CHEB + 1, -1)
+    # r(s) and w(s) a piece as polynomials through them (w(s) is what the bounds' samples are read at)
+    both = np.concatenate([r, wc.reshape(n, CHEB + 1, 1)], axis=2)
+    both = np.linalg.solve(np.broadcast_to(_CHEB_V, (n, CHEB + 1, CHEB + 1)), both)
+    s_poly, w_poly = both[:, :, :-1], both[:, :, -1]
     t = cost.lap("chebyshev", t)
     # the bounds: 33 points a piece along each span's length, its ends first and last
     ns = 33 * count
@@ -198,8 +214,12 @@ def spans(spl: list[BSpline], cum: np.ndarray, axes: tuple[str, ...], margin: fl
     for q in range(1, int(count.max())):  # the piece each sample falls in (the table's last at its end)
         more = (q < count[ss]) & (s_tab[np.minimum(first[ss] + q, n - 1), 0] <= sv)
         pb[more] = first[ss][more] + q
-    node = np.clip((s_tab[pb, :NODES - 1] <= sv[:, None]).sum(axis=1) - 1, 0, NODES - 2)
-    r, rs, rss, rsss = _by_arc(coef[pb], width[pb], s_tab[pb], node, sv)
+    # w at each sample from its piece's w(s) (within 1e-13 of the Newton steps, a tenth of their time)
+    x = (2.0 * sv - sa[pb] - sb[pb]) / (sb[pb] - sa[pb])
+    wb = w_poly[pb, 0]
+    for i in range(1, CHEB + 1):
+        wb = wb * x + w_poly[pb, i]
+    r, rs, rss, rsss = _in_s(_soa(coef[pb]), np.clip(wb, 0.0, width[pb]))
     edge = np.cumsum(ns) - ns
     dir_b = np.minimum(np.maximum.reduceat(np.abs(rs), edge) * margin, 1.0)
     acc_b = np.maximum.reduceat(np.abs(rss), edge) * margin
