@@ -93,7 +93,7 @@ def staged(label: str, program: Path, bench_file: Path | None, trace: str | None
     def timed_run(runner, prog):  # benchmark only: wraps this run's parts, restored below
         for stage, obj, name in (("MLC", runner.mlc, "scan"), ("MLC", runner.mlc, "bus_feedback"),
                                  ("bus + drives", runner.link, "exchange"), ("trace", runner.trace, "write"),
-                                 ("trace", runner.trace, "write_many")):
+                                 ("trace", runner.trace, "write_columns")):
             if obj is not None and hasattr(obj, name):
                 st = _Stage(getattr(obj, name))
                 setattr(obj, name, st)

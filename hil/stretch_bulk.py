@@ -16,7 +16,6 @@ here when every cycle of it would do exactly this, and `bulk_cycles` does it onc
 from __future__ import annotations
 
 import time as _time
-from itertools import repeat
 from typing import Any
 
 import numpy as np
@@ -304,28 +303,31 @@ def _rows(r: Any, outs: list[Stretch], k0: int, m: int, times: list[float], firs
     n_axes = len(r.axes)
     scales, org = r.scales, r.origin.tolist()
     cnt = m - k0
-    cols: list[list] = []
+    trace = r.trace
+    # a Parquet trace takes the columns as they are (float64 arrays); rows for the others
+    as_cols = type(trace) is ParquetTrace
+    done = (lambda a: a) if as_cols else (lambda a: a.tolist())
+    cols: list = []
     for i, (sc, out) in enumerate(zip(scales, outs)):
         cpu, rpc = sc._cpu, sc._raw_per_cps
         pa = np.array(out.position_actual[k0:m], dtype=np.float64)
         va = np.array(out.velocity_actual[k0:m], dtype=np.float64)
-        tq = (np.array(out.torque_actual[k0:m], dtype=np.float64) * sc.units.torque_percent).tolist()
+        tq = done(np.array(out.torque_actual[k0:m], dtype=np.float64) * sc.units.torque_percent)
         if i < n_axes:  # AxisScaling.to_units, drive_to_velocity, torque_percent
-            cols += [positions[k0:m, i].tolist(), (pa / cpu + org[i]).tolist(), (va / rpc / cpu).tolist(), tq,
-                     (np.array(out.following_error[k0:m], dtype=np.float64) / cpu).tolist(), out.statusword[k0:m]]
+            cols += [done(np.ascontiguousarray(positions[k0:m, i])), done(pa / cpu + org[i]), done(va / rpc / cpu), tq,
+                     done(np.array(out.following_error[k0:m], dtype=np.float64) / cpu), out.statusword[k0:m]]
         else:  # drive_to_rpm of the command and the feedback, the angle mod 360
-            cols += [[sc.drive_to_rpm(r.rx[i].target_velocity)] * cnt, (va / rpc / cpu / sc.lead * 60.0).tolist(),
-                     np.remainder(pa / cpu, 360.0).tolist(), tq, out.statusword[k0:m]]
+            cols += [[sc.drive_to_rpm(r.rx[i].target_velocity)] * cnt, done(va / rpc / cpu / sc.lead * 60.0),
+                     done(np.remainder(pa / cpu, 360.0)), tq, out.statusword[k0:m]]
     if timings is None:
-        periods, lates = repeat(r.timing.period, cnt), repeat(r.timing.late, cnt)
+        periods, lates = [r.timing.period] * cnt, [r.timing.late] * cnt
     else:  # real time: each cycle's own
         periods, lates = [t.period for t in timings], [t.late for t in timings]
-    rows = zip([round(t, 9) for t in times], lines, range(first_cycle, first_cycle + cnt), periods, lates,
-               repeat("", cnt), *cols)
-    trace = r.trace
-    if type(trace) is ParquetTrace:
-        trace.write_many(rows)
+    head = [[round(t, 9) for t in times], lines, list(range(first_cycle, first_cycle + cnt)), periods, lates,
+            [""] * cnt]
+    if as_cols:
+        trace.write_columns(head + cols, cnt)
     else:
-        for row in rows:
+        for row in zip(*head, *cols):
             trace.write(row)
     r._row_cycle = r.cycle

@@ -26,7 +26,7 @@ import sys
 import threading
 import time
 from pathlib import Path
-from typing import Any, Iterable, Sequence
+from typing import Any, Sequence
 
 import pyarrow as pa
 import pyarrow.parquet as pq
@@ -75,6 +75,9 @@ class ParquetTrace:
         shutil.rmtree(self.parts, ignore_errors=True)  # a killed earlier run's parts
         self.parts.mkdir()  # fail now, not at the first flush, if the place is not writable
         self._rows: list[Sequence[float | int | str]] = []
+        # what is buffered ahead of _rows, in order: (True, rows) of write(), (False, columns) of write_columns()
+        self._chunks: list[tuple[bool, list]] = []
+        self._pending = 0  # the rows in _chunks
         self._schema: pa.Schema | None = None
         self._n_parts = 0
         self._last_flush = time.monotonic()
@@ -91,18 +94,35 @@ class ParquetTrace:
 
     def write(self, row: Sequence[float | int | str]) -> None:
         self._rows.append(tuple(row))
-        n = len(self._rows)
+        n = len(self._rows) + self._pending
         if n >= self.row_group or (n & 1023 == 0 and time.monotonic() - self._last_flush >= FLUSH_S):
             self._flush()
 
-    def write_many(self, rows: Iterable[tuple]) -> None:
-        """write() for each row (tuples), as a stretch of cycles hands them over (hil/stretch_bulk.py)."""
-        buf = self._rows
-        for row in rows:
-            buf.append(row)
-            n = len(buf)
-            if n >= self.row_group or (n & 1023 == 0 and time.monotonic() - self._last_flush >= FLUSH_S):
+    def write_columns(self, cols: Sequence[Sequence[Any]], n: int) -> None:
+        """n rows handed over as columns (a stretch's cycles, hil/stretch_bulk.py): lists or float64 arrays, one
+        per trace column, each n long. Kept as columns, not turned into rows (issue 17: ≈ 3 µs a cycle of the
+        lathe demo went into the row tuples); the parts hold the same rows: the block is cut at the row
+        counts where write() would flush (a full row group, or each 1,024th row once FLUSH_S passed)."""
+        k = 0
+        while k < n:
+            have = self._pending + len(self._rows)
+            # the next row count write() checks at: a multiple of 1,024, or the full row group
+            stop = min(n, k + self.row_group - have, k + 1024 - (have & 1023))
+            part = list(cols) if k == 0 and stop == n else [c[k:stop] for c in cols]
+            self._block_rows()
+            self._chunks.append((False, part))
+            self._pending += stop - k
+            k = stop
+            have = self._pending
+            if have >= self.row_group or (have & 1023 == 0 and time.monotonic() - self._last_flush >= FLUSH_S):
                 self._flush()
+
+    def _block_rows(self) -> None:
+        """The rows write() buffered go ahead of a column block, as a chunk of their own."""
+        if self._rows:
+            self._pending += len(self._rows)
+            self._chunks.append((True, self._rows))
+            self._rows = []
 
     def _make_schema(self, first: Sequence[Any]) -> pa.Schema:
         fields = []
@@ -119,13 +139,15 @@ class ParquetTrace:
         self._last_flush = time.monotonic()
         if self._error is not None:
             self._raise()
-        if not self._rows:
+        self._block_rows()
+        if not self._chunks:
             return
         if self._schema is None:
-            self._schema = self._make_schema(self._rows[0])
-        self._jobs.put((self._rows, self.parts / f"{self._n_parts:06d}.parquet"))
+            is_rows, first = self._chunks[0]
+            self._schema = self._make_schema(first[0] if is_rows else [c[0] for c in first])
+        self._jobs.put((self._chunks, self.parts / f"{self._n_parts:06d}.parquet"))
         self._n_parts += 1
-        self._rows = []
+        self._chunks, self._pending = [], 0
 
     def _write_parts(self) -> None:
         """The writer thread: each part in turn, until close() or discard() hands it None."""
@@ -138,14 +160,18 @@ class ParquetTrace:
                 except BaseException as e:  # noqa: BLE001 - handed to the run's thread
                     self._error = e
 
-    def _write_part(self, rows: list, part: Path) -> None:
+    def _write_part(self, chunks: list, part: Path) -> None:
+        """One part from its chunks: row lists (write) and column blocks (write_columns)."""
         assert self._schema is not None
         arrays = []
         for i, f in enumerate(self._schema):  # column by column: short GIL holds, not one zip(*rows)
-            col = [r[i] for r in rows]
-            if pa.types.is_string(f.type):
-                col = [v or None for v in col]  # "" = nothing happened: null, as every reader means it
-            arrays.append(pa.array(col, type=f.type))
+            pieces = []
+            for is_rows, ch in chunks:
+                col = [r[i] for r in ch] if is_rows else ch[i]
+                if pa.types.is_string(f.type):
+                    col = [v or None for v in col]  # "" = nothing happened: null, as every reader means it
+                pieces.append(pa.array(col, type=f.type))
+            arrays.append(pieces[0] if len(pieces) == 1 else pa.concat_arrays(pieces))
         tmp = self.parts / f".{part.name}.tmp"
         pq.write_table(pa.Table.from_arrays(arrays, schema=self._schema), tmp, compression="zstd")
         os.replace(tmp, part)
@@ -169,10 +195,21 @@ class ParquetTrace:
         if self._closed:
             return
         self._closed = True
-        self._flush()
-        self._drain()
         if end is not None:
             self.meta["end"] = end
+        self._block_rows()
+        if self._n_parts == 0 and self._chunks:
+            # the whole run in one part (a run shorter than FLUSH_S of wall time and ROW_GROUP rows): the writer
+            # writes it as the trace itself, with the end record, instead of a part read back and written again
+            is_rows, first = self._chunks[0]
+            self._schema = self._make_schema(first[0] if is_rows else [c[0] for c in first])
+            self._jobs.put((self._chunks, self.path))
+            self._chunks, self._pending = [], 0
+            self._drain()
+            shutil.rmtree(self.parts, ignore_errors=True)
+            return
+        self._flush()
+        self._drain()
         if self._schema is None:  # no rows at all: still a valid file with the columns
             self._schema = pa.schema([(c, pa.float64()) for c in self.columns])
         schema = self._schema.with_metadata(self._metadata())
@@ -189,7 +226,7 @@ class ParquetTrace:
     def discard(self) -> None:
         """A run refused after its trace was opened leaves nothing."""
         self._closed = True
-        self._rows = []
+        self._rows, self._chunks = [], []
         try:
             self._drain()
         except Exception:  # noqa: BLE001 - nothing is kept of a refused run, its trace's failure included

@@ -69,8 +69,10 @@ def test_pyarrow_pandas_polars_duckdb_read_the_same_types_and_nulls(trace):
 
 
 def test_a_run_killed_hard_leaves_a_trace_readable_up_to_its_last_flush(tmp_path):
+    """Killed once a part was flushed (FLUSH_S of wall time in: a run that takes longer than that; a run that
+    ends sooner writes its one part as the trace itself at its end, hil/trace_parquet.py)."""
     out = tmp_path / "killed.parquet"
-    p = subprocess.Popen([sys.executable, "-m", "hil.cli", "run", str(ROOT / "examples" / "lathe_demo.nc"),
+    p = subprocess.Popen([sys.executable, "-m", "hil.cli", "run", str(ROOT / "examples" / "lathe_part_g71_g70_g76.nc"),
                           "--trace", str(out), "--no-check", "--no-progress"],
                          env={**os.environ, "PYTHONPATH": str(ROOT)}, stdout=subprocess.DEVNULL,
                          stderr=subprocess.DEVNULL)
