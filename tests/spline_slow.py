@@ -9,7 +9,7 @@ import scipy.sparse as sps
 from scipy.interpolate import BSpline, PPoly
 from scipy.sparse.linalg import spsolve
 
-from nc.motion.spline_fit import LAM, penalty_parts, samples
+from nc.motion.spline_fit import LAM, samples
 
 NODES, CHEB = 9, 9
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(5)
@@ -24,6 +24,26 @@ def distance(curve, cu, pts, cum):
         t = np.clip(np.einsum("ij,ij->i", curve - a, d) / np.maximum(np.einsum("ij,ij->i", d, d), 1e-30), 0.0, 1.0)
         best = np.minimum(best, np.linalg.norm(curve - (a + t[:, None] * d), axis=1))
     return best
+
+
+def penalty_parts(x, k=5, pen=3):
+    """Knots t (at x, ends k + 1 fold), the samples' B-spline rows, the pen-th derivative's rows at 4
+    Gauss-Legendre points a knot interval and those points' quadrature weights: ∫(f^(pen))² = cᵀ·dkᵀ·Q·dk·c."""
+    t = np.concatenate([[x[0]] * k, x, [x[-1]] * k])
+    n = len(t) - k - 1
+    gx, gw = np.polynomial.legendre.leggauss(4)
+    h = np.diff(x) / 2.0
+    at = (x[:-1, None] + h[:, None] * (gx[None, :] + 1.0)).ravel()
+    m = sps.identity(n, format="csr")
+    tt, kk = t, k
+    for _ in range(pen):  # the coefficients of the derivative's B-splines
+        nn = m.shape[0]
+        den = tt[kk + 1: kk + nn] - tt[1: nn]
+        den = np.where(den > 0.0, den, np.inf)
+        m = sps.diags([-kk / den, kk / den], [0, 1], shape=(nn - 1, nn), format="csr") @ m
+        tt, kk = tt[1:-1], kk - 1
+    dk = sps.csr_array(BSpline.design_matrix(at, tt, kk) @ m)
+    return t, BSpline.design_matrix(x, t, k), dk, (h[:, None] * gw[None, :]).ravel()
 
 
 def quintic(x, y, w, lam, k=5, pen=3):

@@ -4,7 +4,7 @@
 PER_SEG samples a segment, the penalty λ·∫r'''², reweighted until every point of the curve is within the
 tolerance. Everything that depends on the knots only (the samples' B-spline rows, the penalty's band, the
 check grid's B-spline rows and its nearest segments) is built once a run (`_Problem`); a round then costs
-one weighted band (np.bincount), one banded Cholesky solve (scipy.linalg.solveh_banded) and a sparse
+one weighted band (np.bincount), one banded Cholesky solve (LAPACK dpbsv) and a sparse
 product for the curve on the grid (decision 53). nc.motion.spline_runs re-exports these names.
 """
 
@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse as sps
 from scipy.interpolate import BSpline, make_smoothing_spline
-from scipy.linalg import solveh_banded
+from scipy.linalg.lapack import dpbsv
 
 PER_SEG = 4  # polyline samples a segment the fit is made to
 DEGREE = 5  # quintic, its r''' continuous (decision 51); 3: decisions 48-50's cubic smoothing spline
@@ -173,23 +173,9 @@ def fit_curve(pts: np.ndarray, lam: float = LAM, w: np.ndarray | None = None, de
     return [make_smoothing_spline(u, p[:, k], w=w, lam=lam) for k in range(pts.shape[1])]
 
 
-def _rows(m: sps.csr_array, width: int) -> tuple[np.ndarray, np.ndarray]:
-    """A sparse matrix whose rows hold `width` consecutive columns each: (first column, values) a row."""
-    m = sps.csr_array(m)
-    m.sum_duplicates()
-    first = np.full(m.shape[0], m.shape[1] - width)
-    vals = np.zeros((m.shape[0], width))
-    nnz = np.diff(m.indptr)
-    row = np.repeat(np.arange(m.shape[0]), nnz)
-    np.minimum.at(first, row, m.indices)
-    first = np.clip(first, 0, m.shape[1] - width)
-    vals[row, m.indices - first[row]] = m.data
-    return first, vals
-
-
 @dataclass
 class _Band:
-    """Σ_rows q·v vᵀ of rows v with `width` consecutive entries, as the upper band of scipy's solveh_banded:
+    """Σ_rows q·v vᵀ of rows v with `width` consecutive entries, as the upper band LAPACK's dpbsv takes:
     fixed indices, one np.bincount for new row weights q."""
 
     n: int
@@ -209,25 +195,36 @@ class _Band:
         return flat.reshape(self.width, self.n)
 
 
-def penalty_parts(x: np.ndarray, k: int = 5, pen: int = 3) -> tuple[np.ndarray, sps.csr_array, sps.csr_array,
-                                                                   np.ndarray]:
-    """Knots t (at x, ends k + 1 fold), the samples' B-spline rows, the pen-th derivative's rows at 4
-    Gauss-Legendre points a knot interval and those points' quadrature weights: ∫(f^(pen))² = cᵀ·dkᵀ·Q·dk·c."""
-    t = np.concatenate([[x[0]] * k, x, [x[-1]] * k])
+def _banded_rows(m: sps.csr_array, width: int) -> tuple[np.ndarray, np.ndarray]:
+    """A B-spline design matrix's rows (each `width` consecutive columns, as scipy builds them):
+    (first column, values) a row."""
+    return m.indices[::width].astype(np.int64), m.data.reshape(-1, width)
+
+
+def _penalty_rows(x: np.ndarray, t: np.ndarray, k: int, pen: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The pen-th derivative's B-spline rows at 4 Gauss-Legendre points a knot interval (first column and
+    k + 1 values a row) and the points' quadrature weights, ∫(f^(pen))² = Σ weight·(row·c)²: the
+    derivative's coefficients as a band (row r from column r), then the degree k − pen B-splines' rows at
+    the Gauss points times it (decision 51 built the same with scipy.sparse products)."""
     n = len(t) - k - 1
     gx, gw = np.polynomial.legendre.leggauss(4)
     h = np.diff(x) / 2.0
     at = (x[:-1, None] + h[:, None] * (gx[None, :] + 1.0)).ravel()
-    m = sps.identity(n, format="csr")
+    m = np.ones((n, 1))
     tt, kk = t, k
-    for _ in range(pen):  # the coefficients of the derivative's B-splines
-        nn = m.shape[0]
+    for _ in range(pen):  # row r of the derivative map: kk/den_r·(c_{r+1} − c_r)
+        nn = len(m)
         den = tt[kk + 1: kk + nn] - tt[1: nn]
-        den = np.where(den > 0.0, den, np.inf)
-        m = sps.diags([-kk / den, kk / den], [0, 1], shape=(nn - 1, nn), format="csr") @ m
-        tt, kk = tt[1:-1], kk - 1
-    dk = sps.csr_array(BSpline.design_matrix(at, tt, kk) @ m)
-    return t, BSpline.design_matrix(x, t, k), dk, (h[:, None] * gw[None, :]).ravel()
+        a = (kk / np.where(den > 0.0, den, np.inf))[:, None]
+        nxt = np.zeros((nn - 1, m.shape[1] + 1))
+        nxt[:, :-1] -= a * m[:-1]
+        nxt[:, 1:] += a * m[1:]
+        m, tt, kk = nxt, tt[1:-1], kk - 1
+    first, d = _banded_rows(BSpline.design_matrix(at, tt, kk, extrapolate=True), kk + 1)
+    vals = np.zeros((len(at), k + 1))
+    for i in range(kk + 1):
+        vals[:, i:i + pen + 1] += d[:, i:i + 1] * m[first + i]
+    return first, vals, (h[:, None] * gw[None, :]).ravel()
 
 
 @dataclass
@@ -237,20 +234,25 @@ class _Problem:
 
     t: np.ndarray
     k: int
-    design: sps.csr_array  # samples × coefficients
+    design_t: sps.csr_array  # coefficients × samples
     fit: _Band  # the samples' part of the normal matrix
     pen: np.ndarray  # λ·∫(f^(pen))², banded
 
     @classmethod
     def of(cls, x: np.ndarray, lam: float, k: int = 5, pen: int = 3) -> "_Problem":
-        t, b, dk, gq = penalty_parts(x, k, pen)
-        n = b.shape[1]
-        return cls(t, k, b, _Band.of(*_rows(b, k + 1), n), lam * _Band.of(*_rows(dk, k + 1), n).band(gq))
+        t = np.concatenate([[x[0]] * k, x, [x[-1]] * k])
+        n = len(t) - k - 1
+        b = BSpline.design_matrix(x, t, k, extrapolate=True)
+        first, vals, gq = _penalty_rows(x, t, k, pen)
+        return cls(t, k, sps.csr_array(b.T), _Band.of(*_banded_rows(b, k + 1), n),
+                   lam * _Band.of(first, vals, n).band(gq))
 
     def solve(self, y: np.ndarray, w: np.ndarray) -> np.ndarray:
         """The coefficients (coefficients × axes) for samples y (samples × axes) with weights w."""
-        rhs = self.design.T @ (w[:, None] * y)
-        return solveh_banded(self.fit.band(w) + self.pen, rhs, check_finite=False)
+        _, c, info = dpbsv(self.fit.band(w) + self.pen, self.design_t @ (w[:, None] * y), lower=0)
+        if info:
+            raise FitError(f"the fit's normal matrix is not positive definite ({info})")
+        return c
 
 
 def quintic(x: np.ndarray, y: np.ndarray, w: np.ndarray, lam: float, k: int = 5, pen: int = 3) -> list[BSpline]:
@@ -274,6 +276,7 @@ def fit_run(pts: np.ndarray, tol: float, lam: float = LAM, rounds: int = 60, ste
     w = np.ones(len(u))
     uu = np.append(np.arange(0.0, cum[-1], step), cum[-1])
     j = np.clip(np.searchsorted(u, uu), 0, len(u) - 1)
+    starts = np.flatnonzero(np.diff(j, prepend=-1))  # j rises with uu: where each sample's points begin
     check = _Check.of(uu, pts, cum, tol)
     if degree == 5:
         prob = _Problem.of(u, lam)
@@ -284,19 +287,21 @@ def fit_run(pts: np.ndarray, tol: float, lam: float = LAM, rounds: int = 60, ste
         w[0] = w[-1] = 1e6  # start and end pinned
         if degree == 5:
             c = prob.solve(p, w)
-            spl = [BSpline(prob.t, c[:, a], prob.k) for a in range(p.shape[1])]
             tc = cost.lap("solve", tc)
-            dist = check.distance((grid @ c).T, BSpline(prob.t, c, prob.k))
+            dist = check.distance((grid @ c).T, BSpline.construct_fast(prob.t, c, prob.k))
         else:
             spl = fit_curve(pts, lam, w, degree)
             dist = check.distance(np.stack([s(uu) for s in spl]),
                                   lambda uf: np.stack([s(uf) for s in spl], axis=1))
         tc = cost.lap("check", tc)
         if dist.max() <= tol:
+            if degree == 5:
+                spl = [BSpline(prob.t, c[:, a], prob.k) for a in range(p.shape[1])]
             return spl, cum
         dev = np.zeros(len(u))  # each sample: the largest distance next to it
-        np.maximum.at(dev, j, dist)
-        np.maximum.at(dev, np.maximum(j - 1, 0), dist)
+        part = np.maximum.reduceat(dist, starts)  # the grid points of each sample's step, at once
+        np.maximum.at(dev, j[starts], part)
+        np.maximum.at(dev, np.maximum(j[starts] - 1, 0), part)
         # bounded: no overflow where tol cannot be met
         w = np.minimum(w * np.clip(dev / (0.9 * tol), 1.0, 10.0) ** 3, 1e9)
         tc = cost.lap("weights", tc)
