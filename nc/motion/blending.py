@@ -99,6 +99,14 @@ class FilterCorners:
     def _clear(self) -> None:
         self._hist.clear()
         self._hist_s.clear()
+        # nc.motion.shares' per-junction verdicts, beside _hist (issue 17, session 11): `_vt` their vtop (fixed at
+        # the push), `_sc` the scan's verdict (None: to be found again), `_sc_dirty` the first index whose inputs
+        # a push may have changed since (window, _tolerance), `_sc_head` the head block's cap the verdicts of the
+        # junctions up to it were found with (their next block is the queue's head).
+        self._vt: list[float] = []
+        self._sc: list[float | None] = []
+        self._sc_dirty = 0
+        self._sc_head = math.nan
         self._h0 = 0  # first entry of _hist still within reach of a window
         self._m = 0  # where the last search for the first junction taken ended
         self._seq0 = 0  # junctions dropped from the front of _hist so far
@@ -110,6 +118,12 @@ class FilterCorners:
         # Sliding maxima over _hist[_m:] as (sequence number, value) of the blocks' tangential
         # acceleration, vtop and length.
         self._maxima: tuple[deque[tuple[int, float]], ...] = (deque(), deque(), deque())
+
+    def touch(self) -> None:
+        """Every junction's caps may have changed (an override, dry run): nc.motion.shares finds its verdicts
+        again."""
+        self._sc_dirty = 0
+        self._sc_head = math.nan
 
     def corner_budget(self, du: Sequence[float], lines: bool = False) -> float:
         """The acceleration and jerk budgets' cap of one isolated tangent jump."""
@@ -212,17 +226,25 @@ class FilterCorners:
         s_j = j_new.s_end
         hist_s = self._hist_s
         hist_s.append(s_j)
+        self._vt.append(j_new.vtop)
+        self._sc.append(None)
         span_max = self.span_max
         while s_j - hist_s[h0] > span_max:
             h0 += 1
         if h0 > 4096:
             del hist[:h0]
             del hist_s[:h0]
+            del self._vt[:h0]
+            del self._sc[:h0]
+            self._sc_dirty = max(0, self._sc_dirty - h0)
             self._seq0 += h0
             self._m -= h0
             last -= h0  # J's index, and its sequence number seq0 + last, stay the same
             h0 = 0
         self._h0 = h0
+        # The junction before J: its next block may have changed (a corner blend trims it and sets its cap).
+        if last - 1 < self._sc_dirty:
+            self._sc_dirty = max(0, last - 1)
         # The search starts where the previous junction's ended; the maxima of tangential
         # acceleration and vtop are kept over hist[m..last] for that m.
         m = self._m
@@ -368,6 +390,8 @@ class FilterCorners:
             # read from the signed windows: the unsigned sums overstate it on a curve.
             c_bud = max(c, self._refine(hist, h0, last, top, top, budget_a, budget_j)[1])
         depth = self._tolerance(blocks, v_hi) if self.tol is not None else 0
+        if m < self._sc_dirty:
+            self._sc_dirty = m  # the walks below lower vbud (and vjunc) over hist[m..last]
         fast = c >= top_q[0][1]  # no junction of the stretch can run as fast as this cap
         seq_m = self._seq0 + m
         bud, self._bud = self._bud, (j_new, seq_m, c_bud)
@@ -495,6 +519,8 @@ class FilterCorners:
                 break
             lo -= 1
         h = vt * half
+        if lo < self._sc_dirty:
+            self._sc_dirty = lo  # vtol and vjunc change over hist[lo:] below
         seg = hist[lo:]
         s = np.array(self._hist_s[lo:])
         du = np.array([b.dv for b in seg], dtype=float)

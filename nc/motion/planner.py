@@ -375,6 +375,8 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops):
     def _limits_changed(self) -> None:
         for b in self.blocks:
             self._update_cap(b)
+        if self.lim.blend is not None:
+            self.lim.blend.touch()  # the caps nc.motion.shares' kept verdicts were found with
         backward(self.blocks, 0, full=True)
         self._pushed = self._need = 0
         self._replan()

@@ -111,12 +111,108 @@ def _scan(fc: "FilterCorners", blocks: Sequence["Block"], pos: float, run_end: f
             break
     if not covered and not (closed or last.s_end > hi):
         return UNKNOWN
-    lo = pos - reach
+    if WALK:
+        return _walk(fc, blocks, pos - reach, hi, seen, prefix if from_prefix else None, v_stop)
+    hist_s = fc._hist_s
+    k_lo = bisect_left(hist_s, pos - reach)
+    k_hi = bisect_right(hist_s, hi)
+    use = 0.0
+    if k_hi > k_lo:
+        # _walk's outcome from the junctions' kept verdicts (module doc of _verdicts): the walk goes from the
+        # newest junction back, so the newest NONE decides unless a use of 1 above it ends the walk first
+        # (where v_stop allows: the vtops it then reads are all of the reach's, so the first use of 1 decides).
+        sc = _verdicts(fc, blocks, k_lo, k_hi, prefix if from_prefix else None)
+        top = max(fc._vt[k_lo:k_hi])
+        if top > seen:
+            seen = top
+        m = max(sc)
+        stop = v_stop >= 0.0 and seen <= v_stop
+        if m == NONE:
+            k = len(sc) - 1 - sc[::-1].index(NONE)
+            if stop and k + 1 < len(sc) and max(sc[k + 1:]) >= 1.0:
+                return 1.0, seen
+            return None
+        if m >= 1.0 and stop:
+            return 1.0, seen
+        if m > 0.0:
+            use = m
+    if k_lo == 0 and fc._seq0 > 0:
+        return None  # junctions within the reach were dropped already
+    return use, seen
+
+
+# _verdicts' codes beside a use in [0, 1]: the walk returns None there (an arc, no budget, not tolerance-free),
+# or skips the junction (no corner, or no use: nan).
+NONE = 2.0
+SKIP = -1.0
+WALK = False  # True: _scan walks every junction as before the kept verdicts (the reference tests compare with)
+
+
+def _verdicts(fc: "FilterCorners", blocks: Sequence["Block"], k_lo: int, k_hi: int,
+              prefix: list[float] | None) -> list[float]:
+    """Each junction hist[k_lo:k_hi]'s verdict for _scan: NONE, SKIP or its use min(1, vjunc / vbud), kept in
+    fc._sc between scans (issue 17, session 11: consecutive scans cover nearly the same ~90 junctions, and a
+    walk over them was the run's largest item). A verdict reads the junction's vjunc, vbud, vtol, vctol and cap
+    and its next block's cap; a push changes those only from fc._sc_dirty on (FilterCorners.window,
+    _tolerance: the stretch and tolerance windows behind the new junction, and the junction before it, whose
+    next block a corner blend trims), an override or dry run every cap (FilterCorners.touch), and a
+    solve the head block's (feed per revolution): the junctions up to the head's, whose next block is the head
+    or who are it, are found again when its cap is not the one they were found with. `prefix`: the queue's s_end
+    up to the first block past the reach (None: take the whole queue)."""
+    sc = fc._sc
+    n = len(sc)
+    d = fc._sc_dirty
+    if d < n:
+        sc[d:] = [None] * (n - d)
+        fc._sc_dirty = n
+    head = blocks[0]
+    if head.cap != fc._sc_head:  # nan the first time
+        h = bisect_right(fc._hist_s, head.s_end)
+        sc[:h] = [None] * h
+        fc._sc_head = head.cap
+    part = sc[k_lo:k_hi]
+    if None not in part:
+        return part
+    hist = fc._hist
+    tol = fc.tol
+    ends = prefix if prefix is not None else [b.s_end for b in blocks]
+    n_ends = len(ends)
+    k = k_lo + part.index(None)
+    i = bisect_right(ends, hist[k].s_end)
+    for k in range(k, k_hi):
+        j = hist[k]
+        if j.seg is not None and j.seg.kind == "arc":
+            sc[k] = NONE
+            continue
+        if j.du_n <= 1e-9:
+            sc[k] = SKIP
+            continue
+        vbud = j.vbud
+        if vbud <= 1e-12:
+            sc[k] = NONE
+            continue
+        if tol is not None:
+            # _tolerance_free, its kept verdict inline; the next block is blocks[i] (j walks on in path order)
+            while i < n_ends and ends[i] <= j.s_end:
+                i += 1
+            if not _free(fc, j, blocks, ends, i):
+                sc[k] = NONE
+                continue
+        r = j.vjunc / vbud
+        sc[k] = SKIP if r != r else r if r < 1.0 else 1.0
+    return sc[k_lo:k_hi]
+
+
+def _walk(fc: "FilterCorners", blocks: Sequence["Block"], lo: float, hi: float, seen: float,
+          prefix: list[float] | None, v_stop: float) -> tuple[float, float] | None:
+    """_scan's junction part as a walk over every junction from the newest back (the reference of the kept
+    verdicts, `WALK`)."""
     use = 0.0
     hist = fc._hist
     tol = fc.tol
     ends: list[float] | None = None  # the queue's s_end, built once a junction needs its next block
-    i = n_ends = 0
+    i = 0
+    from_prefix = prefix is not None
     # FilterCorners keeps every junction since the last stop (its _h0 is relative to the newest
     # push, not to the executing block) and drops old ones only in bulk, counted in _seq0.
     # hist is in path order: the junctions past hi are skipped by bisection, not one by one. The
@@ -139,23 +235,12 @@ def _scan(fc: "FilterCorners", blocks: Sequence["Block"], pos: float, run_end: f
         if tol is not None:
             if ends is None:
                 ends = prefix if from_prefix else [b.s_end for b in blocks]
-                i = n_ends = len(ends)
+                i = len(ends)
             # _tolerance_free, its cached verdict inline: the next block follows j in the queue,
             # at bisect_right(ends, j.s_end), found by stepping back (j walks back in path order)
             while i > 0 and ends[i - 1] > j.s_end:
                 i -= 1
-            if i < n_ends:
-                cap = j.cap
-                c2 = blocks[i].cap
-                if c2 > cap:
-                    cap = c2
-            else:
-                cap = j.vtop
-            tcap = j.vtol if j.vtol < j.vctol else j.vctol
-            if cap == j.tf_cap and tcap == j.tf_tcap:
-                if not j.tf_ok:
-                    return None
-            elif not _tolerance_free(fc, j, blocks, ends):
+            if not _free(fc, j, blocks, ends, i):
                 return None
         r = j.vjunc / vbud
         if r > use:
@@ -171,6 +256,22 @@ def _scan(fc: "FilterCorners", blocks: Sequence["Block"], pos: float, run_end: f
     if k_lo == 0 and fc._seq0 > 0:
         return None  # junctions within the reach were dropped already
     return use, seen
+
+
+def _free(fc: "FilterCorners", j: "Block", blocks: Sequence["Block"], ends: Sequence[float], i: int) -> bool:
+    """_tolerance_free(fc, j, blocks, ends), its verdict kept on j read first; blocks[i] is j's next block
+    (i = bisect_right(ends, j.s_end), which the callers step to)."""
+    if i < len(ends):
+        cap = j.cap
+        c2 = blocks[i].cap
+        if c2 > cap:
+            cap = c2
+    else:
+        cap = j.vtop
+    tcap = j.vtol if j.vtol < j.vctol else j.vctol
+    if cap == j.tf_cap and tcap == j.tf_tcap:
+        return j.tf_ok
+    return _tolerance_free(fc, j, blocks, ends)
 
 
 def _tolerance_free(fc: "FilterCorners", j: "Block", blocks: Sequence["Block"], ends: Sequence[float]) -> bool:
