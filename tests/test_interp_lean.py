@@ -82,10 +82,11 @@ def test_mill_programs_run_the_same_in_the_lean_lane(text: str, budget: int | No
     _same("nc5-mill", text, budget)
 
 
-@settings(max_examples=40, deadline=None)
-@given(text=programs(("X", "Z"), True), budget=st.sampled_from([None, 2]))
-def test_lathe_programs_run_the_same_in_the_lean_lane(text: str, budget: int | None) -> None:
-    _same("nc5-lathe-a", text, budget)  # X in diameter, G99 feed per revolution
+@settings(max_examples=60, deadline=None)
+@given(text=programs(("X", "Z"), True), budget=st.sampled_from([None, 2]),
+       profile=st.sampled_from(["nc5-lathe-a", "nc5-lathe-b", "nc5-lathe-c", "lathe-2018"]))
+def test_lathe_programs_run_the_same_in_the_lean_lane(text: str, budget: int | None, profile: str) -> None:
+    _same(profile, text, budget)  # X in diameter, G99 feed per revolution; G90/G91 on types B and C
 
 
 @pytest.mark.slow
