@@ -93,6 +93,11 @@ def _soa(c: np.ndarray) -> tuple[np.ndarray, ...]:
     return tuple(out)
 
 
+def _take(soa: tuple[np.ndarray, ...], idx: np.ndarray) -> tuple[np.ndarray, ...]:
+    """The stacks of pieces idx (one a point)."""
+    return tuple(np.take(c, idx, axis=2) for c in soa)
+
+
 def _poly(cd: np.ndarray, w: np.ndarray) -> np.ndarray:
     """Polynomials cd (a stack of `_soa`) at w (n): axes × n."""
     acc = cd[0].copy()
@@ -152,7 +157,7 @@ def _in_s(cs: tuple[np.ndarray, ...], w: np.ndarray) -> tuple[np.ndarray, np.nda
 
 
 _CHEB_X = np.cos(np.pi * (np.arange(CHEB + 1) + 0.5) / (CHEB + 1))
-_CHEB_V = np.vander(_CHEB_X, CHEB + 1)  # highest power first
+_CHEB_VI = np.linalg.inv(np.vander(_CHEB_X, CHEB + 1))  # values at the nodes -> coefficients, highest first
 
 
 def spans(spl: list[BSpline], cum: np.ndarray, axes: tuple[str, ...], margin: float = 1.01,
@@ -183,7 +188,8 @@ def spans(spl: list[BSpline], cum: np.ndarray, axes: tuple[str, ...], margin: fl
     # arc-length tables: NODES - 1 Gauss-Legendre intervals a piece
     hw = np.repeat(width / (NODES - 1), NODES - 1)
     w0 = np.tile(np.arange(NODES - 1), n) * hw
-    seg_s = _arc(_soa(np.repeat(coef, NODES - 1, axis=0))[1], w0, w0 + hw).reshape(n, NODES - 1)
+    soa = _soa(coef)  # every piece's stacks once; each batch takes its columns
+    seg_s = _arc(_take(soa, np.repeat(np.arange(n), NODES - 1))[1], w0, w0 + hw).reshape(n, NODES - 1)
     tab = np.concatenate([np.zeros((n, 1)), np.cumsum(seg_s, axis=1)], axis=1)
     off = np.zeros(n)
     for q in range(1, int(count.max())):  # each span's running sum, in its own order
@@ -197,12 +203,12 @@ def spans(spl: list[BSpline], cum: np.ndarray, axes: tuple[str, ...], margin: fl
     sc = (0.5 * (sa[:, None] + sb[:, None]) + 0.5 * (sb - sa)[:, None] * _CHEB_X[None, :]).ravel()
     pc = np.repeat(np.arange(n), CHEB + 1)
     node = np.maximum((s_tab[pc, :NODES - 1] <= sc[:, None]).sum(axis=1) - 1, 0)
-    cs = _soa(coef[pc])
+    cs = _take(soa, pc)
     wc = _newton(cs, width[pc], s_tab[pc], node, sc)
     r = _in_s(cs, wc)[0].reshape(n, CHEB + 1, -1)
     # r(s) and w(s) a piece as polynomials through them (w(s) is what the bounds' samples are read at)
     both = np.concatenate([r, wc.reshape(n, CHEB + 1, 1)], axis=2)
-    both = np.linalg.solve(np.broadcast_to(_CHEB_V, (n, CHEB + 1, CHEB + 1)), both)
+    both = np.einsum("ij,pjk->pik", _CHEB_VI, both)
     s_poly, w_poly = both[:, :, :-1], both[:, :, -1]
     t = cost.lap("chebyshev", t)
     # the bounds: 33 points a piece along each span's length, its ends first and last
@@ -219,7 +225,7 @@ def spans(spl: list[BSpline], cum: np.ndarray, axes: tuple[str, ...], margin: fl
     wb = w_poly[pb, 0]
     for i in range(1, CHEB + 1):
         wb = wb * x + w_poly[pb, i]
-    r, rs, rss, rsss = _in_s(_soa(coef[pb]), np.clip(wb, 0.0, width[pb]))
+    r, rs, rss, rsss = _in_s(_take(soa, pb), np.clip(wb, 0.0, width[pb]))
     edge = np.cumsum(ns) - ns
     dir_b = np.minimum(np.maximum.reduceat(np.abs(rs), edge) * margin, 1.0)
     acc_b = np.maximum.reduceat(np.abs(rss), edge) * margin
