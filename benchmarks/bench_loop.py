@@ -107,35 +107,46 @@ def staged(label: str, program: Path, bench_file: Path | None, trace: str | None
 
     import hil.stretch as stretch
     import hil.stretch_pass as spass
+    import virtual_bus.drive_stretch as ds
 
     nc = _Stage(Channel.step)
     stages["NC"].append(nc)
     # a stretch's planner samples count as NC, its drive models as bus + drives (hil/stretch.py); a stretch that
     # runs the NC's steps (B27, hil/stretch_pass.py: Pass.run) counts as NC but for the drive models it steps
-    patched = {(mod, name): _Stage(getattr(mod, name)) for mod, name in
-               ((stretch, "sample_stretch"), (stretch, "csp_stretch"), (stretch, "csv_stretch"),
-                (spass, "csp_stretch"), (spass, "csv_stretch"))}
-    in_pass = [patched[(spass, "csp_stretch")], patched[(spass, "csv_stretch")]]
+    sampler = _Stage(stretch.sample_stretch)
+    drives = {(cls, name): _Stage(getattr(cls, name)) for cls in (ds.CspRun, ds.CsvRun)
+              for name in ("__init__", "step", "finish")}
+    in_pass = [0.0]
     pass_run = _Stage(spass.Pass.run)
-    stages["NC"] += [patched[(stretch, "sample_stretch")], pass_run]
-    stages["bus + drives"] += [st for (mod, name), st in patched.items() if name != "sample_stretch"]
+
+    def timed_pass(self, n):
+        before = sum(st.seconds for st in drives.values())
+        try:
+            return pass_run(self, n)
+        finally:
+            in_pass[0] += sum(st.seconds for st in drives.values()) - before
+
+    stages["NC"] += [sampler, pass_run]
+    stages["bus + drives"] += list(drives.values())
     BenchRunner.run_program = timed_run
     Channel.step = lambda self: nc(self)
-    spass.Pass.run = lambda self, n: pass_run(self, n)
-    for (mod, name), st in patched.items():
-        setattr(mod, name, st)
+    spass.Pass.run = timed_pass
+    stretch.sample_stretch = sampler
+    for (cls, name), st in drives.items():
+        setattr(cls, name, (lambda st: lambda *a, **k: st(*a, **k))(st))
     try:
         t0 = time.perf_counter()
         res = api.run(program, str(bench_file) if bench_file else None, trace=trace)
         total = time.perf_counter() - t0
     finally:
         BenchRunner.run_program, Channel.step, spass.Pass.run = original, nc.fn, pass_run.fn
-        for (mod, name), st in patched.items():
-            setattr(mod, name, st.fn)
+        stretch.sample_stretch = sampler.fn
+        for (cls, name), st in drives.items():
+            setattr(cls, name, st.fn)
     r, wall, cpu = res.run, holder["wall"], holder["cpu"]
     n = max(1, r.cycles)
     parts = {k: sum(st.seconds for st in v) for k, v in stages.items()}
-    parts["NC"] -= sum(st.seconds for st in in_pass)  # Pass.run's drive models, counted as bus + drives
+    parts["NC"] -= in_pass[0]  # Pass.run's drive models, counted as bus + drives
     parts["rest"] = cpu - sum(parts.values())
     print(f"{label}: {r.cycles} cycles, {r.sim_time:.2f} s simulated; the cycles took {cpu:.2f} s CPU = "
           f"{r.sim_time / cpu:.1f}x real time ({wall:.2f} s wall = {r.sim_time / wall:.1f}x); whole run incl. "

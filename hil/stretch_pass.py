@@ -10,7 +10,7 @@ NC's steps itself, in stepping's order, cycle by cycle where they do more than h
   out (`Planner._refill`: block ends, solves, samples), then its rows at once (`sample_stretch`, to the next cycle
   whose feed may read or whose step refills), filtered as step() filters them.
 What cannot be taken back is a feed's push, so the drive models are stepped a part at a time, over the cycles up to
-each reading cycle before its feed runs (`csp_stretch` carries its state from one call to the next); a drive
+each reading cycle before its feed runs (`CspRun`/`CsvRun` carry the drives' state from one part to the next); a drive
 fault or the bench's overspeed check found there ends the stretch before its cycle, the planner put back to the
 last save after a feed and its steps made again (they are deterministic; everything but a push is saved:
 the planner's fields, queue, filter, share zones and plan). The stretch ends before a cycle whose step would
@@ -31,7 +31,7 @@ from nc.alarms import NcAlarm
 from nc.channel import READS_PER_CYCLE, Channel
 from nc.motion.planner import Planner
 from nc.motion.stretch import Samples, take_rows
-from virtual_bus.drive_stretch import Stretch, csp_stretch, csv_stretch
+from virtual_bus.drive_stretch import CspRun, CsvRun, Stretch
 
 PLAN_KINDS = ("path", "ramp", "cruise")
 FEW = 12  # rows below which the filter takes them one by one (Pass._flush)
@@ -86,14 +86,25 @@ class Pass:
         self.raws: list[np.ndarray] = []  # every part's raw rows
         self.filtered = 0
         self.rows = 0
-        self.outs: list[Stretch] = [Stretch() for _ in rx0]
+        self.runs: list[CspRun | CsvRun] | None = None  # the drive models over the cycles driven (made at the first part)
         self.driven = 0  # cycles the drives were stepped through
         self.targets: list[list[int]] = [[rx.target_position] for rx in rx0[:st.n_axes]]
         self.feeds = 0
         self.reads = not no_reads(ch)  # (constant over the stretch: its feeds read plain moves only)
 
+    @property
+    def outs(self) -> list[Stretch]:
+        """Each drive's feedback over the cycles driven (after run(): the drives' state written, `last` set)."""
+        return [Stretch() for _ in self.rx0] if self.runs is None else [run.out for run in self.runs]
+
     def run(self, n: int) -> int:
         """The stretch's cycles, at most n: how many (the planner after that many steps, `outs` over them)."""
+        m = self._run(n)
+        for run in self.runs or ():
+            run.finish()
+        return m
+
+    def _run(self, n: int) -> int:
         ch, pl = self.ch, self.pl
         src = ahead(ch)
         fed_at = -1
@@ -179,17 +190,22 @@ class Pass:
         self._flush()
         if upto <= self.driven:
             return None
-        a, dt, r = self.driven, self.st.r.bench.cycle, self.st.r
-        for i, (d, rx, out) in enumerate(zip(self.st.drives, self.rx0, self.outs)):
-            part = csp_stretch(d, rx, self.targets[i][a:upto], dt) if i < self.st.n_axes \
-                else csv_stretch(d, rx, upto - a, dt)
-            _extend(out, part)
+        a, r, n_axes = self.driven, self.st.r, self.st.n_axes
+        if self.runs is None:
+            dt = r.bench.cycle
+            self.runs = [CspRun(d, rx, dt) if i < n_axes else CsvRun(d, rx, dt)
+                         for i, (d, rx) in enumerate(zip(self.st.drives, self.rx0))]
+        runs = self.runs
+        for i in range(len(runs)):
+            runs[i].step(self.targets[i][a:upto] if i < n_axes else upto - a)
         self.driven = upto
-        m = min(o.done for o in self.outs)
-        for i in range(self.st.n_axes):
-            over = np.flatnonzero(np.abs(np.asarray(self.outs[i].velocity_actual[a:m])) > r._overspeed[i])
-            if over.size:
-                m = a + int(over[0])
+        m = min(run.out.done for run in runs)
+        for i in range(n_axes):  # a few cycles a part: plain Python, not numpy calls
+            lim, va = r._overspeed[i], runs[i].out.velocity_actual
+            for k in range(a, m):
+                if abs(va[k]) > lim:
+                    m = k
+                    break
         return m if m < upto else None
 
     def _back(self, mark: tuple, stop: int) -> int:
@@ -211,8 +227,8 @@ class Pass:
 
     def _redrive(self) -> None:
         """The drives from the start again, over the stretch's cycles as they now are."""
+        self.runs = None  # dropped, not finished: the drives as they were at the stretch's start
         self.st._restore_drives(self.saved_drives)
-        self.outs = [Stretch() for _ in self.rx0]
         self.driven = 0
         self._drive(self.rows)
 
@@ -226,13 +242,3 @@ class Pass:
         return Samples(np.concatenate([p.positions for p in parts]), [ln for p in parts for ln in p.lines],
                        np.concatenate([p.path_velocity for p in parts]), parts[0].move, moves, np.concatenate(self.raws))
 
-
-def _extend(out: Stretch, part: Stretch) -> None:
-    out.done += part.done
-    out.position_actual += part.position_actual
-    out.velocity_actual += part.velocity_actual
-    out.torque_actual += part.torque_actual
-    out.following_error += part.following_error
-    out.statusword += part.statusword
-    if part.last is not None:
-        out.last = part.last

@@ -50,119 +50,182 @@ def can_stretch(drive: Cia402Drive, rx: RxPdo, mode: int = 8) -> bool:
 
 def csp_stretch(drive: Cia402Drive, rx: RxPdo, targets: Sequence[int], dt: float) -> Stretch:
     """Step `drive` once per target position (0x607A counts) as exchange() would; see the module doc."""
-    out = Stretch()
-    if not targets or not can_stretch(drive, rx):
-        return out
-    p = drive.params
-    units, cpr = p.units, p.counts_per_rev
-    n, h, max_cps, alpha, rad, reached_v = _model(p, dt)
-    kp, kff, window, origin = p.kp, p.kff, p.following_error_window, drive.modes.origin
-    k_raw, t_pct = units.raw_per_count_per_s(cpr), units.torque_percent  # velocity_to_raw, 0x6077
-    inertia, viscous, coulomb, rated = p.inertia, p.viscous, p.coulomb, p.rated_torque
-    base = _STATUS_BASE[State.OPERATION_ENABLED] | SW_FOLLOWING
-    # limit switches (Cia402Drive._limit): a cycle that would reach one is left to exchange(); short of them the
-    # limited drive's sub-steps are the plain ones
-    lo = float(p.negative_limit) if p.negative_limit is not None else -math.inf
-    hi = float(p.positive_limit) if p.positive_limit is not None else math.inf
-    pos, vel, t, command = drive.position, drive.velocity, drive.time, drive.command
-    prev_target = drive._prev_target
-    acc, torque = drive.acceleration, drive.torque
-    pa, va, ta, fe, sws = (out.position_actual, out.velocity_actual, out.torque_actual, out.following_error,
-                           out.statusword)
-    for raw in targets:
-        target = float(raw) - origin
-        prev = prev_target if prev_target is not None else command
-        ff_vel = (target - prev) / dt
-        kff_ff, span = kff * ff_vel, target - prev
-        c_pos, c_vel, c_t, cmd = pos, vel, t, command
-        inside = True
-        for k in range(1, n + 1):  # Cia402Drive._step_following (_step_general with limits), csp, no probe
-            cmd = prev + span * k / n
-            v_cmd = kff_ff + kp * (cmd - c_pos)
-            if not -max_cps <= v_cmd <= max_cps:
-                v_cmd = max(-max_cps, min(max_cps, v_cmd))
-            if v_cmd != c_vel:
-                c_vel += (v_cmd - c_vel) * alpha
-            c_pos = c_pos + c_vel * h
-            if not lo < c_pos < hi:
-                inside = False
-            c_t += h
-        if not inside or abs(cmd - c_pos) > window or abs(c_vel) > 1.2 * max_cps:
-            break  # a limit switch, or Cia402Drive._supervise would fault in this cycle: exchange() takes it
-        c_acc = (c_vel - vel) / dt
-        # Cia402Drive.step's torque of an energised drive (0.1 % of rated) and DriveUnits.velocity_to_raw inline,
-        # the same expressions: a call each per cycle cost a fifth of the loop
-        torque = (inertia * c_acc * rad + viscous * c_vel * rad
-                  + (math.copysign(coulomb, c_vel) if abs(c_vel) > 1 else 0.0)) / rated * 1000.0
-        pos, vel, t, command, acc, prev_target = c_pos, c_vel, c_t, cmd, c_acc, target
-        gap = command - pos
-        sws.append(base | SW_TARGET_REACHED if abs(vel) < reached_v and abs(gap) < 10 else base)
-        pa.append(int(round(pos + origin)))
-        raw = round(vel * k_raw)
-        va.append(raw if -0x7FFFFFFF <= raw <= 0x7FFFFFFF else max(-0x7FFFFFFF, min(0x7FFFFFFF, raw)))
-        ta.append(int(round(torque * 0.1 / t_pct)))
-        fe.append(int(round(gap)))
-    if pa:
-        drive._prev_target = prev_target
-        _finish(drive, rx, out, pos, vel, t, command, acc, torque)
-    return out
+    run = CspRun(drive, rx, dt)
+    run.step(targets)
+    return run.finish()
 
 
 def csv_stretch(drive: Cia402Drive, rx: RxPdo, cycles: int, dt: float) -> Stretch:
     """Step a CSV drive (a spindle at its 0x60FF speed) `cycles` times as exchange(rx, dt) would."""
-    out = Stretch()
-    if cycles <= 0 or not can_stretch(drive, rx, 9):
+    run = CsvRun(drive, rx, dt)
+    run.step(cycles)
+    return run.finish()
+
+
+class CspRun:
+    """csp_stretch a part at a time (a stretch that runs the NC's steps, hil/stretch_pass.py): the drive's state is
+    carried here from one `step` to the next and written to the drive by `finish`, so a part costs its cycles
+    and not the set-up and the TxPdo of a call (issue 17: a CAM pass steps its drives ≈ 14 times). `out` holds
+    every cycle stepped; a part that stops before a faulting cycle leaves the run stopped (`ok` False)."""
+
+    def __init__(self, drive: Cia402Drive, rx: RxPdo, dt: float) -> None:
+        self.drive, self.rx, self.dt = drive, rx, dt
+        self.out = Stretch()
+        self.ok = can_stretch(drive, rx)
+        if not self.ok:
+            return
+        p = drive.params
+        units, cpr = p.units, p.counts_per_rev
+        self.model = _model(p, dt)
+        self.gains = (p.kp, p.kff, p.following_error_window, drive.modes.origin)
+        self.units = (units.raw_per_count_per_s(cpr), units.torque_percent)  # velocity_to_raw, 0x6077
+        self.load = (p.inertia, p.viscous, p.coulomb, p.rated_torque)
+        # limit switches (Cia402Drive._limit): a cycle that would reach one is left to exchange(); short of them
+        # the limited drive's sub-steps are the plain ones
+        self.limits = (float(p.negative_limit) if p.negative_limit is not None else -math.inf,
+                       float(p.positive_limit) if p.positive_limit is not None else math.inf)
+        self.state = (drive.position, drive.velocity, drive.time, drive.command, drive._prev_target,
+                      drive.acceleration, drive.torque)
+
+    def step(self, targets: Sequence[int]) -> None:
+        """The next cycles, one per target; stops (for good) before a cycle that would fault."""
+        if not targets or not self.ok:
+            return
+        n, h, max_cps, alpha, rad, reached_v = self.model
+        kp, kff, window, origin = self.gains
+        k_raw, t_pct = self.units
+        inertia, viscous, coulomb, rated = self.load
+        lo, hi = self.limits
+        base = _STATUS_BASE[State.OPERATION_ENABLED] | SW_FOLLOWING
+        pos, vel, t, command, prev_target, acc, torque = self.state
+        dt = self.dt
+        out = self.out
+        pa, va, ta, fe, sws = (out.position_actual, out.velocity_actual, out.torque_actual, out.following_error,
+                               out.statusword)
+        for raw in targets:
+            target = float(raw) - origin
+            prev = prev_target if prev_target is not None else command
+            ff_vel = (target - prev) / dt
+            kff_ff, span = kff * ff_vel, target - prev
+            c_pos, c_vel, c_t, cmd = pos, vel, t, command
+            inside = True
+            for k in range(1, n + 1):  # Cia402Drive._step_following (_step_general with limits), csp, no probe
+                cmd = prev + span * k / n
+                v_cmd = kff_ff + kp * (cmd - c_pos)
+                if not -max_cps <= v_cmd <= max_cps:
+                    v_cmd = max(-max_cps, min(max_cps, v_cmd))
+                if v_cmd != c_vel:
+                    c_vel += (v_cmd - c_vel) * alpha
+                c_pos = c_pos + c_vel * h
+                if not lo < c_pos < hi:
+                    inside = False
+                c_t += h
+            if not inside or abs(cmd - c_pos) > window or abs(c_vel) > 1.2 * max_cps:
+                self.ok = False
+                break  # a limit switch, or Cia402Drive._supervise would fault in this cycle: exchange() takes it
+            c_acc = (c_vel - vel) / dt
+            # Cia402Drive.step's torque of an energised drive (0.1 % of rated) and DriveUnits.velocity_to_raw
+            # inline, the same expressions: a call each per cycle cost a fifth of the loop
+            torque = (inertia * c_acc * rad + viscous * c_vel * rad
+                      + (math.copysign(coulomb, c_vel) if abs(c_vel) > 1 else 0.0)) / rated * 1000.0
+            pos, vel, t, command, acc, prev_target = c_pos, c_vel, c_t, cmd, c_acc, target
+            gap = command - pos
+            sws.append(base | SW_TARGET_REACHED if abs(vel) < reached_v and abs(gap) < 10 else base)
+            pa.append(int(round(pos + origin)))
+            raw = round(vel * k_raw)
+            va.append(raw if -0x7FFFFFFF <= raw <= 0x7FFFFFFF else max(-0x7FFFFFFF, min(0x7FFFFFFF, raw)))
+            ta.append(int(round(torque * 0.1 / t_pct)))
+            fe.append(int(round(gap)))
+        self.state = (pos, vel, t, command, prev_target, acc, torque)
+        out.done = len(pa)
+
+    def finish(self) -> Stretch:
+        """The drive's state after the last cycle stepped, and that cycle's TxPdo (`out.last`)."""
+        out = self.out
+        if out.position_actual:
+            pos, vel, t, command, prev_target, acc, torque = self.state
+            self.drive._prev_target = prev_target
+            _finish(self.drive, self.rx, out, pos, vel, t, command, acc, torque)
         return out
-    p = drive.params
-    units, cpr = p.units, p.counts_per_rev
-    n, h, max_cps, alpha, rad, reached_v = _model(p, dt)
-    origin, ramp = drive.modes.origin, p.csv_accel * h
-    want = units.raw_to_velocity(rx.target_velocity, cpr)  # apply()'s latch of 0x60FF
-    base = _STATUS_BASE[State.OPERATION_ENABLED] | SW_FOLLOWING
-    pos, vel, t, command, tv = drive.position, drive.velocity, drive.time, drive.command, drive.target_velocity
-    acc, torque = drive.acceleration, drive.torque
-    pa, va, ta, sws = out.position_actual, out.velocity_actual, out.torque_actual, out.statusword
-    k_raw, t_pct = units.raw_per_count_per_s(cpr), units.torque_percent  # as in csp_stretch
-    inertia, viscous, coulomb, rated = p.inertia, p.viscous, p.coulomb, p.rated_torque
-    # the encoder index armed and not latched yet (Cia402Drive._probe): the stretch ends before the cycle whose
-    # sub-steps pass an index edge, which exchange() latches
-    every = (p.index_pulse_every or cpr) if rx.touch_probe_function & 1 and not drive._probe_latched else 0
-    floor = math.floor
-    for _ in range(cycles):
-        c_pos, c_vel, c_t, c_tv, cmd = pos, vel, t, tv, command
-        edge = False
-        # The velocity-loop lines below repeat csp_stretch's on purpose: a call per sub-step would cost about
-        # a third of what the stretch saves.
-        for _k in range(n):  # Cia402Drive._step_following, csv
-            c_tv += max(-ramp, min(ramp, want - c_tv))
-            v_cmd, cmd = c_tv, c_pos
-            if not -max_cps <= v_cmd <= max_cps:
-                v_cmd = max(-max_cps, min(max_cps, v_cmd))
-            if v_cmd != c_vel:
-                c_vel += (v_cmd - c_vel) * alpha
-            new_pos = c_pos + c_vel * h
-            if every and floor(c_pos / every) != floor(new_pos / every):
-                edge = True
-            c_pos = new_pos
-            c_t += h
-        if edge:
-            break  # the index latches in this cycle: exchange() takes it
-        if abs(c_vel) > 1.2 * max_cps:
-            break  # overspeed: exchange() takes the fault
-        c_acc = (c_vel - vel) / dt
-        torque = (inertia * c_acc * rad + viscous * c_vel * rad
-                  + (math.copysign(coulomb, c_vel) if abs(c_vel) > 1 else 0.0)) / rated * 1000.0
-        pos, vel, t, command, tv, acc = c_pos, c_vel, c_t, cmd, c_tv, c_acc
-        sws.append(base | SW_TARGET_REACHED if abs(vel) < reached_v and abs(command - pos) < 10 else base)
-        pa.append(int(round(pos + origin)))
-        raw = round(vel * k_raw)
-        va.append(raw if -0x7FFFFFFF <= raw <= 0x7FFFFFFF else max(-0x7FFFFFFF, min(0x7FFFFFFF, raw)))
-        ta.append(int(round(torque * 0.1 / t_pct)))
-    out.following_error = [0] * len(pa)  # 0x60F4 is a CSP object: 0 in CSV
-    if pa:
-        drive.target_velocity = tv
-        _finish(drive, rx, out, pos, vel, t, command, acc, torque)
-    return out
+
+
+class CsvRun:
+    """csv_stretch a part at a time, as CspRun."""
+
+    def __init__(self, drive: Cia402Drive, rx: RxPdo, dt: float) -> None:
+        self.drive, self.rx, self.dt = drive, rx, dt
+        self.out = Stretch()
+        self.ok = can_stretch(drive, rx, 9)
+        if not self.ok:
+            return
+        p = drive.params
+        units, cpr = p.units, p.counts_per_rev
+        self.model = _model(p, dt)
+        self.want = units.raw_to_velocity(rx.target_velocity, cpr)  # apply()'s latch of 0x60FF
+        self.units = (units.raw_per_count_per_s(cpr), units.torque_percent)  # as in CspRun
+        self.load = (p.inertia, p.viscous, p.coulomb, p.rated_torque)
+        self.origin, self.ramp = drive.modes.origin, p.csv_accel * self.model[1]
+        # the encoder index armed and not latched yet (Cia402Drive._probe): the stretch ends before the cycle
+        # whose sub-steps pass an index edge, which exchange() latches
+        self.every = (p.index_pulse_every or cpr) if rx.touch_probe_function & 1 and not drive._probe_latched else 0
+        self.state = (drive.position, drive.velocity, drive.time, drive.command, drive.target_velocity,
+                      drive.acceleration, drive.torque)
+
+    def step(self, cycles: int) -> None:
+        """The next `cycles` cycles; stops (for good) before a cycle that would fault or latch the index."""
+        if cycles <= 0 or not self.ok:
+            return
+        n, h, max_cps, alpha, rad, reached_v = self.model
+        origin, ramp, want, every = self.origin, self.ramp, self.want, self.every
+        k_raw, t_pct = self.units
+        inertia, viscous, coulomb, rated = self.load
+        base = _STATUS_BASE[State.OPERATION_ENABLED] | SW_FOLLOWING
+        pos, vel, t, command, tv, acc, torque = self.state
+        dt = self.dt
+        out = self.out
+        pa, va, ta, sws = out.position_actual, out.velocity_actual, out.torque_actual, out.statusword
+        floor = math.floor
+        for _ in range(cycles):
+            c_pos, c_vel, c_t, c_tv, cmd = pos, vel, t, tv, command
+            edge = False
+            # The velocity-loop lines below, and the feedback lines after them, repeat CspRun's on purpose: a call
+            # per sub-step (or cycle) would cost about a third of what the stretch saves.
+            for _k in range(n):  # Cia402Drive._step_following, csv
+                c_tv += max(-ramp, min(ramp, want - c_tv))
+                v_cmd, cmd = c_tv, c_pos
+                if not -max_cps <= v_cmd <= max_cps:
+                    v_cmd = max(-max_cps, min(max_cps, v_cmd))
+                if v_cmd != c_vel:
+                    c_vel += (v_cmd - c_vel) * alpha
+                new_pos = c_pos + c_vel * h
+                if every and floor(c_pos / every) != floor(new_pos / every):
+                    edge = True
+                c_pos = new_pos
+                c_t += h
+            if edge or abs(c_vel) > 1.2 * max_cps:
+                self.ok = False
+                break  # the index latches in this cycle, or overspeed: exchange() takes it
+            c_acc = (c_vel - vel) / dt
+            torque = (inertia * c_acc * rad + viscous * c_vel * rad
+                      + (math.copysign(coulomb, c_vel) if abs(c_vel) > 1 else 0.0)) / rated * 1000.0
+            pos, vel, t, command, tv, acc = c_pos, c_vel, c_t, cmd, c_tv, c_acc
+            sws.append(base | SW_TARGET_REACHED if abs(vel) < reached_v and abs(command - pos) < 10 else base)
+            pa.append(int(round(pos + origin)))
+            raw = round(vel * k_raw)
+            va.append(raw if -0x7FFFFFFF <= raw <= 0x7FFFFFFF else max(-0x7FFFFFFF, min(0x7FFFFFFF, raw)))
+            ta.append(int(round(torque * 0.1 / t_pct)))
+        self.state = (pos, vel, t, command, tv, acc, torque)
+        out.following_error += [0] * (len(pa) - len(out.following_error))  # 0x60F4 is a CSP object: 0 in CSV
+        out.done = len(pa)
+
+    def finish(self) -> Stretch:
+        """The drive's state after the last cycle stepped, and that cycle's TxPdo (`out.last`)."""
+        out = self.out
+        if out.position_actual:
+            pos, vel, t, command, tv, acc, torque = self.state
+            self.drive.target_velocity = tv
+            _finish(self.drive, self.rx, out, pos, vel, t, command, acc, torque)
+        return out
 
 
 def _model(p: DriveParams, dt: float) -> tuple[int, float, float, float, float, float]:
