@@ -62,16 +62,24 @@ def samples(pts: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 @dataclass
 class _Segs:
-    """The polyline's segments: starts, vectors and squared lengths."""
+    """The polyline's segments: starts, vectors and squared lengths, and how far each is at least from the
+    segments two before and two after it."""
 
     a: np.ndarray
     d: np.ndarray
     dd: np.ndarray
+    apart: np.ndarray  # 2 × segments: from the one two before / after (inf: none, or one of the nearer)
 
     @classmethod
     def of(cls, pts: np.ndarray) -> "_Segs":
         d = np.diff(pts, axis=0)
-        return cls(pts[:-1], d, np.maximum(np.einsum("ij,ij->i", d, d), 1e-30))
+        dd = np.maximum(np.einsum("ij,ij->i", d, d), 1e-30)
+        # bounding spheres: two segments are at least their centres' distance less their half lengths apart
+        c, half = pts[:-1] + 0.5 * d, 0.5 * np.sqrt(dd)
+        gap = np.linalg.norm(c[2:] - c[:-2], axis=1) - half[2:] - half[:-2]
+        apart = np.full((2, len(d)), np.inf)
+        apart[0, 2:], apart[1, :-2] = gap, gap
+        return cls(pts[:-1], d, dd, apart)
 
     def to(self, curve: np.ndarray, i: np.ndarray) -> np.ndarray:
         """Squared distance of points (points × axes) from segments i (one a point, or candidates × points)."""
@@ -82,12 +90,22 @@ class _Segs:
         return np.einsum("...j,...j->...", r, r)
 
     def distance(self, curve: np.ndarray, k: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Each point's distance from the segments within two of its own (k) and the nearest of them."""
-        i = np.clip(k[None, :] + np.array(_OFFSETS)[:, None], 0, len(self.a) - 1)
+        """Each point's distance from the segments within two of its own (k) and the nearest of them (the
+        first of equals in the order k − 2 … k + 2). The ones two away are measured only where they could be
+        nearer: a point at D from its own segment is at least `apart` − D from them."""
+        i = np.clip(k[None, :] + np.array((-1, 0, 1))[:, None], 0, len(self.a) - 1)
         q = self.to(curve[None, :, :], i)
-        near = np.argmin(q, axis=0)  # the first of equals, as a running minimum over the offsets
+        near = np.argmin(q, axis=0)
         cols = np.arange(len(k))
-        return np.sqrt(q[near, cols]), i[near, cols]
+        dist, seg = np.sqrt(q[near, cols]), i[near, cols]
+        far = np.flatnonzero(np.min(self.apart[:, k], axis=0) - np.sqrt(q[1]) <= dist)
+        if len(far):
+            i = np.clip(k[None, far] + np.array(_OFFSETS)[:, None], 0, len(self.a) - 1)
+            q = self.to(curve[None, far, :], i)
+            near = np.argmin(q, axis=0)
+            cols = np.arange(len(far))
+            dist[far], seg[far] = np.sqrt(q[near, cols]), i[near, cols]
+        return dist, seg
 
 
 def _segment_of(cu: np.ndarray, cum: np.ndarray) -> np.ndarray:
