@@ -9,7 +9,6 @@ import numpy as np
 
 from nc.motion.lookahead import Block
 from nc.motion.plan_state import CHUNK, _near, _Plan
-from nc.motion.profile import clip
 
 
 class CruiseSampling:
@@ -92,7 +91,7 @@ class CruiseSampling:
         v = self.v
         blocks = self.blocks
         s0, t_next, k, nb = self.s, p.t_next, 0, len(blocks)
-        pos: list[np.ndarray] = []
+        pos: list[list[float]] = []  # rows as plain floats (a block's one or two: numpy's calls cost more)
         st: list[float] = []
         offs: list[int] = []
         lines: list[int] = []
@@ -108,11 +107,19 @@ class CruiseSampling:
                 if not (t_next <= duration + 1e-12 and n > 0):
                     break
                 n = min(n, CHUNK)
-                t = t_next + T * np.arange(n)
-                t_next = float(t[-1] + T)
-                s = s0 + clip(t, 0.0, duration) * v
-                pos.append(b.seg.points(clip(s, 0.0, b.length)))
-                st += s.tolist()
+                # t = t_next + T·arange(n), s = s0 + clip(t, 0, duration)·v and a line's points at clip(s, 0,
+                # length) element by element: the same operations, so the same bits (nc.motion.sample_rows)
+                s = [s0 + (duration if duration <= x else x) * v
+                     for x in [0.0 if 0.0 >= x else x for x in [t_next + T * i for i in range(n)]]]
+                t_next = (t_next + T * (n - 1)) + T
+                seg, length = b.seg, b.length
+                sc = [length if length <= x else x for x in [0.0 if 0.0 >= x else x for x in s]]
+                if seg.kind == "line" and seg.length > 0.0:
+                    start, d, seg_len = seg.start.tolist(), (seg.end - seg.start).tolist(), seg.length
+                    pos += [[q + u * e for q, e in zip(start, d)] for u in [x / seg_len for x in sc]]
+                else:
+                    pos += seg.points(np.array(sc)).tolist()
+                st += s
                 offs += [k] * n
                 lines += [b.move.line] * n
                 rows += n
@@ -123,7 +130,7 @@ class CruiseSampling:
                 break
             k, s0, t_next = k + 1, 0.0, p.carry
         p.emitted = True
-        self._buf_pos = np.concatenate(pos) if pos else np.empty((0, len(self.axes)))
+        self._buf_pos = np.array(pos) if pos else np.empty((0, len(self.axes)))
         self._buf_vel = np.full(rows, v)
         self._buf_line = lines
         self._buf_state = [(x, v, 0.0) for x in st]

@@ -52,6 +52,10 @@ class Piecewise:
     @classmethod
     def of(cls, traj: Trajectory) -> "Piecewise":
         rows = [_phases(pr) for pr in traj.profiles[0]]
+        if len(rows) == 1:  # one DoF (every path solve): its columns as they are, no padding (issue 17)
+            r = rows[0]
+            return cls(np.array([r[0]]), np.array([r[1]]), np.array([r[2]]), np.array([r[3]]), np.array([r[4]]),
+                       float(traj.duration), float(traj.position_extrema[0].max))
         n = max(len(r[0]) for r in rows)
         arrs = []
         for k in range(5):
