@@ -23,6 +23,8 @@ DEGREE = 5  # quintic, its r''' continuous (decision 51); 3: decisions 48-50's c
 LAM = 0.01  # λ of the penalty ∫r'''² (mm⁵; of ∫r''² at DEGREE 3: 0.1 mm³); the weights then hold N1.053
 FINE = 20  # the check's finer look: FINE points a grid step (decision 51: 40 over the two steps around)
 _OFFSETS = (-2, -1, 0, 1, 2)  # the segments a curve point is measured against, around its own
+_GL4 = np.polynomial.legendre.leggauss(4)  # the penalty's quadrature a knot interval
+_TRIU = {w: np.triu_indices(w) for w in range(1, 8)}  # a band's pairs of a row's entries
 
 
 class FitError(RuntimeError):
@@ -128,7 +130,7 @@ class _Check:
     @classmethod
     def of(cls, uu: np.ndarray, pts: np.ndarray, cum: np.ndarray, tol: float) -> "_Check":
         segs, k = _Segs.of(pts), _segment_of(uu, cum)
-        own = (np.ascontiguousarray(segs.a[k].T), np.ascontiguousarray(segs.d[k].T), 1.0 / segs.dd[k])
+        own = (np.take(segs.a.T, k, axis=1), np.take(segs.d.T, k, axis=1), 1.0 / segs.dd[k])
         return cls(uu, segs, cum, tol, k, own)
 
     def distance(self, curve: np.ndarray, evaluate) -> np.ndarray:
@@ -204,7 +206,7 @@ class _Band:
     @classmethod
     def of(cls, first: np.ndarray, vals: np.ndarray, n: int) -> "_Band":
         width = vals.shape[1]
-        ia, ib = np.triu_indices(width)
+        ia, ib = _TRIU[width]
         idx = (width - 1 + ia - ib)[None, :] * n + first[:, None] + ib[None, :]
         return cls(n, width, idx, vals[:, ia] * vals[:, ib])
 
@@ -225,7 +227,7 @@ def _penalty_rows(x: np.ndarray, t: np.ndarray, k: int, pen: int) -> tuple[np.nd
     derivative's coefficients as a band (row r from column r), then the degree k − pen B-splines' rows at
     the Gauss points times it (decision 51 built the same with scipy.sparse products)."""
     n = len(t) - k - 1
-    gx, gw = np.polynomial.legendre.leggauss(4)
+    gx, gw = _GL4
     h = np.diff(x) / 2.0
     at = (x[:-1, None] + h[:, None] * (gx[None, :] + 1.0)).ravel()
     m = np.ones((n, 1))
@@ -252,7 +254,7 @@ class _Problem:
 
     t: np.ndarray
     k: int
-    design_t: sps.csr_array  # coefficients × samples
+    design_t: sps.csc_array  # coefficients × samples
     fit: _Band  # the samples' part of the normal matrix
     pen: np.ndarray  # λ·∫(f^(pen))², banded
 
@@ -262,7 +264,7 @@ class _Problem:
         n = len(t) - k - 1
         b = BSpline.design_matrix(x, t, k, extrapolate=True)
         first, vals, gq = _penalty_rows(x, t, k, pen)
-        return cls(t, k, sps.csr_array(b.T), _Band.of(*_banded_rows(b, k + 1), n),
+        return cls(t, k, b.T, _Band.of(*_banded_rows(b, k + 1), n),
                    lam * _Band.of(first, vals, n).band(gq))
 
     def solve(self, y: np.ndarray, w: np.ndarray) -> np.ndarray:
