@@ -133,16 +133,19 @@ class Piecewise:
 def _phases(pr) -> tuple[list, list, list, list, list]:
     t0, p, v, a, j = [], [], [], [], []
     t = 0.0
+    # ruckig's fields are read once each: every read converts the whole array to a new list (issue 17)
     b = pr.brake
     if b.duration > 0.0:
+        bt, bp, bv, ba, bj = b.t, b.p, b.v, b.a, b.j
         for k in range(2):
-            if b.t[k] > 0.0:
-                t0.append(t), p.append(b.p[k]), v.append(b.v[k]), a.append(b.a[k]), j.append(b.j[k])
-                t += b.t[k]
+            if bt[k] > 0.0:
+                t0.append(t), p.append(bp[k]), v.append(bv[k]), a.append(ba[k]), j.append(bj[k])
+                t += bt[k]
+    pt, pp, pv, pa, pj = pr.t, pr.p, pr.v, pr.a, pr.j
     for k in range(7):
-        if pr.t[k] > 0.0:
-            t0.append(t), p.append(pr.p[k]), v.append(pr.v[k]), a.append(pr.a[k]), j.append(pr.j[k])
-            t += pr.t[k]
+        if pt[k] > 0.0:
+            t0.append(t), p.append(pp[k]), v.append(pv[k]), a.append(pa[k]), j.append(pj[k])
+            t += pt[k]
     # The final state, integrated from the last phase (pf is not kept for velocity control).
     if len(t0) > 0:
         h = t - t0[-1]
@@ -150,7 +153,7 @@ def _phases(pr) -> tuple[list, list, list, list, list]:
         ve = v[-1] + h * (a[-1] + h * j[-1] / 2.0)
         ae = a[-1] + h * j[-1]
     else:
-        pe, ve, ae = pr.p[0], pr.v[0], pr.a[0]
+        pe, ve, ae = pp[0], pv[0], pa[0]
     t0.append(t), p.append(pe), v.append(ve), a.append(ae), j.append(0.0)
     return t0, p, v, a, j
 
