@@ -108,17 +108,19 @@ class Pass:
         ch, pl = self.ch, self.pl
         src = ahead(ch)
         fed_at = -1
-        mark = (0, _save(pl), 0)  # (rows, the planner then, parts then): where a drive fault puts it back
+        # [rows, the planner then, parts then]: where a drive fault puts it back. The planner's save is the one the
+        # next _group makes before its step (the same state: a feed's drive check flushed the filter), not one more
+        self._mark = [0, None, 0]
         while self.rows < n:
             if self.rows and self.reads and _feed_due(pl):  # this cycle's feed reads: the drives up to it first
                 stop = self._drive(self.rows + 1)
                 if stop is not None:
-                    return self._back(mark, stop)
+                    return self._back(stop)
                 if self.rows < 2 or not may_read(ch, pl) or not src.peek(READS_PER_CYCLE):
                     break
                 ch._feed_planner()  # plain moves only: it pushes them, nothing else changes
                 self.feeds, fed_at = self.feeds + 1, self.rows
-                mark = (self.rows, _save(pl), len(self.parts))
+                self._mark = [self.rows, None, len(self.parts)]
             if not self._group(n - self.rows):
                 break
         if fed_at == self.rows:  # the stretch ends before the cycle whose feed it ran: its step must not read
@@ -127,7 +129,7 @@ class Pass:
             self._redrive()
             return self.rows
         stop = self._drive(self.rows)
-        return self.rows if stop is None else self._back(mark, stop)
+        return self.rows if stop is None else self._back(stop)
 
     def _group(self, limit: int) -> bool:
         pl = self.pl
@@ -137,7 +139,13 @@ class Pass:
             self._flush()
         # what a step that cannot be taken here changed is put back; a buffered row of a solved plan changes
         # nothing before take_rows accepts it
-        saved = _save(pl) if pl._buf_done or pl._buf_blk is not None else None
+        mark = self._mark
+        steps = pl._buf_done or pl._buf_blk is not None
+        saved = _save(pl) if mark[1] is None or steps else None
+        if mark[1] is None:
+            mark[1] = saved
+        if not steps:
+            saved = None
         try:
             got = _steps(self.ch, pl, limit, self.reads)
         except NcAlarm:  # the step raises: stepping raises it in its own cycle
@@ -181,8 +189,8 @@ class Pass:
         self.filtered = k
         sc, org = self.st.r.scales, self.st.r.origin.tolist()
         for i, t in enumerate(self.targets):
-            c, o = sc[i], org[i]
-            t += [c.to_counts(x - o) for x in pos[:, i].tolist()]
+            cpu, o = sc[i]._cpu, org[i]
+            t += [int(round((x - o) * cpu)) for x in pos[:, i].tolist()]  # AxisScaling.to_counts, inline
 
     def _drive(self, upto: int) -> int | None:
         """The drive models over cycles driven … upto-1 (cycle k steps to the setpoint of cycle k-1); the first
@@ -208,10 +216,11 @@ class Pass:
                     break
         return m if m < upto else None
 
-    def _back(self, mark: tuple, stop: int) -> int:
+    def _back(self, stop: int) -> int:
         """A drive faults in cycle `stop`: the stretch ends before it. The planner from the last save (after a
         feed, or the start), its steps made again up to there; the drives stepped again from the start."""
-        rows, saved, nparts = mark
+        rows, saved, nparts = self._mark
+        assert saved is not None  # (a _group follows every mark before a drive check)
         pl = self.pl
         _restore_planner(pl, saved)  # (a mark is taken after a feed, whose drive check flushed the filter)
         del self.parts[nparts:]

@@ -106,7 +106,7 @@ def test_a_drive_fault_inside_a_pass_lands_on_its_cycle(monkeypatch, tmp_path, w
     text = cam_program(1200).replace("M30", "G01 Z90. F6000\nM30")  # Z moves after the CAM blocks only
     backs = []
     real = hil.stretch_pass.Pass._back
-    monkeypatch.setattr(hil.stretch_pass.Pass, "_back", lambda self, mark, stop: backs.append(stop) or real(self, mark, stop))
+    monkeypatch.setattr(hil.stretch_pass.Pass, "_back", lambda self, stop: backs.append(stop) or real(self, stop))
     runs = []
     for on in ("0", "1"):
         monkeypatch.setenv(ENV, on)
