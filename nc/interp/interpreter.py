@@ -161,7 +161,8 @@ class Interpreter(ExecuteMixin, ReadingMixin, ModalMixin, MotionMixin, NonModalM
                 # a BlockList's parsed items by index (None: a plain line, read when reached); a list of blocks
                 # has no plain lines
                 parsed = getattr(blocks, "parsed", None) or blocks.__getitem__
-                raw_at = getattr(blocks, "raw", None) if self.lean else None  # a plain line's text (BlockList)
+                lean_unread = self.lean  # the frame's lines for the lean lane: looked up at its first plain line
+                raw_at = None
             pc = fr.pc
             if pc >= count:
                 if len(self.stack) == 1:
@@ -176,7 +177,10 @@ class Interpreter(ExecuteMixin, ReadingMixin, ModalMixin, MotionMixin, NonModalM
                     last = self.block
                     continue
                 # a plain motion line in the plain state, run from its text (nc.interp.lean, issue 17)
-                if raw_at is not None and (ev := take(fr, pc, raw_at(pc), limit)) is not None:
+                if lean_unread:
+                    lean_unread = False
+                    raw_at, refused = lean.lines(blocks)
+                if raw_at is not None and pc not in refused and (ev := take(fr, pc, raw_at(pc), limit)) is not None:
                     last = self.block
                     if ev is not nothing:
                         yield ev  # type: ignore[misc]

@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import math
 import re
+from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 from nc.interp.gcodes import lookup
@@ -37,6 +38,8 @@ if TYPE_CHECKING:  # pragma: no cover
 _NUM = r"([+-]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+))[ \t]*"  # a number as nc.program.parser reads one
 _LETTER = re.compile(r"[A-Za-z]")
 _G_MOTION = {"0": 0, "00": 0, "000": 0, "1": 1, "01": 1, "001": 1}  # G00 / G01 as programs write them
+_UNSEEN = object()
+_TEXTS = 4096  # line texts whose shape is kept; then the memo starts over (memory flat)
 NOTHING = object()  # `take`: the line ran and moved nothing (`G1 F100`): no event, as block by block
 
 
@@ -57,11 +60,14 @@ class _Shape:
 class LeanLane:
     """The lane of one interpreter (its axes and code-call tables decide the shapes it takes)."""
 
-    __slots__ = ("ip", "shapes", "last", "axes", "diameter", "g_codes", "tables", "g_ok")
+    __slots__ = ("ip", "shapes", "texts", "refused", "last", "axes", "diameter", "g_codes", "tables", "g_ok")
 
     def __init__(self, ip: "Interpreter") -> None:
         self.ip = ip
         self.shapes: dict[tuple[str, ...], _Shape | None] = {}
+        self.texts: dict[str, _Shape | None] = {}  # line text -> its shape, for lines `last` did not match
+        # id of a program's block list -> (the list, its `raw`, indexes of the lines the lane never takes)
+        self.refused: dict[int, tuple[object, Callable[[int], str | None] | None, set[int]]] = {}
         self.last: _Shape | None = None  # the shape of the last line taken: tried first
         self.axes = tuple(a for a in ip.axes if len(a) == 1 and a in ip._plain_axes)
         self.diameter = ip.profile.diameter_axes
@@ -69,6 +75,17 @@ class LeanLane:
         self.g_codes = lookup(ip.profile, 0.0) == (1, "G00") and lookup(ip.profile, 1.0) == (1, "G01")
         self.tables: object = None  # the code-call tables `g_ok` was found with
         self.g_ok = False
+
+    def lines(self, blocks: object) -> tuple[Callable[[int], str | None] | None, set[int]]:
+        """A block list's plain-line texts (`BlockList.raw`, None for a list of blocks) and the indexes
+        of its lines the lane never takes (`M99`, `T0101`, `G90 G54`: by their letters), which `_run`
+        runs on the general path without asking again (a macro's M99, 5,000 passes)."""
+        hit = self.refused.get(id(blocks))
+        if hit is None or hit[0] is not blocks:  # the list is held: its id is not reused meanwhile
+            if len(self.refused) >= 64:
+                self.refused.clear()
+            hit = self.refused[id(blocks)] = (blocks, getattr(blocks, "raw", None), set())
+        return hit[1], hit[2]
 
     def _g_ok(self) -> bool:
         """Whether a G00/G01 word may be taken: no macro is called for either, by the tables in force
@@ -113,22 +130,30 @@ class LeanLane:
     def take(self, fr: "Frame", pc: int, raw: str, limit: int) -> object:
         """Run the plain line `raw` at `fr.pc == pc`: its Move, NOTHING when it moved nothing, or None
         (nothing done) when the general path must run it."""
-        ip = self.ip
-        if ip._executed >= limit or not self._eligible():
-            return None
         shape = self.last
         m = shape.match(raw) if shape is not None else None
         if m is None:
-            letters = tuple(c.upper() for c in _LETTER.findall(raw))
-            if letters not in self.shapes:
-                self.shapes[letters] = self._shape(letters)
-            shape = self.shapes[letters]
+            # a line of another shape: its shape by its text (a line the lane refuses, `M99` of a macro
+            # called 5,000 times, is refused by one look-up), else by its letters
+            shape = self.texts.get(raw, _UNSEEN)
+            if shape is _UNSEEN:
+                letters = tuple(c.upper() for c in _LETTER.findall(raw))
+                shape = self.shapes.get(letters, _UNSEEN)
+                if shape is _UNSEEN:
+                    shape = self.shapes[letters] = self._shape(letters)
+                if len(self.texts) >= _TEXTS:
+                    self.texts.clear()
+                self.texts[raw] = shape
             if shape is None:
+                self.lines(fr.program.blocks)[1].add(pc)  # never taken: `_run` no longer asks
                 return None
-            m = shape.match(raw)
+            m = shape.match(raw)  # type: ignore[union-attr]
             if m is None:
                 return None
-            self.last = shape
+            self.last = shape  # type: ignore[assignment]
+        ip = self.ip
+        if ip._executed >= limit or not self._eligible():
+            return None
         vals = m.groups()
         st = ip.state
         motion = st.motion
