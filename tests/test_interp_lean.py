@@ -187,3 +187,28 @@ def test_the_block_of_a_lane_line_is_the_parsers_block(line: str) -> None:
         assert (ip.block.words, ip.block.n, ip.block.text) == (parsed.words, parsed.n, parsed.text)
     else:
         assert ip.block == parsed
+
+
+def test_a_bench_run_traces_the_same_with_the_lane(tmp_path, monkeypatch) -> None:
+    """`hil run` on the mill bench, lane on and off: every trace column the same, every cycle, and the
+    axes end where the program's last line says (work offset G54 = 0)."""
+    from pathlib import Path
+
+    from hil import api
+
+    lines = ["G90 G17 G94 G01 F3000"] + [f"X{0.05 * k:.4f} Y{(-1) ** k * 0.02 * k:.4f}" for k in range(1, 60)]
+    lines += ["G0 Z2.", "N10 G1 X1. Y1. F1200", "M30"]
+    prog = tmp_path / "cam.nc"
+    prog.write_text("\n".join(lines) + "\n")
+    bench = str(Path(__file__).resolve().parent.parent / "benches" / "mill-3axis.toml")
+    tables = []
+    for lean in (True, False):
+        monkeypatch.setattr(Interpreter, "lean", lean)
+        trace = tmp_path / f"t{lean}.parquet"
+        res = api.run(str(prog), bench, trace=str(trace))
+        assert res.run.ok
+        tables.append(api.load_trace(trace))
+    assert tables[0].column_names == tables[1].column_names and tables[0].num_rows == tables[1].num_rows
+    assert [c for c in tables[0].column_names if not tables[0][c].equals(tables[1][c])] == []
+    ends = {a: tables[0][f"{a}_cmd"][-1].as_py() for a in "XYZ"}
+    assert ends == pytest.approx({"X": 1.0, "Y": 1.0, "Z": 2.0}, abs=1e-6)
