@@ -417,8 +417,8 @@ class Stretcher(RealTimeStretches):
         org = r.origin.tolist()
         out = []
         for i in range(self.n_axes):
-            sc, o = r.scales[i], org[i]
-            out.append([rx0[i].target_position] + [sc.to_counts(c - o) for c in smp.positions[: n - 1, i].tolist()])
+            cpu, o = r.scales[i]._cpu, org[i]  # AxisScaling.to_counts's expression, inline
+            out.append([rx0[i].target_position] + [int(round((c - o) * cpu)) for c in smp.positions[: n - 1, i].tolist()])
         return out
 
     def _step_drives(self, rx0: list[RxPdo], targets: list[list[int]], n: int) -> list[Stretch]:

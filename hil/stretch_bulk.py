@@ -216,7 +216,8 @@ def bulk_cycles(r: Any, ch: Channel, pl: Planner, smp: Samples, outs: list[Stret
     for i in range(n_axes):
         sc = scales[i]
         r.rx[i].target_position = sc.to_counts(cmds_last[i] - org[i])
-        ferr = max(abs(sc.to_units(fe)) for fe in outs[i].following_error[k0:m])
+        # |fe / cpu| is |fe| / |cpu| exactly and a division by a constant is monotone: the largest |fe| gives the peak
+        ferr = abs(sc.to_units(max(map(abs, outs[i].following_error[k0:m]))))
         if ferr > max_ferr[r.axes[i]]:
             max_ferr[r.axes[i]] = ferr
     mlc = r.mlc

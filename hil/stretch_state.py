@@ -29,13 +29,19 @@ def _signature(ch: Channel) -> tuple:
             ch.css_rpm, ch.spindle_max)
 
 
+_HOOKS: list = []  # (EventPlayer, OperatorPanel), imported at the first call (they import the runner)
+
+
 def _panel_state(on_cycle: Any) -> tuple | None:
     """The on_cycle hook's state while it writes nothing (None: a hook a stretch cannot see into)."""
-    from hil.run_events import EventPlayer
-    from hil.scripting import OperatorPanel
-
     if on_cycle is None:
         return ()
+    if not _HOOKS:
+        from hil.run_events import EventPlayer
+        from hil.scripting import OperatorPanel
+
+        _HOOKS[:] = [EventPlayer, OperatorPanel]
+    EventPlayer, OperatorPanel = _HOOKS
     if isinstance(on_cycle, OperatorPanel):
         return None if on_cycle._pressed else (False,)
     if isinstance(on_cycle, EventPlayer):
