@@ -53,9 +53,9 @@ class Piecewise:
     def of(cls, traj: Trajectory) -> "Piecewise":
         rows = [_phases(pr) for pr in traj.profiles[0]]
         if len(rows) == 1:  # one DoF (every path solve): its columns as they are, no padding (issue 17)
-            r = rows[0]
-            return cls(np.array([r[0]]), np.array([r[1]]), np.array([r[2]]), np.array([r[3]]), np.array([r[4]]),
-                       float(traj.duration), float(traj.position_extrema[0].max))
+            m = np.array(rows[0])  # one array, five (1, phases) views of it
+            return cls(m[0:1], m[1:2], m[2:3], m[3:4], m[4:5], float(traj.duration),
+                       float(traj.position_extrema[0].max))
         n = max(len(r[0]) for r in rows)
         arrs = []
         for k in range(5):

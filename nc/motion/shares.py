@@ -92,20 +92,25 @@ def _scan(fc: "FilterCorners", blocks: Sequence["Block"], pos: float, run_end: f
     # so that prefix answers _tolerance_free as the whole queue does (~45 of ~100 blocks; issue 17).
     prefix: list[float] = []
     from_prefix = True
-    for b in blocks:
-        if b.kind != "path" or b.seg is None:
+    append = prefix.append
+    stop_s = run_end - 1e-9
+    for b in blocks:  # each field read once (~50 blocks a scan, two scans a solve; issue 17)
+        seg = b.seg
+        if seg is None or b.kind != "path":
             covered = True  # dwell, thread, independent rapid: a stop before it ends every window
             from_prefix = False
             break
-        prefix.append(b.s_end)
-        if b.s_end - b.length > hi:
+        s_end = b.s_end
+        append(s_end)
+        if s_end - b.length > hi:
             covered = True
             break
-        if b.seg.kind == "arc":
+        if seg.kind == "arc":
             return None  # the curvature share's centripetal terms
-        if b.vtop > seen:
-            seen = b.vtop
-        if b is not last and b.vjunc <= 0.0 and b.s_end >= run_end - 1e-9:
+        vt = b.vtop
+        if vt > seen:
+            seen = vt
+        if b.vjunc <= 0.0 and b is not last and s_end >= stop_s:
             covered = True  # an exact stop (G09/G61, G00): the filter settles there
             from_prefix = False
             break
