@@ -156,7 +156,7 @@ class _Check:
         side = np.zeros(last + 1, dtype=bool)
         side[np.maximum(close - 1, 0)] = True
         side[np.minimum(close, last)] = True
-        steps = np.flatnonzero(side & (seg[:-1] != seg[1:]))
+        steps = np.flatnonzero(side & ((seg[:-1] != seg[1:]) | (self.k[:-1] != self.k[1:])))
         fine = np.zeros(last + 1)
         if len(steps):
             frac = np.arange(1, FINE) / FINE
