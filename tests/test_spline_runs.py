@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from benchmarks.bench_vs_linuxcnc import START, cam_polyline, cam_surface
-from nc.motion.spline_runs import Cost, fit_run, polyline_distance, span_limits, spans
+from nc.motion.spline_runs import Cost, FitError, fit_run, polyline_distance, span_limits, spans
 from tests import spline_slow as slow
 from tests.motion_helpers import polyline_deviation
 
@@ -153,3 +153,12 @@ def test_the_distance_skips_only_segments_that_cannot_be_nearer():
     f = (cu - cum[k]) / (cum[k + 1] - cum[k])
     curve = pts[k] + f[:, None] * steps[k] + rng.normal(0.0, 0.03, (5000, 3))
     assert np.abs(polyline_distance(curve, cu, pts, cum) - slow.distance(curve, cu, pts, cum)).max() < 1e-12
+
+
+@pytest.mark.parametrize("pts", [[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.1, 0.0]],
+                                 [[0.0, 0.0, 0.0]], [[0.0, 0.0, 0.0], [1.0, np.nan, 0.0], [2.0, 0.0, 0.0]]])
+def test_a_run_the_fit_cannot_take_is_a_fit_error(pts):
+    """A vertex twice (decision 51's spans failed on it with an IndexError), one vertex, a NaN: FitError, which
+    the caller answers with lines, not an exception of numpy's."""
+    with pytest.raises(FitError):
+        fit_run(np.array(pts), 0.02)

@@ -292,7 +292,11 @@ def fit_run(pts: np.ndarray, tol: float, lam: float = LAM, rounds: int = 60, ste
     cost = cost or Cost()
     tc = cost.lap("", 0.0)
     pts = np.asarray(pts, dtype=float)
+    if pts.ndim != 2 or len(pts) < 2 or not np.isfinite(pts).all():
+        raise FitError(f"no fit of {len(pts)} points: two finite vertices or more")
     u, p, cum = samples(pts)
+    if np.diff(cum).min() <= 1e-9:  # a vertex twice: no span between (its knots would coincide)
+        raise FitError("no fit of a run with a segment of no length")
     w = np.ones(len(u))
     uu = np.append(np.arange(0.0, cum[-1], step), cum[-1])
     j = np.clip(np.searchsorted(u, uu), 0, len(u) - 1)
