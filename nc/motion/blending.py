@@ -121,7 +121,9 @@ class FilterCorners:
 
     def touch(self) -> None:
         """Every junction's caps may have changed (an override, dry run): nc.motion.shares finds its verdicts
-        again."""
+        again. Code that changes a queued junction's vjunc, vbud, vtol, vctol or cap outside window/_tolerance
+        (and the planner's head block) must call it too: the kept verdicts would not see the change
+        (tests/test_motion_shares_kept.py compares them with the walk)."""
         self._sc_dirty = 0
         self._sc_head = math.nan
 
