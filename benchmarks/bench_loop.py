@@ -266,7 +266,10 @@ def _cpu_of(pid: int) -> float:
         return 0.0
 
 
-def realtime_runs(d: str, cam_blocks: int = 1500, cam: bool = True) -> None:
+_MODES = {"0": "every cycle stepped", "1": "stretches, B21", "ahead": "stepped, refill and bus ahead"}
+
+
+def realtime_runs(d: str, cam_blocks: int = 1500, cam: bool = True, modes: tuple[str, ...] = ("0", "1")) -> None:
     """`hil run --realtime` at the bench's 1 ms cycle, as a user runs it (hil.api.run: the bench's MLC,
     a Parquet trace): cycle work p50/p99/max for the lathe demo (lathe MLC) and a CAM program on
     benches/mill-3axis.toml. Figures, not a test: the machine's other load sets the tail."""
@@ -283,10 +286,11 @@ def realtime_runs(d: str, cam_blocks: int = 1500, cam: bool = True) -> None:
         programs.append((f"CAM {cam_blocks:,} blocks, mill-3axis", path, root / "benches" / "mill-3axis.toml"))
     runs = [(label + how, program, bench, on)
             for label, program, bench in programs
-            for how, on in ((" (default: stepped)", None), (" (DELTAHIL_STRETCH=1: stretches, B21)", "1"))]
+            for how, on in (((f" (DELTAHIL_STRETCH={m}: {_MODES[m]})" if m in _MODES else f" ({m})"), m)
+                            for m in modes)]
     saved = os.environ.get("DELTAHIL_STRETCH")
     for label, program, bench, on in runs:
-        if on is None:
+        if on == "default":
             os.environ.pop("DELTAHIL_STRETCH", None)
         else:
             os.environ["DELTAHIL_STRETCH"] = on
@@ -337,6 +341,9 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--repeat", type=int, default=1, metavar="N",
                         help="with --realtime-only: N alternating rounds of the runs (overruns move with the load)")
     parser.add_argument("--lathe-only", action="store_true", help="with --realtime-only: the lathe demo only")
+    parser.add_argument("--modes", default="0,1", metavar="M,M",
+                        help="with --realtime-only: the DELTAHIL_STRETCH values run in turn (default 0,1; 'ahead': "
+                             "stepped with the refill and the bus exchange in the slack)")
     args = parser.parse_args(argv)
     with tempfile.TemporaryDirectory() as d:
         if args.ethercat_only:
@@ -344,7 +351,7 @@ def main(argv: list[str] | None = None) -> None:
             return
         if args.realtime_only:
             for _ in range(args.repeat):
-                realtime_runs(d, cam=not args.lathe_only)
+                realtime_runs(d, cam=not args.lathe_only, modes=tuple(args.modes.split(",")))
             return
         issue17(d)
         if args.stages_only:

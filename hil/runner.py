@@ -26,7 +26,7 @@ from hil.clock import CycleTiming, LockStepClock, RealTimeClock
 from hil import retentive
 from hil.drive_homing import home_axes
 from hil.mlc_bridge import drive_status
-from hil.stretch import Stretcher, wanted as stretch_wanted
+from hil.stretch import Stretcher, ahead_wanted, wanted as stretch_wanted
 from hil.trace import TraceSource, TraceWriter, trace_columns
 from mlc.basic import BasicMlc
 from nc.alarm_table import MAX_TIME
@@ -141,7 +141,7 @@ class BenchRunner:
     # ---- public ---------------------------------------------------------------------------
     def run_program(self, program: Program) -> RunResult:
         paced = isinstance(self.clock, RealTimeClock)
-        self._bus_ahead = paced and type(self.link) is SimLink and stretch_wanted(realtime=True)
+        self._bus_ahead = paced and type(self.link) is SimLink and (stretch_wanted(realtime=True) or ahead_wanted())
         if paced:
             _preload(self.bench)
         try:

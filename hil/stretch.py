@@ -19,7 +19,7 @@ early, at the first cycle where it would differ from stepping:
   cycle's outputs differ from what the drives were stepped with: the stretch ends after that cycle.
 Ending early restores the planner and the drives as they were and takes the shorter stretch again (the
 parts are deterministic, so its cycles are the same). `DELTAHIL_STRETCH=0` turns stretches off: tests
-compare both runs column by column.
+compare both runs column by column (`ahead`: real time stepped with the work ahead only, decision B31).
 
 With the basic MLC in lock-step a stretch runs the NC's steps itself, feeds and solves included (decisions
 B26/B27, hil/stretch_pass.py). Its real-time part (decision B21: pacing, work ahead in the slack) is hil/stretch_realtime.py, a mixin on
@@ -70,6 +70,13 @@ def wanted(realtime: bool = False) -> bool:
     return value == "1" if realtime else value != "0"
 
 
+def ahead_wanted() -> bool:
+    """Real time with DELTAHIL_STRETCH=ahead (decision bench B31, opt-in): every cycle stepped, but the planner refill
+    it will make (`Stretcher.ahead`) and its in-process bus exchange worked out in the slack before its tick. In
+    lock-step the value is the default (stretches on)."""
+    return os.environ.get(ENV) == "ahead"
+
+
 class Stretcher(RealTimeStretches):
     """Takes stretches for one runner (a `hil.runner.BenchRunner`)."""
 
@@ -101,13 +108,15 @@ class Stretcher(RealTimeStretches):
         self.reads_ok = os.environ.get(ENV_READS) != "0"
         self.feeds = 0
         self._fed0 = False
+        self.ahead_only = self.paced and not wanted(True)  # real time: steps every cycle, its refill ahead
 
     @classmethod
     def for_runner(cls, runner: Any) -> "Stretcher | None":
         """A stretcher where stretches can be exact: the in-process bus with its simulated drives, in lock-step
         or paced in real time (B21)."""
         link = runner.link
-        if not wanted(type(runner.clock) is RealTimeClock) or type(link) is not SimLink or type(runner.clock) not in (LockStepClock, RealTimeClock):
+        rt = type(runner.clock) is RealTimeClock
+        if not (wanted(rt) or (rt and ahead_wanted())) or type(link) is not SimLink or type(runner.clock) not in (LockStepClock, RealTimeClock):
             return None
         drives = list(link.slaves)
         if len(drives) != len(runner.rx) or any(type(d) is not Cia402Drive for d in drives):
@@ -123,7 +132,7 @@ class Stretcher(RealTimeStretches):
         ch: Channel | None = r.channel
         self._early, self._next_fill = self._next_fill, None  # the one before's, for this start only
         self._taken, self._spec, self._prep = self._spec, None, None  # B22: the one before's, this start's only
-        if limit < 2 or ch is None:
+        if limit < 2 or ch is None or self.ahead_only:
             return False
         kind = self._quiet(r, ch)
         if kind is None:

@@ -191,3 +191,26 @@ def test_a_signal_while_a_stretch_is_paced_lands_on_the_same_cycle(monkeypatch, 
     r = b[1].run
     assert r.stopped_by == "SIGINT" and not r.finished and r.stretched > 0.9 * at
     assert b[1].runner.trace is not None
+
+
+@pytest.mark.parametrize("kw", [{}, {"events": ["t=2:feed-hold", "t=2.6:cycle-start", "t=4:set D21002=50"]}],
+                         ids=["plain", "hold-resume-override"])
+def test_stepping_with_its_refill_and_exchange_ahead_equals_stepping(monkeypatch, tmp_path, kw):
+    """Session 11, route (a): every cycle stepped, but the planner refill a cycle will make (`Stretcher.ahead`) and
+    its in-process bus exchange (`BenchRunner._bus_ahead`) worked out in the slack before its tick
+    (DELTAHIL_STRETCH=ahead): the same trace as plain stepping in every column, with the refills ahead taken."""
+    made: list[Stretcher] = []
+    init = Stretcher.__init__
+
+    def spy(self, *args):
+        init(self, *args)
+        made.append(self)
+
+    monkeypatch.setattr(Stretcher, "__init__", spy)
+    a = _run(monkeypatch, tmp_path, "0", **kw)
+    assert not made  # plain stepping: no stretcher, nothing ahead
+    b = _run(monkeypatch, tmp_path, "ahead", **kw)
+    _same(a, b)
+    r = b[1].run
+    assert r.ok and r.stretched == 0 and b[1].runner._bus_ahead
+    assert len(made) == 1 and made[0].stretches == 0 and made[0].ahead_used > 100  # the lathe demo's refills
