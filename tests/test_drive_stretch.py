@@ -164,3 +164,42 @@ def test_csv_spindle_stretch_equals_exchange_with_its_index_latch(probe):
     assert (want[-1].touch_probe_status == 3) == bool(probe)
     if probe:
         assert before > 0.5 * latch > 5  # the run-up to the first index edge stretches too
+
+
+def test_a_standing_drive_repeats_its_cycle_exactly_in_runs_of_parts():
+    """CspRun/CsvRun (a B27 pass's drives, a part at a time): a drive standing at its target (a mill's Z and its
+    spindle in a CAM program) repeats the cycle it ended where it began, only its time going on; every
+    cycle's feedback and every float of the model are exchange()'s, the standing cycles and the moves after."""
+    from virtual_bus.drive_stretch import CspRun, CsvRun
+
+    params = DriveParams()
+    one, rx1 = _enabled(params, 500.0)
+    many, rx2 = _enabled(params, 500.0)
+    targets = [5000] * 1000 + [0] * 300 + _targets(3, 400) + [0] * 5  # standing at 5000, then at 0
+    want, states = _reference(one, rx1, "target_position", targets)
+    run, k, still = CspRun(many, rx2, 0.001), 0, []
+    for n in (1, 2, 150, 347, 500, 300, 60, 345, 5):
+        run.step(targets[k:k + n])
+        still.append(run.still is not None)
+        k += n
+    rx2.target_position = targets[-1]
+    s = run.finish()
+    assert s.done == len(targets) and still[3:5] == [True, True]  # settled within 500 cycles, then repeated
+    assert list(zip(*(getattr(s, f) for f in FIELDS))) == [tuple(getattr(tx, f) for f in FIELDS) for tx in want]
+    assert _state(many) == states[-1]
+
+    one, rx1 = _enabled(params, 77.0, mode=9)
+    many, rx2 = _enabled(params, 77.0, mode=9)
+    speeds = [0] * 400 + [3000] * 200
+    want, states = _reference(one, rx1, "target_velocity", speeds)
+    got = []
+    for part in (speeds[:400], speeds[400:]):
+        rx2.target_velocity = part[0]
+        run = CsvRun(many, rx2, 0.001)
+        for n in (3, 100, len(part) - 103):
+            run.step(n)
+            still.append(run.still)
+        s = run.finish()
+        got += list(zip(*(getattr(s, f) for f in FIELDS)))
+        assert _state(many) == states[len(got) - 1]
+    assert got == [tuple(getattr(tx, f) for f in FIELDS) for tx in want] and still[-6:-3] == [True] * 3

@@ -86,6 +86,7 @@ class CspRun:
                        float(p.positive_limit) if p.positive_limit is not None else math.inf)
         self.state = (drive.position, drive.velocity, drive.time, drive.command, drive._prev_target,
                       drive.acceleration, drive.torque)
+        self.still: int | None = None  # the target of a cycle that left the drive as it found it (_same)
 
     def step(self, targets: Sequence[int]) -> None:
         """The next cycles, one per target; stops (for good) before a cycle that would fault."""
@@ -102,8 +103,19 @@ class CspRun:
         out = self.out
         pa, va, ta, fe, sws = (out.position_actual, out.velocity_actual, out.torque_actual, out.following_error,
                                out.statusword)
-        for raw in targets:
-            target = float(raw) - origin
+        still = self.still
+        for tgt in targets:
+            if tgt == still:  # the same target again after a cycle that changed nothing: the same cycle, the time on
+                for _k in range(n):
+                    t += h
+                sws.append(sws[-1])
+                pa.append(pa[-1])
+                va.append(va[-1])
+                ta.append(ta[-1])
+                fe.append(fe[-1])
+                continue
+            before = (pos, vel, command, prev_target, acc, torque)
+            target = float(tgt) - origin
             prev = prev_target if prev_target is not None else command
             ff_vel = (target - prev) / dt
             kff_ff, span = kff * ff_vel, target - prev
@@ -136,7 +148,9 @@ class CspRun:
             va.append(raw if -0x7FFFFFFF <= raw <= 0x7FFFFFFF else max(-0x7FFFFFFF, min(0x7FFFFFFF, raw)))
             ta.append(int(round(torque * 0.1 / t_pct)))
             fe.append(int(round(gap)))
+            still = tgt if _same(before, (pos, vel, command, prev_target, acc, torque)) else None
         self.state = (pos, vel, t, command, prev_target, acc, torque)
+        self.still = still
         out.done = len(pa)
 
     def finish(self) -> Stretch:
@@ -170,6 +184,7 @@ class CsvRun:
         self.every = (p.index_pulse_every or cpr) if rx.touch_probe_function & 1 and not drive._probe_latched else 0
         self.state = (drive.position, drive.velocity, drive.time, drive.command, drive.target_velocity,
                       drive.acceleration, drive.torque)
+        self.still = False  # the last cycle left the drive as it found it (_same): the next ones are the same
 
     def step(self, cycles: int) -> None:
         """The next `cycles` cycles; stops (for good) before a cycle that would fault or latch the index."""
@@ -185,7 +200,17 @@ class CsvRun:
         out = self.out
         pa, va, ta, sws = out.position_actual, out.velocity_actual, out.torque_actual, out.statusword
         floor = math.floor
+        still = self.still
         for _ in range(cycles):
+            if still:  # a standing spindle (a mill's CAM program): the same cycle, the time on
+                for _k in range(n):
+                    t += h
+                sws.append(sws[-1])
+                pa.append(pa[-1])
+                va.append(va[-1])
+                ta.append(ta[-1])
+                continue
+            before = (pos, vel, command, tv, acc, torque)
             c_pos, c_vel, c_t, c_tv, cmd = pos, vel, t, tv, command
             edge = False
             # The velocity-loop lines below, and the feedback lines after them, repeat CspRun's on purpose: a call
@@ -214,7 +239,9 @@ class CsvRun:
             raw = round(vel * k_raw)
             va.append(raw if -0x7FFFFFFF <= raw <= 0x7FFFFFFF else max(-0x7FFFFFFF, min(0x7FFFFFFF, raw)))
             ta.append(int(round(torque * 0.1 / t_pct)))
+            still = _same(before, (pos, vel, command, tv, acc, torque))
         self.state = (pos, vel, t, command, tv, acc, torque)
+        self.still = still
         out.following_error += [0] * (len(pa) - len(out.following_error))  # 0x60F4 is a CSP object: 0 in CSV
         out.done = len(pa)
 
@@ -226,6 +253,14 @@ class CsvRun:
             self.drive.target_velocity = tv
             _finish(self.drive, self.rx, out, pos, vel, t, command, acc, torque)
         return out
+
+
+def _same(a: tuple, b: tuple) -> bool:
+    """The same values bit for bit (a zero's sign too): a cycle that starts from `b` as it did from `a` computes the
+    same (the time aside, which only adds up), so a cycle that ended where it started repeats itself exactly."""
+    return all(type(x) is type(y) and x == y
+               and (type(x) is not float or x != 0.0 or math.copysign(1.0, x) == math.copysign(1.0, y))
+               for x, y in zip(a, b))
 
 
 def _model(p: DriveParams, dt: float) -> tuple[int, float, float, float, float, float]:
