@@ -106,13 +106,7 @@ class CspRun:
         still = self.still
         for tgt in targets:
             if tgt == still:  # the same target again after a cycle that changed nothing: the same cycle, the time on
-                for _k in range(n):
-                    t += h
-                sws.append(sws[-1])
-                pa.append(pa[-1])
-                va.append(va[-1])
-                ta.append(ta[-1])
-                fe.append(fe[-1])
+                t = _repeat(out, t, h, n, True)
                 continue
             before = (pos, vel, command, prev_target, acc, torque)
             target = float(tgt) - origin
@@ -203,12 +197,7 @@ class CsvRun:
         still = self.still
         for _ in range(cycles):
             if still:  # a standing spindle (a mill's CAM program): the same cycle, the time on
-                for _k in range(n):
-                    t += h
-                sws.append(sws[-1])
-                pa.append(pa[-1])
-                va.append(va[-1])
-                ta.append(ta[-1])
+                t = _repeat(out, t, h, n, False)
                 continue
             before = (pos, vel, command, tv, acc, torque)
             c_pos, c_vel, c_t, c_tv, cmd = pos, vel, t, tv, command
@@ -253,6 +242,17 @@ class CsvRun:
             self.drive.target_velocity = tv
             _finish(self.drive, self.rx, out, pos, vel, t, command, acc, torque)
         return out
+
+
+def _repeat(out: Stretch, t: float, h: float, n: int, csp: bool) -> float:
+    """The last cycle's feedback once more (_same), and the time after its n sub-steps (summed as they sum it)."""
+    for col in (out.statusword, out.position_actual, out.velocity_actual, out.torque_actual):
+        col.append(col[-1])
+    if csp:  # (CSV fills 0x60F4 after the part)
+        out.following_error.append(out.following_error[-1])
+    for _k in range(n):
+        t += h
+    return t
 
 
 def _same(a: tuple, b: tuple) -> bool:
