@@ -108,7 +108,6 @@ class CspRun:
             if tgt == still:  # the same target again after a cycle that changed nothing: the same cycle, the time on
                 t = _repeat(out, t, h, n, True)
                 continue
-            before = (pos, vel, command, prev_target, acc, torque)
             target = float(tgt) - origin
             prev = prev_target if prev_target is not None else command
             ff_vel = (target - prev) / dt
@@ -129,6 +128,9 @@ class CspRun:
             if not inside or abs(cmd - c_pos) > window or abs(c_vel) > 1.2 * max_cps:
                 self.ok = False
                 break  # a limit switch, or Cia402Drive._supervise would fault in this cycle: exchange() takes it
+            # (a moving drive fails the cheap comparisons: no tuples and no _same call a cycle)
+            before = (pos, vel, command, prev_target, acc, torque) \
+                if c_pos == pos and c_vel == vel and target == prev_target else None
             c_acc = (c_vel - vel) / dt
             # Cia402Drive.step's torque of an energised drive (0.1 % of rated) and DriveUnits.velocity_to_raw
             # inline, the same expressions: a call each per cycle cost a fifth of the loop
@@ -142,7 +144,7 @@ class CspRun:
             va.append(raw if -0x7FFFFFFF <= raw <= 0x7FFFFFFF else max(-0x7FFFFFFF, min(0x7FFFFFFF, raw)))
             ta.append(int(round(torque * 0.1 / t_pct)))
             fe.append(int(round(gap)))
-            still = tgt if _same(before, (pos, vel, command, prev_target, acc, torque)) else None
+            still = tgt if before is not None and _same(before, (pos, vel, command, prev_target, acc, torque)) else None
         self.state = (pos, vel, t, command, prev_target, acc, torque)
         self.still = still
         out.done = len(pa)
@@ -199,7 +201,6 @@ class CsvRun:
             if still:  # a standing spindle (a mill's CAM program): the same cycle, the time on
                 t = _repeat(out, t, h, n, False)
                 continue
-            before = (pos, vel, command, tv, acc, torque)
             c_pos, c_vel, c_t, c_tv, cmd = pos, vel, t, tv, command
             edge = False
             # The velocity-loop lines below, and the feedback lines after them, repeat CspRun's on purpose: a call
@@ -219,6 +220,7 @@ class CsvRun:
             if edge or abs(c_vel) > 1.2 * max_cps:
                 self.ok = False
                 break  # the index latches in this cycle, or overspeed: exchange() takes it
+            before = (pos, vel, command, tv, acc, torque) if c_pos == pos and c_vel == vel and c_tv == tv else None
             c_acc = (c_vel - vel) / dt
             torque = (inertia * c_acc * rad + viscous * c_vel * rad
                       + (math.copysign(coulomb, c_vel) if abs(c_vel) > 1 else 0.0)) / rated * 1000.0
@@ -228,7 +230,7 @@ class CsvRun:
             raw = round(vel * k_raw)
             va.append(raw if -0x7FFFFFFF <= raw <= 0x7FFFFFFF else max(-0x7FFFFFFF, min(0x7FFFFFFF, raw)))
             ta.append(int(round(torque * 0.1 / t_pct)))
-            still = _same(before, (pos, vel, command, tv, acc, torque))
+            still = before is not None and _same(before, (pos, vel, command, tv, acc, torque))
         self.state = (pos, vel, t, command, tv, acc, torque)
         self.still = still
         out.following_error += [0] * (len(pa) - len(out.following_error))  # 0x60F4 is a CSP object: 0 in CSV
