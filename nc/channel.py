@@ -324,6 +324,7 @@ class Channel:
                     self._skip_done()
                 continue  # a Sync: motion has drained, read on
             if self.single_block and self._block_moves:
+                pl.release_run()  # nothing more is read: a run held back runs now (nc.motion.spline_feed)
                 return
             if reads == 0:
                 return  # the rest next cycle
@@ -340,6 +341,8 @@ class Channel:
                 self.raise_alarm(internal_error(exc))
                 return
             if isinstance(ev, Busy):
+                if len(pl.blocks) < 2:
+                    pl.release_run()  # the queue runs dry while the interpreter works: what is held runs
                 return  # the statement budget is spent: the interpreter reads on next cycle
             if isinstance(ev, Move):
                 if self.soft_limits is not None and ev is not self._checked \

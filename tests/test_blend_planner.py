@@ -21,6 +21,7 @@ LIM = {"X": AxisLimits(500, 5000, 250_000), "Y": AxisLimits(500, 5000, 250_000),
 
 
 def _cfg(**kw) -> MotionConfig:
+    kw.setdefault("fit_runs", False)  # corner blends, not fitted runs (those: tests/test_spline_feed.py)
     return MotionConfig(axes=AX, limits=LIM, **kw)
 
 

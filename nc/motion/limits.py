@@ -39,6 +39,8 @@ class MotionConfig:
     # not by a one-cycle velocity step.
     filter_time: float = 0.0
     filter_scurve: float = 0.0
+    # Runs of short feed lines fitted as one curve within path_tolerance (nc.motion.spline_feed, issue 18).
+    fit_runs: bool = True
 
     def filter_cycles(self) -> tuple[int, int]:
         """Window lengths (cycles) of the two moving averages; (1, 1) = no filter."""

@@ -39,6 +39,8 @@ from nc.motion.plan_state import CHUNK, Setpoint, _near, _Plan
 from nc.motion.filter_ramps import HISTORY, FilterStops
 from nc.motion.planner_corners import CornerShares
 from nc.motion.planner_cruise import CruiseSampling
+from nc.motion.planner_runs import FittedRuns
+from nc.motion.spline_feed import NOTHING
 from nc.motion.planner_thread import ThreadStepping
 from nc.motion.profile import clip, solve_axes, solve_position, solve_velocity
 from nc.motion.sample_rows import few_rows
@@ -52,7 +54,7 @@ OPEN_CHUNK = 4  # cycles sampled at a time (CHUNK otherwise) while the queue can
 MAX_SOLVES_PER_CYCLE = 1000  # plans one cycle may start and end before a sample is due (decisions B4)
 
 
-class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops):
+class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedRuns):
     # True: every block of a run starts a new solve, also where the run cruises at its cap (the reference
     # tests compare the cruise sampling against, decision motion 44)
     per_block = False
@@ -148,12 +150,19 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops):
         self._pushes = 0  # moves pushed so far (an open plan re-solves when more came)
         self.output = self.position.copy()  # the last setpoint handed out (filtered)
         self._init_filter_stops()
+        self._init_runs()
 
     # ---- queue ----------------------------------------------------------------------------
     def push(self, move: Move) -> None:
         self.closed = False
+        if self._runs is not None:  # runs of short lines are held back and fitted (nc.motion.spline_feed)
+            self._feed_run(move)
+        else:
+            self._push(move)
+
+    def _push(self, move: Move, span: Segment | None = None) -> None:
         self._pushes += 1
-        b = self._block(move)
+        b = self._block(move) if span is None else self._span_block(move, span)
         if b is None:
             return
         blend = self.lim.blend
@@ -205,7 +214,7 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops):
 
     @property
     def idle(self) -> bool:
-        return not self.blocks and self.plan is None and self._buf_done and self._settled
+        return not self.blocks and self.plan is None and self._buf_done and self._settled and not self._held.moves
 
     @property
     def halted(self) -> bool:
@@ -264,6 +273,7 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops):
         """Feed hold: jerk-limited stop along the path (across blocks if need be); keeps the queue."""
         if self.held:
             return
+        self.release_run()  # what a run holds back joins the queue (an interrupt re-reads the queue)
         self.held = True
         self._replan()
 
@@ -418,6 +428,7 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops):
 
     def _flush(self) -> None:
         self._thread = None
+        self._held = NOTHING
         self.spindle_wait = False
         self._wait_cycles = 0
         self.blocks.clear()

@@ -61,6 +61,8 @@ class ShareZones:
         for z in reversed(self.zones):
             if z.hi < math.inf:
                 break
+            if z.lo >= s:
+                continue  # it begins after this stop (a fitted run's zone, added before its first junction)
             z.hi = s
 
     def blend_allowed(self, start: float, vtop: float, now: float, rest: bool) -> bool:

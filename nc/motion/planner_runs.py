@@ -1,0 +1,75 @@
+"""The planner's side of fitted runs (nc.motion.spline_feed, issue 18, decisions motion 56-58): moves held back
+and let through as spline spans, the filter's share λ = 0 on them (share zones as for corner blends, decision
+45), and the channel's ways to end a run (`closed`, `release_run`). A mixin of `Planner`."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+from nc.motion.lookahead import Block
+from nc.motion.spline_feed import NOTHING, Held, RunFeed
+from nc.motion.spline_runs import SplineSpan, span_limits
+from nc.moves import Move
+
+
+class FittedRuns:
+    """Methods of `nc.motion.planner.Planner` (its state is the planner's own: see that module's doc)."""
+
+    _held: Held = NOTHING
+    _closed: bool = False
+
+    def _init_runs(self) -> None:
+        self._runs = RunFeed(self.cfg, self.lim) if RunFeed.enabled(self.cfg) else None
+        self._held = NOTHING
+
+    @property
+    def closed(self) -> bool:
+        """The channel says no move comes before the queue has run out to rest: a held run ends (is let through)."""
+        return self._closed
+
+    @closed.setter
+    def closed(self, value: bool) -> None:
+        self._closed = value
+        if value and self._held.moves:
+            self.release_run()
+
+    @property
+    def holding(self) -> bool:
+        """Moves are held back (the planner is not idle)."""
+        return bool(self._held.moves)
+
+    def release_run(self) -> None:
+        """Let every held move through (the run fitted to its end): the channel reads nothing more for now."""
+        if self._runs is not None and self._held.moves:
+            self._held, out = self._runs.release(self._held)
+            self._let_through(out)
+
+    def _feed_run(self, move: Move) -> None:
+        self._held, out = self._runs.push(self._held, move)
+        self._let_through(out)
+
+    def _let_through(self, out: list[tuple[Move, SplineSpan | None]]) -> None:
+        spans = [sp for _, sp in out if sp is not None]
+        zones = self._zones
+        if spans and zones is not None:
+            # λ = 0 on the spans (the fit's deviation is the only one); as for a blend, only where the zone keeps
+            # clear of the filter's last corner and of the sample going out, else they run as lines
+            start = self._path_s
+            vtop = 1.5 * max(m.feed or 0.0 for m, sp in out if sp is not None) / 60.0
+            prev = self.blocks[-1] if self.blocks else None
+            if prev is not None and self.lim.junction(prev, self._span_block(*out[0])) <= 0.0:
+                zones.stop(prev.s_end)  # the run begins after a stop: its zone starts there (`_corner` cuts none)
+            if zones.blend_allowed(start, vtop, self._now(), abs(self.v) < 1e-12 and self.plan is None):
+                zones.add_blend(start, start + sum(sp.length for sp in spans), vtop)
+            else:  # as lines; what is still held starts afresh from their end (no span to join)
+                out = [(m, None) for m, _ in out]
+                self._held = replace(self._held, behind=(), fitting=False, tail=None)
+        for m, sp in out:
+            self._push(m, sp)
+
+    def _span_block(self, move: Move, sp: SplineSpan) -> Block:
+        lim = self.lim
+        v, a, j = span_limits(sp, lim.v, lim.acc, lim.jerk)
+        v = min(v, sp.length / (self.cfg.min_segment_cycles * self.cfg.cycle))
+        return Block(move, "path", sp, sp.length, v, a, j, (move.feed or 0.0) / 60.0)
+
