@@ -6,6 +6,8 @@ from __future__ import annotations
 
 from dataclasses import replace
 
+import numpy as np
+
 from nc.motion.lookahead import Block
 from nc.motion.spline_feed import NOTHING, Held, RunFeed
 from nc.motion.spline_runs import SplineSpan, span_limits
@@ -69,7 +71,12 @@ class FittedRuns:
 
     def _span_block(self, move: Move, sp: SplineSpan) -> Block:
         lim = self.lim
-        v, a, j = span_limits(sp, lim.v, lim.acc, lim.jerk)
+        # a and j are those at the cap (they only grow below it): the cap held to the fastest the block may ever
+        # run (the feed, or the dry-run feed when on, at the top override 1.5; a dry run switched on later only
+        # lowers the cap), not the curve's own, so the coupling term
+        # 3·v·a_t·r'' leaves a_t more (decision 58)
+        top = 1.5 * (self.dry_run_feed if self.dry_run else (move.feed or 0.0) / 60.0)
+        v, a, j = span_limits(sp, np.minimum(lim.v, top * np.maximum(sp.dir_bound, 1e-12)), lim.acc, lim.jerk)
         v = min(v, sp.length / (self.cfg.min_segment_cycles * self.cfg.cycle))
         return Block(move, "path", sp, sp.length, v, a, j, (move.feed or 0.0) / 60.0)
 
