@@ -97,7 +97,7 @@ def through_planner(prog: Program, tol: float) -> Stream:
     filter's share is 0 and the output is the raw path delayed, decision 45). An experiment: Planner._block
     is patched for the run, the planner has no hook for spans yet."""
     cfg = load_bench_file(BENCH).motion_config()
-    cfg = dataclasses.replace(cfg, filter_time=0.0, filter_scurve=0.0)
+    cfg = dataclasses.replace(cfg, filter_time=0.0, filter_scurve=0.0, fit_runs=False)  # its own spans, not the planner's fit
     pts = np.array([START] + prog.points, dtype=float)
     cut = spans(*fit_run(pts, tol), cfg.axes)
     lims = [np.array([getattr(cfg.limit(a), f) for a in cfg.axes])

@@ -41,7 +41,7 @@ BATCH = 20  # new segments fixed per window (the fit's cost is per window: fewer
 MAX_LEN = 5.0  # mm: a longer line ends the run (it needs no fit: its corners are few)
 MAX_TURN = math.radians(60.0)  # a sharper vertex ends the run (and is slowed as an ordinary corner)
 PAY = 2.0  # fit where a corner's own cap is below PAY x the feed
-SPLIT = 2  # spans a segment (each its own speed cap: a span's cap is its slowest point's)
+SPLIT = 4  # spans a segment (each its own speed cap: a span's cap is its slowest point's)
 JOIN = 2.0  # mm of path over which a window's first spans are shifted onto the span before them
 FIT_TOL = 0.985  # of N1.053: the fit's own tolerance (the joints' shifts take < 3e-4 mm)
 
@@ -161,11 +161,12 @@ class RunFeed:
             spl, cum = fit_run(pts, FIT_TOL * self.tol)
         except FitError:
             return None
-        # SPLIT spans a segment, each with its own cap; spans() cuts up to its last point's end of the curve:
-        # one more (dropped) unless the run ends here
+        # SPLIT spans a segment, each with its own cap; spans() cuts its last span to the curve's end: one
+        # more (dropped) unless the run ends here
         sub = cum[first:] if end else cum[first:first + n + 2]
         at = (sub[:-1, None] + np.diff(sub)[:, None] * (np.arange(SPLIT) / SPLIT)[None, :]).ravel()
-        return spans(spl, np.append(at, sub[-1]), self.axes)[:n * SPLIT]
+        # (spans() cuts from the curve's start: the segments behind are cut too and dropped)
+        return spans(spl, np.concatenate([cum[:first], at, sub[-1:]]), self.axes)[first:first + n * SPLIT]
 
 
 def _fade(x: np.ndarray, d: int) -> np.ndarray:
