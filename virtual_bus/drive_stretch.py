@@ -104,6 +104,8 @@ class CspRun:
         pa, va, ta, fe, sws = (out.position_actual, out.velocity_actual, out.torque_actual, out.following_error,
                                out.statusword)
         still = self.still
+        ks, neg, over = range(1, n + 1), -max_cps, 1.2 * max_cps  # (the same values the loop computed each time)
+        limited = lo > -math.inf or hi < math.inf
         for tgt in targets:
             if tgt == still:  # the same target again after a cycle that changed nothing: the same cycle, the time on
                 t = _repeat(out, t, h, n, True)
@@ -114,18 +116,18 @@ class CspRun:
             kff_ff, span = kff * ff_vel, target - prev
             c_pos, c_vel, c_t, cmd = pos, vel, t, command
             inside = True
-            for k in range(1, n + 1):  # Cia402Drive._step_following (_step_general with limits), csp, no probe
+            for k in ks:  # Cia402Drive._step_following (_step_general with limits), csp, no probe
                 cmd = prev + span * k / n
                 v_cmd = kff_ff + kp * (cmd - c_pos)
-                if not -max_cps <= v_cmd <= max_cps:
-                    v_cmd = max(-max_cps, min(max_cps, v_cmd))
+                if not neg <= v_cmd <= max_cps:
+                    v_cmd = max(neg, min(max_cps, v_cmd))
                 if v_cmd != c_vel:
                     c_vel += (v_cmd - c_vel) * alpha
                 c_pos = c_pos + c_vel * h
-                if not lo < c_pos < hi:
+                if limited and not lo < c_pos < hi:
                     inside = False
                 c_t += h
-            if not inside or abs(cmd - c_pos) > window or abs(c_vel) > 1.2 * max_cps:
+            if not inside or abs(cmd - c_pos) > window or abs(c_vel) > over:
                 self.ok = False
                 break  # a limit switch, or Cia402Drive._supervise would fault in this cycle: exchange() takes it
             # (a moving drive fails the cheap comparisons: no tuples and no _same call a cycle)
@@ -197,6 +199,7 @@ class CsvRun:
         pa, va, ta, sws = out.position_actual, out.velocity_actual, out.torque_actual, out.statusword
         floor = math.floor
         still = self.still
+        ks, neg, over, neg_ramp = range(n), -max_cps, 1.2 * max_cps, -ramp  # (the values the loop computed each time)
         for _ in range(cycles):
             if still:  # a standing spindle (a mill's CAM program): the same cycle, the time on
                 t = _repeat(out, t, h, n, False)
@@ -205,11 +208,11 @@ class CsvRun:
             edge = False
             # The velocity-loop lines below, and the feedback lines after them, repeat CspRun's on purpose: a call
             # per sub-step (or cycle) would cost about a third of what the stretch saves.
-            for _k in range(n):  # Cia402Drive._step_following, csv
-                c_tv += max(-ramp, min(ramp, want - c_tv))
+            for _k in ks:  # Cia402Drive._step_following, csv
+                c_tv += max(neg_ramp, min(ramp, want - c_tv))
                 v_cmd, cmd = c_tv, c_pos
-                if not -max_cps <= v_cmd <= max_cps:
-                    v_cmd = max(-max_cps, min(max_cps, v_cmd))
+                if not neg <= v_cmd <= max_cps:
+                    v_cmd = max(neg, min(max_cps, v_cmd))
                 if v_cmd != c_vel:
                     c_vel += (v_cmd - c_vel) * alpha
                 new_pos = c_pos + c_vel * h
@@ -217,7 +220,7 @@ class CsvRun:
                     edge = True
                 c_pos = new_pos
                 c_t += h
-            if edge or abs(c_vel) > 1.2 * max_cps:
+            if edge or abs(c_vel) > over:
                 self.ok = False
                 break  # the index latches in this cycle, or overspeed: exchange() takes it
             before = (pos, vel, command, tv, acc, torque) if c_pos == pos and c_vel == vel and c_tv == tv else None
