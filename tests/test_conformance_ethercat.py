@@ -76,6 +76,11 @@ def master(line):
     m.open(line.iface)
     try:
         assert m.config_init() == 3
+        # The ESC's default 100 ms process-data watchdog (0x0420) fails a drive whose master stalls that long;
+        # on a loaded CI machine a test process can, so these tests give it 2 s as a bench master would
+        # (fieldbus.ethercat.link programs 500 ms). Nothing here tests the watchdog itself.
+        for s in m.slaves:
+            s.set_watchdog("processdata", 2000)
         yield m
     finally:
         m.state = pysoem.INIT_STATE
