@@ -139,3 +139,22 @@ def test_a_fitted_run_through_hil_run_stretched_equals_stepped(monkeypatch, tmp_
     assert compare(out[0], out[1]) == []
     stepped, stretched = kept
     assert stretched.run.ok and stretched.run.stretched > 0.5 * stretched.run.cycles
+
+
+def test_single_block_runs_a_held_back_move_at_once():
+    """Single block: the channel reads one move and waits; the move a run holds back is let through (the
+    channel reads nothing more), so each block stops on its own end point and the program finishes."""
+    from nc.channel import RunState
+
+    pts = _polyline(12)
+    stops = []
+
+    def ctl(n, ch):
+        ch.single_block = True
+        if ch.state is RunState.BLOCK_STOP:
+            stops.append(ch.planner.position.copy())
+            ch.cycle_start()
+
+    st = _checked(moves(cam_polyline(12)), _cfg(), pts, on_cycle=ctl)
+    assert st.state is RunState.FINISHED
+    assert np.allclose(stops, np.array(pts[1:]), atol=1e-9)

@@ -64,10 +64,25 @@ class FittedRuns:
             if zones.blend_allowed(start, vtop, self._now(), abs(self.v) < 1e-12 and self.plan is None):
                 zones.add_blend(start, start + sum(sp.length for sp in spans), vtop)
             else:  # as lines; what is still held starts afresh from their end (no span to join)
-                out = [(m, None) for m, _ in out]
+                out = [(m, None) for k, (m, _) in enumerate(out) if k == 0 or m is not out[k - 1][0]]  # a move once
                 self._held = replace(self._held, behind=(), fitting=False, tail=None)
         for m, sp in out:
+            if sp is None and m.kind == "line":
+                m = self._from_curve(m)
             self._push(m, sp)
+
+    def _from_curve(self, m: Move) -> Move:
+        """A line after spans whose curve did not end on its start vertex (a window the fit or the zone refused
+        after the batch before it went out): it starts where the curve ended (within N1.053 of the vertex)."""
+        b = self.blocks[-1] if self.blocks else None
+        if b is None or b.seg is None or b.seg.kind != "spline":
+            return m
+        end = b.seg.end
+        if max(abs(float(m.start.get(a, 0.0)) - float(x)) for a, x in zip(self.axes, end)) <= 1e-9:
+            return m
+        start = dict(m.start)
+        start.update({a: float(x) for a, x in zip(self.axes, end)})
+        return m.replaced(start=start)
 
     def _span_block(self, move: Move, sp: SplineSpan) -> Block:
         lim = self.lim

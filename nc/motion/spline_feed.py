@@ -41,12 +41,14 @@ BATCH = 20  # new segments fixed per window (the fit's cost is per window: fewer
 MAX_LEN = 5.0  # mm: a longer line ends the run (it needs no fit: its corners are few)
 MAX_TURN = math.radians(60.0)  # a sharper vertex ends the run (and is slowed as an ordinary corner)
 PAY = 2.0  # fit where a corner's own cap is below PAY x the feed
+SHARP = 2.0 * math.sin(MAX_TURN / 2.0)  # |Δu| of a MAX_TURN vertex
 SPLIT = 4  # spans a segment (each its own speed cap: a span's cap is its slowest point's)
 JOIN = 2.0  # mm of path over which a window's first spans are shifted onto the span before them
+PIN = 1e-6  # mm: a run's curve must meet its first and last vertex this closely (else it runs as lines)
 FIT_TOL = 0.985  # of N1.053: the fit's own tolerance (the joints' shifts take < 3e-4 mm)
 
 
-@dataclass(frozen=True)
+@dataclass(slots=True)  # never changed in place, only replaced (slots: built on every push, frozen costs 2 µs)
 class Held:
     """The moves a run holds back, the vertices behind them (already let through, for the next window) and
     whether the run is being fitted (False: a first move waits for the junction that decides)."""
@@ -54,7 +56,8 @@ class Held:
     moves: tuple[Move, ...] = ()
     behind: tuple[tuple[float, ...], ...] = ()
     fitting: bool = False
-    last: Move | None = None  # the last eligible move let through as a line: its junction with the next decides
+    end: list[float] | None = None  # end point and direction of the last eligible move (held or let through):
+    u: list[float] | None = None  # its junction with the next decides
     tail: SplineSpan | None = None  # the last span let through (a run's next window joins it)
 
 
@@ -70,60 +73,71 @@ class RunFeed:
         self.blend = lim.blend  # FilterCorners, or None without the filter
         self.acc = cfg.share_tangential * float(lim.acc.min())
         self.corner_j = cfg.share_corner * float(min(lim._corner_j))
+        self._pay: dict[float, float] = {}
 
     @staticmethod
     def enabled(cfg: MotionConfig) -> bool:
         return cfg.fit_runs and (cfg.path_tolerance or 0.0) > 0.0
 
-    # ---- the rules -----------------------------------------------------------------------------
-    def eligible(self, mv: Move) -> bool:
+    # ---- the rules (plain floats: they run on every push, issue 17) ---------------------------------
+    def line(self, mv: Move) -> tuple[list[float], list[float], list[float]] | None:
+        """(start point, end point, unit direction) of an eligible move, else None."""
         if mv.kind != "line" or mv.per_rev or mv.exact_stop or mv.css is not None or "G31" in mv.tags \
                 or not mv.feed:
-            return False
-        return 1e-6 < math.dist(self._pt(mv.start), self._pt(mv.end)) <= MAX_LEN
-
-    def _pt(self, p: dict[str, float]) -> list[float]:
-        return [float(p.get(a, 0.0)) for a in self.axes]  # plain floats: this runs on every push (issue 17)
+            return None
+        a = [float(mv.start.get(x, 0.0)) for x in self.axes]
+        b = [float(mv.end.get(x, 0.0)) for x in self.axes]
+        n = math.dist(a, b)
+        if not 1e-6 < n <= MAX_LEN:
+            return None
+        return a, b, [(q - p) / n for p, q in zip(a, b)]
 
     def _vec(self, p: dict[str, float]) -> np.ndarray:
-        return np.array(self._pt(p))
+        return np.array([float(p.get(a, 0.0)) for a in self.axes])
 
-    def _step(self, m1: Move, m2: Move) -> float | None:
-        """|Δu| at the vertex m1 → m2, None where m2 does not continue m1 (not from its end)."""
-        a, b, b2, c = self._pt(m1.start), self._pt(m1.end), self._pt(m2.start), self._pt(m2.end)
-        if max(abs(x - y) for x, y in zip(b, b2)) > 1e-9:
-            return None
-        l1, l2 = math.dist(a, b), math.dist(b, c)
-        return math.sqrt(sum(((z - y) / l2 - (y - x) / l1) ** 2 for x, y, z in zip(a, b, c)))
-
-    def _pays(self, du: float, feed_mm_min: float) -> bool:
-        f = feed_mm_min / 60.0
-        if self.blend is not None:
-            return self.blend.corner_tolerance(du, self.acc) < PAY * f
-        return self.corner_j / max(du, 1e-12) < PAY * f
+    def _pay_step(self, feed_mm_min: float) -> float:
+        """The least |Δu| whose corner pays at this feed (cached a feed): the tolerance's cap of one corner
+        (decreasing in |Δu|) below PAY × the feed, or without the filter the one-cycle corner's."""
+        thr = self._pay.get(feed_mm_min)
+        if thr is None:
+            f = PAY * feed_mm_min / 60.0
+            if self.blend is None:
+                thr = self.corner_j / max(f, 1e-12)
+            elif self.blend.corner_tolerance(2.0, self.acc) >= f:
+                thr = math.inf
+            else:
+                lo, hi = 0.0, 2.0
+                for _ in range(40):
+                    mid = 0.5 * (lo + hi)
+                    lo, hi = (lo, mid) if self.blend.corner_tolerance(mid, self.acc) < f else (mid, hi)
+                thr = hi
+            self._pay[feed_mm_min] = thr
+        return thr
 
     # ---- the stream ----------------------------------------------------------------------------
     def push(self, st: Held, mv: Move) -> tuple[Held, list[tuple[Move, SplineSpan | None]]]:
         """The held state after mv, and the moves let through (with their span, None: as a line)."""
-        if not self.eligible(mv):
+        ln = self.line(mv)
+        if ln is None:
             st, out = self.release(st)
             return st, out + [(mv, None)]
-        prev = st.moves[-1] if st.moves else st.last
-        du = self._step(prev, mv) if prev is not None else None
-        if du is not None and du > 2.0 * math.sin(MAX_TURN / 2.0):
-            du = None  # a sharp corner: the run ends at it
+        a, end, u = ln
+        du = None
+        if st.end is not None and max([abs(p - q) for p, q in zip(st.end, a)]) <= 1e-9:
+            du = math.sqrt(sum([(p - q) ** 2 for p, q in zip(u, st.u)]))
+            if du > SHARP:
+                du = None  # a sharp corner: the run ends at it
         if du is None:
             st, out = self.release(st)
-            return Held(moves=(mv,)), out  # a first move: the next junction decides
+            return Held(moves=(mv,), end=end, u=u), out  # a first move: the next junction decides
         if st.fitting:
-            st = replace(st, moves=st.moves + (mv,))
+            st = replace(st, moves=st.moves + (mv,), end=end, u=u)
             if len(st.moves) >= BATCH + AHEAD:
                 return self._fix(st, BATCH)
             return st, []
-        if self._pays(du, mv.feed or 0.0):
-            return Held(st.moves + (mv,), (), True), []
-        out = [(m, None) for m in st.moves]
-        return Held(last=mv), out + [(mv, None)]
+        if du > self._pay_step(mv.feed or 0.0):
+            return Held(st.moves + (mv,), (), True, end=end, u=u), []
+        return Held(end=end, u=u), [(m, None) for m in st.moves] + [(mv, None)]
 
     def release(self, st: Held) -> tuple[Held, list[tuple[Move, SplineSpan | None]]]:
         """Everything held let through: the run fitted to its end."""
@@ -146,13 +160,29 @@ class RunFeed:
             return NOTHING, [(m, None) for m in moves]
         if st.tail is not None:
             cut = join(st.tail, cut)
-        if end:  # the run ends on its vertex exactly (the fit pins it to ≈ 1e-8 mm; a plan's end takes seg.end)
+            if not self._within(cut, pts):  # the joint's shift took the curve off the tolerance: as lines
+                return NOTHING, [(m, None) for m in moves]
+        if end:  # the run ends on its vertex exactly (a plan's end takes seg.end)
             cut[-1].end = pts[-1].copy()
         out = [(m, sp) for i, m in enumerate(moves[:n]) for sp in cut[i * SPLIT:(i + 1) * SPLIT]]
         if end:
             return NOTHING, out
         keep = pts[max(0, first + n - BEHIND):first + n + 1]
-        return Held(moves[n:], tuple(tuple(v.tolist()) for v in keep), True, tail=cut[-1]), out
+        return Held(moves[n:], tuple(tuple(v.tolist()) for v in keep), True, st.end, st.u, cut[-1]), out
+
+    def _within(self, cut: list[SplineSpan], pts: np.ndarray) -> bool:
+        """The shifted spans (JoinedSpan) within N1.053 of the window's polyline (every 0.002 mm)."""
+        a, d = pts[:-1], np.diff(pts, axis=0)
+        dd = np.maximum(np.einsum("ij,ij->i", d, d), 1e-30)
+        for sp in cut:
+            if not isinstance(sp, JoinedSpan):
+                break
+            p = sp.points(np.linspace(0.0, sp.length, max(2, int(sp.length / 0.002) + 1)))
+            t = np.clip(np.einsum("pij,ij->pi", p[:, None, :] - a[None], d) / dd, 0.0, 1.0)
+            dist = np.linalg.norm(p[:, None, :] - (a[None] + t[:, :, None] * d[None]), axis=2).min(axis=1)
+            if dist.max() > self.tol:
+                return False
+        return True
 
     def _spans(self, pts: np.ndarray, first: int, n: int, end: bool) -> list[SplineSpan] | None:
         if len(pts) < 3:
@@ -163,6 +193,9 @@ class RunFeed:
             return None
         # SPLIT spans a segment, each with its own cap; spans() cuts its last span to the curve's end: one
         # more (dropped) unless the run ends here
+        ends = np.stack([sp(np.array([0.0, cum[-1]])) for sp in spl], axis=1)
+        if (first == 0 and np.abs(ends[0] - pts[0]).max() > PIN) or (end and np.abs(ends[1] - pts[-1]).max() > PIN):
+            return None  # the pinned ends missed (the weights grown near them outweigh the pin): a step at λ = 0
         sub = cum[first:] if end else cum[first:first + n + 2]
         at = (sub[:-1, None] + np.diff(sub)[:, None] * (np.arange(SPLIT) / SPLIT)[None, :]).ravel()
         # (spans() cuts from the curve's start: the segments behind are cut too and dropped)
