@@ -189,9 +189,9 @@ class Mlc:
         return out
 
     def _clocks(self) -> None:
-        t = self.time
-        self.mem.set_bit(29032, int(t / 0.5) % 2 == 1)
-        self.mem.set_bit(29033, int(t / 0.05) % 2 == 1)
+        t, m = self.time, self.mem.m
+        m[29032] = 1 if int(t / 0.5) % 2 == 1 else 0
+        m[29033] = 1 if int(t / 0.05) % 2 == 1 else 0
 
     def attach_io(self, ports: list[Any], maps: list[Any]) -> None:
         """Remote I/O stations (issue 8): `ports[k]` (a `mlc.remote_io.IoPort`) is station k, `maps[k]`

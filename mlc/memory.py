@@ -27,6 +27,8 @@ _ADDR = re.compile(r"^\s*([MDAXY])\s*(\d{1,5})\s*$", re.IGNORECASE)
 
 _F32, _U32 = struct.Struct("<f"), struct.Struct("<I")  # compiled once: f32 ↔ raw pairs are per-scan work
 
+_F32N = tuple(struct.Struct(f"<{k}f") for k in range(33))  # k floats in a row (the drive status)
+
 WordOrder = Literal["low-first", "high-first"]
 
 
@@ -107,6 +109,10 @@ class DeviceMemory:
 
     set_s16 = set_u16
 
+    def word_bytes(self, n: int, count: int) -> bytes:
+        """The raw bytes of D<n>…D<n+count-1> (to compare a range with what it held before)."""
+        return self._b[2 * n:2 * (n + count)].tobytes()
+
     # ---- pairs ----------------------------------------------------------------------------
     def _pair(self, n: int) -> tuple[int, int]:
         w = self.words
@@ -144,6 +150,16 @@ class DeviceMemory:
             _F32.pack_into(self._b, 2 * n, float(value))
         else:
             self._set_pair(n, _U32.unpack(_F32.pack(float(value)))[0])
+
+    def set_f32s(self, n: int, values: list[float]) -> None:
+        """Consecutive floats from D<n> (pairs n, n+2, …): one packed write when the bytes lie in place."""
+        k = len(values)
+        if self._f32_in_place and 0 <= n and n + 2 * k <= D_SIZE:
+            fmt = _F32N[k] if k < len(_F32N) else struct.Struct(f"<{k}f")
+            fmt.pack_into(self._b, 2 * n, *values)
+        else:
+            for i, v in enumerate(values):
+                self.set_f32(n + 2 * i, v)
 
     # ---- by name --------------------------------------------------------------------------
     def get(self, address: str) -> int:

@@ -13,39 +13,23 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from mlc.manual_alarms import HardLimitLatch, home_mode
+from mlc.drive_status import DriveStatus, write_drive_outputs
 from mlc.memory import DeviceMemory
 from mlc.signals import d2, d3, m2, m3
 from nc.alarms import Alarm
 from nc.softlimits import ManualLimitLatch
 from nc.channel import Channel, RunState
 from nc.manual import ManualMotion
-from nc.motion.css import spindle_speed
 from nc.moves import Aux
 
 AUTO, EDIT, MDI, MPG, JOG, RAPID, INC, HOME = range(8)
 MODE_NAMES = ("AUTO", "EDIT", "MDI", "MPG", "JOG", "RAPID", "INC", "HOME")
 MANUAL_MODES = (MPG, JOG, RAPID, INC, HOME)
+_MODE_BITS = {k: bytes(1 if j == k else 0 for j in range(8)) for k in range(8)}  # mode → M3x000…M3x007
+_NO_MODE = bytes(8)
 SYSTEM_M = {0, 1, 2, 30, 98, 99}  # never handed to the MLC (NC5 §3.8.1)
 ESTOP_ALARM = 0x0401
 SPINDLE_ALARM = 0x0C0A
-
-
-@dataclass
-class DriveStatus:
-    """What the bus tells the NC about one drive, in user units (filled by the bench each cycle)."""
-
-    name: str
-    connected: bool = True
-    servo_on: bool = False
-    fault: bool = False
-    torque: float = 0.0  # 0.1 % of rated (0x6077)
-    velocity: float = 0.0  # mm/s or deg/s (0x606C scaled)
-    rpm: float = 0.0  # motor/load rev per minute
-    position: float = 0.0
-    spindle: bool = False
-    limit: int = 0  # hardware limit switch reached: 1 negative, 2 positive (0x60FD bits 0/1), 3 unknown side
-    machine_position: float = 0.0  # position + the NC-side homing offset (the NC's machine coordinate)
-    mode: int = 8
 
 
 @dataclass
@@ -72,6 +56,8 @@ class ChannelLink:
     _reset_pending: bool = False
     _alarms_seen: set[int] = field(default_factory=set)
     _var_cache: dict = field(default_factory=dict)
+    _var_plan: tuple | None = None  # (exchange, legacy, ((lo, kind, first, count), …)): fixed per exchange
+    _spindle_levels: bytes = bytes(8)  # M2x711, M2x727, … as the last scan saw them (== their `_prev`)
     _program_end: int | None = None
     _mode_switch_cycles: int = 0
     handshake_log: list[tuple[int, str, float]] = field(default_factory=list)  # (cycle, kind, value)
@@ -222,17 +208,30 @@ class ChannelLink:
     def _overrides(self, ch: Channel) -> None:
         """Overrides and program-flow switches are levels: applied whenever they differ from the channel."""
         w, m, b2 = self.mem.words, self.mem.m, 20000 + 1000 * self.x
-        for name, value in (("feed_override", min(w[b2 + 2], 150) / 100.0),  # 0–150 %
-                            ("rapid_override", w[b2 + 4] / 100.0),
-                            ("spindle_override", w[b2 + 26] / 100.0),  # D2x026, applied by the NC (decisions 32)
-                            ("dry_run", bool(m[b2 + 5])),
-                            ("single_block", bool(m[b2 + 8]))):
-            if getattr(ch, name, value) != value:
-                setattr(ch, name, value)
+        # written out, not a loop over (name, value) tuples: five compares every cycle
+        v: float | bool = min(w[b2 + 2], 150) / 100.0  # 0–150 %
+        if getattr(ch, "feed_override", v) != v:
+            ch.feed_override = v
+        v = w[b2 + 4] / 100.0
+        if getattr(ch, "rapid_override", v) != v:
+            ch.rapid_override = v
+        v = w[b2 + 26] / 100.0  # D2x026, applied by the NC (decisions 32)
+        if getattr(ch, "spindle_override", v) != v:
+            ch.spindle_override = v
+        v = bool(m[b2 + 5])
+        if getattr(ch, "dry_run", v) != v:
+            ch.dry_run = v
+        v = bool(m[b2 + 8])
+        if getattr(ch, "single_block", v) != v:
+            ch.single_block = v
 
     def _spindle_alarm(self, ch: Channel) -> None:
         m, prev = self.mem.m, self._prev
         first = m2(self.x, 711)
+        levels = m[first:first + 16 * 8:16]
+        if levels == self._spindle_levels:
+            return  # the same levels as the last scan: no edge, and `_prev` already holds them
+        self._spindle_levels = bytes(levels)
         for a in range(first, first + 16 * 8, 16):  # M2x711, M2x727, … (spindles 1–8)
             k = (a - first) // 16
             if not m[a] and not prev.get(a, False):
@@ -241,6 +240,8 @@ class ChannelLink:
                 self._raise(ch, Alarm(SPINDLE_ALARM, f"MLC activated the alarm of spindle {k + 1}"))
 
     def _user_alarms(self, ch: Channel) -> None:
+        if not self._alarms_seen and self.mem.a.count(0) == len(self.mem.a):
+            return  # none active, none before: the usual case, counted at C speed
         active = set(self.mem.active_alarms())
         for n in sorted(active - self._alarms_seen):
             self._raise(ch, Alarm(f"A{n}", f"MLC user-defined alarm A{n}"))
@@ -256,20 +257,21 @@ class ChannelLink:
             return
         if ex.on_write is None:
             ex.on_write = self._variable_written
-        x, mem = self.x, self.mem
-        for (lo, hi, is_bit) in ex.input_ranges:
-            named = ("dev", id(ex), getattr(ex, "legacy", False), lo, x)
-            where = self._var_cache.get(named)
-            if where is None:  # the device of a range is fixed: named once, not parsed every scan
-                dev = ex.device(lo, x)
-                where = self._var_cache[named] = (dev[0], int(dev[1:]))
-            kind, first = where
-            count = hi - lo + 1
-            raw = bytes(mem.m[first:first + count]) if kind == "M" else mem.d[first:first + count].tobytes()
+        mem, cache = self.mem, self._var_cache
+        legacy = getattr(ex, "legacy", False)
+        plan = self._var_plan
+        if plan is None or plan[0] is not ex or plan[1] != legacy:  # the devices of the ranges, named once
+            ranges = []
+            for (lo, hi, is_bit) in ex.input_ranges:
+                dev = ex.device(lo, self.x)
+                ranges.append((lo, dev[0], int(dev[1:]), hi - lo + 1))
+            plan = self._var_plan = (ex, legacy, tuple(ranges))
+        for lo, kind, first, count in plan[2]:
+            raw = mem.m[first:first + count] if kind == "M" else mem.word_bytes(first, count)
             key = (lo, kind)
-            if self._var_cache.get(key) == raw:
+            if cache.get(key) == raw:
                 continue
-            self._var_cache[key] = raw
+            cache[key] = bytes(raw)
             for k in range(count):
                 ex.set_input(lo + k, float(mem.bit(first + k)) if kind == "M" else float(mem.s16(first + k)))
 
@@ -344,8 +346,7 @@ class ChannelLink:
         m = mem.m
         b3 = 30000 + 1000 * x  # M3x000: the relays below are written straight into the bit array
         mode = self.mode
-        for k in range(8):
-            m[b3 + k] = 1 if mode == k else 0
+        m[b3:b3 + 8] = _MODE_BITS.get(mode, _NO_MODE)  # M3x000…M3x007: one slice, not eight writes
         m[b3 + 32] = 1 if self._mode_switch_cycles > 0 else 0
         self._handshake_output(ch)
         self._css_output(ch)
@@ -360,7 +361,7 @@ class ChannelLink:
         elif not self._reset_pending:
             m[b3 + 19] = 0
         m[b3 + 31] = 1 if getattr(ch, "interrupt_active", False) else 0  # M3x031: M96 in execution
-        m[b3 + 25] = 1 if state is RunState.ALARM or any(not isinstance(a.code, str) for a in self.alarms) else 0
+        m[b3 + 25] = 1 if state is RunState.ALARM or self.alarms and any(not isinstance(a.code, str) for a in self.alarms) else 0
         m[b3 + 40] = 1 if mem.active_alarms() else 0
         block_stop = state is RunState.BLOCK_STOP
         m[b3 + 24] = m[b3 + 39] = 1 if block_stop else 0
@@ -436,56 +437,16 @@ class ChannelLink:
         if ch.css_rpm is not None:
             self.mem.set_f32(d3(self.x, 24), min(ch.css_rpm, self.spindle_max_rpm))
 
-    def _drive_outputs(self, drives: list[DriveStatus], ch: Channel | None = None) -> None:
-        mem, x = self.mem, self.x
-        m = mem.m
-        b3 = 30000 + 1000 * x  # M3x000
-        m[30000] = 1 if all(d.connected for d in drives) else 0  # M30000
-        m[b3 + 34] = 1 if any(d.fault for d in drives) else 0
-        axes = [d for d in drives if not d.spindle]
-        spindles = [d for d in drives if d.spindle]
-        m[b3 + 36] = 1 if all(d.servo_on for d in drives) else 0
-        for k, d in enumerate(axes[:16]):
-            v = d.velocity
-            m[b3 + 256 + k] = 1 if d.connected else 0
-            m[b3 + 272 + k] = 1 if d.servo_on else 0
-            m[b3 + 464 + k] = 1 if abs(v) > 1e-4 else 0  # moving
-            m[b3 + 480 + k] = 1 if v > 1e-4 else 0
-            m[b3 + 496 + k] = 1 if v < -1e-4 else 0
-        w, set_f32 = mem.words, mem.set_f32  # D30240… written as words into the memory itself
-        for k, d in enumerate((axes + spindles)[:32]):
-            torque = int(round(d.torque))
-            w[30240 + k] = torque & 0xFFFF  # s16
-            set_f32(30272 + 2 * k, d.velocity * 60.0)
-            set_f32(30336 + 2 * k, d.rpm)
-            peak = 30400 + k
-            w[peak] = max(w[peak], min(abs(torque), 0xFFFF)) if d.servo_on else 0
-        for k, d in enumerate(spindles[:8]):
-            m[b3 + 96 + k] = 1 if d.connected else 0
-            w[30432 + k] = int(round(d.torque)) & 0xFFFF
-            base = b3 + 704 + 16 * k
-            cmd = self.commanded_rpm(k)
-            if k == 0:  # what the drive is really given: G96, override, G50 clamp
-                css, clamp = (ch.css_rpm, ch.spindle_max) if ch is not None else (None, None)
-                ovr = ch.spindle_factor if ch is not None else self.mem.u16(d2(x, 26)) / 100.0
-                cmd = spindle_speed(cmd, css, clamp, self.spindle_max_rpm, ovr)
-            m[base + 1] = 1 if abs(d.rpm) < 1.0 else 0
-            reached = abs(cmd) > 0 and abs(d.rpm - cmd) <= max(1.0, 0.02 * abs(cmd))
-            m[base] = 1 if reached else 0
-            m[base + 6] = 1 if d.servo_on else 0
-            m[base + 5] = 1 if d.mode == 8 else 0
-            if k == 0:
-                mem.set_f32(d3(x, 26), d.rpm)
-                mem.set_f32(d3(x, 28), d.position % 360.0)
+    _drive_outputs = write_drive_outputs  # mlc/drive_status.py: the drive status relays and words
 
     def commanded_rpm(self, k: int = 0) -> float:
         """Signed spindle speed the MLC relays ask for: direction M2x704/M2x705, speed from S (D3x024) or
         from D2x024 when M2x710 is ON. The spindle override D2x026 is not in it: the NC applies it
         with the G96 speed and the clamps (`nc.motion.css.spindle_speed`, motion decisions 32)."""
         x, mem = self.x, self.mem
-        m, base = mem.m, m2(x, 704 + 16 * k)
-        fwd, rev = bool(m[base]), bool(m[base + 1])
-        if fwd == rev:
+        m, base = mem.m, 20704 + 1000 * x + 16 * k  # M2x704 + 16k
+        fwd = bool(m[base])
+        if fwd == bool(m[base + 1]):
             return 0.0
         src = (mem.u32(d2(x, 24)) if m[base + 6] else mem.f32(d3(x, 24))) if k == 0 else 0.0
         rpm = min(abs(src), self.spindle_max_rpm)
