@@ -10,6 +10,11 @@ import numpy as np
 from nc.motion.lookahead import Block
 from nc.motion.plan_state import CHUNK, _near, _Plan
 
+# Rows a cruise samples at a refill: whole blocks until at least this many. Its cost is per block (~45 blocks for
+# 64 rows on the CAM program: 0.2-0.7 ms in one cycle, a real-time cycle's spike); the chain goes on at the next
+# refill exactly as at a break (`_break_chain`, then `_cruise`), so the rows are the same bits (issue 17)
+ROWS = 16
+
 
 class CruiseSampling:
     """Methods of `nc.motion.planner.Planner` (its state is the planner's own: see that module's doc)."""
@@ -83,7 +88,7 @@ class CruiseSampling:
         return _Plan("cruise", None, math.inf, t0, queued=self._pushes)
 
     def _sample_cruise(self, p: _Plan) -> None:
-        """The rows of a cruise, whole blocks up to at least CHUNK rows: each block as its own solve gives them
+        """The rows of a cruise, whole blocks up to at least ROWS rows: each block as its own solve gives them
         (a constant-speed profile from s0 at the plan time t0, s = s0 + v·t, sampled a CHUNK at a time while
         t <= duration + 1e-9 cycles, as `_refill` and `_sample` do; the next block's t0 the time left over, as
         `_end_plan` carries it), and the snap of a block's start to where the last one ended (`_start_plan`)."""
@@ -126,7 +131,7 @@ class CruiseSampling:
             p.carry = t_next - duration if t_next - duration > 1e-12 else t_next - duration + T
             carries.append(p.carry)
             p.last = k
-            if rows >= CHUNK or k + 1 >= nb or not self._cruising(blocks[k + 1], v):
+            if rows >= ROWS or k + 1 >= nb or not self._cruising(blocks[k + 1], v):
                 break
             k, s0, t_next = k + 1, 0.0, p.carry
         p.emitted = True
