@@ -123,15 +123,20 @@ def test_a_hold_or_a_reset_mid_run_stops_under_control(action):
         assert st.state.value == "idle"
 
 
-def test_a_fitted_run_through_hil_run_stretched_equals_stepped(monkeypatch, tmp_path):
+@pytest.mark.parametrize("inserts", [{}, {60: "M08", 100: "G04 P10"}])
+def test_a_fitted_run_through_hil_run_stretched_equals_stepped(monkeypatch, tmp_path, inserts):
     """`hil run` (lock-step, the bench's basic MLC): the trace with stretches (decisions bench B20-B27) equals the
-    cycle-by-cycle one column by column while runs are held back, fitted and let through."""
+    cycle-by-cycle one column by column while runs are held back, fitted and let through (an M code and a
+    dwell end a run: the channel closes the queue before them)."""
     from benchmarks.trace_ab import compare, one
     from hil.stretch import ENV
     from tests.test_stretch_reads import KW
 
+    lines = cam_polyline(150).text(lcnc=False).splitlines()
+    for at in sorted(inserts, reverse=True):
+        lines.insert(at, inserts[at])
     prog = tmp_path / "cam.nc"
-    prog.write_text(cam_polyline(150).text(lcnc=False))
+    prog.write_text("\n".join(lines) + "\n")
     out, kept = [], []
     for on in ("0", "1"):
         monkeypatch.setenv(ENV, on)
