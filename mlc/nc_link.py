@@ -12,6 +12,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
+import numpy as np
+
 from mlc.manual_alarms import HardLimitLatch, home_mode
 from mlc.drive_status import DriveStatus, write_drive_outputs
 from mlc.memory import DeviceMemory
@@ -57,6 +59,7 @@ class ChannelLink:
     _alarms_seen: set[int] = field(default_factory=set)
     _var_cache: dict = field(default_factory=dict)
     _var_plan: tuple | None = None  # (exchange, legacy, ((lo, kind, first, count), …)): fixed per exchange
+    _cmd_levels: bytes | None = None  # M2x000…M2x019 of the last cycle whose edges fired nothing
     _spindle_levels: bytes = bytes(8)  # M2x711, M2x727, … as the last scan saw them (== their `_prev`)
     _program_end: int | None = None
     _mode_switch_cycles: int = 0
@@ -89,18 +92,30 @@ class ChannelLink:
     # ---- NC reads the MLC's outputs ----------------------------------------------------------------
     def nc_inputs(self, ch: Channel) -> None:
         self.cycle += 1
-        x = self.x
+        b2 = 20000 + 1000 * self.x  # M2x000
         self._estop_input(ch)
         self._mode_input(ch)
-        if self._rising(m2(x, 4)):
-            self._reset(ch)
-        if self._rising(m2(x, 1)):
-            self._feed_hold(ch)
-        if self._rising(m2(x, 0)):
-            self._cycle_start(ch)
-        self._finish_input(ch)
-        if self._rising(m2(x, 19)) and callable(getattr(ch, "interrupt", None)):
-            ch.interrupt()  # M2x019: M96 program interruption (nc.interrupt)
+        levels = self.mem.m[b2:b2 + 20]
+        if levels == self._cmd_levels:  # M2x000…M2x019 as last cycle, which fired nothing: no edge
+            self._finish_input(ch)
+        else:
+            fired = False
+            if self._rising(b2 + 4):
+                self._reset(ch)
+                fired = True
+            if self._rising(b2 + 1):
+                self._feed_hold(ch)
+                fired = True
+            if self._rising(b2):
+                self._cycle_start(ch)
+                fired = True
+            self._finish_input(ch)
+            if self._rising(b2 + 19):
+                fired = True
+                if callable(getattr(ch, "interrupt", None)):
+                    ch.interrupt()  # M2x019: M96 program interruption (nc.interrupt)
+            # kept only when no handler ran in between: then `_prev` holds exactly these levels
+            self._cmd_levels = None if fired else bytes(levels)
         self._overrides(ch)
         self._spindle_alarm(ch)
         self._user_alarms(ch)
@@ -109,7 +124,7 @@ class ChannelLink:
             self._manual(ch)
 
     def _estop_input(self, ch: Channel) -> None:
-        on = self._m2(13)
+        on = bool(self.mem.m[20013 + 1000 * self.x])  # M2x013
         if on and not self._estop:
             alarm = Alarm(ESTOP_ALARM, "emergency stop signal is triggered (M2x013)")
             self.alarms.append(alarm)
@@ -120,7 +135,7 @@ class ChannelLink:
         self._estop = on
 
     def _mode_input(self, ch: Channel) -> None:
-        want = self.mem.u16(d2(self.x, 0))
+        want = self.mem.words[20000 + 1000 * self.x]  # D2x000
         self._mode_switch_cycles = max(0, self._mode_switch_cycles - 1)
         if want == self.mode or want > HOME:
             return
@@ -293,10 +308,11 @@ class ChannelLink:
         if limits is not None and not (self.mode in MANUAL_MODES or mm.clamped or self.limit_latch.latched):
             limits = None
         windows = {}
+        m, b2 = self.mem.m, 20000 + 1000 * x
         for i, a in enumerate(self.axes):
             st = mm.axes[a]
-            st.lock_pos = self._m2(336 + i)
-            st.lock_neg = self._m2(352 + i)
+            st.lock_pos = bool(m[b2 + 336 + i])
+            st.lock_neg = bool(m[b2 + 352 + i])
             st.soft_limit_disabled = False  # M2x368 turns off the 1st segment only (the window below)
             if limits is not None:  # the bench's soft_limits and G10 L21 clamp the manual moves too
                 windows[a] = low, high = self.limit_latch.window(limits, a, not self._m2(368 + i))
@@ -348,8 +364,10 @@ class ChannelLink:
         mode = self.mode
         m[b3:b3 + 8] = _MODE_BITS.get(mode, _NO_MODE)  # M3x000…M3x007: one slice, not eight writes
         m[b3 + 32] = 1 if self._mode_switch_cycles > 0 else 0
-        self._handshake_output(ch)
-        self._css_output(ch)
+        if ch.pending_aux is not None:  # nothing to hand over otherwise (the usual cycle)
+            self._handshake_output(ch)
+        if ch.css_rpm is not None:
+            self._css_output(ch)
         state = ch.state
         held = state is RunState.HOLD
         running = state in (RunState.RUNNING, RunState.WAIT_AUX) and self._system_hold is None
@@ -362,7 +380,8 @@ class ChannelLink:
             m[b3 + 19] = 0
         m[b3 + 31] = 1 if getattr(ch, "interrupt_active", False) else 0  # M3x031: M96 in execution
         m[b3 + 25] = 1 if state is RunState.ALARM or self.alarms and any(not isinstance(a.code, str) for a in self.alarms) else 0
-        m[b3 + 40] = 1 if mem.active_alarms() else 0
+        a = mem.a
+        m[b3 + 40] = 0 if a.count(0) == len(a) else 1  # any user alarm active (counted at C speed)
         block_stop = state is RunState.BLOCK_STOP
         m[b3 + 24] = m[b3 + 39] = 1 if block_stop else 0
         if state is RunState.FINISHED and ch.end is not None and self._program_end is None:
@@ -375,13 +394,14 @@ class ChannelLink:
         if drives is not None:
             self._drive_outputs(drives, ch)
         if self.manual is not None:
-            mm = self.manual
-            for i, a in enumerate(self.axes):
-                st = mm.axes[a]
+            mm, pos = self.manual, ch.planner.position
+            pos = pos.tolist() if isinstance(pos, np.ndarray) else pos  # plain floats: no numpy scalar per axis
+            for i, ax in enumerate(self.axes):
+                st = mm.axes[ax]
                 m[b3 + 320 + i] = 1 if st.homed else 0
                 m[b3 + 336 + i] = 1 if st.home_done else 0
-                m[b3 + 352 + i] = 1 if abs(ch.planner.position[i]) < 1e-6 else 0
-        mem.set_u32(d3(x, 320), len(ch.planner.queue))
+                m[b3 + 352 + i] = 1 if abs(pos[i]) < 1e-6 else 0
+        mem.set_u32(b3 + 320, len(ch.planner.queue))  # D3x320
 
     def _handshake_output(self, ch: Channel) -> None:
         aux = ch.pending_aux

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from operator import itemgetter
 from typing import Any
 
 # Areas a recorded read names: (area, index) → the value seen. AREA_IO_INPUTS is the digital image of a
@@ -32,6 +33,7 @@ class ScanRecord:
     reads: dict[tuple[int, int], Any] = field(default_factory=dict)
     timers: list[tuple[float, float]] = field(default_factory=list)  # (start, seconds) still running, not due
     dirty: bool = False
+    checks: tuple | None = None  # the reads grouped by area for `ScanGate.quiet` (made on first use)
 
     def read(self, area: int, index: int, value: Any) -> None:
         # The first read of a scan is the one the scan decided on (a later read after its own
@@ -62,6 +64,18 @@ def _immutable(state: dict[str, Any]) -> bool:
     return True
 
 
+def _grouped(reads: dict[tuple[int, int], Any]) -> tuple:
+    """(area, itemgetter of the area's indices, the values seen) per area read: comparing what the
+    getter gathers now with the values is the loop `areas[area][i] != v` over every read."""
+    by_area: dict[int, tuple[list[int], list[Any]]] = {}
+    for (area, i), v in reads.items():
+        idx, vals = by_area.setdefault(area, ([], []))
+        idx.append(i)
+        vals.append(v)
+    return tuple((area, itemgetter(*idx), tuple(vals) if len(idx) > 1 else vals[0])
+                 for area, (idx, vals) in by_area.items())
+
+
 class ScanGate:
     """Decides, cycle by cycle, whether the user scan must run (see the module doc)."""
 
@@ -81,10 +95,13 @@ class ScanGate:
         for start, seconds in rec.timers:
             if t - start >= seconds - TIMER_EPS:
                 return False
+        checks = rec.checks
+        if checks is None:
+            checks = rec.checks = _grouped(rec.reads)
         mem = ctx.mem
         areas = (mem.m, mem.words, mem.x, mem.y, mem.a, ctx.io.inputs)
-        for (area, i), v in rec.reads.items():
-            if areas[area][i] != v:
+        for area, get, want in checks:  # one C-level gather and tuple compare per area, not a loop per device
+            if get(areas[area]) != want:
                 return False
         self.skipped += 1
         return True
