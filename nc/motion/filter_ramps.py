@@ -333,16 +333,44 @@ class FilterStops:
                 break
             segs.append(b.seg)
             pos += b.length
-        pts, corners, prev = [], [], None
+        segs = [seg for seg in segs if seg is not None]
+        pieces, rows = [], []  # consecutive lines' points as plain rows (the same values), one array each run
         for seg in segs:
-            if seg is None:
-                continue
-            if prev is not None and np.linalg.norm(seg.unit_tangent(False) - prev.unit_tangent(True)) > CORNER:
-                corners.append(seg.start)
-            prev = seg
             if seg.kind == "line":
-                pts.append(np.vstack([seg.start, seg.end]))
-            else:
-                m = max(2, int(math.ceil(seg.length / 0.005)) + 1)
-                pts.append(seg.points(np.linspace(0.0, seg.length, m)))
-        return np.vstack(pts), np.array(corners).reshape(-1, len(self.axes))
+                rows += [seg.start.tolist(), seg.end.tolist()]
+                continue
+            if rows:
+                pieces.append(np.array(rows))
+                rows = []
+            m = max(2, int(math.ceil(seg.length / 0.005)) + 1)
+            pieces.append(seg.points(np.linspace(0.0, seg.length, m)))
+        if rows:
+            pieces.append(np.array(rows))
+        return np.vstack(pieces), _corners(segs, len(self.axes))
+
+
+def _corners(segs: list, n_axes: int) -> np.ndarray:
+    """The starts of the segments whose tangent turns more than CORNER from the one before, as the per-pair
+    `np.linalg.norm(seg.unit_tangent(False) - prev.unit_tangent(True)) > CORNER` tells (issue 17: that loop was
+    ~10 us a segment over the 64 behind and the queue). A line's tangent is (end - start) / length element by
+    element as unit_tangent computes it; the norms are taken for all pairs at once and only one within 1e-9 of
+    CORNER (where the summation order could tell otherwise) is measured again as before."""
+    if len(segs) < 2:
+        return np.empty((0, n_axes))
+    starts = np.array([seg.start for seg in segs])
+    d = np.array([seg.end for seg in segs]) - starts
+    lengths = np.array([seg.length for seg in segs])
+    live = lengths > 0.0
+    d[live] /= lengths[live, None]
+    d[~live] = 0.0
+    t_in, t_out = d, d.copy()
+    for k, seg in enumerate(segs):
+        if seg.kind != "line" and seg.length > 0.0:
+            t_in[k], t_out[k] = seg.unit_tangent(False), seg.unit_tangent(True)
+    turn = t_in[1:] - t_out[:-1]
+    norm = np.sqrt((turn * turn).sum(1))
+    near = np.flatnonzero(np.abs(norm - CORNER) <= 1e-9)
+    sharp = norm > CORNER
+    for k in near:
+        sharp[k] = np.linalg.norm(turn[k]) > CORNER
+    return starts[1:][sharp].reshape(-1, n_axes)
