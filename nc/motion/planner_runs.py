@@ -48,6 +48,11 @@ class FittedRuns:
 
     def _feed_run(self, move: Move) -> None:
         self._held, out = self._runs.push(self._held, move)
+        if len(out) == 1 and out[0][1] is None:  # the common case on programs not fitted: one move, as it is
+            b = self.blocks[-1] if self.blocks else None
+            if b is None or b.seg is None or b.seg.kind != "spline":
+                self._push(out[0][0])
+                return
         self._let_through(out)
 
     def _let_through(self, out: list[tuple[Move, SplineSpan | None]]) -> None:

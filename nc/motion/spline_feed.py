@@ -82,11 +82,12 @@ class RunFeed:
     # ---- the rules (plain floats: they run on every push, issue 17) ---------------------------------
     def line(self, mv: Move) -> tuple[list[float], list[float], list[float]] | None:
         """(start point, end point, unit direction) of an eligible move, else None."""
-        if mv.kind != "line" or mv.per_rev or mv.exact_stop or mv.css is not None or "G31" in mv.tags \
-                or not mv.feed:
+        if mv.kind != "line" or mv.per_rev or mv.exact_stop or mv.css is not None or not mv.feed \
+                or "G31" in mv.tags:
             return None
-        a = [float(mv.start.get(x, 0.0)) for x in self.axes]
-        b = [float(mv.end.get(x, 0.0)) for x in self.axes]
+        ax, ms, me = self.axes, mv.start, mv.end
+        a = [ms.get(x, 0.0) for x in ax]
+        b = [me.get(x, 0.0) for x in ax]
         n = math.dist(a, b)
         if not 1e-6 < n <= MAX_LEN:
             return None
@@ -123,8 +124,8 @@ class RunFeed:
             return st, out + [(mv, None)]
         a, end, u = ln
         du = None
-        if st.end is not None and max([abs(p - q) for p, q in zip(st.end, a)]) <= 1e-9:
-            du = math.sqrt(sum([(p - q) ** 2 for p, q in zip(u, st.u)]))
+        if st.end is not None and math.dist(st.end, a) <= 1e-9:
+            du = math.dist(u, st.u)  # |Δu|
             if du > SHARP:
                 du = None  # a sharp corner: the run ends at it
         if du is None:
