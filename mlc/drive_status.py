@@ -10,7 +10,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-from mlc.signals import d2, d3
+from mlc.signals import d2
 from nc.motion.css import spindle_speed
 
 
@@ -54,21 +54,30 @@ def write_drive_outputs(self: Any, drives: list[DriveStatus], ch: Any = None) ->
     m[30000] = connected  # M30000
     m[b3 + 34] = fault
     m[b3 + 36] = servo
-    for k, d in enumerate(axes[:16]):
-        v = d.velocity
-        a = b3 + k
-        m[a + 256] = 1 if d.connected else 0
-        m[a + 272] = 1 if d.servo_on else 0
-        m[a + 464] = 1 if abs(v) > 1e-4 else 0  # moving
-        m[a + 480] = 1 if v > 1e-4 else 0
-        m[a + 496] = 1 if v < -1e-4 else 0
-    order = (axes + spindles)[:32]
+    order = axes + spindles if spindles else axes
+    if len(order) > 32:
+        order = order[:32]
     w = mem.words  # D30240… written as words into the memory itself
     for k, d in enumerate(order):
+        servo_on = d.servo_on
+        if k < 16 and not d.spindle:  # the axis relays M3x256+k …
+            v = d.velocity
+            a = b3 + k
+            m[a + 256] = 1 if d.connected else 0
+            m[a + 272] = 1 if servo_on else 0
+            m[a + 464] = 1 if v > 1e-4 or v < -1e-4 else 0  # moving
+            m[a + 480] = 1 if v > 1e-4 else 0
+            m[a + 496] = 1 if v < -1e-4 else 0
         torque = int(round(d.torque))
         w[30240 + k] = torque & 0xFFFF  # s16
-        peak = 30400 + k
-        w[peak] = max(w[peak], min(abs(torque), 0xFFFF)) if d.servo_on else 0
+        if servo_on:  # D30400+k: the peak |torque| while the servo is on, else 0
+            t = -torque if torque < 0 else torque
+            if t > 0xFFFF:
+                t = 0xFFFF
+            if w[30400 + k] < t:
+                w[30400 + k] = t
+        else:
+            w[30400 + k] = 0
     mem.set_f32s(30272, [d.velocity * 60.0 for d in order])  # D30272…: one packed write
     mem.set_f32s(30336, [d.rpm for d in order])
     for k, d in enumerate(spindles[:8]):
@@ -87,5 +96,4 @@ def write_drive_outputs(self: Any, drives: list[DriveStatus], ch: Any = None) ->
         m[base + 6] = 1 if d.servo_on else 0
         m[base + 5] = 1 if d.mode == 8 else 0
         if k == 0:
-            mem.set_f32(d3(x, 26), rpm)
-            mem.set_f32(d3(x, 28), d.position % 360.0)
+            mem.set_f32s(b3 + 26, [rpm, d.position % 360.0])  # D3x026, D3x028
