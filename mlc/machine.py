@@ -231,12 +231,14 @@ class Mlc:
         """M30000 (EtherCAT communication status: every slave in OP, not servo on) and M30032+k (EIO
         node 501+k connected): the k-th I/O slave on the bus in connection order; an in-process module
         with no bus behind it counts as connected while it answers (its `connected`, default True)."""
-        bus_io = self.bus.io if self.bus is not None else []
-        if self.bus is not None:
-            self.mem.set_bit(30000, bool(self.bus.connected))
-        for k in range(min(20, max(len(bus_io), len(self.io_modules)))):
-            on = bus_io[k] if k < len(bus_io) else bool(getattr(self.io_modules[k], "connected", True))
-            self.mem.set_bit(30032 + k, on)  # EIO node 501+k connected
+        bus, m, modules = self.bus, self.mem.m, self.io_modules
+        bus_io = bus.io if bus is not None else ()
+        if bus is not None:
+            m[30000] = 1 if bus.connected else 0
+        n_bus = len(bus_io)
+        for k in range(min(20, max(n_bus, len(modules)))):
+            on = bus_io[k] if k < n_bus else getattr(modules[k], "connected", True)
+            m[30032 + k] = 1 if on else 0  # EIO node 501+k connected
 
     # ---- convenience for scripts and tests ---------------------------------------------------------
     def get(self, address: str) -> int:
