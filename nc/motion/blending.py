@@ -471,7 +471,7 @@ class FilterCorners:
         def cap_at(v: float) -> float:
             """v scaled to the budgets (≥ v: v meets them with its own windows)."""
             sa, sd = sums(v)
-            with np.errstate(divide="ignore"):
+            with np.errstate(divide="ignore", over="ignore"):  # a tiny sum: inf, the min drops it
                 return v * min(float(np.min(np.where(sa > 1e-12, ba / sa, math.inf))),
                                float(np.min(np.where(sd > 1e-12, bj / sd, math.inf))))
 
