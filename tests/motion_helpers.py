@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numpy as np
 
@@ -87,3 +88,15 @@ def check(moves, cfg: MotionConfig, start=(0.0, 0.0, 0.0)) -> Stream:
     r = worst_ratio(st, cfg)
     assert r["v"] <= TOL and r["a"] <= TOL and r["j"] <= TOL, r
     return st
+
+
+def single_block_operator(stops: list) -> Callable:
+    """An `on_cycle` hook that runs single block: records where each block stopped and presses Cycle Start."""
+    from nc.channel import RunState
+
+    def ctl(n, ch):
+        ch.single_block = True
+        if ch.state is RunState.BLOCK_STOP:
+            stops.append(ch.planner.position.copy())
+            ch.cycle_start()
+    return ctl

@@ -7,7 +7,7 @@ import numpy as np
 
 from nc.channel import RunState
 from nc.motion.offline import run
-from tests.motion_helpers import AX, lines, mill_cfg, worst_ratio
+from tests.motion_helpers import AX, lines, mill_cfg, single_block_operator, worst_ratio
 
 TOL = 1.0 + 1e-6
 
@@ -63,13 +63,9 @@ def test_reset_is_a_controlled_stop_then_flush():
 
 def test_single_block_stops_after_each_block():
     cfg = mill_cfg()
-    stops = []
-    def ctl(n, ch):
-        ch.single_block = True
-        if ch.state is RunState.BLOCK_STOP:
-            stops.append(ch.planner.position.copy())
-            ch.cycle_start()
-    st = run(lines([(0, 0, 0), (10, 0, 0), (10, 10, 0), (0, 10, 0)], 3000), cfg, dict(zip(AX, (0, 0, 0))), on_cycle=ctl)
+    stops: list = []
+    st = run(lines([(0, 0, 0), (10, 0, 0), (10, 10, 0), (0, 10, 0)], 3000), cfg, dict(zip(AX, (0, 0, 0))),
+             on_cycle=single_block_operator(stops))
     assert [tuple(np.round(p, 6)) for p in stops] == [(10, 0, 0), (10, 10, 0), (0, 10, 0)]
     assert st.state is RunState.FINISHED
 

@@ -13,7 +13,7 @@ import pytest
 from benchmarks.bench_vs_linuxcnc import START, cam_polyline, cam_surface, chord_circle
 from nc.motion.offline import run
 from nc.moves import Move
-from tests.motion_helpers import TOL, polyline_deviation, worst_ratio
+from tests.motion_helpers import TOL, polyline_deviation, single_block_operator, worst_ratio
 from tests.test_motion_cam import BENCH, moves
 from hil.bench_file import load_bench_file
 
@@ -152,14 +152,7 @@ def test_single_block_runs_a_held_back_move_at_once():
     from nc.channel import RunState
 
     pts = _polyline(12)
-    stops = []
-
-    def ctl(n, ch):
-        ch.single_block = True
-        if ch.state is RunState.BLOCK_STOP:
-            stops.append(ch.planner.position.copy())
-            ch.cycle_start()
-
-    st = _checked(moves(cam_polyline(12)), _cfg(), pts, on_cycle=ctl)
+    stops: list = []
+    st = _checked(moves(cam_polyline(12)), _cfg(), pts, on_cycle=single_block_operator(stops))
     assert st.state is RunState.FINISHED
     assert np.allclose(stops, np.array(pts[1:]), atol=1e-9)
