@@ -162,3 +162,16 @@ def test_a_run_the_fit_cannot_take_is_a_fit_error(pts):
     the caller answers with lines, not an exception of numpy's."""
     with pytest.raises(FitError):
         fit_run(np.array(pts), 0.02)
+
+
+@pytest.mark.parametrize("make", [cam_polyline, cam_surface])
+def test_the_end_tangents_worked_out_at_cut_are_the_spans_own(make):
+    """`spans` works out every span's end tangent and curvature at once (the look-ahead reads them at every
+    junction check); they are what the span's own derivatives give at s = 0 and s = length, to an ulp or two
+    (numpy's batched sums)."""
+    _, sp = _spans(make, 40)
+    for s in sp:
+        for at_end in (False, True):
+            d = s.derivatives(np.array([s.length if at_end else 0.0]))
+            assert np.allclose(s.unit_tangent(at_end), d[1][0], rtol=0.0, atol=1e-15)
+            assert np.allclose(s.curvature_vector(at_end), d[2][0], rtol=0.0, atol=1e-15)
