@@ -22,9 +22,10 @@ from hil.trace_read import TraceFile
 
 ROOT = Path(__file__).resolve().parents[1]
 LATHE = ROOT / "benches" / "lathe-2axis.toml"
-# Z at 100 mm/s from t≈0.7 s, back and forth for ≈ 170 s of simulated time: a signal sent once the run is
-# under way (its first trace part, ≈ 2 s of wall time) must land mid-program however fast the cycle runs.
-LONG = "G98\nG00 X58. Z98.\nG01 Z-300. F6000\n" + "G01 Z98.\nG01 Z-300.\n" * 21 + "M30\n"
+# Z at 100 mm/s from t≈0.7 s, back and forth for ≈ 510 s of simulated time: a signal sent once the run is
+# under way (its first trace part, ≈ 2 s of wall time) must land mid-program however fast the cycle runs (the
+# lathe runs at ~85x real time since issue 17's session 11 work: 170 s of program ended before the signal once).
+LONG = "G98\nG00 X58. Z98.\nG01 Z-300. F6000\n" + "G01 Z98.\nG01 Z-300.\n" * 63 + "M30\n"
 OP_ENABLED = 0x27  # statusword & 0x6F (CiA 402)
 
 
@@ -60,7 +61,7 @@ def test_a_signal_stops_the_axes_under_control(tmp_path, bus, sig):
     a, j = np.diff(v) / 0.001, np.diff(v, 2) / 0.001 ** 2
     assert np.abs(v).max() <= z.max_velocity * 1.001 and np.abs(a).max() <= z.max_acceleration * 1.001
     assert np.abs(j).max() <= z.max_jerk * 1.001
-    assert 1.0 < c["t"][-1] < 160.0  # stopped mid-program, not at its end
+    assert 1.0 < c["t"][-1] < 500.0  # stopped mid-program, not at its end
     enabled = (c["Z_sw"] & 0x6F) == OP_ENABLED
     off = int(np.flatnonzero(enabled)[-1]) + 1  # first row with the drive out of Operation Enabled
     assert off < len(enabled) and not enabled[off:].any()
