@@ -92,6 +92,10 @@ class CspRun:
         """The next cycles, one per target; stops (for good) before a cycle that would fault."""
         if not targets or not self.ok:
             return
+        still = self.still
+        if still is not None and targets[0] == still and list(targets).count(still) == len(targets):
+            self._stand(len(targets))  # a standing axis (Z in an XY contour): no set-up, no loop
+            return
         n, h, max_cps, alpha, rad, reached_v = self.model
         kp, kff, window, origin = self.gains
         k_raw, t_pct = self.units
@@ -103,13 +107,15 @@ class CspRun:
         out = self.out
         pa, va, ta, fe, sws = (out.position_actual, out.velocity_actual, out.torque_actual, out.following_error,
                                out.statusword)
-        still = self.still
         ks, neg, over = range(1, n + 1), -max_cps, 1.2 * max_cps  # (the same values the loop computed each time)
         limited = lo > -math.inf or hi < math.inf
+        rep = 0  # still cycles not written yet: a run of them is written at once (_repeat)
         for tgt in targets:
             if tgt == still:  # the same target again after a cycle that changed nothing: the same cycle, the time on
-                t = _repeat(out, t, h, n, True)
+                rep += 1
                 continue
+            if rep:
+                t, rep = _repeat(out, t, h, n, True, rep), 0
             target = float(tgt) - origin
             prev = prev_target if prev_target is not None else command
             ff_vel = (target - prev) / dt
@@ -141,15 +147,21 @@ class CspRun:
             pos, vel, t, command, acc, prev_target = c_pos, c_vel, c_t, cmd, c_acc, target
             gap = command - pos
             sws.append(base | SW_TARGET_REACHED if abs(vel) < reached_v and abs(gap) < 10 else base)
-            pa.append(int(round(pos + origin)))
+            pa.append(round(pos + origin))  # (round of a float: an int)
             raw = round(vel * k_raw)
             va.append(raw if -0x7FFFFFFF <= raw <= 0x7FFFFFFF else max(-0x7FFFFFFF, min(0x7FFFFFFF, raw)))
-            ta.append(int(round(torque * 0.1 / t_pct)))
-            fe.append(int(round(gap)))
+            ta.append(round(torque * 0.1 / t_pct))
+            fe.append(round(gap))
             still = tgt if before is not None and _same(before, (pos, vel, command, prev_target, acc, torque)) else None
+        if rep:
+            t = _repeat(out, t, h, n, True, rep)
         self.state = (pos, vel, t, command, prev_target, acc, torque)
         self.still = still
         out.done = len(pa)
+
+    def _stand(self, cycles: int) -> None:
+        """`cycles` more cycles at the target of a cycle that left the drive as it found it (_same): that cycle again."""
+        _stand(self, cycles, True)
 
     def finish(self) -> Stretch:
         """The drive's state after the last cycle stepped, and that cycle's TxPdo (`out.last`)."""
@@ -188,6 +200,9 @@ class CsvRun:
         """The next `cycles` cycles; stops (for good) before a cycle that would fault or latch the index."""
         if cycles <= 0 or not self.ok:
             return
+        if self.still:  # a standing spindle (a mill's CAM program): no set-up, no loop
+            self._stand(cycles)
+            return
         n, h, max_cps, alpha, rad, reached_v = self.model
         origin, ramp, want, every = self.origin, self.ramp, self.want, self.every
         k_raw, t_pct = self.units
@@ -200,10 +215,10 @@ class CsvRun:
         floor = math.floor
         still = self.still
         ks, neg, over, neg_ramp = range(n), -max_cps, 1.2 * max_cps, -ramp  # (the values the loop computed each time)
-        for _ in range(cycles):
-            if still:  # a standing spindle (a mill's CAM program): the same cycle, the time on
-                t = _repeat(out, t, h, n, False)
-                continue
+        for c in range(cycles):
+            if still:  # a standing spindle (a mill's CAM program): the same cycle from here on, the time on
+                t = _repeat(out, t, h, n, False, cycles - c)
+                break
             c_pos, c_vel, c_t, c_tv, cmd = pos, vel, t, tv, command
             edge = False
             # The velocity-loop lines below, and the feedback lines after them, repeat CspRun's on purpose: a call
@@ -229,15 +244,19 @@ class CsvRun:
                       + (math.copysign(coulomb, c_vel) if abs(c_vel) > 1 else 0.0)) / rated * 1000.0
             pos, vel, t, command, tv, acc = c_pos, c_vel, c_t, cmd, c_tv, c_acc
             sws.append(base | SW_TARGET_REACHED if abs(vel) < reached_v and abs(command - pos) < 10 else base)
-            pa.append(int(round(pos + origin)))
+            pa.append(round(pos + origin))  # (round of a float: an int)
             raw = round(vel * k_raw)
             va.append(raw if -0x7FFFFFFF <= raw <= 0x7FFFFFFF else max(-0x7FFFFFFF, min(0x7FFFFFFF, raw)))
-            ta.append(int(round(torque * 0.1 / t_pct)))
+            ta.append(round(torque * 0.1 / t_pct))
             still = before is not None and _same(before, (pos, vel, command, tv, acc, torque))
         self.state = (pos, vel, t, command, tv, acc, torque)
         self.still = still
         out.following_error += [0] * (len(pa) - len(out.following_error))  # 0x60F4 is a CSP object: 0 in CSV
         out.done = len(pa)
+
+    def _stand(self, cycles: int) -> None:
+        """`cycles` more cycles of a drive the last of which left it as it found it (_same): that cycle again."""
+        _stand(self, cycles, False)
 
     def finish(self) -> Stretch:
         """The drive's state after the last cycle stepped, and that cycle's TxPdo (`out.last`)."""
@@ -249,15 +268,27 @@ class CsvRun:
         return out
 
 
-def _repeat(out: Stretch, t: float, h: float, n: int, csp: bool) -> float:
-    """The last cycle's feedback once more (_same), and the time after its n sub-steps (summed as they sum it)."""
+def _repeat(out: Stretch, t: float, h: float, n: int, csp: bool, times: int) -> float:
+    """The last cycle's feedback `times` more times (_same), and the time after their n sub-steps each (summed one
+    sub-step at a time, as they sum it)."""
     for col in (out.statusword, out.position_actual, out.velocity_actual, out.torque_actual):
-        col.append(col[-1])
+        col += [col[-1]] * times
     if csp:  # (CSV fills 0x60F4 after the part)
-        out.following_error.append(out.following_error[-1])
-    for _k in range(n):
+        out.following_error += [out.following_error[-1]] * times
+    for _k in range(n * times):
         t += h
     return t
+
+
+def _stand(run: "CspRun | CsvRun", cycles: int, csp: bool) -> None:
+    """A still drive's next cycles (CspRun._stand, CsvRun._stand): its feedback repeated, its time summed on."""
+    n, h = run.model[0], run.model[1]
+    state = run.state
+    out = run.out
+    run.state = (*state[:2], _repeat(out, state[2], h, n, csp, cycles), *state[3:])
+    if not csp:  # 0x60F4 is a CSP object: 0 in CSV (as CsvRun.step fills it)
+        out.following_error += [0] * (len(out.position_actual) - len(out.following_error))
+    out.done = len(out.position_actual)
 
 
 def _same(a: tuple, b: tuple) -> bool:
