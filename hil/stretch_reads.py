@@ -26,58 +26,72 @@ class Ahead:
     """The channel's event stream with events peeked ahead of its feed: handed out first, in order, each with
     the statement budget's count as generating it left it (so the budget reads as in stepping), and a plain
     move with its soft-limit verdict, taken when it was read (`Channel._checked`: the feed does not check it
-    again, after the interpreter has been read further)."""
+    again, after the interpreter has been read further).
+
+    What was peeked is plain moves (`plain`), then at most one other event (`tail`): a peek stops at the first
+    event that is not a plain move, and the next peek stops there again without reading. A plain move was
+    generated without a statement (budget count 0), so handing it out leaves the budget as it is; the channel's
+    feed takes them straight from `plain` (`Channel._feed_planner`, issue 17)."""
 
     def __init__(self, source: Iterator[Event], ch: Channel) -> None:
         self.source = source
         self.ch = ch
-        # (event, the exception reading it raised, budget used and peak after it, a plain move)
-        self.buf: deque[tuple[Event | None, Exception | None, int, int, bool]] = deque()
+        self.plain: deque[Move] = deque()
+        # the event after them: (event, the exception reading it raised, budget used and peak after it)
+        self.tail: tuple[Event | None, Exception | None, int, int] | None = None
 
     def __iter__(self) -> "Ahead":
         return self
 
     def __next__(self) -> Event:
-        if not self.buf:
+        if self.plain:
+            ev = self.ch._checked = self.plain.popleft()
+            return ev
+        tail = self.tail
+        if tail is None:
             return next(self.source)
-        ev, exc, used, peak, plain = self.buf.popleft()
+        self.tail = None
+        ev, exc, used, peak = tail
         budget = self.ch.statement_budget
         if budget is not None and used:
             budget.used = used
             budget.peak = max(budget.peak, peak)
         if exc is not None:
             raise exc
-        if plain:
-            self.ch._checked = ev  # type: ignore[assignment]
         return ev  # type: ignore[return-value]
 
     def peek(self, k: int) -> bool:
         """The next k events (the most one feed reads) generated now and kept: True when all are plain moves
         (module doc), so a feed reading any of them only pushes."""
+        plain = self.plain
+        if len(plain) >= k:
+            return True
+        if self.tail is not None:
+            return False
         ch = self.ch
         budget = ch.statement_budget
         saved = (budget.used, budget.peak) if budget is not None else None
-        plain = True
-        for j in range(k):
-            if j < len(self.buf):
-                plain = self.buf[j][4]
+        source = self.source
+        ok = True
+        while len(plain) < k:
+            if budget is not None:
+                budget.used = 0  # a cycle's budget opens before its first read
+            ev: Event | None = None
+            exc: Exception | None = None
+            try:
+                ev = next(source)
+            except Exception as e:  # StopIteration, an alarm: handed out as the feed would meet it
+                exc = e
+            used = budget.used if budget is not None else 0
+            if exc is None and not used and _plain(ev, ch):
+                plain.append(ev)  # type: ignore[arg-type]
             else:
-                if budget is not None:
-                    budget.used = 0  # a cycle's budget opens before its first read
-                ev: Event | None = None
-                exc: Exception | None = None
-                try:
-                    ev = next(self.source)
-                except Exception as e:  # StopIteration, an alarm: handed out as the feed would meet it
-                    exc = e
-                used = budget.used if budget is not None else 0
-                plain = exc is None and not used and _plain(ev, ch)
-                self.buf.append((ev, exc, used, budget.peak if budget is not None else 0, plain))
-            if not plain:
+                self.tail = (ev, exc, used, budget.peak if budget is not None else 0)
+                ok = False
                 break
-        if budget is not None and saved is not None:
-            budget.used, budget.peak = saved
-        return plain
+        if saved is not None:
+            budget.used, budget.peak = saved  # type: ignore[union-attr]
+        return ok
 
 
 def _plain(ev: Event | None, ch: Channel) -> bool:
@@ -93,7 +107,7 @@ def ahead(ch: Channel) -> Ahead:
     ev = ch.events
     if type(ev) is Ahead and ev.ch is ch:
         return ev
-    ch.events = a = Ahead(ev, ch)  # type: ignore[arg-type]
+    ch.events = ch._ahead = a = Ahead(ev, ch)  # type: ignore[arg-type]
     return a
 
 

@@ -20,6 +20,7 @@ D2x002 feed override, D2x004 rapid override; all take effect in the next cycle, 
 from __future__ import annotations
 
 from collections.abc import Callable, Iterator
+from typing import Any
 from dataclasses import dataclass, field
 from enum import Enum
 
@@ -91,6 +92,8 @@ class Channel:
     _fed: bool = False
     # a move read ahead of the feed whose soft limits were checked then, as the feed checks it when it reads it
     _checked: Move | None = None
+    # the stream read ahead (hil.stretch_reads.Ahead) while it is `events`: its `plain` moves were checked when read
+    _ahead: Any = None
 
     def load(self, events: Iterator[Event]) -> None:
         self.events = events
@@ -307,6 +310,17 @@ class Channel:
             budget.new_cycle()
         # Nothing comes before the queue has run out to rest: its tail is a stop (nc.motion.shares).
         pl.closed = self.end is not None or self._deferred is not None or self._limit_alarm is not None
+        src = self.events
+        if src is self._ahead and src is not None and src.plain and self.state is RunState.RUNNING \
+                and self.end is None and self._limit_alarm is None and self._deferred is None and not self.single_block:
+            # plain moves read ahead (hil.stretch_reads.Ahead: no G31, limits checked, no statement): the loop
+            # below would only push them, with nothing else to check between two (issue 17)
+            plain = src.plain
+            while reads and plain and not pl.full:
+                ev = self._checked = plain.popleft()
+                pl.push(ev)
+                self._block_moves += 1
+                reads -= 1
         while self.state is RunState.RUNNING and self.end is None and not pl.full:
             if self._limit_alarm is not None:
                 if pl.idle:  # the legal moves before it have run out: the offending one never starts
