@@ -45,14 +45,29 @@ def _full(sl: SoftLimits, mv: Move):
         del sl._inside
 
 
-@settings(max_examples=600, deadline=None)
-@given(sl=limits(), mv=moves())
-def test_the_quick_answer_gives_the_full_checks_alarm(sl: SoftLimits, mv: Move) -> None:
+def _same_alarm(sl: SoftLimits, mv: Move) -> None:
     quick = sl.check(mv)
     full = _full(sl, mv)
     assert (quick is None) == (full is None)
     if full is not None:
         assert (quick.code, quick.message, quick.axis) == (full.code, full.message, full.axis)
+
+
+@settings(max_examples=600, deadline=None)
+@given(sl=limits(), mv=moves())
+def test_the_quick_answer_gives_the_full_checks_alarm(sl: SoftLimits, mv: Move) -> None:
+    _same_alarm(sl, mv)
+
+
+@settings(max_examples=400, deadline=None)
+@given(sl=limits(), bench_only=st.booleans(), mvs=st.lists(moves(), min_size=2, max_size=5))
+def test_moves_after_the_first_give_the_full_checks_alarm(sl: SoftLimits, bench_only: bool, mvs: list[Move]) -> None:
+    """From the second move on the axes' parameter names are known: without a G10 L21 value set the bench's
+    1st segment is checked alone (the CAM program's case), with one the loop over all four reads them."""
+    if bench_only:
+        sl.params = {}
+    for mv in mvs:
+        _same_alarm(sl, mv)
 
 
 def test_a_line_past_a_g10_l21_limit_is_refused_and_one_inside_passes() -> None:
@@ -64,3 +79,27 @@ def test_a_line_past_a_g10_l21_limit_is_refused_and_one_inside_passes() -> None:
     assert alarm is not None and (alarm.code, alarm.axis, alarm.line) == (0x0A03, "Y", 4)
     sl.params = {"soft limit 3 Y": 70.0}  # G10 L21 P3 changed: read again
     assert sl.check(past) is None
+
+
+def test_a_g10_l21_limit_set_after_moves_that_had_none_is_read() -> None:
+    """The bench's 1st segment alone while no G10 L21 value is set (the names known after the first move);
+    a value set later in place (G10 L21 P1, P4) is read by the next move, a disabled axis is skipped."""
+    sl = SoftLimits({"X": (-300.0, 300.0)}, {}, ())
+    mv = Move("line", 5, "X250. Y-40.", {"X": 0.0, "Y": 0.0}, {"X": 250.0, "Y": -40.0}, {"X": 250.0, "Y": -40.0})
+    far = Move("line", 6, "X310.", {"X": 0.0, "Y": 0.0}, {"X": 310.0, "Y": 0.0}, {"X": 310.0, "Y": 0.0})
+    assert sl.check(mv) is None and sl.check(mv) is None
+    alarm = sl.check(far)
+    assert alarm is not None and (alarm.code, alarm.axis, alarm.line) == (0x0A01, "X", 6)
+    low = Move("line", 7, "X-300.5", {"X": -299.0, "Y": 0.0}, {"X": -300.5, "Y": 0.0}, {"X": -300.5, "Y": 0.0})
+    alarm = sl.check(low)
+    assert alarm is not None and (alarm.code, alarm.axis, alarm.line) == (0x0A01, "X", 7)
+    sl.disabled.add("X")  # MLC M2x368: the 1st segment of X off
+    assert sl.check(far) is None
+    sl.disabled.clear()
+    sl.params["soft limit 1 X"] = 200.0  # G10 L21 P1 X200.
+    alarm = sl.check(mv)
+    assert alarm is not None and (alarm.code, alarm.axis) == (0x0A01, "X")
+    del sl.params["soft limit 1 X"]
+    sl.params["soft limit 4 Y"] = -30.0  # G10 L21 P4 Y-30.: the 2nd segment
+    alarm = sl.check(mv)
+    assert alarm is not None and (alarm.code, alarm.axis) == (0x0A03, "Y")
