@@ -68,11 +68,21 @@ class PositionFilter:
 
     def push(self, x: np.ndarray, lam: float = 1.0) -> np.ndarray:
         """The next output for input row x; lam: the filter's share (1 = the filter's own output)."""
-        row = np.asarray(x, dtype=float).tolist()
+        return np.array(self._push(np.asarray(x, dtype=float).tolist(), lam))
+
+    def push_rows(self, rows: list[list[float]], lams: list[float] | None = None) -> list[list[float]]:
+        """push() of each row (lists of Python floats; lams[k] the share of row k, None: 1), the outputs as lists
+        (never changed in place): the same values, without two numpy conversions a row (hil/stretch_pass.py)."""
+        p = self._push
+        if lams is None:
+            return [p(row, 1.0) for row in rows]
+        return [p(row, lam) for row, lam in zip(rows, lams)]
+
+    def _push(self, row: list[float], lam: float) -> list[float]:
         same = row == self._last
         if same and self._still >= self.span:
             self._recent = (self._recent[1], self._recent[2], self._out)
-            return np.array(self._out)
+            return self._out
         if same:
             self._still += 1
             row = self._last
@@ -90,14 +100,14 @@ class PositionFilter:
             recent = self._recent
             self.reset(row)
             self._recent = (recent[1], recent[2], row)
-            return np.array(row)
+            return row
         out = [s / n2 for s in s2]
         if lam != 1.0 and self.lag is not None:
             d = self._w1[n1 - 1 - self.lag]
             out = [p + lam * (f - p) for p, f in zip(d, out)]
         self._out = out
         self._recent = (self._recent[1], self._recent[2], out)
-        return np.array(out)
+        return out
 
     def push_many(self, xs: np.ndarray, lam: np.ndarray | None = None) -> np.ndarray:
         """push() each row of `xs` (cycles × axes) in turn (with lam[k] the share of row k; None: 1), the
