@@ -215,10 +215,30 @@ class CsvRun:
         floor = math.floor
         still = self.still
         ks, neg, over, neg_ramp = range(n), -max_cps, 1.2 * max_cps, -ramp  # (the values the loop computed each time)
-        for c in range(cycles):
+        c = 0
+        while c < cycles:
             if still:  # a standing spindle (a mill's CAM program): the same cycle from here on, the time on
                 t = _repeat(out, t, h, n, False, cycles - c)
                 break
+            v_cmd = tv if neg <= tv <= max_cps else max(neg, min(max_cps, tv))
+            if tv == want and tv != 0.0 and vel != 0.0 and ramp >= 0.0 and abs(vel) <= over \
+                    and (v_cmd == vel or vel + (v_cmd - vel) * alpha == vel):
+                # at its speed (the ramp's step 0, the velocity loop's step none, or under half an ulp: a velocity
+                # 7e-9 short of 2.56e7 counts/s stays): only the position and the time move, as far as the cycles
+                # move it and pass no index edge
+                c_acc = (vel - vel) / dt
+                c_torque = (inertia * c_acc * rad + viscous * vel * rad
+                            + (math.copysign(coulomb, vel) if abs(vel) > 1 else 0.0)) / rated * 1000.0
+                raw = round(vel * k_raw)
+                fb = (raw if -0x7FFFFFFF <= raw <= 0x7FFFFFFF else max(-0x7FFFFFFF, min(0x7FFFFFFF, raw)),
+                      round(c_torque * 0.1 / t_pct), base, abs(vel) < reached_v, origin)
+                done, pos, t, command = _at_speed(out, cycles - c, pos, t, command, vel * h, h, n, every, fb)
+                if done:
+                    acc, torque = c_acc, c_torque
+                    c += done
+                    if c == cycles:
+                        break
+            c += 1
             c_pos, c_vel, c_t, c_tv, cmd = pos, vel, t, tv, command
             edge = False
             # The velocity-loop lines below, and the feedback lines after them, repeat CspRun's on purpose: a call
@@ -278,6 +298,37 @@ def _repeat(out: Stretch, t: float, h: float, n: int, csp: bool, times: int) -> 
     for _k in range(n * times):
         t += h
     return t
+
+
+def _at_speed(out: Stretch, cycles: int, pos: float, t: float, command: float, dp: float, h: float, n: int,
+              every: int, fb: tuple) -> tuple[int, float, float, float]:
+    """CsvRun.step's cycles of a spindle at its speed: each sub-step moves the position by dp (its velocity × h, the
+    same product) and the time by h; velocity, torque and status bits stay. As many cycles as move the position
+    and pass no index edge (that cycle is CsvRun.step's): (cycles done, position, time, command after them)."""
+    va_raw, ta_raw, base, slow, origin = fb
+    pa, va, ta, sws = out.position_actual, out.velocity_actual, out.torque_actual, out.statusword
+    floor = math.floor
+    done = 0
+    ks = range(n)
+    while done < cycles:
+        c_pos, c_t, cmd = pos, t, command
+        edge = False
+        for _k in ks:
+            cmd = c_pos
+            new_pos = c_pos + dp
+            if every and floor(c_pos / every) != floor(new_pos / every):
+                edge = True
+            c_pos = new_pos
+            c_t += h
+        if edge or c_pos == pos:
+            break
+        pos, t, command = c_pos, c_t, cmd
+        sws.append(base | SW_TARGET_REACHED if slow and abs(command - pos) < 10 else base)
+        pa.append(round(pos + origin))
+        va.append(va_raw)
+        ta.append(ta_raw)
+        done += 1
+    return done, pos, t, command
 
 
 def _stand(run: "CspRun | CsvRun", cycles: int, csp: bool) -> None:
