@@ -22,7 +22,6 @@ from nc.alarms import Alarm
 from nc.moves import Move
 
 _EPS = 1e-9
-_UNSET = (None, None)
 _AWAY = 1e-6  # mm: a manual move left the limit position it was clamped on
 
 
@@ -57,14 +56,10 @@ class SoftLimits:
     def __post_init__(self) -> None:
         # axis -> the G10 L21 parameter names P1-P4 as `window` reads them, and the axis's scale (`_inside`)
         self._names: dict[str, tuple[str, str, str, str, float]] = {}
-        self._seen: frozenset[str] = frozenset()  # the axes of _names
-        self._all: frozenset[str] = frozenset()  # their parameter names: none set, the bench's 1st segment alone counts
 
     def _keys(self, axis: str) -> tuple[str, str, str, str, float]:
         k = self._names[axis] = (f"soft limit 1 {axis}", f"soft limit 2 {axis}", f"soft limit 3 {axis}",
                                  f"soft limit 4 {axis}", 0.5 if axis in self.diameter_axes else 1.0)
-        self._seen = frozenset(self._names)
-        self._all = frozenset(n for names in self._names.values() for n in names[:4])
         return k
 
     def _inside(self, move: Move) -> bool:
@@ -75,17 +70,6 @@ class SoftLimits:
         if (move.kind == "arc" and move.center) or start.keys() != end.keys():
             return False
         first, params, disabled, names = self.first, self.params, self.disabled, self._names
-        if end.keys() <= self._seen and params.keys().isdisjoint(self._all):
-            # no G10 L21 value for these axes (a CAM program's moves): the loop below reads the bench's 1st
-            # segment alone; the 12 names looked up at C level, not 4 `get` an axis (issue 17: 1.9 us a move)
-            for a, e in end.items():
-                if a not in disabled:
-                    lo, hi = first.get(a, _UNSET)
-                    s = start[a]
-                    if (hi is not None and (e if e > s else s) > hi + _EPS) \
-                            or (lo is not None and (e if e < s else s) < lo - _EPS):
-                        return False
-            return True
         for a, e in end.items():
             s = start[a]
             mn = e if e < s else s  # min(s, e) and max(s, e) as `_path_ranges` takes them

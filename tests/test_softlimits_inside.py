@@ -62,8 +62,8 @@ def test_the_quick_answer_gives_the_full_checks_alarm(sl: SoftLimits, mv: Move) 
 @settings(max_examples=400, deadline=None)
 @given(sl=limits(), bench_only=st.booleans(), mvs=st.lists(moves(), min_size=2, max_size=5))
 def test_moves_after_the_first_give_the_full_checks_alarm(sl: SoftLimits, bench_only: bool, mvs: list[Move]) -> None:
-    """From the second move on the axes' parameter names are known: without a G10 L21 value set the bench's
-    1st segment is checked alone (the CAM program's case), with one the loop over all four reads them."""
+    """Several moves against one SoftLimits (the parameter names it keeps per axis known from the second move
+    on), with G10 L21 values or the bench's 1st segment alone (the CAM program's case)."""
     if bench_only:
         sl.params = {}
     for mv in mvs:
@@ -82,7 +82,7 @@ def test_a_line_past_a_g10_l21_limit_is_refused_and_one_inside_passes() -> None:
 
 
 def test_a_g10_l21_limit_set_after_moves_that_had_none_is_read() -> None:
-    """The bench's 1st segment alone while no G10 L21 value is set (the names known after the first move);
+    """The bench's 1st segment while no G10 L21 value is set (the names kept after the first move);
     a value set later in place (G10 L21 P1, P4) is read by the next move, a disabled axis is skipped."""
     sl = SoftLimits({"X": (-300.0, 300.0)}, {}, ())
     mv = Move("line", 5, "X250. Y-40.", {"X": 0.0, "Y": 0.0}, {"X": 250.0, "Y": -40.0}, {"X": 250.0, "Y": -40.0})
