@@ -22,6 +22,9 @@ if TYPE_CHECKING:  # pragma: no cover
     from nc.interp.host import InterpHost
 
 
+_JOINABLE = ("line", "arc", "rapid", "thread")  # moves a ,C/,R joins, or that carry one
+
+
 def expand_corners(interp: "InterpHost", events: Iterator[Event]) -> Iterator[Event]:
     pending: tuple[Move, str, float] | None = None
     held: list[Event] = []  # M/S/T or dwell events of the next block, issued after the corner
@@ -33,6 +36,13 @@ def expand_corners(interp: "InterpHost", events: Iterator[Event]) -> Iterator[Ev
         ev = next(events, None)
         if ev is None:
             break
+        if type(ev) is Move and pending is None and ev.kind in _JOINABLE:  # the usual event, said first
+            b = interp.block  # a block without ,C/,R marks nothing: said without a call (hot path)
+            if b is None or not b.comma or (mark := _mark(interp, ev)) is None:
+                yield ev
+                continue
+            pending = (ev, mark[0], mark[1])
+            continue
         if type(ev) is MoveList:  # a cycle's moves: through whole unless a corner waits, then one by one
             if pending is None:
                 yield ev
@@ -46,7 +56,7 @@ def expand_corners(interp: "InterpHost", events: Iterator[Event]) -> Iterator[Ev
             yield from _corners_of(interp, ev.moves(), pending, held)
             pending, held = None, []
             continue
-        if isinstance(ev, Move) and ev.kind in ("line", "arc", "rapid", "thread"):
+        if isinstance(ev, Move) and ev.kind in _JOINABLE:
             b = interp.block  # a block without ,C/,R marks nothing: said without a call (hot path)
             mark = None if b is None or not b.comma else _mark(interp, ev)
             if pending is not None:

@@ -147,7 +147,7 @@ class Interpreter(ExecuteMixin, ReadingMixin, ModalMixin, MotionMixin, NonModalM
         take, nothing = lean.take, NOTHING
         cur = None  # the frame `blocks`, `count`, `parsed` and `name` are of (read again when it changes)
         while self.stack:
-            if budget is not None and budget.spent:
+            if budget is not None and budget.used >= budget.limit:  # `spent`, without a property call a block
                 yield BUSY  # the rest of the macro next cycle; the cycle never stalls (decisions B2)
                 continue
             fr = self.stack[-1]

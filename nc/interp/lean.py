@@ -20,7 +20,6 @@ see the same events at the same moments. tests/test_interp_lean.py compares both
 
 from __future__ import annotations
 
-import math
 import re
 from collections.abc import Callable
 from typing import TYPE_CHECKING
@@ -171,10 +170,13 @@ class LeanLane:
         origin = ip.frames.origins(st.wcs, axes)
         diameter = self.diameter
         position = ip.position
-        work = {}
-        for a in axes:
-            v = position.get(a, 0.0) - origin[a]
-            work[a] = v * 2.0 if a in diameter else v
+        if diameter:
+            work = {}
+            for a in axes:
+                v = position.get(a, 0.0) - origin[a]
+                work[a] = v * 2.0 if a in diameter else v
+        else:  # a mill: no axis in diameter (the same sums, without asking per axis)
+            work = {a: position.get(a, 0.0) - origin[a] for a in axes}
         for a, k in shape.axes:
             text = vals[k]
             if "." in text:
@@ -190,9 +192,9 @@ class LeanLane:
             machine = {}
             for a in axes:
                 v = work[a]
-                v = (v / 2.0 if a in diameter else v) + origin[a]
-                if not math.isfinite(v) or abs(v) > 1e9:
-                    return None  # 0x120E from the general path
+                v = (v / 2.0 if diameter and a in diameter else v) + origin[a]
+                if not -1e9 <= v <= 1e9:  # NaN, an infinity, or |v| > 1e9 (isfinite, abs): the general path's
+                    return None  # 0x120E
                 machine[a] = v
         # ---- committed: the state the general path leaves
         fr.pc = pc + 1

@@ -63,6 +63,10 @@ class PreviewWindow:
                     failure = exc
                     done = True
                     break
+                if type(ev) is Move:  # the usual event first (Move has no subclass)
+                    buf.append(ev)
+                    moves += 1
+                    continue
                 if isinstance(ev, Busy):  # the statement budget is spent: the channel reads on next cycle
                     yield ev
                     continue
