@@ -570,6 +570,7 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
                 # after the ramp, cruise at the target speed to the end of the run
                 pw.duration = max(pw.duration, (dist - s) / target)
                 pw.t0[:, -1] = np.minimum(pw.t0[:, -1], pw.duration)
+                pw._lists = None  # `at` reads the changed arrays
             return _Plan("ramp", pw, pw.duration, t0, 0.0, target)
         if self._jf < MAX_FACTOR and a >= 0.0 and v < cap * (1.0 - 1e-6) and vmax >= cap - 1e-9:
             ramp = self._speed_up(b, s, v, a, cap, cruise, dist, v1, ra, rj, t0)
@@ -590,11 +591,11 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
         start = b.s_end - b.length
         if self._zones is not None and self._zones.near(start + s - blend.span_max, start + cruise + blend.span_max):
             return None
+        if dist - cruise < change_distance(cap, v1, MARGIN * ra, MARGIN * rj):
+            return None  # no cruise between the speed-up and the braking (asked first: no scan, session 12)
         f, unknown = jerk_factor(self.cfg, blend, self.blocks, start + s, start + cruise, self.closed)
         if unknown or f <= self._jf * (1.0 + 1e-9):
             return None
-        if dist - cruise < change_distance(cap, v1, MARGIN * ra, MARGIN * rj):
-            return None  # no cruise between the speed-up and the braking
         pw = solve_velocity(s, v, a, cap, ra, rj / self._jf * f)
         end_s = float(pw.sample(np.array([pw.duration]))[0][0])
         if end_s > cruise + 1e-9:

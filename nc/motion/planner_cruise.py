@@ -8,7 +8,7 @@ import math
 import numpy as np
 
 from nc.motion.lookahead import Block
-from nc.motion.plan_state import CHUNK, _near, _Plan
+from nc.motion.plan_state import CHUNK, _Plan
 
 # Rows a cruise samples at a refill: whole blocks until at least this many. Its cost is per block (~45 blocks for
 # 64 rows on the CAM program: 0.2-0.7 ms in one cycle, a real-time cycle's spike); the chain goes on at the next
@@ -102,10 +102,18 @@ class CruiseSampling:
         lines: list[int] = []
         carries: list[float] = []  # the plan time left over at the end of each block
         rows = 0
+        end: list[float] = []  # the last block's end as floats
         while True:
             b = blocks[k]
-            if k and _near(b.seg.start, blocks[k - 1].seg.end):
-                b.seg.start = blocks[k - 1].seg.end.copy()
+            seg = b.seg
+            start = seg.start.tolist()
+            # _near(seg.start, the last block's end) on the lists, and the snap (session 12: each block's points
+            # read once as floats)
+            if k and all(abs(x - y) <= 1e-6 + 1e-5 * abs(y) for x, y in zip(start, end)):
+                seg.start = blocks[k - 1].seg.end.copy()
+                start = end
+            end = seg.end.tolist()
+            d = [e - q for e, q in zip(end, start)]  # seg.end - seg.start: the same float subtraction as numpy's
             duration = (b.length - s0) / v  # ruckig's duration of this profile, to the bit
             while True:
                 n = int(math.floor((duration - t_next) / T + 1e-9)) + 1
@@ -117,10 +125,10 @@ class CruiseSampling:
                 s = [s0 + (duration if duration <= x else x) * v
                      for x in [0.0 if 0.0 >= x else x for x in [t_next + T * i for i in range(n)]]]
                 t_next = (t_next + T * (n - 1)) + T
-                seg, length = b.seg, b.length
+                length = b.length
                 sc = [length if length <= x else x for x in [0.0 if 0.0 >= x else x for x in s]]
                 if seg.kind == "line" and seg.length > 0.0:
-                    start, d, seg_len = seg.start.tolist(), (seg.end - seg.start).tolist(), seg.length
+                    seg_len = seg.length
                     pos += [[q + u * e for q, e in zip(start, d)] for u in [x / seg_len for x in sc]]
                 else:
                     pos += seg.points(np.array(sc)).tolist()

@@ -54,8 +54,10 @@ class Piecewise:
         rows = [_phases(pr) for pr in traj.profiles[0]]
         if len(rows) == 1:  # one DoF (every path solve): its columns as they are, no padding (issue 17)
             m = np.array(rows[0])  # one array, five (1, phases) views of it
-            return cls(m[0:1], m[1:2], m[2:3], m[3:4], m[4:5], float(traj.duration),
-                       float(traj.position_extrema[0].max))
+            dur = float(traj.duration)
+            pw = cls(m[0:1], m[1:2], m[2:3], m[3:4], m[4:5], dur, float(traj.position_extrema[0].max))
+            pw._lists = (dur, *rows[0])  # what `at` would make of the arrays: the same floats (session 12)
+            return pw
         n = max(len(r[0]) for r in rows)
         arrs = []
         for k in range(5):
@@ -78,10 +80,12 @@ class Piecewise:
         # Plain floats: ≈ 10 phases, where numpy's per-call cost was most of the time (same
         # operations in the same order as the array form, so the same result bit for bit).
         dur = self.duration
-        t0 = [x if x < dur else dur for x in self.t0[dof].tolist()]
-        v = self.v[dof].tolist()
-        a = self.a[dof].tolist()
-        j = self.j[dof].tolist()
+        c = self._lists
+        if dof == 0 and c is not None and c[0] == dur:  # `at`'s lists, the arrays' floats (session 12)
+            _, t0, _, v, a, j = c
+        else:
+            t0, v, a, j = self.t0[dof].tolist(), self.v[dof].tolist(), self.a[dof].tolist(), self.j[dof].tolist()
+        t0 = [x if x < dur else dur for x in t0]
         low = min(v)
         for k in range(len(t0) - 1):
             jk = j[k]
@@ -141,11 +145,16 @@ def _phases(pr) -> tuple[list, list, list, list, list]:
             if bt[k] > 0.0:
                 t0.append(t), p.append(bp[k]), v.append(bv[k]), a.append(ba[k]), j.append(bj[k])
                 t += bt[k]
-    pt, pp, pv, pa, pj = pr.t, pr.p, pr.v, pr.a, pr.j
-    for k in range(7):
-        if pt[k] > 0.0:
-            t0.append(t), p.append(pp[k]), v.append(pv[k]), a.append(pa[k]), j.append(pj[k])
-            t += pt[k]
+    pt = pr.t
+    ks = [k for k in range(7) if pt[k] > 0.0]  # the phases kept; gathered by comprehensions (session 12)
+    for k in ks:  # the start times summed in the same order
+        t0.append(t)
+        t += pt[k]
+    pp, pv, pa, pj = pr.p, pr.v, pr.a, pr.j
+    p += [pp[k] for k in ks]
+    v += [pv[k] for k in ks]
+    a += [pa[k] for k in ks]
+    j += [pj[k] for k in ks]
     # The final state, integrated from the last phase (pf is not kept for velocity control).
     if len(t0) > 0:
         h = t - t0[-1]
