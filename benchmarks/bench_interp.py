@@ -16,7 +16,9 @@ pass/fail. rs274 comes with the Debian package linuxcnc-uspace; without it the r
   block  the interpreter's cost a block as the channel pays it (issue 17): `Interpreter.run` in process,
          Move by Move (no bulk lane), on benchmarks/bench_motion.cam_program (--per-block lines of
          `X.. Y..`, the bench_loop CAM program), CPU best of --repeat (at least 3), with the general
-         path alone (`Interpreter.lean = False`) beside it; rs274 -g on the same lines, CPU / blocks.
+         path alone (`Interpreter.lean = False`) beside it; the channel's read side (the same run through
+         `hil.stretch_reads.Ahead.peek` and `Channel._feed_planner` with the mill bench's soft limits, 4 moves a
+         feed, into a planner stand-in that keeps the pushes); rs274 -g on the same lines, CPU / blocks.
 """
 
 from __future__ import annotations
@@ -116,16 +118,61 @@ def best(lean):
             pass
         out.append(time.process_time() - t0)
     return min(out) / n * 1e6
+def feed():
+    # the channel's read side a move: the same run through hil.stretch_reads.Ahead's peek (soft limits of
+    # benches/mill-3axis.toml, the statement budget) and Channel._feed_planner, 4 moves a feed as a stretch
+    # reads them, into a planner stand-in that only keeps the pushes (Planner.push is the planner's cost)
+    try:
+        from hil.bench_file import load_bench_file
+        from hil.stretch_reads import ahead
+    except ImportError:
+        return float("nan")
+    from nc.budget import StatementBudget
+    from nc.channel import Channel, RunState
+    from nc.softlimits import SoftLimits
+    class Taker:
+        closed = idle = True
+        held = False
+        threads_queued = 0
+        def __init__(self):
+            self.blocks = []
+        @property
+        def full(self):
+            return len(self.blocks) >= 8
+        def push(self, move):
+            self.blocks.append(move)
+        def release_run(self):
+            pass
+    bench = load_bench_file("benches/mill-3axis.toml")
+    out = []
+    for _ in range(repeat):
+        profile = make_profile(bench.profile, bench_axes, bench.params)
+        ip = Interpreter(profile)
+        ip.budget = StatementBudget.for_profile(profile)
+        ch = Channel(Taker())
+        ch.soft_limits, ch.statement_budget = SoftLimits.for_bench(bench, profile), ip.budget
+        ch.load(ip.run(prog))
+        ch.cycle_start()
+        src = ahead(ch)
+        t0 = time.process_time()
+        while ch.end is None and ch.state is RunState.RUNNING:
+            del ch.planner.blocks[:4]
+            src.peek(4)
+            ch._feed_planner()
+        out.append(time.process_time() - t0)
+    return min(out) / n * 1e6
+bench_axes = ("X", "Y", "Z")
 lean = hasattr(Interpreter, "lean")
-print(best(None), best(False) if lean else float("nan"))
+print(best(None), best(False) if lean else float("nan"), feed())
 """
 
 
-def per_block(path: Path, tree: str, env: dict, repeat: int) -> tuple[float, float]:
-    """µs a block of `Interpreter.run` on the program at `path` in `tree` (lean lane, general path)."""
+def per_block(path: Path, tree: str, env: dict, repeat: int) -> tuple[float, float, float]:
+    """µs a block of `Interpreter.run` on the program at `path` in `tree` (lean lane, general path), and of the
+    channel's read side (the run through `Ahead.peek` and `Channel._feed_planner`, up to `Planner.push`)."""
     out = subprocess.run([sys.executable, "-c", _PER_BLOCK, str(path), str(max(3, repeat))], env=env, cwd=tree,
                          capture_output=True, text=True, check=True).stdout.split()
-    return float(out[0]), float(out[1])
+    return float(out[0]), float(out[1]), float(out[2])
 
 
 def write_case(name: str, folder: str, blocks: int, passes: int, parts: int) -> None:
@@ -169,9 +216,9 @@ def main() -> int:
                             str(args.per_block if name == "block" else args.blocks), str(args.passes),
                             str(args.parts)], check=True)
             if name == "block":
-                lean, general = per_block(Path(d) / "block.nc", args.tree, env, args.repeat)
+                lean, general, read = per_block(Path(d) / "block.nc", args.tree, env, args.repeat)
                 row = {"case": name, "blocks": args.per_block, "interp_us_block": round(lean, 2),
-                       "general_us_block": round(general, 2)}
+                       "general_us_block": round(general, 2), "read_side_us_block": round(read, 2)}
                 if rs274:
                     ref = min((timed([rs274, "-g", str(Path(d) / "block.ngc")]) for _ in range(max(3, args.repeat))),
                               key=lambda r: r[3])
@@ -203,7 +250,8 @@ def main() -> int:
     for r in rows:
         if r["case"] == "block":
             print(f"block  {r['blocks']} `X Y` lines (bench_motion.cam_program), CPU µs a block: Interpreter.run "
-                  f"{r['interp_us_block']:.2f} (general path alone {r['general_us_block']:.2f}); rs274 -g "
+                  f"{r['interp_us_block']:.2f} (general path alone {r['general_us_block']:.2f}), the channel's read "
+                  f"side {r['read_side_us_block']:.2f} (Ahead.peek, Channel._feed_planner: up to Planner.push); rs274 -g "
                   f"{r.get('rs274_us_block', nan):.2f} (whole command)")
             continue
         print(f"{r['case']:6s} {r['hil_s']:10.2f} {r['hil_cpu_s']:6.2f} {r['hil_peak_mb']:8.0f} "
