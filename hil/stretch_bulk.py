@@ -16,6 +16,9 @@ here when every cycle of it would do exactly this, and `bulk_cycles` does it onc
 from __future__ import annotations
 
 import time as _time
+from functools import reduce
+from itertools import accumulate, repeat
+from operator import add
 from typing import Any
 
 import numpy as np
@@ -167,17 +170,12 @@ def bulk_cycles(r: Any, ch: Channel, pl: Planner, smp: Samples, outs: list[Stret
     cnt = m - k0
     dt = r.bench.cycle
     n_axes = len(r.axes)
-    times = []
-    t = r.time
-    for _ in range(cnt):
-        t += dt
-        times.append(t)
-    r.time = t
+    # the times summed cycle by cycle, as stepping sums them (accumulate and reduce add in order, at C speed)
+    times = list(accumulate(repeat(dt, cnt), add, initial=r.time))
+    r.time = times[-1]
+    del times[0]
     link = r.link
-    lt = link.time
-    for _ in range(cnt):
-        lt += dt
-    link.time = lt
+    link.time = reduce(add, repeat(dt, cnt), link.time)
     link.cycles += cnt
     first_cycle = r.cycle + 1
     r.cycle += cnt
@@ -185,26 +183,28 @@ def bulk_cycles(r: Any, ch: Channel, pl: Planner, smp: Samples, outs: list[Stret
         master.cycles_in_state += cnt  # step() in a held state: the same controlword, one more cycle in it
     rest, last = r._rest, r._last_position
     for i, o in enumerate(outs):
-        n_rest, p_last = rest[i], last[i]
-        for p, v in zip(o.position_actual[k0:m], o.velocity_actual[k0:m]):
-            n_rest = n_rest + 1 if p == p_last and v == 0 else 0
-            p_last = p
-        rest[i], last[i] = n_rest, p_last
+        rest[i], last[i] = _rest(rest[i], last[i], o.position_actual[k0:m], o.velocity_actual[k0:m])
     r.tx = tx = [o.last for o in outs]
     scales, org = r.scales, r.origin.tolist()
     r.actual[:] = [scales[i].to_units(tx[i].position_actual) + o for i, o in enumerate(org)]
     positions, lines = smp.positions, smp.lines
     line = r.line
-    row_lines = []
-    for ln in lines[k0:m]:
-        line = ln or line
-        row_lines.append(line)
+    row_lines = lines[k0:m]
+    if all(row_lines):  # every row names its line (a 0 keeps the one before)
+        line = row_lines[-1]
+    else:
+        row_lines = []
+        for ln in lines[k0:m]:
+            line = ln or line
+            row_lines.append(line)
     if settle is not None:  # Planner.step's spindle settle count reads the measured speed of each cycle
         rpms, cmds = settle
         cmd = float(pl.spindle_command())  # type: ignore[misc]
         if len(scales) > n_axes:
             sc = scales[n_axes]
-            rpms += [sc.drive_to_rpm(v) for v in outs[n_axes].velocity_actual[k0:m]]
+            # AxisScaling.drive_to_rpm over the column: the same divisions and products in the same order
+            va = np.array(outs[n_axes].velocity_actual[k0:m], dtype=np.float64)
+            rpms += (va / sc._raw_per_cps / sc._cpu / sc.lead * 60.0).tolist()
         else:
             rpms += [abs(r.spindle_command_rpm())] * cnt
         cmds += [cmd] * cnt
@@ -255,6 +255,18 @@ def bulk_cycles(r: Any, ch: Channel, pl: Planner, smp: Samples, outs: list[Stret
     return None
 
 
+def _rest(n_rest: int, p_last: int, pa: list[int], va: list[int]) -> tuple[int, int]:
+    """The runner's rest count and last position after these cycles' feedback: a cycle at rest (its position the
+    one before, velocity 0) counts on, any other starts again at 0."""
+    cnt = len(pa)
+    if va.count(0) == cnt and pa.count(p_last) == cnt:  # at rest throughout
+        return n_rest + cnt, p_last
+    k = cnt - 1  # the cycles at rest at the end
+    while k > 0 and va[k] == 0 and pa[k] == pa[k - 1]:
+        k -= 1
+    return cnt - 1 - k, pa[-1]
+
+
 def _mlc(r: Any, ch: Channel, outs: list[Stretch], k0: int, m: int, before_last_step: np.ndarray) -> None:
     """The MLC's scans of cycles k0 … m-1: counts and time per scan, the NC's outputs of the last one."""
     mlc = r.mlc
@@ -280,7 +292,7 @@ def _mlc(r: Any, ch: Channel, outs: list[Stretch], k0: int, m: int, before_last_
             break
         # |round(torque % × 10)| grows with |0x6077| (a product, rounded half to even: odd-symmetric): the
         # largest raw torque gives the peak
-        raw = max(abs(tq) for tq in o.torque_actual[k0:m - 1])
+        raw = max(map(abs, o.torque_actual[k0:m - 1]))
         peak = min(abs(int(round(r.scales[k].torque_percent(raw) * 10.0))), 0xFFFF)
         if peak > words[30400 + k]:
             words[30400 + k] = peak
