@@ -756,7 +756,7 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
                 d -= self.blocks[0].length
                 self._finish_block(keep_plan=True)
             b = self.blocks[0]
-            self.s, self.v, self.a = b.length, float(p.pw.v[0][-1]), 0.0
+            self.s, self.v, self.a = b.length, p.pw.v_end(), 0.0
             self.position = b.seg.end.copy() if b.seg is not None else self.position
             self._finish_block()
         elif p.kind == "dwell":

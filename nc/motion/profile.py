@@ -27,6 +27,9 @@ def clip(x: np.ndarray | float, lo: float, hi: float) -> np.ndarray | np.floatin
 
 _OK = (Result.Working, Result.Finished)
 _POOL: dict[int, tuple[Ruckig, InputParameter]] = {}  # one calculator per DoF count, never per cycle
+# The control interface `_one_dof` last set on the pooled 1-DoF input (with synchronisation Time and target
+# acceleration 0); `solve_axes` drops its entry where it sets those fields itself
+_MODE: dict[int, ControlInterface] = {}
 
 
 def _calc(dofs: int) -> tuple[Ruckig, InputParameter]:
@@ -53,11 +56,7 @@ class Piecewise:
     def of(cls, traj: Trajectory) -> "Piecewise":
         rows = [_phases(pr) for pr in traj.profiles[0]]
         if len(rows) == 1:  # one DoF (every path solve): its columns as they are, no padding (issue 17)
-            m = np.array(rows[0])  # one array, five (1, phases) views of it
-            dur = float(traj.duration)
-            pw = cls(m[0:1], m[1:2], m[2:3], m[3:4], m[4:5], dur, float(traj.position_extrema[0].max))
-            pw._lists = (dur, *rows[0])  # what `at` would make of the arrays: the same floats (session 12)
-            return pw
+            return _OneDof(rows[0], float(traj.duration), float(traj.position_extrema[0].max))
         n = max(len(r[0]) for r in rows)
         arrs = []
         for k in range(5):
@@ -98,6 +97,10 @@ class Piecewise:
         self._vmin = (key, low)
         return low
 
+    def v_end(self) -> float:
+        """DoF 0's velocity at the end of its last phase."""
+        return float(self.v[0][-1])
+
     def at(self, t: float) -> tuple[float, float, float]:
         """sample(np.array([t])) of DoF 0 on plain floats: the same operations in the same order, so the same
         bits (numpy's maximum/minimum keep their first operand on a tie, searchsorted is bisect_right), without
@@ -132,6 +135,36 @@ class Piecewise:
         vel = v + dt * (a + dt * j / 2.0)
         acc = a + dt * j
         return pos, vel, acc
+
+
+class _OneDof(Piecewise):
+    """One DoF's phases (every path solve) as ruckig gave them: read through `at`, `v_min` and `v_end` as the
+    plain lists, the arrays (one array, five (1, phases) views of it: t0[:, -1] written in place changes it) made on
+    first use. A solve's plan is mostly sampled a row or two at a time, and np.array of its rows cost ≈ 2 µs a
+    solve (issue 17, session 12); the lists hold the floats the arrays would (float64 both ways)."""
+
+    def __init__(self, rows: tuple[list, list, list, list, list], duration: float, p_max: float) -> None:
+        self._rows = rows
+        self._m: np.ndarray | None = None
+        self.duration = duration
+        self.p_max = p_max
+        self._vmin = None
+        self._lists = (duration, *rows)  # what `at` makes of the arrays
+
+    def _arr(self, k: int) -> np.ndarray:
+        m = self._m
+        if m is None:
+            m = self._m = np.array(self._rows)
+        return m[k:k + 1]
+
+    t0 = property(lambda self: self._arr(0))  # type: ignore[assignment]
+    p = property(lambda self: self._arr(1))  # type: ignore[assignment]
+    v = property(lambda self: self._arr(2))  # type: ignore[assignment]
+    a = property(lambda self: self._arr(3))  # type: ignore[assignment]
+    j = property(lambda self: self._arr(4))  # type: ignore[assignment]
+
+    def v_end(self) -> float:
+        return self._rows[2][-1] if self._m is None else float(self._m[2, -1])
 
 
 def _phases(pr) -> tuple[list, list, list, list, list]:
@@ -171,14 +204,16 @@ def _one_dof(interface: ControlInterface, p0: float, v0: float, a0: float, p1: f
              v_max: float, a_max: float, j_max: float) -> tuple[Ruckig, InputParameter]:
     """The pooled 1-DoF calculator with its input set: (p0, v0, a0) → (p1, v1, 0) within the limits."""
     otg, inp = _calc(1)
-    inp.control_interface = interface
-    inp.synchronization = Synchronization.Time
+    if _MODE.get(1) is not interface:  # what is set already is not set again (≈ 0.3 µs a field, issue 17)
+        inp.control_interface = interface
+        inp.synchronization = Synchronization.Time
+        inp.target_acceleration = [0.0]
+        _MODE[1] = interface
     inp.current_position = [p0]
     inp.current_velocity = [v0]
     inp.current_acceleration = [a0]
     inp.target_position = [p1]
     inp.target_velocity = [v1]
-    inp.target_acceleration = [0.0]
     inp.max_velocity = [v_max]
     inp.max_acceleration = [a_max]
     inp.max_jerk = [j_max]
@@ -219,6 +254,7 @@ def solve_axes(p0, v0, a0, p1, v_max, a_max, j_max, velocity: bool = False) -> P
     """Every axis independently (no synchronisation) to rest at p1, or to v = 0 when `velocity`."""
     n = len(p0)
     otg, inp = _calc(n)
+    _MODE.pop(n, None)  # _one_dof sets its fields again (a one-axis machine shares its input)
     inp.control_interface = ControlInterface.Velocity if velocity else ControlInterface.Position
     inp.synchronization = Synchronization.No
     inp.current_position = list(map(float, p0))
