@@ -81,11 +81,11 @@ class Pass:
     def __init__(self, st: Any, ch: Channel, pl: Planner, rx0: list, saved_drives: list[dict]) -> None:
         self.st, self.ch, self.pl = st, ch, pl
         self.rx0, self.saved_drives = rx0, saved_drives
-        self.parts: list[Samples] = []  # positions filtered up to `filtered` rows, the rest raw
+        self.parts: list[Samples] = []  # (their positions: the raw rows; the filtered ones are out_rows)
+        self.out_rows: list[list[float]] = []  # the filtered rows, `filtered` of them
         self.pending: list[tuple[np.ndarray, np.ndarray | None]] = []  # (raw rows, λ) not filtered yet
         self.raws: list[np.ndarray] = []  # every part's raw rows
         self.filtered = 0
-        self._unfiltered = 0  # the first part not filtered yet
         self.rows = 0
         self.runs: list[CspRun | CsvRun] | None = None  # the drive models over the cycles driven (made at the first part)
         self.driven = 0  # cycles the drives were stepped through
@@ -174,22 +174,14 @@ class Pass:
         self.pending = []
         f = pl.filter
         if f is None:
-            pos = np.array(raw, dtype=float)
-            rows = pos.tolist()
+            rows = np.asarray(raw, dtype=float).tolist()
         elif len(raw) < FEW:  # push_many's numpy costs ≈ 35 µs whatever the rows; push_rows ≈ 1.5 µs a row, the same bits
             rows = f.push_rows(np.asarray(raw, dtype=float).tolist(), None if lam is None else lam.tolist())
-            pos = np.array(rows)
         else:
-            pos = f.push_many(raw, lam)
-            rows = pos.tolist()
-        pl.output = pos[-1].copy()
-        k = self.filtered
-        parts = self.parts
-        for j in range(self._unfiltered, len(parts)):  # the parts taken since the last flush
-            smp = parts[j]
-            smp.positions = pos[k - self.filtered:k - self.filtered + len(smp.lines)]
-            k += len(smp.lines)
-        self.filtered, self._unfiltered = k, len(parts)
+            rows = f.push_many(raw, lam).tolist()
+        pl.output = np.array(rows[-1])
+        self.out_rows += rows  # (an array once, in samples())
+        self.filtered += len(rows)
         sc, org = self.st.r.scales, self.st.r.origin.tolist()
         for i, t in enumerate(self.targets):
             cpu, o = sc[i]._cpu, org[i]
@@ -230,7 +222,7 @@ class Pass:
         del self.raws[nparts:]
         self.pending = []
         self.rows = self.filtered = rows
-        self._unfiltered = nparts
+        del self.out_rows[rows:]
         for t in self.targets:
             del t[rows + 1:]
         while self.rows < stop and self._group(stop - self.rows):
@@ -252,6 +244,6 @@ class Pass:
         moves: list[Any] = []
         for p in parts:
             moves += p.moves if p.moves is not None else [p.move] * len(p.lines)
-        return Samples(np.concatenate([p.positions for p in parts]), [ln for p in parts for ln in p.lines],
+        return Samples(np.array(self.out_rows), [ln for p in parts for ln in p.lines],
                        np.concatenate([p.path_velocity for p in parts]), parts[0].move, moves, np.concatenate(self.raws))
 
