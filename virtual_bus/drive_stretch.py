@@ -87,6 +87,12 @@ class CspRun:
         self.state = (drive.position, drive.velocity, drive.time, drive.command, drive._prev_target,
                       drive.acceleration, drive.torque)
         self.still: int | None = None  # the target of a cycle that left the drive as it found it (_same)
+        n, max_cps, (lo, hi) = self.model[0], self.model[2], self.limits
+        # step()'s constants in one tuple (a CAM pass steps a drive every few cycles: its set-up counts); the sub-step
+        # factors as the loop computed them each time, the speed limits, whether a limit switch is set
+        self.consts = (*self.model, *self.gains, *self.units, *self.load, lo, hi,
+                       _STATUS_BASE[State.OPERATION_ENABLED] | SW_FOLLOWING, range(1, n + 1), -max_cps,
+                       1.2 * max_cps, lo > -math.inf or hi < math.inf)
 
     def step(self, targets: Sequence[int]) -> None:
         """The next cycles, one per target; stops (for good) before a cycle that would fault."""
@@ -96,19 +102,13 @@ class CspRun:
         if still is not None and targets[0] == still and list(targets).count(still) == len(targets):
             self._stand(len(targets))  # a standing axis (Z in an XY contour): no set-up, no loop
             return
-        n, h, max_cps, alpha, rad, reached_v = self.model
-        kp, kff, window, origin = self.gains
-        k_raw, t_pct = self.units
-        inertia, viscous, coulomb, rated = self.load
-        lo, hi = self.limits
-        base = _STATUS_BASE[State.OPERATION_ENABLED] | SW_FOLLOWING
+        (n, h, max_cps, alpha, rad, reached_v, kp, kff, window, origin, k_raw, t_pct, inertia, viscous, coulomb, rated,
+         lo, hi, base, ks, neg, over, limited) = self.consts
         pos, vel, t, command, prev_target, acc, torque = self.state
         dt = self.dt
         out = self.out
         pa, va, ta, fe, sws = (out.position_actual, out.velocity_actual, out.torque_actual, out.following_error,
                                out.statusword)
-        ks, neg, over = range(1, n + 1), -max_cps, 1.2 * max_cps  # (the same values the loop computed each time)
-        limited = lo > -math.inf or hi < math.inf
         rep = 0  # still cycles not written yet: a run of them is written at once (_repeat)
         for tgt in targets:
             if tgt == still:  # the same target again after a cycle that changed nothing: the same cycle, the time on
