@@ -235,6 +235,10 @@ class RealTimeClock:
         if not self._written:
             self.written()
 
+    def slack_ns(self) -> int:
+        """ns since this cycle's outputs were written: the work done so far in its slack (decision B33)."""
+        return self.now_ns() - self._done_ns if self._done_ns is not None else 0
+
     def left_ns(self) -> int:
         """ns until the next cycle's deadline (negative: it is missed); work in the slack asks before it starts."""
         return self._deadline - self.now_ns()

@@ -5,6 +5,7 @@ A mixin of `hil.stretch.Stretcher`, on its state."""
 from __future__ import annotations
 
 import copy
+from operator import is_
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from typing import Any
@@ -30,10 +31,18 @@ PREP_LEFT_NS = 600_000
 FIRST_CHANGE_NS = 40_000
 FIRST_CHANGE_MARGIN_NS = 150_000
 # A start nothing prepared (after a stepped cycle: a block's end, a dropped or cut start) samples and models only
-# this many cycles in its slack (B23): its work there scales with the cycles (≈ 25 µs a cycle on the 2-vCPU VM), and
-# its paced slacks still have room for the next start's parts (4-5); 4 left too few, so nothing was prepared
-COLD_CYCLES = 8
+# this many cycles in its slack (B23): its work there scales with the cycles (≈ 25 µs a cycle on the 2-vCPU VM). 4
+# (was 8) since B33: its 2-3 paced slacks hold the next start's 4-5 parts, several a slack within SLACK_BUDGET_NS
+COLD_CYCLES = 4
+# B33: a paced slack takes one part of the next start, and more while less than this went since the cycle's
+# outputs were written (on the clock the pacer reads; the parts are ≈ 50-250 µs each, a refill's solve more)
+SLACK_BUDGET_NS = 250_000
 _WRITTEN: dict[int, set] = {}
+
+
+def _all_same(d: dict, a: dict) -> bool:
+    """Every field of `a` is the very object in `d` (B22's check, in C loops: ≈ 3x a generator's speed, B33)."""
+    return all(map(is_, map(d.get, a), a.values()))
 
 
 def _fed(ch: Channel, pl: Planner) -> None:
@@ -92,8 +101,12 @@ class RealTimeStretches:
                 out.target_position = col[c]
             clock.written()
             clock.done()
-            if self._prep is not None and c < m - 1 and clock.left_ns() > PREP_LEFT_NS:
-                try:  # a part of the next stretch's start in this slack (B22)
+            # parts of the next stretch's start in this slack (B22): one, more while its budget holds (B33)
+            first = True
+            while self._prep is not None and c < m - 1 and clock.left_ns() > PREP_LEFT_NS \
+                    and (first or clock.slack_ns() < SLACK_BUDGET_NS):
+                first = False
+                try:
                     next(self._prep)
                 except StopIteration:
                     self._prep = None
@@ -322,28 +335,35 @@ class RealTimeStretches:
         if _signature(ch) != spec.sig:
             return False
         d, a = pl.__dict__, spec.saved_pl["pl"]
-        if len(d) != len(a) or any(d.get(k) is not v for k, v in a.items()):
+        if len(d) != len(a) or not _all_same(d, a):
             return False
         q = pl.blocks
-        if len(q) != len(spec.blocks) or any(x is not y for x, y in zip(q, spec.blocks)):
+        if len(q) != len(spec.blocks) or not all(map(is_, q, spec.blocks)):
             return False
         if pl.plan is not None and pl.plan.__dict__ != spec.plan_fields:
             return False
         z = spec.saved_pl.get("zones")
-        if z is not None and (len(z) != len(pl._zones.zones) or any(x is not y for x, y in zip(z, pl._zones.zones))):
+        if z is not None and (len(z) != len(pl._zones.zones) or not all(map(is_, z, pl._zones.zones))):
             return False
         f = pl.filter
         if f is not None:
             fd, fs = f.__dict__, spec.saved_pl["f"]
-            if len(fd) != len(fs) or any(
-                    (len(v) != len(fs[k]) or any(x is not y for x, y in zip(v, fs[k])))
-                    if k in ("_w1", "_w2") else v is not fs[k] for k, v in fd.items()):
+            if len(fd) != len(fs):
                 return False
+            for k, v in fd.items():
+                w = fs[k]
+                if k in ("_w1", "_w2"):  # the windows: the same rows
+                    if len(v) != len(w) or not all(map(is_, v, w)):
+                        return False
+                elif v is not w:
+                    return False
         for drv, s0 in zip(self.drives, spec.saved_drives):
             dd = drv.__dict__
-            if len(dd) != len(s0) or any(k != "_rx" and dd.get(k) is not v for k, v in s0.items()):
+            if len(dd) != len(s0):
                 return False
-            s0["_rx"] = dd["_rx"]  # what a cut restores, as run() saves it
+            s0["_rx"] = dd["_rx"]  # (not compared) what a cut restores, as run() saves it
+            if not _all_same(dd, s0):
+                return False
         return all(a == b for a, b in zip(r.rx, spec.rx0))
 
     def _cut_ahead(self, pl: Planner, saved_pl: dict, saved_drives: list[dict], rx0: list[RxPdo],

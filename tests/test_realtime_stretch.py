@@ -110,17 +110,7 @@ def _same(a: tuple, b: tuple) -> None:
 @pytest.mark.parametrize("kw", [{}, {"events": ["t=2:feed-hold", "t=2.6:cycle-start", "t=4:set D21002=50"]}],
                          ids=["plain", "hold-resume-override"])
 def test_a_realtime_run_with_stretches_equals_stepping(monkeypatch, tmp_path, kw):
-    taken: list[bool] = []  # B22: stretch starts worked out in the slacks of the stretch before, and taken
-    spec_start = Stretcher._spec_start
-
-    def spy(self, *args):
-        had = self._taken is not None
-        started = spec_start(self, *args)
-        if had:
-            taken.append(started is not None)
-        return started
-
-    monkeypatch.setattr(Stretcher, "_spec_start", spy)
+    taken = _taken_starts(monkeypatch)  # B22: stretch starts worked out in the slacks of the stretch before, taken
     lengths = _stretch_lengths(monkeypatch)
     a = _run(monkeypatch, tmp_path, "0", **kw)
     b = _run(monkeypatch, tmp_path, "1", **kw)
@@ -153,6 +143,43 @@ def test_starts_worked_out_ahead_and_dropped_leave_the_run_as_stepping(monkeypat
     assert b[1].run.stretched > 0.8 * b[1].run.cycles
     # B23: a start nothing prepared works out only COLD_CYCLES cycles in its slack (here: every start)
     assert max(lengths) == COLD_CYCLES and sum(lengths) == b[1].run.stretched
+
+
+def test_the_slack_budget_bounds_the_parts_of_the_next_start_a_slack_takes(monkeypatch, tmp_path):
+    """B33: a paced slack takes one part of the next start, and more while SLACK_BUDGET_NS has not gone since its
+    outputs were written. On the fake clock (1 µs a read) a budget of 0 leaves one part a slack (B22), so a cold
+    start's COLD_CYCLES (4) stretch has too few slacks for the 4-5 parts and most of them are not prepared; the
+    default budget prepares them. Both runs equal stepping in every column."""
+    import hil.stretch_realtime
+
+    a = _run(monkeypatch, tmp_path, "0")
+    runs = {}
+    for budget in (0, hil.stretch_realtime.SLACK_BUDGET_NS):
+        monkeypatch.setattr(hil.stretch_realtime, "SLACK_BUDGET_NS", budget)
+        taken = _taken_starts(monkeypatch)
+        lengths = _stretch_lengths(monkeypatch)
+        b = _run(monkeypatch, tmp_path, "1")
+        _same(a, b)
+        runs[budget] = (sum(taken), lengths.count(COLD_CYCLES), len(lengths))
+    (one_part, cold_one, n_one), (budgeted, cold, n) = runs.values()
+    assert COLD_CYCLES == 4 and budgeted > 0.9 * n  # nearly every start prepared in the slacks before it
+    assert cold_one > 2 * cold and one_part < budgeted  # one part a slack: after a cold start the next is cold too
+
+
+def _taken_starts(monkeypatch) -> list[bool]:
+    """Each start that found one worked out ahead (B22): True where it took it (filled as the runs go)."""
+    taken: list[bool] = []
+    spec_start = Stretcher._spec_start
+
+    def spy(self, *args):
+        had = self._taken is not None
+        started = spec_start(self, *args)
+        if had:
+            taken.append(started is not None)
+        return started
+
+    monkeypatch.setattr(Stretcher, "_spec_start", spy)
+    return taken
 
 
 def _stretch_lengths(monkeypatch) -> list[int]:
