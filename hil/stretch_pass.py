@@ -37,10 +37,12 @@ PLAN_KINDS = ("path", "ramp", "cruise")
 FEW = 12  # rows below which the filter takes them one by one (Pass._flush)
 
 
-def _save(pl: Planner) -> dict:
-    """Everything a planner step but a push changes (module doc)."""
-    saved = _save_planner(pl)
-    saved["blocks"] = list(pl.blocks)
+def _save(pl: Planner, filt: bool = True) -> dict:
+    """Everything a planner step but a push changes (module doc); `filt` False: not the position filter's state,
+    which a step here leaves as it is (the pass filters its rows itself, `Pass._flush`)."""
+    saved = _save_planner(pl, filt)
+    if "blocks" not in saved:
+        saved["blocks"] = list(pl.blocks)
     if pl.plan is not None:
         saved["plan"] = (pl.plan, dict(pl.plan.__dict__))
     return saved
@@ -142,7 +144,8 @@ class Pass:
         # nothing before take_rows accepts it
         mark = self._mark
         steps = pl._buf_done or pl._buf_blk is not None
-        saved = _save(pl) if mark[1] is None or steps else None
+        # (the mark's save puts the filter back too: a drive fault takes back the rows filtered since)
+        saved = _save(pl, mark[1] is None) if mark[1] is None or steps else None
         if mark[1] is None:
             mark[1] = saved
         if not steps:

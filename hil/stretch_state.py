@@ -84,16 +84,17 @@ def _sample_across(pl: Planner, n: int) -> Samples | None:
     return sample_stretch(pl, n, across=True)
 
 
-def _save_planner(pl: Planner) -> dict:
+def _save_planner(pl: Planner, filt: bool = True) -> dict:
     """What sample_stretch changes: the planner's own fields, its position filter's state and share zones (and
-    its queue, of which a stretch across a cruise's blocks finishes some)."""
+    its queue, of which a stretch across a cruise's blocks finishes some). `filt` False: not the filter's state
+    (a step that does not filter: hil/stretch_pass.py)."""
     saved: dict[str, Any] = {"pl": dict(pl.__dict__)}
     if pl._buf_blk is not None:
         saved["blocks"] = list(pl.blocks)
     if pl._zones is not None:  # the filter's share zones: sampling drops those it passed (ShareZones.lam)
         saved["zones"] = list(pl._zones.zones)
     f = pl.filter
-    if f is not None:
+    if f is not None and filt:
         fs = dict(f.__dict__)
         fs["_w1"], fs["_w2"] = deque(f._w1, maxlen=f._w1.maxlen), deque(f._w2, maxlen=f._w2.maxlen)
         saved["f"] = fs
