@@ -489,6 +489,39 @@ class FilterCorners:
                 v = 0.5 * (best + v)
         return best, max(bud, best)
 
+    def _reach_back(self, h0: int, last: int, s_j: float, vt: float, half: float) -> tuple[int, float]:
+        """`_tolerance`'s reach behind J: the junction walk
+            lo = last
+            while lo > h0:
+                b = hist[lo - 1]; vt = max(vt, b.vtop)
+                if s_j - b.s_end > 3.0 * vt * half: break
+                lo -= 1
+        in stretches (issue 17: it walked ~100 junctions a call): the junctions that pass at the vt reached so far
+        (a suffix: s_end only grows) are found by bisection on `_hist_s` and their vtops taken at once from `_vt`
+        (the fields side by side), so (lo, vt) come out as the walk's."""
+        hs, vts = self._hist_s, self._vt
+        lo = last
+        while lo > h0:
+            x = 3.0 * vt * half
+            k = bisect.bisect_left(hs, s_j - x, h0, lo)  # about where the test turns; made exact below
+            while k < lo and s_j - hs[k] > x:
+                k += 1
+            while k > h0 and not s_j - hs[k - 1] > x:
+                k -= 1
+            if k < lo:  # hist[k:lo] pass at vt, so with their own vtops too (the walk's vt only grows)
+                top = max(vts[k:lo])
+                if top > vt:
+                    vt = top
+                lo = k
+                continue
+            top = vts[lo - 1]  # the walk's next junction fails at vt: it is tested with its own vtop
+            if top > vt:
+                vt = top
+            if s_j - hs[lo - 1] > 3.0 * vt * half:
+                break
+            lo -= 1
+        return lo, vt
+
     def _tolerance(self, blocks: Sequence["Block"], v_hi: float) -> int:
         """Evaluate the deviation model (nc.motion.deviation) at the junctions within half a
         window (at the fastest speed nearby) behind the newest one J, with every junction known
@@ -512,14 +545,7 @@ class FilterCorners:
             # the braking term inline (`braking` without a jerk)
             if vt * self.kd.g0 * sum_n + sum_n * self.amax * self.t2sum / 192.0 <= self.tol:
                 return 0
-        lo = last
-        while lo > h0:
-            b = hist[lo - 1]
-            if b.vtop > vt:
-                vt = b.vtop
-            if s_j - b.s_end > 3.0 * vt * half:
-                break
-            lo -= 1
+        lo, vt = self._reach_back(h0, last, s_j, vt, half)
         h = vt * half
         if lo < self._sc_dirty:
             self._sc_dirty = lo  # vtol and vjunc change over hist[lo:] below

@@ -34,6 +34,13 @@ class Segment:
     _cos: tuple[float, ...] | None = None  # |_dir|: the direction cosines, for the block limits
 
     @classmethod
+    def line_of(cls, axes: tuple[str, ...], ls: list[float], le: list[float], length: float,
+                d: list[float]) -> "Segment":
+        """A line from its start, end, length (math.dist) and unit direction worked out already (the run
+        feed's `RunFeed.geom`, issue 17): the segment `of` makes from the same move, bit for bit."""
+        return cls(axes, np.array(ls), np.array(le), length, "line", _dir=tuple(d), _cos=tuple([abs(x) for x in d]))
+
+    @classmethod
     def of(cls, move: Move, axes: tuple[str, ...]) -> "Segment":
         start, end = move.start, move.end
         ls = [float(start.get(a, 0.0)) for a in axes]

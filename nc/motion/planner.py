@@ -160,9 +160,9 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
         else:
             self._push(move)
 
-    def _push(self, move: Move, span: Segment | None = None) -> None:
+    def _push(self, move: Move, span: Segment | None = None, line: Segment | None = None) -> None:
         self._pushes += 1
-        b = self._block(move) if span is None else self._span_block(move, span)
+        b = self._block(move, line) if span is None else self._span_block(move, span)
         if b is None:
             return
         blend = self.lim.blend
@@ -350,10 +350,12 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
         return Setpoint(self.position.copy(), self.line, float(self._buf_vel[i]), blk)
 
     # ---- planning -------------------------------------------------------------------------
-    def _block(self, move: Move) -> Block | None:
+    def _block(self, move: Move, seg: Segment | None = None) -> Block | None:
+        """The move's block; `seg`: its line segment when the run feed built it already."""
         if move.kind == "dwell":
             return Block(move, "dwell", None, 0.0, 0.0, 1.0, 1.0, None)
-        seg = Segment.of(move, self.axes)
+        if seg is None:
+            seg = Segment.of(move, self.axes)
         if seg.length < 1e-9:
             return None
         if move.kind == "rapid" and self.cfg.rapid_independent:

@@ -9,6 +9,7 @@ from dataclasses import replace
 import numpy as np
 
 from nc.motion.lookahead import Block
+from nc.motion.path import Segment
 from nc.motion.spline_feed import NOTHING, Held, RunFeed
 from nc.motion.spline_runs import SplineSpan, span_limits
 from nc.moves import Move
@@ -51,7 +52,9 @@ class FittedRuns:
         if len(out) == 1 and out[0][1] is None:  # the common case on programs not fitted: one move, as it is
             b = self.blocks[-1] if self.blocks else None
             if b is None or b.seg is None or b.seg.kind != "spline":
-                self._push(out[0][0])
+                m = out[0][0]
+                g = self._runs.geom  # its geometry, when the run feed just worked it out (issue 17)
+                self._push(m, line=Segment.line_of(self.axes, *g[1:]) if g is not None and g[0] is m else None)
                 return
         self._let_through(out)
 

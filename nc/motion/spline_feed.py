@@ -74,6 +74,9 @@ class RunFeed:
         self.acc = cfg.share_tangential * float(lim.acc.min())
         self.corner_j = cfg.share_corner * float(min(lim._corner_j))
         self._pay: dict[float, float] = {}
+        # The last eligible move's geometry (move, start, end, length, unit direction): the planner's line
+        # Segment of that move is built from it (the same floats as Segment.of's own, issue 17)
+        self.geom: tuple[Move, list[float], list[float], float, list[float]] | None = None
 
     @staticmethod
     def enabled(cfg: MotionConfig) -> bool:
@@ -81,17 +84,19 @@ class RunFeed:
 
     # ---- the rules (plain floats: they run on every push, issue 17) ---------------------------------
     def line(self, mv: Move) -> tuple[list[float], list[float], list[float]] | None:
-        """(start point, end point, unit direction) of an eligible move, else None."""
+        """(start point, end point, unit direction) of an eligible move, else None (kept in `geom`)."""
         if mv.kind != "line" or mv.per_rev or mv.exact_stop or mv.css is not None or not mv.feed \
                 or "G31" in mv.tags:
             return None
         ax, ms, me = self.axes, mv.start, mv.end
-        a = [ms.get(x, 0.0) for x in ax]
-        b = [me.get(x, 0.0) for x in ax]
+        a = [float(ms.get(x, 0.0)) for x in ax]  # float(): as Segment.of reads them
+        b = [float(me.get(x, 0.0)) for x in ax]
         n = math.dist(a, b)
         if not 1e-6 < n <= MAX_LEN:
             return None
-        return a, b, [(q - p) / n for p, q in zip(a, b)]
+        u = [(q - p) / n for p, q in zip(a, b)]
+        self.geom = (mv, a, b, n, u)
+        return a, b, u
 
     def _vec(self, p: dict[str, float]) -> np.ndarray:
         return np.array([float(p.get(a, 0.0)) for a in self.axes])
