@@ -136,6 +136,34 @@ class FilterCorners:
                 v = min(v, ba / d, bj / d)
         return v
 
+    def corner_caps(self, du: Sequence[float], du_n: float, lines: bool, acc: float) -> tuple[float, float]:
+        """(corner_budget(du, lines), corner_tolerance(du_n, acc)): one call a pushed junction, 3 axes spelt out
+        (issue 17; min(a, b) / d is min(a / d, b / d) exactly, so `_bmin` serves for the two budgets)."""
+        if len(du) != 3:
+            return self.corner_budget(du, lines), self.corner_tolerance(du_n, acc)
+        bm = self._bmin[0 if lines else 1]
+        v = math.inf
+        d = du[0]
+        if d > 1e-12:
+            x = bm[0] / d
+            if x < v:
+                v = x
+        d = du[1]
+        if d > 1e-12:
+            x = bm[1] / d
+            if x < v:
+                v = x
+        d = du[2]
+        if d > 1e-12:
+            x = bm[2] / d
+            if x < v:
+                v = x
+        tol = self.tol
+        if tol is None or du_n <= 1e-12:
+            return v, math.inf
+        room = tol - du_n * acc * self.t2sum / 192.0  # `braking` without a jerk
+        return v, 0.0 if room <= 0.0 else room / (du_n * self.kd.g0)
+
     def corner_tolerance(self, du_n: float, acc: float) -> float:
         """The path tolerance's cap of one isolated tangent jump of norm du_n: the deviation model
         is `_tolerance`'s, except that a corner whose braking alone cuts the tolerance is an
@@ -255,12 +283,25 @@ class FilterCorners:
         maxima = self._maxima
         acc_q, top_q, len_q = maxima
         seq, seq_m = self._seq0 + last, self._seq0 + m
-        for q, x in ((acc_q, j_new.a), (top_q, j_new.vtop), (len_q, j_new.length)):
-            while q and q[-1][1] <= x:  # _push_max and _drop_before inline (once per pushed block)
-                q.pop()
-            q.append((seq, x))
-            while q[0][0] < seq_m:
-                q.popleft()
+        # _push_max and _drop_before inline, queue by queue (once per pushed block)
+        x = j_new.a
+        while acc_q and acc_q[-1][1] <= x:
+            acc_q.pop()
+        acc_q.append((seq, x))
+        while acc_q[0][0] < seq_m:
+            acc_q.popleft()
+        x = j_new.vtop
+        while top_q and top_q[-1][1] <= x:
+            top_q.pop()
+        top_q.append((seq, x))
+        while top_q[0][0] < seq_m:
+            top_q.popleft()
+        x = j_new.length
+        while len_q and len_q[-1][1] <= x:
+            len_q.pop()
+        len_q.append((seq, x))
+        while len_q[0][0] < seq_m:
+            len_q.popleft()
         tail = blocks[-1]
         t_w = self.t_j
         # J is crossed no faster than either block beside it can run.

@@ -239,12 +239,11 @@ class Limits:
         if self.blend is not None and not raw:
             b1.dv = dv
             b1.du = du
-            b1.du_n = math.sqrt(sum([d * d for d in du]))
-            if b1.du_n > 1e-9:
+            b1.du_n = du_n = math.sqrt(sum([d * d for d in du]))
+            if du_n > 1e-9:
                 lines = s1.kind == "line" and s2.kind == "line"
-                b1.vbud = self.blend.corner_budget(du, lines)
-                b1.vctol = self.blend.corner_tolerance(b1.du_n, max(b1.a, b2.a))
-                v = min(v, b1.vbud, b1.vctol)
+                b1.vbud, b1.vctol = vb, vc = self.blend.corner_caps(du, du_n, lines, max(b1.a, b2.a))
+                v = min(v, vb, vc)
         elif max(du) > 1e-9:
             vj = va = math.inf
             for d, cj, ca in zip(du, self._corner_j, self._corner_a):
