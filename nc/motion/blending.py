@@ -599,11 +599,13 @@ class FilterCorners:
         ev_l = ev.tolist()
         nseg = len(seg)
         tol = self.tol
-        room = np.empty(len(ev_l))
-        for r, i in enumerate(ev_l):
+        t2sum = self.t2sum
+        room_l = []
+        for i in ev_l:
             b = seg[i]
             nx = seg[i + 1] if i + 1 < nseg else blocks[-1]
-            room[r] = tol - self.braking(b.du_n, b.a if b.a > nx.a else nx.a)
+            room_l.append(tol - b.du_n * (b.a if b.a > nx.a else nx.a) * t2sum / 192.0)  # `braking` inline
+        room = np.array(room_l, dtype=float)
         near = s >= s_j - 2.0 * h - 1e-12
         caps = self.kd.caps(s[ev], room, vt, s[near], du[near], vb[near])
         lim = vt * (1.0 - 1e-9)
@@ -618,14 +620,15 @@ class FilterCorners:
         held = np.abs(s[upd][:, None] - s[None, :]) <= reach[None, :]
         vtol = np.where(held, ctol[None, :], math.inf).min(axis=1)
         depth = 0
-        n = len(blocks)
+        i0 = nseg + 1 - len(blocks)  # seg[i] is blocks[i - nseg - 1]: queued from i0 on
         for i, vt_i in zip(upd.tolist(), vtol.tolist()):
             b = seg[i]
             b.vtol = vt_i
-            k = nseg - i + 1  # seg[-1] is blocks[-2]
-            v = b.vbase if b.vbase < vt_i else vt_i
-            if k <= n and abs(v - b.vjunc) > 1e-9 * max(v, 1.0):
-                b.vjunc = v
-                if k > depth:
-                    depth = k
+            if i >= i0:
+                v = b.vbase if b.vbase < vt_i else vt_i
+                if abs(v - b.vjunc) > 1e-9 * (1.0 if 1.0 > v else v):  # max(v, 1.0) spelt out
+                    b.vjunc = v
+                    k = nseg - i + 1  # seg[-1] is blocks[-2]
+                    if k > depth:
+                        depth = k
         return depth

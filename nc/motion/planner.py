@@ -162,14 +162,19 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
 
     def _push(self, move: Move, span: Segment | None = None, line: Segment | None = None) -> None:
         self._pushes += 1
-        b = self._block(move, line) if span is None else self._span_block(move, span)
+        if span is not None:
+            b = self._span_block(move, span)
+        else:  # one argument when there is no line: benchmarks/bench_spline_bound.py patches _block(self, move)
+            b = self._block(move) if line is None else self._block(move, line)
         if b is None:
             return
         blend = self.lim.blend
         if blend is not None:
             b.vtop = b.cap_hard
             if b.kind == "path" and not b.rapid and not b.move.per_rev:
-                b.vtop = min(b.cap_hard, 1.5 * (self.dry_run_feed if self.dry_run else (b.feed or 0.0)))
+                x = 1.5 * (self.dry_run_feed if self.dry_run else (b.feed or 0.0))
+                if x < b.cap_hard:  # min(cap_hard, x), spelt out (once per push)
+                    b.vtop = x
         self._update_cap(b)
         added = 1
         if self.blocks:
@@ -184,9 +189,13 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
         self.threads_queued += b.kind == "thread"
         self._pushed += added
         # Blocks pushed since the last pass never had one: the pass must reach past all of them.
-        need = max(self._need + added, self._pushed)
+        need = self._need + added  # max() spelt out here and below
+        if self._pushed > need:
+            need = self._pushed
         if blend is not None:
-            need = max(need, blend.window(self.blocks))
+            w = blend.window(self.blocks)
+            if w > need:
+                need = w
         self._need = need
 
     def lookahead(self) -> None:

@@ -22,17 +22,18 @@ class CornerShares:
             zones.stop(prev.s_end)
             return 0
         blk = None
-        if zones is not None and zones.inside(prev.s_end, max(prev.vtop, b.vtop)):
+        top = b.vtop if b.vtop > prev.vtop else prev.vtop  # max(prev.vtop, b.vtop)
+        if zones is not None and zones.inside(prev.s_end, top):
             # λ stays below 1 here: not blended, the junction is taken as without the filter, and
             # that is what a blend must beat
             prev.vjunc = min(prev.vjunc, self.lim.junction(prev, b, raw=True))
         if (self.lim.blend is None or zones is not None) and self._may_blend(prev):
-            if zones is None or zones.blend_allowed(prev.s_end - prev.length, max(prev.vtop, b.vtop), self._now(),
+            if zones is None or zones.blend_allowed(prev.s_end - prev.length, top, self._now(),
                                                     abs(self.v) < 1e-12 and self.plan is None):
                 blk = blend_block(self.lim, prev, b, tol)
         if blk is None:
             if zones is not None and (prev.du_n > 1e-9 or "arc" in (prev.seg.kind, b.seg.kind)):
-                if zones.hard(prev.s_end, max(prev.vtop, b.vtop)):
+                if zones.hard(prev.s_end, top):
                     prev.vjunc = min(prev.vjunc, self.lim.junction(prev, b, raw=True))
             return 0
         # Both lines gave path to it: the running lengths follow.

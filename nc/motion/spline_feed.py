@@ -89,12 +89,18 @@ class RunFeed:
                 or "G31" in mv.tags:
             return None
         ax, ms, me = self.axes, mv.start, mv.end
-        a = [float(ms.get(x, 0.0)) for x in ax]  # float(): as Segment.of reads them
-        b = [float(me.get(x, 0.0)) for x in ax]
+        if len(ax) == 3:  # spelt out (once per push)
+            x, y, z = ax
+            a = [float(ms.get(x, 0.0)), float(ms.get(y, 0.0)), float(ms.get(z, 0.0))]  # float(): as Segment.of
+            b = [float(me.get(x, 0.0)), float(me.get(y, 0.0)), float(me.get(z, 0.0))]
+        else:
+            a = [float(ms.get(x, 0.0)) for x in ax]
+            b = [float(me.get(x, 0.0)) for x in ax]
         n = math.dist(a, b)
         if not 1e-6 < n <= MAX_LEN:
             return None
-        u = [(q - p) / n for p, q in zip(a, b)]
+        u = [(b[0] - a[0]) / n, (b[1] - a[1]) / n, (b[2] - a[2]) / n] if len(ax) == 3 else \
+            [(q - p) / n for p, q in zip(a, b)]
         self.geom = (mv, a, b, n, u)
         return a, b, u
 
@@ -143,6 +149,8 @@ class RunFeed:
             return st, []
         if du > self._pay_step(mv.feed or 0.0):
             return Held(st.moves + (mv,), (), True, end=end, u=u), []
+        if not st.moves:  # the common case on programs not fitted
+            return Held((), (), False, end, u), [(mv, None)]
         return Held(end=end, u=u), [(m, None) for m in st.moves] + [(mv, None)]
 
     def release(self, st: Held) -> tuple[Held, list[tuple[Move, SplineSpan | None]]]:
