@@ -115,6 +115,9 @@ class FilterCorners:
         # The last window's budget share, for the next one: (J's block, sequence number of the
         # stretch's first junction, c_bud). Every queued junction of that stretch has vbud <= c_bud.
         self._bud: tuple["Block", int, float] | None = None
+        # Sequence number from which the queued junctions' vbud rise (older <= newer) up to J (issue 17): a walk that
+        # lowers them to a cap, newest first, stops at the first one already at or below it.
+        self._mono = 0
         # Sliding maxima over _hist[_m:] as (sequence number, value) of the blocks' tangential
         # acceleration, vtop and length.
         self._maxima: tuple[deque[tuple[int, float]], ...] = (deque(), deque(), deque())
@@ -388,12 +391,15 @@ class FilterCorners:
             it run at no more than their common cap c: it covers no more path than J's speed
             plus what the acceleration adds going back, nor than the highest speed anywhere in
             the stretch (a block between junctions ≤ c reaches √(c² + 2·A·L)) allows in T."""
-            c = cap(k + 1)
+            c = capped[k + 1] = cap(k + 1)
             d = s_j - hist_s[k]
             if (c if c < top else top) * t_w + pad < d:
                 return False
             return (c * c + two_al) * t_w2 >= d * d and v_hi * t_w >= d
 
+        # cap(k) of the searches below, by k (valid while v_hi stays): the search mostly ends one junction past
+        # where it began, whose cap the first `taken` found (issue 17: one `cap` a push fewer)
+        capped: dict[int, float] = {}
         m0 = m
         if taken(m):
             while m > h0 and taken(m - 1):
@@ -409,6 +415,7 @@ class FilterCorners:
                 pad = 0.5 * acc_q[0][1] * t_w2
                 two_al = 2.0 * acc_q[0][1] * len_q[0][1]
                 v_hi = top_q[0][1]
+                capped.clear()  # cap() reads v_hi
                 while m > h0 and taken(m - 1):
                     m -= 1
         else:
@@ -418,7 +425,10 @@ class FilterCorners:
             for q in maxima:
                 _drop_before(q, self._seq0 + m)
         self._m = m
-        c = c_bud = cap(m)  # c_bud: the budgets' cap not held to top (nc.motion.shares)
+        c = capped.get(m)
+        if c is None:
+            c = cap(m)
+        c_bud = c  # the budgets' cap not held to top (nc.motion.shares)
         if c < top:
             # The sums over the whole stretch bound the filter's acceleration and jerk from
             # above; the windows themselves (at the speed they are crossed) are far less on a
@@ -441,15 +451,31 @@ class FilterCorners:
         if fast:
             # Only the budgets' share falls: the queued junctions hist[m..last] (blocks[-2] back),
             # without the bookkeeping the caps' backward-pass depth needs below (issue 17).
-            if bud is not None and seq_m >= bud[1] and c_bud >= bud[2] and len(blocks) > 2 and blocks[-3] is bud[0]:
-                # The last window's stretch holds all of this one's junctions but J, at vbud <= its share
-                # <= this one's: only J's can fall (issue 17, no walk over the stretch per push).
-                if j_new.vbud > c_bud:
-                    j_new.vbud = c_bud
-                return depth
-            for b in islice(reversed(blocks), 1, last - m + 2):
-                if b.vbud > c_bud:
-                    b.vbud = c_bud
+            seq0 = self._seq0
+            lo_q = last + 2 - len(blocks)  # hist[lo_q] is blocks[0]'s junction: the oldest still queued
+            if j_new.vbud > c_bud:
+                j_new.vbud = c_bud
+            if not (bud is not None and seq_m >= bud[1] and c_bud >= bud[2] and len(blocks) > 2
+                    and blocks[-3] is bud[0]):
+                # (Else the last window's stretch holds all of this one's junctions but J, at vbud <= its share
+                # <= this one's: only J's can fall, issue 17.) The walk goes from the newest back and stops at
+                # the first junction at or below c_bud within the rising run (`_mono`): the older ones there
+                # are no higher. Below the run it walks on as before.
+                stop = m if m > lo_q else lo_q
+                mono = self._mono - seq0
+                lim = mono if mono > stop else stop
+                for b in islice(reversed(blocks), 2, last - lim + 2):  # hist[last - 1] down to hist[lim]
+                    if b.vbud > c_bud:
+                        b.vbud = c_bud
+                    else:
+                        break
+                for b in hist[stop:lim]:
+                    if b.vbud > c_bud:
+                        b.vbud = c_bud
+                if mono < m:
+                    self._mono = seq0 + m  # hist[m..] rise still (min with c_bud keeps the order); before m: not known
+            if last - 1 < lo_q or j_new.vbud < hist[last - 1].vbud:
+                self._mono = seq0 + last  # J is below the junction before it: the rising run starts again at J
             return depth
         k = 2
         idx = last
@@ -470,6 +496,7 @@ class FilterCorners:
                         depth = k
             k += 1
             idx -= 1
+        self._mono = self._seq0 + last  # not followed through this walk: from J on
         return depth
 
     def _refine(self, hist: list["Block"], h0: int, last: int, c: float, top: float,
