@@ -42,22 +42,10 @@ if TYPE_CHECKING:
 
 
 
-def _push_max(q: deque[tuple[int, float]], seq: int, value: float) -> None:
-    """Append to a sliding maximum (a deque of decreasing values; the front is the maximum)."""
-    while q and q[-1][1] <= value:
-        q.pop()
-    q.append((seq, value))
-
-
 def _push_front_max(q: deque[tuple[int, float]], seq: int, value: float) -> None:
     """Extend a sliding maximum backwards by an entry older than all it holds."""
     if not q or value > q[0][1]:
         q.appendleft((seq, value))
-
-
-def _drop_before(q: deque[tuple[int, float]], seq: int) -> None:
-    while q[0][0] < seq:
-        q.popleft()
 
 
 class FilterCorners:
@@ -286,7 +274,8 @@ class FilterCorners:
         maxima = self._maxima
         acc_q, top_q, len_q = maxima
         seq, seq_m = self._seq0 + last, self._seq0 + m
-        # _push_max and _drop_before inline, queue by queue (once per pushed block)
+        # the sliding maxima: append (dropping the smaller values before) and drop what fell out front,
+        # queue by queue (once per pushed block)
         x = j_new.a
         while acc_q and acc_q[-1][1] <= x:
             acc_q.pop()
@@ -422,8 +411,13 @@ class FilterCorners:
             m += 1
             while not taken(m):
                 m += 1
-            for q in maxima:
-                _drop_before(q, self._seq0 + m)
+            sm = self._seq0 + m  # what fell out front, queue by queue
+            while acc_q[0][0] < sm:
+                acc_q.popleft()
+            while top_q[0][0] < sm:
+                top_q.popleft()
+            while len_q[0][0] < sm:
+                len_q.popleft()
         self._m = m
         c = capped.get(m)
         if c is None:
