@@ -154,7 +154,7 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
 
     # ---- queue ----------------------------------------------------------------------------
     def push(self, move: Move) -> None:
-        self.closed = False
+        self._closed = False  # the `closed` setter's whole work for False (once per push)
         if self._runs is not None:  # runs of short lines are held back and fitted (nc.motion.spline_feed)
             self._feed_run(move)
         else:
@@ -372,7 +372,7 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
         v, a, j = self.lim.block_limits(seg)
         feed = None if move.kind == "rapid" else (move.feed or 0.0) / (1.0 if move.per_rev else 60.0)
         kind = "thread" if move.kind == "thread" else "path"
-        return Block(move, kind, seg, seg.length, v, a, j, feed, rapid=move.kind == "rapid")
+        return Block(move, kind, seg, seg.length, v, a, j, feed, move.kind == "rapid")  # the 9th field: rapid
 
     def _update_cap(self, b: Block, rpm: float | None = None) -> float:
         if b.kind != "path" and b.kind != "thread":

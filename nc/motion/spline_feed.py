@@ -147,7 +147,9 @@ class RunFeed:
             if len(st.moves) >= BATCH + AHEAD:
                 return self._fix(st, BATCH)
             return st, []
-        if du > self._pay_step(mv.feed or 0.0):
+        feed = mv.feed or 0.0
+        thr = self._pay.get(feed)  # _pay_step's cache read here (once per push)
+        if du > (thr if thr is not None else self._pay_step(feed)):
             return Held(st.moves + (mv,), (), True, end=end, u=u), []
         if not st.moves:  # the common case on programs not fitted
             return Held((), (), False, end, u), [(mv, None)]
