@@ -5,7 +5,10 @@ from __future__ import annotations
 from typing import Any
 
 from fieldbus.cia402 import State
+from hil.cycle_lean import factors
 from mlc.nc_link import DriveStatus
+
+_FAULT, _REACTION = State.FAULT, State.FAULT_REACTION_ACTIVE
 
 
 def drive_status(runner: Any, status: Any) -> list[DriveStatus]:
@@ -18,17 +21,21 @@ def drive_status(runner: Any, status: Any) -> list[DriveStatus]:
         out = [DriveStatus(runner._name(i), spindle=i >= n_axes) for i in range(len(runner.masters))]
         runner._drive_status = out
     enabled = State.OPERATION_ENABLED
-    for i, (m, tx, sc, d) in enumerate(zip(runner.masters, runner.tx, runner.scales, out)):
-        raw = tx.velocity_actual
+    facs = getattr(runner, "_factors", None) or factors(runner.scales)  # unit factors read once (hil/cycle_lean.py)
+    origin = runner.origin.tolist()
+    for i, (m, tx, f, d) in enumerate(zip(runner.masters, runner.tx, facs, out)):
+        # AxisScaling's conversions spelt out, the same divisions in the same order (bit for bit)
+        cpu = f.cpu
         d.connected = status is None or status.slave_ok(i)  # the slave in OP (issue 6)
-        d.servo_on = m.state is enabled
-        d.fault = m.faulted
-        d.torque = sc.torque_percent(tx.torque_actual) * 10.0  # D30240: 0.1 %
-        d.velocity = sc.drive_to_velocity(raw)
-        d.rpm = d.velocity / sc.lead * 60.0  # AxisScaling.drive_to_rpm, velocity not converted twice
-        d.position = sc.to_units(tx.position_actual)
+        st = m.state
+        d.servo_on = st is enabled
+        d.fault = st is _FAULT or st is _REACTION
+        d.torque = tx.torque_actual * f.torque * 10.0  # D30240: 0.1 %
+        d.velocity = v = tx.velocity_actual / f.raw_per_cps / cpu
+        d.rpm = v / f.lead * 60.0  # AxisScaling.drive_to_rpm, velocity not converted twice
+        d.position = p = tx.position_actual / cpu
         if i < n_axes:  # the limit switch (0x60FD bits 0/1 when bit 11 is set) and the NC's machine position
             d.limit = ((tx.digital_inputs & 0x3) or 0x3) if tx.statusword & 0x0800 else 0
-            d.machine_position = d.position + float(runner.origin[i])
+            d.machine_position = p + origin[i]
         d.mode = getattr(tx, "mode_display", 8)
     return out

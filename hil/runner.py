@@ -18,11 +18,12 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from fieldbus.cia402 import SW_INTERNAL_LIMIT, Cia402Master, State, Target
+from fieldbus.cia402 import Cia402Master, State, Target
 from fieldbus.link import BusError, BusLink, SimLink
 from fieldbus.pdo import RxPdo, TxPdo
 from hil.bench import Bench
 from hil.clock import CycleTiming, LockStepClock, RealTimeClock
+from hil.cycle_lean import OVERSPEED, factors, feedback, row, setpoints
 from hil import retentive
 from hil.drive_homing import home_axes
 from hil.mlc_bridge import drive_status
@@ -30,7 +31,7 @@ from hil.stretch import Stretcher, ahead_wanted, wanted as stretch_wanted
 from hil.trace import TraceSource, TraceWriter, trace_columns
 from mlc.basic import BasicMlc
 from nc.alarm_table import MAX_TIME
-from nc.alarms import SERVO_ALARM, Alarm, NcAlarm, internal_error
+from nc.alarms import Alarm, NcAlarm, internal_error
 from nc.budget import StatementBudget
 from nc.channel import Channel, RunState, skip_hook
 from nc.interp import Interpreter
@@ -50,7 +51,6 @@ STANDSTILL_TIMEOUT = 10.0  # s the stop path waits for the axes to stand before 
 # velocity feedback reads 0. Velocity alone cannot say it: Delta drives report 0x606C in 0.1 rpm of
 # the motor, which reads 0 below 1 rpm (2,133 counts/s at 1,280,000 counts/rev).
 REST_CYCLES = 3
-OVERSPEED = 1.2  # App. A 0x0602: measured axis speed above this multiple of its limit (the virtual drive's own AL007 margin)
 LIMIT_HYSTERESIS = 0.05  # mm (deg): how far off a limit switch an axis must get before a new hit counts
 FROZEN_S = 0.2  # s of unchanged feedback from a moving drive that mean it left the bus
 
@@ -97,6 +97,7 @@ class BenchRunner:
         self._rest = [0] * len(self.rx)  # cycles each drive's feedback has stood still (see REST_CYCLES)
         self._last_position: list[int | None] = [None] * len(self.rx)
         self.scales = [a.scaling for a in bench.axes] + [s.scaling for s in bench.spindles]
+        self._factors = factors(self.scales)  # the cycle's unit factors, read once (hil/cycle_lean.py)
         # App. A 0x0602 overspeed protection: an axis's measured speed beyond OVERSPEED × its limit, in the
         # drive's own 0x606C units so the cycle compares integers (decisions cycles.md)
         self._overspeed = [abs(self.scales[i].velocity_to_drive(OVERSPEED * a.limits.max_velocity))
@@ -350,32 +351,7 @@ class BenchRunner:
         self.cycle += 1
         self.time += self.bench.cycle
         n_axes = len(self.axes)
-        rest, last = self._rest, self._last_position
-        for i, (m, tx) in enumerate(zip(self.masters, self.tx)):
-            self.rx[i].controlword = m.step(tx.statusword)
-            p = tx.position_actual
-            rest[i] = rest[i] + 1 if p == last[i] and tx.velocity_actual == 0 else 0
-            last[i] = p
-            if m.faulted and i not in self._alarmed_drives:
-                self._alarmed_drives.add(i)
-                self._alarm(Alarm(SERVO_ALARM, f"servo alarm on {self._name(i)}: drive error code 0x{tx.error_code:04X}",
-                                  line=self.line or None, axis=self._name(i), info=tx.error_code))
-            if i < n_axes and abs(tx.velocity_actual) > self._overspeed[i] and i not in self._alarmed_drives:
-                self._alarmed_drives.add(i)
-                v = self.scales[i].drive_to_velocity(tx.velocity_actual)
-                self._alarm(Alarm(0x0602, f"overspeed protection: axis {self._name(i)} at {abs(v):.1f}/s, beyond "
-                                          f"{OVERSPEED:g} x its maximum velocity {self.bench.axes[i].limits.max_velocity:g}/s",
-                                  line=self.line or None, axis=self._name(i)))
-            if tx.statusword & SW_INTERNAL_LIMIT and i < n_axes:
-                if i not in self._at_limit:
-                    self._at_limit[i] = p
-                    if i not in self._alarmed_drives:
-                        self._alarm(Alarm(0x0402, f"hardware limit reached on axis {self._name(i)}",
-                                          line=self.line or None, axis=self._name(i)))
-            elif self._at_limit and i in self._at_limit and abs(p - self._at_limit[i]) > self._limit_hysteresis[i]:
-                del self._at_limit[i]  # left the switch (hil script, App. A 0x0A06): the next hit raises again
-        scales, txs = self.scales, self.tx
-        self.actual[:] = [scales[i].to_units(txs[i].position_actual) + o for i, o in enumerate(self.origin.tolist())]
+        feedback(self, tx, n_axes)  # masters, alarms, actual positions (hil/cycle_lean.py)
         ch = self.channel if not self._planner_failed else None  # a failed NC is not stepped again
         if ch is not None:
             # The link's state is read once per cycle: the drive status and the bus relays share it.
@@ -395,23 +371,7 @@ class BenchRunner:
             elif self._braking and not ch.emergency and not self._planner_failed:
                 self._reenable(ch)  # E-stop released and reset: servo on again where the axes stand
         following = ch is not None and not self._braking
-        cmds, org, max_ferr = self._commands.tolist(), self.origin.tolist(), self.result.max_ferr
-        for i in range(n_axes):
-            m, rx = self.masters[i], self.rx[i]
-            if following and m.enabled:
-                rx.target_position = scales[i].to_counts(cmds[i] - org[i])
-            elif self._braking and self.tx[i].statusword & 0x6F == 0x27:
-                # Until the drive takes its quick stop, the setpoint goes on at the speed it had:
-                # a setpoint that stopped dead would brake harder than the drive's own ramp.
-                rx.target_position += self._coast[i]
-                self._commands[i] = self.scales[i].to_units(rx.target_position) + self.origin[i]
-            else:
-                # Not enabled: follow the actual position so enabling never jumps.
-                rx.target_position = self.tx[i].position_actual
-                self._commands[i] = self.actual[i]
-            ferr = abs(scales[i].to_units(txs[i].following_error))
-            if ferr > max_ferr[self.axes[i]]:
-                max_ferr[self.axes[i]] = ferr
+        setpoints(self, following, n_axes)  # hil/cycle_lean.py
         for k, sc in enumerate(self.scales[n_axes:]):
             if k == 0 and ch is not None:  # G96 speed, override, G50/G92 S clamp (issue 5; decisions A39, 32)
                 rpm = self.spindle_command_rpm()  # the speed is computed once, not also as below
@@ -456,22 +416,7 @@ class BenchRunner:
                                       "period", line=self.line or None))
 
     def _row(self) -> list:
-        # Full-precision floats: the trace feeds checks that differentiate positions three times.
-        row: list = [round(self.time, 9), self.line, self.cycle, self.timing.period, self.timing.late,
-                     self._new_alarms()]
-        n_axes = len(self.axes)
-        for i, (cmd, act) in enumerate(zip(self._commands.tolist(), self.actual.tolist())):
-            tx, sc = self.tx[i], self.scales[i]
-            row += [cmd, act, sc.drive_to_velocity(tx.velocity_actual),
-                    sc.torque_percent(tx.torque_actual), sc.to_units(tx.following_error), tx.statusword]
-        for k, sc in enumerate(self.scales[n_axes:]):
-            tx = self.tx[n_axes + k]
-            row += [sc.drive_to_rpm(self.rx[n_axes + k].target_velocity),
-                    sc.drive_to_rpm(tx.velocity_actual), sc.to_units(tx.position_actual) % 360.0,
-                    sc.torque_percent(tx.torque_actual), tx.statusword]
-        for src in self.trace_sources:
-            row += list(src.values(self))
-        return row
+        return row(self, len(self.axes))  # hil/cycle_lean.py
 
     # ---- endings ---------------------------------------------------------------------------
     def _alarm(self, alarm: Alarm) -> None:

@@ -168,6 +168,8 @@ class Mlc:
     def spindle_drive(self, runner: Any) -> tuple[int, float | None, float | None]:
         """The first spindle drive's (mode, position setpoint deg, speed override rpm) this cycle:
         CSV as a spindle, CSP while positioning (M29/M19) or while it is the channel's C axis."""
+        if self.caxis.idle():  # the usual cycle: a spindle that stays one, its feedback not read
+            return self._caxis_checked(runner, (MODE_CSV, None, None))
         n = len(runner.axes)
         tx = runner.tx[n]
         index = runner.spindle_index_angle() if tx.touch_probe_status & 0x0002 else None
@@ -180,6 +182,10 @@ class Mlc:
                                     line=runner.line or None, axis=runner.bench.spindles[0].name))
             return MODE_CSV, None, None  # the spindle stays a spindle; the alarm stops the channel
         out = self.caxis.drive(runner.spindle_actual_angle(), runner.spindle_actual_rpm(), index, c_cmd)
+        return self._caxis_checked(runner, out)
+
+    def _caxis_checked(self, runner: Any, out: tuple[int, float | None, float | None]) -> tuple[int, float | None, float | None]:
+        """App. A 0x0C01 once when the positioning outlasted its check time; `out` passed on."""
         if self.caxis.failed and not self.caxis_alarmed:
             self.caxis_alarmed = True
             runner._alarm(Alarm(0x0C01, f"spindle positioning failed: not {'in C-axis mode' if self.caxis.purpose == 'C' else 'oriented'} "

@@ -80,6 +80,15 @@ class SpindleAxisSwitch:
         self.mem.set_bit(m3(self.x, 706), state == ORIENTED)
 
     # ---- once per cycle, from the runner -------------------------------------------------------------
+    def idle(self) -> bool:
+        """The usual cycle, counted as `drive` counts it: a spindle that stays a spindle (nothing asked, so
+        `drive` would return (MODE_CSV, None, None) at once, reading none of its feedback). True: this
+        cycle is done; False: call `drive` (issue 17: the runner skips the feedback it would not read)."""
+        if self.state != SPINDLE or self._want_c() or self._want_orient():
+            return False
+        self._cycles += 1  # SPINDLE has no positioning started: drive()'s check-time test is a no-op here
+        return True
+
     def drive(self, angle: float, rpm: float, index: float | None,
               c_command: float | None) -> tuple[int, float | None, float | None]:
         """(mode of operation, position setpoint in cumulative spindle degrees or None,
