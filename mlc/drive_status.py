@@ -14,7 +14,7 @@ from mlc.signals import d2
 from nc.motion.css import spindle_speed
 
 
-@dataclass
+@dataclass(slots=True)  # set field by field every cycle (hil/mlc_bridge.py): slots, no instance dict
 class DriveStatus:
     """What the bus tells the NC about one drive, in user units (filled by the bench each cycle)."""
 
@@ -39,10 +39,8 @@ def write_drive_outputs(self: Any, drives: list[DriveStatus], ch: Any = None) ->
     mem, x = self.mem, self.x
     m = mem.m
     b3 = 30000 + 1000 * x  # M3x000
-    # one pass for the summary relays and the split (no generator per relay: this runs every cycle)
+    # one pass for the summary relays (no generator per relay: this runs every cycle)
     connected, fault, servo = 1, 0, 1
-    axes: list[DriveStatus] = []
-    spindles: list[DriveStatus] = []
     for d in drives:
         if not d.connected:
             connected = 0
@@ -50,13 +48,17 @@ def write_drive_outputs(self: Any, drives: list[DriveStatus], ch: Any = None) ->
             fault = 1
         if not d.servo_on:
             servo = 0
-        (spindles if d.spindle else axes).append(d)
+    # the axes / spindles split, made once for the bench's records (the same list, filled in place each cycle)
+    split = self._drive_split
+    if split is None or split[0] is not drives or split[1] != len(drives):
+        axes = [d for d in drives if not d.spindle]
+        spindles = [d for d in drives if d.spindle]
+        order = axes + spindles if spindles else axes
+        split = self._drive_split = (drives, len(drives), order[:32], spindles[:8])
+    order, spindles = split[2], split[3]
     m[30000] = connected  # M30000
     m[b3 + 34] = fault
     m[b3 + 36] = servo
-    order = axes + spindles if spindles else axes
-    if len(order) > 32:
-        order = order[:32]
     w = mem.words  # D30240… written as words into the memory itself
     for k, d in enumerate(order):
         servo_on = d.servo_on
@@ -80,7 +82,7 @@ def write_drive_outputs(self: Any, drives: list[DriveStatus], ch: Any = None) ->
             w[30400 + k] = 0
     mem.set_f32s(30272, [d.velocity * 60.0 for d in order])  # D30272…: one packed write
     mem.set_f32s(30336, [d.rpm for d in order])
-    for k, d in enumerate(spindles[:8]):
+    for k, d in enumerate(spindles):
         m[b3 + 96 + k] = 1 if d.connected else 0
         w[30432 + k] = int(round(d.torque)) & 0xFFFF
         base = b3 + 704 + 16 * k

@@ -59,6 +59,7 @@ class ChannelLink:
     _alarms_seen: set[int] = field(default_factory=set)
     _var_cache: dict = field(default_factory=dict)
     _var_plan: tuple | None = None  # (exchange, legacy, ((lo, kind, first, count), …)): fixed per exchange
+    _drive_split: tuple | None = None  # (drives list, its length, axes + spindles (32 at most), spindles (8 at most)): mlc/drive_status.py
     _cmd_levels: bytes | None = None  # M2x000…M2x019 of the last cycle whose edges fired nothing
     _spindle_levels: bytes = bytes(8)  # M2x711, M2x727, … as the last scan saw them (== their `_prev`)
     _program_end: int | None = None
