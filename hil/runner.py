@@ -133,6 +133,7 @@ class BenchRunner:
         self.retain: str | None = None  # hil run --retain FILE: the retentive # variables (hil/retentive.py)
         self._retained = None  # the variables loaded from it, saved back when the run ends
         self._overrun_alarmed = False
+        self._hooks: tuple | None = None  # (link, mlc, what they offer the cycle): asked once, see _cycle
         self._bus_ahead = False  # real time on the sim bus: a stepped cycle's exchange runs before its tick
 
     def trace_columns(self) -> list[str]:
@@ -353,12 +354,17 @@ class BenchRunner:
         n_axes = len(self.axes)
         feedback(self, tx, n_axes)  # masters, alarms, actual positions (hil/cycle_lean.py)
         ch = self.channel if not self._planner_failed else None  # a failed NC is not stepped again
+        hooks = self._hooks
+        if hooks is None or hooks[0] is not self.link or hooks[1] is not self.mlc:  # what they offer, asked once
+            hooks = self._hooks = (self.link, self.mlc, callable(getattr(self.link, "status", None)),
+                                   hasattr(self.mlc, "bus_feedback"), hasattr(self.mlc, "bus_status"),
+                                   callable(getattr(self.mlc, "spindle_drive", None)))
         if ch is not None:
             # The link's state is read once per cycle: the drive status and the bus relays share it.
-            status = self.link.status() if callable(getattr(self.link, "status", None)) else None
-            if hasattr(self.mlc, "bus_feedback"):  # drive status for the MLC's special M/D (issue 8)
+            status = self.link.status() if hooks[2] else None
+            if hooks[3]:  # drive status for the MLC's special M/D (issue 8)
                 self.mlc.bus_feedback(drive_status(self, status))
-            if hasattr(self.mlc, "bus_status") and status is not None:
+            if hooks[4] and status is not None:
                 self.mlc.bus_status(status)  # M30000 / EIO relays from the bus state (issue 6)
             self.mlc.scan(ch)
             self._skip_probe(ch)
@@ -372,18 +378,19 @@ class BenchRunner:
                 self._reenable(ch)  # E-stop released and reset: servo on again where the axes stand
         following = ch is not None and not self._braking
         setpoints(self, following, n_axes)  # hil/cycle_lean.py
-        for k, sc in enumerate(self.scales[n_axes:]):
-            if k == 0 and ch is not None:  # G96 speed, override, G50/G92 S clamp (issue 5; decisions A39, 32)
+        winding = self._winding_down
+        for k in range(n_axes, len(self.scales)):
+            sc = self.scales[k]
+            if winding:
+                rpm = 0.0  # the run is over: spindles ramp down before their drives are disabled
+            elif k == n_axes and ch is not None:  # G96 speed, override, G50/G92 S clamp (issue 5; decisions A39, 32)
                 rpm = self.spindle_command_rpm()  # the speed is computed once, not also as below
             else:
                 rpm = self.mlc.spindle.signed_rpm if (ch is not None and ch.state is not RunState.ALARM) else 0.0
-            if self._winding_down:
-                rpm = 0.0  # the run is over: spindles ramp down before their drives are disabled
-            self.rx[n_axes + k].target_velocity = sc.rpm_to_drive(rpm)
-            hook = getattr(self.mlc, "spindle_drive", None)  # spindle ↔ C axis, M19: CSV ↔ CSP (issue 8)
-            if k == 0 and ch is not None and callable(hook) and not self._winding_down:
+            self.rx[k].target_velocity = sc.rpm_to_drive(rpm)
+            if k == n_axes and ch is not None and hooks[5] and not winding:  # spindle ↔ C axis, M19: CSV ↔ CSP (issue 8)
                 rx = self.rx[n_axes]
-                rx.mode, deg, vel = hook(self)
+                rx.mode, deg, vel = self.mlc.spindle_drive(self)
                 if deg is not None:
                     rx.target_position = sc.to_counts(deg)
                 if vel is not None:
