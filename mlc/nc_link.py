@@ -256,8 +256,8 @@ class ChannelLink:
                 self._raise(ch, Alarm(SPINDLE_ALARM, f"MLC activated the alarm of spindle {k + 1}"))
 
     def _user_alarms(self, ch: Channel) -> None:
-        if not self._alarms_seen and self.mem.a.count(0) == len(self.mem.a):
-            return  # none active, none before: the usual case, counted at C speed
+        if not self._alarms_seen and self.mem.no_alarms():
+            return  # none active, none before: the usual case (DeviceMemory.no_alarms)
         active = set(self.mem.active_alarms())
         for n in sorted(active - self._alarms_seen):
             self._raise(ch, Alarm(f"A{n}", f"MLC user-defined alarm A{n}"))
@@ -381,8 +381,7 @@ class ChannelLink:
             m[b3 + 19] = 0
         m[b3 + 31] = 1 if getattr(ch, "interrupt_active", False) else 0  # M3x031: M96 in execution
         m[b3 + 25] = 1 if state is RunState.ALARM or self.alarms and any(not isinstance(a.code, str) for a in self.alarms) else 0
-        a = mem.a
-        m[b3 + 40] = 0 if a.count(0) == len(a) else 1  # any user alarm active (counted at C speed)
+        m[b3 + 40] = 0 if mem.no_alarms() else 1  # any user alarm active
         block_stop = state is RunState.BLOCK_STOP
         m[b3 + 24] = m[b3 + 39] = 1 if block_stop else 0
         if state is RunState.FINISHED and ch.end is not None and self._program_end is None:
