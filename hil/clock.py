@@ -239,6 +239,10 @@ class RealTimeClock:
         """ns since this cycle's outputs were written: the work done so far in its slack (decision B33)."""
         return self.now_ns() - self._done_ns if self._done_ns is not None else 0
 
+    def work_ns(self) -> int:
+        """ns from this cycle's tick to its outputs written (0 before they are): its own work (decision B34)."""
+        return self._done_ns - self._start_ns if self._written and self._done_ns is not None else 0
+
     def left_ns(self) -> int:
         """ns until the next cycle's deadline (negative: it is missed); work in the slack asks before it starts."""
         return self._deadline - self.now_ns()

@@ -260,11 +260,10 @@ class BenchRunner:
             if stretcher is not None and not stopping and stretcher.run(max_cycles - 1 - self.cycle):
                 continue  # it ended before max_cycles: the check below is for a stepped cycle
             # real time: this cycle's planner refill computed now, in the slack (decision B21)
-            ahead = stretcher.ahead() if stretcher is not None and not stopping else None
-            if ahead is None:
-                self._exchange()
-            else:
-                self._exchange(ahead)
+            # ... unless the cycle before was long or the tick is near: then this cycle does it itself (B34)
+            skip = stretcher is not None and stretcher.paced and not stopping and stretcher.skip_ahead()
+            ahead = stretcher.ahead() if stretcher is not None and not stopping and not skip else None
+            self._exchange(ahead, bus_ahead=not skip)
             if self.cycle == max_cycles:  # an alarm like any other: the channel stops along the path
                 self._end_reason = "max_time"
                 ch.raise_alarm(Alarm(MAX_TIME_ALARM, f"run exceeded the bench's max_time of {self.bench.max_time:g} s",
@@ -336,10 +335,11 @@ class BenchRunner:
             ch.skip(latched)
 
     # ---- the cycle ------------------------------------------------------------------------
-    def _exchange(self, step: Callable[[Channel], object] | None = None) -> None:
+    def _exchange(self, step: Callable[[Channel], object] | None = None, bus_ahead: bool = True) -> None:
         # Real time on the in-process bus: this cycle's drive models run before its wake-up, in the slack
-        # (decision B21); nothing between here and the tick reads or writes the PDOs or the drives
-        tx = self.link.exchange(self.rx) if self._bus_ahead else None
+        # (decision B21; not with bus_ahead False, B34); nothing between here and the tick reads or writes the
+        # PDOs or the drives
+        tx = self.link.exchange(self.rx) if self._bus_ahead and bus_ahead else None
         self.timing = self.clock.tick()
         if self.timing.overrun:
             self._overrun()

@@ -90,6 +90,7 @@ class Stretcher(RealTimeStretches):
         self.stretches = 0  # stretches taken and cycles in them (benchmarks, tests)
         self.cycles = 0
         self.ahead_used = 0  # real time: refills computed ahead and taken by their cycle
+        self.aheads_skipped = 0  # real time: stepped cycles whose work ahead was skipped (B34)
         # real time: the refill the next stretch starts with, worked out in the slack before the last cycle of the
         # one before, with what it read (the planner's fields, the channel's signature): taken if still the same
         self._next_fill: tuple | None = None

@@ -37,6 +37,12 @@ COLD_CYCLES = 4
 # B33: a paced slack takes one part of the next start, and more while less than this went since the cycle's
 # outputs were written (on the clock the pacer reads; the parts are ≈ 50-250 µs each, a refill's solve more)
 SLACK_BUDGET_NS = 250_000
+# B34: a stepped cycle's work ahead (its in-process bus exchange and its refill, p50 150 µs in the CAM program) is
+# skipped when the cycle before it worked longer than AHEAD_WORK_NS or less than AHEAD_LEFT_NS of the period is left:
+# the next cycle then does that work itself, after its tick, as stepping does (a block solve's ≈ 1 ms cycle left
+# no room for it: 29 of 44 late ticks of CAM followed such slacks, B33)
+AHEAD_WORK_NS = 350_000
+AHEAD_LEFT_NS = 300_000
 _WRITTEN: dict[int, set] = {}
 
 
@@ -148,6 +154,15 @@ class RealTimeStretches:
                 self.fills_early += 1
                 return fill
         return self._refill_ahead(r, ch, pl)
+
+    def skip_ahead(self) -> bool:
+        """Real time (B34): True when this slack should not work the next stepped cycle's part ahead (its bus
+        exchange, its refill): the cycle before it was long, or the next tick is near. Counted."""
+        clock = self.r.clock
+        if clock.work_ns() > AHEAD_WORK_NS or clock.left_ns() < AHEAD_LEFT_NS:
+            self.aheads_skipped += 1
+            return True
+        return False
 
     def ahead(self) -> Callable[[Channel], Setpoint] | None:
         """Real time (B21): the planner's refill of the next cycle (a stepped cycle where the planner's buffer

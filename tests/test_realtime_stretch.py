@@ -241,3 +241,46 @@ def test_stepping_with_its_refill_and_exchange_ahead_equals_stepping(monkeypatch
     r = b[1].run
     assert r.ok and r.stretched == 0 and b[1].runner._bus_ahead
     assert len(made) == 1 and made[0].stretches == 0 and made[0].ahead_used > 100  # the lathe demo's refills
+
+
+@pytest.mark.parametrize("on", ["ahead", "1"])
+def test_work_ahead_skipped_after_a_long_cycle_leaves_the_run_as_stepping(monkeypatch, tmp_path, on):
+    """B34: a stepped cycle's work ahead (its refill, `Stretcher.ahead`, and its in-process bus exchange) is skipped
+    when the cycle before it worked longer than AHEAD_WORK_NS (or too little of the period is left); that cycle then
+    refills and exchanges itself after its tick. With a threshold of 0 it fires before every stepped cycle (the fake
+    clock reads 1 µs a read, so every cycle works > 0): no refill is taken ahead, no exchange runs before its tick,
+    and the run still equals stepping in every column; with the default thresholds the fake clock's short cycles
+    skip nothing."""
+    import hil.stretch_realtime
+    from hil.runner import BenchRunner
+
+    made: list[Stretcher] = []
+    init = Stretcher.__init__
+
+    def spy(self, *args):
+        init(self, *args)
+        made.append(self)
+
+    monkeypatch.setattr(Stretcher, "__init__", spy)
+    before: list[bool] = []  # per exchange: may it run before its tick (False: the loop skipped it, B34)?
+    exchange = BenchRunner._exchange
+
+    def spy_exchange(self, step=None, bus_ahead=True):
+        before.append(bus_ahead)
+        return exchange(self, step, bus_ahead)
+
+    monkeypatch.setattr(BenchRunner, "_exchange", spy_exchange)
+    a = _run(monkeypatch, tmp_path, "0")
+    default = _run(monkeypatch, tmp_path, on)
+    _same(a, default)
+    on_default = made[-1]
+    assert on_default.aheads_skipped == 0 and on_default.ahead_used > (100 if on == "ahead" else 10)
+    assert all(before)
+    del before[:]
+    monkeypatch.setattr(hil.stretch_realtime, "AHEAD_WORK_NS", 0)
+    b = _run(monkeypatch, tmp_path, on)
+    _same(a, b)
+    st = made[-1]
+    assert st.ahead_used == 0 and st.aheads_skipped >= on_default.ahead_used  # each refill taken ahead before
+    assert before.count(False) == st.aheads_skipped  # the skipped cycles exchanged after their tick
+    assert b[1].runner._bus_ahead and b[1].run.ok and b[1].run.overruns == 0
