@@ -263,7 +263,12 @@ class BenchRunner:
             # ... unless the cycle before was long or the tick is near: then this cycle does it itself (B34)
             skip = stretcher is not None and stretcher.paced and not stopping and stretcher.skip_ahead()
             ahead = stretcher.ahead() if stretcher is not None and not stopping and not skip else None
-            self._exchange(ahead, bus_ahead=not skip)
+            if skip:
+                self._exchange(None, bus_ahead=False)
+            elif ahead is None:
+                self._exchange()
+            else:
+                self._exchange(ahead)
             if self.cycle == max_cycles:  # an alarm like any other: the channel stops along the path
                 self._end_reason = "max_time"
                 ch.raise_alarm(Alarm(MAX_TIME_ALARM, f"run exceeded the bench's max_time of {self.bench.max_time:g} s",

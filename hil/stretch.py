@@ -41,6 +41,7 @@ from hil.clock import LockStepClock, RealTimeClock
 from hil.stretch_bulk import bulk_cycles, bulk_ok, first_change, outputs_hold
 from hil.stretch_pass import Pass, _save as _save_nc, no_reads
 from hil.stretch_reads import may_read
+from hil import stretch_realtime
 from hil.stretch_realtime import COLD_CYCLES, FIRST_CHANGE_NS, RealTimeStretches, _fed
 from hil.stretch_state import (_across, _event_due, _panel_state, _refilled, _restore_planner, _sample_across,
                                _save_planner, _signature, _stand_queued)
@@ -91,6 +92,7 @@ class Stretcher(RealTimeStretches):
         self.cycles = 0
         self.ahead_used = 0  # real time: refills computed ahead and taken by their cycle
         self.aheads_skipped = 0  # real time: stepped cycles whose work ahead was skipped (B34)
+        self.colds_skipped = 0  # real time: starts nothing prepared, not taken for lack of time left (B35)
         # real time: the refill the next stretch starts with, worked out in the slack before the last cycle of the
         # one before, with what it read (the planner's fields, the channel's signature): taken if still the same
         self._next_fill: tuple | None = None
@@ -173,6 +175,9 @@ class Stretcher(RealTimeStretches):
                 return started
         if self.paced:  # real time, a start nothing prepared: a short one, the next prepared in its slacks (B23)
             n = min(n, COLD_CYCLES)
+            if r.clock.left_ns() < stretch_realtime.COLD_LEFT_NS:  # B35: too little of the period left for its work: step
+                self.colds_skipped += 1
+                return False
         if n < 2:
             return False
         saved_pl = _save_planner(pl)

@@ -43,6 +43,9 @@ SLACK_BUDGET_NS = 250_000
 # no room for it: 29 of 44 late ticks of CAM followed such slacks, B33)
 AHEAD_WORK_NS = 350_000
 AHEAD_LEFT_NS = 300_000
+# B35: a start nothing prepared (B23: its samples and models in this slack, p50 ≈ 600 µs in the CAM program at load
+# 1-3) is taken only while this much of the period is left; else the cycle steps (exact, as always)
+COLD_LEFT_NS = 700_000
 _WRITTEN: dict[int, set] = {}
 
 

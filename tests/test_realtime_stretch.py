@@ -198,6 +198,19 @@ def _stretch_lengths(monkeypatch) -> list[int]:
     return lengths
 
 
+def _made_stretchers(monkeypatch) -> list[Stretcher]:
+    """Each Stretcher the runs make (filled as the runs go)."""
+    made: list[Stretcher] = []
+    init = Stretcher.__init__
+
+    def spy(self, *args):
+        init(self, *args)
+        made.append(self)
+
+    monkeypatch.setattr(Stretcher, "__init__", spy)
+    return made
+
+
 def test_a_stop_inside_a_stretch_is_taken_at_the_next_cycle(monkeypatch, tmp_path):
     a = _run(monkeypatch, tmp_path, "0", stop_at=5000)
     b = _run(monkeypatch, tmp_path, "1", stop_at=5000)
@@ -226,14 +239,7 @@ def test_stepping_with_its_refill_and_exchange_ahead_equals_stepping(monkeypatch
     """Session 11, route (a): every cycle stepped, but the planner refill a cycle will make (`Stretcher.ahead`) and
     its in-process bus exchange (`BenchRunner._bus_ahead`) worked out in the slack before its tick
     (DELTAHIL_STRETCH=ahead): the same trace as plain stepping in every column, with the refills ahead taken."""
-    made: list[Stretcher] = []
-    init = Stretcher.__init__
-
-    def spy(self, *args):
-        init(self, *args)
-        made.append(self)
-
-    monkeypatch.setattr(Stretcher, "__init__", spy)
+    made = _made_stretchers(monkeypatch)
     a = _run(monkeypatch, tmp_path, "0", **kw)
     assert not made  # plain stepping: no stretcher, nothing ahead
     b = _run(monkeypatch, tmp_path, "ahead", **kw)
@@ -254,14 +260,7 @@ def test_work_ahead_skipped_after_a_long_cycle_leaves_the_run_as_stepping(monkey
     import hil.stretch_realtime
     from hil.runner import BenchRunner
 
-    made: list[Stretcher] = []
-    init = Stretcher.__init__
-
-    def spy(self, *args):
-        init(self, *args)
-        made.append(self)
-
-    monkeypatch.setattr(Stretcher, "__init__", spy)
+    made = _made_stretchers(monkeypatch)
     before: list[bool] = []  # per exchange: may it run before its tick (False: the loop skipped it, B34)?
     exchange = BenchRunner._exchange
 
@@ -284,3 +283,19 @@ def test_work_ahead_skipped_after_a_long_cycle_leaves_the_run_as_stepping(monkey
     assert st.ahead_used == 0 and st.aheads_skipped >= on_default.ahead_used  # each refill taken ahead before
     assert before.count(False) == st.aheads_skipped  # the skipped cycles exchanged after their tick
     assert b[1].runner._bus_ahead and b[1].run.ok and b[1].run.overruns == 0
+
+
+def test_a_start_nothing_prepared_needs_time_left_in_the_period(monkeypatch, tmp_path):
+    """B35: a start nothing prepared (its samples and drive models in this slack) is taken only while COLD_LEFT_NS of
+    the period is left, else the cycle steps. Above the period it never is: every start is refused (the first ones
+    are cold, and only stretches prepare the next), the run is stepped and equals stepping in every column."""
+    import hil.stretch_realtime
+
+    made = _made_stretchers(monkeypatch)
+    a = _run(monkeypatch, tmp_path, "0")
+    b = _run(monkeypatch, tmp_path, "1")
+    assert made[-1].colds_skipped == 0 and b[1].run.stretched > 0.8 * b[1].run.cycles  # the fake clock's slack
+    monkeypatch.setattr(hil.stretch_realtime, "COLD_LEFT_NS", 2_000_000)
+    b = _run(monkeypatch, tmp_path, "1")
+    _same(a, b)
+    assert made[-1].colds_skipped > 1000 and b[1].run.stretched == 0 and b[1].run.ok
