@@ -41,8 +41,8 @@ SLACK_BUDGET_NS = 250_000
 # skipped when the cycle before it worked longer than AHEAD_WORK_NS or less than AHEAD_LEFT_NS of the period is left:
 # the next cycle then does that work itself, after its tick, as stepping does (a block solve's ≈ 1 ms cycle left
 # no room for it: 29 of 44 late ticks of CAM followed such slacks, B33)
-AHEAD_WORK_NS = 350_000
-AHEAD_LEFT_NS = 300_000
+AHEAD_WORK_NS = 300_000
+AHEAD_LEFT_NS = 500_000
 # B35: a start nothing prepared (B23: its samples and models in this slack, p50 ≈ 600 µs in the CAM program at load
 # 1-3) is taken only while this much of the period is left; else the cycle steps (exact, as always)
 COLD_LEFT_NS = 700_000
