@@ -39,6 +39,8 @@ def _status_base(state: State) -> int:
 
 
 _STATUS_BASE = {s: _status_base(s) for s in State}
+_ENABLED = State.OPERATION_ENABLED
+_SW_FOLLOWING = _STATUS_BASE[_ENABLED] | SW_FOLLOWING  # an enabled CSP / CSV drive's statusword, before its flags
 
 
 @dataclass
@@ -116,9 +118,61 @@ class Cia402Drive:
         )
 
     def exchange(self, rx: RxPdo, dt: float) -> TxPdo:
-        self.apply(rx)
-        self.step(dt)
-        return self.feedback()
+        cw, mode = rx.controlword, self.mode
+        if (self.state is not _ENABLED or cw != self._last_cw or cw & 0x8F != 0x0F or rx.mode != mode
+                or (mode != 8 and mode != 9) or self.external_fault):
+            self.apply(rx)
+            self.step(dt)
+            return self.feedback()
+        return self._exchange_following(rx, dt, mode == 8)
+
+    def _exchange_following(self, rx: RxPdo, dt: float, csp: bool) -> TxPdo:
+        """`apply`, `step` and `feedback` of the usual cycle (issue 17): enabled in CSP or CSV, the
+        controlword held, no mode change, no injected fault. The same operations in the same order as
+        those three, on local variables: the state machine returns at once, no profile mode applies, and
+        the state stays enabled unless `_supervise` faults (then `feedback` builds the image)."""
+        p = self.params
+        self._rx = rx
+        cpr, units = p.counts_per_rev, p.units
+        rpc = 600.0 / cpr if units.velocity == "0.1 rpm" else 1.0  # DriveUnits.raw_per_count_per_s
+        self._want_cps = rx.target_velocity / rpc
+        origin = self.modes.origin
+        if p.negative_limit is not None or p.positive_limit is not None:
+            self.step(dt)
+        else:
+            n = max(1, p.substeps)
+            h = dt / n
+            prev, target, ff_vel = self._setpoint(float(rx.target_position) - origin, csp, dt)
+            v_before = self.velocity
+            max_cps = p.max_speed_rpm / 60.0 * cpr
+            alpha = 1.0 - math.exp(-p.velocity_bandwidth * h)
+            self._step_following(n, h, prev, target, ff_vel, max_cps, alpha, csp,
+                                 bool(rx.touch_probe_function & 1))
+            vel = self.velocity
+            acc = self.acceleration = (vel - v_before) / dt
+            rad = 2.0 * math.pi / cpr
+            torque_nm = (p.inertia * acc * rad + p.viscous * vel * rad
+                         + (math.copysign(p.coulomb, vel) if abs(vel) > 1 else 0.0))
+            self.torque = torque_nm / p.rated_torque * 1000.0
+            gap = self.command - self.position
+            if (csp and abs(gap) > p.following_error_window) or abs(vel) > 1.2 * max_cps:
+                self._supervise()
+        if self.state is not _ENABLED or self._limit_flags:
+            return self.feedback()
+        # feedback() of an enabled CSP / CSV drive off its limit switches
+        vel, pos, gap = self.velocity, self.position, self.command - self.position
+        sw = _SW_FOLLOWING
+        if abs(vel) < 0.001 * (p.max_speed_rpm / 60.0 * cpr) and abs(gap) < 10:
+            sw |= SW_TARGET_REACHED
+        if abs(gap) > p.following_error_window:
+            sw |= SW_FOLLOWING_ERROR
+        raw = round(vel * rpc)  # DriveUnits.velocity_to_raw
+        return TxPdo(sw, int(round(pos + origin)), max(-0x7FFFFFFF, min(0x7FFFFFFF, int(raw))),
+                     int(round(self.torque * 0.1 / units.torque_percent)), int(round(gap)) if csp else 0,
+                     self.error_code, self.mode,
+                     0x0003 if self._probe_latched else (0x0001 if rx.touch_probe_function & 1 else 0),
+                     self._probe_pos + int(round(origin)),
+                     0x4 if p.home_switch is not None and pos < p.home_switch else 0)
 
     # ---- state machine ------------------------------------------------------------------
     def _state_machine(self, cw: int) -> None:
@@ -185,14 +239,7 @@ class Cia402Drive:
         h = dt / n
         energised = self.state in (State.OPERATION_ENABLED, State.QUICK_STOP_ACTIVE, State.FAULT_REACTION_ACTIVE)
         target = float(self._rx.target_position) - self.modes.origin  # 0x607A in PUU, homing shifted them
-        # CSP: the drive's interpolator spreads the new target over the cycle.
-        if self.state is State.OPERATION_ENABLED and self.mode == 8:
-            prev = self._prev_target if self._prev_target is not None else self.command
-            ff_vel = (target - prev) / dt
-            self._prev_target = target
-        else:
-            prev = target = self.command
-            ff_vel = 0.0
+        prev, target, ff_vel = self._setpoint(target, self.state is State.OPERATION_ENABLED and self.mode == 8, dt)
         v_before = self.velocity
         # The state and mode cannot change inside the cycle (faults are taken in _supervise, after
         # it): the branch, the speed limit and the filter gain are chosen once, not per sub-step.
@@ -215,6 +262,15 @@ class Cia402Drive:
                      + (math.copysign(p.coulomb, self.velocity) if abs(self.velocity) > 1 else 0.0))
         self.torque = torque_nm / p.rated_torque * 1000.0 if energised else 0.0
         self._supervise()
+
+    def _setpoint(self, target: float, csp: bool, dt: float) -> tuple[float, float, float]:
+        """The cycle's interpolation: (start, end, feed-forward speed). In CSP the drive's interpolator spreads
+        the new target over the cycle; otherwise the command stays where it is."""
+        if csp:
+            prev = self._prev_target if self._prev_target is not None else self.command
+            self._prev_target = target
+            return prev, target, (target - prev) / dt
+        return self.command, self.command, 0.0
 
     def _step_following(self, n: int, h: float, prev: float, target: float, ff_vel: float, max_cps: float,
                         alpha: float, csp: bool, probing: bool) -> None:
