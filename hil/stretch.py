@@ -293,7 +293,8 @@ class Stretcher(RealTimeStretches):
                         self._cut_outs = None
                         self._prep = self._prepare(r, ch, pl, last_raw, positions, m) if j == m else \
                             self._cut_ahead(pl, saved_pl, saved_drives, rx0, targets, j)
-                        end, timings = self._pace(r, k, stop, positions, targets, panel)
+                        rows = self._paced_rows(r, outs, smp, k)  # each paced cycle's row in its slack (B36)
+                        end, timings = self._pace(r, k, stop, positions, targets, panel, rows)
                         if end < stop or r.stop_request is not None or _panel_state(r.on_cycle) != panel:
                             j = end  # a stop or a press ended it (in its last paced cycle too): at once up to there
                             self._prep = self._spec = self._cut_outs = None
@@ -305,7 +306,7 @@ class Stretcher(RealTimeStretches):
                         if settle:
                             rpms, cmds = rpms[:k], cmds[:k]
                     last_row = bulk_cycles(r, ch, pl, smp, outs, k, m, raw[m - 1], (rpms, cmds) if settle else None,
-                                           timings)
+                                           timings, timings is not None and r.trace is not None)
                     if last_row is not None:  # real time: the last cycle, paced after the rest
                         if not cut and self._spec is None:  # nothing cuts this stretch any more: the next
                             self._fill_next(r, ch, pl, last_raw)  # one's refill, unless its start is worked out

@@ -161,11 +161,13 @@ def outputs_hold(r: Any, ch: Channel, position: np.ndarray) -> bool:
 
 def bulk_cycles(r: Any, ch: Channel, pl: Planner, smp: Samples, outs: list[Stretch], k0: int, m: int,
                 before_last_step: np.ndarray, settle: tuple[list[float], list[float]] | None,
-                timings: list[CycleTiming] | None = None) -> Any:
+                timings: list[CycleTiming] | None = None, rows_paced: bool = False) -> Any:
     """Cycles k0 … m-1 of the stretch as the runner's cycle would run them one by one (module doc). `timings`:
     real time, the cycles were paced one by one (hil.stretch.Stretcher._pace) with these timings, which the
     trace rows take; the clock has counted them. With one timing fewer than cycles, the last cycle is paced
-    after this (in the slack before it): its trace row is left to the returned `last_row(timing)`."""
+    after this (in the slack before it): its trace row is left to the returned `last_row(timing)`, the
+    runner's own row (its state is that cycle's now). `rows_paced`: the paced cycles' rows were written in
+    their own slacks (decision B36), none here."""
     t_wall = _time.perf_counter_ns()
     cnt = m - k0
     dt = r.bench.cycle
@@ -224,7 +226,9 @@ def bulk_cycles(r: Any, ch: Channel, pl: Planner, smp: Samples, outs: list[Stret
     if type(mlc) is Mlc and n_axes < len(r.rx):
         mlc.caxis._cycles += cnt  # Mlc.spindle_drive → SpindleAxisSwitch.drive, a spindle staying one
     deferred = timings is not None and len(timings) == cnt - 1
-    if r.trace is not None:
+    if r.trace is not None and rows_paced:
+        r._row_cycle = r.cycle
+    elif r.trace is not None:
         if deferred:
             _rows(r, outs, k0, m - 1, times[:-1], first_cycle, row_lines[:-1], positions, timings)
         else:
@@ -240,8 +244,9 @@ def bulk_cycles(r: Any, ch: Channel, pl: Planner, smp: Samples, outs: list[Stret
 
         def last_row(timing: CycleTiming) -> None:
             r.timing = timing
-            if r.trace is not None:
-                _rows(r, outs, m - 1, m, times[-1:], first_cycle + cnt - 1, row_lines[-1:], positions, [timing])
+            if r.trace is not None:  # the stepped cycle's row (one row in numpy cost ≈ 100 µs of the slack, B36)
+                r.trace.write(r._row())
+                r._row_cycle = r.cycle
             if r.on_cycle is not None:
                 r.on_cycle(r)  # the last cycle's own call: a press while it waited is taken as stepping takes it
             if r.progress is not None:

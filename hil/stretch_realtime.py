@@ -87,12 +87,14 @@ class RealTimeStretches:
     """`Stretcher`'s real-time methods."""
 
     def _pace(self, r: Any, k: int, m: int, positions: np.ndarray, targets: list[list[int]],
-              panel: tuple | None) -> tuple[int, list[CycleTiming]]:
+              panel: tuple | None, rows: Callable[[int, CycleTiming], None] | None = None
+              ) -> tuple[int, list[CycleTiming]]:
         """Real time, a bulk stretch (B21): cycles k … m-1 paced one by one, each its tick (the wait for its
         deadline, the overrun count, its timing) and its outputs, the setpoints of its sample (converted
-        ahead, here in the slack); the rest of those cycles (MLC, counters, trace rows) is done at once after
-        the last one (`bulk_cycles`). Ends after a cycle in which a stop was asked or the panel was pressed,
-        which the next cycle must see. Returns the end (k + the cycles paced) and their timings."""
+        ahead, here in the slack), and with `rows` its trace row (B36); the rest of those cycles (MLC,
+        counters) is done at once after the last one (`bulk_cycles`). Ends after a cycle in which a stop was
+        asked or the panel was pressed, which the next cycle must see. Returns the end (k + the cycles paced)
+        and their timings."""
         clock, rx = r.clock, r.rx
         n_axes = self.n_axes
         org = r.origin.tolist()
@@ -110,6 +112,8 @@ class RealTimeStretches:
                 out.target_position = col[c]
             clock.written()
             clock.done()
+            if rows is not None:  # the cycle's trace row, in its own slack as stepping writes it (B36)
+                rows(c, t)
             # parts of the next stretch's start in this slack (B22): one, more while its budget holds (B33)
             first = True
             while self._prep is not None and c < m - 1 and clock.left_ns() > PREP_LEFT_NS \
@@ -122,6 +126,42 @@ class RealTimeStretches:
             if r.stop_request is not None or _panel_state(r.on_cycle) != panel:
                 break
         return k + len(timings), timings
+
+    def _paced_rows(self, r: Any, outs: list[Stretch], smp: Samples, k: int
+                    ) -> Callable[[int, CycleTiming], None] | None:
+        """B36: the trace row of each paced cycle c = k, k+1, … (in order), written in its own slack instead of all
+        at once in the bulk part's: BenchRunner._row's expressions (hil/cycle_lean.row) on the stretch's columns,
+        with the time, cycle and line carried as bulk_cycles and stepping count them. None without a trace."""
+        trace = r.trace
+        if trace is None:
+            return None
+        write, facs, n_axes, dt = trace.write, r._factors, self.n_axes, r.bench.cycle
+        org = r.origin.tolist()
+        positions, lines = smp.positions, smp.lines
+        # the spindle's command column: its target velocity, the same through the stretch (_still_quiet)
+        spindle = [r.rx[i].target_velocity / f.raw_per_cps / f.cpu / f.lead * 60.0
+                   for i, f in enumerate(facs) if i >= n_axes]
+        axes = list(zip(outs[:n_axes], facs[:n_axes], org))
+        spindles = list(zip(outs[n_axes:], facs[n_axes:], spindle))
+        now = [r.time, r.cycle, r.line]
+
+        def row(c: int, timing: CycleTiming) -> None:
+            t, cycle, line = now
+            t += dt  # as bulk_cycles' accumulate and stepping's r.time add, one cycle at a time
+            line = lines[c] or line
+            now[:] = t, cycle + 1, line
+            out: list = [round(t, 9), line, cycle + 1, timing.period, timing.late, ""]  # no alarms: _quiet
+            for cmd, (o, f, o0) in zip(positions[c].tolist(), axes):
+                cpu = f.cpu
+                out += [cmd, o.position_actual[c] / cpu + o0, o.velocity_actual[c] / f.raw_per_cps / cpu,
+                        o.torque_actual[c] * f.torque, o.following_error[c] / cpu, o.statusword[c]]
+            for o, f, cmd in spindles:
+                cpu, rpc, lead = f.cpu, f.raw_per_cps, f.lead
+                out += [cmd, o.velocity_actual[c] / rpc / cpu / lead * 60.0, o.position_actual[c] / cpu % 360.0,
+                        o.torque_actual[c] * f.torque, o.statusword[c]]
+            write(out)
+
+        return row
 
     def _fill_next(self, r: Any, ch: Channel, pl: Planner, last_raw: Any) -> None:
         """In the slack before a paced stretch's last cycle, with its bulk part (nothing cuts it any more), where

@@ -112,6 +112,7 @@ def _same(a: tuple, b: tuple) -> None:
 def test_a_realtime_run_with_stretches_equals_stepping(monkeypatch, tmp_path, kw):
     taken = _taken_starts(monkeypatch)  # B22: stretch starts worked out in the slacks of the stretch before, taken
     lengths = _stretch_lengths(monkeypatch)
+    rows = _paced_rows(monkeypatch)
     a = _run(monkeypatch, tmp_path, "0", **kw)
     b = _run(monkeypatch, tmp_path, "1", **kw)
     _same(a, b)
@@ -119,6 +120,10 @@ def test_a_realtime_run_with_stretches_equals_stepping(monkeypatch, tmp_path, kw
     if not kw:  # (--at events are read cycle by cycle: no paced bulk, stretches start as in B21)
         assert len(taken) > 500 and sum(taken) > 0.9 * len(taken)  # most starts were worked out ahead and taken
         assert max(lengths) == RT_CYCLES  # the prepared ones; a cold start takes COLD_CYCLES (B23)
+        # B36: a paced cycle's trace row is written in its own slack (after its outputs), not in the bulk part's
+        assert len(rows) > 0.8 * r.cycles and all(rows)
+    else:
+        assert not rows
     assert r.ok and r.realtime and r.overruns == 0
     assert r.stretched > 0.8 * r.cycles  # most cycles come from stretches, each paced on its own
     assert set(a[0]["period"][1:]) == {0.001}  # every cycle ticked: a 1 ms period on the fake clock
@@ -180,6 +185,27 @@ def _taken_starts(monkeypatch) -> list[bool]:
 
     monkeypatch.setattr(Stretcher, "_spec_start", spy)
     return taken
+
+
+def _paced_rows(monkeypatch) -> list[bool]:
+    """Each trace row a paced cycle wrote itself (B36): True where its outputs were written before it (filled as
+    the runs go)."""
+    rows: list[bool] = []
+    paced_rows = Stretcher._paced_rows
+
+    def spy(self, r, *args):
+        row = paced_rows(self, r, *args)
+        if row is None:
+            return None
+
+        def counted(c, timing):
+            rows.append(r.clock._written)
+            row(c, timing)
+
+        return counted
+
+    monkeypatch.setattr(Stretcher, "_paced_rows", spy)
+    return rows
 
 
 def _stretch_lengths(monkeypatch) -> list[int]:
