@@ -26,6 +26,7 @@ import numpy as np
 from fieldbus.pdo import TxPdo
 from hil.clock import CycleTiming
 from hil.mlc_bridge import drive_status
+from hil.stretch_state import _hooks
 from hil.trace_parquet import ParquetTrace
 from mlc.basic import BasicMlc
 from mlc.machine import Mlc
@@ -53,9 +54,7 @@ def written_devices(x: int) -> set[tuple[int, int]]:
 
 def bulk_ok(r: Any) -> bool:
     """Every cycle after a stretch's first would take the path `bulk_cycles` takes (module doc)."""
-    from hil.scripting import OperatorPanel
-
-    if r.trace_sources or not (r.on_cycle is None or type(r.on_cycle) is OperatorPanel):
+    if r.trace_sources or not (r.on_cycle is None or type(r.on_cycle) is _hooks()[1]):  # OperatorPanel
         return False  # device columns and --at events are read cycle by cycle
     mlc = r.mlc
     if type(mlc) is BasicMlc:
