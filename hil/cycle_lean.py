@@ -12,11 +12,12 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-from fieldbus.cia402 import SW_INTERNAL_LIMIT, State
+from fieldbus.cia402 import CW_ENABLE_OPERATION, STATES_BY_BITS, SW_INTERNAL_LIMIT, State, Target
 from nc.alarms import SERVO_ALARM, Alarm
 
 OVERSPEED = 1.2  # App. A 0x0602: measured axis speed above this multiple of its limit (the virtual drive's own AL007 margin)
 _FAULT, _REACTION, _ENABLED = State.FAULT, State.FAULT_REACTION_ACTIVE, State.OPERATION_ENABLED
+_KEEP_ENABLED = Target.ENABLED
 
 
 @dataclass(frozen=True, slots=True)
@@ -43,7 +44,13 @@ def feedback(r: Any, txs: list[Any], n_axes: int) -> None:
     origin = r.origin.tolist()
     for i, (m, tx) in enumerate(zip(r.masters, txs)):
         sw = tx.statusword
-        rxs[i].controlword = m.step(sw)
+        if m.state is _ENABLED and m.target is _KEEP_ENABLED and STATES_BY_BITS[sw & 0x7F] is _ENABLED:
+            # Cia402Master.step's usual cycle, spelt out: enabled, asked to stay so, still enabled
+            m.cycles_in_state += 1
+            m._reset_phase = 0
+            rxs[i].controlword = CW_ENABLE_OPERATION
+        else:
+            rxs[i].controlword = m.step(sw)
         p, v = tx.position_actual, tx.velocity_actual
         rest[i] = rest[i] + 1 if p == last[i] and v == 0 else 0
         last[i] = p
@@ -75,7 +82,9 @@ def feedback(r: Any, txs: list[Any], n_axes: int) -> None:
 def row(r: Any, n_axes: int) -> list:
     """One trace row (full-precision floats: the trace feeds checks that differentiate positions three times)."""
     timing, txs, facs = r.timing, r.tx, r._factors
-    out: list = [round(r.time, 9), r.line, r.cycle, timing.period, timing.late, r._new_alarms()]
+    ch = r.channel
+    alarms = r._new_alarms() if r.result.alarms or (ch is not None and ch.alarms) else ""  # the usual row: none
+    out: list = [round(r.time, 9), r.line, r.cycle, timing.period, timing.late, alarms]
     for i, (cmd, act) in enumerate(zip(r._commands.tolist(), r.actual.tolist())):
         tx, f = txs[i], facs[i]
         cpu = f.cpu

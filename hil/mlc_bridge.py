@@ -23,10 +23,12 @@ def drive_status(runner: Any, status: Any) -> list[DriveStatus]:
     enabled = State.OPERATION_ENABLED
     facs = getattr(runner, "_factors", None) or factors(runner.scales)  # unit factors read once (hil/cycle_lean.py)
     origin = runner.origin.tolist()
+    states = status.states if status is not None else None  # LinkStatus.slave_ok spelt out
+    n_states = len(states) if states is not None else 0
     for i, (m, tx, f, d) in enumerate(zip(runner.masters, runner.tx, facs, out)):
         # AxisScaling's conversions spelt out, the same divisions in the same order (bit for bit)
         cpu = f.cpu
-        d.connected = status is None or status.slave_ok(i)  # the slave in OP (issue 6)
+        d.connected = states is None or (i < n_states and states[i] == "OP")  # the slave in OP (issue 6)
         st = m.state
         d.servo_on = st is enabled
         d.fault = st is _FAULT or st is _REACTION

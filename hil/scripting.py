@@ -66,8 +66,8 @@ class OperatorPanel:
         if self._pressed:
             mem.set_bit(m2(x, 0), False)
             self._pressed = False
-        held = mem.bit(m3(x, 37)) or mem.bit(m3(x, 38))
-        if not held or self.resume_after is None:
+        m, b3 = mem.m, 30000 + 1000 * x  # M3x037 / M3x038 read straight from the bits: this runs every cycle
+        if not (m[b3 + 37] or m[b3 + 38]) or self.resume_after is None:
             self._held_since = None
             return
         if self._held_since is None:

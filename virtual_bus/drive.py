@@ -281,6 +281,8 @@ class Cia402Drive:
         pos, vel, t = self.position, self.velocity, self.time
         kff_ff, kp, span = p.kff * ff_vel, p.kp, target - prev
         ramp, want, tv = p.csv_accel * h, self._want_cps, self.target_velocity
+        # an armed probe that has latched stays latched while armed: `_probe` would return at once each sub-step
+        latch = probing and not self._probe_latched
         for k in range(1, n + 1):
             if csp:
                 cmd = prev + span * k / n
@@ -293,8 +295,9 @@ class Cia402Drive:
             if v_cmd != vel:
                 vel += (v_cmd - vel) * alpha
             new_pos = pos + vel * h
-            if probing:
+            if latch:
                 self._probe(pos, new_pos)
+                latch = not self._probe_latched
             pos = new_pos
             t += h
         if not csp:
