@@ -94,11 +94,16 @@ class ChannelLink:
     def nc_inputs(self, ch: Channel) -> None:
         self.cycle += 1
         b2 = 20000 + 1000 * self.x  # M2x000
-        self._estop_input(ch)
-        self._mode_input(ch)
-        levels = self.mem.m[b2:b2 + 20]
+        m = self.mem.m
+        # the usual scan asks neither: E-stop low now and before, no mode switch counting down or asked for
+        if m[b2 + 13] or self._estop:
+            self._estop_input(ch)
+        if self._mode_switch_cycles or self.mem.words[b2] != self.mode:
+            self._mode_input(ch)
+        levels = m[b2:b2 + 20]
         if levels == self._cmd_levels:  # M2x000…M2x019 as last cycle, which fired nothing: no edge
-            self._finish_input(ch)
+            if self._handed is not None:  # no code handed over: no finish to wait for
+                self._finish_input(ch)
         else:
             fired = False
             if self._rising(b2 + 4):
