@@ -38,7 +38,7 @@ from fieldbus.cia402 import State, Target
 from fieldbus.link import SimLink
 from fieldbus.pdo import RxPdo, TxPdo
 from hil.clock import LockStepClock, RealTimeClock
-from hil.stretch_bulk import bulk_cycles, bulk_ok, first_change, outputs_hold
+from hil.stretch_bulk import bulk_cycles, bulk_ok, count_cycles, first_change, outputs_hold
 from hil.stretch_pass import Pass, _save as _save_nc, no_reads
 from hil.stretch_reads import may_read
 from hil import stretch_realtime
@@ -294,7 +294,13 @@ class Stretcher(RealTimeStretches):
                         self._prep = self._prepare(r, ch, pl, last_raw, positions, m) if j == m else \
                             self._cut_ahead(pl, saved_pl, saved_drives, rx0, targets, j)
                         rows = self._paced_rows(r, outs, smp, k)  # each paced cycle's row in its slack (B36)
-                        end, timings = self._pace(r, k, stop, positions, targets, panel, rows)
+                        counted = [k]  # and the counters of the cycles paced, in the slack before the bulk part's
+
+                        def count(c: int, outs: list[Stretch] = outs, k: int = k) -> None:
+                            count_cycles(r, outs, k, c + 1)
+                            counted[0] = c + 1
+
+                        end, timings = self._pace(r, k, stop, positions, targets, panel, rows, count)
                         if end < stop or r.stop_request is not None or _panel_state(r.on_cycle) != panel:
                             j = end  # a stop or a press ended it (in its last paced cycle too): at once up to there
                             self._prep = self._spec = self._cut_outs = None
@@ -306,7 +312,8 @@ class Stretcher(RealTimeStretches):
                         if settle:
                             rpms, cmds = rpms[:k], cmds[:k]
                     last_row = bulk_cycles(r, ch, pl, smp, outs, k, m, raw[m - 1], (rpms, cmds) if settle else None,
-                                           timings, timings is not None and r.trace is not None)
+                                           timings, timings is not None and r.trace is not None,
+                                           counted[0] if timings is not None else None)
                     if last_row is not None:  # real time: the last cycle, paced after the rest
                         if not cut and self._spec is None:  # nothing cuts this stretch any more: the next
                             self._fill_next(r, ch, pl, last_raw)  # one's refill, unless its start is worked out

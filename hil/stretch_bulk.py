@@ -160,31 +160,20 @@ def outputs_hold(r: Any, ch: Channel, position: np.ndarray) -> bool:
 
 def bulk_cycles(r: Any, ch: Channel, pl: Planner, smp: Samples, outs: list[Stretch], k0: int, m: int,
                 before_last_step: np.ndarray, settle: tuple[list[float], list[float]] | None,
-                timings: list[CycleTiming] | None = None, rows_paced: bool = False) -> Any:
+                timings: list[CycleTiming] | None = None, rows_paced: bool = False, counted: int | None = None) -> Any:
     """Cycles k0 … m-1 of the stretch as the runner's cycle would run them one by one (module doc). `timings`:
     real time, the cycles were paced one by one (hil.stretch.Stretcher._pace) with these timings, which the
     trace rows take; the clock has counted them. With one timing fewer than cycles, the last cycle is paced
     after this (in the slack before it): its trace row is left to the returned `last_row(timing)`, the
     runner's own row (its state is that cycle's now). `rows_paced`: the paced cycles' rows were written in
-    their own slacks (decision B36), none here."""
+    their own slacks (decision B36), none here; `counted`: with them, cycles k0 … counted-1 were counted in a
+    paced slack too (count_cycles)."""
     t_wall = _time.perf_counter_ns()
     cnt = m - k0
-    dt = r.bench.cycle
     n_axes = len(r.axes)
-    # the times summed cycle by cycle, as stepping sums them (accumulate and reduce add in order, at C speed)
-    times = list(accumulate(repeat(dt, cnt), add, initial=r.time))
-    r.time = times[-1]
-    del times[0]
-    link = r.link
-    link.time = reduce(add, repeat(dt, cnt), link.time)
-    link.cycles += cnt
     first_cycle = r.cycle + 1
-    r.cycle += cnt
-    for master in r.masters:
-        master.cycles_in_state += cnt  # step() in a held state: the same controlword, one more cycle in it
-    rest, last = r._rest, r._last_position
-    for i, o in enumerate(outs):
-        rest[i], last[i] = _rest(rest[i], last[i], o.position_actual[k0:m], o.velocity_actual[k0:m])
+    # the times summed cycle by cycle, as stepping sums them (accumulate and reduce add in order, at C speed)
+    times = count_cycles(r, outs, k0 if counted is None else counted, m)
     r.tx = tx = [o.last for o in outs]
     scales, org = r.scales, r.origin.tolist()
     r.actual[:] = [scales[i].to_units(tx[i].position_actual) + o for i, o in enumerate(org)]
@@ -203,9 +192,10 @@ def bulk_cycles(r: Any, ch: Channel, pl: Planner, smp: Samples, outs: list[Stret
         cmd = float(pl.spindle_command())  # type: ignore[misc]
         if len(scales) > n_axes:
             sc = scales[n_axes]
-            # AxisScaling.drive_to_rpm over the column: the same divisions and products in the same order
-            va = np.array(outs[n_axes].velocity_actual[k0:m], dtype=np.float64)
-            rpms += (va / sc._raw_per_cps / sc._cpu / sc.lead * 60.0).tolist()
+            # AxisScaling.drive_to_rpm over the column: the same divisions and products in the same order (in
+            # Python: a real-time stretch's ≈ 16 values cost less than numpy's conversions, B36)
+            rpc, cpu, lead = sc._raw_per_cps, sc._cpu, sc.lead
+            rpms += [v / rpc / cpu / lead * 60.0 for v in outs[n_axes].velocity_actual[k0:m]]
         else:
             rpms += [abs(r.spindle_command_rpm())] * cnt
         cmds += [cmd] * cnt
@@ -213,21 +203,13 @@ def bulk_cycles(r: Any, ch: Channel, pl: Planner, smp: Samples, outs: list[Stret
     cmds_last = positions[m - 1].tolist()
     r._commands[:] = cmds_last
     r.line = line
-    max_ferr = r.result.max_ferr
     for i in range(n_axes):
-        sc = scales[i]
-        r.rx[i].target_position = sc.to_counts(cmds_last[i] - org[i])
-        # |fe / cpu| is |fe| / |cpu| exactly and a division by a constant is monotone: the largest |fe| gives the peak
-        ferr = abs(sc.to_units(max(map(abs, outs[i].following_error[k0:m]))))
-        if ferr > max_ferr[r.axes[i]]:
-            max_ferr[r.axes[i]] = ferr
-    mlc = r.mlc
-    if type(mlc) is Mlc and n_axes < len(r.rx):
-        mlc.caxis._cycles += cnt  # Mlc.spindle_drive → SpindleAxisSwitch.drive, a spindle staying one
+        r.rx[i].target_position = scales[i].to_counts(cmds_last[i] - org[i])
     deferred = timings is not None and len(timings) == cnt - 1
     if r.trace is not None and rows_paced:
         r._row_cycle = r.cycle
     elif r.trace is not None:
+        assert counted is None  # (the rows need every cycle's time)
         if deferred:
             _rows(r, outs, k0, m - 1, times[:-1], first_cycle, row_lines[:-1], positions, timings)
         else:
@@ -257,6 +239,37 @@ def bulk_cycles(r: Any, ch: Channel, pl: Planner, smp: Samples, outs: list[Stret
     clock.jitter.add_repeated(0.0, cnt, first_cycle)
     clock.exec.add_repeated((_time.perf_counter_ns() - t_wall) * 1e-9 / cnt, cnt, first_cycle)
     return None
+
+
+def count_cycles(r: Any, outs: list[Stretch], k0: int, m: int) -> list[float]:
+    """The runner's counters over cycles k0 … m-1 of a stretch (bulk_cycles' first part): time and cycle, the
+    masters' cycles in their state, the rest counters, the largest following error, the C axis switch's cycles.
+    Each adds on in order, so counting a stretch in parts (its paced cycles in a slack, B36) counts as at once.
+    Returns the cycles' times."""
+    cnt = m - k0
+    dt = r.bench.cycle
+    times = list(accumulate(repeat(dt, cnt), add, initial=r.time))
+    r.time = times[-1]
+    del times[0]
+    link = r.link
+    link.time = reduce(add, repeat(dt, cnt), link.time)
+    link.cycles += cnt
+    r.cycle += cnt
+    for master in r.masters:
+        master.cycles_in_state += cnt  # step() in a held state: the same controlword, one more cycle in it
+    rest, last = r._rest, r._last_position
+    for i, o in enumerate(outs):
+        rest[i], last[i] = _rest(rest[i], last[i], o.position_actual[k0:m], o.velocity_actual[k0:m])
+    n_axes, scales, max_ferr = len(r.axes), r.scales, r.result.max_ferr
+    for i in range(n_axes):
+        # |fe / cpu| is |fe| / |cpu| exactly and a division by a constant is monotone: the largest |fe| gives the peak
+        ferr = abs(scales[i].to_units(max(map(abs, outs[i].following_error[k0:m])))) if cnt else 0.0
+        if ferr > max_ferr[r.axes[i]]:
+            max_ferr[r.axes[i]] = ferr
+    mlc = r.mlc
+    if type(mlc) is Mlc and n_axes < len(r.rx):
+        mlc.caxis._cycles += cnt  # Mlc.spindle_drive → SpindleAxisSwitch.drive, a spindle staying one
+    return times
 
 
 def _rest(n_rest: int, p_last: int, pa: list[int], va: list[int]) -> tuple[int, int]:

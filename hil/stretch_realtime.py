@@ -87,12 +87,13 @@ class RealTimeStretches:
     """`Stretcher`'s real-time methods."""
 
     def _pace(self, r: Any, k: int, m: int, positions: np.ndarray, targets: list[list[int]],
-              panel: tuple | None, rows: Callable[[int, CycleTiming], None] | None = None
-              ) -> tuple[int, list[CycleTiming]]:
+              panel: tuple | None, rows: Callable[[int, CycleTiming], None] | None = None,
+              count: Callable[[int], None] | None = None) -> tuple[int, list[CycleTiming]]:
         """Real time, a bulk stretch (B21): cycles k … m-1 paced one by one, each its tick (the wait for its
         deadline, the overrun count, its timing) and its outputs, the setpoints of its sample (converted
-        ahead, here in the slack), and with `rows` its trace row (B36); the rest of those cycles (MLC,
-        counters) is done at once after the last one (`bulk_cycles`). Ends after a cycle in which a stop was
+        ahead, here in the slack), and with `rows` its trace row (B36); with `count`, the runner's counters of
+        the cycles paced so far in the slack before the last one's (B36); the rest of those cycles (the MLC)
+        is done at once after the last one (`bulk_cycles`). Ends after a cycle in which a stop was
         asked or the panel was pressed, which the next cycle must see. Returns the end (k + the cycles paced)
         and their timings."""
         clock, rx = r.clock, r.rx
@@ -114,6 +115,8 @@ class RealTimeStretches:
             clock.done()
             if rows is not None:  # the cycle's trace row, in its own slack as stepping writes it (B36)
                 rows(c, t)
+            if count is not None and c == m - 2:  # the counters of cycles k … c, not in the bulk part's slack
+                count(c)
             # parts of the next stretch's start in this slack (B22): one, more while its budget holds (B33)
             first = True
             while self._prep is not None and c < m - 1 and clock.left_ns() > PREP_LEFT_NS \

@@ -259,6 +259,33 @@ def test_a_signal_while_a_stretch_is_paced_lands_on_the_same_cycle(monkeypatch, 
     assert b[1].runner.trace is not None
 
 
+def test_a_signal_after_a_paced_stretch_counted_its_cycles_lands_on_the_same_cycle(monkeypatch, tmp_path):
+    """B36: the runner's counters of a paced stretch's cycles (time, cycle, rest counters, the largest following
+    error ...) are counted in the slack before the bulk part's, for the cycles paced so far, and the bulk part counts
+    the rest. A SIGINT while the pacer waits for the next cycle (after that count) or for the cycle before the
+    counted one (before it) ends the stretch there: the bulk part then counts none or all of its cycles, and both
+    runs equal stepping in every column."""
+    import hil.stretch
+
+    ticks: list[int] = []  # the clock's tick (cycle) in whose slack each count ran
+    count_cycles = hil.stretch.count_cycles
+
+    def spy(r, outs, k0, m):
+        ticks.append(r.clock._n)
+        return count_cycles(r, outs, k0, m)
+
+    monkeypatch.setattr(hil.stretch, "count_cycles", spy)
+    _run(monkeypatch, tmp_path, "1")
+    assert len(ticks) > 500
+    at = ticks[len(ticks) // 3]
+    for signal_at, counted in ((at + 1, True), (at - 1, False)):
+        del ticks[:]
+        a = _run(monkeypatch, tmp_path, "0", signal_at=signal_at)
+        b = _run(monkeypatch, tmp_path, "1", signal_at=signal_at)
+        _same(a, b)
+        assert b[1].run.stopped_by == "SIGINT" and not b[1].run.finished and (at in ticks) == counted
+
+
 @pytest.mark.parametrize("kw", [{}, {"events": ["t=2:feed-hold", "t=2.6:cycle-start", "t=4:set D21002=50"]}],
                          ids=["plain", "hold-resume-override"])
 def test_stepping_with_its_refill_and_exchange_ahead_equals_stepping(monkeypatch, tmp_path, kw):
