@@ -82,6 +82,7 @@ class SimLink:
     cycles: int = 0
     infos: list[SlaveInfo] = field(default_factory=list)
     io_devices: list[Any] = field(default_factory=list)  # in-process remote I/O modules (hil/remote_io.py)
+    _status: tuple[list[SlaveInfo], int, LinkStatus] | None = field(default=None, repr=False, compare=False)
 
     def open(self) -> list[SlaveInfo]:
         self.infos = [SlaveInfo(i, s.name, getattr(s, "kind", "drive"), 0x000001DD, 0, "OP", "sim")
@@ -100,9 +101,14 @@ class SimLink:
         pass
 
     def status(self) -> LinkStatus:
-        """In-process slaves never leave the line: connected once opened."""
-        return LinkStatus(bool(self.infos), [i.name for i in self.infos], [i.kind for i in self.infos],
-                          [i.state for i in self.infos])
+        """In-process slaves never leave the line: connected once opened. The same status every cycle
+        (the runner reads it each cycle, issue 17), made again when `open` lists the slaves anew."""
+        st = self._status
+        if st is None or st[0] is not self.infos or st[1] != len(self.infos):
+            st = self._status = (self.infos, len(self.infos), LinkStatus(
+                bool(self.infos), [i.name for i in self.infos], [i.kind for i in self.infos],
+                [i.state for i in self.infos]))
+        return st[2]
 
     # SDO to a simulated slave's object dictionary (Delta servo parameters 0x2000+); same signature
     # as EthercatLink.sdo_read / sdo_write.
