@@ -289,8 +289,18 @@ def backward(blocks: Sequence[Block], lo: int = 0, full: bool = False, depth: in
     # This runs ≈ 10 times per pushed block (the tail within braking distance changes on every
     # push), so it works on locals: the downstream block's fields are carried over from the
     # previous step, and min() is spelt out (same operands, same result, no builtin call).
-    nx_vend, nx_binding, nx_cap, nx_length, nx_a, nx_j = 0.0, True, nx.cap, nx.length, nx.a, nx.j
-    nx_av, nx_ad, nx_aa, nx_aj = nx.anchor_v, nx.anchor_d, nx.anchor_a, nx.anchor_j
+    # One name per value, one assignment each: a tuple of four or more is built and unpacked (session 13).
+    nx_vend = 0.0
+    nx_binding = True
+    nx_cap = nx.cap
+    nx_length = nx.length
+    nx_a = nx.a
+    nx_j = nx.j
+    nx_av = nx.anchor_v
+    nx_ad = nx.anchor_d
+    nx_aa = nx.anchor_a
+    nx_aj = nx.anchor_j
+    k_stop = n if full else depth - 2  # the pass may stop past k_stop (k + 2 > depth), never when `full`
     for k, b in enumerate(islice(it, n - 1 - lo)):
         b_cap = b.cap
         local = b.vjunc  # min(b.vjunc, b.cap, nx.cap)
@@ -302,17 +312,27 @@ def backward(blocks: Sequence[Block], lo: int = 0, full: bool = False, depth: in
             v, av, ad, aa, aj = 0.0, 0.0, 0.0, nx_a, nx_j
         else:
             if nx_binding:
-                av, ad, aa, aj = nx_vend, nx_length, nx_a, nx_j
+                av = nx_vend
+                ad = nx_length
+                aa = nx_a
+                aj = nx_j
             else:
-                av, ad = nx_av, nx_ad + nx_length
+                av = nx_av
+                ad = nx_ad + nx_length
                 aa = nx_a if nx_a < nx_aa else nx_aa  # min(nx.anchor_a, nx.a)
                 aj = nx_j if nx_j < nx_aj else nx_aj
             r = reach(av, ad, MARGIN * aa, MARGIN * aj)
             v = r if r < local else local
         binding = v >= local - 1e-12
-        if not full and k + 2 > depth and binding and b.binding and -1e-12 <= v - b.vend <= 1e-12:
+        if k > k_stop and binding and b.binding and -1e-12 <= v - b.vend <= 1e-12:
             break
-        b.vend, b.binding = v, binding
-        b.anchor_v, b.anchor_d, b.anchor_a, b.anchor_j = av, ad, aa, aj
-        nx_vend, nx_binding, nx_cap, nx_length, nx_a, nx_j = v, binding, b_cap, b.length, b.a, b.j
-        nx_av, nx_ad, nx_aa, nx_aj = av, ad, aa, aj
+        b.vend = nx_vend = v
+        b.binding = nx_binding = binding
+        b.anchor_v = nx_av = av
+        b.anchor_d = nx_ad = ad
+        b.anchor_a = nx_aa = aa
+        b.anchor_j = nx_aj = aj
+        nx_cap = b_cap
+        nx_length = b.length
+        nx_a = b.a
+        nx_j = b.j

@@ -639,21 +639,17 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
         `jf`: factor on the run's tangential jerk (nc.motion.shares).
         """
         self.lookahead()
-        blocks = self.blocks
-        b = blocks[0]
+        it = iter(self.blocks)  # the queue walked in order (a deque indexes in O(k)); b is blocks[k], nx blocks[k + 1]
+        b = next(it)
         dist, ra, rj = b.length, b.a, b.j
         vmax = cap
-        k = 0
-        n = len(blocks)
-        while True:
-            b = blocks[k]
-            if k + 1 >= n:
-                return dist, min(b.vend, vmax), ra, rj * jf, vmax
-            nx = blocks[k + 1]
-            if nx.kind != "path" or nx.cap < cap - 1e-9 or b.vend <= 0.0 or k >= 2 * self.depth \
+        cap_lo = cap - 1e-9
+        k_max = 2 * self.depth
+        for k, nx in enumerate(it):
+            if nx.kind != "path" or nx.cap < cap_lo or b.vend <= 0.0 or k >= k_max \
                     or (b.vend >= vmax - 1e-9 and dist >= cruise_from):
                 return dist, min(b.vend, vmax), ra, rj * jf, vmax
-            if b.vjunc < cap - 1e-9:
+            if b.vjunc < cap_lo:
                 if b.binding and b.vend >= max_speed_at(self.v, self.a, dist - self.s, ra, rj * jf):
                     # Not reachable faster than it allows from the present state (a rising
                     # chain of caps behind a corner): it cannot bind, and a profile that ended
@@ -664,8 +660,14 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
                 else:
                     vmax = min(vmax, b.vjunc)
             dist += nx.length
-            ra, rj = min(ra, nx.a), min(rj, nx.j)
-            k += 1
+            x = nx.a  # ra = min(ra, nx.a) and rj = min(rj, nx.j), spelt out
+            if x < ra:
+                ra = x
+            x = nx.j
+            if x < rj:
+                rj = x
+            b = nx
+        return dist, min(b.vend, vmax), ra, rj * jf, vmax  # b is the queue's last block
 
     def _plan_indep(self, b: Block, t0: float) -> _Plan | None:
         assert b.seg is not None
