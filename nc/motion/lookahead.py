@@ -232,16 +232,16 @@ class Limits:
             d0, d1, d2 = t2[0] - t1[0], t2[1] - t1[1], t2[2] - t1[2]
             dv = (d0, d1, d2)
             du = (abs(d0), abs(d1), abs(d2))
-            sq = [d0 * d0, d1 * d1, d2 * d2]  # |d|·|d| is d·d bit for bit
+            sq_sum = d0 * d0 + d1 * d1 + d2 * d2  # |d|·|d| is d·d bit for bit; sum() adds them in this order from 0
         else:
             dv = tuple([p - q for p, q in zip(t2, t1)])
             du = tuple([abs(d) for d in dv])
-            sq = None
+            sq_sum = sum([d * d for d in du])
         cfg = self.cfg
         if self.blend is not None and not raw:
             b1.dv = dv
             b1.du = du
-            b1.du_n = du_n = math.sqrt(sum(sq if sq is not None else [d * d for d in du]))
+            b1.du_n = du_n = math.sqrt(sq_sum)
             if du_n > 1e-9:
                 lines = s1.kind == "line" and s2.kind == "line"
                 b1.vbud, b1.vctol = vb, vc = self.blend.corner_caps(du, du_n, lines, max(b1.a, b2.a))

@@ -29,6 +29,7 @@ from __future__ import annotations
 import math
 from bisect import bisect_left, bisect_right
 from collections.abc import Sequence
+from itertools import islice
 from typing import TYPE_CHECKING
 
 from nc.motion.limits import MotionConfig
@@ -88,22 +89,20 @@ def _scan(fc: "FilterCorners", blocks: Sequence["Block"], pos: float, run_end: f
     hi = run_end + reach
     covered = False
     last = blocks[-1]
-    # The queue's s_end up to the first block past hi: a junction within hi has its next block there,
-    # so that prefix answers _tolerance_free as the whole queue does (~45 of ~100 blocks; issue 17).
-    prefix: list[float] = []
-    from_prefix = True
-    append = prefix.append
+    # The queue up to the first block past hi: a junction within hi has its next block there, so that
+    # prefix's s_end answer _tolerance_free as the whole queue's do (~45 of ~100 blocks; issue 17). Its
+    # length, not the list: _verdicts makes the list when it finds a verdict again (1 scan in 6, session 13).
+    n_pre = None  # the whole queue
     stop_s = run_end - 1e-9
-    for b in blocks:  # each field read once (~50 blocks a scan, two scans a solve; issue 17)
+    for i, b in enumerate(blocks):  # each field read once (~50 blocks a scan, two scans a solve; issue 17)
         seg = b.seg
         if seg is None or b.kind != "path":
             covered = True  # dwell, thread, independent rapid: a stop before it ends every window
-            from_prefix = False
             break
         s_end = b.s_end
-        append(s_end)
         if s_end - b.length > hi:
             covered = True
+            n_pre = i + 1
             break
         if seg.kind == "arc":
             return None  # the curvature share's centripetal terms
@@ -112,12 +111,11 @@ def _scan(fc: "FilterCorners", blocks: Sequence["Block"], pos: float, run_end: f
             seen = vt
         if b.vjunc <= 0.0 and b is not last and s_end >= stop_s:
             covered = True  # an exact stop (G09/G61, G00): the filter settles there
-            from_prefix = False
             break
     if not covered and not (closed or last.s_end > hi):
         return UNKNOWN
     if WALK:
-        return _walk(fc, blocks, pos - reach, hi, seen, prefix if from_prefix else None, v_stop)
+        return _walk(fc, blocks, pos - reach, hi, seen, n_pre, v_stop)
     hist_s = fc._hist_s
     k_lo = bisect_left(hist_s, pos - reach)
     k_hi = bisect_right(hist_s, hi)
@@ -126,7 +124,7 @@ def _scan(fc: "FilterCorners", blocks: Sequence["Block"], pos: float, run_end: f
         # _walk's outcome from the junctions' kept verdicts (module doc of _verdicts): the walk goes from the
         # newest junction back, so the newest NONE decides unless a use of 1 above it ends the walk first
         # (where v_stop allows: the vtops it then reads are all of the reach's, so the first use of 1 decides).
-        sc = _verdicts(fc, blocks, k_lo, k_hi, prefix if from_prefix else None)
+        sc = _verdicts(fc, blocks, k_lo, k_hi, n_pre)
         top = max(fc._vt[k_lo:k_hi])
         if top > seen:
             seen = top
@@ -154,7 +152,7 @@ WALK = False  # True: _scan walks every junction as before the kept verdicts (th
 
 
 def _verdicts(fc: "FilterCorners", blocks: Sequence["Block"], k_lo: int, k_hi: int,
-              prefix: list[float] | None) -> list[float]:
+              n_pre: int | None) -> list[float]:
     """Each junction hist[k_lo:k_hi]'s verdict for _scan: NONE, SKIP or its use min(1, vjunc / vbud), kept in
     fc._sc between scans (issue 17, session 11: consecutive scans cover nearly the same ~90 junctions, and a
     walk over them was the run's largest item). A verdict reads the junction's vjunc, vbud, vtol, vctol and cap
@@ -162,8 +160,8 @@ def _verdicts(fc: "FilterCorners", blocks: Sequence["Block"], k_lo: int, k_hi: i
     _tolerance: the stretch and tolerance windows behind the new junction, and the junction before it, whose
     next block a corner blend trims), an override or dry run every cap (FilterCorners.touch), and a
     solve the head block's (feed per revolution): the junctions up to the head's, whose next block is the head
-    or who are it, are found again when its cap is not the one they were found with. `prefix`: the queue's s_end
-    up to the first block past the reach (None: take the whole queue)."""
+    or who are it, are found again when its cap is not the one they were found with. `n_pre`: the queue's blocks
+    up to the first one past the reach (None: the whole queue), whose s_end `_free` reads."""
     sc = fc._sc
     n = len(sc)
     d = fc._sc_dirty
@@ -180,7 +178,7 @@ def _verdicts(fc: "FilterCorners", blocks: Sequence["Block"], k_lo: int, k_hi: i
         return part
     hist = fc._hist
     tol = fc.tol
-    ends = prefix if prefix is not None else [b.s_end for b in blocks]
+    ends = [b.s_end for b in islice(blocks, n_pre)]
     n_ends = len(ends)
     k = k_lo + part.index(None)
     i = bisect_right(ends, hist[k].s_end)
@@ -209,7 +207,7 @@ def _verdicts(fc: "FilterCorners", blocks: Sequence["Block"], k_lo: int, k_hi: i
 
 
 def _walk(fc: "FilterCorners", blocks: Sequence["Block"], lo: float, hi: float, seen: float,
-          prefix: list[float] | None, v_stop: float) -> tuple[float, float] | None:
+          n_pre: int | None, v_stop: float) -> tuple[float, float] | None:
     """_scan's junction part as a walk over every junction from the newest back (the reference of the kept
     verdicts, `WALK`)."""
     use = 0.0
@@ -217,7 +215,6 @@ def _walk(fc: "FilterCorners", blocks: Sequence["Block"], lo: float, hi: float, 
     tol = fc.tol
     ends: list[float] | None = None  # the queue's s_end, built once a junction needs its next block
     i = 0
-    from_prefix = prefix is not None
     # FilterCorners keeps every junction since the last stop (its _h0 is relative to the newest
     # push, not to the executing block) and drops old ones only in bulk, counted in _seq0.
     # hist is in path order: the junctions past hi are skipped by bisection, not one by one. The
@@ -239,7 +236,7 @@ def _walk(fc: "FilterCorners", blocks: Sequence["Block"], lo: float, hi: float, 
             return None
         if tol is not None:
             if ends is None:
-                ends = prefix if from_prefix else [b.s_end for b in blocks]
+                ends = [b.s_end for b in islice(blocks, n_pre)]
                 i = len(ends)
             # _tolerance_free, its cached verdict inline: the next block follows j in the queue,
             # at bisect_right(ends, j.s_end), found by stepping back (j walks back in path order)
