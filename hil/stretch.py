@@ -93,6 +93,7 @@ class Stretcher(RealTimeStretches):
         self.ahead_used = 0  # real time: refills computed ahead and taken by their cycle
         self.aheads_skipped = 0  # real time: stepped cycles whose work ahead was skipped (B34)
         self.colds_skipped = 0  # real time: starts nothing prepared, not taken for lack of time left (B35)
+        self.starts_skipped = 0  # real time: no start tried for lack of time left (B36)
         # real time: the refill the next stretch starts with, worked out in the slack before the last cycle of the
         # one before, with what it read (the planner's fields, the channel's signature): taken if still the same
         self._next_fill: tuple | None = None
@@ -135,6 +136,9 @@ class Stretcher(RealTimeStretches):
         self._early, self._next_fill = self._next_fill, None  # the one before's, for this start only
         self._taken, self._spec, self._prep = self._spec, None, None  # B22: the one before's, this start's only
         if limit < 2 or ch is None or self.ahead_only:
+            return False
+        if self.paced and r.clock.left_ns() < stretch_realtime.START_LEFT_NS:
+            self.starts_skipped += 1  # B36: too near the next tick for a start's checks and set-up: step
             return False
         kind = self._quiet(r, ch)
         if kind is None:

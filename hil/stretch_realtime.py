@@ -46,6 +46,9 @@ AHEAD_LEFT_NS = 500_000
 # B35: a start nothing prepared (B23: its samples and models in this slack, p50 ≈ 600 µs in the CAM program at load
 # 1-3) is taken only while this much of the period is left; else the cycle steps (exact, as always)
 COLD_LEFT_NS = 700_000
+# B36: no stretch start at all (not even a prepared one: its checks and set-up, p50 ≈ 330 µs at load 4) while less
+# than this is left of the period, as after a stepped cycle's block solve in the CAM program; the cycle steps
+START_LEFT_NS = 500_000
 _WRITTEN: dict[int, set] = {}
 
 

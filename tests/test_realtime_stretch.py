@@ -348,7 +348,24 @@ def test_a_start_nothing_prepared_needs_time_left_in_the_period(monkeypatch, tmp
     a = _run(monkeypatch, tmp_path, "0")
     b = _run(monkeypatch, tmp_path, "1")
     assert made[-1].colds_skipped == 0 and b[1].run.stretched > 0.8 * b[1].run.cycles  # the fake clock's slack
+    assert made[-1].starts_skipped == 0  # (B36's guard neither)
     monkeypatch.setattr(hil.stretch_realtime, "COLD_LEFT_NS", 2_000_000)
     b = _run(monkeypatch, tmp_path, "1")
     _same(a, b)
     assert made[-1].colds_skipped > 1000 and b[1].run.stretched == 0 and b[1].run.ok
+
+
+def test_no_start_is_tried_near_the_next_tick(monkeypatch, tmp_path):
+    """B36: no stretch start, prepared or not, is tried while less than START_LEFT_NS of the period is left; the
+    cycle steps. On the fake clock's short cycles the default skips none; above the period every start is skipped
+    before its checks (no cold start is even refused), and the run equals stepping in every column."""
+    import hil.stretch_realtime
+
+    made = _made_stretchers(monkeypatch)
+    a = _run(monkeypatch, tmp_path, "0")
+    monkeypatch.setattr(hil.stretch_realtime, "START_LEFT_NS", 2_000_000)
+    b = _run(monkeypatch, tmp_path, "1")
+    _same(a, b)
+    st = made[-1]
+    assert st.starts_skipped > 10_000 and st.colds_skipped == 0 and st.specs_used == 0
+    assert b[1].run.stretched == 0 and b[1].run.ok
