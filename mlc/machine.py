@@ -169,6 +169,8 @@ class Mlc:
         """The first spindle drive's (mode, position setpoint deg, speed override rpm) this cycle:
         CSV as a spindle, CSP while positioning (M29/M19) or while it is the channel's C axis."""
         if self.caxis.idle():  # the usual cycle: a spindle that stays one, its feedback not read
+            if not self.caxis.failed or self.caxis_alarmed:  # _caxis_checked would only pass it on
+                return MODE_CSV, None, None
             return self._caxis_checked(runner, (MODE_CSV, None, None))
         n = len(runner.axes)
         tx = runner.tx[n]

@@ -473,7 +473,7 @@ class ChannelLink:
         fwd = bool(m[base])
         if fwd == bool(m[base + 1]):
             return 0.0
-        src = (mem.u32(d2(x, 24)) if m[base + 6] else mem.f32(d3(x, 24))) if k == 0 else 0.0
+        src = (mem.u32(20024 + 1000 * x) if m[base + 6] else mem.f32(30024 + 1000 * x)) if k == 0 else 0.0  # D2x024, D3x024
         rpm = min(abs(src), self.spindle_max_rpm)
         return rpm if fwd else -rpm
 

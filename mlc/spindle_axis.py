@@ -84,7 +84,8 @@ class SpindleAxisSwitch:
         """The usual cycle, counted as `drive` counts it: a spindle that stays a spindle (nothing asked, so
         `drive` would return (MODE_CSV, None, None) at once, reading none of its feedback). True: this
         cycle is done; False: call `drive` (issue 17: the runner skips the feedback it would not read)."""
-        if self.state != SPINDLE or self._want_c() or self._want_orient():
+        m, b2 = self.mem.m, 20000 + 1000 * self.x  # _want_c and _want_orient read straight from the bits
+        if self.state != SPINDLE or m[b2 + 708] or m[M_REQUEST_LATHE] or m[b2 + 706]:
             return False
         self._cycles += 1  # SPINDLE has no positioning started: drive()'s check-time test is a no-op here
         return True
