@@ -82,6 +82,9 @@ class Block:
     tf_tcap: float = math.nan
     tf_ok: bool = False
     trim0: float = 0.0  # path its start gave to a corner blend before it (nc.motion.corner_blends)
+    # A path block that is not an arc (the jerk-factor scan's walk reads this one field for the three it
+    # tests, session 13): set as the block joins the queue; False means "test them" (nc.motion.shares._scan).
+    scan_plain: bool = False
 
 
 def change_distance(v0: float, v1: float, a: float, j: float) -> float:

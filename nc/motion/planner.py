@@ -185,6 +185,8 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
         b.s_end = self._path_s
         if self._zones is not None:
             self._zones.block(b.s_end - b.length, b.vtop)
+        seg = b.seg
+        b.scan_plain = b.kind == "path" and seg is not None and seg.kind != "arc"
         self.blocks.append(b)
         self.threads_queued += b.kind == "thread"
         self._pushed += added

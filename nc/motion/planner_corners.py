@@ -45,6 +45,7 @@ class CornerShares:
             zones.add_blend(blk.s_end - blk.length, blk.s_end, max(prev.vtop, b.vtop))
         for x in (prev, blk, b):
             self._update_cap(x)
+        blk.scan_plain = blk.kind == "path" and blk.seg is not None and blk.seg.kind != "arc"  # as `_push` sets it
         self.blocks.append(blk)
         if self.lim.blend is not None:
             # The filter's windows walk the queue and their junction history side by side: the junction

@@ -95,16 +95,18 @@ def _scan(fc: "FilterCorners", blocks: Sequence["Block"], pos: float, run_end: f
     n_pre = None  # the whole queue
     stop_s = run_end - 1e-9
     for i, b in enumerate(blocks):  # each field read once (~50 blocks a scan, two scans a solve; issue 17)
-        seg = b.seg
-        if seg is None or b.kind != "path":
-            covered = True  # dwell, thread, independent rapid: a stop before it ends every window
-            break
+        plain = b.scan_plain  # a path block, not an arc: the kind and segment tests below answer as they do here
+        if not plain:
+            seg = b.seg
+            if seg is None or b.kind != "path":
+                covered = True  # dwell, thread, independent rapid: a stop before it ends every window
+                break
         s_end = b.s_end
         if s_end - b.length > hi:
             covered = True
             n_pre = i + 1
             break
-        if seg.kind == "arc":
+        if not plain and seg.kind == "arc":
             return None  # the curvature share's centripetal terms
         vt = b.vtop
         if vt > seen:
