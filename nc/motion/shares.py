@@ -29,7 +29,8 @@ from __future__ import annotations
 import math
 from bisect import bisect_left, bisect_right
 from collections.abc import Sequence
-from itertools import islice
+from itertools import chain, islice
+from operator import attrgetter
 from typing import TYPE_CHECKING
 
 from nc.motion.limits import MotionConfig
@@ -73,6 +74,8 @@ def jerk_factor(cfg: MotionConfig, fc: "FilterCorners", blocks: Sequence["Block"
 
 
 UNKNOWN = (-1.0, -1.0)  # _scan: the queue ends before the reach does
+_ZERO = (0.0,)
+_VTOP = attrgetter("vtop")
 # Above FilterCorners._boost_ratio's largest value (2: doubling the jerk at most doubles the speed-up) by
 # far more than its rounding: _tolerance_free's bound.
 RATIO_BOUND = 2.001
@@ -85,7 +88,6 @@ def _scan(fc: "FilterCorners", blocks: Sequence["Block"], pos: float, run_end: f
     caller's factor is 1 for a use of 1, so once a junction uses 1 and no vtop in the reach exceeds
     v_stop (no wider scan follows) the rest only needs those vtops (issue 17: 722 of the CAM program's
     2,303 scans)."""
-    seen = 0.0
     hi = run_end + reach
     covered = False
     last = blocks[-1]
@@ -93,6 +95,7 @@ def _scan(fc: "FilterCorners", blocks: Sequence["Block"], pos: float, run_end: f
     # prefix's s_end answer _tolerance_free as the whole queue's do (~45 of ~100 blocks; issue 17). Its
     # length, not the list: _verdicts makes the list when it finds a verdict again (1 scan in 6, session 13).
     n_pre = None  # the whole queue
+    n_seen = None  # the blocks whose vtop counts (None: all), their fastest found after the walk
     stop_s = run_end - 1e-9
     for i, b in enumerate(blocks):  # each field read once (~50 blocks a scan, two scans a solve; issue 17)
         plain = b.scan_plain  # a path block, not an arc: the kind and segment tests below answer as they do here
@@ -100,22 +103,25 @@ def _scan(fc: "FilterCorners", blocks: Sequence["Block"], pos: float, run_end: f
             seg = b.seg
             if seg is None or b.kind != "path":
                 covered = True  # dwell, thread, independent rapid: a stop before it ends every window
+                n_seen = i
                 break
         s_end = b.s_end
         if s_end - b.length > hi:
             covered = True
             n_pre = i + 1
+            n_seen = i
             break
         if not plain and seg.kind == "arc":
             return None  # the curvature share's centripetal terms
-        vt = b.vtop
-        if vt > seen:
-            seen = vt
         if b.vjunc <= 0.0 and b is not last and s_end >= stop_s:
             covered = True  # an exact stop (G09/G61, G00): the filter settles there
+            n_seen = i + 1
             break
     if not covered and not (closed or last.s_end > hi):
         return UNKNOWN
+    # The fastest vtop of the blocks walked (C-level over them, session 13): from 0.0 on, each taken where
+    # it is higher, as `if vt > seen: seen = vt` in the walk did (max() keeps the first of equal ones)
+    seen = max(chain(_ZERO, map(_VTOP, islice(blocks, n_seen))))
     if WALK:
         return _walk(fc, blocks, pos - reach, hi, seen, n_pre, v_stop)
     hist_s = fc._hist_s
