@@ -64,10 +64,12 @@ MODE_CSP, MODE_CSV = 8, 9
 
 
 def wanted(realtime: bool = False) -> bool:
-    """Stretches on? Lock-step: unless DELTAHIL_STRETCH=0. Real time: only with DELTAHIL_STRETCH=1 (B21 amended:
-    a stretch start's work ahead, ≈ 0.6-1 ms, overran its slack ~8x as often as stepping every cycle)."""
+    """Stretches on? Unless DELTAHIL_STRETCH=0, in lock-step and (since decision bench B37) in real time too, where
+    `ahead` means every cycle stepped with its work ahead (B31). B21 had made them opt-in in real time (a start's
+    work, ≈ 0.6-1 ms in one slack, overran it); B22-B36 cut that work into parts and guards, and with B36 they
+    miss fewer deadlines than stepping on the lathe demo and the CAM program (interleaved runs, B32's rule)."""
     value = os.environ.get(ENV)
-    return value == "1" if realtime else value != "0"
+    return value not in ("0", "ahead") if realtime else value != "0"
 
 
 def ahead_wanted() -> bool:

@@ -136,6 +136,19 @@ def test_a_realtime_run_with_stretches_equals_stepping(monkeypatch, tmp_path, kw
     assert "cycle work" in lines and b["max"] > 0
 
 
+def test_stretches_are_the_default_in_real_time_too(monkeypatch):
+    """B37: without DELTAHIL_STRETCH a real-time run takes stretches as a lock-step one does; `0` steps every cycle
+    in both, `ahead` (B31) steps every cycle in real time with its refill and exchange ahead."""
+    from hil.stretch import ahead_wanted, wanted
+
+    monkeypatch.delenv(ENV, raising=False)
+    assert wanted(realtime=True) and wanted(realtime=False) and not ahead_wanted()
+    for value, rt, lockstep, ahead in (("0", False, False, False), ("1", True, True, False),
+                                       ("ahead", False, True, True)):
+        monkeypatch.setenv(ENV, value)
+        assert (wanted(realtime=True), wanted(realtime=False), ahead_wanted()) == (rt, lockstep, ahead)
+
+
 def test_starts_worked_out_ahead_and_dropped_leave_the_run_as_stepping(monkeypatch, tmp_path):
     """B22: every start worked out in the slacks before it is dropped (as when what it read changed): the planner
     and the drives were left as found (the filter's share zones too, which sampling pops), so the run still
