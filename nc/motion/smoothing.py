@@ -89,19 +89,34 @@ class PositionFilter:
         else:
             self._still = 0
             self._last = row
-        self._s1 = s1 = [s + (a - b) for s, a, b in zip(self._s1, row, self._w1[0])]
-        self._w1.append(row)
         n1, n2 = self.n1, self.n2
-        y1 = [s / n1 for s in s1]
-        self._s2 = s2 = [s + (a - b) for s, a, b in zip(self._s2, y1, self._w2[0])]
-        self._w2.append(y1)
+        if len(row) == 3:  # the comprehensions below spelt out for 3 axes: once a cycle (session 13)
+            x0, x1, x2 = row
+            s0, s1, s2 = self._s1
+            o0, o1, o2 = self._w1[0]  # read before the append drops it
+            s0 += x0 - o0  # s + (a - b)
+            s1 += x1 - o1
+            s2 += x2 - o2
+            self._s1 = [s0, s1, s2]
+            self._w1.append(row)
+            x0, x1, x2 = y1 = [s0 / n1, s1 / n1, s2 / n1]
+            t0, t1, t2 = self._s2
+            o0, o1, o2 = self._w2[0]
+            self._s2 = s2 = [t0 + (x0 - o0), t1 + (x1 - o1), t2 + (x2 - o2)]
+            self._w2.append(y1)
+        else:
+            self._s1 = s1 = [s + (a - b) for s, a, b in zip(self._s1, row, self._w1[0])]
+            self._w1.append(row)
+            y1 = [s / n1 for s in s1]
+            self._s2 = s2 = [s + (a - b) for s, a, b in zip(self._s2, y1, self._w2[0])]
+            self._w2.append(y1)
         if self._still >= self.span:
             # Constant input for a whole window: the exact value, free of summation round-off.
             recent = self._recent
             self.reset(row)
             self._recent = (recent[1], recent[2], row)
             return row
-        out = [s / n2 for s in s2]
+        out = [s2[0] / n2, s2[1] / n2, s2[2] / n2] if len(s2) == 3 else [s / n2 for s in s2]
         if lam != 1.0 and self.lag is not None:
             d = self._w1[n1 - 1 - self.lag]
             out = [p + lam * (f - p) for p, f in zip(d, out)]
