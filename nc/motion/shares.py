@@ -53,7 +53,10 @@ def jerk_factor(cfg: MotionConfig, fc: "FilterCorners", blocks: Sequence["Block"
     if st <= 0.0 or st + pool > 1.0 + 1e-9 or not blocks:
         return 1.0, False
     t_w = fc.t_j
-    v_hi = max(b.vtop for b in (blocks[0], blocks[-1]))
+    v_hi = blocks[0].vtop  # max() of the two, spelt out (no generator a scan, session 13)
+    x = blocks[-1].vtop
+    if x > v_hi:
+        v_hi = x
     # Whether a junction using its whole share (use 1) already makes the factor 1: then _scan may stop at
     # the first such junction once no block faster than v_hi lies in the reach (every other outcome of
     # its scan, None included, gives 1.0 too).
@@ -192,7 +195,7 @@ def _verdicts(fc: "FilterCorners", blocks: Sequence["Block"], k_lo: int, k_hi: i
     i = bisect_right(ends, hist[k].s_end)
     for k in range(k, k_hi):
         j = hist[k]
-        if j.seg is not None and j.seg.kind == "arc":
+        if not j.scan_plain and j.seg is not None and j.seg.kind == "arc":  # scan_plain: a path block, no arc
             sc[k] = NONE
             continue
         if j.du_n <= 1e-9:
