@@ -135,6 +135,7 @@ class BenchRunner:
         self._overrun_alarmed = False
         self._hooks: tuple | None = None  # (link, mlc, what they offer the cycle): asked once, see _cycle
         self._bus_ahead = False  # real time on the sim bus: a stepped cycle's exchange runs before its tick
+        self._stretcher: Stretcher | None = None  # run_events' (hil/stretch.py), for _settle too (B38)
 
     def trace_columns(self) -> list[str]:
         extra = [c for src in self.trace_sources for c in src.columns]
@@ -253,6 +254,7 @@ class BenchRunner:
         give_up = max_cycles + int(STANDSTILL_TIMEOUT / self.bench.cycle)
         stopping = False
         stretcher = Stretcher.for_runner(self)  # quiet cycles a stretch at a time (issue 17, decision B20)
+        self._stretcher = stretcher  # the settle after the program takes stretches too (B38)
         while ch.busy and self.cycle < give_up:
             if self.stop_request is not None and not stopping:
                 stopping = True  # along the path, jerk-limited, then flush: the NC's reset
@@ -274,9 +276,9 @@ class BenchRunner:
                 ch.raise_alarm(Alarm(MAX_TIME_ALARM, f"run exceeded the bench's max_time of {self.bench.max_time:g} s",
                                      line=self.line or None))
         self.result.program_time = self.time - t0
-        self.result.stretched = stretcher.cycles if stretcher is not None else 0
         self.result.finished = ch.state is RunState.FINISHED
         self._settle()
+        self.result.stretched = stretcher.cycles if stretcher is not None else 0  # the settle's too (B38)
 
     # ---- spindle feedback for the planner (issue 5: feed per rev, CSS, threading) -----------
     def spindle_command_rpm(self) -> float:
@@ -476,12 +478,25 @@ class BenchRunner:
         return self._rest[i] >= REST_CYCLES and (self.tx[i].following_error == 0 or not self.masters[i].enabled)
 
     def _settle(self) -> None:
-        """Keep cycling on the final setpoints until the axes stand still (or the settle time ends)."""
-        for _ in range(int(self.bench.settle_time / self.bench.cycle)):
-            self._exchange()
-            still = all(self._at_rest(i) for i in range(len(self.axes)))
-            if still:
-                break
+        """Keep cycling on the final setpoints until the axes stand still (or the settle time ends). Quiet cycles a
+        stretch at a time (decision bench B38): a stretch ends after the first cycle the axes stand still."""
+        total = int(self.bench.settle_time / self.bench.cycle)
+        stretcher, done = self._stretcher, 0
+        if stretcher is not None:
+            stretcher.settling = True
+        try:
+            while done < total:
+                c0 = self.cycle
+                if stretcher is not None and stretcher.run(total - done):
+                    done += self.cycle - c0
+                else:
+                    self._exchange()
+                    done += 1
+                if all(self._at_rest(i) for i in range(len(self.axes))):
+                    break
+        finally:
+            if stretcher is not None:
+                stretcher.settling = False
 
     def _standstill(self) -> None:
         """Cycle until every axis stands (the channel's stop along the path, or the drives' quick

@@ -114,6 +114,9 @@ class Stretcher(RealTimeStretches):
         self.feeds = 0
         self._fed0 = False
         self.ahead_only = self.paced and not wanted(True)  # real time: steps every cycle, its refill ahead
+        # B38: the runner's settle after the program (BenchRunner._settle) asks for stretches too: the channel has
+        # finished and stands, only the drives settle; a stretch ends at the first cycle every axis is at rest
+        self.settling = False
 
     @classmethod
     def for_runner(cls, runner: Any) -> "Stretcher | None":
@@ -150,8 +153,8 @@ class Stretcher(RealTimeStretches):
                 and (may_read(ch, pl) or (no_reads(ch) and not ch.alarms and not pl.held)):
             return self._run_pass(r, ch, pl, limit)  # B27: the NC's steps inside the stretch
         fill = None
-        if kind in ("wait", "drain"):  # standing: an M/S/T code waits for its finish, or the filter's tail
-            n = min(limit, self.max_cycles)
+        if kind in ("wait", "drain", "settle"):  # standing: an M/S/T code waits for its finish, the filter's tail,
+            n = min(limit, self.max_cycles)        # or the drives settle after the program (B38)
             if kind == "drain":  # the cycle that begins with the filter settled issues the waiting code: stepped
                 n = min(n, pl.filter.span - pl.filter._still)
             self._sampler = stand_stretch
@@ -198,7 +201,7 @@ class Stretcher(RealTimeStretches):
             if n < 2:
                 _restore_planner(pl, saved_pl)
                 return False
-        if kind != "wait":
+        if kind not in ("wait", "settle"):  # (a finished channel's step feeds nothing either)
             _fed(ch, pl)
         rx0 = [copy.copy(rx) for rx in r.rx]  # what the drives are stepped with (the runner's change per cycle)
         saved_drives = [dict(d.__dict__) for d in self.drives]
@@ -233,6 +236,8 @@ class Stretcher(RealTimeStretches):
         cycle a drive or the bench's overspeed check would fault in, then played."""
         saved_pl, saved_drives, rx0, targets = saved
         m = min(o.done for o in outs)
+        if self.settling:  # B38: BenchRunner._settle stops after the first cycle every axis is at rest
+            m = min(m, self._first_rest(r, outs, m))
         for i in range(self.n_axes):  # the bench's overspeed check (App. A 0x0602) fires in that cycle
             v, lim = outs[i].velocity_actual[:m], r._overspeed[i]
             if v and max(map(abs, v)) > lim:  # (in Python: numpy's conversions cost ≈ 20 µs a start, B33)
@@ -357,6 +362,27 @@ class Stretcher(RealTimeStretches):
         self.cycles += k
         return True
 
+    def _first_rest(self, r: Any, outs: list[Stretch], m: int) -> int:
+        """B38: the cycles of a settle stretch up to and including the first one after which every axis is at rest
+        (BenchRunner._at_rest on the rest counters feedback() would count, its following error); m if none."""
+        from hil.runner import REST_CYCLES
+
+        axes = range(self.n_axes)
+        rest, last = r._rest[:self.n_axes], r._last_position[:self.n_axes]
+        enabled = [r.masters[i].enabled for i in axes]  # (a stretch keeps every master in its state)
+        for c in range(m):
+            still = True
+            for i in axes:
+                o = outs[i]
+                p = o.position_actual[c]
+                rest[i] = rest[i] + 1 if p == last[i] and o.velocity_actual[c] == 0 else 0
+                last[i] = p
+                if rest[i] < REST_CYCLES or (o.following_error[c] != 0 and enabled[i]):
+                    still = False
+            if still:
+                return c + 1
+        return m
+
     # ---- real time -----------------------------------------------------------------------------------
     def _bulk_ok(self, r: Any) -> bool:
         """At once (stretch_bulk), or in real time paced with only the outputs per cycle (B21). Not on a bench
@@ -400,6 +426,11 @@ class Stretcher(RealTimeStretches):
             if hasattr(watch, "_aux") and watch._aux is not ch.pending_aux:
                 return None  # AuxWatch has not seen the code yet (it times the wait)
             return "wait"
+        if ch.state is RunState.FINISHED and self.settling:  # B38: the program's end, the drives settling
+            if (ch.pending_aux is not None or pl.blocks or pl.plan is not None or ch.single_block
+                    or (isinstance(mlc, Mlc) and (mlc.link._handed is not None or mlc.link._system_hold is not None))):
+                return None
+            return "settle"
         if ch.state is not RunState.RUNNING or ch.pending_aux is not None:
             return None
         if isinstance(mlc, Mlc) and mlc.link._handed is not None:

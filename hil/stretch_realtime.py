@@ -319,7 +319,7 @@ class RealTimeStretches:
             pl.position = here
         if standing:
             f = pl.filter
-            wait = sampler is stand_stretch and ch.state is RunState.WAIT_AUX
+            wait = sampler is stand_stretch and ch.state in (RunState.WAIT_AUX, RunState.FINISHED)  # FINISHED: B38
             n = self.max_cycles if wait else min(self.max_cycles, f.span - f._still) if f is not None else 0
         elif rows == 0 and fill is None:
             return
@@ -386,7 +386,7 @@ class RealTimeStretches:
         if spec.fill is not None:
             self._sampler = _refilled(spec.fill)  # a cut samples again from before the refill
             self.fills_early += 1
-        if kind != "wait":  # as Stretcher.run
+        if kind not in ("wait", "settle"):  # as Stretcher.run
             _fed(ch, pl)
         for d, after in zip(self.drives, spec.drives_after):
             d.__dict__.clear()

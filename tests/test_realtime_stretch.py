@@ -382,3 +382,50 @@ def test_no_start_is_tried_near_the_next_tick(monkeypatch, tmp_path):
     st = made[-1]
     assert st.starts_skipped > 10_000 and st.colds_skipped == 0 and st.specs_used == 0
     assert b[1].run.stretched == 0 and b[1].run.ok
+
+
+def test_the_settle_after_the_program_takes_stretches_and_ends_on_the_same_cycle(monkeypatch, tmp_path):
+    """B38: after the program the runner cycles until the axes stand (BenchRunner._settle); those cycles take
+    stretches too (standing samples, the drives settling), each ending after the first cycle every axis is at
+    rest, so the settle ends on the cycle stepping ends it and the trace equals stepping's in every column."""
+    from hil.runner import BenchRunner
+
+    stepped: dict[str, int] = {}
+    settle, exchange = BenchRunner._settle, BenchRunner._exchange
+    flag = [None]
+    ends: list[int] = []
+
+    def spy_settle(self):
+        flag[0] = self
+        c0 = self.cycle
+        try:
+            settle(self)
+        finally:
+            flag[0] = None
+        n, _ = stepped.get(self._run_mode, (0, 0))
+        stepped[self._run_mode] = (n, self.cycle - c0)
+        ends.append(self.cycle)
+
+    def spy_exchange(self, *a, **k):
+        if flag[0] is self:
+            n, c = stepped.get(self._run_mode, (0, 0))
+            stepped[self._run_mode] = (n + 1, c)
+        return exchange(self, *a, **k)
+
+    monkeypatch.setattr(BenchRunner, "_settle", spy_settle)
+    monkeypatch.setattr(BenchRunner, "_exchange", spy_exchange)
+    for mode in ("0", "1"):
+        monkeypatch.setattr(BenchRunner, "_run_mode", mode, raising=False)
+        if mode == "0":
+            a = _run(monkeypatch, tmp_path, mode)
+        else:
+            b = _run(monkeypatch, tmp_path, mode)
+    _same(a, b)
+    (steps_0, cycles_0), (steps_1, cycles_1) = stepped["0"], stepped["1"]
+    assert cycles_0 == cycles_1 > 20 and steps_0 == cycles_0  # the same settle, every cycle stepped without
+    assert steps_1 <= 2  # with stretches: at most a cold start's refusal (B35) stepped
+    # the settle ended where the axes stood: their feedback unchanged in its last rows, no following error left
+    assert ends[0] == ends[1]
+    end = b[0]["cycle"].index(ends[1])
+    for axis in ("X", "Z"):
+        assert len(set(b[0][f"{axis}_act"][end - 2:end + 1])) == 1 and b[0][f"{axis}_ferr"][end] == 0.0
