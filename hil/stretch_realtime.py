@@ -40,12 +40,17 @@ SLACK_BUDGET_NS = 250_000
 # B34: a stepped cycle's work ahead (its in-process bus exchange and its refill, p50 150 µs in the CAM program) is
 # skipped when the cycle before it worked longer than AHEAD_WORK_NS or less than AHEAD_LEFT_NS of the period is left:
 # the next cycle then does that work itself, after its tick, as stepping does (a block solve's ≈ 1 ms cycle left
-# no room for it: 29 of 44 late ticks of CAM followed such slacks, B33)
-AHEAD_WORK_NS = 300_000
+# no room for it: 29 of 44 late ticks of CAM followed such slacks, B33). 600 µs (was 300) since B39: the lathe demo's
+# stepped cycles paced are 200-430 µs, and over 300 each skipped the next one's exchange ahead, which made that one
+# as long: chains of 2-5 stepped cycles over 150 µs after a block end (benchmarks/rt_census.py)
+AHEAD_WORK_NS = 600_000
 AHEAD_LEFT_NS = 500_000
 # B35: a start nothing prepared (B23: its samples and models in this slack, p50 ≈ 600 µs in the CAM program at load
-# 1-3) is taken only while this much of the period is left; else the cycle steps (exact, as always)
-COLD_LEFT_NS = 700_000
+# 1-3) is taken only while this much of the period is left; else the cycle steps (exact, as always). 550 µs (was
+# 700) since B39: after a block end's stepped cycle (200-400 µs) 700 refused the next start 1-4 times in a row, each
+# refusal a stepped cycle of 200-400 µs (37-86 a lathe demo run, the most of its stepped cycles); at 500-600 the
+# overruns stayed as many (rt_census A/B)
+COLD_LEFT_NS = 550_000
 # B36: no stretch start at all (not even a prepared one: its checks and set-up, p50 ≈ 330 µs at load 4) while less
 # than this is left of the period, as after a stepped cycle's block solve in the CAM program; the cycle steps
 START_LEFT_NS = 500_000
