@@ -208,10 +208,14 @@ class Pass:
         m = min(run.out.done for run in runs)
         for i in range(n_axes):  # a few cycles a part: plain Python, not numpy calls
             lim, va = r._overspeed[i], runs[i].out.velocity_actual
-            for k in range(a, m):
+            w = len(va)  # the cycles written: a still drive's later ones (CspRun.lag) repeat the last
+            for k in range(a, m if m <= w else w):
                 if abs(va[k]) > lim:
                     m = k
                     break
+            else:
+                if m > w and abs(va[-1]) > lim:
+                    m = max(a, w)
         return m if m < upto else None
 
     def _back(self, stop: int) -> int:

@@ -71,6 +71,9 @@ class CspRun:
     def __init__(self, drive: Cia402Drive, rx: RxPdo, dt: float) -> None:
         self.drive, self.rx, self.dt = drive, rx, dt
         self.out = Stretch()
+        # still cycles stepped and counted in out.done but not written yet (`_settle`): a standing axis's parts
+        # (Z through an XY contour, ≈ 1,400 parts of 1-10 cycles in the CAM program) cost a count, not a call each
+        self.lag = 0
         self.ok = can_stretch(drive, rx)
         if not self.ok:
             return
@@ -100,8 +103,11 @@ class CspRun:
             return
         still = self.still
         if still is not None and targets[0] == still and list(targets).count(still) == len(targets):
-            self._stand(len(targets))  # a standing axis (Z in an XY contour): no set-up, no loop
+            self.lag += len(targets)  # a standing axis (Z in an XY contour): no set-up, no loop, written later
+            self.out.done += len(targets)
             return
+        if self.lag:
+            self._settle()
         (n, h, max_cps, alpha, rad, reached_v, kp, kff, window, origin, k_raw, t_pct, inertia, viscous, coulomb, rated,
          lo, hi, base, ks, neg, over, limited) = self.consts
         pos, vel, t, command, prev_target, acc, torque = self.state
@@ -159,12 +165,15 @@ class CspRun:
         self.still = still
         out.done = len(pa)
 
-    def _stand(self, cycles: int) -> None:
-        """`cycles` more cycles at the target of a cycle that left the drive as it found it (_same): that cycle again."""
-        _stand(self, cycles, True)
+    def _settle(self) -> None:
+        """The still cycles counted (`lag`) written: the cycle that left the drive as it found it (_same), again."""
+        _stand(self, self.lag, True)
+        self.lag = 0
 
     def finish(self) -> Stretch:
         """The drive's state after the last cycle stepped, and that cycle's TxPdo (`out.last`)."""
+        if self.lag:
+            self._settle()
         out = self.out
         if out.position_actual:
             pos, vel, t, command, prev_target, acc, torque = self.state
@@ -179,6 +188,7 @@ class CsvRun:
     def __init__(self, drive: Cia402Drive, rx: RxPdo, dt: float) -> None:
         self.drive, self.rx, self.dt = drive, rx, dt
         self.out = Stretch()
+        self.lag = 0  # still cycles counted in out.done, not written yet (as CspRun.lag: a mill's standing spindle)
         self.ok = can_stretch(drive, rx, 9)
         if not self.ok:
             return
@@ -200,8 +210,9 @@ class CsvRun:
         """The next `cycles` cycles; stops (for good) before a cycle that would fault or latch the index."""
         if cycles <= 0 or not self.ok:
             return
-        if self.still:  # a standing spindle (a mill's CAM program): no set-up, no loop
-            self._stand(cycles)
+        if self.still:  # a standing spindle (a mill's CAM program): no set-up, no loop, written at finish()
+            self.lag += cycles
+            self.out.done += cycles
             return
         n, h, max_cps, alpha, rad, reached_v = self.model
         origin, ramp, want, every = self.origin, self.ramp, self.want, self.every
@@ -274,12 +285,11 @@ class CsvRun:
         out.following_error += [0] * (len(pa) - len(out.following_error))  # 0x60F4 is a CSP object: 0 in CSV
         out.done = len(pa)
 
-    def _stand(self, cycles: int) -> None:
-        """`cycles` more cycles of a drive the last of which left it as it found it (_same): that cycle again."""
-        _stand(self, cycles, False)
-
     def finish(self) -> Stretch:
         """The drive's state after the last cycle stepped, and that cycle's TxPdo (`out.last`)."""
+        if self.lag:  # (a still spindle stays still: its lag is written here, once)
+            _stand(self, self.lag, False)
+            self.lag = 0
         out = self.out
         if out.position_actual:
             pos, vel, t, command, tv, acc, torque = self.state
@@ -332,7 +342,8 @@ def _at_speed(out: Stretch, cycles: int, pos: float, t: float, command: float, d
 
 
 def _stand(run: "CspRun | CsvRun", cycles: int, csp: bool) -> None:
-    """A still drive's next cycles (CspRun._stand, CsvRun._stand): its feedback repeated, its time summed on."""
+    """A still drive's next cycles (`lag`, written by CspRun._settle, CsvRun.finish): its feedback repeated, its time
+    summed on."""
     n, h = run.model[0], run.model[1]
     state = run.state
     out = run.out
