@@ -169,7 +169,7 @@ class BenchRunner:
             if paced:
                 _quiet_gc()
             else:  # B42: what is built so far (modules, the parsed program) frozen out of the collector's walks
-                gc.freeze()  # for the run: a generation-2 walk in a CAM program cost ≈ 9 µs a cycle of the run
+                gc.freeze()  # for the run: in a 2nd CAM run in one process a generation-2 walk cost ≈ 9 µs a cycle
             if not self.power_up() or not home_axes(self):  # axes with a bench `homing` table: drive homing
                 return self._finish()
             interp.take_position(dict(zip(self.axes, self.actual.tolist())))
