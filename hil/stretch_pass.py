@@ -92,6 +92,9 @@ class Pass:
         self.runs: list[CspRun | CsvRun] | None = None  # the drive models over the cycles driven (made at the first part)
         self.driven = 0  # cycles the drives were stepped through
         self.targets: list[list[int]] = [[rx.target_position] for rx in rx0[:st.n_axes]]
+        # each axis's AxisScaling.to_counts factor and origin (the runner's: nothing in a pass shifts it)
+        org = st.r.origin.tolist()
+        self.to_counts = [(sc._cpu, org[i]) for i, sc in enumerate(st.r.scales[:st.n_axes])]
         self.feeds = 0
         self.reads = not no_reads(ch)  # (constant over the stretch: its feeds read plain moves only)
 
@@ -171,9 +174,12 @@ class Pass:
         if not self.pending:
             return
         pl, pending = self.pl, self.pending
-        raw = pending[0][0] if len(pending) == 1 else np.concatenate([r for r, _ in pending])
-        lam = None if all(lm is None for _, lm in pending) else \
-            np.concatenate([np.ones(len(r)) if lm is None else lm for r, lm in pending])
+        if len(pending) == 1:  # (most flushes: a part of one take)
+            raw, lam = pending[0]
+        else:
+            raw = np.concatenate([r for r, _ in pending])
+            lam = None if all(lm is None for _, lm in pending) else \
+                np.concatenate([np.ones(len(r)) if lm is None else lm for r, lm in pending])
         self.pending = []
         f = pl.filter
         if f is None:
@@ -185,10 +191,13 @@ class Pass:
         pl.output = np.array(rows[-1])
         self.out_rows += rows  # (an array once, in samples())
         self.filtered += len(rows)
-        sc, org = self.st.r.scales, self.st.r.origin.tolist()
-        for i, t in enumerate(self.targets):
-            cpu, o = sc[i]._cpu, org[i]
-            t += [round((row[i] - o) * cpu) for row in rows]  # AxisScaling.to_counts, inline (round: an int)
+        if len(rows) == 1:  # (a reading cycle's part: one row)
+            row = rows[0]
+            for i, (t, (cpu, o)) in enumerate(zip(self.targets, self.to_counts)):
+                t.append(round((row[i] - o) * cpu))
+        else:
+            for i, (t, (cpu, o)) in enumerate(zip(self.targets, self.to_counts)):
+                t += [round((row[i] - o) * cpu) for row in rows]  # AxisScaling.to_counts, inline (round: an int)
 
     def _drive(self, upto: int) -> int | None:
         """The drive models over cycles driven … upto-1 (cycle k steps to the setpoint of cycle k-1); the first
