@@ -38,6 +38,7 @@ from nc.interp import Interpreter
 from nc.interrupt import m96_link
 from nc.motion import Planner
 from nc.motion.css import spindle_speed
+from nc.motion.spline_fit import load_scipy
 from nc.moves import Event, Move
 from nc.profiles import make_profile
 from nc.program import Program, parse_program
@@ -147,6 +148,8 @@ class BenchRunner:
         self._bus_ahead = paced and type(self.link) is SimLink and (stretch_wanted(realtime=True) or ahead_wanted())
         if paced:
             _preload(self.bench)
+        elif type(self.link) is not SimLink:  # lock-step on a real bus: a stall would trip its watchdog
+            load_scipy()  # (a spline fit's scipy imports, ≈ 0.17 s; the sim bus waits for its first use)
         try:
             # Everything the program needs is built before the drives are enabled: once cycles
             # run (paced in real time), a cycle has no room for it.
@@ -626,3 +629,4 @@ def _preload(bench: Bench) -> None:
     from mlc.signals import _by_name
 
     _by_name(1)
+    load_scipy()  # imported on first use otherwise (nc/motion/spline_fit.py)

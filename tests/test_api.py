@@ -81,6 +81,20 @@ def test_import_hil_stays_light():
     assert out.stdout.strip() == "False"
 
 
+def test_a_run_without_a_spline_fit_does_not_import_scipys_fitting_parts(tmp_path):
+    """scipy.interpolate/sparse/linalg (≈ 0.17 s of every `hil run`) are imported by a spline fit when it runs, and
+    before paced cycles (hil/runner.py _preload), where the import would overrun a cycle."""
+    names = "('scipy.interpolate', 'scipy.sparse', 'scipy.linalg')"
+    code = ("import sys, hil; r = hil.run('examples/lathe_demo.nc'); "
+            f"print(r.run.ok, any(m in sys.modules for m in {names}))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT)
+    assert out.stdout.split() == ["True", "False"], out.stderr
+    code = ("import sys; from hil.bench import default_lathe; from hil.runner import _preload; "
+            f"_preload(default_lathe()); print(all(m in sys.modules for m in {names}))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT)
+    assert out.stdout.strip() == "True", out.stderr
+
+
 def test_importing_the_report_leaves_matplotlibs_backend_alone(tmp_path):
     code = ("import matplotlib; matplotlib.use('svg'); import hil.report, hil.plot; "
             "print(matplotlib.get_backend())")

@@ -12,11 +12,13 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
-import scipy.sparse as sps
-from scipy.interpolate import BSpline, make_smoothing_spline
-from scipy.linalg.lapack import dpbsv
+
+if TYPE_CHECKING:  # scipy's interpolate, sparse and linalg take ≈ 0.17 s to import: only a spline fit needs them
+    import scipy.sparse as sps
+    from scipy.interpolate import BSpline
 
 PER_SEG = 4  # polyline samples a segment the fit is made to
 DEGREE = 5  # quintic, its r''' continuous (decision 51); 3: decisions 48-50's cubic smoothing spline
@@ -25,6 +27,14 @@ FINE = 20  # the check's finer look: FINE points a grid step (decision 51: 40 ov
 _OFFSETS = (-2, -1, 0, 1, 2)  # the segments a curve point is measured against, around its own
 _GL4 = np.polynomial.legendre.leggauss(4)  # the penalty's quadrature a knot interval
 _TRIU = {w: np.triu_indices(w) for w in range(1, 8)}  # a band's pairs of a row's entries
+
+
+def load_scipy() -> None:
+    """Import the scipy parts a fit uses (each function imports what it calls when it runs): `hil`'s runner does
+    it before paced cycles or a real bus, where an import's ≈ 0.17 s inside a cycle would overrun it."""
+    import scipy.interpolate  # noqa: F401
+    import scipy.linalg.lapack  # noqa: F401
+    import scipy.sparse  # noqa: F401
 
 
 class FitError(RuntimeError):
@@ -190,6 +200,8 @@ def fit_curve(pts: np.ndarray, lam: float = LAM, w: np.ndarray | None = None, de
     w[0] = w[-1] = 1e6
     if degree == 5:
         return quintic(u, p, w, lam)
+    from scipy.interpolate import make_smoothing_spline
+
     return [make_smoothing_spline(u, p[:, k], w=w, lam=lam) for k in range(pts.shape[1])]
 
 
@@ -240,6 +252,8 @@ def _penalty_rows(x: np.ndarray, t: np.ndarray, k: int, pen: int) -> tuple[np.nd
         nxt[:, :-1] -= a * m[:-1]
         nxt[:, 1:] += a * m[1:]
         m, tt, kk = nxt, tt[1:-1], kk - 1
+    from scipy.interpolate import BSpline
+
     first, d = _banded_rows(BSpline.design_matrix(at, tt, kk, extrapolate=True), kk + 1)
     vals = np.zeros((len(at), k + 1))
     for i in range(kk + 1):
@@ -262,6 +276,8 @@ class _Problem:
     def of(cls, x: np.ndarray, lam: float, k: int = 5, pen: int = 3) -> "_Problem":
         t = np.concatenate([[x[0]] * k, x, [x[-1]] * k])
         n = len(t) - k - 1
+        from scipy.interpolate import BSpline
+
         b = BSpline.design_matrix(x, t, k, extrapolate=True)
         first, vals, gq = _penalty_rows(x, t, k, pen)
         return cls(t, k, b.T, _Band.of(*_banded_rows(b, k + 1), n),
@@ -269,6 +285,8 @@ class _Problem:
 
     def solve(self, y: np.ndarray, w: np.ndarray) -> np.ndarray:
         """The coefficients (coefficients × axes) for samples y (samples × axes) with weights w."""
+        from scipy.linalg.lapack import dpbsv
+
         _, c, info = dpbsv(self.fit.band(w) + self.pen, self.design_t @ (w[:, None] * y), lower=0)
         if info:
             raise FitError(f"the fit's normal matrix is not positive definite ({info})")
@@ -280,6 +298,8 @@ def quintic(x: np.ndarray, y: np.ndarray, w: np.ndarray, lam: float, k: int = 5,
     (y: samples × axes), one banded solve."""
     prob = _Problem.of(x, lam, k, pen)
     c = prob.solve(y, w)
+    from scipy.interpolate import BSpline
+
     return [BSpline(prob.t, c[:, j], k) for j in range(y.shape[1])]
 
 
@@ -302,6 +322,8 @@ def fit_run(pts: np.ndarray, tol: float, lam: float = LAM, rounds: int = 60, ste
     j = np.clip(np.searchsorted(u, uu), 0, len(u) - 1)
     starts = np.flatnonzero(np.diff(j, prepend=-1))  # j rises with uu: where each sample's points begin
     check = _Check.of(uu, pts, cum, tol)
+    from scipy.interpolate import BSpline
+
     if degree == 5:
         prob = _Problem.of(u, lam)
         grid = BSpline.design_matrix(uu, prob.t, prob.k, extrapolate=True)  # no bounds check in Python

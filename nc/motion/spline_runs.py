@@ -14,12 +14,16 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+from typing import TYPE_CHECKING
+
 import numpy as np
-from scipy.interpolate import BSpline, PPoly
 
 from nc.motion.path import Segment
 from nc.motion.spline_fit import (DEGREE, LAM, PER_SEG, Cost, FitError, fit_curve, fit_run, polyline_distance, quintic,
                                   samples)
+
+if TYPE_CHECKING:  # scipy.interpolate is imported where a fit runs (nc.motion.spline_fit.load_scipy)
+    from scipy.interpolate import BSpline
 
 __all__ = ["DEGREE", "LAM", "PER_SEG", "Cost", "FitError", "fit_curve", "fit_run", "polyline_distance", "quintic", "samples",
            "SplineSpan", "spans", "span_limits"]
@@ -177,6 +181,8 @@ def spans(spl: list[BSpline], cum: np.ndarray, axes: tuple[str, ...], margin: fl
     samples each one batch over every piece of the run."""
     cost = cost or Cost()
     t = cost.lap("", 0.0)
+    from scipy.interpolate import PPoly
+
     pp = [PPoly.from_spline(s) for s in spl]
     x = pp[0].x
     keep = np.diff(x) > 0.0
