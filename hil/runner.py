@@ -23,7 +23,7 @@ from fieldbus.link import BusError, BusLink, SimLink
 from fieldbus.pdo import RxPdo, TxPdo
 from hil.bench import Bench
 from hil.clock import CycleTiming, LockStepClock, RealTimeClock
-from hil.cycle_lean import OVERSPEED, factors, feedback, row, setpoints
+from hil.cycle_lean import OVERSPEED, WARM_AHEAD_NS, WARM_MIN_NS, factors, feedback, row, setpoints, warm
 from hil import retentive
 from hil.drive_homing import home_axes
 from hil.mlc_bridge import drive_status
@@ -352,6 +352,12 @@ class BenchRunner:
         # (decision B21; not with bus_ahead False, B34); nothing between here and the tick reads or writes the
         # PDOs or the drives
         tx = self.link.exchange(self.rx) if self._bus_ahead and bus_ahead else None
+        if tx is not None:
+            left = self.clock.left_ns() - int(self.clock.config.busy_wait * 1e9) - WARM_AHEAD_NS
+            if left > 0:  # sleep to just before the clock's own spin, so nothing runs between the reads and the tick
+                self.clock.sleep(left * 1e-9)
+            if self.clock.left_ns() > WARM_MIN_NS:
+                warm(self, len(self.axes))  # reads only: the caches hold what the cycle reads first (B43)
         self.timing = self.clock.tick()
         if self.timing.overrun:
             self._overrun()
