@@ -24,6 +24,10 @@ compare both runs column by column (`ahead`: real time stepped with the work ahe
 With the basic MLC in lock-step a stretch runs the NC's steps itself, feeds and solves included (decisions
 B26/B27, hil/stretch_pass.py). Its real-time part (decision B21: pacing, work ahead in the slack) is hil/stretch_realtime.py, a mixin on
 the same state; the planner saved and restored around a stretch, and the channel's signature, hil/stretch_state.py.
+
+Why one file of ~510 lines: `Stretcher` is one decision (may the next cycles be taken at once, and where must they
+end), and its start, cut, settle (B38) and finish checks read and restore the same runner, planner and drive state;
+what is not that decision lives beside it (stretch_bulk, stretch_pass, stretch_reads, stretch_state, stretch_realtime).
 """
 
 from __future__ import annotations
