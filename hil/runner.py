@@ -484,9 +484,8 @@ class BenchRunner:
             self._row_cycle = self.cycle
 
     def _at_rest(self, i: int) -> bool:
-        """Drive i stands: feedback unchanged for REST_CYCLES and, while it follows the NC's
-        setpoint, no following error left (a drive braking on its own quick stop has none to meet)."""
-        return self._rest[i] >= REST_CYCLES and (self.tx[i].following_error == 0 or not self.masters[i].enabled)
+        """Drive i stands (`stands`, on its rest counter and this cycle's feedback)."""
+        return stands(self._rest[i], self.tx[i].following_error, self.masters[i].enabled)
 
     def _settle(self) -> None:
         """Keep cycling on the final setpoints until the axes stand still (or the settle time ends). Quiet cycles a
@@ -590,6 +589,13 @@ class BenchRunner:
     def _name(self, i: int) -> str:
         n = len(self.axes)
         return self.axes[i] if i < n else self.bench.spindles[i - n].name
+
+
+def stands(rest: int, following_error: int, enabled: bool) -> bool:
+    """A drive stands: feedback unchanged for REST_CYCLES and, while it follows the NC's setpoint, no following
+    error left (a drive braking on its own quick stop has none to meet). BenchRunner._at_rest, and a settle
+    stretch's end (hil/stretch.py, B38)."""
+    return rest >= REST_CYCLES and (following_error == 0 or not enabled)
 
 
 def _quiet_gc() -> None:

@@ -42,7 +42,7 @@ from fieldbus.cia402 import State, Target
 from fieldbus.link import SimLink
 from fieldbus.pdo import RxPdo, TxPdo
 from hil.clock import LockStepClock, RealTimeClock
-from hil.stretch_bulk import bulk_cycles, bulk_ok, count_cycles, first_change, outputs_hold
+from hil.stretch_bulk import _rest, bulk_cycles, bulk_ok, count_cycles, first_change, outputs_hold
 from hil.stretch_pass import Pass, _save as _save_nc, no_reads
 from hil.stretch_reads import may_read
 from hil import stretch_realtime
@@ -369,7 +369,7 @@ class Stretcher(RealTimeStretches):
     def _first_rest(self, r: Any, outs: list[Stretch], m: int) -> int:
         """B38: the cycles of a settle stretch up to and including the first one after which every axis is at rest
         (BenchRunner._at_rest on the rest counters feedback() would count, its following error); m if none."""
-        from hil.runner import REST_CYCLES
+        from hil.runner import stands
 
         axes = range(self.n_axes)
         rest, last = r._rest[:self.n_axes], r._last_position[:self.n_axes]
@@ -378,11 +378,8 @@ class Stretcher(RealTimeStretches):
             still = True
             for i in axes:
                 o = outs[i]
-                p = o.position_actual[c]
-                rest[i] = rest[i] + 1 if p == last[i] and o.velocity_actual[c] == 0 else 0
-                last[i] = p
-                if rest[i] < REST_CYCLES or (o.following_error[c] != 0 and enabled[i]):
-                    still = False
+                rest[i], last[i] = _rest(rest[i], last[i], o.position_actual[c:c + 1], o.velocity_actual[c:c + 1])
+                still = still and stands(rest[i], o.following_error[c], enabled[i])
             if still:
                 return c + 1
         return m
