@@ -79,6 +79,7 @@ def jerk_factor(cfg: MotionConfig, fc: "FilterCorners", blocks: Sequence["Block"
 UNKNOWN = (-1.0, -1.0)  # _scan: the queue ends before the reach does
 _ZERO = (0.0,)
 _VTOP = attrgetter("vtop")
+_S_END = attrgetter("s_end")
 # Above FilterCorners._boost_ratio's largest value (2: doubling the jerk at most doubles the speed-up) by
 # far more than its rounding: _tolerance_free's bound.
 RATIO_BOUND = 2.001
@@ -172,7 +173,7 @@ def _verdicts(fc: "FilterCorners", blocks: Sequence["Block"], k_lo: int, k_hi: i
     next block a corner blend trims), an override or dry run every cap (FilterCorners.touch), and a
     solve the head block's (feed per revolution): the junctions up to the head's, whose next block is the head
     or who are it, are found again when its cap is not the one they were found with. `n_pre`: the queue's blocks
-    up to the first one past the reach (None: the whole queue), whose s_end `_free` reads."""
+    up to the first one past the reach (None: the whole queue), whose s_end the tolerance verdict reads."""
     sc = fc._sc
     n = len(sc)
     d = fc._sc_dirty
@@ -189,7 +190,7 @@ def _verdicts(fc: "FilterCorners", blocks: Sequence["Block"], k_lo: int, k_hi: i
         return part
     hist = fc._hist
     tol = fc.tol
-    ends = [b.s_end for b in islice(blocks, n_pre)]
+    ends = list(map(_S_END, islice(blocks, n_pre)))
     n_ends = len(ends)
     k = k_lo + part.index(None)
     i = bisect_right(ends, hist[k].s_end)
@@ -209,7 +210,17 @@ def _verdicts(fc: "FilterCorners", blocks: Sequence["Block"], k_lo: int, k_hi: i
             # _tolerance_free, its kept verdict inline; the next block is blocks[i] (j walks on in path order)
             while i < n_ends and ends[i] <= j.s_end:
                 i += 1
-            if not _free(fc, j, blocks, ends, i):
+            # _tolerance_free's kept verdict read first, inline (session 15: ~7 calls a scan that finds verdicts
+            # again); blocks[i] is j's next block, i = bisect_right(ends, j.s_end) as _tolerance_free finds it
+            if i < n_ends:
+                cap = j.cap
+                c2 = blocks[i].cap
+                if c2 > cap:
+                    cap = c2
+            else:
+                cap = j.vtop
+            tcap = j.vtol if j.vtol < j.vctol else j.vctol
+            if not (j.tf_ok if cap == j.tf_cap and tcap == j.tf_tcap else _tolerance_free(fc, j, blocks, ends)):
                 sc[k] = NONE
                 continue
         r = j.vjunc / vbud
@@ -225,7 +236,6 @@ def _walk(fc: "FilterCorners", blocks: Sequence["Block"], lo: float, hi: float, 
     hist = fc._hist
     tol = fc.tol
     ends: list[float] | None = None  # the queue's s_end, built once a junction needs its next block
-    i = 0
     # FilterCorners keeps every junction since the last stop (its _h0 is relative to the newest
     # push, not to the executing block) and drops old ones only in bulk, counted in _seq0.
     # hist is in path order: the junctions past hi are skipped by bisection, not one by one. The
@@ -248,12 +258,7 @@ def _walk(fc: "FilterCorners", blocks: Sequence["Block"], lo: float, hi: float, 
         if tol is not None:
             if ends is None:
                 ends = [b.s_end for b in islice(blocks, n_pre)]
-                i = len(ends)
-            # _tolerance_free, its cached verdict inline: the next block follows j in the queue,
-            # at bisect_right(ends, j.s_end), found by stepping back (j walks back in path order)
-            while i > 0 and ends[i - 1] > j.s_end:
-                i -= 1
-            if not _free(fc, j, blocks, ends, i):
+            if not _tolerance_free(fc, j, blocks, ends):  # (the reference: the next block by bisection)
                 return None
         r = j.vjunc / vbud
         if r > use:
@@ -269,22 +274,6 @@ def _walk(fc: "FilterCorners", blocks: Sequence["Block"], lo: float, hi: float, 
     if k_lo == 0 and fc._seq0 > 0:
         return None  # junctions within the reach were dropped already
     return use, seen
-
-
-def _free(fc: "FilterCorners", j: "Block", blocks: Sequence["Block"], ends: Sequence[float], i: int) -> bool:
-    """_tolerance_free(fc, j, blocks, ends), its verdict kept on j read first; blocks[i] is j's next block
-    (i = bisect_right(ends, j.s_end), which the callers step to)."""
-    if i < len(ends):
-        cap = j.cap
-        c2 = blocks[i].cap
-        if c2 > cap:
-            cap = c2
-    else:
-        cap = j.vtop
-    tcap = j.vtol if j.vtol < j.vctol else j.vctol
-    if cap == j.tf_cap and tcap == j.tf_tcap:
-        return j.tf_ok
-    return _tolerance_free(fc, j, blocks, ends)
 
 
 def _tolerance_free(fc: "FilterCorners", j: "Block", blocks: Sequence["Block"], ends: Sequence[float]) -> bool:
