@@ -9,8 +9,8 @@ cycle: its first, or one before the stretch went to its bulk part), or `stepped:
 no stretch there: `start left` (B36: too little of the period left for a start), `cold left` (B35: a start nothing
 prepared, too little left), `not quiet: <condition>` (the first of `Stretcher._quiet`'s conditions that held; a
 block's end, a code's handshake, ...), `too short` (quiet, but fewer than 2 cycles to take: the buffer's end) and
-`stopping`/`no stretcher`. A stepped cycle's label says too whether its refill and bus exchange ran ahead (B21/B31)
-or were skipped (B34). It prints per class the count, the work p50/p99/max and how many cycles passed 150 µs, and
+`stopping`/`no stretcher`. A stepped cycle's label says too whether its refill and bus exchange ran ahead (B21/B31),
+its whole channel step (`step ahead`, the basic MLC, B46) or were skipped (B34). It prints per class the count, the work p50/p99/max and how many cycles passed 150 µs, and
 where the run's p99 lands. Figures, not a test: the wrappers add ≈ 1-2 µs to a stepped cycle's slack.
 """
 
@@ -122,11 +122,19 @@ def install() -> None:
     S.Stretcher.run, S.Stretcher._quiet, S.Stretcher._pace = _run, _quiet, _pace
     exchange = R.BenchRunner._exchange
 
-    def _exchange(self, step=None, bus_ahead=True):
+    def _exchange(self, step=None, bus_ahead=True, ahead=None):
         how = "skipped ahead" if not bus_ahead else "refill ahead" if step is not None else "bus ahead"
         _tag[0] = f"stepped: {_why[0]} ({how})"
+        if ahead is not None:  # B46: the whole channel step ahead, or (where it cannot) the refill ahead or nothing
+            def ahead(tx, _ahead=ahead):
+                st = self._stretcher
+                n = st.steps_ahead
+                step = _ahead(tx)
+                how = "step ahead" if st.steps_ahead != n else "refill ahead" if step is not None else "bus ahead"
+                _tag[0] = f"stepped: {_why[0]} ({how})"
+                return step
         try:
-            return exchange(self, step, bus_ahead)
+            return exchange(self, step, bus_ahead, ahead)
         finally:
             if _why[0] not in ("power_up", "settle", "shutdown"):
                 _why[0] = "stopping"  # unless Stretcher.run says otherwise before the next one

@@ -8,7 +8,8 @@ Each piece is wrapped (its exclusive thread CPU, so a piece inside another count
 worked out in a paced slack (B22) is listed as `prep:`. A slack is put in one class: a block-end `solve` (the
 planner's refill or plan solve > 200 µs), `bulk` (a paced stretch's cycles at once, before its last), `start` (a
 stretch start, prepared ahead or not: `cold start` with its own samples and drive models), `prep part` or `other`
-(a paced cycle's bookkeeping). It prints the slack distribution, per class its p50/p99/max, how many slacks passed
+(a paced cycle's bookkeeping), or `step ahead` (a stepped cycle's channel step before its tick, the basic MLC,
+B46). It prints the slack distribution, per class its p50/p99/max, how many slacks passed
 300/500 µs and how many late ticks followed, and the mean split of the classes that pass 300 µs. Figures, not a
 test: the wrappers add ≈ 1 µs a call, and the load of the machine sets the tail.
 """
@@ -30,10 +31,12 @@ sys.path.insert(0, str(ROOT))
 
 import hil.clock as clock_mod  # noqa: E402
 import hil.stretch as S  # noqa: E402
+import hil.stretch_ahead as SA  # noqa: E402
 import hil.stretch_bulk as SB  # noqa: E402
 import hil.stretch_realtime as SR  # noqa: E402
 import hil.stretch_state as SS  # noqa: E402
 from mlc.nc_link import ChannelLink  # noqa: E402
+from nc.channel import Channel  # noqa: E402
 from nc.motion.planner import Planner  # noqa: E402
 
 _tt = time.thread_time_ns
@@ -132,6 +135,8 @@ def install() -> None:
             setattr(cls, n, _wrap(f"{cls.__name__}.{n}", getattr(cls, n)))
     import hil.runner as R
     R.BenchRunner._exchange = _wrap("BenchRunner._exchange", R.BenchRunner._exchange)
+    SA.step_ahead = _wrap("step_ahead", SA.step_ahead)  # B46: a stepped cycle's channel step before its tick
+    Channel._feed_planner = _wrap("Channel._feed_planner", Channel._feed_planner)
     S.Stretcher._prepare = _wrap_gen("_prepare", S.Stretcher._prepare)
     S.Stretcher._cut_ahead = _wrap_gen("_cut_ahead", S.Stretcher._cut_ahead)
 
@@ -141,6 +146,8 @@ def kind(d: dict[str, int]) -> str:
         return "solve"
     if "bulk_cycles" in d:
         return "bulk"
+    if "step_ahead" in d:
+        return "step ahead"
     if "Stretcher.run" in d and ("csp_stretch" in d or "csv_stretch" in d):
         return "cold start"
     if "Stretcher._spec_start" in d or "Stretcher._quiet" in d:

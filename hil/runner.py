@@ -27,6 +27,7 @@ from hil.cycle_lean import OVERSPEED, WARM_AHEAD_NS, WARM_MIN_NS, factors, feedb
 from hil import retentive
 from hil.drive_homing import home_axes
 from hil.mlc_bridge import drive_status
+from hil import stretch_ahead
 from hil.stretch import Stretcher, ahead_wanted, wanted as stretch_wanted
 from hil.trace import TraceSource, TraceWriter, trace_columns
 from mlc.basic import BasicMlc
@@ -269,9 +270,12 @@ class BenchRunner:
             # real time: this cycle's planner refill computed now, in the slack (decision B21)
             # ... unless the cycle before was long or the tick is near: then this cycle does it itself (B34)
             skip = stretcher is not None and stretcher.paced and not stopping and stretcher.skip_ahead()
-            ahead = stretcher.ahead() if stretcher is not None and not stopping and not skip else None
+            whole = not skip and not stopping and stretcher is not None and stretch_ahead.wanted(self)
+            ahead = stretcher.ahead() if stretcher is not None and not stopping and not skip and not whole else None
             if skip:
                 self._exchange(None, bus_ahead=False)
+            elif whole:  # the basic MLC: the cycle's whole channel step ahead, after its exchange (B46)
+                self._exchange(None, ahead=lambda tx: stretch_ahead.step_ahead(stretcher, tx))
             elif ahead is None:
                 self._exchange()
             else:
@@ -347,11 +351,14 @@ class BenchRunner:
             ch.skip(latched)
 
     # ---- the cycle ------------------------------------------------------------------------
-    def _exchange(self, step: Callable[[Channel], object] | None = None, bus_ahead: bool = True) -> None:
+    def _exchange(self, step: Callable[[Channel], object] | None = None, bus_ahead: bool = True,
+                  ahead: Callable[[list[TxPdo]], Callable[[Channel], object] | None] | None = None) -> None:
         # Real time on the in-process bus: this cycle's drive models run before its wake-up, in the slack
         # (decision B21; not with bus_ahead False, B34); nothing between here and the tick reads or writes the
         # PDOs or the drives
         tx = self.link.exchange(self.rx) if self._bus_ahead and bus_ahead else None
+        if tx is not None and ahead is not None:
+            step = ahead(tx)  # the channel step on this feedback, ahead too where nothing before it can tell (B46)
         if tx is not None:
             left = self.clock.left_ns() - int(self.clock.config.busy_wait * 1e9) - WARM_AHEAD_NS
             if left > 0:  # sleep to just before the clock's own spin, so nothing runs between the reads and the tick

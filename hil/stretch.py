@@ -27,7 +27,8 @@ the same state; the planner saved and restored around a stretch, and the channel
 
 Why one file of ~510 lines: `Stretcher` is one decision (may the next cycles be taken at once, and where must they
 end), and its start, cut, settle (B38) and finish checks read and restore the same runner, planner and drive state;
-what is not that decision lives beside it (stretch_bulk, stretch_pass, stretch_reads, stretch_state, stretch_realtime).
+what is not that decision lives beside it (stretch_bulk, stretch_pass, stretch_reads, stretch_state, stretch_realtime;
+stretch_ahead: with the basic MLC, a stepped cycle's whole channel step before its tick, B46).
 """
 
 from __future__ import annotations
@@ -121,6 +122,7 @@ class Stretcher(RealTimeStretches):
         # B38: the runner's settle after the program (BenchRunner._settle) asks for stretches too: the channel has
         # finished and stands, only the drives settle; a stretch ends at the first cycle every axis is at rest
         self.settling = False
+        self.steps_ahead = 0  # real time, the basic MLC: stepped cycles whose channel step ran before the tick (B46)
 
     @classmethod
     def for_runner(cls, runner: Any) -> "Stretcher | None":

@@ -54,14 +54,10 @@ class StopAt:
         return [float(runner.stop_request is not None)]
 
 
-def _run(monkeypatch, tmp_path, on: str, stop_at: int | None = None, signal_at: int | None = None,
-         **kw) -> tuple[dict, api.Result]:
-    """A real-time run of the lathe demo on a fake clock; `stop_at`: a trace column asks for a stop in that cycle;
-    `signal_at`: a SIGINT's stop is asked while the pacer waits for that cycle (ticks counted by the clock)."""
-    monkeypatch.setenv(ENV, on)
+def fake_clock(monkeypatch) -> tuple[FakeTime, list[RealTimeClock]]:
+    """Real-time runs from now on paced by a `FakeTime` (deterministic), without SCHED_FIFO; the clocks made."""
     ft = FakeTime()
     clocks: list[RealTimeClock] = []
-    runners: list = []
 
     def make_clock(cycle, realtime, config=None):
         assert realtime
@@ -72,6 +68,16 @@ def _run(monkeypatch, tmp_path, on: str, stop_at: int | None = None, signal_at: 
 
     monkeypatch.setattr(hil.clock, "make_clock", make_clock)
     monkeypatch.setattr(hil.clock, "acquire_realtime", lambda config, owner: Granted())  # no SCHED_FIFO in tests
+    return ft, clocks
+
+
+def _run(monkeypatch, tmp_path, on: str, stop_at: int | None = None, signal_at: int | None = None,
+         **kw) -> tuple[dict, api.Result]:
+    """A real-time run of the lathe demo on a fake clock; `stop_at`: a trace column asks for a stop in that cycle;
+    `signal_at`: a SIGINT's stop is asked while the pacer waits for that cycle (ticks counted by the clock)."""
+    monkeypatch.setenv(ENV, on)
+    ft, clocks = fake_clock(monkeypatch)
+    runners: list = []
     from hil.runner import BenchRunner
 
     real_init = BenchRunner.__init__
