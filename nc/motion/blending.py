@@ -26,7 +26,6 @@ import bisect
 import math
 from collections import deque
 from itertools import islice
-from operator import attrgetter
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
@@ -36,7 +35,6 @@ from nc.motion.deviation import KernelDeviation
 from nc.motion.limits import MotionConfig
 from nc.motion.shares import MAX_FACTOR
 
-_DV, _VBASE, _CTOL = attrgetter("dv"), attrgetter("vbase"), attrgetter("ctol")
 USAGE_SCALE = 4.0  # below this many times the top speed a junction's budget use is worth refining
 
 if TYPE_CHECKING:
@@ -97,6 +95,11 @@ class FilterCorners:
         self._sc: list[float | None] = []
         self._sc_dirty = 0
         self._sc_head = math.nan
+        # Kept by nc.motion.shares between scans (session 15): `_sc_ok` a range of _sc found already (no None
+        # in it), `_vq` the sliding maximum of _vt over the range `_vq_at` the last scan read.
+        self._sc_ok = (0, 0)
+        self._vq: deque[tuple[int, float]] = deque()
+        self._vq_at = (0, 0)
         self._h0 = 0  # first entry of _hist still within reach of a window
         self._m = 0  # where the last search for the first junction taken ended
         self._seq0 = 0  # junctions dropped from the front of _hist so far
@@ -260,6 +263,10 @@ class FilterCorners:
             del self._vt[:h0]
             del self._sc[:h0]
             self._sc_dirty = max(0, self._sc_dirty - h0)
+            lo, hi = self._sc_ok
+            self._sc_ok = (max(0, lo - h0), max(0, hi - h0))
+            self._vq.clear()
+            self._vq_at = (0, 0)
             self._seq0 += h0
             self._m -= h0
             last -= h0  # J's index, and its sequence number seq0 + last, stay the same
@@ -618,9 +625,8 @@ class FilterCorners:
             self._sc_dirty = lo  # vtol and vjunc change over hist[lo:] below
         seg = hist[lo:]
         s = np.array(self._hist_s[lo:])
-        # the fields read C-level (session 15: ~100 junctions a call): the same lists as the comprehensions
-        du = np.array(list(map(_DV, seg)), dtype=float)
-        vb = np.fromiter(map(_VBASE, seg), float, len(seg))
+        du = np.array([b.dv for b in seg], dtype=float)
+        vb = np.fromiter((b.vbase for b in seg), float, len(seg))
         ev = np.nonzero(s >= s_j - h - 1e-12)[0]
         # The loops below run over Python lists, not numpy scalars (issue 17: ~70 junctions a call)
         ev_l = ev.tolist()
@@ -641,7 +647,7 @@ class FilterCorners:
             b.ctol = c
             if c < lim and b.s_end > self._lim_s:
                 self._lim_s = b.s_end
-        ctol = np.fromiter(map(_CTOL, seg), float, nseg)
+        ctol = np.fromiter((b.ctol for b in seg), float, nseg)
         reach = np.minimum(ctol, vt) * half + 1e-12
         upd = np.nonzero(near)[0]
         held = np.abs(s[upd][:, None] - s[None, :]) <= reach[None, :]
