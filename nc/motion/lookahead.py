@@ -115,7 +115,7 @@ def reach(v0: float, length: float, a: float, j: float) -> float:
     qb = 2.0 * v0 / a + a / j
     qc = 2.0 * v0 * a / j - 2.0 * length
     dv = (-qb + _sqrt(qb * qb - 4.0 * qa * qc)) / (2.0 * qa)
-    return v0 + max(dv, 0.0)
+    return v0 + (0.0 if 0.0 > dv else dv)  # max(dv, 0.0)
 
 
 def max_speed_at(v0: float, a0: float, d: float, a: float, j: float) -> float:
@@ -193,7 +193,9 @@ class Limits:
         if seg.kind == "blend":
             v, a, j = self._blend_limits(seg, v, a, j)
         if not short_ok:
-            v = min(v, seg.length / (cfg.min_segment_cycles * self.T))
+            x = seg.length / (cfg.min_segment_cycles * self.T)
+            if x < v:  # min(v, x) spelt out (session 15)
+                v = x
         return v, a, j
 
     def _blend_limits(self, seg: Segment, v: float, a: float, j: float) -> tuple[float, float, float]:
@@ -247,8 +249,12 @@ class Limits:
             b1.du_n = du_n = math.sqrt(sq_sum)
             if du_n > 1e-9:
                 lines = s1.kind == "line" and s2.kind == "line"
-                b1.vbud, b1.vctol = vb, vc = self.blend.corner_caps(du, du_n, lines, max(b1.a, b2.a))
-                v = min(v, vb, vc)
+                a = b2.a if b2.a > b1.a else b1.a  # max(b1.a, b2.a) and min(v, vb, vc) spelt out (session 15)
+                b1.vbud, b1.vctol = vb, vc = self.blend.corner_caps(du, du_n, lines, a)
+                if vb < v:
+                    v = vb
+                if vc < v:
+                    v = vc
         elif max(du) > 1e-9:
             vj = va = math.inf
             for d, cj, ca in zip(du, self._corner_j, self._corner_a):
@@ -270,7 +276,7 @@ class Limits:
                 # spread over its first window T1 with it.
                 t = self.blend.t_a if self.blend is not None and not raw else self.T
                 v = min(v, float(np.min(np.sqrt(0.4 * cfg.share_curvature * self.jerk[m] * t / dk[m]))))
-        return max(v, 0.0)
+        return 0.0 if 0.0 > v else v  # max(v, 0.0)
 
 
 def backward(blocks: Sequence[Block], lo: int = 0, full: bool = False, depth: int = 0) -> None:

@@ -380,18 +380,26 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
         if b.kind != "path" and b.kind != "thread":
             b.cap = 0.0
             return 0.0
+        # min(cap, x) spelt out `x if x < cap else cap` (min keeps the first of equal ones; ~3 a push, session 15)
         cap = b.cap_hard
         if b.rapid:
-            cap = cap * self._rapid_ovr if self._rapid_ovr > 0.0 else min(cap, self.cfg.slow_rapid)
+            if self._rapid_ovr > 0.0:
+                cap = cap * self._rapid_ovr
+            else:
+                x = self.cfg.slow_rapid
+                cap = x if x < cap else cap
         elif self.dry_run:
-            cap = min(cap, self.dry_run_feed * self._feed_ovr)
+            x = self.dry_run_feed * self._feed_ovr
+            cap = x if x < cap else cap
         else:
             feed = b.feed or 0.0
             if b.move.per_rev:
                 feed *= abs(rpm if rpm is not None else self.spindle_rpm()) / 60.0
-            cap = min(cap, feed * self._feed_ovr)
-        if b.vtop > 0.0:
-            cap = min(cap, b.vtop)  # the filter windows were sized with it (dry run switched on later)
+            x = feed * self._feed_ovr
+            cap = x if x < cap else cap
+        x = b.vtop
+        if x > 0.0 and x < cap:
+            cap = x  # the filter windows were sized with it (dry run switched on later)
         b.cap = cap
         return cap
 
@@ -567,7 +575,10 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
                 # Forward pass: no more than the entry state can reach (a braking state first ramps
                 # its deceleration out, losing a²/2j of speed over v·|a|/j of path).
                 ve, de = (v - a * a / (2.0 * rj), dist - s - v * abs(a) / rj) if a < 0.0 else (v, dist - s)
-                v1 = min(v1, reach(max(ve, 0.0), max(de, 0.0), MARGIN * ra, MARGIN * rj))
+                # min(v1, reach(max(ve, 0.0), max(de, 0.0), …)) spelt out (session 15)
+                x = reach(0.0 if 0.0 > ve else ve, 0.0 if 0.0 > de else de, MARGIN * ra, MARGIN * rj)
+                if x < v1:
+                    v1 = x
                 pw = solve_position(s, v, a, dist, v1, vmax, ra, rj)
                 if pw is not None and pw.p_max <= dist + 1e-7 and pw.v_min() >= -1e-7:
                     break
@@ -650,7 +661,7 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
         for k, nx in enumerate(it):
             if nx.kind != "path" or nx.cap < cap_lo or b.vend <= 0.0 or k >= k_max \
                     or (b.vend >= vmax - 1e-9 and dist >= cruise_from):
-                return dist, min(b.vend, vmax), ra, rj * jf, vmax
+                return dist, vmax if vmax < b.vend else b.vend, ra, rj * jf, vmax  # min(b.vend, vmax)
             if b.vjunc < cap_lo:
                 if b.binding and b.vend >= max_speed_at(self.v, self.a, dist - self.s, ra, rj * jf):
                     # Not reachable faster than it allows from the present state (a rising
@@ -658,9 +669,10 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
                     # there at zero acceleration would only lose time.
                     pass
                 elif not extend or b.binding:
-                    return dist, min(b.vend, vmax), ra, rj * jf, vmax
+                    return dist, vmax if vmax < b.vend else b.vend, ra, rj * jf, vmax  # min(b.vend, vmax)
                 else:
-                    vmax = min(vmax, b.vjunc)
+                    if b.vjunc < vmax:  # min(vmax, b.vjunc)
+                        vmax = b.vjunc
             dist += nx.length
             x = nx.a  # ra = min(ra, nx.a) and rj = min(rj, nx.j), spelt out
             if x < ra:
@@ -669,7 +681,7 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
             if x < rj:
                 rj = x
             b = nx
-        return dist, min(b.vend, vmax), ra, rj * jf, vmax  # b is the queue's last block
+        return dist, vmax if vmax < b.vend else b.vend, ra, rj * jf, vmax  # b is the queue's last block
 
     def _plan_indep(self, b: Block, t0: float) -> _Plan | None:
         assert b.seg is not None

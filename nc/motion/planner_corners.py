@@ -67,7 +67,8 @@ class CornerShares:
         if prev is head:
             return False
         room = prev.s_end - prev.length - head.s_end
-        return room >= change_distance(max(head.cap, abs(self.v)), 0.0, self._a_lo, self._j_lo)
+        v = abs(self.v)
+        return room >= change_distance(v if v > head.cap else head.cap, 0.0, self._a_lo, self._j_lo)  # max() spelt out
 
     def _now(self) -> float:
         """Path position (Block.s_end's scale) of the last sample handed out."""

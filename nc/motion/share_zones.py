@@ -102,7 +102,9 @@ class ShareZones:
         else it is the filter's, and λ = 1 within its reach."""
         if self.inside(s, vtop):
             return True
-        self._hard = max(self._hard, s + self.reach(vtop))
+        x = s + self.reach(vtop)
+        if x > self._hard:  # max(self._hard, x) spelt out (once a push, session 15)
+            self._hard = x
         return False
 
     def lam(self, s: float) -> float:

@@ -69,7 +69,10 @@ def jerk_factor(cfg: MotionConfig, fc: "FilterCorners", blocks: Sequence["Block"
             return 1.0, True
         use, seen = got
         if seen <= v_hi:
-            return min(MAX_FACTOR, max(1.0, (1.0 - use * pool) / st)), False
+            f = (1.0 - use * pool) / st  # min(MAX_FACTOR, max(1.0, f)) spelt out (session 15)
+            if not f > 1.0:
+                f = 1.0
+            return (f if f < MAX_FACTOR else MAX_FACTOR), False
         v_hi = seen
     return 1.0, False
 
@@ -330,7 +333,13 @@ def _tolerance_free(fc: "FilterCorners", j: "Block", blocks: Sequence["Block"], 
     # the next block (its cap is the feed's): one step, it follows j in the queue (`ends`: the queue's
     # s_end, increasing)
     k = bisect_right(ends, j.s_end)
-    cap = max(j.cap, blocks[k].cap) if k < len(ends) else j.vtop
+    if k < len(ends):
+        cap = j.cap
+        c2 = blocks[k].cap
+        if c2 > cap:  # max(j.cap, c2) spelt out (session 15)
+            cap = c2
+    else:
+        cap = j.vtop
     tcap = j.vtol if j.vtol < j.vctol else j.vctol
     # A queued junction's inputs rarely change between solves (issue 17): the verdict is kept with
     # the two it was found for; du_n, a, j and the tolerance are fixed once the junction is pushed.
