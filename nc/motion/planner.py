@@ -484,7 +484,8 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
                 continue
             n = int(math.floor((p.duration - p.t_next) / T + 1e-9)) + 1
             if p.t_next <= p.duration + 1e-12 and n > 0:
-                self._sample(p, min(n, OPEN_CHUNK if p.open else CHUNK))
+                c = OPEN_CHUNK if p.open else CHUNK
+                self._sample(p, c if c < n else n)  # min(n, c)
                 if not self._buf_done:
                     return
                 if self.plan is None:

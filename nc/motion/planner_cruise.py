@@ -119,7 +119,8 @@ class CruiseSampling:
                 n = int(math.floor((duration - t_next) / T + 1e-9)) + 1
                 if not (t_next <= duration + 1e-12 and n > 0):
                     break
-                n = min(n, CHUNK)
+                if CHUNK < n:  # min(n, CHUNK)
+                    n = CHUNK
                 # t = t_next + T·arange(n), s = s0 + clip(t, 0, duration)·v and a line's points at clip(s, 0,
                 # length) element by element: the same operations, so the same bits (nc.motion.sample_rows)
                 s = [s0 + (duration if duration <= x else x) * v

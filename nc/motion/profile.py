@@ -223,7 +223,7 @@ def _one_dof(interface: ControlInterface, p0: float, v0: float, a0: float, p1: f
 def solve_position(p0: float, v0: float, a0: float, p1: float, v1: float, v_max: float, a_max: float,
                    j_max: float) -> Piecewise | None:
     """Time-optimal 1-DoF profile (p0, v0, a0) → (p1, v1, 0); None when ruckig cannot solve it."""
-    otg, inp = _one_dof(ControlInterface.Position, p0, v0, a0, p1, v1, max(v_max, 1e-9), a_max, j_max)
+    otg, inp = _one_dof(ControlInterface.Position, p0, v0, a0, p1, v1, 1e-9 if 1e-9 > v_max else v_max, a_max, j_max)
     traj = Trajectory(1)
     try:
         ok = otg.calculate(inp, traj) in _OK
