@@ -284,25 +284,14 @@ class FilterCorners:
         acc_q, top_q, len_q = maxima
         seq, seq_m = self._seq0 + last, self._seq0 + m
         # the sliding maxima: append (dropping the smaller values before) and drop what fell out front
-        # (inline, once per pushed block; queue by queue spelt out, session 15)
-        x = j_new.a
-        while acc_q and acc_q[-1][1] <= x:
-            acc_q.pop()
-        acc_q.append((seq, x))
-        while acc_q[0][0] < seq_m:
-            acc_q.popleft()
-        x = j_new.vtop
-        while top_q and top_q[-1][1] <= x:
-            top_q.pop()
-        top_q.append((seq, x))
-        while top_q[0][0] < seq_m:
-            top_q.popleft()
-        x = j_new.length
-        while len_q and len_q[-1][1] <= x:
-            len_q.pop()
-        len_q.append((seq, x))
-        while len_q[0][0] < seq_m:
-            len_q.popleft()
+        # (inline, once per pushed block; a loop over the three, not spelt out queue by queue: the same
+        # operations, and the unrolled form saved no measurable time, session 15)
+        for q, x in ((acc_q, j_new.a), (top_q, j_new.vtop), (len_q, j_new.length)):
+            while q and q[-1][1] <= x:
+                q.pop()
+            q.append((seq, x))
+            while q[0][0] < seq_m:
+                q.popleft()
         tail = blocks[-1]
         t_w = self.t_j
         # J is crossed no faster than either block beside it can run.
