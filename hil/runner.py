@@ -209,6 +209,7 @@ class BenchRunner:
 
     def power_up(self) -> bool:
         """Bring every drive to operation enabled, one state-machine step per cycle."""
+        self.clock.prepare()  # real time asked for before the bus is in OP: its slaves' watchdogs run from there (E23)
         self.link.open()
         self._opened = True  # a link that failed to open is not cycled at shutdown (no 2nd alarm)
         self.clock.start(self.link)
