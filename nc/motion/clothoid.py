@@ -10,16 +10,54 @@ curvature at its ends, direction cosines), so the planner samples it as any othe
 
 from __future__ import annotations
 
+import importlib.util
 import math
+import sys
 from dataclasses import dataclass, field
+from importlib.machinery import EXTENSION_SUFFIXES
+from pathlib import Path
+from typing import Callable
 
 import numpy as np
-from scipy.special import fresnel
 
 from nc.motion.path import Segment
 
 MAX_TURN = math.radians(135.0)  # sharper corners are not blended: they stop nearly anyway
 MIN_TURN = 1e-6  # below this a junction counts as tangent
+_UFUNCS = "scipy.special._special_ufuncs"  # the extension module whose ufunc scipy.special.fresnel is
+
+
+def _load_fresnel() -> Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]:
+    """scipy.special.fresnel, without importing the scipy.special package (bench decision B47): its __init__ costs
+    ≈ 0.17 s (the array-API back-end support pulls array_api_compat, numpy.testing and numpy.f2py), a sixth of
+    `hil run`'s whole process (issue 17), while the ufunc's own extension module loads in ≈ 1 ms. It is the very
+    same ufunc object (a single-phase extension: scipy.special, imported later, gets the same one), so the values
+    are scipy's. Any surprise in scipy's layout (the module moved or renamed in a later scipy): the public import."""
+    if "scipy.special" in sys.modules or _UFUNCS in sys.modules:  # imported already: nothing to save
+        from scipy.special import fresnel
+
+        return fresnel
+    try:
+        scipy_spec = importlib.util.find_spec("scipy")  # found, not imported (a top-level name)
+        assert scipy_spec is not None and scipy_spec.origin is not None
+        files = (Path(scipy_spec.origin).parent / "special" / f"_special_ufuncs{suffix}" for suffix in EXTENSION_SUFFIXES)
+        path = next(f for f in files if f.is_file())
+        spec = importlib.util.spec_from_file_location(_UFUNCS, path)
+        assert spec is not None and spec.loader is not None
+        module = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(module)
+        sys.modules.pop(_UFUNCS, None)  # out again: a later `import scipy.special` loads it as its own submodule
+        fresnel = module.fresnel
+        if not isinstance(fresnel, np.ufunc) or fresnel.nin != 1 or fresnel.nout != 2:
+            raise ImportError(f"{_UFUNCS}.fresnel is not the (S, C) ufunc")
+        return fresnel
+    except Exception:  # noqa: BLE001 - any failure of the short way: the public one
+        from scipy.special import fresnel
+
+        return fresnel
+
+
+fresnel = _load_fresnel()
 
 
 def unit_clothoid(theta: float, s: np.ndarray | float) -> tuple[np.ndarray, np.ndarray]:
