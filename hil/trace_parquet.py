@@ -28,6 +28,7 @@ import time
 from pathlib import Path
 from typing import Any, Sequence
 
+import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
 
@@ -51,13 +52,45 @@ def _type_of(name: str, value: float | int | str | None) -> pa.DataType:
     return pa.float64()
 
 
+_NUMPY = {pa.float64(): ("fiu", np.float64), pa.int64(): ("iu", np.int64), pa.uint16(): ("iu", np.uint16)}
+
+
+def _column(values: list, typ: pa.DataType) -> pa.Array:
+    """One trace column as an Arrow array, built from numpy buffers (bench decision B48): `pa.array` imports pandas
+    on its first call, to ask whether the values are a pandas array (≈ 0.17 s of every `hil run --trace`, issue 17),
+    and costs ≈ 5 µs a call. The array holds what `pa.array(values, type=typ)` holds, so the file is the same;
+    values it does not take this way (a None among numbers, a float in an integer column, a statusword out of
+    range, not a str in a string column) go to `pa.array`, which converts or refuses them as before (one
+    difference: a bool in an integer column is stored as 0/1, where pa.array refused it)."""
+    n = len(values)
+    try:
+        if typ == pa.string():
+            data = [v.encode() if v else b"" for v in values]  # "" and None: null, as every reader means it
+            valid = np.fromiter(map(bool, data), bool, n)
+            offsets = np.zeros(n + 1, np.int32)
+            np.cumsum(np.fromiter(map(len, data), np.int32, n), out=offsets[1:])
+            nulls = n - int(np.count_nonzero(valid))
+            bitmap = pa.py_buffer(np.packbits(valid, bitorder="little")) if nulls else None
+            return pa.Array.from_buffers(typ, n, [bitmap, pa.py_buffer(offsets), pa.py_buffer(b"".join(data))], nulls)
+        kinds, dtype = _NUMPY[typ]
+        arr = np.array(values)
+        if n and arr.dtype.kind not in kinds:
+            raise TypeError(f"{arr.dtype} for {typ}")
+        if n and arr.dtype.kind in "iu" and dtype is not np.int64:  # pyarrow's range checks
+            low, high = (0, 0xFFFF) if dtype is np.uint16 else (-(2**53), 2**53)  # 16 bits; an int exact as a float
+            if arr.min() < low or arr.max() > high:
+                raise OverflowError(f"{typ} out of range")
+        return pa.Array.from_buffers(typ, n, [None, pa.py_buffer(np.ascontiguousarray(arr, dtype=dtype))], 0)
+    except (TypeError, ValueError, AttributeError, OverflowError, KeyError):
+        return pa.array([v or None for v in values] if typ == pa.string() else values, type=typ)
+
+
 def _warm_up() -> None:
-    """pyarrow's first conversion of Python values (and its first zstd page) costs 0.3–0.5 s of lazy
-    set-up. Done at the first row group's flush, inside the bus cycle, that stalled an EtherCAT line
-    past its SM watchdog (AL 0x001B) two seconds into every run; so it is done here, before cycling."""
-    tab = pa.Table.from_arrays([pa.array([0.0], type=pa.float64()), pa.array([0], type=pa.int64()),
-                                pa.array([0], type=pa.uint16()), pa.array([""], type=pa.string())],
-                               names=["f", "i", "u", "s"])
+    """pyarrow's first Parquet file (its zstd codec, the writer's set-up) costs lazy set-up; at the first row
+    group's flush, inside the bus cycle, that stalled an EtherCAT line past its SM watchdog (AL 0x001B) two seconds
+    into every run (then 0.3–0.5 s: pa.array's pandas import, B48); so it is done here, before cycling."""
+    tab = pa.Table.from_arrays([_column([0.0], pa.float64()), _column([0], pa.int64()), _column([0], pa.uint16()),
+                                _column([""], pa.string())], names=["f", "i", "u", "s"])
     pq.write_table(tab, pa.BufferOutputStream(), compression="zstd")
 
 
@@ -165,13 +198,13 @@ class ParquetTrace:
         assert self._schema is not None
         arrays = []
         for i, f in enumerate(self._schema):  # column by column: short GIL holds, not one zip(*rows)
-            pieces = []
+            values: list = []  # the chunks' pieces joined first: one conversion a column, not one a chunk (B48)
             for is_rows, ch in chunks:
-                col = [r[i] for r in ch] if is_rows else ch[i]
-                if pa.types.is_string(f.type):
-                    col = [v or None for v in col]  # "" = nothing happened: null, as every reader means it
-                pieces.append(pa.array(col, type=f.type))
-            arrays.append(pieces[0] if len(pieces) == 1 else pa.concat_arrays(pieces))
+                if is_rows:
+                    values.extend([r[i] for r in ch])
+                else:
+                    values.extend(ch[i].tolist() if isinstance(ch[i], np.ndarray) else ch[i])
+            arrays.append(_column(values, f.type))
         tmp = self.parts / f".{part.name}.tmp"
         pq.write_table(pa.Table.from_arrays(arrays, schema=self._schema), tmp, compression="zstd")
         os.replace(tmp, part)
@@ -217,7 +250,8 @@ class ParquetTrace:
         try:
             with pq.ParquetWriter(tmp, schema, compression="zstd") as writer:
                 for part in sorted(self.parts.glob("*.parquet")):
-                    writer.write_table(pq.read_table(part).replace_schema_metadata(schema.metadata))
+                    # ParquetFile.read, not pq.read_table: the dataset reader imports pandas (B48)
+                    writer.write_table(pq.ParquetFile(part).read().replace_schema_metadata(schema.metadata))
             os.replace(tmp, self.path)
         finally:
             tmp.unlink(missing_ok=True)

@@ -1,11 +1,16 @@
 """What a `hil run` imports (issue 17: the user times the whole process, imports included): the scipy.special
-package (≈ 0.17 s) is not imported for the corner blends' Fresnel integrals, whose values stay scipy's."""
+package (≈ 0.17 s) is not imported for the corner blends' Fresnel integrals, whose values stay scipy's (bench
+decision B47), and a Parquet trace does not import pandas (≈ 0.17 s), its columns the same (B48)."""
 
 from __future__ import annotations
 
 import subprocess
 import sys
 from pathlib import Path
+
+import pyarrow as pa
+import pyarrow.parquet as pq
+import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -27,12 +32,33 @@ def test_the_blends_fresnel_integrals_are_scipys_without_importing_scipy_special
     assert _python(code) == ["False", "True", "True", "True"]
 
 
-def test_a_run_with_blends_and_a_parquet_trace_does_not_import_scipy_special(tmp_path):
+def test_a_run_with_blends_and_a_parquet_trace_imports_neither_scipy_special_nor_pandas(tmp_path):
     trace = tmp_path / "t.parquet"
     code = ("import sys; from hil.cli import main; import nc.motion.clothoid as c; calls = []; f = c.fresnel; "
             "c.fresnel = lambda x: calls.append(1) or f(x); "  # counted: the demo's corners are blended
             f"rc = main(['run', 'examples/lathe_demo.nc', '--trace', {str(trace)!r}]); "
-            "print(rc, len(calls) > 0, 'scipy.special' in sys.modules)")
+            "print(rc, len(calls) > 0, 'scipy.special' in sys.modules, 'pandas' in sys.modules)")
     out = _python(code)
-    assert out[-3:] == ["0", "True", "False"]
-    assert trace.stat().st_size > 0
+    assert out[-4:] == ["0", "True", "False", "False"]
+    t = pq.read_table(trace)
+    assert t.num_rows == 14396 and t.column("X_cmd").to_pylist()[-1] == pytest.approx(50.0)
+
+
+def test_a_trace_in_several_parts_is_joined_without_pandas_and_holds_what_pyarrow_converts(tmp_path):
+    """Rows and column blocks, a row group of 100: the parts are written and read back for the join."""
+    trace = tmp_path / "p.parquet"
+    code = ("import sys, numpy as np; from hil.trace_parquet import ParquetTrace; "
+            f"w = ParquetTrace({str(trace)!r}, ['t', 'line', 'alarm', 'X_cmd', 'X_sw'], row_group=100); "
+            "[w.write([k * 0.001, k // 10, '' if k % 7 else '0x1001', k * 0.5, k]) for k in range(150)]; "
+            "ks = np.arange(150, 420); w.write_columns([(ks * 0.001).tolist(), (ks // 10).tolist(), "
+            "['' if k % 9 else 'ü' for k in ks], ks * 0.5, ks.tolist()], len(ks)); "
+            "w.close({'reason': 'completed'}); print('pandas' in sys.modules)")
+    assert _python(code) == ["False"]
+    ks = range(420)
+    want = pa.table({"t": pa.array([k * 0.001 for k in ks]), "line": pa.array([k // 10 for k in ks]),
+                     "alarm": pa.array([(None if k % 7 else "0x1001") if k < 150 else (None if k % 9 else "ü")
+                                        for k in ks]),
+                     "X_cmd": pa.array([k * 0.5 for k in ks]), "X_sw": pa.array(list(ks), type=pa.uint16())})
+    got = pq.read_table(trace)
+    assert pq.ParquetFile(trace).metadata.num_row_groups == 5
+    assert got.select(want.column_names).equals(want.cast(got.select(want.column_names).schema))
