@@ -99,10 +99,12 @@ class Result:
 
         moves = None
         if self.runner is not None:
-            from hil.checks import offline_moves
+            from hil.checks import offline_moves, program_start
             from hil.session import load_program
+            from hil.trace_read import TraceFile
 
-            moves, _ = offline_moves(load_program(self.program), self.bench)
+            start = program_start(TraceFile(str(self.trace.path)), self.bench.axis_names)
+            moves, _ = offline_moves(load_program(self.program), self.bench, start)
         return {name.removesuffix(".png"): fig for name, _, fig in trace_figures(self.trace.path, self.bench, moves)}
 
     @property
@@ -304,13 +306,13 @@ def _set_overrides(mlc: Any, feed: float, rapid: float, spindle: float) -> None:
 
 
 def _checks(trace_path: str, bench: Bench, program: Any) -> list[Any]:
-    from hil.checks import offline_moves, run_checks
+    from hil.checks import offline_moves, program_start, run_checks
     from hil.trace_read import TraceFile
 
     tf = TraceFile(trace_path)
     if (tf.num_rows if tf.num_rows >= 0 else tf.table(["t"]).num_rows) == 0:
         return []  # no cycle ran (a bus that never opened): the run's alarm is the result; nothing to judge
-    moves, why = offline_moves(program, bench)
+    moves, why = offline_moves(program, bench, program_start(tf, bench.axis_names))
     return run_checks(tf, bench.checks, bench, moves, why)
 
 

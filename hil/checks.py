@@ -90,10 +90,32 @@ class _Cols:
 NO_PROGRAM = "needs the program (--program)"
 
 
-def program_moves(program: Program, bench: Bench) -> list[Move]:
-    """The programmed path in machine coordinates, from the axes' power-on positions."""
+def program_row(trace: TraceFile | _Cols) -> int | None:
+    """Index of the trace's last row before the program's first block (line 0 up to it: power-up and drive
+    homing), the row the program starts from; None when no block ran or the trace has no line column."""
+    cols = trace if isinstance(trace, _Cols) else _Cols(trace)
+    if "line" not in cols.trace.columns:
+        return None
+    ran = np.flatnonzero(cols["line"] > 0)
+    return max(int(ran[0]) - 1, 0) if ran.size else None
+
+
+def program_start(trace: TraceFile | _Cols, axes: list[str]) -> dict[str, float] | None:
+    """Where the run's program started: each axis's actual position in `program_row`, which the NC took as its
+    start (decision B51). On a real bus the axes stand wherever they were left, and drive homing moves and
+    renames them, so the bench's power-on `start` is not where the first move begins. None where unknown."""
+    cols = trace if isinstance(trace, _Cols) else _Cols(trace)
+    row = program_row(cols)
+    if row is None:
+        return None
+    return {a: float(cols[f"{a}_act"][row]) for a in axes if f"{a}_act" in cols.trace.columns}
+
+
+def program_moves(program: Program, bench: Bench, start: dict[str, float] | None = None) -> list[Move]:
+    """The programmed path in machine coordinates, from `start` (`program_start` of a run's trace), else from
+    the axes' power-on positions."""
     profile = make_profile(bench.profile, bench.axis_names, bench.params)
-    interp = Interpreter(profile, {a.name: a.start for a in bench.axes})
+    interp = Interpreter(profile, {a.name: a.start for a in bench.axes} | (start or {}))
     # runs of plain G0/G1 blocks read in bulk (issue 16's MoveBatch, a cycle's MoveList): the same
     # Move objects, a third of the interpreter's time on a 5,000-block CAM program (issue 17)
     interp.bulk = True
@@ -108,11 +130,12 @@ def program_moves(program: Program, bench: Bench) -> list[Move]:
     return out
 
 
-def offline_moves(program: Program, bench: Bench) -> tuple[list[Move] | None, str]:
+def offline_moves(program: Program, bench: Bench, start: dict[str, float] | None = None
+                  ) -> tuple[list[Move] | None, str]:
     """`program_moves`, or None and why: a program that reads what only a run answers (servo
     parameters, MLC registers) alarms offline, and its path checks are skipped saying so."""
     try:
-        return program_moves(program, bench), NO_PROGRAM
+        return program_moves(program, bench, start), NO_PROGRAM
     except NcAlarm as e:
         return None, f"the program does not run offline, so its path is unknown here: alarm {e}"
 
@@ -215,6 +238,12 @@ def check_limits(cols: _Cols, bench: Bench, tolerance: float) -> list[CheckResul
         x = cols[name]
         unit = "deg" if ax.units == "deg" else "mm"
         commanded = _commanded_rows(cols, ax.name, len(x))
+        if "line" in cols.trace.columns:
+            # Before the program's first block the NC sends no path: the drives enable and home themselves,
+            # and a homing's new origin is a step of the position, not a speed (decision B51)
+            row = program_row(cols)
+            since = np.arange(len(x)) >= (row if row is not None else len(x))
+            commanded = since if commanded is None else commanded & since
         for order, (label, lim) in enumerate((("velocity", ax.limits.max_velocity),
                                               ("acceleration", ax.limits.max_acceleration),
                                               ("jerk", ax.limits.max_jerk)), start=1):

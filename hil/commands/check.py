@@ -88,7 +88,7 @@ def trace_bench(args: argparse.Namespace, tf: TraceFile) -> tuple[Bench | None, 
 def prepare(args: argparse.Namespace, cmd: str):
     """Bench, checks, trace, the programmed moves and where the bench came from; bad input raises
     InputError / TraceReadError / NcAlarm."""
-    from hil.checks import program_moves
+    from hil.checks import program_moves, program_start
     from hil.session import InputError, load_program
     from hil.trace import axes_of, csv_meta_path
     from hil.trace_read import TraceFile
@@ -110,7 +110,8 @@ def prepare(args: argparse.Namespace, cmd: str):
         if missing:
             raise InputError(f"{args.trace} has no columns for axis {', '.join(missing)} of bench {bench.name}")
     # The program given here is the user's: an alarm offline is reported as the NC would (exit 1).
-    moves = program_moves(load_program(args.program), bench) if args.program and bench is not None else None
+    moves = program_moves(load_program(args.program), bench, program_start(tf, bench.axis_names)) \
+        if args.program and bench is not None else None
     return bench, checks, tf, moves, origin
 
 
