@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import os
 import pkgutil
 import sys
 from collections.abc import Sequence
@@ -59,6 +60,11 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
 
 def main(argv: Sequence[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
+    if "numpy" not in sys.modules:  # before numpy loads OpenBLAS, which reads it once
+        # One OpenBLAS thread (bench decision B47): at numpy's import OpenBLAS starts a thread per core, whose
+        # start-up spins ≈ 0.1 s of CPU on 2 cores in every `hil` process; deltahil's matrices are a few rows. A
+        # user's own setting stays.
+        os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
     # `hil path …` registers `path` alone (some 150 arguments of every other command not built at
     # start-up); anything else (`hil --help`, a misspelt command) gets the whole parser
     first = argv[0] if argv else ""

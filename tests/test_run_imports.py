@@ -62,3 +62,19 @@ def test_a_trace_in_several_parts_is_joined_without_pandas_and_holds_what_pyarro
     got = pq.read_table(trace)
     assert pq.ParquetFile(trace).metadata.num_row_groups == 5
     assert got.select(want.column_names).equals(want.cast(got.select(want.column_names).schema))
+
+
+def test_the_hil_command_starts_no_openblas_threads_unless_the_user_asks():
+    """numpy's OpenBLAS starts a thread per core at import, ≈ 0.1 s of CPU in every `hil` process (B47)."""
+    import os
+
+    code = ("import os, sys; from hil.cli import main; rc = main(['path', 'examples/lathe_demo.nc']); import numpy; "
+            "print(len(os.listdir('/proc/self/task')), os.environ.get('OPENBLAS_NUM_THREADS'))")
+    env = {k: v for k, v in os.environ.items() if k != "OPENBLAS_NUM_THREADS"}
+    plain = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, env=env)
+    asked = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT,
+                           env={**env, "OPENBLAS_NUM_THREADS": "2"})
+    (n_plain, set_plain), (n_asked, set_asked) = (p.stdout.split()[-2:] for p in (plain, asked))
+    assert (set_plain, set_asked) == ("1", "2")
+    if (os.cpu_count() or 1) >= 2:  # OpenBLAS starts one thread fewer than the threads it is allowed
+        assert int(n_plain) == int(n_asked) - 1
