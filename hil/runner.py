@@ -262,30 +262,32 @@ class BenchRunner:
         stopping = False
         stretcher = Stretcher.for_runner(self)  # quiet cycles a stretch at a time (issue 17, decision B20)
         self._stretcher = stretcher  # the settle after the program takes stretches too (B38)
-        while ch.busy and self.cycle < give_up:
-            if self.stop_request is not None and not stopping:
-                stopping = True  # along the path, jerk-limited, then flush: the NC's reset
-                ch.reset()
-            if stretcher is not None and not stopping and stretcher.run(max_cycles - 1 - self.cycle):
-                continue  # it ended before max_cycles: the check below is for a stepped cycle
-            # real time: this cycle's planner refill computed now, in the slack (decision B21)
-            # ... unless the cycle before was long or the tick is near: then this cycle does it itself (B34)
-            skip = stretcher is not None and stretcher.paced and not stopping and stretcher.skip_ahead()
-            whole = not skip and not stopping and stretcher is not None and stretch_ahead.wanted(self)
-            ahead = stretcher.ahead() if stretcher is not None and not stopping and not skip and not whole else None
-            if skip:
-                self._exchange(None, bus_ahead=False)
-            elif whole:  # the basic MLC: the cycle's whole channel step ahead, after its exchange (B46)
-                self._exchange(None, ahead=lambda tx: stretch_ahead.step_ahead(stretcher, tx))
-            elif ahead is None:
-                self._exchange()
-            else:
-                self._exchange(ahead)
-            if self.cycle == max_cycles:  # an alarm like any other: the channel stops along the path
-                self._end_reason = "max_time"
-                ch.raise_alarm(Alarm(MAX_TIME_ALARM, f"run exceeded the bench's max_time of {self.bench.max_time:g} s",
-                                     line=self.line or None))
-        self.result.program_time = self.time - t0
+        try:  # the time the program ran, also when a bus alarm ends it from inside a cycle
+            while ch.busy and self.cycle < give_up:
+                if self.stop_request is not None and not stopping:
+                    stopping = True  # along the path, jerk-limited, then flush: the NC's reset
+                    ch.reset()
+                if stretcher is not None and not stopping and stretcher.run(max_cycles - 1 - self.cycle):
+                    continue  # it ended before max_cycles: the check below is for a stepped cycle
+                # real time: this cycle's planner refill computed now, in the slack (decision B21)
+                # ... unless the cycle before was long or the tick is near: then this cycle does it itself (B34)
+                skip = stretcher is not None and stretcher.paced and not stopping and stretcher.skip_ahead()
+                whole = not skip and not stopping and stretcher is not None and stretch_ahead.wanted(self)
+                ahead = stretcher.ahead() if stretcher is not None and not stopping and not skip and not whole else None
+                if skip:
+                    self._exchange(None, bus_ahead=False)
+                elif whole:  # the basic MLC: the cycle's whole channel step ahead, after its exchange (B46)
+                    self._exchange(None, ahead=lambda tx: stretch_ahead.step_ahead(stretcher, tx))
+                elif ahead is None:
+                    self._exchange()
+                else:
+                    self._exchange(ahead)
+                if self.cycle == max_cycles:  # an alarm like any other: the channel stops along the path
+                    self._end_reason = "max_time"
+                    ch.raise_alarm(Alarm(MAX_TIME_ALARM, f"run exceeded the bench's max_time of {self.bench.max_time:g} s",
+                                         line=self.line or None))
+        finally:
+            self.result.program_time = self.time - t0
         self.result.finished = ch.state is RunState.FINISHED
         self._settle()
         self.result.stretched = stretcher.cycles if stretcher is not None else 0  # the settle's too (B38)

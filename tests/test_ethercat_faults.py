@@ -60,6 +60,23 @@ def test_dropped_frames_beyond_tolerance_raise_0x0601_and_stop():
     assert_stopped_after_alarm(run.recorder, result)  # the slaves' own fault reaction brakes them
 
 
+def test_a_line_that_never_answers_again_ends_the_run_in_seconds():
+    """Every frame lost from frame 300 on (a pulled cable, the slaves' process killed): the alarm after the bench's
+    bad cycles, then the stop path cycles the dead line at SOEM's 2 ms receive timeout until the drives' feedback
+    is seen frozen, and the run ends (decisions E27). At 100 ms a lost frame (plus an AL-state read each) that
+    took minutes."""
+    t0 = time.monotonic()
+    result, history, link = run("drop@300x1000000")
+    wall = time.monotonic() - t0
+    assert not result.finished and [a.code for a in result.alarms] == [0x0601]
+    assert "no frame returned" in result.alarms[0].message and "no slave answered" in result.alarms[0].message
+    assert 0.25 < result.program_time < 0.35  # the program ran until the line went (frame 300, less power-up)
+    assert link.stats.lost_frames > 200  # the stop path cycled the dead line until the feedback was seen frozen
+    assert wall < 12.0, wall  # power-up, 300 cycles and the stop path; minutes before E27
+    # every drive left with the line: their own fault reaction brakes them, unseen; none is left enabled
+    assert_stopped_after_alarm(run.recorder, result, lost=("X", "Z", "S1"))
+
+
 def test_late_frames_raise_0x0601():
     result, _, _ = run("late@300x6:150")  # answers 150 ms late, after the 100 ms receive timeout
     assert not result.finished and result.alarms[0].code == 0x0601

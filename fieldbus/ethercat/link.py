@@ -56,6 +56,9 @@ class LinkStats:
     events: list[str] = field(default_factory=list)
 
 
+LOST_LINE_TIMEOUT_US = 2_000  # receive timeout once the line is lost after its alarm (SOEM's EC_TIMEOUTRET)
+
+
 @dataclass
 class EthercatLink:
     iface: str
@@ -87,6 +90,7 @@ class EthercatLink:
         self._states: list[str] = []  # per slave as `infos` lists them, refreshed on every bad cycle
         self._all_op: list[str] = []  # what `_states` reads after a good frame (shared, never changed in place)
         self._failed = False  # a bus alarm was raised and the line was not recovered since
+        self._lost = 0  # consecutive lost frames (no answer at all)
         # status() of the last call, with what it was built from: `_states` (by identity: it is replaced, never
         # changed in place), `_failed` and whether the master is open
         self._status: tuple[list[str], bool, bool, LinkStatus] | None = None
@@ -310,11 +314,15 @@ class EthercatLink:
             for s, data in zip(self.io, self._io_out):  # remote I/O outputs the MLC wrote (mlc/remote_io.py)
                 s.output = data
         m.send_processdata()
-        wkc = m.receive_processdata(self.receive_timeout_us)
+        # A line silent for twice the slaves' SM watchdog after its alarm (every drive has dropped out of OP and
+        # braked on its own fault reaction) is waited for no longer than SOEM's own 2 ms a frame: the stop path
+        # cycles it until the drives' feedback is seen frozen, and 100 ms a lost frame made that minutes (E27)
+        dead = self._failed and self._lost * self.receive_timeout_us > 2_000 * self.watchdog_ms
+        wkc = m.receive_processdata(LOST_LINE_TIMEOUT_US if dead else self.receive_timeout_us)
         stats = self.stats
         stats.cycles += 1
         if wkc == m.expected_wkc:
-            self._bad = 0
+            self._bad = self._lost = 0
             if not self._failed:  # the full working counter: every slave exchanged, so every slave is in OP
                 self._states = self._all_op
             last = self._last
@@ -354,8 +362,15 @@ class EthercatLink:
         self._bad += 1
         if wkc < 0:
             self.stats.lost_frames += 1
-        m.read_state()
-        self._states = [state_name(s.state) for s in self.drives + self.io]
+            self._lost += 1
+        else:
+            self._lost = 0
+        # A lost frame says no slave answered: reading their AL states needs the same line, and on a dead line each
+        # read waits out SOEM's timeouts (≈ 2.3 s with 4 slaves): they are read only where a frame came back
+        # (decisions E27)
+        if wkc >= 0:
+            m.read_state()
+            self._states = [state_name(s.state) for s in self.drives + self.io]
         if self._failed:
             return self._ride_on(wkc)
         try:
@@ -384,13 +399,15 @@ class EthercatLink:
                                            f"{A.al_text(s.al_status)}", axis=self._axis(name), info=s.al_status))
         if self._bad > self.max_bad_cycles:
             what = "no frame returned" if wkc < 0 else f"working counter {wkc}, expected {m.expected_wkc}"
-            lost = [(s, name) for s, name in self._named(m) if s.state != pysoem.OP_STATE]
+            silent = self._lost >= self._bad  # every frame of the run lost: no state could be read
+            lost = [] if silent else [(s, name) for s, name in self._named(m) if s.state != pysoem.OP_STATE]
             bad = [name for _, name in lost]
             who = bad[0] if bad else (self.names[0] if self.names else "line")
             # Only remote I/O stations gone, every drive still in OP: the EIO alarm (NC5 App. A 0x1426).
             code = A.EIO_FAILED if lost and all(id(s) in io for s, _ in lost) else A.DISCONNECTED
-            raise BusError(Alarm(code, f"EtherCAT communication lost for {self._bad} cycles ({what}); "
-                                       f"not in OP: {', '.join(bad) or 'none'}", axis=self._axis(who)))
+            where = "no slave answered" if silent else f"not in OP: {', '.join(bad) or 'none'}"
+            raise BusError(Alarm(code, f"EtherCAT communication lost for {self._bad} cycles ({what}); {where}",
+                                 axis=self._axis(who)))
         self.stats.events.append(f"cycle {self.stats.cycles}: bad working counter {wkc}, riding through")
         return list(self._last)
 
