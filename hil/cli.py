@@ -2,7 +2,7 @@
 so capabilities can be added without touching this file.
 
 Exit codes (README): 0 success, 1 the run or program raised an alarm, 2 bad usage or a bad input
-file, 3 a run that completed but failed a check (hil run), 128 + n for a run stopped by signal n
+file, 3 a run that completed but failed a check (hil run), 128 + n for a run (or a command) stopped by signal n
 (hil/stop_signals.py), 130 interrupted. No Python traceback reaches the user: an unexpected error is reported as
 NC internal alarm 0x0000.
 """
@@ -17,6 +17,7 @@ import sys
 from collections.abc import Sequence
 
 import hil.commands
+from hil.stop_signals import SignalStop, exit_code, signals_end_command
 from nc.alarms import internal_error
 
 EXIT_OK, EXIT_ALARM, EXIT_USAGE = 0, 1, 2
@@ -72,10 +73,14 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser(first if known else None)
     args = parser.parse_args(argv)
     try:
-        return int(args.func(args) or 0)
+        with signals_end_command():  # SIGTERM/SIGHUP outside a run: a message and 128 + n, not a silent death
+            return int(args.func(args) or 0)
     except UsageError as exc:
         print(f"hil {args.command}: {exc}", file=sys.stderr)
         return EXIT_USAGE
+    except SignalStop as exc:
+        print(f"hil {args.command}: stopped by {exc.name}", file=sys.stderr)
+        return exit_code(exc.name)
     except KeyboardInterrupt:
         print("hil: interrupted", file=sys.stderr)
         return 130

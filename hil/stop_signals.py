@@ -44,3 +44,35 @@ def stop_on_signals(runner: Any) -> Iterator[None]:
 
 def exit_code(name: str) -> int:
     return 128 + int(signal.Signals[name])
+
+
+class SignalStop(KeyboardInterrupt):
+    """SIGTERM or SIGHUP outside a run (start-up, bring-up's imports, writing the report): the command ends as
+    Ctrl-C ends it there, its `finally` blocks and atomic writes done, and `hil` exits 128 + n saying so."""
+
+    def __init__(self, name: str) -> None:
+        super().__init__(name)
+        self.name = name
+
+
+@contextmanager
+def signals_end_command() -> Iterator[None]:
+    """For the whole `hil` command (main thread): SIGTERM and SIGHUP whose handling is the default raise
+    SignalStop (a run's own stop_on_signals takes them over while it runs). An ignored signal (nohup) stays
+    ignored; the previous handlers come back at the end."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def handler(signum: int, frame: Any) -> None:
+        raise SignalStop(signal.Signals(signum).name)
+
+    previous = {}
+    for s in STOP_SIGNALS:
+        if s != signal.SIGINT and signal.getsignal(s) is signal.SIG_DFL:
+            previous[s] = signal.signal(s, handler)
+    try:
+        yield
+    finally:
+        for s, h in previous.items():
+            signal.signal(s, h)

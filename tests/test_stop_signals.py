@@ -156,3 +156,42 @@ def test_a_signal_leaves_no_temporary_check_trace(tmp_path, sig):
     out, err = p.communicate(timeout=120)
     assert p.returncode == 128 + sig and "checks" in out and "Traceback" not in err, out + err
     assert not list(tmp.iterdir())
+
+
+def _signal_inside_the_command(monkeypatch, sig):
+    """`hil run`'s work replaced by one that receives `sig` before any run starts (start-up, imports)."""
+    import hil.commands.run as run_cmd
+
+    def receives(args, scope):
+        os.kill(os.getpid(), sig)
+        time.sleep(2.0)  # the handler raises at once; never reached otherwise
+        return 0
+
+    monkeypatch.setattr(run_cmd, "_run_and_print", receives)
+
+
+@pytest.mark.parametrize("sig, code", [(signal.SIGTERM, 143), (signal.SIGHUP, 129)])
+def test_a_signal_before_the_run_ends_the_command_with_its_code(monkeypatch, capsys, sig, code):
+    """SIGTERM/SIGHUP before a run has started (its own handlers not yet set) used to kill `hil` silently;
+    now the command ends through its `finally` blocks, says so and exits 128 + n."""
+    from hil.cli import main
+
+    before = signal.getsignal(sig)
+    _signal_inside_the_command(monkeypatch, sig)
+    assert main(["run", str(ROOT / "examples" / "lathe_demo.nc")]) == code
+    assert f"hil run: stopped by {signal.Signals(sig).name}" in capsys.readouterr().err
+    assert signal.getsignal(sig) is before  # given back
+
+
+def test_an_ignored_hangup_stays_ignored(monkeypatch, capsys):
+    """Under nohup SIGHUP is ignored: `hil` leaves it so, and the command goes on."""
+    from hil.cli import main
+
+    previous = signal.signal(signal.SIGHUP, signal.SIG_IGN)
+    try:
+        _signal_inside_the_command(monkeypatch, signal.SIGHUP)
+        monkeypatch.setattr(time, "sleep", lambda s: None)
+        assert main(["run", str(ROOT / "examples" / "lathe_demo.nc")]) == 0
+        assert signal.getsignal(signal.SIGHUP) is signal.SIG_IGN
+    finally:
+        signal.signal(signal.SIGHUP, previous)
