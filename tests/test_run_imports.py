@@ -78,3 +78,31 @@ def test_the_hil_command_starts_no_openblas_threads_unless_the_user_asks():
     assert (set_plain, set_asked) == ("1", "2")
     if (os.cpu_count() or 1) >= 2:  # OpenBLAS starts one thread fewer than the threads it is allowed
         assert int(n_plain) == int(n_asked) - 1
+
+
+def test_a_run_whose_bench_has_checks_reads_its_trace_back_without_pandas(tmp_path):
+    """The post-run checks of benches/mill-3axis.toml read the trace's columns as numpy arrays (B48)."""
+    from benchmarks.bench_motion import cam_program
+
+    prog, trace = tmp_path / "cam.nc", tmp_path / "cam.parquet"
+    prog.write_text(cam_program(300))
+    code = ("import sys; from hil.cli import main; "
+            f"rc = main(['run', {str(prog)!r}, '--bench', 'benches/mill-3axis.toml', '--trace', {str(trace)!r}]); "
+            "print(rc, 'pandas' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT)
+    assert out.stdout.split()[-2:] == ["0", "False"], out.stderr
+    assert "ok    contour error:" in out.stdout and "ok    jerk X:" in out.stdout
+
+
+def test_trace_columns_read_as_numpy_equal_pyarrows_to_numpy():
+    import numpy as np
+
+    from hil.trace_read import _numbers
+
+    parts = [pa.array([1.5, -2.0, np.nan, 4.0]), pa.array([5.0, 6.0])]
+    for col in (pa.chunked_array(parts), pa.chunked_array([parts[0].slice(1, 2)]), pa.chunked_array([], pa.float64()),
+                pa.chunked_array([pa.array([1, 65535], pa.uint16()), pa.array([7], pa.uint16()).slice(0, 1)]),
+                pa.chunked_array([pa.array([3, None], pa.int64())])):
+        got, want = _numbers(col), col.to_numpy()
+        assert got.dtype == want.dtype and np.array_equal(got, want, equal_nan=True)
+        assert got.flags.writeable == want.flags.writeable
