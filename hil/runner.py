@@ -22,6 +22,7 @@ from fieldbus.cia402 import Cia402Master, State, Target
 from fieldbus.link import BusError, BusLink, SimLink
 from fieldbus.pdo import RxPdo, TxPdo
 from hil.bench import Bench
+from hil.bus_work import BusWork
 from hil.clock import CycleTiming, LockStepClock, RealTimeClock
 from hil.cycle_lean import OVERSPEED, WARM_AHEAD_NS, WARM_MIN_NS, factors, feedback, row, setpoints, warm
 from hil import retentive
@@ -120,6 +121,8 @@ class BenchRunner:
         self.origin = np.zeros(n_axes)
         # The pacer: lock-step virtual time unless a real-time clock is given.
         self.clock = clock or LockStepClock(bench.cycle)
+        # A field bus: the wait for it and the master's own work per cycle, apart (decisions E25)
+        self._bus_work = BusWork.for_link(link, self.clock.realtime)
         self.timing = CycleTiming(bench.cycle, 0.0)
         self.progress = progress  # anything with update(runner) and close(); see hil.progress
         # Extra trace columns (MLC signals ...): append TraceSources before the run starts and open
@@ -369,6 +372,8 @@ class BenchRunner:
             if self.clock.left_ns() > WARM_MIN_NS:
                 warm(self, len(self.axes))  # reads only: the caches hold what the cycle reads first (B43)
         self.timing = self.clock.tick()
+        if self._bus_work is not None:
+            self._bus_work.tick()
         if self.timing.overrun:
             self._overrun()
         self._cycle(tx if tx is not None else self.link.exchange(self.rx), step)
@@ -424,6 +429,9 @@ class BenchRunner:
                 if vel is not None:
                     rx.target_velocity = sc.rpm_to_drive(vel)
         self.clock.written()  # the outputs the next exchange sends: the end of the cycle's work (decision B21)
+        bus_work = self._bus_work
+        if bus_work is not None and bus_work.realtime:  # where the clock ends the cycle's work: here in real time
+            bus_work.written(self.cycle)
         if self.trace is not None:
             self.trace.write(self._row())
             self._row_cycle = self.cycle
@@ -432,6 +440,8 @@ class BenchRunner:
         if self.progress is not None:
             self.progress.update(self)
         self.clock.done()
+        if bus_work is not None and not bus_work.realtime:  # (lock-step: at done)
+            bus_work.written(self.cycle)
 
     def _new_alarms(self) -> str:
         """Codes of the alarms raised since the previous row (by the bench or by the channel)."""
@@ -590,6 +600,8 @@ class BenchRunner:
         if isinstance(c, RealTimeClock):
             r.timing["latency"] = c.latency.summary()
             r.timing["between"] = c.between.summary()  # work in the periods' slack (decision B21)
+        if self._bus_work is not None:
+            r.timing.update(self._bus_work.summary())  # bus wait, master work (decision E25)
         if self.channel is not None:
             for a in self.channel.alarms:
                 if a not in r.alarms:

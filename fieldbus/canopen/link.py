@@ -21,6 +21,7 @@ import itertools
 import logging
 import threading
 import time
+from time import perf_counter_ns
 from collections.abc import Callable, Sequence
 from typing import Any
 
@@ -103,6 +104,9 @@ class CanopenLink:
         self._next_sync = 0.0
         self._opened_at = 0.0
         self.capture: Any = None  # fieldbus.capture.CanCapture: `hil run --capture FILE.asc`
+        # True: the caller holds the cycle (a real-time clock), so exchange() sends the SYNC at once (E24)
+        self.paced = False
+        self.wait_ns = 0  # the last exchange's time in sending, the SYNC and the wait for the TPDOs (E25)
 
     @classmethod
     def for_bench(cls, bench: Any, interface: str, channel: str = "") -> "CanopenLink":
@@ -358,8 +362,15 @@ class CanopenLink:
             return [TxPdo() for _ in self.nodes_cfg]
         net = self.network
         live = [n for n in self._nodes if not n.lost]
-        if not self.lockstep:
-            # The SYNC producer runs at the bench cycle, whatever the caller's loop does.
+        frames = [(0x200 + 0x100 * k + n.cfg.node_id, frame.pack_rx(rx))
+                  for n, rx in zip(self._nodes, outputs) if not n.lost for k, frame in enumerate(n.rx_frames)]
+        for io in self._io:  # remote I/O outputs (mlc/remote_io.py), acting on this SYNC
+            if not io.lost and io.cfg.outputs:
+                frames.append((0x200 + io.cfg.node_id, io.outputs.to_bytes((io.cfg.outputs + 7) // 8, "little")))
+        t0 = perf_counter_ns()  # from here to the last TPDO: the wait for the bus (decisions E25)
+        if not self.lockstep and not self.paced:
+            # The SYNC producer holds the bench cycle against a caller that does not pace itself (lock-step over a
+            # real transport); a real-time clock paces the caller, and the SYNC goes when it asks (decisions E24)
             self._next_sync += self.cycle_time
             delay = self._next_sync - time.monotonic()
             if delay > 0:
@@ -369,30 +380,16 @@ class CanopenLink:
         with self._lock:
             for n in live:
                 n.received.clear()
-        for n, rx in zip(self._nodes, outputs):
-            if n.lost:
-                continue
-            for k, frame in enumerate(n.rx_frames):
-                data = frame.pack_rx(rx)
-                cob = 0x200 + 0x100 * k + n.cfg.node_id
-                if self.lockstep:
-                    net.send_raw(cob, data)
-                else:
-                    net.send_message(cob, data)
-        for io in self._io:  # remote I/O outputs (mlc/remote_io.py), acting on this SYNC
-            if io.lost or not io.cfg.outputs:
-                continue
-            data = io.outputs.to_bytes((io.cfg.outputs + 7) // 8, "little")
-            if self.lockstep:
-                net.send_raw(0x200 + io.cfg.node_id, data)
-            else:
-                net.send_message(0x200 + io.cfg.node_id, data)
+        send = net.send_raw if self.lockstep else net.send_message
+        for cob, data in frames:
+            send(cob, data)
         net.sync.transmit()  # lock-step: delivers RPDOs + SYNC, the slaves answer, we collect
         self.cycles += 1
         if self.lockstep:
             self.time += self.cycle_time
         else:
             self._wait(lambda: all(len(n.received) == len(n.tx_frames) for n in live), self.tpdo_timeout)
+        self.wait_ns = perf_counter_ns() - t0
         with self._lock:
             for n in live:
                 if len(n.received) < len(n.tx_frames):

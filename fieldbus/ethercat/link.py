@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import struct
 import time
+from time import perf_counter_ns
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
@@ -96,6 +97,7 @@ class EthercatLink:
         self._status: tuple[list[str], bool, bool, LinkStatus] | None = None
         self._io_out: list[bytes] = []  # per I/O slave: the output image the next frame carries
         self._io_in: list[bytes] = []  # per I/O slave: the input image of the last good frame
+        self.wait_ns = 0  # the last exchange's time in pysoem's send and receive: the wait for the line (E25)
 
     @classmethod
     def for_bench(cls, bench, iface: str) -> "EthercatLink":
@@ -313,12 +315,14 @@ class EthercatLink:
         if self.io:
             for s, data in zip(self.io, self._io_out):  # remote I/O outputs the MLC wrote (mlc/remote_io.py)
                 s.output = data
+        t0 = perf_counter_ns()
         m.send_processdata()
         # A line silent for twice the slaves' SM watchdog after its alarm (every drive has dropped out of OP and
         # braked on its own fault reaction) is waited for no longer than SOEM's own 2 ms a frame: the stop path
         # cycles it until the drives' feedback is seen frozen, and 100 ms a lost frame made that minutes (E27)
         dead = self._failed and self._lost * self.receive_timeout_us > 2_000 * self.watchdog_ms
         wkc = m.receive_processdata(LOST_LINE_TIMEOUT_US if dead else self.receive_timeout_us)
+        self.wait_ns = perf_counter_ns() - t0
         stats = self.stats
         stats.cycles += 1
         if wkc == m.expected_wkc:

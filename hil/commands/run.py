@@ -198,6 +198,10 @@ def print_timing(r: RunResult, out=None) -> None:
     if e:
         print("cycle work     " + "  ".join(f"{k} {e.get(k, 0.0) * 1e6:.1f} µs" for k in ("p50", "p99", "max"))
               + ("  (wall clock, lock-step)" if not r.realtime else ""), file=out)
+    for key, label in (("bus_wait", "bus wait       "), ("master", "master work    ")):  # a field bus (E25)
+        w = r.timing.get(key, {})
+        if w:
+            print(label + "  ".join(f"{k} {w.get(k, 0.0) * 1e6:.1f} µs" for k in ("p50", "p99", "max")), file=out)
     b = r.timing.get("between", {})
     if r.realtime and b:  # the work done in the periods' slack (decision B21): with cycle work, what a tick waits for
         print("between cycles " + "  ".join(f"{k} {b.get(k, 0.0) * 1e6:.1f} µs" for k in ("p50", "p99", "max")),
