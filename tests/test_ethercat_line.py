@@ -12,7 +12,7 @@ import pytest
 
 from fieldbus.ethercat.link import EthercatLink, SdoAbort
 from fieldbus.link import BusError
-from fieldbus.pdo import PdoEntry, PdoLayout
+from fieldbus.pdo import ASDA_E, PdoEntry, PdoLayout
 from virtual_bus.ethercat.veth import SimProcess, VethPair, can_create
 
 REASON = can_create()
@@ -85,10 +85,20 @@ def test_sdo_api_reads_writes_and_reports_aborts(line):
 
 def test_unmappable_pdo_layout_raises_pdo_mismatch(line):
     bad = PdoLayout("bad", (PdoEntry(0x6041, 0, 16, "controlword"),), (PdoEntry(0x6041, 0, 16, "statusword"),))
-    link = EthercatLink(line.iface, names=["X"], layouts=[bad])
+    link = EthercatLink(line.iface, names=["X", "Z", "S1"], layouts=[bad, ASDA_E, ASDA_E])
     with pytest.raises(BusError) as exc:
         link.open()
     assert exc.value.alarm.code == 0x141E and "0x06040041" in exc.value.alarm.message
+
+
+def test_a_line_with_more_drives_than_the_bench_is_refused(line):
+    """Three drives on the line, a bench naming two: mapped by order, the third would idle and a bench spindle
+    could command another machine's axis; the master refuses the line (decisions E28)."""
+    link = EthercatLink(line.iface, names=["X", "Z"])
+    with pytest.raises(BusError) as exc:
+        link.open()
+    assert exc.value.alarm.code == 0x141E
+    assert "3 CiA 402 drives found" in exc.value.alarm.message and "names 2 (X, Z)" in exc.value.alarm.message
 
 
 def test_unsupported_cycle_time_raises_0x141f(line):

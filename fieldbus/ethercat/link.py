@@ -193,7 +193,13 @@ class EthercatLink:
         if len(self.drives) < len(self.names):
             raise BusError(Alarm(A.NO_SLAVES, f"{len(self.drives)} CiA 402 drives found on {self.iface}, "
                                               f"the bench needs {len(self.names)} ({', '.join(self.names)})"))
-        self.drives = self.drives[: len(self.names)]
+        if len(self.drives) > len(self.names):
+            # Mapped by order, the bench's drives would take the line's first ones and the rest would idle in
+            # PRE-OP: a line that is not the configured one (another machine's, a drive added) would have the bench's
+            # spindle command drive a linear axis. A master refuses a line unlike its configuration (decisions E28).
+            raise BusError(Alarm(A.PDO_MISMATCH, f"{len(self.drives)} CiA 402 drives found on {self.iface}, the bench "
+                                                 f"names {len(self.names)} ({', '.join(self.names)}): the line does not "
+                                                 f"match the bench; describe every drive on it"))
         self._check_aliases()
         layouts = list(self.layouts) or [ASDA_E] * len(self.names)
         self._structs = layouts
