@@ -106,3 +106,11 @@ def test_trace_columns_read_as_numpy_equal_pyarrows_to_numpy():
         got, want = _numbers(col), col.to_numpy()
         assert got.dtype == want.dtype and np.array_equal(got, want, equal_nan=True)
         assert got.flags.writeable == want.flags.writeable
+
+
+def test_a_run_without_a_trace_does_not_import_pyarrow():
+    """pyarrow (≈ 45 ms with its ssl and socket) is for a Parquet trace; the stretch's trace columns ask for it only
+    where one is open (hil/stretch_bulk.py)."""
+    code = ("import sys; from hil.cli import main; rc = main(['run', 'examples/lathe_demo.nc']); "
+            "print(rc, 'pyarrow' in sys.modules)")
+    assert _python(code)[-2:] == ["0", "False"]
