@@ -63,8 +63,10 @@ def _ranges(counts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _unique(x: np.ndarray) -> np.ndarray:
-    """np.unique of an int array by sorting (numpy's hash-based unique costs more here)."""
-    x = np.sort(x)
+    """np.unique of an int array by sorting (numpy's hash-based unique costs more here). The keys come nearly
+    sorted (run-major): the stable sort (timsort) takes them ≈ 7× faster than the default quicksort (the CAM
+    program's checks: 39 → 6 ms), and sorted ints are the same whichever sort made them."""
+    x = np.sort(x, kind="stable")
     return x[np.concatenate(([True], x[1:] != x[:-1]))] if len(x) else x
 
 
