@@ -87,9 +87,11 @@ def rs274(program: Path, repeat: int) -> tuple[float | None, str]:
         return None, "skipped: rs274 not installed (apt-get install linuxcnc-uspace)"
     runs = [timed([exe, "-g", str(program)]) for _ in range(repeat)]
     wall, _, out, rc = min(runs, key=lambda r: r[0])
-    if rc != 0:
-        errors = [ln.strip() for ln in out.splitlines() if ln.strip() and "N....." not in ln]
-        return None, f"skipped: rs274 stops ({errors[-1] if errors else f'exit {rc}'})"
+    if rc != 0:  # its message, then the block it stopped at, among the canonical calls ("  12 N..... …")
+        lines = [ln.strip() for ln in out.splitlines()]
+        errors = [(m, b) for m, b in zip(lines, lines[1:]) if m and "N....." not in m and m != "executing"]
+        why = f"{errors[0][0]} at '{errors[0][1].split('(')[0].strip()}'" if errors else f"exit {rc}"
+        return None, f"skipped: rs274 stops ({why})"
     return wall, f"{len(out.splitlines())} canonical calls"
 
 
