@@ -88,6 +88,7 @@ class EthercatLink:
         # per drive, decided once at bring-up: the master derives 0x60F4 / reads 0x603F (no PDO carries it)
         self._derived_fe: list[bool] = []
         self._derived_ec: list[bool] = []
+        self._plan: list[tuple] = []  # (slave, layout, derive 0x60F4, read 0x603F) per drive
         self._states: list[str] = []  # per slave as `infos` lists them, refreshed on every bad cycle
         self._all_op: list[str] = []  # what `_states` reads after a good frame (shared, never changed in place)
         self._failed = False  # a bus alarm was raised and the line was not recovered since
@@ -205,6 +206,8 @@ class EthercatLink:
         self._structs = layouts
         self._derived_fe = [not layout.carries(0x60F4) for layout in layouts]
         self._derived_ec = [not layout.carries(0x603F) for layout in layouts]
+        # per drive, what a good frame's cycle does with it, in one pass (E26)
+        self._plan = list(zip(self.drives, layouts, self._derived_fe, self._derived_ec))
         errors: list[Alarm] = []
         for s, layout, name in zip(self.drives, layouts, self.names):
             s.config_func = self._mapper(s, layout, name, errors)
@@ -336,25 +339,26 @@ class EthercatLink:
             if not self._failed:  # the full working counter: every slave exchanged, so every slave is in OP
                 self._states = self._all_op
             last = self._last
-            for s, layout, tx in zip(self.drives, self._structs, last):
+            # Inputs unpacked, then what the layout does not carry (no Delta PDO set maps 0x60F4; ASDA_E leaves 0x603F
+            # out): the following error in CSP is the target just sent less the position reached (the drive's own
+            # 0x60F4 in lock-step; 0 until enabled, the command follows the actual position), and the error code is
+            # read over SDO once when the fault bit rises. Drive by drive in one pass, not three loops (E26).
+            for (s, layout, fe, ec), rx, tx in zip(self._plan, outputs, last):
                 layout.unpack_tx(s.input, tx)
-            self._derive(outputs)
+                if fe:
+                    tx.following_error = rx.target_position - tx.position_actual \
+                        if tx.mode_display == 8 and tx.statusword & 0x6F == 0x27 else 0
+                if ec:
+                    if not tx.statusword & SW_FAULT:
+                        tx.error_code = 0
+                    elif not tx.error_code:
+                        tx.error_code = _error_code(s)
             if self.io:
-                self._io_in = [bytes(s.input) for s in self.io]
+                self._io_in = [s.input for s in self.io]  # (pysoem hands out a new bytes object every read)
             if self.dc and self.drift_check_every and not self._failed and stats.cycles % self.drift_check_every == 0:
                 self._check_drift()
             return list(last)
         return self._bad_cycle(m, wkc)
-
-    def _derive(self, outputs: Sequence[RxPdo]) -> None:
-        """What the layout does not carry (no Delta PDO set maps 0x60F4; ASDA_E leaves 0x603F out):
-        the following error in CSP is the target just sent less the position reached (the drive's own
-        0x60F4 in lock-step), and the error code is read over SDO once when the fault bit rises."""
-        for derive, rx, tx in zip(self._derived_fe, outputs, self._last):
-            if derive:  # the drive's command follows the actual position until enabled
-                live = tx.mode_display == 8 and tx.statusword & 0x6F == 0x27
-                tx.following_error = rx.target_position - tx.position_actual if live else 0
-        self._read_error_codes()
 
     def _read_error_codes(self) -> None:
         for s, derive, tx in zip(self.drives, self._derived_ec, self._last):
@@ -362,10 +366,7 @@ class EthercatLink:
                 if not tx.statusword & SW_FAULT:
                     tx.error_code = 0
                 elif not tx.error_code:
-                    try:
-                        tx.error_code = int.from_bytes(s.sdo_read(0x603F, 0, 2), "little") or 0xFF00
-                    except Exception:  # unreadable: still a fault; 0xFF00 is CiA 402's "device specific"
-                        tx.error_code = 0xFF00
+                    tx.error_code = _error_code(s)
 
     def _bad_cycle(self, m, wkc: int) -> list[TxPdo]:
         self.stats.bad_cycles += 1
@@ -552,3 +553,11 @@ class EthercatLink:
         except Exception:  # closing must never turn into a second fault
             pass
         m.close()
+
+
+def _error_code(s) -> int:
+    """The drive's 0x603F over SDO, read once when its fault bit rises."""
+    try:
+        return int.from_bytes(s.sdo_read(0x603F, 0, 2), "little") or 0xFF00
+    except Exception:  # unreadable: still a fault; 0xFF00 is CiA 402's "device specific"
+        return 0xFF00
