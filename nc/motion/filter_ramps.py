@@ -316,7 +316,8 @@ class FilterStops:
         ends = np.cumsum([b.length for b in self.blocks])
         idx = np.minimum(np.searchsorted(ends, sp, side="left"), len(ends) - 1)
         out = np.empty((len(sp), len(self.axes)))
-        for k in np.unique(idx):
+        order = np.sort(idx)  # np.unique's values (np.unique imports numpy.ma on first use: ≈ 9 ms of `hil run`)
+        for k in order[np.concatenate(([True], order[1:] != order[:-1]))]:
             m = idx == k
             b = self.blocks[int(k)]
             base = ends[k] - b.length
