@@ -37,7 +37,7 @@ def test_a_run_with_blends_and_a_parquet_trace_imports_neither_scipy_special_nor
     code = ("import sys; from hil.cli import main; import nc.motion.clothoid as c; calls = []; f = c.fresnel; "
             "c.fresnel = lambda x: calls.append(1) or f(x); "  # counted: the demo's corners are blended
             f"rc = main(['run', 'examples/lathe_demo.nc', '--trace', {str(trace)!r}]); "
-            "print(rc, len(calls) > 0, *(m in sys.modules for m in ('scipy.special', 'pandas', 'numpy.ma'))))")
+            "print(rc, len(calls) > 0, *(m in sys.modules for m in ('scipy.special', 'pandas', 'numpy.ma')))")
     out = _python(code)
     assert out[-5:] == ["0", "True", "False", "False", "False"]  # numpy.ma: np.unique's first call imports it
     t = pq.read_table(trace)
