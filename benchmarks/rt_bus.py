@@ -1,13 +1,15 @@
 """Real time on the field buses (issue 17, session 16; decisions E24–E26): `hil run` of the lathe demo against
 virtual slaves in another process, printing the summary's cycle work split into bus wait and master work.
 
-    sudo python benchmarks/rt_bus.py [--rounds N] [--only ethercat|canopen] [--lockstep]
+    sudo python benchmarks/rt_bus.py [--rounds N] [--only ethercat|canopen] [--lockstep] [--tree DIR]
 
 - ethercat: the guide's bench (docs/guide/ethercat-virtual.md): `hil sim ethercat` on a fresh veth pair per run
   (fresh slaves: each run from power-on), `hil run --realtime --trace` at 1 ms;
 - canopen: the CANopen guide's 4 ms bench, `hil sim canopen` over udp_multicast in a loopback-only namespace;
 - --lockstep: the EtherCAT run without --realtime as well (cycles/s by the wall, master work).
-Each run is its own `hil run` process (mlockall and SCHED_FIFO stay in it). Needs root; measures, never asserts.
+Each run is its own `hil run` process (mlockall and SCHED_FIFO stay in it), whose CPU time and voluntary context
+switches (all its threads: python-can's receive thread too) are printed per cycle. `--tree DIR`: run another
+checkout's `hil` (before/after pairs). Needs root; measures, never asserts.
 """
 
 from __future__ import annotations
@@ -29,17 +31,27 @@ from virtual_bus.ethercat.veth import SimProcess  # noqa: E402
 
 BENCH = ROOT / "benches" / "lathe-2axis.toml"
 PROGRAM = ROOT / "examples" / "lathe_demo.nc"
+TREE = ROOT  # the checkout whose `hil` runs (--tree)
+# `hil run` with its own rusage printed at the end (CPU of all its threads, voluntary context switches)
+WRAP = ("import resource, sys\nfrom hil.cli import main\ntry:\n    main(sys.argv[1:])\nfinally:\n"
+        "    r = resource.getrusage(resource.RUSAGE_SELF)\n"
+        "    print(f'rusage {r.ru_utime + r.ru_stime} {r.ru_nvcsw}', file=sys.stderr)\n")
 KEYS = ("cycles", "result", "cycle work", "bus wait", "master work", "between cycles", "cycle jitter")
 
 
 def _hil(prefix: list[str], bus: str, bench: Path, realtime: bool, trace: Path) -> tuple[dict[str, str], float]:
-    cmd = [*prefix, sys.executable, "-m", "hil.cli", "run", str(PROGRAM), "--bench", str(bench), "--bus", bus,
-           "--no-check", "--trace", str(trace)] + (["--realtime"] if realtime else [])
+    cmd = [*prefix, sys.executable, "-c", WRAP, "run", str(TREE / "examples" / PROGRAM.name), "--bench", str(bench),
+           "--bus", bus, "--no-check", "--trace", str(trace)] + (["--realtime"] if realtime else [])
     t0 = time.perf_counter()
-    p = subprocess.run(cmd, capture_output=True, text=True, cwd=ROOT, env=dict(os.environ, PYTHONPATH=str(ROOT)))
+    p = subprocess.run(cmd, capture_output=True, text=True, cwd=TREE, env=dict(os.environ, PYTHONPATH=str(TREE)))
     wall = time.perf_counter() - t0
     lines = {ln[:15].strip(): ln[15:].strip() for ln in (p.stdout + p.stderr).splitlines() if len(ln) > 15}
-    return {k: lines.get(k, "") for k in KEYS} | {"overruns": lines.get("overruns", "0")}, wall
+    got = {k: lines.get(k, "") for k in KEYS} | {"overruns": lines.get("overruns", "0")}
+    cycles = int(got["cycles"].split()[0]) if got["cycles"] else 0
+    use = re.search(r"rusage ([\d.]+) (\d+)", p.stderr)
+    got["rusage"] = (f"CPU {float(use.group(1)) / cycles * 1e6:.0f} µs, {int(use.group(2)) / cycles:.1f} voluntary "
+                     "switches a cycle") if use and cycles else "rusage n/a"
+    return got, wall
 
 
 def _p(text: str, key: str) -> float:
@@ -55,7 +67,7 @@ def ethercat(rounds: int, lockstep: bool, tmp: Path) -> None:
             cycles = int(got["cycles"].split()[0]) if got["cycles"] else 0
             mode = "realtime" if realtime else f"lock-step {cycles / wall:,.0f} cycles/s by the process wall"
             print(f"ethercat {mode}: {got['result']}; cycle work {got['cycle work']}; bus wait {got['bus wait']}; "
-                  f"master work {got['master work']}; overruns {got['overruns'].split()[0]}", flush=True)
+                  f"master work {got['master work']}; overruns {got['overruns'].split()[0]}; {got['rusage']}", flush=True)
 
 
 def _ip(*args: str) -> None:
@@ -86,7 +98,7 @@ def canopen(rounds: int, tmp: Path) -> None:
                 sim.terminate()
                 sim.communicate(timeout=10)
             print(f"canopen realtime 4 ms: {got['result']}; cycle work {got['cycle work']}; bus wait {got['bus wait']}; "
-                  f"master work {got['master work']}; overruns {got['overruns'].split()[0]}", flush=True)
+                  f"master work {got['master work']}; overruns {got['overruns'].split()[0]}; {got['rusage']}", flush=True)
     finally:
         subprocess.run(["ip", "netns", "del", ns], capture_output=True)
 
@@ -96,7 +108,10 @@ def main() -> int:
     ap.add_argument("--rounds", type=int, default=3)
     ap.add_argument("--only", choices=("ethercat", "canopen"))
     ap.add_argument("--lockstep", action="store_true", help="EtherCAT lock-step runs too")
+    ap.add_argument("--tree", type=Path, default=ROOT, help="the checkout whose hil runs (default: this one)")
     a = ap.parse_args()
+    global TREE
+    TREE = a.tree.resolve()
     if os.geteuid() != 0:
         print("rt_bus: needs root (network namespaces, veth pairs, raw sockets)", file=sys.stderr)
         return 2

@@ -106,6 +106,7 @@ class CanopenLink:
         self.capture: Any = None  # fieldbus.capture.CanCapture: `hil run --capture FILE.asc`
         # True: the caller holds the cycle (a real-time clock), so exchange() sends the SYNC at once (E24)
         self.paced = False
+        self._pending = 0  # TPDOs of the current SYNC not yet received (counted down by the receive thread)
         self.wait_ns = 0  # the last exchange's time in sending, the SYNC and the wait for the TPDOs (E25)
 
     @classmethod
@@ -350,8 +351,12 @@ class CanopenLink:
                 return  # a short TPDO is not processed (CiA 301 PDO length error)
             with self._lock:
                 frame.unpack_tx(data, into=n.tx)
-                n.received.add(can_id)
-                self._lock.notify_all()
+                if can_id not in n.received and not n.lost:
+                    n.received.add(can_id)
+                    # the cycle's waiter is woken once, by its last TPDO, not by each (E26)
+                    self._pending -= 1
+                    if self._pending == 0:
+                        self._lock.notify_all()
         return cb
 
     # ---- the cycle ------------------------------------------------------------------------
@@ -380,6 +385,7 @@ class CanopenLink:
         with self._lock:
             for n in live:
                 n.received.clear()
+            self._pending = sum(len(n.tx_frames) for n in live)  # TPDOs this SYNC must bring
         send = net.send_raw if self.lockstep else net.send_message
         for cob, data in frames:
             send(cob, data)
@@ -388,7 +394,7 @@ class CanopenLink:
         if self.lockstep:
             self.time += self.cycle_time
         else:
-            self._wait(lambda: all(len(n.received) == len(n.tx_frames) for n in live), self.tpdo_timeout)
+            self._wait(lambda: self._pending <= 0, self.tpdo_timeout)
         self.wait_ns = perf_counter_ns() - t0
         with self._lock:
             for n in live:
