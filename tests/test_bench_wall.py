@@ -19,7 +19,8 @@ def test_the_wall_benchmark_reports_the_lathe_demos_process():
     (row,) = data["rows"]
     assert row["simulated_s"] == 14.396  # the lathe demo's 14,396 cycles of 1 ms, as `hil run` prints them
     assert 0 < data["python_pass_s"] < row["wall_best_s"]  # the process includes the interpreter's start
-    assert row["x_real_wall"] == round(14.396 / row["wall_best_s"], 1)
+    # x real time is simulated / wall before either is rounded for the table: one rounding step apart at most
+    assert abs(row["x_real_wall"] - 14.396 / row["wall_best_s"]) <= 0.1
     assert 0 < row["imports_s"] < row["wall_best_s"] and row["modules"] > 100
     # rs274 cannot read the lathe demo (Fanuc lathe T-words): skipped with its reason, or absent
     assert row["rs274_wall_s"] is None and row["rs274_note"].startswith("skipped: rs274")
