@@ -30,7 +30,9 @@ def add_canopen(sims: argparse._SubParsersAction) -> None:
 
 
 def cmd_sim_canopen(args: argparse.Namespace) -> int:
-    import can  # python-can (and its MDF4 support) only when the simulator runs
+    from fieldbus.canopen.pycan import load  # python-can only when the simulator runs, without asammdf (B50)
+
+    can = load()
 
     from fieldbus.canopen.netns import check_multicast_allowed
     from hil.session import InputError, load_bench, sim_io_stations, sim_slaves
