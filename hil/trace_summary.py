@@ -60,6 +60,32 @@ def slice_mask(batch: pa.RecordBatch, lo: Bound | None, hi: Bound | None, state:
     return pa.array(keep)
 
 
+def _bound_text(b: Bound) -> str:
+    return f"L{b.line}" if b.line is not None else f"{b.time:g} s"
+
+
+def check_bounds(lo: Bound | None, hi: Bound | None) -> None:
+    """--from after --to (both times or both lines) selects nothing: a usage error, not an empty file
+    (decisions B53)."""
+    if lo is None or hi is None:
+        return
+    if (lo.time is not None and hi.time is not None and lo.time > hi.time) or \
+            (lo.line is not None and hi.line is not None and lo.line > hi.line):
+        raise ValueError(f"--from {_bound_text(lo)} lies after --to {_bound_text(hi)}: the slice is empty")
+
+
+def empty_slice(tf: TraceFile, lo: Bound | None, hi: Bound | None) -> ValueError:
+    """The error for bounds that select no row of a trace that has rows: it names what the trace
+    holds, so the user can pick bounds inside it (decisions B53)."""
+    whole = summarise(tf)
+    asked = " ".join(f"{k} {_bound_text(b)}" for k, b in (("--from", lo), ("--to", hi)) if b is not None)
+    if whole.rows == 0:
+        return ValueError(f"{tf.path}: empty trace")
+    lines = sorted(whole.lines)
+    held = f"t {whole.t0:.3f} … {whole.t1:.3f} s" + (f", lines {lines[0]} … {lines[-1]}" if lines else "")
+    return ValueError(f"{tf.path}: {asked} selects no rows (the trace holds {held})")
+
+
 @dataclass
 class Summary:
     rows: int = 0
@@ -171,6 +197,7 @@ def export(tf: TraceFile, out: str | Path, lo: Bound | None = None, hi: Bound | 
     if suffix not in EXPORT_SUFFIXES:
         raise ValueError(f"{out}: cannot write {suffix or 'a file without a suffix'}; "
                          f"choose {', '.join(EXPORT_SUFFIXES)}")
+    check_bounds(lo, hi)
     if columns:
         missing = [c for c in columns if c not in tf.columns]
         if missing:
@@ -201,6 +228,9 @@ def export(tf: TraceFile, out: str | Path, lo: Bound | None = None, hi: Bound | 
     if writer is None:
         raise ValueError(f"{tf.path}: empty trace")
     writer.close()
+    if rows == 0 and (lo is not None or hi is not None):
+        tmp.unlink(missing_ok=True)  # no file of headers only: the bounds missed the trace
+        raise empty_slice(tf, lo, hi)
     tmp.replace(out)
     return rows
 
@@ -229,7 +259,7 @@ def _export_mdf(tf: TraceFile, out: str | Path, tmp: Path, lo, hi, columns, need
     if lo is not None or hi is not None:
         table = table.filter(slice_mask(table, lo, hi, {}))
     if table.num_rows == 0:
-        raise ValueError(f"{tf.path}: empty trace")
+        raise empty_slice(tf, lo, hi) if lo is not None or hi is not None else ValueError(f"{tf.path}: empty trace")
     units = tf.units()
     t = table.column("t").to_numpy()
     signals = []

@@ -21,7 +21,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def cmd_trace(args: argparse.Namespace) -> int:
     from hil.trace_read import TraceFile, TraceReadError  # pyarrow: only when a trace is read
-    from hil.trace_summary import Bound, export, format_summary, summarise
+    from hil.trace_summary import Bound, check_bounds, empty_slice, export, format_summary, summarise
 
     try:
         lo = Bound.parse(args.lo) if args.lo else None
@@ -34,7 +34,11 @@ def cmd_trace(args: argparse.Namespace) -> int:
             rows = export(tf, args.out, lo, hi, cols)
             print(f"wrote {rows} rows to {args.out}")
             return EXIT_OK
-        print(format_summary(tf, summarise(tf, lo, hi)))
+        check_bounds(lo, hi)
+        s = summarise(tf, lo, hi)
+        if s.rows == 0 and (lo is not None or hi is not None):
+            raise empty_slice(tf, lo, hi)  # "rows 0" read as a trace with nothing in it (decisions B53)
+        print(format_summary(tf, s))
     except BrokenPipeError:  # `hil trace … | head`: hil.cli ends quietly
         raise
     except OSError as exc:
