@@ -63,9 +63,22 @@ class TraceFile:
         self.partial = self.path.is_dir() and any(self.path.glob("*.parquet"))
         if not self.path.is_file() and not self.partial:
             raise TraceReadError(f"{path}: no such trace file")
-        self.parquet = self.partial or is_parquet(self.path)
+        head = _magic(self.path) if not self.partial else b""
+        if head.startswith(b"MDF "):  # `hil trace --out x.mf4` writes it; asammdf or CANape read it
+            raise TraceReadError(f"{path}: an MDF4 file: hil reads traces as CSV, Parquet or Arrow IPC "
+                                 "(open MDF4 in asammdf or CANape)")
+        # `hil trace --out x.feather/.arrow` exports Arrow IPC: read back as the Parquet path reads (bench B54)
+        self.ipc = head.startswith(b"ARROW1")
+        self.parquet = self.partial or self.ipc or is_parquet(self.path)
+        self.kind = "Arrow IPC" if self.ipc else "Parquet" if self.parquet else "CSV"
         try:
-            if self.partial:
+            if self.ipc:
+                import pyarrow.dataset as ds
+
+                self._pf = _Parts(ds.dataset([str(self.path)], format="ipc"))
+                self.columns = list(self._pf.schema_arrow.names)
+                self.num_rows = self._pf.num_rows
+            elif self.partial:
                 import pyarrow.dataset as ds
 
                 self._pf = _Parts(ds.dataset(sorted(str(p) for p in self.path.glob("*.parquet")), format="parquet"))
@@ -163,8 +176,17 @@ def _numbers(col: pa.ChunkedArray) -> np.ndarray:
     return col.to_numpy()
 
 
+def _magic(path: Path) -> bytes:
+    try:
+        with open(path, "rb") as f:
+            return f.read(8)
+    except OSError:
+        return b""  # the open below names the error
+
+
 class _Parts:
-    """The few ParquetFile calls TraceFile makes, over the row-group files of a partial trace."""
+    """The few ParquetFile calls TraceFile makes, over the row-group files of a partial trace (or an
+    Arrow IPC export)."""
 
     def __init__(self, dataset) -> None:
         self._ds = dataset

@@ -149,7 +149,7 @@ def _marked_rows(cols: dict, name: str, t: np.ndarray, line: np.ndarray) -> list
 
 
 def format_summary(tf: TraceFile, s: Summary) -> str:
-    out = [f"trace          {tf.path}  ({'Parquet' if tf.parquet else 'CSV'}, {len(tf.columns)} columns)"]
+    out = [f"trace          {tf.path}  ({tf.kind}, {len(tf.columns)} columns)"]
     if s.rows == 0:
         return "\n".join(out + ["rows           0"])
     out.append(f"rows           {s.rows}  (t {s.t0:.3f} … {s.t1:.3f} s)")

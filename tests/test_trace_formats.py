@@ -114,3 +114,31 @@ def test_trace_out_mf4_has_units_and_other_suffixes_are_refused(trace, tmp_path,
     capsys.readouterr()
     assert main(["trace", str(trace), "--out", str(tmp_path / "x.xlsx")]) == 2
     assert ".xlsx" in capsys.readouterr().err and not (tmp_path / "x.xlsx").exists()
+
+
+@pytest.mark.parametrize("suffix", [".feather", ".arrow"])
+def test_an_arrow_ipc_export_is_read_back_by_trace_check_and_report(trace, tmp_path, capsys, suffix):
+    """bench B54: `hil trace --out x.feather` wrote a file `hil trace x.feather` refused with a utf-8 codec error."""
+    out = tmp_path / f"x{suffix}"
+    assert main(["trace", str(trace), "--out", str(out)]) == 0
+    capsys.readouterr()
+    assert main(["trace", str(out)]) == 0
+    text = capsys.readouterr().out
+    rows = pq.read_metadata(trace).num_rows
+    assert f"(Arrow IPC, " in text and f"rows           {rows}  (t 0.001 … " in text
+    assert "0x0401 at cycle 300 (t=0.300 s)" in text  # the E-stop's alarm row, as from the Parquet trace
+    assert main(["check", str(out), "--max-ferr", "1"]) == 0
+    assert "ok    following error X" in capsys.readouterr().out
+    back = tmp_path / "back.csv"
+    assert main(["trace", str(out), "--from", "0.1", "--to", "0.2", "--out", str(back)]) == 0
+    assert len(back.read_text().splitlines()) == 1 + 101
+
+
+def test_an_mdf4_export_given_as_a_trace_says_what_it_is(trace, tmp_path, capsys):
+    pytest.importorskip("asammdf")
+    out = tmp_path / "x.mf4"
+    assert main(["trace", str(trace), "--out", str(out)]) == 0
+    capsys.readouterr()
+    assert main(["trace", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "x.mf4: an MDF4 file: hil reads traces as CSV, Parquet or Arrow IPC" in err and "codec" not in err
