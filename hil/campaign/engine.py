@@ -8,10 +8,13 @@ row. A case never aborts the campaign: every outcome is a row.
 
 from __future__ import annotations
 
+import signal
 import socket
 import sys
+import threading
 import time
 from collections.abc import Callable, Iterator, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Any
 
@@ -48,10 +51,17 @@ def _dask(cases: Sequence[CaseInputs], engine: Engine) -> Iterator[dict[str, Any
             import os
 
             n = engine.workers or os.cpu_count() or 1
-            cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
-                                   host="127.0.0.1", silence_logs=50)
+            # Ctrl-C reaches the whole foreground process group: the worker processes must leave it to
+            # this one (which stops the cluster and writes what finished), not die with a traceback
+            # each (bench B55). They are spawned ignoring SIGINT (SIG_IGN survives exec; Python and
+            # asyncio then keep it), and _QuietWorker keeps a restarted worker the same.
+            with _sigint_ignored():
+                cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
+                                       host="127.0.0.1", silence_logs=50)
         client = Client(cluster if cluster is not None else engine.scheduler, timeout="30s")
         try:
+            if cluster is not None:
+                client.register_plugin(_quiet_worker(), name="hil-sigint-ignored")
             # The scheduler decides when a case has lost too many workers; on a cluster that is not
             # ours it has its own setting, so the campaign's `retries` is set there too.
             client.run_on_scheduler(_allow_failures, engine.retries - 1)
@@ -74,6 +84,31 @@ def _dask(cases: Sequence[CaseInputs], engine: Engine) -> Iterator[dict[str, Any
             client.close()
             if cluster is not None:
                 cluster.close()
+
+
+@contextmanager
+def _sigint_ignored() -> Iterator[None]:
+    if threading.current_thread() is not threading.main_thread():
+        yield  # only the main thread sets handlers (a campaign run from a library thread)
+        return
+    old = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, old)
+
+
+def _quiet_worker() -> Any:
+    """A Dask worker plugin: the worker process ignores SIGINT (bench B55). Built here so that
+    importing this module does not import distributed."""
+    from distributed import WorkerPlugin
+
+    class QuietWorker(WorkerPlugin):
+        def setup(self, worker=None) -> None:
+            if threading.current_thread() is threading.main_thread():
+                signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+    return QuietWorker()
 
 
 def _allow_failures(n: int, dask_scheduler=None) -> None:
