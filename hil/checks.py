@@ -241,6 +241,12 @@ def check_limits(cols: _Cols, bench: Bench, tolerance: float) -> list[CheckResul
     out = []
     t = cols["t"]
     dt = _median(np.diff(t)) if len(t) > 1 else bench.cycle
+    # Before the program's first block the NC sends no path: the drives enable and home themselves, and a homing's
+    # new origin is a step of the position, not a speed (decision B51); one mask for every axis
+    since = None
+    if "line" in cols.trace.columns:
+        row = program_row(cols)
+        since = np.arange(len(t)) >= (row if row is not None else len(t))
     for ax in bench.axes:
         name = f"{ax.name}_cmd"
         if name not in cols.trace.columns:
@@ -248,11 +254,7 @@ def check_limits(cols: _Cols, bench: Bench, tolerance: float) -> list[CheckResul
         x = cols[name]
         unit = "deg" if ax.units == "deg" else "mm"
         commanded = _commanded_rows(cols, ax.name, len(x))
-        if "line" in cols.trace.columns:
-            # Before the program's first block the NC sends no path: the drives enable and home themselves,
-            # and a homing's new origin is a step of the position, not a speed (decision B51)
-            row = program_row(cols)
-            since = np.arange(len(x)) >= (row if row is not None else len(x))
+        if since is not None:
             commanded = since if commanded is None else commanded & since
         for order, (label, lim) in enumerate((("velocity", ax.limits.max_velocity),
                                               ("acceleration", ax.limits.max_acceleration),
