@@ -80,6 +80,7 @@ def test_hil_servo_over_the_bench_bus_by_sdo(hil):
     assert r.code == 0, r.err
     assert "P1-44 = 16777216" in r.out and "object 0x212C:0 over SDO (sim)" in r.out
     r = hil("servo", "set", "X", "P2-00", "99999")
-    assert r.code == 1 and "SDO abort 0x06090030" in r.err
+    assert r.code == 1 and "SDO abort 0x06090030 (value out of range)" in r.err
+    assert r.err.count("0x06090030") == 1, r.err  # the code once, with its meaning
     r = hil("servo", "get", "Q", "P2-00")
     assert r.code == 2 and "axis 'Q'" in r.err

@@ -82,12 +82,23 @@ def _over_sdo(args, bench, position: int, group: int, number: int, label: str, i
         code = getattr(exc, "code", None)
         if code is None:
             raise
-        print(f"hil servo: {label} on {where}: SDO abort 0x{code:08X}: {exc}", file=sys.stderr)
+        # the drive's own text where the table has none (the exception's text repeats the code: once is enough)
+        from hil.servo_link import SDO_TEXT
+        print(f"hil servo: {label} on {where}: SDO abort 0x{code:08X} ({SDO_TEXT.get(code, _reason(exc))})",
+              file=sys.stderr)
         return 1
     finally:
         link.close()
     _report(args, label, where, value)
     return 0
+
+
+def _reason(exc: Exception) -> str:
+    """An SDO abort's own reason: pysoem's text ends in ": reason", canopen's in ", reason" after the code."""
+    text = str(exc)
+    if text.startswith(("SDO abort 0x", "Code 0x")):
+        return text.rsplit(": " if text.startswith("SDO") else ", ", 1)[-1]
+    return text
 
 
 def _over_modbus(args, group: int, number: int, label: str, address: int) -> int:
