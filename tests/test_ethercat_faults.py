@@ -35,6 +35,7 @@ def run(*faults: str, stall_at: int = 0, stall: float = 0.0):
         rec = Recorder(chain=on_cycle)
         result = BenchRunner(bench, link, on_cycle=rec).run_program(parse_program(PROGRAM, name="fault.nc"))
     run.recorder = rec  # type: ignore[attr-defined]
+    run.sim_log = sim.log  # type: ignore[attr-defined]  # the slaves' --verbose log (SimProcess fills it on exit)
     return result, history, link
 
 
@@ -109,6 +110,10 @@ def test_sm_watchdog_expiry_drops_to_safeop_with_0x001b():
     # drives that fault on the lost outputs name CiA 402's communication fault, read by SDO (no 0x603F PDO)
     assert all(s.info == 0x7500 for s in result.alarms if s.code == 0xF002)
     assert_stopped_after_alarm(run.recorder, result)
+    # the slaves' side (decision E33): while the master was silent the moving X braked to standstill by itself
+    log = run.sim_log  # type: ignore[attr-defined]
+    assert "X: AL status 0x001B (Sync manager watchdog): no process data for 500 ms -> SAFE-OP + ERROR" in log, log
+    assert "X: drive braked from " in log and "to standstill in " in log and "FAULT 0x7500, power stage off" in log, log
 
 
 def test_al_error_raises_0x0601_with_the_al_code():

@@ -40,6 +40,8 @@ class DriveApp(SlaveApp):
     _images: Images = field(default_factory=Images)
     _codec: DriveCodec | None = None  # the mapping in force in one function per direction, see `_codec_for`
     _codec_maps: tuple[object, object] = (None, None)
+    _coast_t: float = 0.0  # time since the drive began its fault reaction with no master (`coast`)
+    _coast_v: float = 0.0  # its speed then (counts/s)
 
     def attach(self, od: ObjectDictionary) -> None:
         self.od = od
@@ -139,6 +141,26 @@ class DriveApp(SlaveApp):
         self._publish()
         return self._images.get(rx_map, tx_map, od).pack(tx_map, od)
 
+    @property
+    def coasting(self) -> bool:
+        return self.drive.state in (State.OPERATION_ENABLED, State.QUICK_STOP_ACTIVE, State.FAULT_REACTION_ACTIVE)
+
+    def coast(self, dt: float) -> str | None:
+        """No master: the communication fault reaction (as in `cycle` with `lost`) runs on in the drive's own
+        time, so it brakes on the quick-stop ramp to standstill and drops its power stage (FAULT)."""
+        d = self.drive
+        if d.state is not State.FAULT_REACTION_ACTIVE:
+            self._coast_t, self._coast_v = 0.0, d.velocity
+            d.fault(COMM_FAULT)
+        d.step(dt)
+        self._coast_t += dt
+        if d.state is State.FAULT_REACTION_ACTIVE:
+            return None
+        how = (f"braked from {self._coast_v:.0f} counts/s to standstill in {self._coast_t:.3f} s"
+               if abs(self._coast_v) >= 1.0 else "at standstill")
+        return (f"drive {how} on its communication fault reaction, at {round(d.position)} counts; "
+                f"FAULT 0x{d.error_code:04X}, power stage off")
+
     def _rx_from_od(self) -> RxPdo:
         rx = RxPdo(mode=self.drive.mode)
         for attr, e in self._rx_pairs:
@@ -167,6 +189,16 @@ class DioApp(SlaveApp):
     in_objs: list[tuple[int, int]] = field(default_factory=list)  # (index, bits) per input module
     out_objs: list[tuple[int, int]] = field(default_factory=list)
     _images: Images = field(default_factory=Images)
+
+    @property
+    def coasting(self) -> bool:
+        return self.outputs != 0
+
+    def coast(self, dt: float) -> str | None:
+        """No master: the outputs go to their safe state, off (an ESC's process-data watchdog: a spindle enable
+        or a coolant valve must not stay on with nobody in charge)."""
+        was, self.outputs = self.outputs, 0
+        return f"outputs off (were 0x{was:X}): their safe state with no master"
 
     def attach(self, od: ObjectDictionary) -> None:
         self.od = od

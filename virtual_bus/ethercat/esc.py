@@ -28,6 +28,8 @@ from virtual_bus.ethercat.registers import (
 
 _U16, _U32, _U64 = struct.Struct("<H"), struct.Struct("<I"), struct.Struct("<Q")
 HOP_NS = 500  # forwarding delay per ESC and cable, what the DC delay measurement sees
+STATE_TEXT = {1: "INIT", 2: "PRE-OP", 3: "BOOT", 4: "SAFE-OP", 8: "OP"}
+COAST_MAX_STEPS = 60_000  # cycles a silent line's slave runs on in one idle tick (a minute at 1 ms)
 
 
 @dataclass
@@ -54,6 +56,26 @@ class SlaveApp:
         return b""
 
     def refresh(self, index: int) -> None: ...
+
+    def coast(self, dt: float) -> str | None:
+        """The application's own time while the master sends nothing (the line silent after the slave fell out
+        of OP by an error): `dt` seconds of it. Returns a line for the log when something a bench engineer
+        watches happened (a drive reached standstill, outputs went to their safe state), else None."""
+        return None
+
+    @property
+    def coasting(self) -> bool:
+        """Whether `coast` still has something to do (a drive braking)."""
+        return False
+
+
+def _al_text(code: int) -> str:
+    """ETG.1000.6's name of an AL status code, as the master's side prints it (pysoem's table)."""
+    try:
+        import pysoem
+        return pysoem.al_status_code_to_string(code)
+    except Exception:  # pysoem missing or refusing the code: the number alone says it
+        return "AL status code"
 
 
 @dataclass
@@ -267,11 +289,11 @@ class Esc:
         struct.pack_into("<H", self.mem, R_EEP_CTRL, status)
 
     # ---- AL state machine -----------------------------------------------------------------
-    def al_error(self, code: int, state: int | None = None) -> None:
+    def al_error(self, code: int, state: int | None = None, why: str = "") -> None:
         s = state if state is not None else self.al_state
         struct.pack_into("<H", self.mem, R_AL_STATUS, s | AL_ERROR)
         struct.pack_into("<H", self.mem, R_AL_CODE, code)
-        self.events.append(f"AL error 0x{code:04X} in state {s}")
+        self.events.append(f"AL status 0x{code:04X} ({_al_text(code)}){why} -> {STATE_TEXT.get(s, s)} + ERROR")
 
     def _set_state(self, s: int) -> None:
         struct.pack_into("<H", self.mem, R_AL_STATUS, s)
@@ -400,6 +422,8 @@ class Esc:
                 mem[inputs:inputs + len(got)] = got
         elif reads and state == SAFEOP:
             lost = bool(status & AL_ERROR) and self.outputs_written > 0  # dropped out of OP
+            if lost:
+                self.last_cycle_ns = time.monotonic_ns()  # this frame is the drive's time: `coast` goes on from it
             self._write_inputs(self.app.cycle(outputs, self.rx_map, self.tx_map, step=lost, dt=self.cycle_time,
                                               lost=lost))
         if reads:
@@ -437,7 +461,28 @@ class Esc:
         wd = self.watchdog_ns()
         if wd and now_ns - self.last_output_ns > wd:
             struct.pack_into("<H", self.mem, R_WD_STATUS, 0)
-            self.al_error(AL_SM_WATCHDOG, SAFEOP)
+            self.al_error(AL_SM_WATCHDOG, SAFEOP, f": no process data for {wd / 1e6:g} ms")
+
+    def coast(self, now_ns: int) -> None:
+        """The line is silent after this slave fell out of OP by an error (its master gone, stalled or cut
+        off): the application's time runs on by the clock, a cycle at a time, so a drive brakes on its
+        communication fault reaction to standstill as a real one does on its own (decision E33). A master
+        that still reads the slave steps it frame by frame instead (`logical`)."""
+        if not self.mem[R_AL_STATUS] & AL_ERROR or not self.outputs_written:
+            return
+        app = self.app
+        if not app.coasting:
+            self.last_cycle_ns = now_ns
+            return
+        dt = self.cycle_time
+        steps = min(int((now_ns - self.last_cycle_ns) * 1e-9 / dt), COAST_MAX_STEPS)
+        for _ in range(steps):
+            msg = app.coast(dt)
+            if msg is not None:
+                self.events.append(msg)
+            if not app.coasting:
+                break
+        self.last_cycle_ns = now_ns
 
     # ---- mailbox --------------------------------------------------------------------------
     def _mailbox_written(self) -> None:

@@ -200,6 +200,9 @@ class Chain:
         now = time.monotonic_ns()
         for s in self.reachable():
             s.check_watchdog(now)
+            s.coast(now)
+            while s.events:
+                self.log(f"{s.name}: {s.events.pop(0)}")
 
     def states(self) -> list[tuple[str, int, int]]:
         return [(s.name, s.al_state, s.u16(R_AL_CODE)) for s in self.slaves]
