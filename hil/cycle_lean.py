@@ -35,6 +35,29 @@ def factors(scales: list[Any]) -> list[Factors]:
                     sc.lead) for sc in scales]
 
 
+# Cycles a drive's fault reset at power-up may take before a fault it still shows is its alarm (decision B72): the
+# master's two-cycle reset edge, the drive's answer a frame or two later on a field bus, and room for a slow drive;
+# also how early in the power-up a fault counts as one the drive brought with it.
+RESET_CYCLES = 20
+
+
+def power_up_reset(r: Any, i: int, m: Any, st: Any, code: int) -> bool:
+    """A fault a drive shows at power-up (latched before this run: a master that died, a drive powered on in
+    fault) is reset once, as the operator's RESET before cycle start, and noted in the result; True while that
+    reset is under way. A fault that stays, comes back or arises while powering is the servo alarm (B72)."""
+    resets = r._power_up_reset
+    if resets is None:
+        return False
+    if i not in resets:
+        if st is not _FAULT or r.cycle > RESET_CYCLES:  # braking (reacting to a fault now), or late: an alarm
+            return False
+        resets[i] = r.cycle
+        r.result.power_up_resets.append((r._name(i), code))
+        m.fault_reset()
+        return True
+    return r.cycle - resets[i] <= RESET_CYCLES
+
+
 def feedback(r: Any, txs: list[Any], n_axes: int) -> None:
     """The drives' feedback of this cycle: each master stepped (its controlword into the RxPdo), the rest
     counters, servo alarm (fault), App. A 0x0602 overspeed and 0x0402 hardware limit, then `r.actual`."""
@@ -55,7 +78,7 @@ def feedback(r: Any, txs: list[Any], n_axes: int) -> None:
         rest[i] = rest[i] + 1 if p == last[i] and v == 0 else 0
         last[i] = p
         st = m.state
-        if (st is _FAULT or st is _REACTION) and i not in alarmed:
+        if (st is _FAULT or st is _REACTION) and i not in alarmed and not power_up_reset(r, i, m, st, tx.error_code):
             alarmed.add(i)
             r._alarm(Alarm(SERVO_ALARM, f"servo alarm on {r._name(i)}: drive error code 0x{tx.error_code:04X}",
                            line=r.line or None, axis=r._name(i), info=tx.error_code))

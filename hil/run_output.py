@@ -48,6 +48,8 @@ def as_dict(result: Any, allow_unfired: bool = False) -> dict[str, Any]:
         "events": {"applied": [{"spec": e.spec, "t": e.fired_time, "cycle": e.fired_cycle, "line": e.fired_line,
                                 "action": str(e.action)} for e in applied],
                    "never_fired": [e.spec for e in result.unfired]},
+        "power_up_fault_resets": [{"drive": a, "error_code": c}
+                                  for a, c in getattr(result.run, "power_up_resets", ())],
         "program_time_s": result.program_time, "sim_time_s": result.sim_time, "cycles": result.cycles,
         "max_following_error": result.max_following_error, "final_position": result.final_position,
         "trace": str(result.trace.path) if result.trace is not None else None,

@@ -24,7 +24,7 @@ from fieldbus.pdo import RxPdo, TxPdo
 from hil.bench import Bench
 from hil.bus_work import BusWork
 from hil.clock import CycleTiming, LockStepClock, RealTimeClock
-from hil.cycle_lean import OVERSPEED, WARM_AHEAD_NS, WARM_MIN_NS, factors, feedback, row, setpoints, warm
+from hil.cycle_lean import OVERSPEED, RESET_CYCLES, WARM_AHEAD_NS, WARM_MIN_NS, factors, feedback, row, setpoints, warm
 from hil import retentive
 from hil.drive_homing import home_axes
 from hil.mlc_bridge import drive_status
@@ -64,6 +64,7 @@ class RunResult:
     sim_time: float = 0.0
     program_time: float = 0.0
     enable_cycles: int = 0
+    power_up_resets: list[tuple[str, int]] = field(default_factory=list)  # (drive, its error code) reset at power-up
     max_ferr: dict[str, float] = field(default_factory=dict)
     final: dict[str, float] = field(default_factory=dict)
     alarms: list[Alarm] = field(default_factory=list)
@@ -112,6 +113,8 @@ class BenchRunner:
         self.line = 0
         self.actual = np.zeros(n_axes)
         self._alarmed_drives: set[int] = set()
+        # During power-up (else None): drive -> the cycle its latched fault was reset at (decision B72)
+        self._power_up_reset: dict[int, int] | None = None
         # axis -> position (counts) where its drive reported the limit switch: 0x0402 once per hit; the hit ends
         # when the axis is off the switch and LIMIT_HYSTERESIS away (a servo settling on the edge is no new hit)
         self._at_limit: dict[int, int] = {}
@@ -219,13 +222,18 @@ class BenchRunner:
         for m in self.masters:
             m.request(Target.ENABLED)
         limit = max(1, int(round(self.bench.enable_timeout / self.bench.cycle)))
-        for _ in range(limit):
-            self._exchange()
-            if all(m.enabled for m in self.masters):
-                self.result.enable_cycles = self.cycle
-                return True
-            if any(m.faulted for m in self.masters):
-                break
+        resets = self._power_up_reset = {}  # feedback() resets a fault the drive had before the run, once (B72)
+        try:
+            for _ in range(limit):
+                self._exchange()
+                if all(m.enabled for m in self.masters):
+                    self.result.enable_cycles = self.cycle
+                    return True
+                if any(m.faulted and not (i in resets and self.cycle - resets[i] <= RESET_CYCLES)
+                       for i, m in enumerate(self.masters)):
+                    break
+        finally:
+            self._power_up_reset = None
         n_axes = len(self.axes)
         faulted = any(m.faulted for m in self.masters)  # the wait stopped at a fault: name the faulted drives
         for code, what, idx in ((0x0A07, "servo not ready", range(n_axes)),  # App. A: the axis is not servo ON

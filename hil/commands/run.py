@@ -214,7 +214,9 @@ def print_summary(program: str, bench: Bench, r: RunResult, out=None) -> None:
     out = out or sys.stdout
     print(f"program        {program}  (profile {bench.profile}, bench {bench.name}, bus {bench.bus})", file=out)
     print(f"cycles         {r.cycles}  ({bench.cycle * 1000:g} ms cycle, {r.sim_time:.3f} s simulated)", file=out)
-    print(f"drives enabled after {r.enable_cycles} cycles", file=out)
+    resets = getattr(r, "power_up_resets", ())
+    reset = ("  (fault reset at power-up: " + ", ".join(f"{a} 0x{c:04X}" for a, c in resets) + ")") if resets else ""
+    print(f"drives enabled after {r.enable_cycles} cycles{reset}", file=out)
     print(f"program time   {r.program_time:.3f} s simulated", file=out)
     units = {a.name: "deg" if a.units == "deg" else "mm" for a in bench.axes}
     ferr = "  ".join(f"{a} {v:.4f} {units.get(a, 'mm')}" for a, v in r.max_ferr.items())
