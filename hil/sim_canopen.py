@@ -26,6 +26,8 @@ def add_canopen(sims: argparse._SubParsersAction) -> None:
     p.add_argument("--channel", help=argparse.SUPPRESS)
     p.add_argument("--bench", help="bench file (TOML); default: the built-in 2-axis lathe")
     p.add_argument("--duration", type=float, help="stop after this many seconds")
+    p.add_argument("--verbose", action="store_true",
+                   help="log what the drives do on their own to stderr (a master gone silent: AL180, braking)")
     p.set_defaults(func=cmd_sim_canopen)
 
 
@@ -56,6 +58,8 @@ def cmd_sim_canopen(args: argparse.Namespace) -> int:
     except (OSError, ValueError, ImportError, can.CanError) as exc:  # CanError: no such python-can interface
         print(f"hil sim canopen: cannot open {args.interface}:{args.channel}: {exc}", file=sys.stderr)
         return EXIT_USAGE
+    if args.verbose:
+        bus.log = lambda msg: print(f"hil sim canopen: {msg}", file=sys.stderr, flush=True)
     io = sim_io_stations(bench)
     for station in io:  # remote I/O stations on the same bus (mlc/remote_io.py)
         station.attach(bus.network)

@@ -104,3 +104,52 @@ def test_hil_run_drives_hil_sim_canopen_across_processes_in_real_time(netns, tmp
     # Every bench cycle was one SYNC that each node served (UDP may drop a frame); NMT stop at the end.
     served = [int(n) for n in re.findall(r"\d STOPPED [a-z ]+, (\d+) SYNC", err)]
     assert len(served) == 3 and all(cycles - 5 <= n <= cycles for n in served), err
+
+
+def test_a_killed_master_leaves_its_drives_braked_in_fault_and_the_next_run_resets_them(netns, tmp_path):
+    """Decisions E34 and B72: `hil run` gives the drives its heartbeat to watch (0x1016); killed with -9 mid-move,
+    it sends nothing more, and each drive raises AL180 (EMCY 0x8130), brakes to standstill and drops its power
+    stage by itself. The next `hil run` finds them in fault, resets them once at power-up and runs."""
+    import threading
+    import time
+
+    group = "239.74.163.4"
+    bench = tmp_path / "lathe-4ms.toml"
+    text = (ROOT / "benches" / "lathe-2axis.toml").read_text().replace("cycle_ms = 1.0", "cycle_ms = 4.0")
+    bench.write_text(text.split("[checks]")[0])
+    slow = tmp_path / "slow.nc"
+    slow.write_text("G21 G18 G98\nG01 X160. F300\nM30\n")  # X from 60 to 80 mm at 5 mm/s: 4 s of motion
+    short = tmp_path / "short.nc"
+    short.write_text("G21 G18 G98\nG01 Z90. F1200\nM30\n")
+    sim = _Sim(netns, group, "--bench", str(bench), "--verbose")
+    lines: list[str] = []
+    reader = threading.Thread(target=lambda: lines.extend(iter(sim.proc.stderr.readline, "")), daemon=True)
+    reader.start()
+    try:
+        master = subprocess.Popen(_in_ns(netns, "-m", "hil.cli", "run", str(slow), "--bench", str(bench),
+                                         "--bus", f"canopen:udp_multicast:{group}"),
+                                  stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, cwd=ROOT)
+        end = time.monotonic() + 40
+        while not any("node 1 (X): watching the heartbeat of node 127" in x for x in lines):
+            assert master.poll() is None and time.monotonic() < end, "".join(lines)
+            time.sleep(0.05)
+        time.sleep(1.0)  # enabled and on its way (the move takes 4 s)
+        master.kill()
+        master.wait()
+        end = time.monotonic() + 10
+        while not any("node 1 (X): drive braked" in x for x in lines) and time.monotonic() < end:
+            time.sleep(0.05)
+        run = subprocess.run(_in_ns(netns, "-m", "hil.cli", "run", str(short), "--bench", str(bench),
+                                    "--bus", f"canopen:udp_multicast:{group}"),
+                             capture_output=True, text=True, timeout=60, cwd=ROOT)
+    finally:
+        sim.proc.terminate()  # (not sim.stop(): its communicate() would read the stderr the reader reads)
+        sim.proc.wait(10)
+        reader.join(5)
+    log = "".join(lines)
+    assert "node 1 (X): no heartbeat from node 127 for 250 ms: AL180 (heartbeat event), EMCY 0x8130" in log, log
+    braked = [x for x in lines if "node 1 (X): drive braked from" in x]
+    assert braked and "to standstill in" in braked[0] and "FAULT 0x0180, power stage off" in braked[0], log
+    assert run.returncode == 0, run.stdout + run.stderr
+    assert "(fault reset at power-up: X 0x0180, Z 0x0180, S1 0x0180)" in run.stdout, run.stdout
+    assert "result         completed" in run.stdout

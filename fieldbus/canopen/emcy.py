@@ -20,6 +20,7 @@ DELTA_TO_CIA: dict[int, int] = {
     0x0013: 0x5441,  # emergency stop input → drive interlock
     0x0014: 0xFF00,  # reverse inhibit limit (device specific)
     0x0015: 0xFF00,  # forward inhibit limit (device specific)
+    0x0180: 0x8130,  # heartbeat event (ASDA-A3 AL180: no master heartbeat within 0x1016) → heartbeat error
 }
 
 CIA_TEXT: dict[int, str] = {

@@ -48,6 +48,9 @@ ALARM_INTERPOLATION = 0x141F  # the servo does not support the interpolation tim
 
 NMT_BOOTUP, NMT_STOPPED, NMT_OPERATIONAL, NMT_PREOP = 0, 4, 5, 127
 NMT_NAMES = {0: "BOOT-UP", 4: "STOPPED", 5: "OPERATIONAL", 127: "PRE-OPERATIONAL"}
+# The master's own heartbeat, on a real transport (decision E34): the drives consume it (0x1016) and stop on
+# their own when it stops, as the ASDA-A3's AL180. The highest node ID, which benches leave to the master.
+MASTER_NODE_ID = 0x7F
 CIA402_DEVICE_PROFILE = 402
 CIA401_DEVICE_PROFILE = 401  # generic I/O modules (remote I/O stations)
 ALARM_EIO_FAILED = 0x1426  # the system remote module (EIO) failed
@@ -102,6 +105,7 @@ class CanopenLink:
         self._emcys: list[tuple[Node, Emcy]] = []
         self.faults: list[tuple[str, FaultEpisode]] = []  # (drive, episode) in the order they began
         self._next_sync = 0.0
+        self._next_heartbeat = 0  # perf_counter_ns when the master's next heartbeat is due (real transports)
         self._opened_at = 0.0
         self.capture: Any = None  # fieldbus.capture.CanCapture: `hil run --capture FILE.asc`
         # True: the caller holds the cycle (a real-time clock), so exchange() sends the SYNC at once (E24)
@@ -238,6 +242,10 @@ class CanopenLink:
         self._sdo(n, lambda: setattr(sdo[0x60C2][1], "raw", value), 0x60C2)
         self._sdo(n, lambda: setattr(sdo[0x60C2][2], "raw", index), 0x60C2)
         self._sdo(n, lambda: setattr(sdo[0x1017], "raw", int(round(self.heartbeat_period * 1000))), 0x1017)
+        if not self.lockstep and 0x1016 in sdo and nid != MASTER_NODE_ID:
+            # consume the master's heartbeat, within the time the master gives the drives' own (E34)
+            consumer = MASTER_NODE_ID << 16 | int(round(self.heartbeat_timeout * 1000))
+            self._sdo(n, lambda: setattr(sdo[0x1016][1], "raw", consumer), 0x1016)
         for maps, frames, base in ((n.remote.rpdo, n.rx_frames, 0x200), (n.remote.tpdo, n.tx_frames, 0x180)):
             for k in range(MAX_PDOS):
                 m = maps[k + 1]
@@ -387,6 +395,9 @@ class CanopenLink:
                 n.received.clear()
             self._pending = sum(len(n.tx_frames) for n in live)  # TPDOs this SYNC must bring
         send = net.send_raw if self.lockstep else net.send_message
+        if not self.lockstep and t0 >= self._next_heartbeat:  # the master's heartbeat (E34), OPERATIONAL
+            self._next_heartbeat = t0 + int(self.heartbeat_period * 1e9)
+            frames.append((0x700 + MASTER_NODE_ID, b"\x05"))
         for cob, data in frames:
             send(cob, data)
         net.sync.transmit()  # lock-step: delivers RPDOs + SYNC, the slaves answer, we collect

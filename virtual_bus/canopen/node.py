@@ -22,6 +22,7 @@ from fieldbus.canopen.emcy import Emcy, emcy_for_delta
 from fieldbus.canopen.objects import ASDA_B3_EDS, MAX_PDO_BYTES, MAX_PDOS, OBJECT_ATTRS
 from fieldbus.cia402 import State
 from fieldbus.pdo import PdoEntry, PdoLayout, RxPdo, copy_rx
+from virtual_bus.canopen.master_watch import MasterWatch
 from virtual_bus.drive import Cia402Drive
 from virtual_bus.drive_modes import MODE_OBJECTS, check_value
 from virtual_bus.servo_params import ServoParamError, ServoParams, coe_objects
@@ -67,6 +68,7 @@ class Cia402Slave:
         self._dirty = True
         self._period: float | None = None  # 0x60C2 in seconds, see interpolation_period
         self._fault_reported = 0
+        self.watch: MasterWatch | None = None  # the master's heartbeat, in `hil sim canopen` (serve) only
         self._add_servo_params()
         self._mode_defaults()
         self.node.add_read_callback(self._on_read)
@@ -305,6 +307,8 @@ class Cia402Slave:
             return
         self._refresh_mapping()
         self.syncs += 1
+        if self.watch is not None:
+            self.watch.synced()
         dt = self.interpolation_period
         operational = self.node.nmt.state == "OPERATIONAL"
         if operational:
@@ -332,6 +336,11 @@ class Cia402Slave:
         elif not faulted and self._fault_reported:
             self._emcy_queue.append((self.syncs + self.emcy_delay, Emcy(0x0000, 0x00, 0)))  # error reset
             self._fault_reported = 0
+
+    def report_fault(self, emcy: Emcy) -> None:
+        """Send a fault's EMCY now, not at a SYNC (the master may send none any more: master_watch.py)."""
+        self._fault_reported = self.drive.error_code
+        self._send_emcy(emcy)
 
     def _send_emcy(self, emcy: Emcy) -> None:
         """On the COB-ID of 0x1014; none when its bit 31 says the EMCY is not valid (CiA 301)."""

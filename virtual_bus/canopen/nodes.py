@@ -12,17 +12,20 @@ from __future__ import annotations
 
 import logging
 import threading
-from collections.abc import Sequence
+import time
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 import canopen
 
 from fieldbus.canopen.lockstep import LockstepNetwork
 from fieldbus.canopen.objects import ASDA_B3_EDS
+from virtual_bus.canopen.master_watch import MasterWatch
 from virtual_bus.canopen.node import Cia402Slave
 from virtual_bus.drive import Cia402Drive
 
 log = logging.getLogger("virtual_bus.canopen")
+WATCH_PERIOD_S = 0.01  # how often a served node looks at its master's heartbeat (and steps a braking drive)
 
 
 class SlaveBus:
@@ -34,6 +37,9 @@ class SlaveBus:
         self.slaves = [Cia402Slave(first_id + i, d, str(f or ASDA_B3_EDS)) for i, (d, f) in enumerate(zip(drives, files))]
         self.syncs = 0
         self._lock = threading.Lock()
+        self.log: Callable[[str], None] = lambda msg: None  # `hil sim canopen --verbose`
+        self._watching: threading.Thread | None = None
+        self._closed = threading.Event()
         network.subscribe(0x80, self._on_sync)
         for s in self.slaves:
             s.attach(network)
@@ -54,7 +60,27 @@ class SlaveBus:
                 # Heartbeats run on simulated time: one interpolation period per SYNC.
                 self.network.advance(alive[0].interpolation_period if alive else 0.0)
 
+    def watch_master(self, every: float = WATCH_PERIOD_S) -> None:
+        """Each drive watches the master's heartbeat (0x1016) from a thread of its own, as a drive's firmware
+        does, so a master gone silent is seen without a SYNC (virtual_bus/canopen/master_watch.py, E34)."""
+        for s in self.slaves:
+            s.watch = MasterWatch(s)
+            s.watch.subscribe()
+
+        def loop() -> None:
+            while not self._closed.wait(every):
+                with self._lock:
+                    now = time.monotonic()
+                    lines = [(s, m) for s in self.slaves if s.alive and s.watch is not None
+                             for m in s.watch.check(now)]
+                for s, m in lines:
+                    self.log(f"node {s.node_id} ({s.drive.name}): {m}")
+
+        self._watching = threading.Thread(target=loop, name="canopen-master-watch", daemon=True)
+        self._watching.start()
+
     def close(self) -> None:
+        self._closed.set()
         for s in self.slaves:
             s.node.nmt.stop_heartbeat()
         self.network.disconnect()
@@ -74,6 +100,7 @@ def serve(drives: Sequence[Cia402Drive], interface: str, channel: str, stop: thr
     network = canopen.Network()
     network.connect(interface=interface, channel=channel)
     bus = SlaveBus(drives, network, eds=eds)
+    bus.watch_master()
     log.info("CANopen nodes %s on %s:%s", [s.node_id for s in bus.slaves], interface, channel)
     if ready is not None:
         ready.set()
