@@ -55,6 +55,22 @@ def _check_types(path: str | Path, schema: pa.Schema) -> None:
             raise TraceReadError(f"{path}: column {c!r} must hold numbers, got {f.type}")
 
 
+def _missing(path: Path) -> str:
+    """Why there is no trace to read: a run killed hard leaves `<trace>.part` (bench decisions, B73)."""
+    from hil.trace_parquet import FLUSH_S  # (only on this error path)
+
+    part = path if path.name.endswith(".part") else path.with_name(path.name + ".part")
+    if part.is_dir() and part != path and any(part.glob("*.parquet")):
+        return (f"no such trace file; {part.name} is what a run killed before it finished left: give that (its "
+                "rows up to its last flush), or rerun")
+    if part.is_dir():  # a Parquet trace's parts, with none in it
+        why = f"a run killed before its first flush ({FLUSH_S:g} s of wall time) left it with no rows"
+        return f"{why}; rerun" if part == path else f"no such trace file; {part.name}: {why}; rerun"
+    if part.is_file() and part != path:
+        return f"no such trace file; {part.name} is what a run killed before it finished left: give that, or rerun"
+    return "no such trace file"
+
+
 class TraceFile:
     def __init__(self, path: str | Path) -> None:
         self.path = Path(path)
@@ -62,7 +78,7 @@ class TraceFile:
         # row-group files up to its last flush, read here as one partial trace.
         self.partial = self.path.is_dir() and any(self.path.glob("*.parquet"))
         if not self.path.is_file() and not self.partial:
-            raise TraceReadError(f"{path}: no such trace file")
+            raise TraceReadError(f"{path}: {_missing(self.path)}")
         head = _magic(self.path) if not self.partial else b""
         if head.startswith(b"MDF "):  # `hil trace --out x.mf4` writes it; asammdf or CANape read it
             raise TraceReadError(f"{path}: an MDF4 file: hil reads traces as CSV, Parquet or Arrow IPC "

@@ -142,3 +142,21 @@ def test_an_mdf4_export_given_as_a_trace_says_what_it_is(trace, tmp_path, capsys
     assert main(["trace", str(out)]) == 2
     err = capsys.readouterr().err
     assert "x.mf4: an MDF4 file: hil reads traces as CSV, Parquet or Arrow IPC" in err and "codec" not in err
+
+
+def test_a_trace_a_killed_run_left_unfinished_is_pointed_at(tmp_path, capsys):
+    """`hil trace t.parquet` after a run writing it was killed hard: the message names the `.part` it left,
+    or says that one holds no rows (killed before its first flush), not just 'no such trace file' (B73)."""
+    empty = tmp_path / "a.parquet.part"
+    empty.mkdir()
+    assert main(["trace", str(tmp_path / "a.parquet")]) == 2
+    err = capsys.readouterr().err
+    assert "no such trace file; a.parquet.part: a run killed before its first flush (2 s of wall time) left it" \
+           " with no rows; rerun" in err
+    assert main(["trace", str(empty)]) == 2
+    assert "a.parquet.part: a run killed before its first flush" in capsys.readouterr().err
+    (tmp_path / "b.csv.part").write_text("t,line\n0.001,1\n")
+    assert main(["check", str(tmp_path / "b.csv")]) == 2
+    assert "b.csv.part is what a run killed before it finished left: give that, or rerun" in capsys.readouterr().err
+    assert main(["trace", str(tmp_path / "c.csv")]) == 2
+    assert capsys.readouterr().err.strip().endswith("c.csv: no such trace file")
