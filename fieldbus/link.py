@@ -23,6 +23,16 @@ class SlaveInfo:
     product_code: int = 0
     state: str = ""
     layout: str = ""
+    drive: str = ""  # a CiA 402 drive's state from 0x6041 over SDO, with its 0x603F error code in fault (scan)
+
+
+def drive_state_text(statusword: int, error_code: int) -> str:
+    """'switch on disabled', 'fault 0x7500': what `hil scan` shows of a drive (its statusword and error code)."""
+    from fieldbus.cia402 import State, decode_state
+
+    st = decode_state(statusword)
+    fault = st in (State.FAULT, State.FAULT_REACTION_ACTIVE)
+    return st.value + (f" 0x{error_code:04X}" if fault else "")
 
 
 @dataclass

@@ -279,9 +279,40 @@ def test_hil_scan_lists_the_canopen_nodes(hil):
     assert all("vendor 0x000001DD" in row and "product 0x00006080" in row and " drive " in row for row in rows)
     assert all("[asda-b3-e: 16777216 counts/rev, velocity 0.1 rpm, torque 0.1 %]" in row for row in rows)
     assert [int(row.split()[0]) for row in rows] == [1, 2, 3]
+    assert all("CiA 402 switch on disabled  [" in row for row in rows)  # 0x6041 over SDO, as powered on
     r = hil("scan", "--bus", "canopen:virtual", "--json")  # the same, one JSON record a node
     assert r.code == 0, r.err
     records = [json.loads(line) for line in r.out.splitlines()]
     assert [(x["position"], x["product"], x["model"], x["counts_per_rev"], x["velocity_unit"],
              x["torque_unit_percent"]) for x in records] == \
         [(k, "0x00006080", "asda-b3-e", 16_777_216, "0.1 rpm", 0.1) for k in (1, 2, 3)]
+    assert all(x["drive_state"] == "switch on disabled" for x in records)
+
+
+def test_scan_shows_a_faulted_drive_and_leaves_a_stopped_node_alone():
+    """A drive left in fault (a master that died, E34) shows its error code; a node a master's NMT stop left in
+    STOPPED has no SDO (CiA 301), so the scan says so instead of timing out on it (decision B74)."""
+    import canopen
+
+    from fieldbus.canopen.scan import scan
+    from hil.bench import default_lathe
+    from hil.session import sim_slaves
+    from virtual_bus.canopen.nodes import SlaveBus
+
+    channel = "scan-states"
+    net = canopen.Network()
+    net.connect(interface="virtual", channel=channel)
+    bus = SlaveBus(sim_slaves(default_lathe()), net)
+    try:
+        for s in bus.slaves:
+            s.node.sdo[0x1017].raw = 100  # heartbeats every 100 ms, as hil run sets them
+            s.node.nmt.send_command(0x80)  # (re)start the heartbeat with that period
+        bus.slaves[0].drive.fault(0x0180)
+        bus.slaves[0].drive.step(0.001)
+        bus.slaves[2].node.nmt.send_command(0x02)  # STOPPED
+        got = scan("virtual", channel, 1_000_000, wait=0.3)
+    finally:
+        bus.close()
+    by_id = {s.position: s for s in got}
+    assert by_id[1].drive == "fault 0x0180" and by_id[2].drive == "switch on disabled"
+    assert by_id[3].state == "STOPPED" and by_id[3].kind == "?" and "no SDO" in by_id[3].name

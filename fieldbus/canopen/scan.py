@@ -10,7 +10,7 @@ import canopen
 from canopen.sdo.exceptions import SdoAbortedError, SdoCommunicationError
 
 from fieldbus.canopen.link import ALARM_ESTABLISH, connect_args
-from fieldbus.link import BusError, SlaveInfo
+from fieldbus.link import BusError, SlaveInfo, drive_state_text
 from nc.alarms import Alarm
 
 
@@ -39,6 +39,14 @@ def scan(interface: str, channel: str, bitrate: int, wait: float = 0.5) -> list[
 
 
 def _identify(node: canopen.RemoteNode, nid: int, wait: float) -> SlaveInfo:
+    try:
+        state = node.nmt.wait_for_heartbeat(wait)  # if the node produces one (0x1017)
+    except canopen.nmt.NmtError:
+        state = "PRE-OP/OP"  # found, so it answered SDO: it is not STOPPED
+    if state == "STOPPED":  # no SDO in STOPPED (CiA 301): nothing to ask it
+        return SlaveInfo(nid, f"node {nid} (STOPPED, as a master's NMT stop leaves it: no SDO, so no identity, "
+                              "until NMT pre-operational)", "?", 0, 0, "STOPPED")
+
     def u32(index: int, sub: int) -> int:
         try:
             return int.from_bytes(node.sdo.upload(index, sub)[:4], "little")
@@ -52,8 +60,11 @@ def _identify(node: canopen.RemoteNode, nid: int, wait: float) -> SlaveInfo:
         name = ""
     profile = device_type & 0xFFFF
     kind = "drive" if profile == 402 else "io" if profile == 401 else f"cia{profile}"
-    try:
-        state = node.nmt.wait_for_heartbeat(wait)  # if the node produces one (0x1017)
-    except canopen.nmt.NmtError:
-        state = "PRE-OP/OP"  # it answered SDO, so it is not STOPPED
-    return SlaveInfo(nid, name or f"node {nid}", kind, u32(0x1018, 1), u32(0x1018, 2), state)
+    drive = ""
+    if kind == "drive":
+        try:
+            drive = drive_state_text(int.from_bytes(node.sdo.upload(0x6041, 0)[:2], "little"),
+                                     int.from_bytes(node.sdo.upload(0x603F, 0)[:2], "little"))
+        except (SdoAbortedError, SdoCommunicationError):
+            pass  # no such object: the scan shows what it has
+    return SlaveInfo(nid, name or f"node {nid}", kind, u32(0x1018, 1), u32(0x1018, 2), state, drive=drive)

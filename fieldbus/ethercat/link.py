@@ -24,7 +24,7 @@ import pysoem
 
 from fieldbus.ethercat import alarms as A
 from fieldbus.ethercat.pdo_mapping import mapping_sdos, mapping_sdos_complete
-from fieldbus.link import BusError, LinkStatus, SlaveInfo
+from fieldbus.link import BusError, LinkStatus, SlaveInfo, drive_state_text
 from fieldbus.cia402 import SW_FAULT
 from fieldbus.pdo import ASDA_E, LAYOUTS, PdoLayout, RxPdo, TxPdo
 from nc.alarms import Alarm
@@ -149,6 +149,8 @@ class EthercatLink:
             for info, s in zip(infos, m.slaves):
                 if info.kind == "io":
                     info.name, info.layout = self._io_identity(s)
+                else:
+                    info.drive = self._drive_state(s)
             return infos
         finally:
             m.close()
@@ -160,6 +162,17 @@ class EthercatLink:
         except Exception:
             return "io"
         return "drive" if device_type & 0xFFFF == 402 else "io"
+
+    @staticmethod
+    def _drive_state(s) -> str:
+        """The drive's CiA 402 state (0x6041) and, in fault, its error code (0x603F), over SDO: a drive left in
+        fault (a master that died, E33) shows here before a run resets it (B72)."""
+        try:
+            sw = struct.unpack("<H", s.sdo_read(0x6041, 0)[:2])[0]
+            code = struct.unpack("<H", s.sdo_read(0x603F, 0)[:2])[0]
+        except Exception:  # no such object or no mailbox answer: the scan shows what it has
+            return ""
+        return drive_state_text(sw, code)
 
     @staticmethod
     def _io_identity(s) -> tuple[str, str]:

@@ -10,7 +10,8 @@ from hil.cli import EXIT_ALARM, EXIT_OK, EXIT_USAGE
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser("scan", help="list the slaves on a bus (vendor, product, name, AL or NMT state)")
+    p = sub.add_parser("scan", help="list the slaves on a bus (vendor, product, name, AL or NMT state; a drive's "
+                                    "CiA 402 state, and its error code in fault)")
     p.add_argument("--bus", required=True, help="ethercat:IFACE, or canopen:INTERFACE:CHANNEL (canopen:virtual: "
                                                 "the bench's simulated nodes in this process)")
     p.add_argument("--bench", help="with canopen:virtual: whose drives to simulate (default: the built-in lathe)")
@@ -51,6 +52,7 @@ def cmd_scan(args: argparse.Namespace) -> int:
             print(strict_json.dumps({"position": s.position, "vendor": f"0x{s.vendor_id:08X}",
                               "product": f"0x{s.product_code:08X}", "name": s.name, "kind": s.kind,
                               "state": s.state} | ({"modules": s.layout} if s.kind == "io" and s.layout else {})
+                                    | ({"drive_state": s.drive} if s.drive else {})
                                     | ({"model": m.key, "counts_per_rev": m.counts_per_rev,
                                         "velocity_unit": m.units.velocity,
                                         "torque_unit_percent": m.units.torque_percent} if m else {})))
@@ -59,7 +61,7 @@ def cmd_scan(args: argparse.Namespace) -> int:
                      f"torque {m.units.torque_percent:g} %]") if m else ""
             print(f"{s.position:3d}  vendor 0x{s.vendor_id:08X}  product 0x{s.product_code:08X}  "
                   f"{s.state:8s} {s.kind:5s}  {s.name}" + (f"  [{s.layout}]" if s.kind == "io" and s.layout else "")
-                  + model)
+                  + (f"  CiA 402 {s.drive}" if s.drive else "") + model)
     return EXIT_OK
 
 
