@@ -273,7 +273,7 @@ def run(program: str | Path, bench: str | Path | Bench | None = None, *, bus: st
 
                 columns = runner.trace_columns()
                 try:
-                    runner.trace = open_trace(trace_path, columns, run_meta(b, str(program)), column_units(columns, b))
+                    runner.trace = open_trace(trace_path, columns, run_meta(b, str(program), libs), column_units(columns, b))
                 except OSError as exc:
                     raise InputError(f"cannot write trace {trace_path}: {exc.strerror}") from None
             if scope is not None:  # the live scope reads the rows the trace is written from

@@ -63,5 +63,27 @@ def test_no_flags_judges_the_trace_as_its_run_was(hil, tmp_path):
     assert hil("run", PROGRAM, "--bench", fast_z_bench(tmp_path), "--trace", trace).code == 0
     r = hil("check", trace)
     assert "following error X" in r.out and "velocity Z: 421.8 mm/s <= 800" in r.out and "jitter p99" in r.out
-    # the bench's contour check needs the program: not given, so nothing passes on it
-    assert r.code == 1 and "SKIP  contour error: needs the program" in r.out
+    # the bench's contour check takes the program the run recorded (B75); this one reads servo parameters, which
+    # only a run answers, so its path is unknown offline and the check is skipped saying so, as after `hil run`
+    assert f"program {PROGRAM.resolve()} (recorded in the trace)" in r.out
+    assert "SKIP  contour error: the program does not run offline" in r.out and r.code == 0, r.out + r.err
+
+
+def test_the_recorded_program_judges_the_path_while_its_file_is_unchanged(hil, tmp_path):
+    """Decision B75: `hil check/report TRACE` judge the contour against the program the run recorded (path and
+    SHA-256 in the trace); once the file changed, they say so and the check needs --program again."""
+    prog = tmp_path / "p.nc"
+    prog.write_text((ROOT / "examples" / "lathe_demo.nc").read_text())
+    trace = tmp_path / "t.parquet"
+    assert hil("run", prog, "--bench", ROOT / "benches" / "lathe-2axis.toml", "--trace", trace).code == 0
+    r = hil("check", trace)
+    assert r.code == 0, r.out + r.err
+    assert f"program {prog.resolve()} (recorded in the trace)" in r.out and "ok    contour error: " in r.out
+    r = hil("report", trace, "--out", tmp_path / "rep")
+    assert r.code == 0 and f"program {prog.resolve()} (recorded in the trace)" in r.out
+    prog.write_text(prog.read_text() + "(edited after the run)\n")
+    r = hil("check", trace)
+    assert r.code == 1 and "SKIP  contour error: needs the program (--program)" in r.out
+    assert f"note: the program the run recorded, {prog.resolve()}, has changed since the run" in r.err
+    r = hil("check", trace, "--program", ROOT / "examples" / "lathe_demo.nc")  # the user's word wins
+    assert r.code == 0 and "ok    contour error: " in r.out and "recorded in the trace)\n" not in r.out

@@ -88,7 +88,7 @@ def trace_bench(args: argparse.Namespace, tf: TraceFile) -> tuple[Bench | None, 
 def prepare(args: argparse.Namespace, cmd: str):
     """Bench, checks, trace, the programmed moves and where the bench came from; bad input raises
     InputError / TraceReadError / NcAlarm."""
-    from hil.checks import program_moves, program_start
+    from hil.checks import NO_PROGRAM, program_moves, program_start
     from hil.session import InputError, load_program
     from hil.trace import axes_of, csv_meta_path
     from hil.trace_read import TraceFile
@@ -109,10 +109,24 @@ def prepare(args: argparse.Namespace, cmd: str):
         missing = [a for a in bench.axis_names if f"{a}_cmd" not in tf.columns]
         if missing:
             raise InputError(f"{args.trace} has no columns for axis {', '.join(missing)} of bench {bench.name}")
-    # The program given here is the user's: an alarm offline is reported as the NC would (exit 1).
-    moves = program_moves(load_program(args.program), bench, program_start(tf, bench.axis_names)) \
-        if args.program and bench is not None else None
-    return bench, checks, tf, moves, origin
+    if args.program and bench is not None:
+        # The program given here is the user's: an alarm offline is reported as the NC would (exit 1).
+        return bench, checks, tf, program_moves(load_program(args.program), bench,
+                                                program_start(tf, bench.axis_names)), origin, NO_PROGRAM
+    moves, why = None, NO_PROGRAM
+    if bench is not None:  # the program the run recorded, while its file is unchanged (B75)
+        from hil.checks import offline_moves
+        from hil.trace_meta import recorded_program
+
+        program, libs, note = recorded_program(tf.meta)
+        if program:
+            # an offline alarm (a program reading what only a run answers) skips the path checks saying why,
+            # as after `hil run`
+            moves, why = offline_moves(load_program(program, libs), bench, program_start(tf, bench.axis_names))
+            origin += f"\nprogram {program} (recorded in the trace)"
+        elif note:
+            print(f"hil {cmd}: note: {note}: give --program for the path checks", file=sys.stderr)
+    return bench, checks, tf, moves, origin, why
 
 
 def prepared(args: argparse.Namespace, cmd: str):
@@ -139,12 +153,12 @@ def cmd_check(args: argparse.Namespace) -> int:
     ready = prepared(args, "check")
     if isinstance(ready, int):
         return ready
-    bench, checks, tf, moves, origin = ready
+    bench, checks, tf, moves, origin, why = ready
     if not checks.any:
         print("hil check: no checks to run: give a --bench with [checks] or limits such as --max-ferr", file=sys.stderr)
         return EXIT_USAGE
     try:  # the trace is read here: damage past its header shows now
-        results = run_checks(tf, checks, bench, moves)
+        results = run_checks(tf, checks, bench, moves, why)
     except TraceReadError as exc:
         print(f"hil check: {exc}", file=sys.stderr)
         return EXIT_USAGE

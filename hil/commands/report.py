@@ -27,9 +27,9 @@ def cmd_report(args: argparse.Namespace) -> int:
     ready = prepared(args, "report")
     if isinstance(ready, int):
         return ready
-    bench, checks, tf, moves, origin = ready
+    bench, checks, tf, moves, origin, why = ready
     try:  # the trace is read here: damage past its header shows now
-        results = run_checks(tf, checks, bench, moves) if checks.any else None
+        results = run_checks(tf, checks, bench, moves, why) if checks.any else None
         rep = write_report(args.trace, args.out, bench, moves, results, args.title)
     except TraceReadError as exc:
         print(f"hil report: {exc}", file=sys.stderr)
