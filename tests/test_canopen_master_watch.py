@@ -93,3 +93,40 @@ def test_a_master_that_stops_the_node_first_is_not_lost(line):
     x.node.nmt.state = "STOPPED"
     time.sleep(0.15)
     assert d.state is State.OPERATION_ENABLED and not emcys and len(log) == 1
+
+
+def _master_side(channel: str, reject: int | None):
+    """A drive node on `channel` (refusing 0x1016:1 with `reject`), and the link's view of it as a master."""
+    from fieldbus.canopen.link import CanopenLink
+    from fieldbus.canopen.nodes import Node, NodeConfig
+    from fieldbus.pdo import ASDA_CSP
+    from virtual_bus.canopen.node import Cia402Slave
+
+    slave_net, net = canopen.Network(), canopen.Network()
+    slave_net.connect(interface="virtual", channel=channel)
+    net.connect(interface="virtual", channel=channel)
+    slave = Cia402Slave(1, sim_slaves(default_lathe())[0],
+                        reject_writes={(0x1016, 1): reject} if reject is not None else None)
+    slave.attach(slave_net)
+    cfg = NodeConfig(1, "X", ASDA_CSP)
+    node = Node(cfg, net.add_node(1, str(cfg.eds)), [], [])
+    link = CanopenLink([cfg], "virtual", channel)
+    return slave, node, link, (slave_net, net)
+
+
+def test_the_master_sets_the_drives_consumer_time_and_a_refusal_only_warns(caplog):
+    """`hil run` on a real transport writes 0x1016:1 = 127 << 16 | 2.5 heartbeat periods (E34); a drive that
+    refuses it is run anyway, with a warning that it will not stop by itself."""
+    for reject, channel in ((None, "mw-ok"), (0x06090030, "mw-refused")):
+        slave, node, link, nets = _master_side(channel, reject)
+        try:
+            link._watch_master(node)
+        finally:
+            for n in nets:
+                n.disconnect()
+        if reject is None:
+            assert slave._value(0x1016, 1) == 0x7F << 16 | 50  # a virtual link's heartbeat: 20 ms, × 2.5
+        else:
+            assert slave._value(0x1016, 1) == 0
+            assert "refused the master's heartbeat to watch (0x1016:1, SDO abort 0x06090030" in caplog.text
+            assert "it will not stop by itself if this master dies" in caplog.text

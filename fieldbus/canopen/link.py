@@ -242,10 +242,8 @@ class CanopenLink:
         self._sdo(n, lambda: setattr(sdo[0x60C2][1], "raw", value), 0x60C2)
         self._sdo(n, lambda: setattr(sdo[0x60C2][2], "raw", index), 0x60C2)
         self._sdo(n, lambda: setattr(sdo[0x1017], "raw", int(round(self.heartbeat_period * 1000))), 0x1017)
-        if not self.lockstep and 0x1016 in sdo and nid != MASTER_NODE_ID:
-            # consume the master's heartbeat, within the time the master gives the drives' own (E34)
-            consumer = MASTER_NODE_ID << 16 | int(round(self.heartbeat_timeout * 1000))
-            self._sdo(n, lambda: setattr(sdo[0x1016][1], "raw", consumer), 0x1016)
+        if not self.lockstep:
+            self._watch_master(n)
         for maps, frames, base in ((n.remote.rpdo, n.rx_frames, 0x200), (n.remote.tpdo, n.tx_frames, 0x180)):
             for k in range(MAX_PDOS):
                 m = maps[k + 1]
@@ -321,6 +319,24 @@ class CanopenLink:
         """Outputs station k's RPDO carries from the next cycle on."""
         if k < len(self._io):
             self._io[k].outputs = value & ((1 << self._io[k].cfg.outputs) - 1)
+
+    def _watch_master(self, n: Node) -> None:
+        """The drive consumes the master's heartbeat within the time the master gives the drives' own (E34); a
+        drive without 0x1016, or one that refuses it, runs as before, only without stopping by itself when the
+        master dies (said once in the log)."""
+        sdo = n.remote.sdo
+        if 0x1016 not in sdo or n.cfg.node_id == MASTER_NODE_ID:
+            return
+        consumer = MASTER_NODE_ID << 16 | int(round(self.heartbeat_timeout * 1000))
+
+        def watch() -> None:
+            try:
+                sdo[0x1016][1].raw = consumer
+            except SdoAbortedError as exc:
+                log.warning("%s refused the master's heartbeat to watch (0x1016:1, SDO abort 0x%08X, %s): it "
+                            "will not stop by itself if this master dies", self._label(n), exc.code, _abort_text(exc))
+
+        self._sdo(n, watch, 0x1016)  # (no answer at all is the usual bring-up alarm)
 
     def _sdo(self, n: Node, op: Callable[[], Any], index: int, what: str = "") -> Any:
         try:
