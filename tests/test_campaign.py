@@ -168,7 +168,7 @@ def cluster():
                                   "--name", name, "--host", "127.0.0.1")
         with Client(address, timeout="30s") as client:
             client.wait_for_workers(3, timeout=60)
-            yield address, client, workers
+            yield address, client, workers | {"scheduler": procs[0]}
     finally:
         for p in [*workers.values(), *procs]:
             if p.poll() is None:
@@ -254,3 +254,27 @@ def test_a_run_past_max_time_is_a_timeout_and_params_sweep_is_a_variant(tmp_path
     # alarm 0xDE03 at max_time, then the channel stops along the path before the run ends
     assert {r["status"] for r in rs} == {"timeout"} and all(0.4 <= r["program_time_s"] <= 0.6 for r in rs)
     assert all(r["program_time_s"] < r["sim_time_s"] < 0.9 for r in rs)
+
+
+def test_a_scheduler_that_goes_away_ends_the_campaign_resumably(serial, cluster, tmp_path):
+    """Decision B76: the scheduler killed mid-campaign: what finished is written, no case that never ran is a
+    row (they were `worker_lost` failures), no distributed traceback, exit 3; the same command resumes."""
+    address, client, workers = cluster
+    run = campaign_on(address, DATA / "campaign.toml", tmp_path / "r")
+    end = time.monotonic() + 60
+    while not client.processing() or not any(client.processing().values()):
+        assert time.monotonic() < end and run.poll() is None
+        time.sleep(0.02)
+    os.killpg(workers["scheduler"].pid, signal.SIGKILL)
+    out, err = run.communicate(timeout=120)
+    assert run.returncode == 3, out + err
+    assert f"hil campaign: lost the connection to the scheduler {address} after " in err
+    assert "run the same command again (with a scheduler) to resume" in err
+    assert "Traceback" not in err and "worker_lost" not in out
+    done = pq.read_table(tmp_path / "r" / "results.parquet").to_pylist()
+    assert all(r["status"] != "worker_lost" for r in done) and len(done) < 13
+    # resumed on a cluster of its own: the rest runs, and the matrix is the serial one
+    p = hil("campaign", str(DATA / "campaign.toml"), "--out", str(tmp_path / "r"), "--workers", "0", "--quiet")
+    assert p.returncode == 1, p.stdout + p.stderr
+    assert f"({len(done)} already done, {13 - len(done)} run)" in p.stdout
+    assert rows(tmp_path / "r") == rows(serial)

@@ -22,6 +22,11 @@ from hil.campaign.inputs import CaseInputs
 from hil.campaign.worker import lost_row, run_case
 
 
+class SchedulerLost(Exception):
+    """The cluster's scheduler went away mid-campaign (stopped, crashed, its host gone): the cases not
+    finished were never judged, so they are no rows; the campaign ends like an interrupted one (B76)."""
+
+
 @dataclass
 class Engine:
     scheduler: str | None = None  # tcp://HOST:PORT of an existing cluster; None = a local cluster
@@ -59,6 +64,8 @@ def _dask(cases: Sequence[CaseInputs], engine: Engine) -> Iterator[dict[str, Any
                 cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
                                        host="127.0.0.1", silence_logs=50)
         client = Client(cluster if cluster is not None else engine.scheduler, timeout="30s")
+        quiet = _quiet_client()  # a lost scheduler is the campaign's to report, not tracebacks from distributed
+        quiet.__enter__()
         try:
             if cluster is not None:
                 client.register_plugin(_quiet_worker(), name="hil-sigint-ignored")
@@ -75,15 +82,41 @@ def _dask(cases: Sequence[CaseInputs], engine: Engine) -> Iterator[dict[str, Any
             for f in as_completed(futures):
                 case = by_key[f.key]
                 try:
-                    yield f.result()
+                    row = f.result()
                 except (FutureCancelledError, Exception) as exc:  # KilledWorker after `retries` lost workers
-                    yield lost_row(case, f"{type(exc).__name__}: {exc}", engine.retries)
+                    if _scheduler_gone(client, exc):
+                        where = engine.scheduler or "of the local cluster"
+                        raise SchedulerLost(f"lost the connection to the scheduler {where}") from None
+                    row = lost_row(case, f"{type(exc).__name__}: {exc}", engine.retries)
                 finally:
                     f.release()
+                yield row
         finally:
-            client.close()
-            if cluster is not None:
-                cluster.close()
+            try:
+                client.close()
+                if cluster is not None:
+                    cluster.close()
+            finally:
+                quiet.__exit__(None, None, None)
+
+
+def _scheduler_gone(client: Any, exc: BaseException) -> bool:
+    """A future cancelled because the client lost its scheduler (not a case's own failure)."""
+    return "scheduler-connection-lost" in str(exc) or client.status not in ("running", "connecting", "newly-created")
+
+
+@contextmanager
+def _quiet_client() -> Iterator[None]:
+    """distributed's client logs a lost scheduler as ERROR tracebacks on stderr; the campaign says it itself."""
+    import logging
+
+    log = logging.getLogger("distributed.client")
+    level = log.level
+    log.setLevel(logging.CRITICAL)
+    try:
+        yield
+    finally:
+        log.setLevel(level)
 
 
 @contextmanager

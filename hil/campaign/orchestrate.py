@@ -8,7 +8,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from hil.campaign.engine import Engine, Progress, run_cases
+from hil.campaign.engine import Engine, Progress, SchedulerLost, run_cases
 from hil.campaign.inputs import gather
 from hil.campaign.matrix_html import matrix_page
 from hil.campaign.results import RESULTS, Journal, report_dir, to_table, trace_dir, write_atomic
@@ -20,6 +20,8 @@ class CampaignOutcome:
     rows: list[dict[str, Any]] = field(default_factory=list)
     skipped: int = 0  # cases whose result was already there (resume)
     interrupted: bool = False
+    lost: str = ""  # why the cluster went away mid-campaign (SchedulerLost), else ""
+    unrun: int = 0  # cases to run that never finished (an interrupted or lost campaign)
     results: Path | None = None
 
     @property
@@ -52,6 +54,7 @@ def run_campaign(path: str | Path, out: str | Path, engine: Engine | None = None
     outcome.skipped = len(kept)
     outcome.rows = list(kept)
     progress = Progress(len(todo), quiet)
+    ran = 0
     try:
         for row in run_cases(todo, engine):
             trace_bytes = row.pop("_trace_bytes", None)
@@ -63,10 +66,15 @@ def run_campaign(path: str | Path, out: str | Path, engine: Engine | None = None
             journal.append(row)
             outcome.rows.append(row)
             progress.update(row)
+            ran += 1
     except KeyboardInterrupt:
         outcome.interrupted = True
+    except SchedulerLost as exc:  # what finished is written and the journal kept: the same command resumes (B76)
+        outcome.interrupted = True
+        outcome.lost = str(exc)
     finally:
         progress.close()
+        outcome.unrun = len(todo) - ran
     outcome.rows = [r for r in outcome.rows if r["input_hash"] in wanted]
     outcome.results = out / RESULTS
     write_atomic(to_table(outcome.rows), outcome.results)

@@ -7,6 +7,7 @@ import argparse
 import sys
 
 EXIT_OK, EXIT_FAIL, EXIT_USAGE = 0, 1, 2
+EXIT_CLUSTER = 3  # the cluster's scheduler went away mid-campaign: resumable, nothing judged for the rest (B76)
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -81,6 +82,11 @@ def cmd_campaign(args: argparse.Namespace) -> int:
         print(f"  … and {len(bad) - 20} more (see results.parquet)")
     print(f"results        {outcome.results}")
     print(f"summary        {outcome.results.parent / 'summary.html'}")
+    if outcome.lost:
+        done = total - outcome.skipped
+        print(f"hil campaign: {outcome.lost} after {done} of {done + outcome.unrun} cases; what finished is written: "
+              "run the same command again (with a scheduler) to resume", file=sys.stderr)
+        return EXIT_CLUSTER
     if outcome.interrupted:
         print("hil campaign: interrupted; run the same command again to resume", file=sys.stderr)
         return 130
