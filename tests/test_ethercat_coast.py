@@ -80,3 +80,14 @@ def test_a_slave_still_in_op_is_the_masters_not_coasted():
     d.state, d.velocity = State.OPERATION_ENABLED, 2.0e6
     chain.tick()
     assert d.state is State.OPERATION_ENABLED and d.velocity == 2.0e6 and not log
+
+
+def test_a_drive_already_braking_when_the_line_went_silent_is_logged_from_its_speed_then():
+    """A master that read the slave after the trip had begun the fault reaction frame by frame; with the line
+    silent from then on, the log still gives the speed the drive braked from when the master went."""
+    chain, x, _, log = _silent_chain(2.0e6, dio_outputs=0)
+    d = x.app.drive
+    d.fault(0x7500)  # as a read with `lost` starts it
+    chain.tick()
+    assert d.state is State.FAULT
+    assert any(m.startswith("X: drive braked from 2000000 counts/s to standstill") for m in log), log

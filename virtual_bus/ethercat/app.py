@@ -149,8 +149,9 @@ class DriveApp(SlaveApp):
         """No master: the communication fault reaction (as in `cycle` with `lost`) runs on in the drive's own
         time, so it brakes on the quick-stop ramp to standstill and drops its power stage (FAULT)."""
         d = self.drive
+        if self._coast_t == 0.0:  # the first step with no master (the reaction may have begun on a read already)
+            self._coast_v = d.velocity
         if d.state is not State.FAULT_REACTION_ACTIVE:
-            self._coast_t, self._coast_v = 0.0, d.velocity
             d.fault(COMM_FAULT)
         d.step(dt)
         self._coast_t += dt
@@ -158,6 +159,7 @@ class DriveApp(SlaveApp):
             return None
         how = (f"braked from {self._coast_v:.0f} counts/s to standstill in {self._coast_t:.3f} s"
                if abs(self._coast_v) >= 1.0 else "at standstill")
+        self._coast_t = 0.0  # (a next loss of its master is logged afresh)
         return (f"drive {how} on its communication fault reaction, at {round(d.position)} counts; "
                 f"FAULT 0x{d.error_code:04X}, power stage off")
 
