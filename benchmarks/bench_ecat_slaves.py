@@ -83,15 +83,13 @@ def cycle_frames(chain, frames: int) -> float:
 
 
 def model_share(chain, frames: int) -> float:
-    """CPU seconds of the drive models alone over `frames` cycles (each drive's `apply`, `step` and
-    `feedback` on its last outputs), the part of a frame that is virtual_bus/drive.py, not the ESC."""
+    """CPU seconds of the drive models alone over `frames` cycles (each drive's `exchange` on its last
+    outputs, as a frame makes it), the part of a frame that is virtual_bus/drive.py, not the ESC."""
     drives = [(s.app.drive, s.app.drive._rx, s.cycle_time) for s in chain.slaves]
     c0 = time.thread_time()
     for _ in range(frames):
         for d, rx, dt in drives:
-            d.apply(rx)
-            d.step(dt)
-            d.feedback()
+            d.exchange(rx, dt)
     return time.thread_time() - c0
 
 

@@ -97,7 +97,10 @@ class DriveApp(SlaveApp):
             raise SdoAbort(exc.code) from None
 
     def _publish(self) -> None:
-        for e, v in zip(self._tx_entries, self._tx_values(self.drive.feedback())):
+        self._publish_fb(self.drive.feedback())
+
+    def _publish_fb(self, fb: TxPdo) -> None:
+        for e, v in zip(self._tx_entries, self._tx_values(fb)):
             e.value = int(v)
 
     def refresh(self, index: int) -> None:
@@ -131,11 +134,17 @@ class DriveApp(SlaveApp):
             else:
                 self._images.get(rx_map, tx_map, od).unpack(outputs, rx_map, od)
                 rx = self._rx_from_od()
-            if self.drive.mode == CST and 0x60E0 in od.objects:  # torque limits may travel in 0x1603
-                self.drive.modes.objects.positive_torque_limit = od.value(0x60E0)
-                self.drive.modes.objects.negative_torque_limit = od.value(0x60E1)
-            self.drive.apply(rx)
-            self.drive.step(dt)
+            drive = self.drive
+            if drive.mode == CST and 0x60E0 in od.objects:  # torque limits may travel in 0x1603
+                drive.modes.objects.positive_torque_limit = od.value(0x60E0)
+                drive.modes.objects.negative_torque_limit = od.value(0x60E1)
+            # apply, step and feedback in one call: the drive's fused path of an enabled CSP / CSV cycle
+            # (the one CANopen's SYNC takes), the three calls otherwise (issue 17)
+            fb = drive.exchange(rx, dt)
+            if codec is not None:
+                return codec.write_tx(fb)
+            self._publish_fb(fb)
+            return self._images.get(rx_map, tx_map, od).pack(tx_map, od)
         if codec is not None:
             return codec.write_tx(self.drive.feedback())
         self._publish()
