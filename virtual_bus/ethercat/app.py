@@ -120,35 +120,43 @@ class DriveApp(SlaveApp):
               lost: bool = False) -> bytes:
         od = self.od
         assert od is not None
-        codec = self._codec_for(rx_map, tx_map, od)
-        if step and lost:
-            # Out of OP by an error (SM watchdog, sync, AL error): the outputs are not valid any more.
-            # The drive takes its communication fault reaction (CiA 402 0x6007 = 2: fault, braking on
-            # the quick-stop ramp) and its time runs on, so the master still sees it brake.
-            if self.drive.state in (State.OPERATION_ENABLED, State.QUICK_STOP_ACTIVE):
-                self.drive.fault(COMM_FAULT)  # a drive that was not powering its motor has nothing to stop
-            self.drive.step(dt)
-        elif step:
+        codec, maps = self._codec, self._codec_maps
+        if maps[0] is not rx_map or maps[1] is not tx_map:
+            codec = self._codec_for(rx_map, tx_map, od)
+        drive = self.drive
+        if step and not lost:
             if codec is not None:  # the usual frame: outputs into their objects and the RxPdo in one call
-                rx = codec.read_rx(outputs, self.drive.mode)
+                rx = codec.read_rx(outputs, drive.mode)
             else:
                 self._images.get(rx_map, tx_map, od).unpack(outputs, rx_map, od)
                 rx = self._rx_from_od()
-            drive = self.drive
-            if drive.mode == CST and 0x60E0 in od.objects:  # torque limits may travel in 0x1603
-                drive.modes.objects.positive_torque_limit = od.value(0x60E0)
-                drive.modes.objects.negative_torque_limit = od.value(0x60E1)
+            if drive.mode == CST:
+                self._torque_limits()
             # apply, step and feedback in one call: the drive's fused path of an enabled CSP / CSV cycle
             # (the one CANopen's SYNC takes), the three calls otherwise (issue 17)
             fb = drive.exchange(rx, dt)
             if codec is not None:
                 return codec.write_tx(fb)
-            self._publish_fb(fb)
-            return self._images.get(rx_map, tx_map, od).pack(tx_map, od)
-        if codec is not None:
-            return codec.write_tx(self.drive.feedback())
-        self._publish()
+        else:
+            if step:
+                # Out of OP by an error (SM watchdog, sync, AL error): the outputs are not valid any more.
+                # The drive takes its communication fault reaction (CiA 402 0x6007 = 2: fault, braking on
+                # the quick-stop ramp) and its time runs on, so the master still sees it brake.
+                if drive.state in (State.OPERATION_ENABLED, State.QUICK_STOP_ACTIVE):
+                    drive.fault(COMM_FAULT)  # a drive that was not powering its motor has nothing to stop
+                drive.step(dt)
+            fb = drive.feedback()
+            if codec is not None:
+                return codec.write_tx(fb)
+        self._publish_fb(fb)
         return self._images.get(rx_map, tx_map, od).pack(tx_map, od)
+
+    def _torque_limits(self) -> None:
+        """CST: the torque limits may travel in 0x1603; the drive takes them from their objects."""
+        od = self.od
+        if od is not None and 0x60E0 in od.objects:
+            self.drive.modes.objects.positive_torque_limit = od.value(0x60E0)
+            self.drive.modes.objects.negative_torque_limit = od.value(0x60E1)
 
     @property
     def coasting(self) -> bool:

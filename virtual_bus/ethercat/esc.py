@@ -260,6 +260,25 @@ class Esc:
         if hit(R_SM + 6, 1) or hit(R_SM + 8 + 6, 1):
             self._mailbox_repeat()
 
+    def fixed_address(self, adp: int) -> bool:
+        """Whether a configured-address datagram (FPxx, FRMW) is this slave's: its station address, or its
+        alias where DL control 0x0103 bit 0 enables alias addressing."""
+        mem = self.mem
+        return adp == _U16.unpack_from(mem, R_STATION)[0] or (bool(mem[0x0103] & 0x01) and adp == _U16.unpack_from(mem, R_ALIAS)[0])
+
+    def frmw(self, adp: int, ado: int, data: bytearray | memoryview) -> int:
+        """FRMW, in every process-data frame of a DC master: the addressed slave (the reference clock) reads,
+        every other one takes the value as the system time (or a plain write elsewhere). Returns the WKC
+        increment, as the line's generic datagram handling counts it."""
+        if self.fixed_address(adp):
+            got = self.read(ado, len(data))
+            if got is None:
+                return 0
+            data[:] = got
+        else:
+            self.dc_write(ado, bytes(data))
+        return 0 if self.wkc_fault else 1
+
     def dc_write(self, addr: int, data: bytes) -> None:
         """System-time write from ARMW/FRMW (not a plain register write)."""
         if addr == R_DC_SYSTIME and len(data) in (4, 8):
@@ -417,7 +436,7 @@ class Esc:
             self.last_cycle_ns = now
             self.last_output_ns = now
             self.outputs_written += 1
-            got = self.app.cycle(outputs, self.rx_map, self.tx_map, step=True, dt=dt)
+            got = self.app.cycle(outputs, self.rx_map, self.tx_map, True, dt)
             if got:
                 mem[inputs:inputs + len(got)] = got
         elif reads and state == SAFEOP:

@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 
 from virtual_bus.ethercat.esc import Esc
 from virtual_bus.ethercat.registers import (APRD, APRW, APWR, ARMW, BRD, BRW, BWR, FPRD, FPRW, FPWR, FRMW, LRD, LRW,
-                                            LWR, R_AL_CODE, R_STATION)
+                                            LWR, R_AL_CODE)
 from virtual_bus.ethercat.faults import Fault
 
 ETH_P_ECAT = 0x88A4
@@ -132,6 +132,8 @@ class Chain:
             for k, (pos, cmd, logical, _wpos, data) in enumerate(grams):
                 if LRD <= cmd <= LRW:
                     inc = s.logical(cmd, logical, data)  # the address is not changed on the way
+                elif cmd == FRMW:  # the DC time every cycle's frame carries; a fixed address is not changed either
+                    inc = s.frmw(logical & 0xFFFF, logical >> 16, data)
                 else:
                     adp = _U16.unpack_from(buf, pos + 2)[0]  # auto-increment addresses count down on the way
                     inc, new_adp = self._datagram(s, cmd, adp, logical >> 16, data)
@@ -150,8 +152,7 @@ class Chain:
     def _datagram(s: Esc, cmd: int, adp: int, ado: int, data: memoryview) -> tuple[int, int]:
         n = len(data)
         if cmd in _FIXED:  # first: the FRMW that distributes DC time rides in every cycle's frame
-            addressed = adp == _U16.unpack_from(s.mem, R_STATION)[0] \
-                or (bool(s.mem[0x0103] & 0x01) and adp == s.u16(0x0012))
+            addressed = s.fixed_address(adp)
             new_adp = adp
         elif cmd in (APRD, APWR, APRW, ARMW):
             addressed = adp == 0
