@@ -117,7 +117,7 @@ class DriveCodec:
         rx, tx = PdoImage.compile(rx_map, od), PdoImage.compile(tx_map, od)
         if rx is None or tx is None:
             return None
-        scope: dict = {"RxPdo": RxPdo, "_unpack": rx.reader.unpack_from, "_pack": tx.writer.pack, "_int": _int}
+        scope: dict = {"RxPdo": RxPdo, "_unpack": rx.reader.unpack_from, "_pack": tx.writer.pack}
         # outputs: v<k> is the k-th mapped value, stored in its entry; a field takes the last value mapped to it
         lines = ["def read_rx(data, mode):"]
         names = [f"v{k}" for k in range(len(rx.entries))]
@@ -133,7 +133,7 @@ class DriveCodec:
             obj = od.objects.get(index)
             if attr not in fields and obj is not None and sub in obj.entries:
                 scope[f"u{k}"] = obj.entries[sub]
-                fields[attr] = f"_int(u{k}.value)"
+                fields[attr] = f"(x if isinstance(x := u{k}.value, int) else 0)"  # ObjectDictionary.value's rule
         fields.setdefault("mode", "mode")
         lines.append("    return RxPdo(" + ", ".join(f"{a}={x}" for a, x in fields.items()) + ")")
         # inputs: every TxPdo field the dictionary has goes to its entry; the mapped ones are packed masked
@@ -152,7 +152,3 @@ class DriveCodec:
         lines.append(f"    return _pack({', '.join(packed)})")
         exec(compile("\n".join(lines) + "\n", "<drive codec>", "exec"), scope)
         return cls(scope["read_rx"], scope["write_tx"])
-
-
-def _int(v) -> int:
-    return v if isinstance(v, int) else 0  # ObjectDictionary.value's rule
