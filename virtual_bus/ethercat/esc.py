@@ -212,8 +212,11 @@ class Esc:
     def read(self, addr: int, n: int) -> bytes | None:
         end = addr + n
         if addr < R_DC_SYSTIME + 8 and end > R_DC_SYSTIME:
-            _U64.pack_into(self.mem, R_DC_SYSTIME, self.system_ns(self.frame_ns + self.position * HOP_NS))
-        mi = self.sm(1)
+            # the DC reference's system time, read by every cycle's FRMW: system_ns at the frame's arrival, inlined
+            mem = self.mem
+            local = self.local_ns(self.frame_ns + self.position * HOP_NS)
+            _U64.pack_into(mem, R_DC_SYSTIME, (local + _U64.unpack_from(mem, R_DC_OFFSET)[0]) & 0xFFFFFFFFFFFFFFFF)
+        mi = self._sms.get(1) or self.sm(1)
         if mi.enabled and mi.length and addr < mi.end and end > mi.start:
             if not self.mbx_full:
                 return None  # an empty read mailbox does not answer (no WKC)
@@ -475,9 +478,9 @@ class Esc:
         return self._wd_ns
 
     def check_watchdog(self, now_ns: int) -> None:
-        if self.mem[R_AL_STATUS] & 0x0F != OP or not self.rx_map or not self.sm(2).control & 0x40:
+        if self.mem[R_AL_STATUS] & 0x0F != OP or not self.rx_map or not (self._sms.get(2) or self.sm(2)).control & 0x40:
             return
-        wd = self.watchdog_ns()
+        wd = self._wd_ns if self._wd_ns is not None else self.watchdog_ns()  # decoded once (every slave, every frame)
         if wd and now_ns - self.last_output_ns > wd:
             struct.pack_into("<H", self.mem, R_WD_STATUS, 0)
             self.al_error(AL_SM_WATCHDOG, SAFEOP, f": no process data for {wd / 1e6:g} ms")
