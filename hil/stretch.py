@@ -62,10 +62,11 @@ from virtual_bus.drive_stretch import Stretch, can_stretch, csp_stretch, csv_str
 ENV = "DELTAHIL_STRETCH"  # "0": every cycle is stepped (the reference the tests compare against)
 ENV_READS = "DELTAHIL_STRETCH_READS"  # "0": no feeds or solves inside stretches (B25's, benchmarks compare)
 MAX_CYCLES = 64  # the planner's buffers are up to 64 cycles: a stretch never spans two
-# A stretch whose NC steps inside it (B27) refills the planner itself, so the buffer does not bound it: up to
-# PASS_CYCLES (decision B68: each start and end costs ≈ 0.3 ms and often a stepped cycle after it; a stop signal
-# waits for the stretch's end, ≤ 256 ms simulated, ≈ 30 ms of CPU on a CAM program)
-PASS_CYCLES = 256
+# A stretch whose NC steps inside it (B27) refills the planner itself, so the buffer does not bound it: PASS_CYCLES,
+# then on to the first cycle whose feed reads nothing, at most PASS_OVER more (decision B68: a start and an end cost
+# ≈ 0.3 ms, and a stretch cannot start at a reading cycle: one ending before it left it and the next ones stepped;
+# a stop signal waits for the stretch's end, ≤ 0.3 s simulated, ≈ 30 ms of CPU on a CAM program)
+PASS_CYCLES, PASS_OVER = 256, 32
 # Real time (decision B21): a stretch's planner samples and drive models are computed in the slack of the period
 # before its first cycle, so that work must fit there; RT_CYCLES cycles of it cost ≈ 0.2 ms on the lathe demo
 RT_CYCLES = 16
@@ -221,7 +222,8 @@ class Stretcher(RealTimeStretches):
 
     def _run_pass(self, r: Any, ch: Channel, pl: Planner, limit: int) -> bool:
         """A stretch whose NC steps inside it (B27, hil/stretch_pass.py), played at once."""
-        n = first_change(r, ch, [], 0, min(limit, PASS_CYCLES), [])  # the basic MLC: an AuxWatch warning due
+        # (the basic MLC: an AuxWatch warning due)
+        n = first_change(r, ch, [], 0, min(limit, PASS_CYCLES + PASS_OVER), [])
         if n < 2:
             return False
         self._fed0, ch._fed = ch._fed, False  # a feed a stretch before ran for this first cycle (B26)
@@ -229,7 +231,7 @@ class Stretcher(RealTimeStretches):
         saved_pl = _save_nc(pl)
         rx0 = [copy.copy(rx) for rx in r.rx]  # what the drives are stepped with (the runner's change per cycle)
         saved_drives = [dict(d.__dict__) for d in self.drives]
-        ps = Pass(self, ch, pl, rx0, saved_drives)
+        ps = Pass(self, ch, pl, rx0, saved_drives, PASS_CYCLES)
         m = ps.run(n)
         self.feeds += ps.feeds
         if m < 2:  # (no feed ran: feeds come from the third cycle on)

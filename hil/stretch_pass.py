@@ -80,8 +80,12 @@ def _steps(ch: Channel, pl: Planner, limit: int, reads: bool) -> tuple[np.ndarra
 class Pass:
     """The NC pass of one stretch and its drive models, a part at a time (module doc)."""
 
-    def __init__(self, st: Any, ch: Channel, pl: Planner, rx0: list, saved_drives: list[dict]) -> None:
+    def __init__(self, st: Any, ch: Channel, pl: Planner, rx0: list, saved_drives: list[dict],
+                 soft: int | None = None) -> None:
         self.st, self.ch, self.pl = st, ch, pl
+        # from `soft` cycles on, the stretch ends before the first cycle whose feed reads nothing (decision B68: the
+        # next stretch can start there; one cannot start at a reading cycle)
+        self.soft = soft
         self.rx0, self.saved_drives = rx0, saved_drives
         self.parts: list[Samples] = []  # (their positions: the raw rows; the filtered ones are out_rows)
         self.out_rows: list[list[float]] = []  # the filtered rows, `filtered` of them
@@ -105,12 +109,12 @@ class Pass:
 
     def run(self, n: int) -> int:
         """The stretch's cycles, at most n: how many (the planner after that many steps, `outs` over them)."""
-        m = self._run(n)
+        m = self._run(n, n if self.soft is None else self.soft)
         for run in self.runs or ():
             run.finish()
         return m
 
-    def _run(self, n: int) -> int:
+    def _run(self, n: int, soft: int) -> int:
         ch, pl = self.ch, self.pl
         src = ahead(ch)
         fed_at = -1
@@ -118,6 +122,8 @@ class Pass:
         # next _group makes before its step (the same state: a feed's drive check flushed the filter), not one more
         self._mark = [0, None, 0]
         while self.rows < n:
+            if self.rows >= soft and not (self.reads and _feed_due(pl)):
+                break
             if self.rows and self.reads and _feed_due(pl):  # this cycle's feed reads: the drives up to it first
                 stop = self._drive(self.rows + 1)
                 if stop is not None:

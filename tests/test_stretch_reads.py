@@ -139,3 +139,30 @@ def test_blends_arcs_and_exact_stops_inside_passes_equal_stepping(monkeypatch, t
     assert compare(out[0], out[1]) == []
     assert stretched.run.ok and counts["passes"] > 0
     assert stretched.run.stretched > 0.9 * stretched.run.cycles, (stretched.run.stretched, stretched.run.cycles)
+
+
+def test_long_passes_end_before_a_cycle_that_reads_nothing(monkeypatch, tmp_path):
+    """Decision B68: a stretch that runs the NC's steps is not bound by the planner's 64-cycle buffer. Past
+    PASS_CYCLES it goes on to the first cycle whose feed reads nothing, at most PASS_OVER more, so the next
+    stretch can start there (none starts at a reading cycle). Small values here, for many ends in a short run: the
+    trace is stepping's, and no pass that ended past PASS_CYCLES before its limit left a cycle whose feed reads."""
+    import hil.stretch
+
+    monkeypatch.setattr(hil.stretch, "PASS_CYCLES", 40)
+    monkeypatch.setattr(hil.stretch, "PASS_OVER", 8)
+    ends = []
+    real = hil.stretch_pass.Pass.run
+
+    def ended(self, n):
+        m = real(self, n)
+        ends.append((n, m, hil.stretch_pass._feed_due(self.pl) and hil.stretch_pass.may_read(self.ch, self.pl)))
+        return m
+
+    monkeypatch.setattr(hil.stretch_pass.Pass, "run", ended)
+    out, (stepped, stretched), _ = _both(monkeypatch, tmp_path, cam_program(1500))
+    assert compare(out[0], out[1]) == []
+    assert stepped.run.stretched == 0 and stretched.run.ok
+    assert ends and all(n <= 48 for n, _, _ in ends)
+    past = [(m, reads) for n, m, reads in ends if 40 <= m < n]  # ended by the rule (or by the program's end)
+    assert len(past) > 10 and not any(reads for _, reads in past), past
+    assert any(m > 40 for m, _ in past)  # some went on past PASS_CYCLES through reading cycles
