@@ -101,6 +101,8 @@ def one(program: str, kw: dict, trace: Path, keep: list | None = None) -> tuple:
     for m in meta.values():
         if isinstance(m, dict):
             m.pop("written", None)  # the wall-clock date of the file
+            if isinstance(m.get("program_file"), dict):  # (decision B75) its path: the CAM runs' program is written
+                m["program_file"].pop("path", None)  # to a new temporary folder each time; its SHA-256 is compared
     summary = (r.run.cycles, [a.code_text for a in r.alarms], r.run.final, r.run.finished, handshakes, meta)
     return cols, summary
 
