@@ -191,7 +191,6 @@ def run(program: str | Path, bench: str | Path | Bench | None = None, *, bus: st
     from hil.placement import lockstep_clock
     from hil.progress import Progress
     from hil.remote_io import attach_remote_io
-    from hil.run_events import EventPlayer, EventSpecError, parse_events
     from hil.runner import BenchRunner, RunResult
     from hil.scripting import mlc_setup
     from hil.session import InputError, load_program, make_link
@@ -238,6 +237,8 @@ def run(program: str | Path, bench: str | Path | Bench | None = None, *, bus: st
     attach_remote_io(b, m, link)
     player = None
     if wants_events:
+        from hil.run_events import EventPlayer, EventSpecError, parse_events  # here: a run without events needs none
+
         if not hasattr(m, "mem"):
             raise InputError("--at/--events write MLC devices: they need a Delta MLC, not --mlc basic")
         try:

@@ -4,6 +4,7 @@ show; plain functions the `hil.stretch.Stretcher` and its real-time part share."
 
 from __future__ import annotations
 
+import sys
 from collections import deque
 from collections.abc import Callable
 from typing import Any
@@ -29,15 +30,20 @@ def _signature(ch: Channel) -> tuple:
             ch.css_rpm, ch.spindle_max)
 
 
-_HOOKS: list = []  # (EventPlayer, OperatorPanel), imported at the first call (they import the runner)
+class _NoPlayer:
+    """Stands for `EventPlayer` while hil.run_events is not imported: hil.api.run imports it for --at/--events only."""
+
+
+_HOOKS: list = []  # [EventPlayer, OperatorPanel], looked up once, not imported a call (they import the runner; B36)
 
 
 def _hooks() -> list:
     if not _HOOKS:
-        from hil.run_events import EventPlayer
         from hil.scripting import OperatorPanel
 
-        _HOOKS[:] = [EventPlayer, OperatorPanel]
+        _HOOKS[:] = [_NoPlayer, OperatorPanel]
+    if _HOOKS[0] is _NoPlayer and "hil.run_events" in sys.modules:  # an EventPlayer can exist from now on
+        _HOOKS[0] = sys.modules["hil.run_events"].EventPlayer
     return _HOOKS
 
 
@@ -45,7 +51,7 @@ def _panel_state(on_cycle: Any) -> tuple | None:
     """The on_cycle hook's state while it writes nothing (None: a hook a stretch cannot see into)."""
     if on_cycle is None:
         return ()
-    EventPlayer, OperatorPanel = _HOOKS or _hooks()
+    EventPlayer, OperatorPanel = _hooks()
     if isinstance(on_cycle, OperatorPanel):
         return None if on_cycle._pressed else (False,)
     if isinstance(on_cycle, EventPlayer):
@@ -59,7 +65,7 @@ def _panel_state(on_cycle: Any) -> tuple | None:
 def _event_due(r: Any) -> bool:
     """An `--at` event fired at the end of the last cycle: the scan of this one sees its write."""
     oc = r.on_cycle  # (the class looked up once, not imported a call: ≈ 15 µs of a real-time start, B36)
-    return oc is not None and isinstance(oc, (_HOOKS or _hooks())[0]) and any(e.fired_cycle == r.cycle + 1 for e in oc.events)
+    return oc is not None and isinstance(oc, _hooks()[0]) and any(e.fired_cycle == r.cycle + 1 for e in oc.events)
 
 
 def _across(ch: Channel, pl: Planner, n: int) -> int:

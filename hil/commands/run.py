@@ -159,8 +159,6 @@ def _run_and_print(args: argparse.Namespace, scope) -> int:
 
 def print_run(program: str, r, out) -> None:
     """The text summary of a run, as `hil run` prints it."""
-    from hil.run_events import EventPlayer
-
     print_summary(program, r.bench, r.run, out)
     for w in r.warnings:  # M/S/T codes the MLC left waiting (hil/aux_watch.py)
         print(w.text, file=out)
@@ -169,7 +167,9 @@ def print_run(program: str, r, out) -> None:
     if waits:  # threads armed only once the spindle settled at its command (motion decisions 33)
         print("spindle settle " + "  ".join(f"line {ln} {w * r.bench.cycle * 1000:g} ms" for ln, w in waits)
               + " before the thread", file=out)
-    player = runner.on_cycle if isinstance(runner.on_cycle, EventPlayer) else None
+    # an EventPlayer exists only if hil.api.run imported hil.run_events, for --at/--events (not imported otherwise)
+    events = sys.modules.get("hil.run_events")
+    player = runner.on_cycle if events is not None and isinstance(runner.on_cycle, events.EventPlayer) else None
     if player is not None:
         print("\n".join(player.summary()), file=out)
     print_timing(r.run, out)
