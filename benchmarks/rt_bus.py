@@ -2,6 +2,7 @@
 virtual slaves in another process, printing the summary's cycle work split into bus wait and master work.
 
     sudo python benchmarks/rt_bus.py [--rounds N] [--only ethercat|canopen] [--lockstep] [--tree DIR]
+                                     [--program lathe|cam] [--blocks N] [--tag NAME]
 
 - ethercat: the guide's bench (docs/guide/ethercat-virtual.md): `hil sim ethercat` on a fresh veth pair per run
   (fresh slaves: each run from power-on), `hil run --realtime --trace` at 1 ms;
@@ -9,7 +10,9 @@ virtual slaves in another process, printing the summary's cycle work split into 
 - --lockstep: the EtherCAT run without --realtime as well (cycles/s by the wall, master work).
 Each run is its own `hil run` process (mlockall and SCHED_FIFO stay in it), whose CPU time and voluntary context
 switches (all its threads: python-can's receive thread too) are printed per cycle. `--tree DIR`: run another
-checkout's `hil` (before/after pairs). Needs root; measures, never asserts.
+checkout's `hil` (before/after pairs). `--program cam`: benchmarks/bench_motion.py's CAM program (`--blocks`, 1,500)
+on benches/mill-3axis.toml (the basic MLC) instead of the lathe demo. `--tag`: in the network namespaces' names (a
+helper's name: its own to remove). Needs root; measures, never asserts.
 """
 
 from __future__ import annotations
@@ -31,6 +34,7 @@ from virtual_bus.ethercat.veth import SimProcess  # noqa: E402
 
 BENCH = ROOT / "benches" / "lathe-2axis.toml"
 PROGRAM = ROOT / "examples" / "lathe_demo.nc"
+TAG = "rtb"
 TREE = ROOT  # the checkout whose `hil` runs (--tree)
 # `hil run` with its own rusage printed at the end (CPU of all its threads, voluntary context switches)
 WRAP = ("import resource, sys\nfrom hil.cli import main\ntry:\n    main(sys.argv[1:])\nfinally:\n"
@@ -40,7 +44,8 @@ KEYS = ("cycles", "result", "cycle work", "bus wait", "master work", "between cy
 
 
 def _hil(prefix: list[str], bus: str, bench: Path, realtime: bool, trace: Path) -> tuple[dict[str, str], float]:
-    cmd = [*prefix, sys.executable, "-c", WRAP, "run", str(TREE / "examples" / PROGRAM.name), "--bench", str(bench),
+    prog = PROGRAM if PROGRAM.parent != ROOT / "examples" else TREE / "examples" / PROGRAM.name
+    cmd = [*prefix, sys.executable, "-c", WRAP, "run", str(prog), "--bench", str(bench),
            "--bus", bus, "--no-check", "--trace", str(trace)] + (["--realtime"] if realtime else [])
     t0 = time.perf_counter()
     p = subprocess.run(cmd, capture_output=True, text=True, cwd=TREE, env=dict(os.environ, PYTHONPATH=str(TREE)))
@@ -62,7 +67,7 @@ def _p(text: str, key: str) -> float:
 def ethercat(rounds: int, lockstep: bool, tmp: Path) -> None:
     for i in range(rounds):
         for realtime in ((True, False) if lockstep else (True,)):
-            with SimProcess("--bench", str(BENCH), "--io", "1", tag="rtb") as sim:
+            with SimProcess("--bench", str(BENCH), "--io", "1", tag=TAG) as sim:
                 got, wall = _hil([], f"ethercat:{sim.iface}", BENCH, realtime, tmp / "ec.parquet")
             cycles = int(got["cycles"].split()[0]) if got["cycles"] else 0
             mode = "realtime" if realtime else f"lock-step {cycles / wall:,.0f} cycles/s by the process wall"
@@ -75,10 +80,11 @@ def _ip(*args: str) -> None:
 
 
 def canopen(rounds: int, tmp: Path) -> None:
-    bench = tmp / "lathe-4ms.toml"  # the CANopen guide's 4 ms bench
+    bench = tmp / f"{BENCH.stem}-4ms.toml"  # the CANopen guide's 4 ms bench
     bench.write_text(BENCH.read_text().replace("cycle_ms = 1.0", "cycle_ms = 4.0")
-                     .replace("max_following_error = { X = 0.1, Z = 0.1 }", "max_following_error = { X = 0.3, Z = 0.3 }"))
-    ns = f"rtb-co-{uuid.uuid4().hex[:6]}"
+                     .replace("max_following_error = { X = 0.1, Z = 0.1 }", "max_following_error = { X = 0.3, Z = 0.3 }")
+                     .replace("max_following_error = 0.1", "max_following_error = 0.3"))
+    ns = f"{TAG}-co-{uuid.uuid4().hex[:6]}"
     _ip("netns", "add", ns)
     try:
         for cmd in (("link", "set", "lo", "up"), ("link", "set", "lo", "multicast", "on"),
@@ -109,9 +115,18 @@ def main() -> int:
     ap.add_argument("--only", choices=("ethercat", "canopen"))
     ap.add_argument("--lockstep", action="store_true", help="EtherCAT lock-step runs too")
     ap.add_argument("--tree", type=Path, default=ROOT, help="the checkout whose hil runs (default: this one)")
+    ap.add_argument("--program", choices=("lathe", "cam"), default="lathe")
+    ap.add_argument("--blocks", type=int, default=1500, help="--program cam: its blocks")
+    ap.add_argument("--tag", default="rtb", help="in the network namespaces' names")
     a = ap.parse_args()
-    global TREE
-    TREE = a.tree.resolve()
+    global TREE, BENCH, PROGRAM, TAG
+    TREE, TAG = a.tree.resolve(), a.tag
+    tmpdir = tempfile.TemporaryDirectory()
+    if a.program == "cam":  # the CAM program on the mill bench (the basic MLC)
+        from benchmarks.bench_motion import cam_program
+        BENCH = ROOT / "benches" / "mill-3axis.toml"
+        PROGRAM = Path(tmpdir.name) / "cam.nc"
+        PROGRAM.write_text(cam_program(a.blocks) + "\n")
     if os.geteuid() != 0:
         print("rt_bus: needs root (network namespaces, veth pairs, raw sockets)", file=sys.stderr)
         return 2

@@ -29,6 +29,7 @@ from hil import retentive
 from hil.drive_homing import home_axes
 from hil.mlc_bridge import drive_status
 from hil import stretch_ahead
+from hil.bus_ahead import BusAhead
 from hil.stretch import Stretcher, ahead_wanted, wanted as stretch_wanted
 from hil.trace import TraceSource, TraceWriter, trace_columns
 from mlc.basic import BasicMlc
@@ -144,6 +145,7 @@ class BenchRunner:
         self._hooks: tuple | None = None  # (link, mlc, what they offer the cycle): asked once, see _cycle
         self._bus_ahead = False  # real time on the sim bus: a stepped cycle's exchange runs before its tick
         self._stretcher: Stretcher | None = None  # run_events' (hil/stretch.py), for _settle too (B38)
+        self._ahead: BusAhead | None = None  # real time on a field bus: work ahead in the slack (B60)
 
     def trace_columns(self) -> list[str]:
         extra = [c for src in self.trace_sources for c in src.columns]
@@ -272,6 +274,8 @@ class BenchRunner:
         give_up = max_cycles + int(STANDSTILL_TIMEOUT / self.bench.cycle)
         stopping = False
         stretcher = Stretcher.for_runner(self)  # quiet cycles a stretch at a time (issue 17, decision B20)
+        # real time on a field bus: the next cycle's refill and feed reads worked out in the slack (B60)
+        self._ahead = bus_ahead = BusAhead.for_runner(self) if stretcher is None else None
         self._stretcher = stretcher  # the settle after the program takes stretches too (B38)
         try:  # the time the program ran, also when a bus alarm ends it from inside a cycle
             while ch.busy and self.cycle < give_up:
@@ -289,6 +293,8 @@ class BenchRunner:
                     self._exchange(None, bus_ahead=False)
                 elif whole:  # the basic MLC: the cycle's whole channel step ahead, after its exchange (B46)
                     self._exchange(None, ahead=lambda tx: stretch_ahead.step_ahead(stretcher, tx))
+                elif bus_ahead is not None and not stopping:
+                    self._exchange(bus_ahead.step())
                 elif ahead is None:
                     self._exchange()
                 else:

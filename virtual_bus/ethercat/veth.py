@@ -21,8 +21,9 @@ class VethPair:
 
     @classmethod
     def create(cls, tag: str = "") -> "VethPair":
-        uid = (tag + secrets.token_hex(3))[:8]
-        pair = cls(f"dhil-{uid}", f"ecm{uid}", f"ecs{uid}")
+        hexid = secrets.token_hex(3)
+        uid = (tag + hexid)[:8] if len(tag) <= 3 else tag[:2] + hexid  # (interface names: 15 characters at most)
+        pair = cls(f"dhil-{tag}{hexid}", f"ecm{uid}", f"ecs{uid}")  # the namespace: the whole tag
         _ip("netns", "add", pair.netns)
         try:
             _ip("link", "add", pair.master_if, "type", "veth", "peer", "name", pair.slave_if)
