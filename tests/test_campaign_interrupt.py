@@ -75,3 +75,30 @@ def _group_left(pgid: int, within: float) -> list[str]:
         if not left or time.monotonic() > end:
             return left
         time.sleep(0.2)
+
+
+def test_a_ctrl_c_while_the_local_cluster_starts_is_held_not_lost(tmp_path):
+    """Decision B77: while the local cluster's workers are spawned the campaign ignores SIGINT, so that they inherit
+    SIG_IGN (B55); a Ctrl-C in that window (seconds on a loaded machine) was lost, and the campaign ran to its end.
+    Now it ends the campaign once the window closes, and a child spawned in the window still ignores it."""
+    script = tmp_path / "window.py"
+    script.write_text(
+        "import signal, subprocess, sys, time\n"
+        "from hil.campaign.engine import _sigint_ignored\n"
+        "try:\n"
+        "    with _sigint_ignored():\n"
+        "        child = subprocess.Popen([sys.executable, '-c', 'import signal; print(signal.getsignal(signal.SIGINT) == signal.SIG_IGN)'],"
+        " stdout=subprocess.PIPE, text=True)\n"
+        "        print('window', flush=True)\n"
+        "        time.sleep(3)\n"
+        "        print('child', child.communicate()[0].strip(), flush=True)\n"
+        "    print('lost', flush=True)\n"
+        "except KeyboardInterrupt:\n"
+        "    print('interrupted', flush=True)\n")
+    p = subprocess.Popen([sys.executable, str(script)], env=dict(os.environ, PYTHONPATH=str(ROOT)),
+                         stdout=subprocess.PIPE, text=True, start_new_session=True)
+    assert p.stdout.readline().strip() == "window"
+    time.sleep(0.5)  # (the witness is up)
+    os.killpg(p.pid, signal.SIGINT)  # the terminal's Ctrl-C, mid-start
+    out = p.communicate(timeout=60)[0].split()
+    assert out == ["child", "True", "interrupted"], out  # the child ignores it; this process was told

@@ -10,11 +10,12 @@ from __future__ import annotations
 
 import signal
 import socket
+import subprocess
 import sys
 import threading
 import time
 from collections.abc import Callable, Iterator, Sequence
-from contextlib import contextmanager
+from contextlib import closing, contextmanager
 from dataclasses import dataclass
 from typing import Any
 
@@ -45,59 +46,63 @@ def run_cases(cases: Sequence[CaseInputs], engine: Engine) -> Iterator[dict[str,
 
 def _dask(cases: Sequence[CaseInputs], engine: Engine) -> Iterator[dict[str, Any]]:
     import dask
-    from distributed import Client, LocalCluster, as_completed
-    from distributed.client import FutureCancelledError
+    from distributed import LocalCluster
 
     with dask.config.set({"distributed.scheduler.allowed-failures": engine.retries - 1,
                           "distributed.worker.daemon": False,  # a worker may start its own processes
                           "distributed.admin.system-monitor.gil.enabled": False}):
         cluster = None
-        if engine.scheduler is None:
-            import os
-
-            n = engine.workers or os.cpu_count() or 1
-            # Ctrl-C reaches the whole foreground process group: the worker processes must leave it to
-            # this one (which stops the cluster and writes what finished), not die with a traceback
-            # each (bench B55). They are spawned ignoring SIGINT (SIG_IGN survives exec; Python and
-            # asyncio then keep it), and _QuietWorker keeps a restarted worker the same.
-            with _sigint_ignored():
-                cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
-                                       host="127.0.0.1", silence_logs=50)
-        client = Client(cluster if cluster is not None else engine.scheduler, timeout="30s")
-        quiet = _quiet_client()  # a lost scheduler is the campaign's to report, not tracebacks from distributed
-        quiet.__enter__()
         try:
-            if cluster is not None:
-                client.register_plugin(_quiet_worker(), name="hil-sigint-ignored")
-            # The scheduler decides when a case has lost too many workers; on a cluster that is not
-            # ours it has its own setting, so the campaign's `retries` is set there too.
-            client.run_on_scheduler(_allow_failures, engine.retries - 1)
-            by_key = {}
-            futures = []
-            for c in cases:
-                # pure=False: a rerun is a new computation, never a cached result
-                f = client.submit(run_case, c, key=f"case-{c.input_hash}-{time.monotonic_ns()}", pure=False)
-                by_key[f.key] = c
-                futures.append(f)
-            for f in as_completed(futures):
-                case = by_key[f.key]
-                try:
-                    row = f.result()
-                except (FutureCancelledError, Exception) as exc:  # KilledWorker after `retries` lost workers
-                    if _scheduler_gone(client, exc):
-                        where = engine.scheduler or "of the local cluster"
-                        raise SchedulerLost(f"lost the connection to the scheduler {where}") from None
-                    row = lost_row(case, f"{type(exc).__name__}: {exc}", engine.retries)
-                finally:
-                    f.release()
-                yield row
+            if engine.scheduler is None:
+                import os
+
+                n = engine.workers or os.cpu_count() or 1
+                # Ctrl-C reaches the whole foreground process group: the worker processes must leave it to
+                # this one (which stops the cluster and writes what finished), not die with a traceback
+                # each (bench B55). They are spawned ignoring SIGINT (SIG_IGN survives exec; Python and
+                # asyncio then keep it), and _QuietWorker keeps a restarted worker the same. A Ctrl-C while
+                # they start is held, not lost (B77): it ends the campaign once the cluster is there to close.
+                with _sigint_ignored():
+                    cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                                           dashboard_address=None, host="127.0.0.1", silence_logs=50)
+            yield from _on_cluster(cases, engine, cluster)
         finally:
+            if cluster is not None:
+                cluster.close()
+
+
+def _on_cluster(cases: Sequence[CaseInputs], engine: Engine, cluster: Any) -> Iterator[dict[str, Any]]:
+    """The cases on a cluster (ours, or the one at engine.scheduler), rows as they finish."""
+    from distributed import Client, as_completed
+    from distributed.client import FutureCancelledError
+
+    client = Client(cluster if cluster is not None else engine.scheduler, timeout="30s")
+    # a lost scheduler is the campaign's to report, not tracebacks from distributed's client
+    with _quiet_client(), closing(client):
+        if cluster is not None:
+            client.register_plugin(_quiet_worker(), name="hil-sigint-ignored")
+        # The scheduler decides when a case has lost too many workers; on a cluster that is not
+        # ours it has its own setting, so the campaign's `retries` is set there too.
+        client.run_on_scheduler(_allow_failures, engine.retries - 1)
+        by_key = {}
+        futures = []
+        for c in cases:
+            # pure=False: a rerun is a new computation, never a cached result
+            f = client.submit(run_case, c, key=f"case-{c.input_hash}-{time.monotonic_ns()}", pure=False)
+            by_key[f.key] = c
+            futures.append(f)
+        for f in as_completed(futures):
+            case = by_key[f.key]
             try:
-                client.close()
-                if cluster is not None:
-                    cluster.close()
+                row = f.result()
+            except (FutureCancelledError, Exception) as exc:  # KilledWorker after `retries` lost workers
+                if _scheduler_gone(client, exc):
+                    where = engine.scheduler or "of the local cluster"
+                    raise SchedulerLost(f"lost the connection to the scheduler {where}") from None
+                row = lost_row(case, f"{type(exc).__name__}: {exc}", engine.retries)
             finally:
-                quiet.__exit__(None, None, None)
+                f.release()
+            yield row
 
 
 def _scheduler_gone(client: Any, exc: BaseException) -> bool:
@@ -119,16 +124,31 @@ def _quiet_client() -> Iterator[None]:
         log.setLevel(level)
 
 
+# the witness of a Ctrl-C while the local cluster starts (_sigint_ignored): SIGINT's default action ends it
+WITNESS = "import signal, time; signal.signal(signal.SIGINT, signal.SIG_DFL); time.sleep(3600)"
+
+
 @contextmanager
 def _sigint_ignored() -> Iterator[None]:
     if threading.current_thread() is not threading.main_thread():
         yield  # only the main thread sets handlers (a campaign run from a library thread)
         return
+    # The Ctrl-C is the whole process group's: this process ignores it here so that the workers it spawns inherit
+    # SIG_IGN (B55). A child started first, which does not ignore it, is the witness of one that came meanwhile:
+    # it dies by it, and the Ctrl-C is raised here once the window closes instead of being lost (B77).
+    witness = subprocess.Popen([sys.executable, "-c", WITNESS], stdin=subprocess.DEVNULL,
+                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     old = signal.signal(signal.SIGINT, signal.SIG_IGN)
     try:
         yield
     finally:
         signal.signal(signal.SIGINT, old)
+        came = witness.poll() is not None
+        if not came:
+            witness.kill()
+        witness.wait()
+    if came:
+        raise KeyboardInterrupt
 
 
 def _quiet_worker() -> Any:
