@@ -65,6 +65,8 @@ class AuxWatch:
     def update(self, runner: Any) -> None:
         ch = runner.channel
         aux = ch.pending_aux if ch is not None and ch.state is RunState.WAIT_AUX else None
+        if aux is not None and aux.kind == "M" and aux.value in (0, 1):
+            aux = None  # M00/M01 are never strobed: they wait for the operator's Cycle Start, not for M2x016
         if aux is not self._aux:
             if self._warned is not None and ch.state in ANSWERED:  # not flushed by an alarm or reset
                 self._warned.answered_t = round(runner.time, 9)

@@ -197,6 +197,13 @@ class ChannelLink:
             self._set3(38, False)
             self._complete(ch, aux)
             return
+        aux = ch.pending_aux
+        if aux is not None and aux is not self._last_done and aux.kind == "M" \
+                and (aux.value == 0 or (aux.value == 1 and self._m2(9))):
+            # the NC holds at M00/M01 since its last step; this scan's outputs would publish M3x037/M3x038.
+            # A press in this very scan releases it too, as the NC itself is on hold (decision bench B56)
+            self._complete(ch, aux)
+            return
         ch.cycle_start()  # starts, resumes after feed hold, or runs the next single block
 
     def _finish_input(self, ch: Channel) -> None:

@@ -1,0 +1,61 @@
+"""`hil run` at the edges a bench engineer tries: an M00 hold's line in the trace and its `line=N` events
+(decision B56), `--max-time` (B57), events after an E-stop (B58) — checked on the trace in simulated time."""
+
+from __future__ import annotations
+
+import csv
+
+import numpy as np
+
+from hil.cli import main
+from tests.conftest import ROOT
+
+MILL = str(ROOT / "benches" / "mill-3axis.toml")
+# 50 mm/s along X, then M00 on line 3, then back
+M00 = "G90 G54 G17 G21 G94\nG01 X20. F3000\nM00\nG01 X0. F3000\nM30\n"
+
+
+def read(path) -> dict[str, np.ndarray | list[str]]:
+    rows = list(csv.DictReader(open(path)))
+    cols: dict = {c: np.array([float(r[c]) for r in rows]) for c in rows[0] if c not in ("alarm", "event")}
+    cols["event"] = [r.get("event", "") for r in rows]
+    return cols
+
+
+def run(tmp_path, program: str, *args: str, bench: str = MILL) -> tuple[int, dict]:
+    prog = tmp_path / "p.nc"
+    prog.write_text(program)
+    trace = tmp_path / "t.csv"
+    code = main(["run", str(prog), "--bench", bench, "--trace", str(trace), "--no-check", *args])
+    return code, read(trace) if trace.exists() else {}
+
+
+def test_the_m00_block_is_the_current_line_while_it_holds(tmp_path, capsys):
+    code, c = run(tmp_path, M00, "--m00-resume", "0.3", "--at", "line=3:set D21006=7")
+    out = capsys.readouterr().out
+    assert code == 0, out
+    held = np.flatnonzero(c["line"] == 3)
+    # the hold: X stands at 20 for the operator's 0.3 s, and every row of it names line 3
+    assert 0.29 <= len(held) * 0.001 <= 0.32, len(held)
+    assert np.allclose(c["X_cmd"][held], 20.0, atol=1e-9)
+    assert np.all(np.diff(held) == 1) and c["line"][held[-1] + 1] == 4
+    assert "never triggered" not in out and "line 3  set D21006=7   [line=3]" in out
+
+
+def test_a_line_event_on_the_m00_block_presses_cycle_start(tmp_path, capsys):
+    # the simulated operator would wait 5 s; the scripted Cycle Start on the M00 line resumes at once
+    code, c = run(tmp_path, M00, "--m00-resume", "5", "--at", "line=3:cycle-start")
+    out = capsys.readouterr().out
+    assert code == 0, out
+    held = np.flatnonzero(c["line"] == 3)
+    assert 1 <= len(held) <= 3, len(held)  # the press lands in the scan after the first cycle of line 3
+    assert c["t"][-1] < 2.5 and abs(c["X_cmd"][-1]) < 1e-9
+
+
+def test_an_m00_hold_longer_than_the_aux_timeout_is_no_mlc_finish_warning(tmp_path, capsys):
+    # M00 is never strobed: it waits for Cycle Start, so --aux-timeout (the MLC's M2x016) does not apply
+    code, c = run(tmp_path, M00, "--mlc", "lathe", "--m00-resume", "2", "--aux-timeout", "1")
+    out = capsys.readouterr()
+    assert code == 0 and "warning" not in out.out + out.err, out
+    assert 1.99 <= np.count_nonzero(c["line"] == 3) * 0.001 <= 2.02
+
