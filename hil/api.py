@@ -175,7 +175,8 @@ def run(program: str | Path, bench: str | Path | Bench | None = None, *, bus: st
         check: bool | None = None, trace_signals: str | None = None, m00_resume: float = 0.5,
         realtime: bool = False, overrun: str | None = None, progress: Any = None,
         servo_modbus: str | None = None, servo_baud: int = 38400, capture: str | Path | None = None,
-        scope: Any = None, aux_timeout: float = 5.0, home: bool = True, retain: str | Path | None = None) -> Result:
+        scope: Any = None, aux_timeout: float = 5.0, home: bool = True, retain: str | Path | None = None,
+        max_time: float | None = None) -> Result:
     """Run `program` on a bench in lock-step virtual time (or `realtime`); see the module doc.
 
     `bench`: a bench file, a `Bench`, or None for the built-in 2-axis lathe. `events`: `--at`
@@ -186,7 +187,8 @@ def run(program: str | Path, bench: str | Path | Bench | None = None, *, bus: st
     `hil.scope.Scope` that streams this run's rows to its page. `aux_timeout`: simulated seconds an
     M/S/T code may wait for the MLC's finish before a warning (0: never). `home`: False skips the drive
     homing of axes with a bench `homing` table (hil/drive_homing.py; the drives keep their last origin). `retain`: a
-    JSON file holding the retentive # variables from run to run (hil/retentive.py)."""
+    JSON file holding the retentive # variables from run to run (hil/retentive.py). `max_time`: simulated seconds
+    after which the run stops under control with alarm 0xDE03, in place of the bench's max_time (decision B57)."""
     from hil.clock import make_clock
     from hil.placement import lockstep_clock
     from hil.progress import Progress
@@ -201,6 +203,8 @@ def run(program: str | Path, bench: str | Path | Bench | None = None, *, bus: st
         raise InputError(f"--m00-resume {m00_resume:g}: seconds must be >= 0")
     if not 0.0 <= aux_timeout < float("inf"):
         raise InputError(f"--aux-timeout {aux_timeout:g}: seconds must be >= 0 (0: no warning)")
+    if max_time is not None and not 0.0 < max_time < float("inf"):
+        raise InputError(f"--max-time {max_time:g}: simulated seconds must be > 0")
     feed = _percent("feed override", feed_override, 150.0)
     rapid = _percent("rapid override", rapid_override, 100.0)
     spindle = _percent("spindle override", spindle_override, 120.0)
@@ -219,6 +223,10 @@ def run(program: str | Path, bench: str | Path | Bench | None = None, *, bus: st
         return Result(str(program), b, RunResult(alarms=[exc.alarm]))
     if overrun:
         b.realtime.overrun = overrun
+    if max_time is not None:  # the bench's own guard, given for this run (0xDE03; decision B57)
+        from dataclasses import replace as _with
+
+        b = _with(b, max_time=max_time)  # (a copy: a caller's Bench keeps its own)
     if capture:  # refuse a sim bus or a wrong suffix before anything starts
         _capture_suffix(str(capture), b)
     link = make_link(b)
@@ -250,6 +258,8 @@ def run(program: str | Path, bench: str | Path | Bench | None = None, *, bus: st
     runner = BenchRunner(b, link, None, m, player or panel, clock=clock, progress=progress)
     runner.unreferenced = unreferenced
     runner.retain = str(retain) if retain else None
+    if max_time is not None:
+        runner.max_time_name = "--max-time"
     runner.trace_sources += signal_sources
     if player is not None:
         runner.trace_sources.append(player)

@@ -139,6 +139,7 @@ class BenchRunner:
         self._bus_closed = False
         self.stop_request: str | None = None  # a signal's name (hil/stop_signals.py): stop, then end
         self.unreferenced: frozenset[str] = frozenset()  # axes without origin (hil run --no-home): 0x0A08
+        self.max_time_name = "the bench's max_time"  # what set bench.max_time, for 0xDE03's message (B57)
         self.retain: str | None = None  # hil run --retain FILE: the retentive # variables (hil/retentive.py)
         self._retained = None  # the variables loaded from it, saved back when the run ends
         self._overrun_alarmed = False
@@ -301,7 +302,7 @@ class BenchRunner:
                     self._exchange(ahead)
                 if self.cycle == max_cycles:  # an alarm like any other: the channel stops along the path
                     self._end_reason = "max_time"
-                    ch.raise_alarm(Alarm(MAX_TIME_ALARM, f"run exceeded the bench's max_time of {self.bench.max_time:g} s",
+                    ch.raise_alarm(Alarm(MAX_TIME_ALARM, f"run exceeded {self.max_time_name} of {self.bench.max_time:g} s",
                                          line=self.line or None))
         finally:
             self.result.program_time = self.time - t0

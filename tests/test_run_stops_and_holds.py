@@ -59,3 +59,35 @@ def test_an_m00_hold_longer_than_the_aux_timeout_is_no_mlc_finish_warning(tmp_pa
     assert code == 0 and "warning" not in out.out + out.err, out
     assert 1.99 <= np.count_nonzero(c["line"] == 3) * 0.001 <= 2.02
 
+
+CUT = "G90 G54 G17 G21 G94\nG01 X100. F3000\nM30\n"  # 2 s at 50 mm/s along X on the mill
+
+
+def test_max_time_stops_a_run_held_by_a_zero_feed_override(tmp_path, capsys):
+    # 0 % feed override: the cut never moves; --max-time 1.5 ends it as the bench's max_time would, at 1.5 s
+    code, c = run(tmp_path, CUT, "--feed-override", "0", "--max-time", "1.5")
+    out = capsys.readouterr().out
+    assert code == 1, out
+    assert "ALARM 0xDE03 at line 2 -- run exceeded --max-time of 1.5 s" in out and "result         STOPPED" in out
+    assert np.all(np.abs(c["X_cmd"]) < 1e-9)  # nothing moved
+    hit = [i for i, a in enumerate(csv.DictReader(open(tmp_path / "t.csv"))) if a["alarm"] == "0xDE03"]
+    assert len(hit) == 1 and abs(c["t"][hit[0]] - 1.5) < 0.0015
+    assert c["t"][-1] < 2.0 and int(c["X_sw"][-1]) & 0x6F in (0x40, 0x21)  # drives disabled at the end
+
+
+def test_max_time_cuts_a_moving_axis_along_the_path(tmp_path, capsys):
+    code, c = run(tmp_path, CUT, "--max-time", "1")
+    out = capsys.readouterr().out
+    assert code == 1 and "run exceeded --max-time of 1 s" in out, out
+    x = c["X_cmd"]
+    stop = int(np.argmax(c["t"] >= 1.0))
+    assert 45.0 < x[stop] < 55.0 and x[-1] < 70.0  # X was at ≈ 50 mm, braked along the path, never reached 100
+    assert np.all(np.diff(x) >= -1e-9)  # no reversal: a jerk-limited stop, not a jump
+    assert int(c["X_sw"][-1]) & 0x6F in (0x40, 0x21)
+
+
+def test_bad_max_time_is_a_usage_error(tmp_path, capsys):
+    for bad in ("0", "-1", "nan", "inf"):
+        code, _ = run(tmp_path, CUT, "--max-time", bad)
+        err = capsys.readouterr().err
+        assert code == 2 and f"--max-time {bad}: simulated seconds must be > 0" in err and "Traceback" not in err

@@ -79,6 +79,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--home", action=argparse.BooleanOptionalAction, default=True,
                    help="home the axes whose bench entry has a `homing` table by their drives before the program "
                         "(default); --no-home: the drives keep the origin of their last homing")
+    p.add_argument("--max-time", metavar="SECONDS", type=float,
+                   help="stop the run after this much simulated time (from power-up) as the bench's max_time does: "
+                        "axes stopped along the path, drives disabled at standstill, alarm 0xDE03, exit 1 "
+                        "(default: the bench's max_time, 3600 s)")
     p.add_argument("--allow-unfired", action="store_true",
                    help="an --at/--events event that never fired does not fail the run")
     p.set_defaults(func=cmd_run)
@@ -126,7 +130,7 @@ def _run_and_print(args: argparse.Namespace, scope) -> int:
                 overrun=args.overrun, progress=True if wants_progress(args.progress) else None,
                 servo_modbus=args.servo_modbus, servo_baud=args.servo_baud,
                 capture=args.capture, scope=scope, aux_timeout=args.aux_timeout, home=args.home,
-                retain=args.retain)
+                retain=args.retain, max_time=args.max_time)
     except InputError as exc:
         if exc.alarm is not None:
             print_alarm(exc.alarm)
