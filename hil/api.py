@@ -205,6 +205,12 @@ def run(program: str | Path, bench: str | Path | Bench | None = None, *, bus: st
         raise InputError(f"--aux-timeout {aux_timeout:g}: seconds must be >= 0 (0: no warning)")
     if max_time is not None and not 0.0 < max_time < float("inf"):
         raise InputError(f"--max-time {max_time:g}: simulated seconds must be > 0")
+    if retain:  # a store the run could not write back: refused before anything moves (hil/retentive.py)
+        from hil.retentive import unusable
+
+        why = unusable(retain)
+        if why is not None:
+            raise InputError(f"--retain {retain}: {why}")
     feed = _percent("feed override", feed_override, 150.0)
     rapid = _percent("rapid override", rapid_override, 100.0)
     spindle = _percent("spindle override", spindle_override, 120.0)

@@ -43,6 +43,20 @@ def load(path: str | Path, variables: Variables) -> None:
     variables.values.update(values)
 
 
+def unusable(path: str | Path) -> str | None:
+    """Why `path` cannot hold the retentive memory at all (then the run must not start), or None. Checked before the
+    drives are enabled: a save that fails only when the run ends loses the run's counts after its axes moved."""
+    p = Path(path)
+    if p.is_dir():
+        return "is a folder, not a file"
+    folder = p.parent
+    if not folder.is_dir():
+        return f"its folder does not exist ({folder})" if str(folder) not in ("", ".") else "its folder does not exist"
+    if not os.access(folder, os.W_OK):
+        return f"its folder {folder} is not writable"
+    return None
+
+
 def save(path: str | Path, variables: Variables) -> None:
     """Write the retentive variables that hold a value (vacant ones are left out) to `path`, atomically."""
     p = Path(path)

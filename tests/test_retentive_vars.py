@@ -46,3 +46,16 @@ def test_0x140b_a_corrupt_retentive_store_stops_the_run_before_it_starts(hil, pr
     assert r.code == 1 and "ALARM 0x140B" in r.out + r.err and why in r.out + r.err
     assert store.read_text() == text
     assert not trace.exists() or len(trace.read_text().splitlines()) <= 1
+
+
+@pytest.mark.parametrize("where, why", [("missing/retain.json", "its folder does not exist"),
+                                        ("a_dir", "is a folder, not a file")], ids=["no-folder", "folder"])
+def test_a_retain_file_that_cannot_be_written_is_refused_before_the_run(hil, program, tmp_path, where, why):
+    """A --retain FILE whose folder is missing ran the whole program and only then failed to save (0x140B after the
+    axes had moved, the count lost): it is a bad option, refused before the drives are enabled (exit 2)."""
+    (tmp_path / "a_dir").mkdir()
+    trace = tmp_path / "t.csv"
+    store = tmp_path / where
+    r = hil("run", program(COUNTER), "--retain", store, "--trace", trace)
+    assert r.code == 2 and f"--retain {store}: {why}" in r.err and "Traceback" not in r.err, r.out + r.err
+    assert not trace.exists() and not (tmp_path / "missing").exists()
