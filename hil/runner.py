@@ -302,8 +302,11 @@ class BenchRunner:
                     self._exchange(ahead)
                 if self.cycle == max_cycles:  # an alarm like any other: the channel stops along the path
                     self._end_reason = "max_time"
+                    aux = ch.pending_aux  # an M/S/T block the NC waits on is where it stands (B57)
+                    where = dict(line=aux.line, block=aux.block or None, program=aux.program) if aux is not None and aux.line \
+                        else dict(line=self.line or None)
                     ch.raise_alarm(Alarm(MAX_TIME_ALARM, f"run exceeded {self.max_time_name} of {self.bench.max_time:g} s",
-                                         line=self.line or None))
+                                         **where))
         finally:
             self.result.program_time = self.time - t0
         self.result.finished = ch.state is RunState.FINISHED

@@ -91,3 +91,13 @@ def test_bad_max_time_is_a_usage_error(tmp_path, capsys):
         code, _ = run(tmp_path, CUT, "--max-time", bad)
         err = capsys.readouterr().err
         assert code == 2 and f"--max-time {bad}: simulated seconds must be > 0" in err and "Traceback" not in err
+
+
+def test_max_time_names_the_block_the_nc_waits_on(tmp_path, capsys):
+    # an MLC that never answers M09: the run stands at line 3 (M09), where max_time finds it, not at the move before
+    mlc = tmp_path / "never.py"
+    mlc.write_text("def scan(mlc):\n    pass\n")
+    code, c = run(tmp_path, "G90 G54 G17 G21 G94\nG01 X10. F3000\nM09\nG01 X0.\nM30\n", "--mlc", str(mlc),
+                  "--max-time", "1", "--aux-timeout", "0.5")
+    out = capsys.readouterr().out
+    assert code == 1 and "ALARM 0xDE03 in p.nc at line 3: M09 -- run exceeded --max-time of 1 s" in out, out
