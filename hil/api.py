@@ -256,7 +256,7 @@ def run(program: str | Path, bench: str | Path | Bench | None = None, *, bus: st
         if not hasattr(m, "mem"):
             raise InputError("--at/--events write MLC devices: they need a Delta MLC, not --mlc basic")
         try:
-            parsed = parse_events(list(events), list(event_files), b.axis_names, m.link.x)
+            parsed = parse_events(list(events), list(event_files), b.axis_names, m.link.x, b.cycle)
         except EventSpecError as exc:
             raise InputError(str(exc)) from None
         traced = [c for src in signal_sources for c in src.columns]

@@ -185,8 +185,10 @@ def read_events_file(path: str) -> list[tuple[str, str]]:
     return out
 
 
-def parse_events(at: Sequence[str], files: Sequence[str], axes: Sequence[str], channel: int = 1) -> list[RunEvent]:
-    """Every ``--at`` then every events file line, in order; EventSpecError names the bad one."""
+def parse_events(at: Sequence[str], files: Sequence[str], axes: Sequence[str], channel: int = 1,
+                 cycle_s: float | None = None) -> list[RunEvent]:
+    """Every ``--at`` then every events file line, in order; EventSpecError names the bad one. `cycle_s`: the
+    bench's cycle, to compare ``t=`` with ``cycle=`` triggers (refuse_after_estop)."""
     items = [("--at", s) for s in at] + [item for f in files for item in read_events_file(f)]
     events = []
     for where, spec in items:
@@ -194,7 +196,39 @@ def parse_events(at: Sequence[str], files: Sequence[str], axes: Sequence[str], c
             events.append(parse_event(spec, axes, channel))
         except EventSpecError as exc:
             raise EventSpecError(f"{where}: {exc}") from None
+    refuse_after_estop(list(zip((w for w, _ in items), events)), cycle_s)
     return events
+
+
+# What the operator does to recover from an E-stop; a run ends at its E-stop, so these can never act after it.
+RECOVERY = ("estop-off", "reset", "cycle-start")
+
+
+def _when(tr: Trigger, cycle_s: float | None) -> float | None:
+    """The simulated time a t= / cycle= trigger fires at (None: it depends on the run, or on a cycle not given)."""
+    if tr.kind == "t":
+        return tr.value
+    if tr.kind == "cycle" and cycle_s is not None:
+        return tr.value * cycle_s
+    return None
+
+
+def refuse_after_estop(items: Sequence[tuple[str, RunEvent]], cycle_s: float | None) -> None:
+    """EventSpecError for an ``estop-off``, ``reset`` or ``cycle-start`` timed after an ``estop`` (decision B58):
+    the E-stop aborts the program (alarm 0x0401) and `hil run` ends once the drives stand, so such an event would
+    only be reported as never fired. E-stop recovery is exercised with `hil script` (machine.estop(), reset())."""
+    stops = [(w, e, t) for w, e in items if e.action.label == "estop" and (t := _when(e.trigger, cycle_s)) is not None]
+    if not stops:
+        return
+    w0, first, t0 = min(stops, key=lambda s: s[2])
+    for where, e in items:
+        t = _when(e.trigger, cycle_s)
+        if e.action.label in RECOVERY and t is not None and t > t0:
+            raise EventSpecError(
+                f"{where}: {e.spec!r} comes after the E-stop {first.spec!r} ({w0}), and a run ends at its E-stop: "
+                "the NC aborts the program with alarm 0x0401 and `hil run` stops once the drives stand, so it could "
+                "never act. Exercise E-stop recovery with `hil script` (machine.estop(), machine.estop(False), "
+                "machine.reset()); see docs/guide/mlc.md")
 
 
 # ---- playing them during the run ------------------------------------------------------------------
@@ -272,14 +306,22 @@ class EventPlayer:
     def summary(self) -> list[str]:
         fired = sorted((e for e in self.events if e.fired_cycle is not None), key=lambda e: e.fired_cycle)
         missed = [e for e in self.events if e.fired_cycle is None]
+        why = self.why_unfired()
         head = f"events         {len(fired)} applied" + (f", {len(missed)} never triggered" if missed else "")
         out = [head]
         for e in fired:
             out.append(f"  t={e.fired_time:.3f} s  cycle {e.fired_cycle}  line {e.fired_line}  {e.action}"
                        f"   [{e.trigger}]")
         for e in missed:
-            out.append(f"  never triggered: {e.spec}")
+            out.append(f"  never triggered: {e.spec}{why}")
         return out
+
+    def why_unfired(self) -> str:
+        """Why events after an E-stop never fired: the E-stop ended the run (decision B58); "" without one."""
+        stop = next((e for e in self.events if e.action.label == "estop" and e.fired_time is not None), None)
+        if stop is None:
+            return ""
+        return f"  (the E-stop at t={stop.fired_time:.3f} s ended the run)"
 
 
 __all__ = ["EventPlayer", "EventSpecError", "RunEvent", "parse_event", "parse_events", "read_events_file"]

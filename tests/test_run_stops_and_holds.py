@@ -101,3 +101,22 @@ def test_max_time_names_the_block_the_nc_waits_on(tmp_path, capsys):
                   "--max-time", "1", "--aux-timeout", "0.5")
     out = capsys.readouterr().out
     assert code == 1 and "ALARM 0xDE03 in p.nc at line 3: M09 -- run exceeded --max-time of 1 s" in out, out
+
+
+def test_recovery_events_timed_after_an_estop_are_refused_before_the_run(tmp_path, capsys):
+    # the E-stop aborts the program and the run ends at it: estop-off / reset / cycle-start later could never act
+    ev = tmp_path / "ev.txt"
+    ev.write_text("t=0.3:estop\nt=0.2:set D21006=1\ncycle=600:estop-off   # release\nt=0.7:reset\n")
+    code, c = run(tmp_path, CUT, "--events", str(ev))
+    err = capsys.readouterr().err
+    assert code == 2 and not c and "Traceback" not in err, err
+    assert f"{ev}:3: 'cycle=600:estop-off' comes after the E-stop 't=0.3:estop' ({ev}:1)" in err
+    assert "alarm 0x0401" in err and "hil script" in err
+    # before the E-stop they are fine, and an event after it that is no recovery stays a run-time matter
+    code, c = run(tmp_path, CUT, "--at", "t=0.1:feed-hold", "--at", "t=0.2:cycle-start", "--at", "t=0.5:estop",
+                  "--at", "t=5:set D21006=1")
+    io = capsys.readouterr()
+    assert code == 1 and "ALARM 0x0401" in io.out, io.out
+    assert "never triggered: t=5:set D21006=1  (the E-stop at t=0.500 s ended the run)" in io.out
+    assert "applied" in io.out and "cycle-start (pulse M21000)   [t=0.2]" in io.out
+    assert "(the E-stop at t=0.500 s ended the run)" in io.err

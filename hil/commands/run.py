@@ -146,8 +146,10 @@ def _run_and_print(args: argparse.Namespace, scope) -> int:
         print_run(args.program, r, text)
     _, code = verdict(r, args.allow_unfired)
     if r.unfired and not args.allow_unfired:
+        player = r.runner.on_cycle if r.runner is not None else None
+        why = player.why_unfired() if hasattr(player, "why_unfired") else ""  # an E-stop ended the run (B58)
         print(f"hil run: {len(r.unfired)} event(s) never fired (--allow-unfired to accept): "
-              + "; ".join(e.spec for e in r.unfired), file=sys.stderr)
+              + "; ".join(e.spec for e in r.unfired) + why, file=sys.stderr)
     if args.junit:
         try:
             write_atomic(args.junit, junit_xml(r, args.allow_unfired))
