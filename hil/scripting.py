@@ -34,7 +34,7 @@ from mlc.nc_link import MODE_NAMES
 from mlc.signals import d2, d3, m2, m3
 from nc.alarms import Alarm, NcAlarm
 from nc.softlimits import SoftLimits
-from nc.channel import Channel
+from nc.channel import Channel, RunState
 from nc.interp import Interpreter
 from nc.interrupt import m96_link
 from nc.motion import Planner
@@ -105,6 +105,7 @@ class Machine:
         self.watchers: list[Callable[["Machine"], None]] = []
         self._mpg_count = 0
         self.alarms: list[Alarm] = []
+        self.cleared: dict[int, float] = {}  # id(alarm) -> simulated time of the reset that cleared it (B59)
 
     # ---- life cycle ----------------------------------------------------------------------------
     def power_up(self) -> None:
@@ -376,7 +377,23 @@ class Machine:
         self.pulse(m2(self.x, OPERATOR_BUTTONS["cycle-start"]))
 
     def reset(self) -> None:
+        """The RESET button. The alarms standing before it are cleared when it takes (NC5: reset clears an alarm
+        whose cause is gone): the channel is out of alarm and no E-stop is held (decision B59)."""
+        ch = self.runner.channel
+        before = self.active_alarms()
         self.pulse(m2(self.x, OPERATOR_BUTTONS["reset"]))
+        if ch is not None and not ch.emergency and ch.state is not RunState.ALARM:
+            for a in before:
+                self.cleared.setdefault(id(a), self.time)
+
+    def all_alarms(self) -> list[Alarm]:
+        """Every alarm the script met, cleared ones included, in order."""
+        ch = self.runner.channel
+        return self.alarms + [a for a in (ch.alarms if ch is not None else []) if a not in self.alarms]
+
+    def active_alarms(self) -> list[Alarm]:
+        """The alarms no reset has cleared: what makes `hil script` exit 1."""
+        return [a for a in self.all_alarms() if id(a) not in self.cleared]
 
     # ---- what the drives did -----------------------------------------------------------------------
     def summary(self) -> list[str]:
@@ -391,9 +408,9 @@ class Machine:
                 lines.append(f"{name:<4} peak {rec.peak_rpm:8.1f} rpm, now "
                              f"{self.runner.scales[i].drive_to_rpm(self.runner.tx[i].velocity_actual):8.1f} rpm  "
                              f"modes {'/'.join(_mode_name(m) for m in rec.modes)}")
-        alarms = self.alarms + [a for a in (self.runner.channel.alarms if self.runner.channel else [])
-                                if a not in self.alarms]
-        lines.append("alarms  " + ("; ".join(str(a) for a in alarms) if alarms else "none"))
+        alarms = [str(a) + (f" (cleared by reset at t={self.cleared[id(a)]:.3f} s)" if id(a) in self.cleared else "")
+                  for a in self.all_alarms()]
+        lines.append("alarms  " + ("; ".join(alarms) if alarms else "none"))
         return lines
 
     def report(self) -> None:

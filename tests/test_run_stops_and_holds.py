@@ -120,3 +120,32 @@ def test_recovery_events_timed_after_an_estop_are_refused_before_the_run(tmp_pat
     assert "never triggered: t=5:set D21006=1  (the E-stop at t=0.500 s ended the run)" in io.out
     assert "applied" in io.out and "cycle-start (pulse M21000)   [t=0.2]" in io.out
     assert "(the E-stop at t=0.500 s ended the run)" in io.err
+
+
+RECOVER = """def main(machine):
+    machine.jog("Z", -1, 0.3)
+    machine.estop()
+    machine.wait(0.3)
+    machine.estop({release})
+    machine.reset()
+    machine.wait(0.2)
+    machine.jog("Z", 1, 0.2)
+"""
+
+
+def test_a_script_that_recovers_from_its_estop_ends_ok_and_says_the_alarm_was_cleared(tmp_path, capsys):
+    # NC5: E-stop → 0x0401; released and reset, the alarm is gone and the axes jog again (decision B59)
+    script = tmp_path / "recover.py"
+    script.write_text(RECOVER.format(release="False"))
+    code = main(["script", str(script)])
+    out = capsys.readouterr().out
+    assert code == 0, out
+    assert "ALARM 0x0401 -- emergency stop signal is triggered (M2x013) (cleared by reset at t=0.6" in out
+    z = next(ln for ln in out.splitlines() if ln.startswith("Z ")).split()
+    end, low = float(z[3]), float(z[7].split("…")[0])
+    assert end - low > 3.0, z  # after the recovery Z jogged back up 3.3 mm from where the E-stop braked it
+    # the E-stop still pressed at the reset: nothing is cleared, the alarm stands, exit 1
+    script.write_text(RECOVER.format(release="True"))
+    code = main(["script", str(script)])
+    out = capsys.readouterr().out
+    assert code == 1 and "cleared by reset" not in out and "ALARM 0x0401" in out, out

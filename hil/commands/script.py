@@ -53,8 +53,7 @@ def open_machine(args: argparse.Namespace):
 def finish(machine, ok: bool = True) -> int:
     machine.report()
     machine.close()
-    alarms = machine.alarms + (machine.runner.channel.alarms if machine.runner.channel else [])
-    return EXIT_OK if ok and not alarms else EXIT_ALARM
+    return EXIT_OK if ok and not machine.active_alarms() else EXIT_ALARM  # a reset cleared the others (B59)
 
 
 def cmd_script(args: argparse.Namespace) -> int:
