@@ -19,6 +19,7 @@ from __future__ import annotations
 import functools
 import gc
 import os
+import sys
 import tempfile
 from collections.abc import Callable, Sequence
 from contextvars import ContextVar
@@ -300,6 +301,12 @@ def run(program: str | Path, bench: str | Path | Bench | None = None, *, bus: st
                     if runner.trace is not None:
                         runner.trace.discard()
                     raise InputError(str(exc)) from None
+                if getattr(scope, "wait", False):  # --scope-wait: every input is checked by now, nothing moved yet
+                    try:
+                        scope.wait_for_browser(sys.stderr, lambda: runner.stop_request)
+                    except BaseException:  # Ctrl-C while waiting: no trace left behind
+                        runner.trace.discard()
+                        raise
             if servo_modbus:  # G10 L40/L41 over the drives' RS-485 port (issue 8)
                 import serial
 

@@ -22,8 +22,9 @@ import time
 from collections import deque
 from dataclasses import dataclass, field
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
-from typing import Any, Sequence
+from typing import Any, Callable, Sequence
 
+from hil.stop_signals import SignalStop
 from hil.trace import TraceWriter, axes_of, spindles_of
 
 RING_ROWS = 60_000  # newest rows kept for a browser that connects late (60 s of 1 ms cycles)
@@ -113,6 +114,7 @@ class Scope:
     spec: str | None = None
     linger_s: float = 30.0
     port: int = 0
+    wait: bool = False  # --scope-wait: hil.run holds the run for a browser once its inputs are checked
     tap: ScopeTap | None = None
     chosen: list[str] = field(default_factory=list)
     _server: ThreadingHTTPServer | None = None
@@ -143,14 +145,19 @@ class Scope:
         self.tap = ScopeTap(trace, columns)
         return self.tap
 
-    def wait_for_browser(self, out: Any) -> None:
-        """`--scope-wait`: hold the run until a page is open, so it is watched from its first row."""
+    def wait_for_browser(self, out: Any, stopped: Callable[[], str | None] = lambda: None) -> None:
+        """`--scope-wait`: hold the run until a page is open, so it is watched from its first row. `stopped`: the
+        signal that asked the run to stop meanwhile (hil.stop_signals), which ends the command as it would end
+        it outside a run (SIGINT: interrupted; SIGTERM/SIGHUP: stopped by it, 128 + n)."""
         print(f"scope: waiting for a browser at {self.url} before the run starts (Ctrl-C to stop)",
               file=out, flush=True)
         while True:
             with self._lock:
                 if self._clients:
                     return
+            name = stopped()
+            if name is not None:
+                raise KeyboardInterrupt(name) if name == "SIGINT" else SignalStop(name)
             time.sleep(0.05)
 
     def linger(self, out: Any) -> None:

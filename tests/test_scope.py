@@ -57,6 +57,43 @@ def test_unknown_scope_column_is_bad_usage(tmp_path):
     assert p.returncode == 2 and "unknown column(s) Q_cmd" in p.stderr and "X_ferr" in p.stderr
 
 
+@pytest.mark.parametrize("args, code, message", [
+    (["missing.nc"], 1, "ALARM 0x0002"),
+    (["p.nc", "--at", "t=1:frobnicate"], 2, "expected set DEVICE=VALUE"),
+    (["p.nc", "--scope-columns", "Q_cmd"], 2, "unknown column(s) Q_cmd"),
+    (["p.nc", "--bench", "missing.toml"], 2, "missing.toml"),
+], ids=["no-program", "bad-event", "bad-column", "no-bench"])
+def test_scope_wait_refuses_bad_input_before_waiting_for_a_browser(tmp_path, args, code, message):
+    """--scope-wait held a run with a missing program or a bad option until a browser opened the page, and only then
+    said the input was bad: the inputs are checked first, the wait comes right before the drives are enabled."""
+    (tmp_path / "p.nc").write_text(PROGRAM)
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}  # (run from tmp_path: this tree's hil, not an installed one)
+    p = subprocess.run([sys.executable, "-m", "hil.cli", "run", *args, "--scope", "--scope-wait"], cwd=tmp_path,
+                       env=env, capture_output=True, text=True, timeout=60)
+    assert p.returncode == code and message in p.stdout + p.stderr, p.stdout + p.stderr
+    assert "waiting for a browser" not in p.stderr and "Traceback" not in p.stderr
+
+
+def test_sigterm_while_scope_waits_ends_the_command_with_143_and_no_trace(tmp_path):
+    """The wait for a browser is part of the run now (its inputs checked, its trace open): a SIGTERM there ends the
+    command as before the run, `stopped by SIGTERM` and 143, and leaves no trace (nor its .part)."""
+    (tmp_path / "p.nc").write_text(PROGRAM)
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    p = subprocess.Popen([sys.executable, "-m", "hil.cli", "run", "p.nc", "--scope", "--scope-wait", "--trace", "t.csv"],
+                         cwd=tmp_path, env=env, stderr=subprocess.PIPE, text=True)
+    try:
+        for line in p.stderr:
+            if "waiting for a browser" in line:
+                break
+        p.terminate()
+        err = p.stderr.read()
+        assert p.wait(timeout=30) == 143 and "hil run: stopped by SIGTERM" in err and "Traceback" not in err, err
+    finally:
+        if p.poll() is None:
+            p.kill()
+    assert not list(tmp_path.glob("t.csv*"))
+
+
 def test_scope_streams_while_lock_step_run_goes(tmp_path):
     driver = chromium_driver()
     (tmp_path / "p.nc").write_text(LONG_PROGRAM)

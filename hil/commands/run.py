@@ -112,8 +112,7 @@ def _start_scope(args: argparse.Namespace):
 
     scope = Scope(args.scope_columns, linger_s=max(0.0, args.scope_linger), port=args.scope_port)
     print(f"scope: {scope.start()} (127.0.0.1 only)", file=sys.stderr, flush=True)
-    if args.scope_wait:
-        scope.wait_for_browser(sys.stderr)
+    scope.wait = args.scope_wait  # hil.run waits once the inputs are checked, before the drives are enabled
     return scope
 
 
