@@ -149,3 +149,17 @@ def test_a_script_that_recovers_from_its_estop_ends_ok_and_says_the_alarm_was_cl
     code = main(["script", str(script)])
     out = capsys.readouterr().out
     assert code == 1 and "cleared by reset" not in out and "ALARM 0x0401" in out, out
+
+
+def test_a_campaign_fault_with_recovery_after_its_estop_is_a_bad_campaign_file(tmp_path, capsys):
+    # each case would have refused it at run time, reported as a meaningless "alarm 0x0000": refused with the file
+    import shutil
+
+    shutil.copytree(ROOT / "tests" / "data" / "campaign", tmp_path / "c")
+    spec = tmp_path / "c" / "recover.toml"
+    spec.write_text('[campaign]\nprograms = ["short_turn.nc"]\nbenches = ["bench.toml"]\nfaults = ["recover"]\n'
+                    '[faults]\nrecover = ["t=0.3:estop", "t=0.6:estop-off", "t=0.7:reset"]\n')
+    code = main(["campaign", str(spec), "--out", str(tmp_path / "out"), "--workers", "1"])
+    err = capsys.readouterr().err
+    assert code == 2 and "fault 'recover'" in err and "'t=0.6:estop-off' comes after the E-stop 't=0.3:estop'" in err, err
+    assert "Traceback" not in err and not (tmp_path / "out" / "results.parquet").exists()

@@ -29,12 +29,12 @@ def apply_variant(text: str, source: str, case: Case | Any, checks: dict[str, An
         if r.errors:
             raise BenchFileError(f"{source} with the campaign's [checks]", r.errors)
     if case.events:
-        from hil.run_events import EventSpecError, parse_event
+        from hil.run_events import EventSpecError, parse_event, refuse_after_estop
 
-        for e in case.events:
-            try:
-                parse_event(e, bench.axis_names)
-            except EventSpecError as exc:
-                raise BenchFileError(f"{source}, fault {case.fault!r}" if hasattr(case, "fault") else source,
-                                     [str(exc)]) from None
+        try:
+            parsed = [(f"event {i}", parse_event(e, bench.axis_names)) for i, e in enumerate(case.events, 1)]
+            refuse_after_estop(parsed, bench.cycle)  # recovery timed after the fault's E-stop (decision B58)
+        except EventSpecError as exc:
+            raise BenchFileError(f"{source}, fault {case.fault!r}" if hasattr(case, "fault") else source,
+                                 [str(exc)]) from None
     return bench
