@@ -152,7 +152,7 @@ def test_a_script_that_recovers_from_its_estop_ends_ok_and_says_the_alarm_was_cl
 
 
 def test_a_campaign_fault_with_recovery_after_its_estop_is_a_bad_campaign_file(tmp_path, capsys):
-    # each case would have refused it at run time, reported as a meaningless "alarm 0x0000": refused with the file
+    # each case would have refused it at run time, reported as an internal-error alarm: refused with the file
     import shutil
 
     shutil.copytree(ROOT / "tests" / "data" / "campaign", tmp_path / "c")
