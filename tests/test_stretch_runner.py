@@ -43,7 +43,7 @@ def test_lathe_demo_stretched_equals_stepped(monkeypatch, tmp_path):
 
 @pytest.mark.parametrize("events", [
     ["t=2:feed-hold", "t=2.6:cycle-start", "t=4:set D21002=50"],  # hold, resume, feed override 50 %
-    ["t=3:estop", "t=3.5:estop-off", "t=3.6:reset"],
+    ["t=3:estop", "t=3.02:set D21002=50"],  # an event while the drives brake (recovery after it: B58)
     ["t=2.0005:set D21002=70", "t=2.0205:set D21002=120"],  # override changes inside a stretch's span
     ["line=12:set D21002=60", "Z<-30:set D21002=80", "cycle=9000:set D21002=100"],  # line, position, cycle
 ])
