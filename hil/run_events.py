@@ -95,7 +95,11 @@ def parse_trigger(text: str, axes: Sequence[str]) -> Trigger:
             raise EventSpecError(f"trigger {text!r}: the time must be a finite number of seconds ≥ 0")
         return Trigger("t", t)
     if m := _COUNT.match(text):
-        return Trigger(m.group(1).lower(), int(m.group(2)))
+        kind, n = m.group(1).lower(), int(m.group(2))
+        if n < 1:  # line 0 is what the trace names before the program and after its end: it fired there
+            raise EventSpecError(f"trigger {text!r}: " + ("program lines start at 1" if kind == "line"
+                                                          else "bench cycles start at 1"))
+        return Trigger(kind, n)
     if m := _AXIS.match(text):
         axis = m.group(1).upper()
         if axis not in axes:

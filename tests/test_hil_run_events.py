@@ -125,6 +125,8 @@ def test_events_file_and_named_operator_actions(tmp_path, capsys):
     ("t=1:set D21002=70000", "takes 0…65535"),
     ("t=1:set D21002=12.5", "has a fraction"),
     ("Q<5:set M21019=1", "axis Q is not on the bench"),
+    ("line=0:set D21006=1", "program lines start at 1"),  # it fired after the program's end, where line is 0
+    ("cycle=0:feed-hold", "bench cycles start at 1"),
     ("t=1:frobnicate", "expected set DEVICE=VALUE"),
 ])
 def test_bad_event_specs_exit_2_with_a_message(tmp_path, capsys, spec, message):
