@@ -112,16 +112,21 @@ def _scheduler_gone(client: Any, exc: BaseException) -> bool:
 
 @contextmanager
 def _quiet_client() -> Iterator[None]:
-    """distributed's client logs a lost scheduler as ERROR tracebacks on stderr; the campaign says it itself."""
+    """distributed logs a lost scheduler as ERROR tracebacks on stderr, from its client, its batched comms and
+    more; the campaign says what went wrong itself (B76), so every `distributed` logger is held at CRITICAL."""
     import logging
 
-    log = logging.getLogger("distributed.client")
-    level = log.level
-    log.setLevel(logging.CRITICAL)
+    import distributed  # noqa: F401  (its loggers exist once it is imported)
+
+    names = ["distributed"] + [n for n in logging.root.manager.loggerDict if n.startswith("distributed.")]
+    saved = [(log, log.level) for log in map(logging.getLogger, names)]
+    for log, _ in saved:
+        log.setLevel(logging.CRITICAL)
     try:
         yield
     finally:
-        log.setLevel(level)
+        for log, level in saved:
+            log.setLevel(level)
 
 
 # the witness of a Ctrl-C while the local cluster starts (_sigint_ignored): SIGINT's default action ends it
