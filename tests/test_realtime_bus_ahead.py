@@ -24,7 +24,7 @@ from hil.bus_ahead import BusAhead
 from hil.clock import RealTimeClock
 from hil.stretch import ENV
 from tests.conftest import ROOT
-from tests.test_realtime_cam import _program, _same
+from tests.test_realtime_cam import _same, events_equal_stepping
 from tests.test_realtime_stretch import StopAt, fake_clock
 from virtual_bus.ethercat.veth import SimProcess, can_create
 
@@ -73,11 +73,7 @@ def test_the_cam_programs_refills_and_feeds_are_worked_out_ahead_and_equal_stepp
     ({200: "X400. Y0.5"}, "0x0A01"),  # beyond the 300 mm soft limit: the moves before it run out, then the alarm
 ])
 def test_other_events_in_the_cam_program_step_as_before(monkeypatch, tmp_path, inserts, alarm):
-    text = _program(300, inserts)
-    a = _run(monkeypatch, tmp_path, text, "0")
-    b = _run(monkeypatch, tmp_path, text, "1")
-    _same(a, b)
-    assert [x.code_text for x in b["res"].alarms] == ([] if alarm is None else [alarm])
+    b = events_equal_stepping(lambda text, on: _run(monkeypatch, tmp_path, text, on), 300, inserts, alarm)
     assert b["st"].peeks > 10
 
 

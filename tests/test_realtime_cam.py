@@ -94,12 +94,18 @@ def test_the_cam_programs_feeds_and_solves_run_before_the_tick_and_equal_steppin
     ({450: "X400. Y0.5"}, "0x0A01"),  # beyond the 300 mm soft limit: the moves before it run out, then the alarm
 ])
 def test_other_events_in_the_cam_program_step_as_before(monkeypatch, tmp_path, inserts, alarm):
-    text = _program(600, inserts)
-    a = _run(monkeypatch, tmp_path, text, "0")
-    b = _run(monkeypatch, tmp_path, text, "1")
+    b = events_equal_stepping(lambda text, on: _run(monkeypatch, tmp_path, text, on), 600, inserts, alarm)
+    assert b["st"].steps_ahead > 100
+
+
+def events_equal_stepping(run, blocks: int, inserts: dict[int, str], alarm: str | None) -> dict:
+    """The CAM program with `inserts` run stepped ("0") and with the work ahead ("1"): the same trace, and the
+    alarm expected (or none); the run with the work ahead, for what it did. Shared with test_realtime_bus_ahead."""
+    text = _program(blocks, inserts)
+    a, b = run(text, "0"), run(text, "1")
     _same(a, b)
     assert [x.code_text for x in b["res"].alarms] == ([] if alarm is None else [alarm])
-    assert b["st"].steps_ahead > 100
+    return b
 
 
 @pytest.mark.parametrize("kw", [{"stop_at": 700}, {"feed_override": 80.0},
