@@ -50,10 +50,16 @@ def as_dict(result: Any, allow_unfired: bool = False) -> dict[str, Any]:
                    "never_fired": [e.spec for e in result.unfired]},
         "power_up_fault_resets": [{"drive": a, "error_code": c}
                                   for a, c in getattr(result.run, "power_up_resets", ())],
+        "fitted_windows": _fits(getattr(result.run, "fits_ahead", None)),
         "program_time_s": result.program_time, "sim_time_s": result.sim_time, "cycles": result.cycles,
         "max_following_error": result.max_following_error, "final_position": result.final_position,
         "trace": str(result.trace.path) if result.trace is not None else None,
     })
+
+
+def _fits(fits: tuple[int, int] | None) -> dict[str, int] | None:
+    """B86: a real-time run's fitted windows, by where they were worked out (None: no second process)."""
+    return None if fits is None else {"ahead": fits[0], "in_cycle": fits[1]}
 
 
 def to_json(result: Any, allow_unfired: bool = False) -> str:

@@ -25,7 +25,7 @@ from hil.bench import Bench
 from hil.bus_work import BusWork
 from hil.clock import CycleTiming, LockStepClock, RealTimeClock
 from hil.cycle_lean import OVERSPEED, RESET_CYCLES, WARM_AHEAD_NS, WARM_MIN_NS, factors, feedback, row, setpoints, warm
-from hil import retentive
+from hil import fit_ahead, retentive
 from hil.drive_homing import home_axes
 from hil.mlc_bridge import drive_status
 from hil import stretch_ahead
@@ -76,6 +76,7 @@ class RunResult:
     granted: str = ""  # what the system granted the real-time loop
     stopped_by: str | None = None  # the signal (SIGINT, SIGTERM, SIGHUP) whose stop ended the run
     stretched: int = 0  # cycles run in stretches (hil/stretch.py), not stepped one by one
+    fits_ahead: tuple[int, int] | None = None  # B86: fitted windows (taken from the second process, fitted in a cycle)
 
     @property
     def ok(self) -> bool:
@@ -147,6 +148,10 @@ class BenchRunner:
         self._bus_ahead = False  # real time on the sim bus: a stepped cycle's exchange runs before its tick
         self._stretcher: Stretcher | None = None  # run_events' (hil/stretch.py), for _settle too (B38)
         self._ahead: BusAhead | None = None  # real time on a field bus: work ahead in the slack (B60)
+        # Fitted windows worked out by a second process (B86): "auto" in real time, "wait" (lock-step tests: the
+        # run waits for each window), "off"; None: hil.fit_ahead.mode()
+        self.fit_ahead: str | None = None
+        self._fit_ahead = None
 
     def trace_columns(self) -> list[str]:
         extra = [c for src in self.trace_sources for c in src.columns]
@@ -179,6 +184,7 @@ class BenchRunner:
             if hasattr(self.mlc, "attach_variables"):  # MLC ↔ #25000–#25511 exchange (issue 8)
                 self.mlc.attach_variables(interp.vars)
             planner = self.make_planner()
+            self._start_fit_ahead(interp, program, planner, paced)
             if paced:
                 _quiet_gc()
             else:  # B42: what is built so far (modules, the parsed program) frozen out of the collector's walks
@@ -186,6 +192,8 @@ class BenchRunner:
             if not self.power_up() or not home_axes(self):  # axes with a bench `homing` table: drive homing
                 return self._finish()
             interp.take_position(dict(zip(self.axes, self.actual.tolist())))
+            if self._fit_ahead is not None:
+                self._fit_ahead.begin(dict(zip(self.axes, self.actual.tolist())))
             self.run_events(interp.run(program), planner)
         except BusError as exc:
             self._alarm(exc.alarm)
@@ -211,10 +219,27 @@ class BenchRunner:
                 except OSError as exc:  # the retentive memory cannot be written: the next run would lose it
                     self.result.alarms.append(Alarm(retentive.RETENTIVE_ERROR, f"retentive variables {self.retain}: "
                                                                                 f"cannot be written ({exc.strerror})"))
+            if self._fit_ahead is not None:
+                self.result.fits_ahead = self._fit_ahead.close()
+                self._fit_ahead = None
             if paced:
                 gc.enable()
             gc.unfreeze()  # (B42: what was frozen for the run collectable again once it is over)
         return self._finish()
+
+    def _start_fit_ahead(self, interp: Interpreter, program: Program, planner: Planner, paced: bool) -> None:
+        """B86: in real time, a bench whose planner fits runs gets them worked out ahead by a forked child."""
+        mode = self.fit_ahead or fit_ahead.mode()
+        if planner._runs is None or mode == "off" or (mode == "auto" and not paced):
+            return
+        # Where the axes will stand, as far as known before power-up: a simulated axis's power-on position (a real
+        # drive's may differ: the child starts again from where `begin` says)
+        guess = {a.name: float(a.start) for a in self.bench.axes}
+        self._fit_ahead = fit_ahead.start(interp, program, planner.cfg, guess, wait=mode == "wait")
+        if self._fit_ahead is not None:
+            planner._runs.memo = self._fit_ahead.memo
+            if mode == "auto":  # paced cycles have no time to wait: the first windows now
+                self._fit_ahead.prefetch(PREFETCH_S)
 
     def power_up(self) -> bool:
         """Bring every drive to operation enabled, one state-machine step per cycle."""
@@ -636,6 +661,9 @@ def stands(rest: int, following_error: int, enabled: bool) -> bool:
     error left (a drive braking on its own quick stop has none to meet). BenchRunner._at_rest, and a settle
     stretch's end (hil/stretch.py, B38)."""
     return rest >= REST_CYCLES and (following_error == 0 or not enabled)
+
+
+PREFETCH_S = 1.0  # B86: before a real-time run's power-up, the child's first windows are waited for this long at most
 
 
 def _quiet_gc() -> None:

@@ -211,6 +211,9 @@ def print_timing(r: RunResult, out=None) -> None:
     if r.realtime and b:  # the work done in the periods' slack (decision B21): with cycle work, what a tick waits for
         print("between cycles " + "  ".join(f"{k} {b.get(k, 0.0) * 1e6:.1f} µs" for k in ("p50", "p99", "max")),
               file=out)
+    if r.fits_ahead is not None and sum(r.fits_ahead):  # B86
+        ahead, here = r.fits_ahead
+        print(f"fitted windows {ahead} worked out ahead by a second process, {here} in the cycle", file=out)
     if r.overruns:
         print(f"overruns       {r.overruns} cycles ran past their deadline", file=sys.stderr if not r.alarms else out)
 

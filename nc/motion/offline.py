@@ -61,11 +61,14 @@ class _Collector:
 
 def run(events: Iterable[Event] | Iterator[Event], cfg: MotionConfig, start: dict[str, float] | None = None,
         spindle_rpm: Callable[[], float] | None = None, max_cycles: int = 10_000_000, keep: bool = True,
-        on_cycle: Callable[[int, Channel], None] | None = None) -> Stream:
-    """Step the channel until the program ends; `keep=False` keeps only the last position (streaming)."""
+        on_cycle: Callable[[int, Channel], None] | None = None, fit_memo=None) -> Stream:
+    """Step the channel until the program ends; `keep=False` keeps only the last position (streaming).
+    `fit_memo`: where the planner's fitted runs take and leave their windows (nc.motion.fit_memo)."""
     ch: Channel
     rpm_box = {"rpm": 0.0}
     planner = Planner(cfg, start, spindle_rpm=spindle_rpm or (lambda: rpm_box["rpm"]))
+    if fit_memo is not None and planner._runs is not None:
+        planner._runs.memo = fit_memo
     ch = Channel(planner)
     ch.load(iter(events))
     ch.cycle_start()

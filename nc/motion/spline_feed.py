@@ -31,6 +31,7 @@ from dataclasses import dataclass, field, fields, replace
 
 import numpy as np
 
+from nc.motion.fit_memo import MISSING, FitMemo, window_key
 from nc.motion.limits import MotionConfig
 from nc.motion.spline_runs import FitError, SplineSpan, fit_run, spans
 from nc.moves import Move
@@ -59,6 +60,7 @@ class Held:
     end: list[float] | None = None  # end point and direction of the last eligible move (held or let through):
     u: list[float] | None = None  # its junction with the next decides
     tail: SplineSpan | None = None  # the last span let through (a run's next window joins it)
+    key: bytes = b""  # the key of the window that made `tail` (nc.motion.fit_memo)
 
 
 NOTHING = Held()
@@ -77,6 +79,8 @@ class RunFeed:
         # The last eligible move's geometry (move, start, end, length, unit direction): the planner's line
         # Segment of that move is built from it (the same floats as Segment.of's own, issue 17)
         self.geom: tuple[Move, list[float], list[float], float, list[float]] | None = None
+        # Windows worked out ahead by another process (hil/fit_ahead.py, decision bench B86), or None
+        self.memo: FitMemo | None = None
 
     @staticmethod
     def enabled(cfg: MotionConfig) -> bool:
@@ -171,20 +175,36 @@ class RunFeed:
         pts = np.array(verts)
         first = len(verts) - 1 - len(moves)  # segments behind
         end = n == len(moves)
-        cut = self._spans(pts, first, n, end)
-        if cut is None:  # no fit within the tolerance: as lines, the run ends
+        memo, key = self.memo, b""
+        if memo is None:
+            cut = self._solve(st, pts, first, n, end)
+        else:
+            key = window_key(st.key if st.tail is not None else b"", pts, first, n, end)
+            cut = memo.get(key)
+            if cut is MISSING:
+                cut = self._solve(st, pts, first, n, end)
+                memo.put(key, cut)
+        if cut is None:  # no fit within the tolerance, or the joint left it: as lines, the run ends
             return NOTHING, [(m, None) for m in moves]
-        if st.tail is not None:
-            cut = join(st.tail, cut)
-            if not self._within(cut, pts):  # the joint's shift took the curve off the tolerance: as lines
-                return NOTHING, [(m, None) for m in moves]
         if end:  # the run ends on its vertex exactly (a plan's end takes seg.end)
             cut[-1].end = pts[-1].copy()
         out = [(m, sp) for i, m in enumerate(moves[:n]) for sp in cut[i * SPLIT:(i + 1) * SPLIT]]
         if end:
             return NOTHING, out
         keep = pts[max(0, first + n - BEHIND):first + n + 1]
-        return Held(moves[n:], tuple(tuple(v.tolist()) for v in keep), True, st.end, st.u, cut[-1]), out
+        return Held(moves[n:], tuple(tuple(v.tolist()) for v in keep), True, st.end, st.u, cut[-1], key), out
+
+    def _solve(self, st: Held, pts: np.ndarray, first: int, n: int, end: bool) -> list[SplineSpan] | None:
+        """The window's spans, joined onto the run's last span, or None where the fit or the joint misses
+        N1.053. A function of its inputs alone (nc.motion.fit_memo keys them)."""
+        cut = self._spans(pts, first, n, end)
+        if cut is None:
+            return None
+        if st.tail is not None:
+            cut = join(st.tail, cut)
+            if not self._within(cut, pts):  # the joint's shift took the curve off the tolerance
+                return None
+        return cut
 
     def _within(self, cut: list[SplineSpan], pts: np.ndarray) -> bool:
         """The shifted spans (JoinedSpan) within N1.053 of the window's polyline (every 0.002 mm)."""

@@ -1,0 +1,111 @@
+"""Fitted runs' windows worked out ahead, by another process (decision bench B86).
+
+A window's fit (`RunFeed._fix`: the smoothing spline, its spans, the joint onto the span before, the tolerance
+check) costs 7–35 ms of CPU. A run in real time does it in the cycle whose push completes the window, and that
+cycle overran by as much (a 400-segment CAM polyline on the mill bench: 55 ms of cycle work, 91 overruns). A
+window's result is a pure function of its inputs: the window's vertices, how many of its moves go out, whether
+the run ends there, and the span the window before ended with. So another process that runs the same program
+offline (hil/fit_ahead.py) works every window out ahead and sends it here, keyed by those inputs; the cycle
+takes it from here instead of fitting. Where that process saw other inputs (an override, a variable the MLC
+set, a run cut by a feed hold), the key differs, the cycle fits the window itself, as before: the result is the
+same bits either way, only where the CPU is spent differs.
+
+The key of a window chains the key of the window that made its joint's span (`Held.key`): equal keys, equal
+spans before, so equal results.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import pickle
+import struct
+from collections import OrderedDict
+from typing import Any, Protocol
+
+import numpy as np
+
+MISSING = object()  # not known here: the caller works it out
+KEY_SIZE = 16
+KEEP = 64  # results kept after they are read: a stretch pass may read a window again after a restore
+MARK = b"\0" * KEY_SIZE  # a message of this key alone: the sender's run is past its start (`FitSender.mark`)
+
+
+def window_key(prev: bytes, pts: np.ndarray, first: int, n: int, end: bool) -> bytes:
+    """The window's inputs as a key (`prev`: the key of the window whose last span the joint is made on)."""
+    h = hashlib.blake2b(prev, digest_size=KEY_SIZE)
+    h.update(np.ascontiguousarray(pts, dtype=float).tobytes())
+    h.update(struct.pack("<iiq?", pts.shape[0], first, n, end))
+    return h.digest()
+
+
+class FitMemo(Protocol):
+    def get(self, key: bytes) -> Any:
+        """The window's result (spans, or None: as lines), or MISSING."""
+
+    def put(self, key: bytes, result: Any) -> None:
+        """A result worked out here."""
+
+
+class FitSender:
+    """The working-ahead side: every window it works out goes to the connection."""
+
+    def __init__(self, conn) -> None:
+        self.conn = conn
+        self.sent = 0
+
+    def get(self, key: bytes) -> Any:
+        return MISSING
+
+    def put(self, key: bytes, result: Any) -> None:
+        for sp in result or ():  # the ends the look-ahead asks for at every junction, worked out here (kept in the
+            sp._end(True)  # span, so they travel with it): in the run's cycle they cost more than the fit
+            sp._end(False)
+        self.conn.send_bytes(key + pickle.dumps(result, protocol=pickle.HIGHEST_PROTOCOL))
+        self.sent += 1
+
+    def mark(self) -> None:
+        """Every window of the run's first cycles is sent (hil.fit_ahead: the run may start)."""
+        self.conn.send_bytes(MARK)
+
+
+class FitReceiver:
+    """The cycle's side: what the connection brought, read without waiting (`wait`: until the key or the sender's
+    end arrives, for lock-step tests that must not race the sender). Counts what was found and what was not."""
+
+    def __init__(self, conn, wait: bool = False) -> None:
+        self.conn = conn
+        self.wait = wait
+        self.blobs: OrderedDict[bytes, bytes] = OrderedDict()
+        self.found: set[bytes] = set()  # windows taken from the sender (a set: a restored pass reads one again)
+        self.fitted: set[bytes] = set()  # windows the cycle worked out itself
+        self.closed = False  # the sender ended (its program done, or it failed)
+        self.marked = False  # the sender is past the run's first cycles
+
+    def _read(self) -> None:
+        msg = self.conn.recv_bytes()
+        if msg == MARK:
+            self.marked = True
+            return
+        self.blobs[msg[:KEY_SIZE]] = msg[KEY_SIZE:]
+        while len(self.blobs) > KEEP:
+            self.blobs.popitem(last=False)
+
+    def _drain(self, key: bytes) -> None:
+        """Read up to the key (the sender's windows come in the run's order: mostly the next message is it)."""
+        try:
+            while not self.closed and key not in self.blobs and (self.wait or self.conn.poll()):
+                self._read()
+        except (EOFError, OSError):
+            self.closed = True
+
+    def get(self, key: bytes) -> Any:
+        if key not in self.blobs:
+            self._drain(key)
+        blob = self.blobs.get(key)
+        if blob is None:
+            return MISSING
+        self.found.add(key)
+        return pickle.loads(blob)  # new objects every time: the planner may change its spans
+
+    def put(self, key: bytes, result: Any) -> None:
+        self.fitted.add(key)

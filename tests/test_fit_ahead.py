@@ -1,0 +1,116 @@
+"""Fitted windows worked out ahead by a second process (decision bench B86): the same setpoints as fitting them in
+the cycle, every window taken from the child where it saw the run's inputs, the child started again when the axes
+stood elsewhere than guessed, and reaped when the run ends."""
+
+from __future__ import annotations
+
+import json
+import os
+
+import numpy as np
+import pyarrow.parquet as pq
+import pytest
+
+from benchmarks.bench_vs_linuxcnc import cam_polyline
+from hil import api, fit_ahead
+from hil.bench_file import load_bench_file
+from hil.run_output import to_json
+from nc.interp import Interpreter
+from nc.motion.offline import run as offline_run
+from nc.profiles import make_profile
+from nc.program.blocks import parse_program
+from tests.conftest import ROOT
+from tests.test_realtime_stretch import fake_clock
+
+MILL = ROOT / "benches" / "mill-3axis.toml"
+pytestmark = pytest.mark.skipif(not hasattr(os, "fork"), reason="the second process is forked (POSIX)")
+
+
+@pytest.fixture(scope="module")
+def program_text() -> str:
+    return cam_polyline(100).text(False)  # 100 segments of ≈ 0.8 mm turning ≈ 15°: fitted, 5 windows
+
+
+def _columns(path) -> dict:
+    t = pq.read_table(path)
+    return {c: t.column(c).to_pylist() for c in t.column_names}
+
+
+def _run(monkeypatch, tmp_path, text: str, mode: str, realtime: bool = False, tag: str = "") -> tuple:
+    monkeypatch.setenv("DELTAHIL_FIT_AHEAD", mode)
+    prog = tmp_path / "cam.nc"
+    prog.write_text(text)
+    trace = tmp_path / f"t{mode}{tag}.parquet"
+    res = api.run(str(prog), str(MILL), trace=str(trace), realtime=realtime, check=False, trace_signals=None)
+    return res, _columns(trace)
+
+
+def _same(a: dict, b: dict) -> None:
+    assert list(a) == list(b)
+    for c in a:
+        if c not in ("period", "late"):  # (real time: the pacing's own columns)
+            assert a[c] == b[c], f"column {c}"
+
+
+def test_windows_from_the_child_give_the_same_setpoints_as_fitting_in_the_cycle(monkeypatch, tmp_path, program_text):
+    off, cols_off = _run(monkeypatch, tmp_path, program_text, "0")
+    ahead, cols_ahead = _run(monkeypatch, tmp_path, program_text, "wait")
+    assert off.run.fits_ahead is None  # no second process
+    found, fitted = ahead.run.fits_ahead
+    assert found >= 4 and fitted == 0  # every window taken from the child
+    _same(cols_off, cols_ahead)
+    assert ahead.run.final == off.run.final and ahead.ok and off.ok
+
+
+def test_the_child_starts_again_from_where_the_axes_stood(program_text):
+    """Guessed wrong before power-up (a real drive stood elsewhere): the child runs the program again from where
+    `begin` says, and its windows are those the run needs."""
+    cfg = load_bench_file(MILL).motion_config()
+    prog = parse_program(program_text, name="cam.nc")
+    actual = {"X": 0.0, "Y": 0.0, "Z": 100.0}
+
+    def interp():
+        return Interpreter(make_profile("nc5-mill", ("X", "Y", "Z")))
+
+    child = fit_ahead.start(interp(), prog, cfg, {"X": 5.0, "Y": -3.0, "Z": 80.0}, wait=True)
+    assert child is not None
+    try:
+        child.begin(dict(actual))
+        it = interp()
+        it.take_position(actual)
+        with_child = offline_run(it.run(prog), cfg, actual, fit_memo=child.memo)
+    finally:
+        found, fitted = child.close()
+    it = interp()
+    it.take_position(actual)
+    alone = offline_run(it.run(prog), cfg, actual)
+    assert found >= 4 and fitted == 0
+    assert np.array_equal(with_child.positions, alone.positions)
+
+
+def test_a_real_time_run_takes_windows_from_the_child_and_reaps_it(monkeypatch, tmp_path, program_text):
+    made: list[fit_ahead.FitAhead] = []
+    start = fit_ahead.start
+
+    def spy(*a, **k):
+        child = start(*a, **k)
+        made.append(child)
+        return child
+
+    monkeypatch.setattr(fit_ahead, "start", spy)
+    fake_clock(monkeypatch)
+    rt, cols_rt = _run(monkeypatch, tmp_path, program_text, "auto", realtime=True)
+    monkeypatch.setattr(fit_ahead, "start", start)
+    off, cols_off = _run(monkeypatch, tmp_path, program_text, "0", realtime=True, tag="rt")
+    assert len(made) == 1 and off.run.fits_ahead is None
+    found, fitted = rt.run.fits_ahead
+    assert found >= 1 and found + fitted >= 4  # (on a fake clock the run may outpace the child: those fitted here)
+    _same(cols_off, cols_rt)
+    with pytest.raises(ChildProcessError):  # reaped: no child left behind
+        os.waitpid(made[0].pid, os.WNOHANG)
+    assert json.loads(to_json(rt))["fitted_windows"] == {"ahead": found, "in_cycle": fitted}
+
+
+def test_a_lock_step_run_starts_no_child(monkeypatch, tmp_path, program_text):
+    res, _ = _run(monkeypatch, tmp_path, program_text, "auto")  # lock-step: fitting in the cycle misses no deadline
+    assert res.run.fits_ahead is None
