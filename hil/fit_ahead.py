@@ -88,7 +88,7 @@ def start(interp, program, cfg: MotionConfig, guess: dict[str, float], wait: boo
     `guess` (where the axes are believed to stand before power-up; `begin` says where they do). None where fork
     fails. `wait`: the run waits for each window the child has not sent yet (lock-step tests)."""
     results_r, results_w = Pipe(duplex=False)
-    _widen(results_w)
+    capacity = _widen(results_w)
     start_r, start_w = Pipe(duplex=False)
     try:
         pid = os.fork()
@@ -101,7 +101,7 @@ def start(interp, program, cfg: MotionConfig, guess: dict[str, float], wait: boo
         try:
             results_r.close()
             start_w.close()
-            _child(interp, program, cfg, dict(guess), start_r, results_w)
+            _child(interp, program, cfg, dict(guess), start_r, FitSender(results_w, capacity))
         except BaseException:  # noqa: BLE001 - the run fits what it does not get; nothing to report from here
             code = 1
         finally:
@@ -111,18 +111,19 @@ def start(interp, program, cfg: MotionConfig, guess: dict[str, float], wait: boo
     return FitAhead(pid, start_w, FitReceiver(results_r, wait=wait))
 
 
-def _widen(conn: Connection) -> None:
+def _widen(conn: Connection) -> int:
     """The pipe as wide as an unprivileged process may make it (Linux: 1 MiB, ≈ 10 windows of ≈ 93 kB): the child
-    blocks once the run is that far behind (a 64 kB pipe held less than one window: the child then ran in step
-    with the run, one window behind)."""
+    waits once the run is that far behind (a 64 kB pipe held less than one window: the child then ran in step
+    with the run, one window behind). Its size in bytes, 0 where unknown (the child then writes without waiting
+    for room)."""
     try:
         import fcntl
 
         with open("/proc/sys/fs/pipe-max-size") as f:
             size = int(f.read())
-        fcntl.fcntl(conn.fileno(), getattr(fcntl, "F_SETPIPE_SZ", 1031), size)
+        return fcntl.fcntl(conn.fileno(), getattr(fcntl, "F_SETPIPE_SZ", 1031), size)
     except (OSError, ValueError, ImportError):
-        pass
+        return 0
 
 
 class _Moved(Exception):
@@ -133,7 +134,7 @@ class _Moved(Exception):
 
 
 def _child(interp, program, cfg: MotionConfig, start: dict[str, float], start_r: Connection,
-           results_w: Connection) -> None:
+           sender: FitSender) -> None:
     """Run the program offline from `start`, sending every window; when the run's `begin` says the axes stood
     elsewhere, again from there (the windows already sent are keyed by their vertices: they stay unused)."""
     for s in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):  # a Ctrl-C is the run's; the run ends this child
@@ -151,7 +152,6 @@ def _child(interp, program, cfg: MotionConfig, start: dict[str, float], start_r:
     interp.servo.handler = None  # G10 L40-L46 would talk to the bus: not from here
     from nc.motion.offline import run
 
-    sender = FitSender(results_w)
     known: list[bool] = [False]  # the run's start position arrived
 
     def check(n: int, _ch) -> None:
@@ -183,4 +183,4 @@ def _child(interp, program, cfg: MotionConfig, start: dict[str, float], start_r:
                 start = actual
                 continue
         break
-    results_w.close()
+    sender.conn.close()

@@ -47,11 +47,26 @@ class FitMemo(Protocol):
 
 
 class FitSender:
-    """The working-ahead side: every window it works out goes to the connection."""
+    """The working-ahead side: every window it works out goes to the connection. `capacity`: the pipe's size in
+    bytes; a message is written only once it fits whole, so the reader (a paced cycle) never finds half a
+    message and waits for the rest from a process the scheduler may have put aside."""
 
-    def __init__(self, conn) -> None:
+    def __init__(self, conn, capacity: int = 0) -> None:
         self.conn = conn
+        self.capacity = capacity
         self.sent = 0
+
+    def _room(self, size: int) -> None:
+        import fcntl
+        import termios
+        import time
+
+        queued = bytearray(4)
+        while True:
+            fcntl.ioctl(self.conn.fileno(), termios.FIONREAD, queued)
+            if int.from_bytes(queued, "little") + size <= self.capacity:
+                return
+            time.sleep(0.002)
 
     def get(self, key: bytes) -> Any:
         return MISSING
@@ -60,7 +75,10 @@ class FitSender:
         for sp in result or ():  # the ends the look-ahead asks for at every junction, worked out here (kept in the
             sp._end(True)  # span, so they travel with it): in the run's cycle they cost more than the fit
             sp._end(False)
-        self.conn.send_bytes(key + pickle.dumps(result, protocol=pickle.HIGHEST_PROTOCOL))
+        msg = key + pickle.dumps(result, protocol=pickle.HIGHEST_PROTOCOL)
+        if self.capacity:
+            self._room(len(msg) + 8)  # (send_bytes' length header)
+        self.conn.send_bytes(msg)
         self.sent += 1
 
     def mark(self) -> None:
