@@ -176,8 +176,8 @@ def _scan(fc: "FilterCorners", blocks: Sequence["Block"], pos: float, run_end: f
             return 1.0, seen
         if m > 0.0:
             use = m
-    if k_lo == 0 and fc._seq0 > 0:
-        return None  # junctions within the reach were dropped already
+    if fc._seq_v > 0 and k_lo <= fc._seq_v - fc._seq0:
+        return None  # junctions within the reach were dropped already (by the bulk drop: FilterCorners._seq_v)
     return use, seen
 
 
@@ -279,7 +279,7 @@ def _walk(fc: "FilterCorners", blocks: Sequence["Block"], lo: float, hi: float, 
     tol = fc.tol
     ends: list[float] | None = None  # the queue's s_end, built once a junction needs its next block
     # FilterCorners keeps every junction since the last stop (its _h0 is relative to the newest
-    # push, not to the executing block) and drops old ones only in bulk, counted in _seq0.
+    # push, not to the executing block) and drops those no scan reads any more, counted in _seq0.
     # hist is in path order: the junctions past hi are skipped by bisection, not one by one. The
     # loop runs over ~85 junctions per solve on dense CAM paths (issue 17): max()/min() spelt out.
     # The junctions before lo by bisection too (hist is in path order): the loop stops at k_lo, and when
@@ -313,8 +313,8 @@ def _walk(fc: "FilterCorners", blocks: Sequence["Block"], lo: float, hi: float, 
                         top = x
                 if top <= v_stop:
                     return use, top
-    if k_lo == 0 and fc._seq0 > 0:
-        return None  # junctions within the reach were dropped already
+    if fc._seq_v > 0 and k_lo <= fc._seq_v - fc._seq0:
+        return None  # junctions within the reach were dropped already (by the bulk drop: FilterCorners._seq_v)
     return use, seen
 
 
