@@ -25,6 +25,7 @@ from dataclasses import dataclass, field
 from ruckig import InputParameter, OutputParameter, Result, Ruckig
 
 from mlc.memory import DeviceMemory
+from nc.exit_release import release_at_exit
 from mlc.signals import m2, m3
 
 MODE_CSP = 8
@@ -162,6 +163,8 @@ class SpindleAxisSwitch:
         base = index + target
         k = math.ceil((angle + ahead - base - 1e-9) / 360.0) if velocity > 0 else round((angle - base) / 360.0)
         self.goal = base + 360.0 * k
+        if self._otg is None:  # the first positioning: in the bench's cycles, so freed at exit (B83)
+            release_at_exit(self, "_otg", "_inp", "_out")
         self._otg = Ruckig(1, self.cycle)
         inp = self._inp = InputParameter(1)
         self._out = OutputParameter(1)

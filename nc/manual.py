@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from ruckig import ControlInterface, InputParameter, OutputParameter, Result, Ruckig
 
+from nc.exit_release import release_at_exit
 from nc.motion.limits import MotionConfig
 
 
@@ -59,6 +60,7 @@ class ManualMotion:
         self._otg = [Ruckig(1, self.cfg.cycle) for _ in range(n)]
         self._out = [OutputParameter(1) for _ in range(n)]
         self._inp = [self._make_input(i) for i in range(n)]
+        release_at_exit(self, "_otg", "_out", "_inp")  # in the bench's cycles: nanobind's leak report at exit (B83)
         self._mode: list[str | None] = [None] * n  # "velocity", "position" or None (at rest)
         self._target = self.position.copy()
         self._vcap = np.array([self.cfg.limit(a).max_velocity for a in self.cfg.axes])
