@@ -20,10 +20,13 @@ import copy
 import os
 import signal
 from dataclasses import dataclass
-from multiprocessing.connection import Connection, Pipe
+from typing import TYPE_CHECKING
 
 from nc.motion.fit_memo import FitReceiver, FitSender
 from nc.motion.limits import MotionConfig
+
+if TYPE_CHECKING:  # multiprocessing's connection module (≈ 5 ms) loads in `start`: every run imports this module
+    from multiprocessing.connection import Connection
 
 
 MARK_CYCLES = 200  # the child's cycles after which the run may start (`prefetch`)
@@ -87,6 +90,8 @@ def start(interp, program, cfg: MotionConfig, guess: dict[str, float], wait: boo
     """Fork the child for `program` (a parsed Program) on a copy of `interp` as it stands now, starting at once from
     `guess` (where the axes are believed to stand before power-up; `begin` says where they do). None where fork
     fails. `wait`: the run waits for each window the child has not sent yet (lock-step tests)."""
+    from multiprocessing.connection import Pipe  # only a run that fits ahead loads it (B84)
+
     results_r, results_w = Pipe(duplex=False)
     capacity = _widen(results_w)
     start_r, start_w = Pipe(duplex=False)

@@ -169,6 +169,25 @@ def test_an_event_after_a_run_without_events_in_one_process_still_fires_and_hold
     assert int(alone[2]) > 14396 + 550  # the hold's 0.6 s and the ramps around it, at 1 ms a cycle
 
 
+# What a lathe demo run with a Parquet trace must not import (B84): each costs every run and only some runs use it
+NOT_IN_A_LATHE_RUN = {
+    "multiprocessing.connection": "hil.fit_ahead's pipes: only a real-time run that fits ahead (B86)",
+    "mlc.remote_io": "a bench's remote I/O stations ([[io]]); mlc.program names IoMap in annotations only",
+    "scipy.special": "the blends' Fresnel integrals load the extension alone (B47)",
+    "pandas": "the trace's columns from numpy buffers (B48)",
+    "numpy.ma": "np.unique / np.median spelt without it (session 16)",
+    "hil.run_events": "--at/--events only (B65)",
+}
+
+
+def test_a_lathe_run_imports_none_of_the_modules_it_does_not_use(tmp_path):
+    code = ("import sys; from hil.cli import main; "
+            f"rc = main(['run', 'examples/lathe_demo.nc', '--trace', {str(tmp_path / 't.parquet')!r}]); "
+            f"print('IMPORTED', rc, *sorted(m for m in {sorted(NOT_IN_A_LATHE_RUN)!r} if m in sys.modules))")
+    out = _python(code)
+    assert out[out.index("IMPORTED") + 1:] == ["0"]
+
+
 def test_a_file_a_user_mlc_helper_leaves_open_is_written_and_the_exit_is_quiet(tmp_path):
     """The `hil` command skips the finalization's garbage collections (a freeze at the end of `hil.cli.main`, B83,
     ≈ 35 ms of the exit; B64 before it). What they did for a user must still happen: a user's MLC module whose
