@@ -20,6 +20,7 @@ Remote I/O (bench [[io]] stations): ``machine.set_input("X3")`` switches the sim
 from __future__ import annotations
 
 import math
+from numbers import Integral, Real
 import runpy
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -28,6 +29,8 @@ from typing import Any, Callable
 from hil.bench import Bench
 from hil.remote_io import IoNotSimulated, attach_remote_io, io_terminal
 from hil.runner import BenchRunner
+from hil import script_args as arg
+from hil.script_args import ScriptError
 from hil.session import make_link
 from mlc.machine import Mlc
 from mlc.nc_link import MODE_NAMES
@@ -46,10 +49,6 @@ from nc.store import ProgramStore
 # the script API below and `hil run --at "t=…:feed-hold"` (hil/run_events.py).
 OPERATOR_BUTTONS = {"cycle-start": 0, "feed-hold": 1, "reset": 4, "interrupt": 19}
 ESTOP_RELAY = 13  # M2x013: emergency stop, a level (ON = stopped)
-
-
-class ScriptError(Exception):
-    """A script asked for something the bench cannot do (unknown axis, timeout …)."""
 
 
 @dataclass
@@ -159,17 +158,19 @@ class Machine:
         return self.runner.time
 
     def cycle(self, n: int = 1) -> None:
-        for _ in range(n):
+        for _ in range(arg.whole("machine.cycle", "n", n, 0)):
             self.runner._exchange()
 
-    def wait(self, seconds: float) -> None:
-        self.cycle(max(1, int(round(seconds / self.bench.cycle))))
+    def wait(self, s: float) -> None:
+        self.cycle(max(1, int(round(arg.seconds(f"machine.wait({s!r})", s) / self.bench.cycle))))
 
     def wait_until(self, predicate: Callable[[], bool], timeout: float = 10.0, what: str = "condition") -> float:
         """Cycle until `predicate()` is true; returns the simulated time it took."""
+        if not callable(predicate):
+            raise ScriptError(f"machine.wait_until: {predicate!r} is not a function to call")
         t0 = self.time
-        limit = int(round(timeout / self.bench.cycle))
-        for _ in range(limit):
+        limit = int(round(arg.seconds(f"machine.wait_until(…, timeout={timeout!r})", timeout, positive=True) / self.bench.cycle))
+        for _ in range(max(1, limit)):
             if predicate():
                 return self.time - t0
             self.cycle()
@@ -177,13 +178,29 @@ class Machine:
 
     # ---- devices ---------------------------------------------------------------------------------
     def get(self, address: str) -> int:
-        return self.mlc.get(address)
+        from mlc.memory import DeviceError
+
+        try:
+            return self.mlc.get(arg.text("machine.get", "address", address))
+        except DeviceError as exc:
+            raise ScriptError(f"machine.get({address!r}): {exc}") from None
 
     def set(self, address: str, value: int | bool = True) -> None:
-        self.mlc.put(address, int(value))
+        from mlc.memory import DeviceError
+
+        if not isinstance(value, bool):  # a relay's True/False, or a number for a D device
+            value = arg.number(f"machine.set({address!r}, …)", "value", value)
+        try:
+            self.mlc.put(arg.text("machine.set", "address", address), int(value))
+        except DeviceError as exc:
+            raise ScriptError(f"machine.set({address!r}, …): {exc}") from None
 
     def pulse(self, relay: int, cycles: int = 2) -> None:
         """Press a button relay for a few cycles (edge-triggered commands)."""
+        from mlc.memory import M_SIZE
+
+        arg.whole("machine.pulse", "relay", relay, 0, M_SIZE - 1)
+        cycles = arg.whole("machine.pulse", "cycles", cycles, 1)
         self.mlc.mem.set_bit(relay, True)
         self.cycle(cycles)
         self.mlc.mem.set_bit(relay, False)
@@ -232,7 +249,7 @@ class Machine:
 
     # ---- operator actions through the special relays -------------------------------------------------
     def mode(self, name: str) -> None:
-        name = name.upper()
+        name = arg.text("machine.mode", "mode", name).upper()
         if name not in MODE_NAMES:
             raise ScriptError(f"unknown mode {name!r}; choose one of {', '.join(MODE_NAMES)}")
         k = MODE_NAMES.index(name)
@@ -242,9 +259,12 @@ class Machine:
     def mpg(self, axis: str, pulses: int, ratio: int = 1, rate: float = 100.0) -> None:
         """Turn the handwheel `pulses` detents (negative: backwards) at `rate` detents/s on `axis`."""
         i = self.axis_index(axis)
-        if not 0 <= ratio <= 0xFFFF:  # D2x009 is a word: the manual's 1/10/100 are usual, not the limit
-            raise ScriptError(f"MPG ratio {ratio}: D2x009 holds 0-65535 (usually 1, 10 or 100)")
-        if not 0.0 < rate < math.inf:  # no detents would ever come
+        # detents: a fraction would never be reached, the handwheel would turn on
+        pulses = arg.whole("machine.mpg", "pulses", pulses, -(1 << 31), (1 << 31) - 1, "of detents (+ or -)")
+        if not isinstance(ratio, Integral) or isinstance(ratio, bool) or not 0 <= ratio <= 0xFFFF:
+            # D2x009 is a word: the manual's 1/10/100 are usual, not the limit
+            raise ScriptError(f"MPG ratio {ratio!r}: D2x009 holds 0-65535 (usually 1, 10 or 100)")
+        if not isinstance(rate, Real) or not 0.0 < rate < math.inf:  # no detents would ever come
             raise ScriptError(f"MPG rate {rate:g}: detents per second must be > 0")
         mem = self.mlc.mem
         mem.set_u16(d2(self.x, 8), i)
@@ -266,11 +286,16 @@ class Machine:
 
     def settle(self, axis: str | None = None, timeout: float = 10.0) -> None:
         mm = self.mlc.manual
+        arg.seconds(f"machine.settle(timeout={timeout!r})", timeout, positive=True)
         self.wait_until(lambda: not mm.busy, timeout, "manual motion to finish")
         self.cycle(int(0.05 / self.bench.cycle))
 
     def jog(self, axis: str, direction: int, seconds: float, percent: int = 100) -> None:
         i = self.axis_index(axis)
+        if direction not in (1, -1) or isinstance(direction, bool):
+            raise ScriptError(f"machine.jog: direction {direction!r} must be 1 (+) or -1 (-)")
+        arg.seconds(f"machine.jog({axis!r}, {direction}, {seconds!r})", seconds)
+        percent = arg.whole("machine.jog", "percent", percent, 0, 100)  # D2x006 in percentage mode: 0-100 %
         if not self.mlc.mem.bit(m3(self.x, 4)):
             self.mode("JOG")
         self.mlc.mem.set_u16(d2(self.x, 6), percent)
@@ -283,6 +308,8 @@ class Machine:
     def inc(self, axis: str, steps: int, units: int = 1000) -> None:
         """`steps` presses of the INC key, each `units` × N9.013 (default 1000 × 0.001 = 1 mm)."""
         i = self.axis_index(axis)
+        steps = arg.whole("machine.inc", "steps", steps, -(1 << 31), (1 << 31) - 1, "of presses (+ or -)")
+        units = arg.whole("machine.inc", "units", units, 0, 0xFFFF_FFFF)  # D2x014 is a double word
         if not self.mlc.mem.bit(m3(self.x, 6)):
             self.mode("INC")
         self.mlc.mem.set_u32(d2(self.x, 14), units)
@@ -293,6 +320,7 @@ class Machine:
 
     def home(self, axis: str, timeout: float = 60.0) -> float:
         i = self.axis_index(axis)
+        arg.seconds(f"machine.home({axis!r}, timeout={timeout!r})", timeout, positive=True)
         if not self.mlc.mem.bit(m3(self.x, 7)):
             self.mode("HOME")
         self.pulse(m2(self.x, 320 + i))
@@ -306,6 +334,7 @@ class Machine:
         """Load program text in AUTO and press Cycle Start; returns at once (the channel runs on as the
         script cycles), so a script can feed-hold, reset or E-stop it mid-way."""
         r = self.runner
+        text = arg.text("machine.start_program", "program text", text)
         self.mlc.mem.set_u16(d2(self.x, 0), 0)
         self.wait_until(lambda: self.mlc.link.mode == 0 and not self.mlc.manual.busy, 5.0, "AUTO mode")
         try:
@@ -327,6 +356,7 @@ class Machine:
 
     def run_program(self, text: str, name: str = "program", timeout: float = 600.0) -> float:
         """Run program text to its end through cycle start and the handshakes; returns its time."""
+        arg.seconds(f"machine.run_program(…, timeout={timeout!r})", timeout, positive=True)
         prev_mode = self.mlc.link.mode
         t0 = self.time
         ch = self.start_program(text, name)
@@ -345,6 +375,7 @@ class Machine:
 
     def spindle(self, rpm: float, direction: int = 1, wait: bool = True) -> float:
         """Start (M03/M04 S…) or stop (rpm 0: M05) the spindle through MDI and the handshake."""
+        arg.number("machine.spindle", "rpm", rpm)
         if rpm == 0 or direction == 0:
             return self.mdi("M05")
         return self.mdi(f"{'M03' if direction > 0 else 'M04'} S{abs(rpm):g}")
@@ -352,9 +383,8 @@ class Machine:
     def spindle_override(self, percent: int) -> None:
         """The operator's spindle override D2x026 (%): the NC applies it under G97 and G96 alike,
         within G50/G92 S and the spindle maximum, and holds 100 % during threads (motion decisions 32)."""
-        if not 0 <= int(percent) <= 65535:
-            raise ValueError(f"spindle override {percent} % is outside 0-65535")
-        self.mlc.mem.set_u16(d2(self.x, 26), int(percent))
+        percent = arg.whole("machine.spindle_override", "percent", percent, 0, 65535)  # D2x026's range
+        self.mlc.mem.set_u16(d2(self.x, 26), percent)
         self.cycle()
 
     def get_rpm(self, spindle: int = 0) -> float:

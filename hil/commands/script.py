@@ -66,8 +66,9 @@ def cmd_script(args: argparse.Namespace) -> int:
         return code
     try:
         run_script(args.script, machine, args.args)
-    except ScriptError as exc:
-        print(f"hil script: {exc}", file=sys.stderr)
+    except ScriptError as exc:  # the API refused a call: where in the script, what it said (B80)
+        line = _script_line(args, exc)
+        print(f"hil script: {args.script}{f' at line {line}' if line else ''}: {exc}", file=sys.stderr)
         machine.report()
         machine.close()
         return EXIT_ALARM if "does not exist" not in str(exc) else EXIT_USAGE
@@ -87,11 +88,19 @@ def cmd_script(args: argparse.Namespace) -> int:
     return finish(machine)
 
 
-def _script_failed(args: argparse.Namespace, machine, exc: Exception) -> int:
+def _script_line(args: argparse.Namespace, exc: BaseException) -> int | None:
+    """The script's line the exception came through last (its own frames, not hil's)."""
+    import os
     import traceback
 
-    frames = [f for f in traceback.extract_tb(exc.__traceback__) if f.filename.endswith(args.script.split("/")[-1])]
-    where = f" at line {frames[-1].lineno}" if frames else ""
+    mine = os.path.realpath(args.script)
+    frames = [f for f in traceback.extract_tb(exc.__traceback__) if os.path.realpath(f.filename) == mine]
+    return frames[-1].lineno if frames else None
+
+
+def _script_failed(args: argparse.Namespace, machine, exc: Exception) -> int:
+    line = _script_line(args, exc)
+    where = f" at line {line}" if line else ""
     print(f"hil script: {args.script} raised{where}: {type(exc).__name__}: {exc}", file=sys.stderr)
     machine.report()
     machine.close()
