@@ -90,7 +90,8 @@ class BenchRunner:
         self.bench = bench
         self.link = link
         self.trace = trace
-        self.mlc = mlc or BasicMlc(max_rpm=min((s.max_rpm for s in bench.spindles), default=6000.0))
+        self.mlc = mlc or BasicMlc(max_rpm=min((s.max_rpm for s in bench.spindles), default=6000.0),
+                                   cycle_time=bench.cycle)
         self.on_cycle = on_cycle
         self.axes = bench.axis_names
         n_axes, n_sp = len(bench.axes), len(bench.spindles)

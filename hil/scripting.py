@@ -476,7 +476,7 @@ def build_mlc(bench: Bench, spec: str | None) -> Any:
     spec = spec or bench.mlc_program
     max_rpm = min((s.max_rpm for s in bench.spindles), default=6000.0)
     if spec == "basic":
-        return BasicMlc(max_rpm=max_rpm)
+        return BasicMlc(max_rpm=max_rpm, cycle_time=bench.cycle)
     program = None if spec in ("lathe", "default") else load_mlc_program(spec)
     mlc = Mlc(program, axes=bench.axis_names, cycle=bench.cycle, motion=bench.motion_config(), max_rpm=max_rpm)
     if "N0.1025" in bench.params:  # 1st spindle positioning check time, ms (App. A 0x0C01)
@@ -507,6 +507,7 @@ def mlc_setup(bench: Bench, mlc_spec: str | None, signals: str | None, m00_resum
     except MlcLoadError as exc:
         raise InputError(str(exc)) from None
     if not isinstance(mlc, Mlc):
+        mlc.m00_resume = m00_resume  # the basic MLC's M00 hold: its operator is built in (decision B78)
         return mlc, None, []
     sources = []
     if signals:

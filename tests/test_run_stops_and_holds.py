@@ -60,6 +60,34 @@ def test_an_m00_hold_longer_than_the_aux_timeout_is_no_mlc_finish_warning(tmp_pa
     assert 1.99 <= np.count_nonzero(c["line"] == 3) * 0.001 <= 2.02
 
 
+def test_m00_holds_on_the_basic_mlc_until_the_operators_cycle_start(tmp_path, capsys):
+    # the mill's basic MLC: M00 is the NC's hold (M3x037 until Cycle Start), as on the lathe MLC (decision B78)
+    for resume in (0.3, 1.2):
+        code, c = run(tmp_path, M00, "--m00-resume", str(resume))
+        out = capsys.readouterr().out
+        assert code == 0 and "basic" in out, out
+        held = np.flatnonzero(c["line"] == 3)
+        assert resume - 0.01 <= len(held) * 0.001 <= resume + 0.02, (resume, len(held))
+        assert np.allclose(c["X_cmd"][held], 20.0, atol=1e-9) and abs(c["X_cmd"][-1]) < 1e-9
+    # the same hold as the lathe MLC's on the same bench, within two cycles
+    _, lathe = run(tmp_path, M00, "--m00-resume", "1.2", "--mlc", "lathe")
+    assert abs(np.count_nonzero(lathe["line"] == 3) - len(held)) <= 2
+
+
+def test_m01_runs_on_under_the_basic_mlc_and_m00_resume_0_does_not_wait(tmp_path, capsys):
+    # M01 holds only with the optional-stop switch M2x009 (§3.8.1.2), which the basic MLC has not
+    code, c = run(tmp_path, M00.replace("M00", "M01"), "--m00-resume", "5")
+    assert code == 0 and np.count_nonzero(c["line"] == 3) <= 2 and c["t"][-1] < 2.5
+    code, c = run(tmp_path, M00, "--m00-resume", "0")
+    assert code == 0 and np.count_nonzero(c["line"] == 3) <= 2 and c["t"][-1] < 2.5
+    capsys.readouterr()
+    # the lathe MLC with the switch ON holds M01 for the operator's --m00-resume, as the guide says
+    code, c = run(tmp_path, M00.replace("M00", "M01"), "--mlc", "lathe", "--at", "t=0:set M21009=1",
+                  "--m00-resume", "0.7")
+    assert code == 0 and 0.69 <= np.count_nonzero(c["line"] == 3) * 0.001 <= 0.72
+    capsys.readouterr()
+
+
 CUT = "G90 G54 G17 G21 G94\nG01 X100. F3000\nM30\n"  # 2 s at 50 mm/s along X on the mill
 
 
