@@ -132,8 +132,9 @@ class TraceFile:
         return meta if isinstance(meta, dict) else {}
 
     def units(self) -> dict[str, str]:
-        if not self.parquet:
-            return {}
+        if not self.parquet:  # a CSV trace's units are in its side file, with the run's record (bench B81)
+            units = self.meta.get("units")
+            return {str(k): str(v) for k, v in units.items()} if isinstance(units, dict) else {}
         return {f.name: f.metadata[b"unit"].decode() for f in self._pf.schema_arrow
                 if f.metadata and b"unit" in f.metadata}
 

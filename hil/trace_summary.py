@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import json
+
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -209,6 +211,7 @@ def export(tf: TraceFile, out: str | Path, lo: Bound | None = None, hi: Bound | 
     tmp = Path(str(out) + ".part")
     if suffix == ".mf4":
         return _export_mdf(tf, out, tmp, lo, hi, columns, need)
+    record, units = _record(tf)
     try:
         for batch in tf.batches(need):
             if lo is not None or hi is not None:
@@ -216,7 +219,8 @@ def export(tf: TraceFile, out: str | Path, lo: Bound | None = None, hi: Bound | 
             if columns:
                 batch = batch.select(columns)
             if writer is None:
-                writer = _writer(suffix, tmp, batch.schema)
+                schema = batch.schema if suffix == ".csv" else _with_record(batch.schema, record, units)
+                writer = _writer(suffix, tmp, schema)
             if batch.num_rows:
                 writer.write_batch(batch) if hasattr(writer, "write_batch") else writer.write(batch)
                 rows += batch.num_rows
@@ -232,7 +236,40 @@ def export(tf: TraceFile, out: str | Path, lo: Bound | None = None, hi: Bound | 
         tmp.unlink(missing_ok=True)  # no file of headers only: the bounds missed the trace
         raise empty_slice(tf, lo, hi)
     tmp.replace(out)
+    if suffix == ".csv":
+        _csv_record(out, record, units)
     return rows
+
+
+def _record(tf: TraceFile) -> tuple[dict, dict[str, str]]:
+    """The run's record (provenance, bench, program, end) and the columns' units an export carries on (bench
+    B81): a converted trace is judged, reported and exported again as the one it came from."""
+    meta = {k: v for k, v in tf.meta.items() if k != "units"}
+    return meta, tf.units()
+
+
+def _with_record(schema, record: dict, units: dict[str, str]):
+    """Parquet / Arrow IPC: the record in the schema's `deltahil` metadata, each unit in its field's."""
+    from hil.trace_parquet import META_KEY
+
+    fields = [f if f.metadata or f.name not in units else f.with_metadata({"unit": units[f.name]}) for f in schema]
+    meta = dict(schema.metadata or {})
+    if record and META_KEY not in meta:
+        meta[META_KEY] = json.dumps(record, allow_nan=False, default=str).encode()
+    return pa.schema(fields, metadata=meta or None)
+
+
+def _csv_record(out: str | Path, record: dict, units: dict[str, str]) -> None:
+    """CSV: the record in the side file `hil run` writes (never an older file's left beside the export)."""
+    from hil.trace import csv_meta_path
+
+    side = csv_meta_path(out)
+    if not record and not units:
+        side.unlink(missing_ok=True)
+        return
+    tmp = side.with_name(side.name + ".part")
+    tmp.write_text(json.dumps({**record, **({"units": units} if units else {})}, default=str))
+    tmp.replace(side)
 
 
 def _writer(suffix: str, tmp: Path, schema):

@@ -160,3 +160,32 @@ def test_a_trace_a_killed_run_left_unfinished_is_pointed_at(tmp_path, capsys):
     assert "b.csv.part is what a run killed before it finished left: give that, or rerun" in capsys.readouterr().err
     assert main(["trace", str(tmp_path / "c.csv")]) == 2
     assert capsys.readouterr().err.strip().endswith("c.csv: no such trace file")
+
+
+def test_an_export_keeps_the_runs_bench_program_end_and_units(trace, tmp_path, capsys):
+    """bench B81: `hil trace --out x.csv` of a Parquet trace (and the other way) dropped the run's record: the
+    converted trace no longer knew its bench (`hil check x.csv --limits` asked for --bench), its end or units."""
+    from hil.trace_parquet import read_meta
+
+    meta = TraceFile(trace).meta
+    assert meta["end"]["alarm"] == "0x0401" and meta["bench"]["name"] == "lathe-2axis"
+    csv_out, back, arrow = tmp_path / "x.csv", tmp_path / "back.parquet", tmp_path / "x.arrow"
+    assert main(["trace", str(trace), "--out", str(csv_out)]) == 0
+    assert {k: v for k, v in TraceFile(csv_out).meta.items() if k != "units"} == meta
+    assert TraceFile(csv_out).meta["units"]["X_cmd"] == "mm"
+    capsys.readouterr()
+    assert main(["check", str(csv_out), "--max-ferr", "1"]) == 0
+    assert "bench lathe-2axis (recorded in the trace" in capsys.readouterr().out
+    for out in (back, arrow):  # CSV → Parquet / Arrow IPC: the side file's record goes into the schema again
+        assert main(["trace", str(csv_out), "--out", str(out)]) == 0
+        schema = pq.read_schema(out) if out.suffix == ".parquet" else pa.ipc.open_file(out).schema
+        assert read_meta(schema) == meta and schema.field("Z_vel").metadata == {b"unit": b"mm/s"}
+    mf4 = pytest.importorskip("asammdf").MDF
+    assert main(["trace", str(csv_out), "--out", str(tmp_path / "x.mf4")]) == 0
+    assert mf4(str(tmp_path / "x.mf4")).get("X_cmd").unit == "mm"  # the CSV's units reach MDF4 too
+    # an export of a trace without a record leaves none, not an older file's, beside its CSV
+    bare = tmp_path / "bare.csv"
+    bare.write_text("t,line,X_cmd\n0.001,0,1.0\n")
+    (tmp_path / "y.csv.meta.json").write_text('{"program": "older.nc"}')
+    assert main(["trace", str(bare), "--out", str(tmp_path / "y.csv")]) == 0
+    assert not (tmp_path / "y.csv.meta.json").exists()
