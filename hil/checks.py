@@ -278,6 +278,9 @@ def check_limits(cols: _Cols, bench: Bench, tolerance: float) -> list[CheckResul
     return out
 
 
+QUICK_STOP_ALARMS = ("0x0401", "0x0000")  # E-stop (M2x013), NC internal error: the drives' quick stop follows
+
+
 def _commanded_rows(cols: _Cols, axis: str, n: int) -> np.ndarray | None:
     """Rows where the axis's drive was in Operation Enabled, i.e. followed the NC's setpoint. In quick
     stop (E-stop, a failed planner) the drive brakes on its own ramp: that is judged by
@@ -285,7 +288,15 @@ def _commanded_rows(cols: _Cols, axis: str, n: int) -> np.ndarray | None:
     name = f"{axis}_sw"
     if name not in cols.trace.columns:
         return None
-    return (cols[name].astype(np.int64) & 0x6F) == 0x27
+    state = cols[name].astype(np.int64) & 0x6F
+    followed = state == 0x27
+    if "alarm" in cols.trace.columns:
+        # From an E-stop's or a failed cycle's row until the drive takes its quick stop, the bench lets the
+        # setpoint coast at the drive's speed (B10, B12): the drive's stop, not the NC's path (decision B82)
+        for i in np.flatnonzero(np.isin(cols["alarm"], QUICK_STOP_ALARMS)).tolist():
+            taken = np.flatnonzero(state[i:] != 0x27)
+            followed[i:i + int(taken[0]) if taken.size else len(state)] = False
+    return followed
 
 
 def _braking_check(cols: _Cols, axis: str, limit: float, tolerance: float, dt: float,

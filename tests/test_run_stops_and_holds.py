@@ -26,7 +26,7 @@ def run(tmp_path, program: str, *args: str, bench: str = MILL) -> tuple[int, dic
     prog = tmp_path / "p.nc"
     prog.write_text(program)
     trace = tmp_path / "t.csv"
-    code = main(["run", str(prog), "--bench", bench, "--trace", str(trace), "--no-check", *args])
+    code = main(["run", str(prog), *(["--bench", bench] if bench else []), "--trace", str(trace), "--no-check", *args])
     return code, read(trace) if trace.exists() else {}
 
 
@@ -191,3 +191,20 @@ def test_a_campaign_fault_with_recovery_after_its_estop_is_a_bad_campaign_file(t
     err = capsys.readouterr().err
     assert code == 2 and "fault 'recover'" in err and "'t=0.6:estop-off' comes after the E-stop 't=0.3:estop'" in err, err
     assert "Traceback" not in err and not (tmp_path / "out" / "results.parquet").exists()
+
+
+def test_limits_judge_an_estop_mid_deceleration_by_its_quick_stop_not_the_coast(tmp_path, capsys):
+    # the E-stop at 0.3 s hits X while it decelerates: until the drive takes its quick stop the bench lets the
+    # setpoint coast at the drive's speed (B12) — a step of the acceleration that is no planned path (decision B82)
+    code, c = run(tmp_path, (ROOT / "tests" / "data" / "campaign" / "short_turn.nc").read_text(), "--at", "t=0.3:estop",
+                  bench=str(ROOT / "benches" / "lathe-2axis.toml"))
+    assert code == 1
+    capsys.readouterr()
+    assert main(["check", str(tmp_path / "t.csv"), "--limits"]) == 0
+    out = capsys.readouterr().out
+    assert "ok    jerk X: " in out and "ok    quick stop deceleration X: " in out and "0 failed" in out, out
+    # the coast is there (what the jerk check flagged before): the setpoint's third difference across the
+    # E-stop's row is far over X's 1.5e5 mm/s^3, with the drive still in Operation Enabled
+    stop = int(np.flatnonzero(c["t"] >= 0.3)[0])
+    jerk = np.abs(np.diff(c["X_cmd"][stop - 3:stop + 3], n=3)) / 0.001 ** 3
+    assert jerk.max() > 5 * 1.5e5 and int(c["X_sw"][stop]) & 0x6F == 0x27, jerk
