@@ -132,6 +132,11 @@ def test_diff_flags_a_changed_bench_limit(serial, tmp_path):
      "checks.max_following_error.Q"),
     ("[[case]]\nprogram = 'short_turn.nc'\n", "case[0].bench"),
     ("[campaign\n", "not valid TOML"),
+    # an MLC no case could load: the file's error (as `hil run --mlc` refuses it), not an alarm 0x0000 per case (campaigns.md: exit 2)
+    ("[campaign]\nprograms = ['short_turn.nc']\nbenches = ['bench.toml']\nmlc = 'nosuchmodule'\n",
+     "campaign.mlc: MLC module nosuchmodule failed to load: ModuleNotFoundError"),
+    ("[campaign]\nprograms = ['short_turn.nc']\nbenches = ['bench.toml']\nmlc = 'gone.py'\n",
+     "campaign.mlc: MLC module "),
 ])
 def test_a_bad_campaign_file_names_the_field(tmp_path, text, field):
     p = run_quiet(with_data(tmp_path, "bad.toml", text), tmp_path / "o")

@@ -105,6 +105,8 @@ def parse_campaign(data: dict[str, Any], source: Path) -> Campaign:
     c.max_time = r.number(top, "max_time", "campaign.max_time", None, positive=True)
     c.trace = r.boolean(top, "trace", "campaign.trace", False)
     c.mlc = r.string(top, "mlc", "campaign.mlc", None)
+    if c.mlc:
+        _check_mlc(r, c.mlc, root)
     c.retries = r.integer(top, "retries", "campaign.retries", 3, minimum=1, maximum=20) or 3
     cross = r.boolean(top, "cross", "campaign.cross", True)
 
@@ -147,6 +149,19 @@ def parse_campaign(data: dict[str, Any], source: Path) -> Campaign:
     seen: set[Case] = set()  # a case listed twice (cross product and [[case]]) runs once
     c.cases = [x for x in c.cases if not (x in seen or seen.add(x))]
     return c
+
+
+def _check_mlc(r: FieldReader, spec: str, root: Path) -> None:
+    """The MLC every case runs, loaded once here: one that cannot load is the file's error (exit 2), as `hil run
+    --mlc` refuses it, not an internal-error alarm in every case."""
+    if spec in ("basic", "lathe", "default"):
+        return
+    from mlc.machine import MlcLoadError, load_program
+
+    try:
+        load_program(str((root / spec).resolve()) if spec.endswith(".py") else spec)
+    except MlcLoadError as exc:
+        r.err("campaign.mlc", str(exc))
 
 
 def _paths(r: FieldReader, data: dict, key: str, path: str, root: Path, *, required: bool,
