@@ -447,9 +447,9 @@ class Channel:
         if aux.kind == "S" and not aux.args.get("max"):
             self.spindle_rpm = aux.value
         self.pending_aux = aux
-        if aux.kind == "M" and aux.value in (0, 1) and aux.line:
-            # M00/M01 is the current block while it holds (NC5 §3.8.1): the trace's line and `--at line=N`
-            # name it, until the next block starts (decision bench B56)
+        if aux.wait and aux.line:
+            # an M/S/T block is the current block while the NC waits on it (its MLC finish, an M00 hold): the
+            # trace's line and `--at line=N` name it, until the next block starts (decisions bench B56, B79)
             self.planner.line = aux.line
         if aux.wait:
             self.state = RunState.WAIT_AUX

@@ -88,6 +88,22 @@ def test_m01_runs_on_under_the_basic_mlc_and_m00_resume_0_does_not_wait(tmp_path
     capsys.readouterr()
 
 
+# the lathe: Z feeds to -5, the turret indexes 2 stations (0.3 s, mlc/lathe.py) on line 3, Z feeds back
+TURRET = "G21 G18 G98\nG01 Z-5. F600\nT0303\nG01 Z0.\nM30\n"
+
+
+def test_an_mst_block_is_the_current_line_while_the_nc_waits_for_its_finish(tmp_path, capsys):
+    # NC5's screen shows the block being executed: the T block while the turret indexes (decision B79)
+    code, c = run(tmp_path, TURRET, "--at", "line=3:set D21006=7", bench="")
+    out = capsys.readouterr().out
+    assert code == 0, out
+    held = np.flatnonzero(c["line"] == 3)
+    assert 0.29 <= len(held) * 0.001 <= 0.31, len(held)  # 2 stations × 0.15 s, the handshake's scans
+    assert np.all(np.diff(held) == 1) and np.allclose(c["Z_cmd"][held], -5.0, atol=1e-9)
+    assert c["line"][held[0] - 1] == 2 and c["line"][held[-1] + 1] == 4
+    assert "line 3  set D21006=7   [line=3]" in out and "never triggered" not in out
+
+
 CUT = "G90 G54 G17 G21 G94\nG01 X100. F3000\nM30\n"  # 2 s at 50 mm/s along X on the mill
 
 

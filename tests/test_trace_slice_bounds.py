@@ -35,7 +35,9 @@ def test_a_slice_outside_the_trace_exits_2_and_writes_nothing(trace, tmp_path, c
     cap = capsys.readouterr()
     assert says in cap.err and "Traceback" not in cap.err + cap.out
     if "selects no rows" in says:
-        assert ", lines 3 … 5)" in cap.err  # the program's moving lines the user can slice by
+        # the program's lines the user can slice by: the moves, M03 S600 while the spindle runs up and M30 while
+        # the drives settle (an M/S/T block is the current line while the NC waits on it, decision B79)
+        assert ", lines 2 … 6)" in cap.err
     assert "wrote" not in cap.out and "rows           0" not in cap.out
     if out is not None:
         assert sorted(p.name for p in tmp_path.iterdir()) == []  # neither the file nor its .part
