@@ -625,7 +625,9 @@ class BenchRunner:
     def _end_record(self) -> dict:
         """How the run ended, for the trace's metadata: reason, first alarm, last cycle."""
         pool = self.result.alarms + (self.channel.alarms if self.channel is not None else [])
-        reason = getattr(self, "_end_reason", None) or self.stop_request or ("alarm" if pool else "completed")
+        # "aborted": the NC left the program without an alarm, a reset flushed it (decision B11)
+        done = "completed" if self.result.finished or self.channel is None else "aborted"
+        reason = getattr(self, "_end_reason", None) or self.stop_request or ("alarm" if pool else done)
         return {"reason": reason, "alarm": pool[0].code_text if pool else None,
                 "alarm_line": pool[0].line if pool else None, "cycle": self.cycle, "t": round(self.time, 9),
                 "complete": reason != "interrupted", "bus": "closed" if self._bus_closed else "open",

@@ -224,3 +224,21 @@ def test_limits_judge_an_estop_mid_deceleration_by_its_quick_stop_not_the_coast(
     stop = int(np.flatnonzero(c["t"] >= 0.3)[0])
     jerk = np.abs(np.diff(c["X_cmd"][stop - 3:stop + 3], n=3)) / 0.001 ** 3
     assert jerk.max() > 5 * 1.5e5 and int(c["X_sw"][stop]) & 0x6F == 0x27, jerk
+
+
+def test_a_reset_that_aborts_the_program_says_so_in_the_summary_and_the_end_record(tmp_path, capsys):
+    # RESET flushes the program (NC5 App. B M2x004, decision B58): the run ends there without an alarm; the
+    # summary said only `STOPPED` and the trace's end record `completed`
+    from hil.trace_read import TraceFile
+
+    prog = tmp_path / "p.nc"
+    prog.write_text(CUT)
+    trace = tmp_path / "t.parquet"
+    code = main(["run", str(prog), "--bench", MILL, "--trace", str(trace), "--no-check", "--at", "t=0.5:reset"])
+    out = capsys.readouterr().out
+    assert code == 1 and "alarms         none" in out, out
+    assert "result         STOPPED: the program was aborted before its end (a reset flushes it)" in out, out
+    end = TraceFile(trace).meta["end"]
+    assert end["reason"] == "aborted" and end["alarm"] is None and end["complete"], end
+    x = TraceFile(trace).arrays(["X_cmd"])["X_cmd"]
+    assert 10.0 < x[-1] < 40.0  # it stopped on the way to X100, at 0.5 s of 50 mm/s

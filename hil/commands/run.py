@@ -240,4 +240,6 @@ def print_summary(program: str, bench: Bench, r: RunResult, out=None) -> None:
     why = f" by {r.stopped_by}: axes stopped along the path, drives disabled at standstill" if r.stopped_by else ""
     if r.stopped_by and r.ok:
         why = f" ({r.stopped_by} came after the program's end)"
+    elif not r.ok and not r.alarms and not r.stopped_by:
+        why = ": the program was aborted before its end (a reset flushes it)"
     print(f"result         {'completed' if r.ok else 'STOPPED'}{why}", file=out)
