@@ -150,6 +150,21 @@ def _marked_rows(cols: dict, name: str, t: np.ndarray, line: np.ndarray) -> list
     return [(int(cyc[i]), float(t[i]), int(line[i]), x) for i, x in enumerate(texts) if x]
 
 
+def end_note(meta: dict) -> str | None:
+    """How the traced run ended, when not at its program's end (the trace's end record, decision B87), else None."""
+    end = meta.get("end") if isinstance(meta, dict) else None
+    if not isinstance(end, dict) or end.get("reason") in (None, "completed"):
+        return None
+    reason = str(end["reason"])
+    what = {"alarm": "by an alarm", "aborted": "aborted (a reset flushed the program)",
+            "interrupted": "interrupted (the trace was cut)"}.get(reason, f"by {reason}")
+    alarm = end.get("alarm")
+    if alarm:
+        what += f" {alarm}" + (f" at line {end['alarm_line']}" if end.get("alarm_line") else "")
+    when = f" at t={float(end['t']):.3f} s (cycle {end.get('cycle')})" if end.get("t") is not None else ""
+    return f"run ended {what}{when}, before its program's end"
+
+
 def format_summary(tf: TraceFile, s: Summary) -> str:
     out = [f"trace          {tf.path}  ({tf.kind}, {len(tf.columns)} columns)"]
     if s.rows == 0:
@@ -177,6 +192,9 @@ def format_summary(tf: TraceFile, s: Summary) -> str:
         out.append(f"events         {len(s.events) or 'none'}")
         for cyc, t, ln, text in s.events[:20]:
             out.append(f"  {text} at cycle {cyc} (t={t:.3f} s), line {ln}")
+    note = end_note(tf.meta)
+    if note:
+        out.append(f"end            {note}")
     return "\n".join(out)
 
 

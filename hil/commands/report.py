@@ -39,6 +39,11 @@ def cmd_report(args: argparse.Namespace) -> int:
         return EXIT_USAGE
     if origin:
         print(f"bench {origin}")
+    from hil.trace_summary import end_note
+
+    note = end_note(tf.meta)
+    if note:  # B87 (the report's summary says it too)
+        print(note)
     print(f"wrote {rep.html}")
     if rep.interactive:
         print(f"  {rep.interactive} (interactive, opens offline)")
