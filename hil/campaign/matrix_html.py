@@ -11,8 +11,8 @@ from typing import Any
 
 from hil.campaign.results import report_dir
 
-COLOURS = {"completed": "#c8f0c8", "alarm": "#f6c2c2", "check_failed": "#f9e0a8", "worker_lost": "#d9d9d9",
-           "timeout": "#e3c8f0"}
+COLOURS = {"completed": "#c8f0c8", "alarm": "#f6c2c2", "check_failed": "#f9e0a8", "not_triggered": "#f0e6c8",
+           "worker_lost": "#d9d9d9", "timeout": "#e3c8f0"}
 
 
 def variant(row: dict[str, Any]) -> str:

@@ -16,7 +16,7 @@ import pyarrow.parquet as pq
 
 from hil import strict_json
 
-STATUSES = ("completed", "alarm", "check_failed", "worker_lost", "timeout")
+STATUSES = ("completed", "alarm", "check_failed", "not_triggered", "worker_lost", "timeout")
 KEY_COLUMNS = ("program", "bench", "bus", "override", "rapid_override", "spindle_override", "params", "fault")
 # Fixed columns and their types; per-axis metrics (max_ferr_X, peak_v_share_X …) are float64 and
 # follow, in name order. A value that does not apply (no alarm, an axis a bench lacks) is null.

@@ -76,6 +76,9 @@ def _execute(case: CaseInputs, scratch: Path) -> dict[str, Any]:
                    message=a.message[:500])
     elif failed:
         out.update(status="check_failed", checks_failed="; ".join(c.name for c in failed))
+    elif result.unfired:  # B88: the case's fault never happened, so the case tested nothing of it (hil run: exit 3)
+        never = "; ".join(e.spec for e in result.unfired)
+        out.update(status="not_triggered", message=f"never triggered: {never}"[:500])
     else:
         out["status"] = "completed"
     if trace.exists():
