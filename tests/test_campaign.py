@@ -137,6 +137,13 @@ def test_diff_flags_a_changed_bench_limit(serial, tmp_path):
      "campaign.mlc: MLC module nosuchmodule failed to load: ModuleNotFoundError"),
     ("[campaign]\nprograms = ['short_turn.nc']\nbenches = ['bench.toml']\nmlc = 'gone.py'\n",
      "campaign.mlc: MLC module "),
+    # a parameter the bench file itself refuses (B89): the name, or a value out of its range
+    ("[campaign]\nprograms = ['short_turn.nc']\nbenches = ['bench.toml']\n[params]\n'N9.999' = [1, 2]\n",
+     "params.'N9.999': unknown parameter (did you mean N1.299?)"),
+    ("[campaign]\nprograms = ['short_turn.nc']\nbenches = ['bench.toml']\n[params]\n'N1.053' = [0.01, 99999]\n",
+     "params.'N1.053': must be within [0, 10] (mm), got 99999"),
+    ("[[case]]\nprogram = 'short_turn.nc'\nbench = 'bench.toml'\nparams = {'N9.999' = 1}\n",
+     "case[0].params.N9.999: unknown parameter"),
 ])
 def test_a_bad_campaign_file_names_the_field(tmp_path, text, field):
     p = run_quiet(with_data(tmp_path, "bad.toml", text), tmp_path / "o")

@@ -229,8 +229,23 @@ def _sweeps(r: FieldReader, table: dict) -> dict[str, list[float]]:
         if not values or len(good) != len(values):
             r.err(path, f"must be a finite number or an array of them, got {v!r}")
             continue
+        bad = _param_error(name, good)
+        if bad:
+            r.err(path, bad)
+            continue
         out[name] = [float(x) for x in good]
     return out
+
+
+def _param_error(name: str, values: list) -> str | None:
+    """The bench file's own check of a parameter (hil/bench_params.py, B89): its name and each value's range."""
+    from hil.bench_params import check_param
+
+    for x in values:
+        bad = check_param(name, x)
+        if bad:
+            return bad
+    return None
 
 
 def _faults(r: FieldReader, table: dict) -> dict[str, tuple[str, ...]]:
@@ -264,6 +279,8 @@ def _case(r: FieldReader, item: dict, path: str, root: Path, faults: dict[str, t
     for k, v in params.items():
         if isinstance(v, bool) or not isinstance(v, (int, float)) or v != v or abs(v) == float("inf"):
             r.err(f"{path}.params.{k}", f"must be a finite number, got {v!r}")
+        elif bad := _param_error(k, [v]):
+            r.err(f"{path}.params.{k}", bad)
         else:
             values[k] = float(v)
     r.unknown(item, f"{path}.", _CASE)
