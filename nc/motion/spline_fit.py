@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
+from functools import cache
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -25,7 +26,15 @@ DEGREE = 5  # quintic, its r''' continuous (decision 51); 3: decisions 48-50's c
 LAM = 0.01  # λ of the penalty ∫r'''² (mm⁵; of ∫r''² at DEGREE 3: 0.1 mm³); the weights then hold N1.053
 FINE = 20  # the check's finer look: FINE points a grid step (decision 51: 40 over the two steps around)
 _OFFSETS = (-2, -1, 0, 1, 2)  # the segments a curve point is measured against, around its own
-_GL4 = np.polynomial.legendre.leggauss(4)  # the penalty's quadrature a knot interval
+
+
+@cache
+def _gl4() -> tuple[np.ndarray, np.ndarray]:
+    """The penalty's quadrature a knot interval (numpy.polynomial, 4-8 ms to import, loaded by the first fit: a
+    run that never fits does without it, B84)."""
+    return np.polynomial.legendre.leggauss(4)
+
+
 _TRIU = {w: np.triu_indices(w) for w in range(1, 8)}  # a band's pairs of a row's entries
 
 
@@ -35,6 +44,8 @@ def load_scipy() -> None:
     import scipy.interpolate  # noqa: F401
     import scipy.linalg.lapack  # noqa: F401
     import scipy.sparse  # noqa: F401
+
+    _gl4()  # (numpy.polynomial with it)
 
 
 class FitError(RuntimeError):
@@ -239,7 +250,7 @@ def _penalty_rows(x: np.ndarray, t: np.ndarray, k: int, pen: int) -> tuple[np.nd
     derivative's coefficients as a band (row r from column r), then the degree k − pen B-splines' rows at
     the Gauss points times it (decision 51 built the same with scipy.sparse products)."""
     n = len(t) - k - 1
-    gx, gw = _GL4
+    gx, gw = _gl4()
     h = np.diff(x) / 2.0
     at = (x[:-1, None] + h[:, None] * (gx[None, :] + 1.0)).ravel()
     m = np.ones((n, 1))

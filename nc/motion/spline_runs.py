@@ -13,6 +13,7 @@ The planner does not use them yet: `benchmarks/bench_spline_bound.py` does (deci
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import cache
 
 from typing import TYPE_CHECKING
 
@@ -30,7 +31,12 @@ __all__ = ["DEGREE", "LAM", "PER_SEG", "Cost", "FitError", "fit_curve", "fit_run
 
 NODES = 9  # arc-length table nodes a polynomial piece
 CHEB = 9  # degree of a piece's position as a polynomial in its path length
-_GL_X, _GL_W = np.polynomial.legendre.leggauss(5)
+
+
+@cache
+def _gl5() -> tuple[np.ndarray, np.ndarray]:
+    """Gauss-Legendre nodes and weights for arc lengths (numpy.polynomial, loaded by the first span: B84)."""
+    return np.polynomial.legendre.leggauss(5)
 
 
 @dataclass
@@ -128,7 +134,7 @@ def _arc(c1: np.ndarray, w0: np.ndarray, w1: np.ndarray) -> np.ndarray:
     """Arc length from w0 to w1 of polynomials whose derivative's stack is c1 (5-point Gauss-Legendre)."""
     h = 0.5 * (w1 - w0)
     out = np.zeros(len(w0))
-    for x, g in zip(_GL_X, _GL_W):
+    for x, g in zip(*_gl5()):
         out += g * _speed(c1, w0 + h * (x + 1.0))
     return out * h
 
