@@ -92,15 +92,17 @@ def start(interp, program, cfg: MotionConfig, guess: dict[str, float], wait: boo
     fails. `wait`: the run waits for each window the child has not sent yet (lock-step tests)."""
     from multiprocessing.connection import Pipe  # only a run that fits ahead loads it (B84)
 
-    results_r, results_w = Pipe(duplex=False)
-    capacity = _widen(results_w)
-    start_r, start_w = Pipe(duplex=False)
-    try:
+    pipes: list[Connection] = []
+    try:  # a machine out of file descriptors or processes: every window is fitted in the cycle, as without it
+        pipes += Pipe(duplex=False)
+        pipes += Pipe(duplex=False)
+        capacity = _widen(pipes[1])
         pid = os.fork()
     except OSError:
-        for c in (results_r, results_w, start_r, start_w):
+        for c in pipes:
             c.close()
         return None
+    results_r, results_w, start_r, start_w = pipes
     if pid == 0:  # the child: never returns into the run's code
         code = 0
         try:

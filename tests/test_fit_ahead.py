@@ -114,3 +114,14 @@ def test_a_real_time_run_takes_windows_from_the_child_and_reaps_it(monkeypatch, 
 def test_a_lock_step_run_starts_no_child(monkeypatch, tmp_path, program_text):
     res, _ = _run(monkeypatch, tmp_path, program_text, "auto")  # lock-step: fitting in the cycle misses no deadline
     assert res.run.fits_ahead is None
+
+
+def test_a_fork_that_fails_leaves_the_windows_to_the_cycle(monkeypatch, tmp_path, program_text):
+    def no_fork():
+        raise OSError(11, "Resource temporarily unavailable")
+
+    monkeypatch.setattr(fit_ahead.os, "fork", no_fork)
+    res, cols = _run(monkeypatch, tmp_path, program_text, "wait")
+    _, cols_off = _run(monkeypatch, tmp_path, program_text, "0", tag="off")
+    assert res.ok and res.run.fits_ahead is None
+    _same(cols_off, cols)
