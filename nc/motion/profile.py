@@ -220,32 +220,42 @@ def _one_dof(interface: ControlInterface, p0: float, v0: float, a0: float, p1: f
     return otg, inp
 
 
+def _calculate(otg: Ruckig, inp: InputParameter, n: int) -> Trajectory | None:
+    """ruckig's solve, None where it cannot. ruckig 0.19 throws on some states exactly at a phase boundary:
+    0 → 1.2 + 1 ulp at a 1500, j 75000 (position), or a feed hold while braking at a_max with
+    v0 = a0²/2j + 1 ulp (velocity, decision motion 62). Two retries move off the boundary: the current
+    accelerations 1e-12 nearer zero (the ramp neither reverses, as a lower jerk can by 1e-8 mm/s, nor steps the
+    acceleration measurably), then the jerk 1 ppb lower as well."""
+    traj = Trajectory(n)
+    try:
+        return traj if otg.calculate(inp, traj) in _OK else None
+    except Exception:  # ruckig.RuckigError
+        pass
+    a = [x * (1.0 - 1e-12) for x in inp.current_acceleration]
+    j0 = list(inp.max_jerk)
+    for j in (j0, [x * (1.0 - 1e-9) for x in j0]):
+        inp.current_acceleration, inp.max_jerk = a, j
+        traj = Trajectory(n)
+        try:
+            return traj if otg.calculate(inp, traj) in _OK else None
+        except Exception:
+            continue
+    return None
+
+
 def solve_position(p0: float, v0: float, a0: float, p1: float, v1: float, v_max: float, a_max: float,
                    j_max: float) -> Piecewise | None:
     """Time-optimal 1-DoF profile (p0, v0, a0) → (p1, v1, 0); None when ruckig cannot solve it."""
     otg, inp = _one_dof(ControlInterface.Position, p0, v0, a0, p1, v1, 1e-9 if 1e-9 > v_max else v_max, a_max, j_max)
-    traj = Trajectory(1)
-    try:
-        ok = otg.calculate(inp, traj) in _OK
-    except Exception:  # ruckig.RuckigError
-        # ruckig 0.19 fails on some inputs exactly at a phase boundary (e.g. 0 → 1.2 + 1 ulp at
-        # a 1500, j 75000, where a/j² … meet): one retry with the jerk 1 ppb lower.
-        inp.max_jerk = [j_max * (1.0 - 1e-9)]
-        traj = Trajectory(1)
-        try:
-            ok = otg.calculate(inp, traj) in _OK
-        except Exception:
-            ok = False
-    if not ok:
-        return None
-    return Piecewise.of(traj)
+    traj = _calculate(otg, inp, 1)
+    return None if traj is None else Piecewise.of(traj)
 
 
 def solve_velocity(p0: float, v0: float, a0: float, v1: float, a_max: float, j_max: float) -> Piecewise:
     """Jerk-limited change of velocity to v1 (ends with a = 0), e.g. a feed hold or override ramp."""
     otg, inp = _one_dof(ControlInterface.Velocity, p0, v0, a0, p0, v1, max(abs(v0), abs(v1), 1e-9), a_max, j_max)
-    traj = Trajectory(1)
-    if otg.calculate(inp, traj) not in _OK:
+    traj = _calculate(otg, inp, 1)
+    if traj is None:
         raise NcAlarm(0x0000, f"velocity ramp {v0:g} → {v1:g} mm/s cannot be planned")
     return Piecewise.of(traj)
 
@@ -266,8 +276,7 @@ def solve_axes(p0, v0, a0, p1, v_max, a_max, j_max, velocity: bool = False) -> P
     inp.max_velocity = list(map(float, v_max))
     inp.max_acceleration = list(map(float, a_max))
     inp.max_jerk = list(map(float, j_max))
-    traj = Trajectory(n)
-    result = otg.calculate(inp, traj)
-    if result not in _OK:
-        raise NcAlarm(0x0000, f"independent-axis rapid cannot be planned ({result})")
+    traj = _calculate(otg, inp, n)
+    if traj is None:
+        raise NcAlarm(0x0000, "independent-axis rapid cannot be planned")
     return Piecewise.of(traj)
