@@ -204,7 +204,10 @@ class BenchRunner:
             self._alarm(exc.alarm)
         except Exception as exc:  # a bug in the NC or the planner: it must not take the stop with it
             self._end_reason = "internal error"
-            self._alarm(internal_error(exc))
+            blk = self.channel.planner.active if self.channel is not None else None
+            mv = blk.move if blk is not None else None  # the block being executed is where it happened
+            self._alarm(internal_error(exc, mv.line or None, mv.block or None, mv.program) if mv is not None
+                        else internal_error(exc, self.line or None))
             self._quick_stop()
         except BaseException:  # a second Ctrl-C: the trace's end record says the run was cut
             self._end_reason = "interrupted"

@@ -99,6 +99,7 @@ class NcAlarm(Exception):
         return self
 
 
-def internal_error(exc: BaseException, line: int | None = None, block: str | None = None) -> Alarm:
+def internal_error(exc: BaseException, line: int | None = None, block: str | None = None,
+                   program: str | None = None) -> Alarm:
     """0x0000 'NC internal error' for anything unexpected, so a user never sees a traceback."""
-    return Alarm(0x0000, f"NC internal error: {type(exc).__name__}: {exc}", line, block)
+    return Alarm(0x0000, f"NC internal error: {type(exc).__name__}: {exc}", line, block, program)

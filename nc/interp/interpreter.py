@@ -12,7 +12,7 @@ from collections import deque
 from collections.abc import Iterator
 
 from nc.alarm_table import ENDLESS_LOOP
-from nc.alarms import NcAlarm
+from nc.alarms import NcAlarm, internal_error
 from nc.budget import StatementBudget
 from nc.interp.corners import expand_corners
 from nc.interp.lean import NOTHING, LeanLane
@@ -116,7 +116,7 @@ class Interpreter(ExecuteMixin, ReadingMixin, ModalMixin, MotionMixin, NonModalM
         self.position.update(machine)
 
     def run(self, program: Program, *, preview: bool = True) -> Iterator[Event]:
-        events: Iterator[Event] = expand_corners(self, self._run(program))
+        events: Iterator[Event] = expand_corners(self, self._guarded(program))
         comp = _compensation()
         if comp is not None:
             events = comp(events, self.profile)
@@ -126,6 +126,18 @@ class Interpreter(ExecuteMixin, ReadingMixin, ModalMixin, MotionMixin, NonModalM
         return events
 
     # ---- the program counter -----------------------------------------------------------------
+    def _guarded(self, program: Program) -> Iterator[Event]:
+        """`_run`, with a bug in the interpreter reported as 0x0000 at the block it was reading (the guide's
+        standard: an internal error names the file, line and block too), not without a place."""
+        try:
+            yield from self._run(program)
+        except NcAlarm:
+            raise
+        except Exception as exc:
+            b = self.block
+            raise NcAlarm(0x0000, internal_error(exc).message, line=getattr(b, "line", None),
+                          block=getattr(b, "text", None), program=self.program_name) from exc
+
     def _run(self, program: Program) -> Iterator[Event]:
         self.program_name = program.name
         self.stack = [Frame(program)]
