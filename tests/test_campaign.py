@@ -216,6 +216,11 @@ def test_scheduler_and_workers_as_processes_run_the_campaign_and_survive_a_kille
     assert run.returncode == 1, out + err
     assert rows(tmp_path / "r") == rows(serial)  # every case completed, the killed one elsewhere
     assert "worker_lost" not in out
+    # the case the killed worker ran (and one queued behind it, B101) ran twice, and its row says so
+    attempts = sorted(r["attempts"] for r in pq.read_table(tmp_path / "r" / "results.parquet").to_pylist())
+    assert attempts[:-2] == [1] * 11 and 2 in attempts[-2:] and max(attempts) == 2, attempts
+    # the team's scheduler keeps its own allowed failures once the campaign is done
+    assert client.run_on_scheduler(lambda dask_scheduler: dask_scheduler.allowed_failures) == 3
 
 
 def test_a_case_that_keeps_losing_its_worker_is_marked_worker_lost(cluster, tmp_path):

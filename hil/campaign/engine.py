@@ -73,8 +73,7 @@ def _dask(cases: Sequence[CaseInputs], engine: Engine) -> Iterator[dict[str, Any
 
 def _on_cluster(cases: Sequence[CaseInputs], engine: Engine, cluster: Any) -> Iterator[dict[str, Any]]:
     """The cases on a cluster (ours, or the one at engine.scheduler), rows as they finish."""
-    from distributed import Client, as_completed
-    from distributed.client import FutureCancelledError
+    from distributed import Client
 
     client = Client(cluster if cluster is not None else engine.scheduler, timeout="30s")
     # a lost scheduler is the campaign's to report, not tracebacks from distributed's client
@@ -82,19 +81,35 @@ def _on_cluster(cases: Sequence[CaseInputs], engine: Engine, cluster: Any) -> It
         if cluster is not None:
             client.register_plugin(_quiet_worker(), name="hil-sigint-ignored")
         # The scheduler decides when a case has lost too many workers; on a cluster that is not
-        # ours it has its own setting, so the campaign's `retries` is set there too.
-        client.run_on_scheduler(_allow_failures, engine.retries - 1)
-        by_key = {}
-        futures = []
-        for c in cases:
-            # pure=False: a rerun is a new computation, never a cached result
-            f = client.submit(run_case, c, key=f"case-{c.input_hash}-{time.monotonic_ns()}", pure=False)
-            by_key[f.key] = c
-            futures.append(f)
-        for f in as_completed(futures):
+        # ours it has its own setting, so the campaign's `retries` is set there for the campaign (and put
+        # back after it: the cluster may be the team's, B101).
+        saved = client.run_on_scheduler(_allow_failures, engine.retries - 1)
+        try:
+            yield from _cases_on(client, cases, engine)
+        finally:
+            if cluster is None and client.status == "running":
+                _try(lambda: client.run_on_scheduler(_allow_failures, saved))
+
+
+def _cases_on(client: Any, cases: Sequence[CaseInputs], engine: Engine) -> Iterator[dict[str, Any]]:
+    from distributed import as_completed
+    from distributed.client import FutureCancelledError
+
+    by_key = {}
+    futures = []
+    for c in cases:
+        # pure=False: a rerun is a new computation, never a cached result
+        f = client.submit(run_case, c, key=f"case-{c.input_hash}-{time.monotonic_ns()}", pure=False)
+        by_key[f.key] = c
+        futures.append(f)
+    for batch in as_completed(futures).batches():
+        # the workers each case lost, from the scheduler's count, one call for what finished together (B101)
+        lost = _try(lambda: client.run_on_scheduler(_workers_lost, [f.key for f in batch])) or {}
+        for f in batch:
             case = by_key[f.key]
             try:
                 row = f.result()
+                row["attempts"] = 1 + lost.get(f.key, 0)
             except (FutureCancelledError, Exception) as exc:  # KilledWorker after `retries` lost workers
                 if _scheduler_gone(client, exc):
                     where = engine.scheduler or "of the local cluster"
@@ -103,6 +118,15 @@ def _on_cluster(cases: Sequence[CaseInputs], engine: Engine, cluster: Any) -> It
             finally:
                 f.release()
             yield row
+
+
+def _try(call: Callable[[], Any]) -> Any:
+    """A bookkeeping call to the scheduler that must not end the campaign (None when it fails: a lost
+    scheduler is found, and reported, by the futures)."""
+    try:
+        return call()
+    except Exception:
+        return None
 
 
 def _scheduler_gone(client: Any, exc: BaseException) -> bool:
@@ -169,8 +193,16 @@ def _quiet_worker() -> Any:
     return QuietWorker()
 
 
-def _allow_failures(n: int, dask_scheduler=None) -> None:
-    dask_scheduler.allowed_failures = n
+def _allow_failures(n: int, dask_scheduler=None) -> int:
+    """Set the scheduler's allowed failures a task; the value it had."""
+    old, dask_scheduler.allowed_failures = dask_scheduler.allowed_failures, n
+    return old
+
+
+def _workers_lost(keys: list[str], dask_scheduler=None) -> dict[str, int]:
+    """How many workers died while they held each task (the scheduler's `suspicious` count)."""
+    tasks = dask_scheduler.tasks
+    return {k: tasks[k].suspicious for k in keys if k in tasks and tasks[k].suspicious}
 
 
 class Progress:
