@@ -220,9 +220,21 @@ def check_contour(cols: _Cols, axes: list[str], moves: list[Move], limit: float,
     line = cols["line"]
     act = np.column_stack([cols[f"{a}_act"] for a in mv_axes]) if mv_axes else np.zeros((len(line), 0))
     dist = contour_distances(act, line, moves, mv_axes, lag_cycles, independent_rapids)
+    # An E-stop's (or a failed cycle's) rows, where the drives brake on their own quick stop and leave the path
+    # by design (stop category 1, B10/B12), are not judged as path: the quick stop check judges them (B102)
+    braking = np.zeros(len(line), dtype=bool)
+    for a in mv_axes:
+        followed = _commanded_rows(cols, a, len(line))
+        if followed is not None:
+            braking |= ~followed
+    off = dist[braking & (dist > 0.0)]
+    dist = np.where(braking, 0.0, dist)
     i = int(np.argmax(dist))
     over = np.flatnonzero(dist > limit)
     detail = f"{over.size} cycles over, first at cycle {cols.where(int(over[0]))['cycle']}" if over.size else ""
+    if off.size:  # said, not judged: how far the drives' own stop took the tool off the path
+        detail += ("; " if detail else "") + (f"not judged: {off.size} cycles the drives braked on their own "
+                                               f"(quick stop, fault), up to {off.max():.4g} mm off the path")
     return CheckResult("contour error", not over.size, float(dist[i]), limit, "mm", detail=detail, **cols.where(i))
 
 

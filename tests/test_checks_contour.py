@@ -156,3 +156,25 @@ def test_the_programmed_path_read_in_bulk_is_the_moves_one_by_one(tmp_path, prog
     want = [ev for ev in interp.run(load_program(str(program), [])) if isinstance(ev, Move)]
     assert len(got) > 100 and got == want
     assert any(m.kind == "arc" for m in got)
+
+
+def test_an_estops_quick_stop_is_said_not_judged_as_contour_error(tmp_path, capsys):
+    """B102: after an E-stop the drives brake on their own ramps (stop category 1) and leave the path; the contour
+    check judges the path the NC commanded up to there and says how far the braking went off it."""
+    from hil.cli import main
+    from tests.conftest import ROOT
+
+    x, lines = 0.0, ["G90 G17 G94 G01 F3000"]
+    for k in range(300):  # bench_loop's CAM curve: 0.01–0.1 mm lines along a sine
+        x += 0.01 + 0.09 * ((k * 7919) % 100) / 100.0
+        lines.append(f"X{x:.4f} Y{20.0 * math.sin(x / 40.0):.4f}")
+    prog = tmp_path / "cam.nc"
+    prog.write_text("\n".join(lines + ["M30"]) + "\n")
+    code = main(["run", str(prog), "--bench", str(ROOT / "benches" / "mill-3axis.toml"), "--at", "t=0.3:estop"])
+    out = capsys.readouterr().out
+    contour = next(ln for ln in out.splitlines() if "contour error" in ln)
+    assert code == 1 and "ALARM 0x0401" in out  # the E-stop is the run's alarm, not a failed check
+    assert contour.lstrip().startswith("ok") and "not judged:" in contour, contour
+    off = float(contour.split("up to ")[1].split(" mm")[0])
+    assert off > 0.05, contour  # the braking left the path by more than the limit: said, with its size
+    assert "quick stop deceleration X" in out and "FAIL" not in out, out
