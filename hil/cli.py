@@ -28,7 +28,7 @@ class UsageError(Exception):
 
 
 class _Version(argparse.Action):
-    """`--version`: the package metadata is read only when asked (importlib.metadata costs start-up)."""
+    """`--version`: the version of the source that runs (hil/version.py, decision B90)."""
 
     def __init__(self, option_strings, dest=argparse.SUPPRESS, default=argparse.SUPPRESS, help=None):
         super().__init__(option_strings, dest=dest, default=default, nargs=0, help=help)

@@ -35,6 +35,9 @@ def installed(tmp_path_factory) -> Path:
     if build.returncode != 0:
         pytest.skip(f"cannot build the wheel here: {build.stderr[-300:]}")
     wheel = next((tmp / "dist").glob("deltahil-*.whl"))
+    from hil.version import __version__
+
+    assert wheel.name.startswith(f"deltahil-{__version__}-")  # the metadata's version is the source's (B90)
     env_dir = tmp / "venv"
     venv.EnvBuilder(system_site_packages=True, with_pip=False).create(env_dir)
     py = env_dir / "bin" / "python"
