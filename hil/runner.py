@@ -41,7 +41,7 @@ from nc.interp import Interpreter
 from nc.interrupt import m96_link
 from nc.motion import Planner
 from nc.motion.css import spindle_speed
-from nc.motion.spline_fit import load_scipy
+from nc.motion.spline_feed import load_fit
 from nc.moves import Event, Move
 from nc.profiles import make_profile
 from nc.program import Program, parse_program
@@ -165,7 +165,7 @@ class BenchRunner:
         if paced:
             _preload(self.bench)
         elif type(self.link) is not SimLink:  # lock-step on a real bus: a stall would trip its watchdog
-            load_scipy()  # (a spline fit's scipy imports, ≈ 0.17 s; the sim bus waits for its first use)
+            load_fit()  # (a spline fit's modules and scipy imports, ≈ 0.18 s; the sim bus waits for its first use)
         try:
             # Everything the program needs is built before the drives are enabled: once cycles
             # run (paced in real time), a cycle has no room for it.
@@ -715,4 +715,4 @@ def _preload(bench: Bench) -> None:
     from mlc.signals import _by_name
 
     _by_name(1)
-    load_scipy()  # imported on first use otherwise (nc/motion/spline_fit.py)
+    load_fit()  # imported on first use otherwise (nc/motion/spline_feed.py)

@@ -5,14 +5,27 @@ and let through as spline spans, the filter's share λ = 0 on them (share zones 
 from __future__ import annotations
 
 from dataclasses import replace
+from typing import TYPE_CHECKING, Callable
 
 import numpy as np
 
 from nc.motion.lookahead import Block
 from nc.motion.path import Segment
 from nc.motion.spline_feed import NOTHING, Held, RunFeed
-from nc.motion.spline_runs import SplineSpan, span_limits
 from nc.moves import Move
+
+if TYPE_CHECKING:
+    from nc.motion.spline_runs import SplineSpan
+
+_span_limits: Callable | None = None  # nc.motion.spline_runs.span_limits, imported by the first span (bench B91)
+
+
+def _load_span_limits() -> Callable:
+    global _span_limits
+    from nc.motion.spline_runs import span_limits
+
+    _span_limits = span_limits
+    return span_limits
 
 
 class FittedRuns:
@@ -99,7 +112,7 @@ class FittedRuns:
         # lowers the cap), not the curve's own, so the coupling term
         # 3·v·a_t·r'' leaves a_t more (decision 58)
         top = 1.5 * (self.dry_run_feed if self.dry_run else (move.feed or 0.0) / 60.0)
-        v, a, j = span_limits(sp, np.minimum(lim.v, top * np.maximum(sp.dir_bound, 1e-12)), lim.acc, lim.jerk)
+        v, a, j = (_span_limits or _load_span_limits())(sp, np.minimum(lim.v, top * np.maximum(sp.dir_bound, 1e-12)), lim.acc, lim.jerk)
         v = min(v, sp.length / (self.cfg.min_segment_cycles * self.cfg.cycle))
         return Block(move, "path", sp, sp.length, v, a, j, (move.feed or 0.0) / 60.0)
 

@@ -27,14 +27,30 @@ held, BEHIND + 1 vertices kept).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, fields, replace
+from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from nc.motion.fit_memo import MISSING, FitMemo, window_key
 from nc.motion.limits import MotionConfig
-from nc.motion.spline_runs import FitError, SplineSpan, fit_run, spans
 from nc.moves import Move
+
+if TYPE_CHECKING:
+    from nc.motion.fit_memo import FitMemo
+    from nc.motion.spline_runs import SplineSpan
+
+
+
+def load_fit() -> None:
+    """Import what a window's fit runs: nc.motion.spline_runs, spline_fit and spline_join, fit_memo's keys, and
+    scipy's fitting parts (spline_fit.load_scipy). Each is imported by the first window fitted, not with the planner,
+    so a run whose program has no run to fit never loads them (bench decision B91); `hil`'s runner calls this before
+    paced cycles or a real bus, where an import inside a cycle would overrun it."""
+    import nc.motion.fit_memo  # noqa: F401
+    import nc.motion.spline_join  # noqa: F401
+    from nc.motion.spline_fit import load_scipy
+
+    load_scipy()
 
 AHEAD = 10  # segments known beyond a span before it is fixed (decision 51)
 BEHIND = 10  # fixed segments a window refits in front of the new ones (so the joint is the same curve)
@@ -44,7 +60,6 @@ MAX_TURN = math.radians(60.0)  # a sharper vertex ends the run (and is slowed as
 PAY = 2.0  # fit where a corner's own cap is below PAY x the feed
 SHARP = 2.0 * math.sin(MAX_TURN / 2.0)  # |Δu| of a MAX_TURN vertex
 SPLIT = 4  # spans a segment (each its own speed cap: a span's cap is its slowest point's)
-JOIN = 2.0  # mm of path over which a window's first spans are shifted onto the span before them
 PIN = 1e-6  # mm: a run's curve must meet its first and last vertex this closely (else it runs as lines)
 FIT_TOL = 0.985  # of N1.053: the fit's own tolerance (the joints' shifts take < 3e-4 mm)
 
@@ -179,6 +194,8 @@ class RunFeed:
         if memo is None:
             cut = self._solve(st, pts, first, n, end)
         else:
+            from nc.motion.fit_memo import MISSING, window_key
+
             key = window_key(st.key if st.tail is not None else b"", pts, first, n, end)
             cut = memo.get(key)
             if cut is MISSING:
@@ -201,6 +218,8 @@ class RunFeed:
         if cut is None:
             return None
         if st.tail is not None:
+            from nc.motion.spline_join import join
+
             cut = join(st.tail, cut)
             if not self._within(cut, pts):  # the joint's shift took the curve off the tolerance
                 return None
@@ -208,6 +227,8 @@ class RunFeed:
 
     def _within(self, cut: list[SplineSpan], pts: np.ndarray) -> bool:
         """The shifted spans (JoinedSpan) within N1.053 of the window's polyline (every 0.002 mm)."""
+        from nc.motion.spline_join import JoinedSpan
+
         a, d = pts[:-1], np.diff(pts, axis=0)
         dd = np.maximum(np.einsum("ij,ij->i", d, d), 1e-30)
         for sp in cut:
@@ -223,6 +244,8 @@ class RunFeed:
     def _spans(self, pts: np.ndarray, first: int, n: int, end: bool) -> list[SplineSpan] | None:
         if len(pts) < 3:
             return None
+        from nc.motion.spline_runs import FitError, fit_run, spans
+
         try:
             spl, cum = fit_run(pts, FIT_TOL * self.tol)
         except FitError:
@@ -236,57 +259,3 @@ class RunFeed:
         at = (sub[:-1, None] + np.diff(sub)[:, None] * (np.arange(SPLIT) / SPLIT)[None, :]).ravel()
         # (spans() cuts from the curve's start: the segments behind are cut too and dropped)
         return spans(spl, np.concatenate([cum[:first], at, sub[-1:]]), self.axes)[first:first + n * SPLIT]
-
-
-def _fade(x: np.ndarray, d: int) -> np.ndarray:
-    """d-th derivative of q(x) = 1 - smoothstep5(x) on [0, 1] (0 beyond): 1 at 0, 0 at 1, C2 at both ends."""
-    x = np.clip(x, 0.0, 1.0)
-    c = np.array([1.0, 0.0, 0.0, -10.0, 15.0, -6.0])
-    for _ in range(d):
-        c = np.polynomial.polynomial.polyder(c)
-    return np.polynomial.polynomial.polyval(x, c)
-
-
-@dataclass
-class JoinedSpan(SplineSpan):
-    """A span near the joint of two windows, shifted onto the span before it (decision motion 57): the two fits
-    differ there by up to 2e-4 mm, a step one cycle turns into 2x the axis jerk. Shift(σ) = (dp + dv·σ)·q(σ/JOIN),
-    σ the path length from the joint (`s0` at this span's start): position and direction meet the span before,
-    and the shift fades out C2 within JOIN mm (its curvature about 3e-4 /mm, its third derivative about
-    1e-3 /mm², within the span's 1 % bounds margin)."""
-
-    dp: np.ndarray = field(default_factory=lambda: np.zeros(0))
-    dv: np.ndarray = field(default_factory=lambda: np.zeros(0))
-    s0: float = 0.0
-
-    def _shift(self, s: np.ndarray, d: int) -> np.ndarray:
-        sig = self.s0 + np.clip(np.asarray(s, dtype=float), 0.0, self.length)
-        x = sig / JOIN
-        p = self.dp[None, :] + sig[:, None] * self.dv[None, :]
-        out = p * (_fade(x, d) / JOIN ** d)[:, None]
-        if d:  # Leibniz: p' = dv, p'' = 0
-            out = out + d * self.dv[None, :] * (_fade(x, d - 1) / JOIN ** (d - 1))[:, None]
-        return np.where((sig < JOIN)[:, None], out, 0.0)
-
-    def points(self, s: np.ndarray) -> np.ndarray:
-        return SplineSpan.points(self, s) + self._shift(s, 0)
-
-    def derivatives(self, s: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        r = SplineSpan.derivatives(self, s)
-        return tuple(x + self._shift(s, d) for d, x in enumerate(r))  # type: ignore[return-value]
-
-
-def join(tail: SplineSpan, cut: list[SplineSpan]) -> list[SplineSpan]:
-    """The spans of a new window, the first of them shifted onto `tail` (the last span of the window before)."""
-    a = tail.derivatives(np.array([tail.length]))
-    b = cut[0].derivatives(np.array([0.0]))
-    dp, dv = a[0][0] - b[0][0], a[1][0] - b[1][0]
-    out, s0 = [], 0.0
-    for sp in cut:
-        if s0 < JOIN:
-            sp = JoinedSpan(**{f.name: getattr(sp, f.name) for f in fields(sp)}, dp=dp, dv=dv, s0=s0)
-            ends = sp.points(np.array([0.0, sp.length]))
-            sp.start, sp.end = ends[0], ends[1]
-        out.append(sp)
-        s0 += sp.length
-    return out
