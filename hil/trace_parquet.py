@@ -30,14 +30,22 @@ from typing import Any, Sequence
 
 import numpy as np
 import pyarrow as pa
-import pyarrow.parquet as pq
 
 from hil.trace import INT_COLUMNS
+
+try:  # pyarrow's Parquet writer itself: pyarrow.parquet's module imports pyarrow.fs (ssl, S3, GCS...) with it (B92)
+    from pyarrow._parquet import ParquetWriter as _Writer
+except ImportError:  # a pyarrow without it: pyarrow.parquet's public writer
+    _Writer = None
 
 ROW_GROUP = 50_000  # rows per row group: ~50 s at 1 ms, a few MB in memory
 FLUSH_S = 2.0  # …or sooner, once this much wall time has passed (real-time runs lose at most this)
 META_KEY = b"deltahil"
 SWITCH_S = 0.0002  # the GIL switch interval while a writer converts (CPython's default 5 ms: a whole period)
+# what pq.write_table(table, where, compression="zstd") gives pyarrow's writer (pyarrow.parquet.core.ParquetWriter's
+# defaults), so the file is the one it writes (tests/test_trace_parquet_writer.py compares the bytes)
+_OPTIONS = dict(version="2.6", use_dictionary=True, compression="zstd", write_statistics=True,
+                writer_engine_version="V2", data_page_version="1.0", use_compliant_nested_type=True, store_schema=True)
 
 
 def _type_of(name: str, value: float | int | str | None) -> pa.DataType:
@@ -115,13 +123,48 @@ def _float_blocks(chunks: list, i: int) -> np.ndarray | None:
     return np.concatenate(pieces)
 
 
+def write_table(table: pa.Table, where: str | Path | pa.NativeFile) -> None:
+    """`pq.write_table(table, where, compression="zstd")`: the same file, through pyarrow's writer class itself
+    (`pyarrow._parquet.ParquetWriter`, what pq's writer wraps), so that a run does not import pyarrow.parquet's
+    module: it imports pyarrow.fs, and with it ssl and the S3/GCS/Azure/HDFS file systems, ≈ 10 ms of CPU in every
+    `hil run --trace` (issue 17, bench decision B92). A pyarrow whose writer is missing or takes other arguments
+    writes through pq.write_table; as pq does, a file left by a failed write is removed."""
+    if _Writer is not None:
+        sink = str(where) if isinstance(where, (str, Path)) else where
+        try:
+            writer = _Writer(sink, table.schema, **_OPTIONS)
+        except TypeError:  # another pyarrow's signature (its arguments are bound before a file is opened)
+            writer = None
+        except Exception:
+            _remove(sink)
+            raise
+        if writer is not None:
+            try:
+                try:
+                    writer.write_table(table, row_group_size=None)
+                finally:
+                    writer.close()
+            except Exception:
+                _remove(sink)
+                raise
+            return
+    import pyarrow.parquet as pq
+
+    pq.write_table(table, where, compression="zstd")
+
+
+def _remove(sink: str | pa.NativeFile) -> None:
+    if isinstance(sink, str):
+        Path(sink).unlink(missing_ok=True)
+
+
 def _warm_up() -> None:
     """pyarrow's first Parquet file (its zstd codec, the writer's set-up) costs lazy set-up; at the first row
     group's flush, inside the bus cycle, that stalled an EtherCAT line past its SM watchdog (AL 0x001B) two seconds
     into every run (then 0.3–0.5 s: pa.array's pandas import, B48); so it is done here, before cycling."""
     tab = pa.Table.from_arrays([_column([0.0], pa.float64()), _column([0], pa.int64()), _column([0], pa.uint16()),
                                 _column([""], pa.string())], names=["f", "i", "u", "s"])
-    pq.write_table(tab, pa.BufferOutputStream(), compression="zstd")
+    write_table(tab, pa.BufferOutputStream())
 
 
 class ParquetTrace:
@@ -240,7 +283,7 @@ class ParquetTrace:
                     values.extend(ch[i].tolist() if isinstance(ch[i], np.ndarray) else ch[i])
             arrays.append(_column(values, f.type))
         tmp = self.parts / f".{part.name}.tmp"
-        pq.write_table(pa.Table.from_arrays(arrays, schema=self._schema), tmp, compression="zstd")
+        write_table(pa.Table.from_arrays(arrays, schema=self._schema), tmp)
         os.replace(tmp, part)
 
     def _drain(self) -> None:
@@ -280,6 +323,8 @@ class ParquetTrace:
         if self._schema is None:  # no rows at all: still a valid file with the columns
             self._schema = pa.schema([(c, pa.float64()) for c in self.columns])
         schema = self._schema.with_metadata(self._metadata())
+        import pyarrow.parquet as pq  # (a run of more than one part: longer than FLUSH_S or ROW_GROUP rows)
+
         tmp = self.path.with_name(f".{self.path.name}.{os.getpid()}.tmp")
         try:
             with pq.ParquetWriter(tmp, schema, compression="zstd") as writer:

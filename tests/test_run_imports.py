@@ -179,6 +179,9 @@ NOT_IN_A_LATHE_RUN = {
     "hil.run_events": "--at/--events only (B65)",
     "numpy.polynomial": "the spline fit's quadrature nodes, worked out at the first fit (B84, session 18 lead)",
     "importlib.metadata": "the trace's deltahil version is the source's, hil/version.py (B90)",
+    "nc.motion.spline_runs": "the fit of runs of short lines, imported by the first window fitted (B91)",
+    "nc.motion.spline_fit": "as nc.motion.spline_runs (B91)",
+    "pyarrow.fs": "pyarrow.parquet's module, with ssl and the cloud file systems: the trace through pyarrow's writer (B92)",
 }
 
 

@@ -16,7 +16,7 @@ from hil.trace_parquet import ParquetTrace
 def test_a_full_row_group_is_written_while_the_run_goes_on(tmp_path, monkeypatch):
     release = threading.Event()
     writing = threading.Event()
-    real_write = pq.write_table
+    real_write = tp.write_table
     callers: list[str] = []
 
     def held_write(*a, **k):  # the writer stays inside its first part until the test lets it go
@@ -26,7 +26,7 @@ def test_a_full_row_group_is_written_while_the_run_goes_on(tmp_path, monkeypatch
         return real_write(*a, **k)
 
     w = ParquetTrace(tmp_path / "w.parquet", ["t", "line", "alarm", "X_sw"], row_group=100)
-    monkeypatch.setattr(tp.pq, "write_table", held_write)
+    monkeypatch.setattr(tp, "write_table", held_write)
     for k in range(250):  # two row groups handed over, the writer still holding the first
         w.write([k * 0.001, k // 10, "" if k % 7 else "0x1001", k])
     assert writing.wait(10)
@@ -47,7 +47,7 @@ def test_a_writer_failure_reaches_the_run_at_close(tmp_path, monkeypatch):
         raise OSError(28, "No space left on device")
 
     w = ParquetTrace(tmp_path / "f.parquet", ["t", "x"], row_group=10)
-    monkeypatch.setattr(tp.pq, "write_table", full_disk)
+    monkeypatch.setattr(tp, "write_table", full_disk)
     with pytest.raises(OSError, match="No space left"):  # at the next hand-over or at close, as it comes
         for k in range(25):
             w.write([k * 0.001, float(k)])

@@ -1,0 +1,92 @@
+"""A Parquet trace is written by pyarrow's writer class itself, without importing pyarrow.parquet's module and its
+file systems (bench decision B92): the file must be the one `pq.write_table(..., compression="zstd")` writes, byte
+for byte, with this pyarrow; a pyarrow whose writer is missing or takes other arguments writes through pq."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pyarrow as pa
+import pyarrow.parquet as pq
+import pytest
+
+import hil.trace_parquet as tp
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _table() -> pa.Table:
+    """A trace's column types: float64 (NaN, -0.0), int64, uint16 statuswords, strings with nulls; units in the field
+    metadata and the run's provenance in the schema's."""
+    n = 3000
+    cols = {
+        "t": pa.array([k * 0.001 for k in range(n)]),
+        "line": pa.array([k // 7 for k in range(n)], pa.int64()),
+        "alarm": pa.array([None if k % 11 else "0x0401" for k in range(n)], pa.string()),
+        "X_cmd": pa.array([(-0.0 if k == 5 else float("nan") if k == 9 else k * 0.25) for k in range(n)]),
+        "X_sw": pa.array([0x1637 if k % 3 else 0x0237 for k in range(n)], pa.uint16()),
+    }
+    fields = [pa.field(name, arr.type, metadata={"unit": "mm"} if name == "X_cmd" else None)
+              for name, arr in cols.items()]
+    return pa.Table.from_arrays(list(cols.values()), schema=pa.schema(fields, metadata={b"deltahil": b'{"a": 1}'}))
+
+
+def _pq_bytes(table: pa.Table, tmp_path: Path) -> bytes:
+    ref = tmp_path / "ref.parquet"
+    pq.write_table(table, ref, compression="zstd")
+    return ref.read_bytes()
+
+
+def test_the_file_is_pq_write_tables_byte_for_byte(tmp_path):
+    table = _table()
+    assert tp._Writer is not None  # this pyarrow has it: the way a run takes
+    out = tmp_path / "t.parquet"
+    tp.write_table(table, out)
+    assert out.read_bytes() == _pq_bytes(table, tmp_path)
+    tp.write_table(table, str(out))
+    assert out.read_bytes() == _pq_bytes(table, tmp_path)
+    buf = pa.BufferOutputStream()
+    tp.write_table(table, buf)
+    assert buf.getvalue().to_pybytes() == _pq_bytes(table, tmp_path)
+    back = pq.ParquetFile(out).read()
+    assert back.drop_columns(["X_cmd"]).equals(table.drop_columns(["X_cmd"]))  # (X_cmd holds a NaN: not equal)
+    assert back.column("X_cmd").to_pylist()[:5] == [0.0, 0.25, 0.5, 0.75, 1.0] and back.num_rows == 3000
+    assert back.schema.metadata[b"deltahil"] == b'{"a": 1}' and back.schema.field("X_cmd").metadata == {b"unit": b"mm"}
+
+
+class _OtherSignature:
+    def __init__(self, *args, **kwargs):
+        raise TypeError("__cinit__() got an unexpected keyword argument 'writer_engine_version'")
+
+
+@pytest.mark.parametrize("writer", [None, _OtherSignature], ids=["no private writer", "another signature"])
+def test_another_pyarrow_writes_through_pq(tmp_path, monkeypatch, writer):
+    monkeypatch.setattr(tp, "_Writer", writer)
+    out = tmp_path / "t.parquet"
+    tp.write_table(_table(), out)
+    assert out.read_bytes() == _pq_bytes(_table(), tmp_path)
+
+
+def test_a_failed_write_leaves_no_file(tmp_path):
+    """As pq.write_table: a table Parquet cannot hold (a union column) raises and leaves nothing behind."""
+    union = pa.UnionArray.from_sparse(pa.array([0, 1], pa.int8()), [pa.array([1, 2]), pa.array(["a", "b"])])
+    table = pa.table({"u": union})
+    out = tmp_path / "u.parquet"
+    with pytest.raises(pa.ArrowException):
+        tp.write_table(table, out)
+    assert not out.exists()
+
+
+def test_a_run_does_not_import_pyarrow_parquet_and_its_trace_reads_back(tmp_path):
+    trace = tmp_path / "t.parquet"
+    code = ("import sys; from hil.cli import main; "
+            f"rc = main(['run', 'examples/lathe_demo.nc', '--trace', {str(trace)!r}]); "
+            "print('RC', rc, *(m in sys.modules for m in ('pyarrow.parquet', 'pyarrow.fs', 'ssl')))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.split()[-4:] == ["0", "False", "False", "False"]
+    f = pq.ParquetFile(trace)
+    assert f.metadata.num_rows == 14396 and f.metadata.num_row_groups == 1
+    assert f.schema_arrow.field("X_sw").type == pa.uint16() and b"deltahil" in f.schema_arrow.metadata
