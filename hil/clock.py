@@ -15,8 +15,6 @@ leaves at a fixed phase to SYNC0, like a DC master must.
 
 from __future__ import annotations
 
-import ctypes
-import ctypes.util
 import os
 import time
 from collections.abc import Callable
@@ -331,6 +329,9 @@ def release_realtime(owner: RealTimeClock) -> None:
 
 
 def _mlockall(g: Granted) -> bool:
+    import ctypes  # (and ctypes.util's subprocess: a real-time run's, not every run's import, bench B91)
+    import ctypes.util
+
     name = ctypes.util.find_library("c")
     if not name:
         g.notes.append("mlockall unavailable")

@@ -154,8 +154,23 @@ def test_a_run_without_events_imports_no_event_player_and_builds_no_whole_signal
     and channel 1's rows, not from the 4-channel table of 5,308 signals (≈ 10 ms of a `hil run`'s start)."""
     code = ("import sys; from hil.cli import main; import mlc.signals as s; rc = main(['run', 'examples/lathe_demo.nc']); "
             "print(rc, 'hil.run_events' in sys.modules, s.signal_table.cache_info().currsize, "
+            "s._by_name.cache_info().currsize, "  # (B91: nor channel 1's whole name index)
             "s.resolve('MST_FINISH') is s.signal_table((1, 2, 3, 4))['M21016'])")  # M2x016: the same object
-    assert _python(code)[-4:] == ["0", "False", "0", "True"]
+    assert _python(code)[-5:] == ["0", "False", "0", "0", "True"]
+
+
+def test_a_name_resolves_to_the_name_indexs_signal():
+    """B91: a name is looked up in the rows that can hold it; the object is the one the whole index (first in its
+    order) gives, for every name of the general block and channels 1-4 (and 0, 5: the general block alone), and
+    what the index does not know stays unknown."""
+    import mlc.signals as s
+
+    for ch in range(6):
+        index = s._by_name(ch)
+        assert all(s._named(ch, name) is sig for name, sig in index.items())
+        for name in ("NOPE", "MST_FINISH_X", "JOG_FWD", "JOG_FWD_", "M21016", "", "PULSE_50MS_1"):
+            assert s._named(ch, name) is index.get(name)
+    assert s.resolve(" jog_fwd_z ", 2) is s._by_name(2)["JOG_FWD_Z"] and s.resolve("ALWAYS_ON").address == "M29035"
 
 
 def test_an_event_after_a_run_without_events_in_one_process_still_fires_and_holds():
