@@ -7,7 +7,7 @@ import numpy as np
 import pyarrow as pa
 import pytest
 
-from hil.trace_parquet import ParquetTrace, _column, _float_blocks
+from hil.trace_parquet import ParquetTrace, _by_column, _column, _float_blocks
 
 
 def _listed(chunks: list, i: int) -> list:
@@ -26,7 +26,7 @@ def _chunks(row_values: list) -> list:
 @pytest.mark.parametrize("rows", [[0.25, 1 / 3], [7, 2**53 + 1, -(2**62)], [1.5, 3], [True, 2.0], []])
 def test_float_blocks_hold_what_the_list_way_holds_bit_for_bit(rows):
     chunks = _chunks(rows)
-    got = _float_blocks(chunks, 0)
+    got = _float_blocks(_by_column(chunks, 1), 0)  # (the writer's rows transposed first, as _write_part does)
     want = _column(_listed(chunks, 0), pa.float64())
     assert got is not None and got.tobytes() == want.buffers()[1].to_pybytes()[:got.nbytes]
     assert len(got) == len(want) == 6 + len(rows)
@@ -41,7 +41,7 @@ def test_float_blocks_hold_what_the_list_way_holds_bit_for_bit(rows):
     [(False, [np.array([1, 2])])],  # an int64 block
 ])
 def test_anything_else_takes_the_list_way(chunks):
-    assert _float_blocks(chunks, 0) is None
+    assert _float_blocks(_by_column(chunks, 1), 0) is None
 
 
 def test_a_trace_of_rows_and_float_blocks_reads_back_as_pyarrow_converts_it(tmp_path):

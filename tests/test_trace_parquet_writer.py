@@ -90,3 +90,35 @@ def test_a_run_does_not_import_pyarrow_parquet_and_its_trace_reads_back(tmp_path
     f = pq.ParquetFile(trace)
     assert f.metadata.num_rows == 14396 and f.metadata.num_row_groups == 1
     assert f.schema_arrow.field("X_sw").type == pa.uint16() and b"deltahil" in f.schema_arrow.metadata
+
+
+def test_a_part_without_alarms_has_the_all_null_column_the_list_way_made(tmp_path):
+    """A part whose alarm column is all "" (no alarm: null) is made at once; it is the column pa.array makes of
+    the nulls, and the file the same bytes as pq's of that column."""
+    n = 1000
+    fast = tp._column([""] * (n - 1) + [None], pa.string())
+    want = pa.array([None] * n, pa.string())
+    assert fast.equals(want) and fast.null_count == n and fast.type == pa.string()
+    mixed = tp._column([""] * (n - 1) + ["0x0401"], pa.string())  # the general way, one alarm
+    assert mixed.null_count == n - 1 and mixed[n - 1].as_py() == "0x0401"
+    out = tmp_path / "a.parquet"
+    tp.write_table(pa.table({"alarm": fast}), out)
+    assert out.read_bytes() == _pq_bytes(pa.table({"alarm": want}), tmp_path)
+    assert tp._column([], pa.string()).equals(pa.array([], pa.string()))
+
+
+def test_rows_are_read_by_column_as_before(tmp_path):
+    """The writer transposes a chunk of rows once (B92): a row with an extra value has it left out, a short row
+    is the trace's failure at close, as when each column was read row by row."""
+    w = tp.ParquetTrace(tmp_path / "x.parquet", ["t", "line"])
+    w.write([0.0, 1, "extra"])
+    w.write([0.001, 2])
+    w.close()
+    t = pq.ParquetFile(tmp_path / "x.parquet").read()
+    assert t.column_names == ["t", "line"] and t.column("line").to_pylist() == [1, 2]
+    w = tp.ParquetTrace(tmp_path / "short.parquet", ["t", "line"])
+    w.write([0.0, 1])
+    w.write([0.001])
+    with pytest.raises(IndexError):
+        w.close()
+    assert not (tmp_path / "short.parquet").exists()
