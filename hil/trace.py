@@ -9,7 +9,6 @@ adds its signals of interest this way). `open_trace` picks the format from the f
 
 from __future__ import annotations
 
-import csv
 import errno
 import json
 import os
@@ -76,6 +75,8 @@ class CsvTrace:
         # Written to a side file and renamed on close, so a failed run never leaves half a trace
         # that looks complete.
         self._tmp = self.path.with_name(self.path.name + ".part")
+        import csv  # (a CSV trace's alone, not a Parquet one's)
+
         self._fh: IO[str] = open(self._tmp, "w", newline="")
         self._w = csv.writer(self._fh)
         self._w.writerow(columns)

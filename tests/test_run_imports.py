@@ -197,6 +197,9 @@ NOT_IN_A_LATHE_RUN = {
     "nc.motion.spline_runs": "the fit of runs of short lines, imported by the first window fitted (B91)",
     "nc.motion.spline_fit": "as nc.motion.spline_runs (B91)",
     "pyarrow.fs": "pyarrow.parquet's module, with ssl and the cloud file systems: the trace through pyarrow's writer (B92)",
+    "ctypes.util": "mlockall's libc look-up (and subprocess): a real-time run's (B91)",
+    "xml.etree.ElementTree": "--junit's report (B91)",
+    "csv": "a CSV trace's writer, not a Parquet trace's (B91)",
 }
 
 
