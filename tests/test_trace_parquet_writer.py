@@ -122,3 +122,14 @@ def test_rows_are_read_by_column_as_before(tmp_path):
     with pytest.raises(IndexError):
         w.close()
     assert not (tmp_path / "short.parquet").exists()
+
+
+def test_a_long_chunk_of_rows_is_transposed_a_slice_at_a_time():
+    """A real-time run's part is all rows: one zip holds the GIL for its whole slice, so slices stay TRANSPOSE rows
+    (the cycle thread takes the GIL back within the writer's switch interval); a short row deep in it still fails."""
+    rows = [(k * 0.001, k) for k in range(600)]
+    sliced = tp._by_column([(True, rows)], 2)
+    assert [len(cols[0]) for _, cols in sliced] == [tp.TRANSPOSE, tp.TRANSPOSE, 600 - 2 * tp.TRANSPOSE]
+    assert [v for _, cols in sliced for v in cols[1]] == list(range(600))
+    with pytest.raises(IndexError):
+        tp._by_column([(True, rows[:500] + [(0.5,)] + rows[500:])], 2)
