@@ -132,7 +132,7 @@ def _by_column(chunks: list, width: int) -> list:
     chunk of rows is mostly one stepped cycle's row between two stretches: 223 of the lathe demo's 478 chunks), so
     that a column is read from every chunk alike (≈ 1.5 ms of the lathe demo's part, B92). In slices: one zip holds
     the GIL for its whole slice, and a real-time run's cycle thread must get it back within the switch interval
-    (`SWITCH_S`; a real-time part is all rows). A row shorter than the schema is refused, as reading its columns one
+    (`SWITCH_S`; a real-time part can hold thousands of rows). A row shorter than the schema is refused, as reading its columns one
     by one refused it (an IndexError: the run's trace failure); a longer one's extra values are left out, as they
     were."""
     out = []

@@ -125,7 +125,7 @@ def test_rows_are_read_by_column_as_before(tmp_path):
 
 
 def test_a_long_chunk_of_rows_is_transposed_a_slice_at_a_time():
-    """A real-time run's part is all rows: one zip holds the GIL for its whole slice, so slices stay TRANSPOSE rows
+    """A real-time run's part can hold thousands of rows: one zip holds the GIL for its whole slice, so slices stay TRANSPOSE rows
     (the cycle thread takes the GIL back within the writer's switch interval); a short row deep in it still fails."""
     rows = [(k * 0.001, k) for k in range(600)]
     sliced = tp._by_column([(True, rows)], 2)
