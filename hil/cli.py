@@ -10,6 +10,7 @@ NC internal alarm 0x0000.
 from __future__ import annotations
 
 import argparse
+import errno
 import importlib
 import os
 import pkgutil
@@ -107,19 +108,46 @@ def _main(argv: list[str]) -> int:
         with signals_end_command():  # SIGTERM/SIGHUP outside a run: a message and 128 + n, not a silent death
             return int(args.func(args) or 0)
     except UsageError as exc:
-        print(f"hil {args.command}: {exc}", file=sys.stderr)
-        return EXIT_USAGE
+        return _say(f"hil {args.command}: {exc}", EXIT_USAGE)
     except SignalStop as exc:
-        print(f"hil {args.command}: stopped by {exc.name}", file=sys.stderr)
-        return exit_code(exc.name)
+        return _say(f"hil {args.command}: stopped by {exc.name}", exit_code(exc.name))
     except KeyboardInterrupt:
-        print("hil: interrupted", file=sys.stderr)
-        return 130
+        return _say("hil: interrupted", 130)
     except BrokenPipeError:
         return _reader_left()
+    except OSError as exc:
+        if exc.errno != errno.EIO:
+            return _internal(exc)
+        # EIO writing to the terminal: it was closed (hung up). The kernel sent SIGHUP, which stopped the run
+        # under control; the summary has no one to read it. End as SIGHUP ends a command (B93).
+        _terminal_gone()
+        return exit_code("SIGHUP")
     except Exception as exc:  # never a traceback: report as the NC's internal alarm
-        print(str(internal_error(exc)), file=sys.stderr)
-        return EXIT_ALARM
+        return _internal(exc)
+
+
+def _internal(exc: Exception) -> int:
+    return _say(str(internal_error(exc)), EXIT_ALARM)
+
+
+def _say(text: str, code: int) -> int:
+    """The last word on stderr, and the exit code; a closed terminal (SIGHUP's) does not turn it into a traceback."""
+    try:
+        print(text, file=sys.stderr)
+    except OSError:
+        _terminal_gone()
+    return code
+
+
+def _terminal_gone() -> None:
+    """stdout and stderr point at the hung-up terminal: Python's exit would flush them again and print
+    'Exception ignored …' to it, so both go to devnull."""
+    try:
+        null = os.open(os.devnull, os.O_WRONLY)
+        for stream in (sys.stdout, sys.stderr):
+            os.dup2(null, stream.fileno())
+    except (OSError, ValueError):  # not real files (pytest capture): nothing to flush
+        pass
 
 
 def _reader_left() -> int:

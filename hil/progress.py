@@ -19,10 +19,11 @@ class Progress:
         self.width = width
         self._next = 0.0
         self._shown = False
+        self._gone = False  # the terminal was closed (B93)
 
     def update(self, runner: Any) -> None:
         now = time.monotonic()
-        if now < self._next:
+        if now < self._next or self._gone:
             return
         self._next = now + self.every
         self.draw(runner.line, runner.time)
@@ -31,15 +32,24 @@ class Progress:
         frac = min(1.0, max(0.0, line / self.last_line))
         fill = int(frac * self.width)
         bar = "#" * fill + "-" * (self.width - fill)
-        self.stream.write(f"\r[{bar}] line {line}/{self.last_line}  t={sim_time:9.3f} s ")
-        self.stream.flush()
-        self._shown = True
+        self._write(f"\r[{bar}] line {line}/{self.last_line}  t={sim_time:9.3f} s ")
+        self._shown = not self._gone
 
     def close(self) -> None:
         if self._shown:
-            self.stream.write("\n")
-            self.stream.flush()
+            self._write("\n")
             self._shown = False
+
+    def _write(self, text: str) -> None:
+        """A closed terminal (EIO after its hang-up) or a reader gone (EPIPE) ends the bar, not the run: the bar
+        is drawn from the cycle loop, and the stop the hang-up asked for runs in that loop too (B93)."""
+        if self._gone:
+            return
+        try:
+            self.stream.write(text)
+            self.stream.flush()
+        except (OSError, ValueError):  # ValueError: the stream was closed under it
+            self._gone = True
 
 
 def wants_progress(flag: bool | None, stream: IO[str] | None = None) -> bool:
