@@ -195,7 +195,8 @@ def _main(argv: list[str]) -> int:
     iface, path = argv
     stop = threading.Event()
     signal.signal(signal.SIGTERM, lambda *_: stop.set())
-    for sig in (signal.SIGINT, signal.SIGHUP):  # Ctrl-C reaches the whole group: keep recording the controlled stop
+    # Ctrl-C and Ctrl-\ reach the whole group: keep recording the controlled stop (B94)
+    for sig in (signal.SIGINT, signal.SIGHUP, signal.SIGQUIT):
         signal.signal(sig, signal.SIG_IGN)
     try:
         sniff(iface, path, stop, ready=lambda: print("ready", flush=True))

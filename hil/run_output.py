@@ -3,7 +3,7 @@ both built from the library's `hil.api.Result`, so the CLI, the pytest plugin an
 
 Exit codes (README): 0 completed and every check passed; 1 ended by an alarm; 3 completed but a
 check failed (an `--at` event that never fired counts as a failed check unless allowed);
-128 + n when signal n stopped the run under control (130 SIGINT, 143 SIGTERM, 129 SIGHUP).
+128 + n when signal n stopped the run under control (130 SIGINT, 143 SIGTERM, 129 SIGHUP, 131 SIGQUIT).
 """
 
 from __future__ import annotations

@@ -74,7 +74,7 @@ class RunResult:
     timing: dict[str, dict[str, float]] = field(default_factory=dict)  # jitter/latency/exec percentiles, s
     overruns: int = 0
     granted: str = ""  # what the system granted the real-time loop
-    stopped_by: str | None = None  # the signal (SIGINT, SIGTERM, SIGHUP) whose stop ended the run
+    stopped_by: str | None = None  # the signal (SIGINT, SIGTERM, SIGHUP, SIGQUIT) whose stop ended the run
     stretched: int = 0  # cycles run in stretches (hil/stretch.py), not stepped one by one
     fits_ahead: tuple[int, int] | None = None  # B86: fitted windows (taken from the second process, fitted in a cycle)
 

@@ -1,11 +1,12 @@
 """Signals end a run through the stop path, as an operator's reset would on the NC.
 
-While a run is in progress, SIGINT (Ctrl-C), SIGTERM and SIGHUP only *request* a stop: the runner
+While a run is in progress, SIGINT (Ctrl-C), SIGTERM, SIGHUP and SIGQUIT (Ctrl-\\) only *request* a stop: the runner
 sees the request at the next cycle, stops the axes along the path under control (jerk-limited, the
 planner's reset), lets them settle, disables the drives at standstill, closes the bus and finishes
 the trace with the signal as its end reason; `hil run` prints its summary and exits 128 + signal
-number (130, 143, 129). A second signal during that stop does not wait: it raises KeyboardInterrupt
+number (130, 143, 129, 131). A second signal during that stop does not wait: it raises KeyboardInterrupt
 at once, and the drives are disabled where they are (their own quick-stop ramp brakes them).
+A SIGHUP or SIGQUIT that was ignored when the run started (nohup; a shell's background job) stays ignored (B94).
 """
 
 from __future__ import annotations
@@ -17,7 +18,14 @@ from contextlib import contextmanager
 from typing import Any
 
 STOP_SIGNALS = tuple(s for s in (getattr(signal, "SIGINT", None), getattr(signal, "SIGTERM", None),
-                                 getattr(signal, "SIGHUP", None)) if s is not None)
+                                 getattr(signal, "SIGHUP", None), getattr(signal, "SIGQUIT", None)) if s is not None)
+# Whoever started `hil` may have chosen to ignore these: nohup (SIGHUP), a shell's background job (SIGQUIT). SIGINT
+# and SIGTERM are always a run's stop (a script's `kill -INT` of its background run stops it, as before).
+KEEP_IGNORED = tuple(getattr(signal, n) for n in ("SIGHUP", "SIGQUIT") if hasattr(signal, n))
+
+
+def _taken(s: int) -> bool:
+    return not (s in KEEP_IGNORED and signal.getsignal(s) is signal.SIG_IGN)
 
 
 @contextmanager
@@ -34,7 +42,7 @@ def stop_on_signals(runner: Any) -> Iterator[None]:
             raise KeyboardInterrupt(f"second {name} during the stop")
         runner.request_stop(name)
 
-    previous = {s: signal.signal(s, handler) for s in STOP_SIGNALS}
+    previous = {s: signal.signal(s, handler) for s in STOP_SIGNALS if _taken(s)}
     try:
         yield
     finally:
@@ -47,7 +55,7 @@ def exit_code(name: str) -> int:
 
 
 class SignalStop(KeyboardInterrupt):
-    """SIGTERM or SIGHUP outside a run (start-up, bring-up's imports, writing the report): the command ends as
+    """SIGTERM, SIGHUP or SIGQUIT outside a run (start-up, bring-up's imports, writing the report): the command ends as
     Ctrl-C ends it there, its `finally` blocks and atomic writes done, and `hil` exits 128 + n saying so."""
 
     def __init__(self, name: str) -> None:
@@ -57,7 +65,7 @@ class SignalStop(KeyboardInterrupt):
 
 @contextmanager
 def signals_end_command() -> Iterator[None]:
-    """For the whole `hil` command (main thread): SIGTERM and SIGHUP whose handling is the default raise
+    """For the whole `hil` command (main thread): SIGTERM, SIGHUP and SIGQUIT whose handling is the default raise
     SignalStop (a run's own stop_on_signals takes them over while it runs). An ignored signal (nohup) stays
     ignored; the previous handlers come back at the end."""
     if threading.current_thread() is not threading.main_thread():

@@ -1,12 +1,14 @@
-"""Closing the terminal a `hil run` shows its progress bar on (issue 17, bench decision B93): the kernel sends
-SIGHUP, and from then on every write to the terminal fails with EIO. The stop along the path must go on as for any
-SIGHUP — axes to rest within their limits, drives disabled at standstill, the trace finished — and `hil` exits
-129 without a traceback (there is nobody to read the summary)."""
+"""What an engineer's terminal does to a run (issue 17). Closing it (bench decision B93): the kernel sends SIGHUP, and
+from then on every write to the terminal fails with EIO; the stop along the path must go on as for any SIGHUP — axes
+to rest within their limits, drives disabled at standstill, the trace finished — and `hil` exits 129 without a
+traceback (there is nobody to read the summary). Ctrl-\\ (SIGQUIT) and nohup (B94)."""
 
 from __future__ import annotations
 
 import errno
 import os
+import signal
+import subprocess
 import sys
 import time
 from pathlib import Path
@@ -40,9 +42,9 @@ class HungUpTerminal:
             raise OSError(errno.EIO, os.strerror(errno.EIO))
 
 
-def assert_stopped_under_control(trace: Path) -> None:
+def assert_stopped_under_control(trace: Path, reason: str = "SIGHUP") -> None:
     tf = TraceFile(trace)
-    assert tf.meta["end"]["reason"] == "SIGHUP" and tf.meta["end"]["complete"]
+    assert tf.meta["end"]["reason"] == reason and tf.meta["end"]["complete"]
     assert tf.meta["end"]["bus"] == "closed"
     c = tf.arrays(["Z_sw", "Z_vel", "Z_act"])
     assert np.abs(c["Z_vel"]).max() > 99  # it was moving at full speed before the hang-up
@@ -115,3 +117,49 @@ def test_closing_the_terminal_stops_the_run_like_a_hangup(tmp_path):
     _, status = os.waitpid(pid, 0)
     assert os.waitstatus_to_exitcode(status) == 129, seen.decode(errors="replace")[-2000:]
     assert_stopped_under_control(trace)
+
+
+def _start(tmp_path: Path, *, ignore: tuple[int, ...] = ()) -> tuple[subprocess.Popen, Path]:
+    """`hil run` on the long program with the signals an interactive shell leaves at their default (pytest's own
+    parent may be a background job, whose SIGQUIT is ignored), `ignore` ignored as nohup or `&` leave them."""
+    prog = tmp_path / "long.nc"
+    prog.write_text(LONG)
+    trace = tmp_path / "run.parquet"
+
+    def dispositions() -> None:
+        for s in (signal.SIGINT, signal.SIGQUIT, signal.SIGHUP, signal.SIGTERM):
+            signal.signal(s, signal.SIG_IGN if s in ignore else signal.SIG_DFL)
+
+    p = subprocess.Popen([sys.executable, "-m", "hil.cli", "run", str(prog), "--bench", str(LATHE),
+                          "--trace", str(trace), "--no-check", "--no-progress"], preexec_fn=dispositions,
+                         env={**os.environ, "PYTHONPATH": str(ROOT)}, stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE, text=True)
+    parts = trace.with_name(trace.name + ".part")
+    deadline = time.monotonic() + 60
+    while not list(parts.glob("*.parquet")) and time.monotonic() < deadline and p.poll() is None:
+        time.sleep(0.02)  # the run is under way (its first row group is on disk)
+    return p, trace
+
+
+def test_ctrl_backslash_stops_the_run_under_control(tmp_path):
+    """SIGQUIT (Ctrl-\\) used to end `hil run` as Python leaves it, a core dump: no stop, no summary, the trace
+    left as its .part (on a field bus the drives enabled until their watchdog). Now it is a stop like Ctrl-C's."""
+    p, trace = _start(tmp_path)
+    p.send_signal(signal.SIGQUIT)
+    out, err = p.communicate(timeout=120)
+    assert p.returncode == 131, out + err
+    assert "STOPPED by SIGQUIT" in out and "program time" in out and "Traceback" not in err
+    assert_stopped_under_control(trace, "SIGQUIT")
+
+
+def test_a_hangup_nohup_ignores_does_not_stop_the_run(tmp_path):
+    """`nohup hil run …` so that the run outlives the terminal: SIGHUP is ignored, and it used to stop the run
+    all the same (the run's own handler replaced the ignore). The run now goes to its end; the README said so."""
+    p, trace = _start(tmp_path, ignore=(signal.SIGHUP,))
+    p.send_signal(signal.SIGHUP)
+    time.sleep(0.5)
+    assert p.poll() is None  # still running
+    p.send_signal(signal.SIGTERM)  # (the whole 510 s program is not waited for)
+    out, err = p.communicate(timeout=120)
+    assert p.returncode == 143 and "STOPPED by SIGTERM" in out, out + err
+    assert_stopped_under_control(trace, "SIGTERM")
