@@ -153,6 +153,8 @@ class BenchRunner:
         # run waits for each window), "off"; None: hil.fit_ahead.mode()
         self.fit_ahead: str | None = None
         self._fit_ahead = None
+        self._cut: KeyboardInterrupt | None = None  # a second signal while waiting for standstill (B95)
+        self.disabling = False  # the shutdown's last cycles, disabling the drives at standstill (B95)
 
     def trace_columns(self) -> list[str]:
         extra = [c for src in self.trace_sources for c in src.columns]
@@ -229,6 +231,8 @@ class BenchRunner:
             if paced:
                 gc.enable()
             gc.unfreeze()  # (B42: what was frozen for the run collectable again once it is over)
+        if self._cut is not None:  # a second signal during the wait for standstill (B95): the caller's Ctrl-C
+            raise self._cut
         return self._finish()
 
     def _start_fit_ahead(self, interp: Interpreter, program: Program, planner: Planner, paced: bool) -> None:
@@ -597,27 +601,37 @@ class BenchRunner:
     def _shutdown(self) -> None:
         """Wait for standstill, then disable every drive in order (operation enabled → ready →
         switch on disabled), close the bus and finish the trace. A second signal (the run was
-        interrupted) disables at once."""
+        interrupted) disables at once; so does one while waiting for standstill, its KeyboardInterrupt kept for
+        run_program to raise once the run is wound up (B95)."""
         try:
-            if getattr(self, "_opened", False) and getattr(self, "_end_reason", None) != "interrupted":
-                self._standstill()
-            for m in self.masters:
-                m.request(Target.DISABLED)
-            for _ in range(20 if getattr(self, "_opened", False) else 0):
-                self._exchange()
-                if all(m.state in (State.SWITCH_ON_DISABLED, State.READY_TO_SWITCH_ON, State.FAULT) for m in self.masters):
-                    break
-        except BusError as exc:
-            self.result.alarms.append(exc.alarm)
-        try:
-            self.link.close()
-            self._bus_closed = True
-        finally:
-            self.clock.stop()
-            if self.trace is not None:
-                self.trace.close(end=self._end_record())
-            if self.progress is not None:
-                self.progress.close()
+            try:
+                if getattr(self, "_opened", False) and getattr(self, "_end_reason", None) != "interrupted":
+                    try:
+                        self._standstill()
+                    except KeyboardInterrupt as exc:  # no more waiting: disabled now
+                        self._end_reason, self._cut = "interrupted", exc
+                self.disabling = True  # standing: a further signal no longer cuts this short (hil/stop_signals.py)
+                for m in self.masters:
+                    m.request(Target.DISABLED)
+                for _ in range(20 if getattr(self, "_opened", False) else 0):
+                    self._exchange()
+                    if all(m.state in (State.SWITCH_ON_DISABLED, State.READY_TO_SWITCH_ON, State.FAULT)
+                           for m in self.masters):
+                        break
+            except BusError as exc:
+                self.result.alarms.append(exc.alarm)
+            except KeyboardInterrupt as exc:  # one more signal in the disable's own cycles: the bus closes now
+                self._end_reason, self._cut = "interrupted", exc
+        finally:  # the bus closed and the trace finished whatever cut the above short (a third signal)
+            try:
+                self.link.close()
+                self._bus_closed = True
+            finally:
+                self.clock.stop()
+                if self.trace is not None:
+                    self.trace.close(end=self._end_record())
+                if self.progress is not None:
+                    self.progress.close()
 
     def request_stop(self, reason: str) -> None:
         """Stop the run under control at the next cycle (a signal, or a caller's own reason)."""

@@ -98,6 +98,66 @@ def test_a_second_signal_during_the_stop_disables_at_once(tmp_path):
     assert 1505 <= off <= 1530 and abs(c["Z_vel"][off - 1]) > 10  # disabled while still moving
 
 
+def _second_signal_run(tmp_path, settle_time: float, when):
+    """SIGINT at cycle 1500 (Z at 100 mm/s), and once more on the first cycle `when(runner)` holds after it."""
+    from hil.runner import BenchRunner
+    from hil.session import load_bench, make_link
+    from hil.trace import open_trace
+    from nc.program import parse_program
+
+    bench = load_bench(str(LATHE))
+    bench.mlc = "basic"
+    bench.settle_time = settle_time
+    sent = []
+
+    def kill(runner):
+        if runner.cycle == 1500 or (len(sent) == 1 and when(runner)):
+            sent.append(runner.cycle)
+            os.kill(os.getpid(), signal.SIGINT)
+
+    runner = BenchRunner(bench, make_link(bench), None, on_cycle=kill)
+    runner.trace = open_trace(tmp_path / "t.parquet", runner.trace_columns())
+    return runner, parse_program(LONG, name="long.nc"), sent
+
+
+def test_a_second_signal_while_waiting_for_standstill_still_disables_and_finishes_the_trace(tmp_path):
+    """The second signal landing in the shutdown's wait for standstill (the path stop done, an axis still settling:
+    a bench with no settle time; on EtherCAT in lock-step that wait is long in wall time) skipped the rest of the
+    shutdown: the drives were never disabled, the bus never closed and the trace left as its .part (bench decision
+    B95). Now it disables at once there too, and the trace says `interrupted`."""
+    from hil.stop_signals import stop_on_signals
+
+    def settling(runner):
+        return getattr(runner, "_winding_down", False) and not all(runner._at_rest(i) for i in range(len(runner.tx)))
+
+    runner, prog, sent = _second_signal_run(tmp_path, 0.0, settling)
+    with pytest.raises(KeyboardInterrupt), stop_on_signals(runner):
+        runner.run_program(prog)
+    assert len(sent) == 2 and sent[1] > 1500
+    assert not (tmp_path / "t.parquet.part").exists()
+    tf = TraceFile(tmp_path / "t.parquet")
+    assert tf.meta["end"]["reason"] == "interrupted" and not tf.meta["end"]["complete"]
+    assert tf.meta["end"]["bus"] == "closed"
+    sw = tf.arrays(["Z_sw"])["Z_sw"]
+    assert (sw[-1] & 0x6F) != OP_ENABLED and tf.num_rows <= sent[1] + 20  # disabled at once, not after a wait
+
+
+def test_a_second_signal_while_the_standing_drives_are_disabled_lets_the_disable_finish(tmp_path):
+    """The axes stand and the drives are being disabled (a few cycles): a second signal there would only cut the
+    disable short and leave them enabled until the bus closes, so it is not taken (B95). The run ends as the first
+    signal's stop, complete."""
+    from hil.stop_signals import stop_on_signals
+
+    runner, prog, sent = _second_signal_run(tmp_path, 0.3, lambda r: getattr(r, "disabling", False))
+    with stop_on_signals(runner):
+        result = runner.run_program(prog)
+    assert len(sent) == 2 and result.stopped_by == "SIGINT"
+    tf = TraceFile(tmp_path / "t.parquet")
+    assert tf.meta["end"]["reason"] == "SIGINT" and tf.meta["end"]["complete"] and tf.meta["end"]["bus"] == "closed"
+    sw = tf.arrays(["Z_sw"])["Z_sw"]
+    assert (sw[-1] & 0x6F) != OP_ENABLED
+
+
 def test_an_internal_error_in_the_cycle_loop_still_stops_under_control(tmp_path):
     """The planner raising mid-move (an injected bug at cycle 1500, Z at full speed) must not take
     the stop with it: the NC internal alarm 0x0000 is raised, every drive does its quick stop (CiA
