@@ -32,6 +32,7 @@ from hil.runner import BenchRunner
 from hil import script_args as arg
 from hil.script_args import ScriptError
 from hil.session import make_link
+from hil.stop_signals import SignalStop
 from mlc.machine import Mlc
 from mlc.nc_link import MODE_NAMES
 from mlc.signals import d2, d3, m2, m3
@@ -103,6 +104,7 @@ class Machine:
         self.records: dict[str, DriveRecord] = {}
         self.watchers: list[Callable[["Machine"], None]] = []
         self._mpg_count = 0
+        self._stopping = False  # a signal ended the script: the stop's own cycles run on (B96)
         self.alarms: list[Alarm] = []
         self.cleared: dict[int, float] = {}  # id(alarm) -> simulated time of the reset that cleared it (B59)
 
@@ -158,8 +160,21 @@ class Machine:
         return self.runner.time
 
     def cycle(self, n: int = 1) -> None:
+        r = self.runner
         for _ in range(arg.whole("machine.cycle", "n", n, 0)):
-            self.runner._exchange()
+            r._exchange()
+            if r.stop_request is not None and not self._stopping:  # a signal (hil/stop_signals.py): the script
+                raise SignalStop(r.stop_request)  # ends at this cycle; its command stops the machine (B96)
+
+    def stop_under_control(self) -> None:
+        """What the operator does when a script must end now (B96): every jog key let go, then RESET — the
+        program and the manual motion stop jerk-limited, the spindle ramps down (NC5 §3.8). The shutdown
+        (close) then waits for standstill and disables the drives."""
+        self._stopping = True
+        for i in range(len(self.runner.axes)):
+            self.mlc.mem.set_bit(m2(self.x, 384 + i), False)
+            self.mlc.mem.set_bit(m2(self.x, 400 + i), False)
+        self.reset()
 
     def wait(self, s: float) -> None:
         self.cycle(max(1, int(round(arg.seconds(f"machine.wait({s!r})", s) / self.bench.cycle))))

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from hil.commands.script import add_bench_options, finish, open_machine
+from hil.commands.script import add_bench_options, finish, open_machine, stoppable
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -23,6 +23,13 @@ def cmd_mpg(args: argparse.Namespace) -> int:
     machine, code = open_machine(args)
     if machine is None:
         return code
+    with stoppable(machine):
+        return _mpg(args, machine)
+
+
+def _mpg(args: argparse.Namespace, machine) -> int:
+    from hil.scripting import ScriptError
+
     try:
         x0 = machine.command(args.axis)
         machine.mpg(args.axis, args.pulses, args.ratio, args.rate)

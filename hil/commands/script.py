@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import argparse
 import sys
+from collections.abc import Iterator
+from contextlib import contextmanager
 
 from hil.cli import EXIT_ALARM, EXIT_OK, EXIT_USAGE
 
@@ -50,6 +52,29 @@ def open_machine(args: argparse.Namespace):
     return machine, None
 
 
+@contextmanager
+def stoppable(machine) -> Iterator[None]:
+    """SIGINT, SIGTERM, SIGHUP and SIGQUIT while a script, `hil mpg` or `hil spindle` drives the bench stop it as they
+    stop `hil run` (B9, B96): the script ends at the next cycle (Machine.cycle raises SignalStop), the operator's
+    RESET with the jog keys let go brings the motion to rest, the drives are disabled at standstill, the report is
+    printed and `hil` exits 128 + n ("hil CMD: stopped by SIG…"). A second signal meanwhile disables at once."""
+    from hil.stop_signals import SignalStop, stop_on_signals
+
+    with stop_on_signals(machine.runner):
+        try:
+            yield
+        except SignalStop:
+            try:
+                machine.stop_under_control()
+            except KeyboardInterrupt:  # the second signal: no more waiting (B9)
+                machine.runner._end_reason = "interrupted"
+                raise
+            finally:
+                machine.close()  # standstill, then the drives disabled
+            machine.report()  # where everything came to rest
+            raise
+
+
 def finish(machine, ok: bool = True) -> int:
     machine.report()
     machine.close()
@@ -57,13 +82,18 @@ def finish(machine, ok: bool = True) -> int:
 
 
 def cmd_script(args: argparse.Namespace) -> int:
+    machine, code = open_machine(args)
+    if machine is None:
+        return code
+    with stoppable(machine):
+        return _script(args, machine)
+
+
+def _script(args: argparse.Namespace, machine) -> int:
     from fieldbus.link import BusError
     from hil.scripting import ScriptError, run_script
     from nc.alarms import NcAlarm
 
-    machine, code = open_machine(args)
-    if machine is None:
-        return code
     try:
         run_script(args.script, machine, args.args)
     except ScriptError as exc:  # the API refused a call: where in the script, what it said (B80)

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import argparse
 
-from hil.commands.script import add_bench_options, finish, open_machine
+from hil.commands.script import add_bench_options, finish, open_machine, stoppable
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -35,6 +35,11 @@ def cmd_spindle(args: argparse.Namespace) -> int:
         print(f"hil spindle: --override {args.override} is outside 0-65535 %", file=__import__("sys").stderr)
         machine.close()
         return 2
+    with stoppable(machine):
+        return _spindle(args, machine)
+
+
+def _spindle(args: argparse.Namespace, machine) -> int:
     machine.spindle_override(args.override)
     up = machine.spindle(args.rpm, -1 if args.ccw else 1)
     machine.wait(args.seconds)
