@@ -324,14 +324,17 @@ def run(program: str | Path, bench: str | Path | Bench | None = None, *, bus: st
             finally:
                 if servo_modbus:
                     runner.servo_modbus.close()
-        checks = _checks(trace_path, b, prog) if trace_path and want_checks else []
+        from nc.alarm_table import TRACE_WRITE
+
+        lost = any(a.code == TRACE_WRITE for a in result.alarms)  # the trace was removed: nothing to judge (B97)
+        checks = _checks(trace_path, b, prog) if trace_path and want_checks and not lost else []
     finally:
         if temporary and trace_path:
             Path(trace_path).unlink(missing_ok=True)
         if cap is not None:
             cap.close()
     return Result(str(program), b, result, checks, list(player.events) if player is not None else [],
-                  TraceRef(Path(trace_path)) if trace_path and not temporary else None, runner)
+                  TraceRef(Path(trace_path)) if trace_path and not temporary and not lost else None, runner)
 
 
 def _capture_suffix(path: str, b: Bench) -> None:

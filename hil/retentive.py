@@ -62,5 +62,9 @@ def save(path: str | Path, variables: Variables) -> None:
     p = Path(path)
     data = {str(n): v for n, v in sorted(variables.values.items()) if variables.is_retentive(n)}
     tmp = p.with_name(f".{p.name}.tmp")
-    tmp.write_text(json.dumps(data, indent=1) + "\n", encoding="utf-8")
-    os.replace(tmp, p)
+    try:
+        tmp.write_text(json.dumps(data, indent=1) + "\n", encoding="utf-8")
+        os.replace(tmp, p)
+    except OSError:  # a full disk: the last good file stays, and no empty temporary beside it (B97)
+        tmp.unlink(missing_ok=True)
+        raise

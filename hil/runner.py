@@ -32,8 +32,9 @@ from hil import stretch_ahead
 from hil.bus_ahead import BusAhead
 from hil.stretch import Stretcher, ahead_wanted, wanted as stretch_wanted
 from hil.trace import TraceSource, TraceWriter, trace_columns
+from hil.write_guard import TraceGuard
 from mlc.basic import BasicMlc
-from nc.alarm_table import MAX_TIME
+from nc.alarm_table import MAX_TIME, TRACE_WRITE
 from nc.alarms import Alarm, NcAlarm, internal_error
 from nc.budget import StatementBudget
 from nc.channel import Channel, RunState, skip_hook
@@ -163,6 +164,8 @@ class BenchRunner:
     # ---- public ---------------------------------------------------------------------------
     def run_program(self, program: Program) -> RunResult:
         paced = isinstance(self.clock, RealTimeClock)
+        if self.trace is not None:  # a trace that cannot be written: alarm 0xDE04, stop, no half trace (B97)
+            TraceGuard(self.trace, self._trace_failed)
         self._bus_ahead = paced and type(self.link) is SimLink and (stretch_wanted(realtime=True) or ahead_wanted())
         if paced:
             _preload(self.bench)
@@ -519,6 +522,12 @@ class BenchRunner:
         if self.channel is not None:
             self.channel.raise_alarm(alarm)
         self.result.alarms.append(alarm)
+
+    def _trace_failed(self, exc: OSError) -> None:
+        """B97: the trace's first failed write (hil/write_guard.py) is an alarm; the channel stops along the path."""
+        self._alarm(Alarm(TRACE_WRITE, f"trace {getattr(self.trace, 'path', '')} cannot be written "
+                                       f"({exc.strerror or exc}): the run stops, the partial trace is removed",
+                          line=self.line or None))
 
     def _begin_quick_stop(self) -> None:
         """Command every enabled drive's quick stop (CiA 402: it brakes on its own ramp, 0x6085). Until a

@@ -8,6 +8,7 @@ from __future__ import annotations
 DELTAHIL_CODES = range(0xDE00, 0xDF00)  # codes of deltahil's own guards, not in the NC5 manual
 ENDLESS_LOOP = 0xDE01
 MAX_TIME = 0xDE03  # the bench's max_time ran out (decisions B13)
+TRACE_WRITE = 0xDE04  # the run's trace could not be written (decisions B97)
 PLANNING_STALL = 0xDE10  # the planner's solves of one cycle all ended before a sample (decisions B4)
 MLC_PROGRAM_ERROR = 0xDE02
 
@@ -202,6 +203,7 @@ ALARM_TABLE: dict[int, tuple[str, str, str]] = {
     # with a real controller sees them only where the NC5 would run on.
     0xDE01: ('instruction', 'Endless-loop guard: too many blocks executed.', "deltahil: more blocks than the parameter 'max blocks' (1,000,000) were executed beyond the program's own; a WHILE or GOTO loop that never ends. Raise 'max blocks' in [params] if the program is meant to run that long."),
     0xDE03: ('bench', "The run exceeded the bench's max_time.", 'deltahil: the bench (or campaign) max_time or `hil run --max-time` ran out before the program ended; the channel stopped along the path as for any alarm (decisions B13). Raise max_time, or find why the program did not end.'),
+    0xDE04: ('bench', 'The trace cannot be written.', "deltahil: writing the run's --trace failed (disk full, read-only or failing file system); the channel stopped along the path as for any alarm and the partial trace was removed, so nothing half-written is left (decisions B97). Free space or choose another place, and run again."),
     0xDE10: ('axis', 'Motion planning guard: no progress within one cycle.', "deltahil: every one of the planner's 1000 solves in one cycle ended before a setpoint was due, as with absurd axis limits (acceleration 1e-50 mm/s^2); check the bench's limits (docs/decisions/budgets.md B4)."),
     0xDE11: ('axis', 'Drive homing failed.', "deltahil: an axis with a bench `homing` table was homed by its drive (CiA 402 homing mode) before the program, and the drive reported a homing error (statusword bit 13 with no limit switch active: no switch found; a limit switch met is App. A 0x1601) or did not finish within the homing timeout; check the method, the home switch wiring and the speeds (docs/decisions/ethercat.md E16)."),
     0xDE02: ('mlc', 'MLC program error: the user MLC program raised an exception.', "deltahil: the MLC program's scan (a user's --mlc FILE.py) raised; the alarm names the file, the line and the program's traceback. The NC stops the channel as for an MLC alarm; fix the program."),
