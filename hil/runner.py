@@ -202,7 +202,7 @@ class BenchRunner:
                 self._fit_ahead.begin(dict(zip(self.axes, self.actual.tolist())))
             self.run_events(interp.run(program), planner)
         except BusError as exc:
-            self._alarm(exc.alarm)
+            self._alarm(self._placed(exc.alarm))
             # A bus alarm naming a drive (CANopen EMCY) is that drive's alarm: its fault bit is not raised again.
             self._alarmed_drives.update(i for i in range(len(self.masters)) if self._name(i) == exc.alarm.axis)
         except NcAlarm as exc:
@@ -522,6 +522,17 @@ class BenchRunner:
         if self.channel is not None:
             self.channel.raise_alarm(alarm)
         self.result.alarms.append(alarm)
+
+    def _placed(self, alarm: Alarm) -> Alarm:
+        """E35: a bus alarm (the link lost, a node gone silent) names where the program stood, as a drive's own
+        alarm does: the block being executed (B100), else the trace's current line."""
+        if alarm.line is not None:
+            return alarm
+        blk = self.channel.planner.active if self.channel is not None else None
+        mv = blk.move if blk is not None else None
+        if mv is not None and mv.line:
+            return replace(alarm, line=mv.line, block=mv.block or None, program=mv.program)
+        return replace(alarm, line=self.line) if self.line else alarm
 
     def _trace_failed(self, exc: OSError) -> None:
         """B97: the trace's first failed write (hil/write_guard.py) is an alarm; the channel stops along the path."""
