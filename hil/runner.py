@@ -639,7 +639,7 @@ class BenchRunner:
                            for m in self.masters):
                         break
             except BusError as exc:
-                self.result.alarms.append(exc.alarm)
+                self.result.alarms.append(self._placed(exc.alarm))
             except KeyboardInterrupt as exc:  # one more signal in the disable's own cycles: the bus closes now
                 self._end_reason, self._cut = "interrupted", exc
         finally:  # the bus closed and the trace finished whatever cut the above short (a third signal)

@@ -44,4 +44,5 @@ def test_a_lost_bus_names_the_line_block_and_file_where_the_program_stood(tmp_pa
     assert abs(c["Z_vel"][-1]) > 1  # mid-move
     assert alarm.line == moving_in and alarm.block == LONG.splitlines()[moving_in - 1] and alarm.program == "long.nc"
     assert f"line {moving_in}" in str(alarm)
+    assert len(result.alarms) > 1 and all(a.line == moving_in for a in result.alarms)  # the stop's own losses too
     assert tf.meta["end"]["alarm_line"] == moving_in
