@@ -7,11 +7,14 @@ the trace with the signal as its end reason; `hil run` prints its summary and ex
 number (130, 143, 129, 131). A second signal during that stop does not wait: it raises KeyboardInterrupt
 at once, and the drives are disabled where they are (their own quick-stop ramp brakes them).
 A SIGHUP or SIGQUIT that was ignored when the run started (nohup; a shell's background job) stays ignored (B94).
+Ctrl-Z (SIGTSTP) is not taken while a run holds the drives on a field bus: a suspended master trips their
+watchdogs (decision ethercat.md E36).
 """
 
 from __future__ import annotations
 
 import signal
+import sys
 import threading
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -45,11 +48,31 @@ def stop_on_signals(runner: Any) -> Iterator[None]:
         runner.request_stop(name)
 
     previous = {s: signal.signal(s, handler) for s in STOP_SIGNALS if _taken(s)}
+    tstp = getattr(signal, "SIGTSTP", None)
+    if tstp is not None and _on_a_field_bus(runner) and signal.getsignal(tstp) is not signal.SIG_IGN:
+        previous[tstp] = signal.signal(tstp, _not_suspended)
     try:
         yield
     finally:
         for s, h in previous.items():
             signal.signal(s, h)
+
+
+def _on_a_field_bus(runner: Any) -> bool:
+    from fieldbus.link import SimLink
+
+    link = getattr(runner, "link", None)
+    return link is not None and not isinstance(link, SimLink)
+
+
+def _not_suspended(signum: int, frame: Any) -> None:
+    """E36: suspended, the master would stop sending process data; every drive's watchdog (EtherCAT SM watchdog,
+    CANopen heartbeat) would trip and it would fault at speed. So the run goes on, and says how to stop it."""
+    try:
+        print("hil: Ctrl-Z (SIGTSTP) not taken while the drives are enabled on the field bus: a suspended master "
+              "trips their watchdogs; Ctrl-C stops the run under control", file=sys.stderr, flush=True)
+    except OSError:  # no terminal to say it on
+        pass
 
 
 def exit_code(name: str) -> int:

@@ -163,3 +163,37 @@ def test_a_hangup_nohup_ignores_does_not_stop_the_run(tmp_path):
     out, err = p.communicate(timeout=120)
     assert p.returncode == 143 and "STOPPED by SIGTERM" in out, out + err
     assert_stopped_under_control(trace, "SIGTERM")
+
+
+def test_ctrl_z_on_a_field_bus_is_not_taken_while_the_drives_are_enabled(capfd):
+    """Ctrl-Z (SIGTSTP) suspends the process: on a field bus the master then stops sending, every drive's watchdog
+    trips and they fault at speed (a `--realtime` run on the virtual EtherCAT bench, suspended 1 s: 0x0601 and 0xF002,
+    X braking 5 m/s² on its own fault reaction). While a run holds the drives on a field bus it is not taken (decision
+    ethercat.md E36): a line on stderr says so and how to stop instead, and the run goes on. In process on
+    canopen:virtual; the test's own SIGTSTP handler stands in for the default (which would stop pytest) and must not
+    be reached."""
+    from hil.runner import BenchRunner
+    from hil.session import load_bench, make_link
+    from hil.stop_signals import stop_on_signals
+    from nc.program import parse_program
+
+    bench = load_bench(str(LATHE))
+    bench.mlc = "basic"
+    bench.bus = "canopen:virtual"
+    reached: list[int] = []
+    previous = signal.signal(signal.SIGTSTP, lambda s, f: reached.append(s))
+    try:
+        def ctrl_z(runner):
+            if runner.cycle == 300:
+                os.kill(os.getpid(), signal.SIGTSTP)
+
+        runner = BenchRunner(bench, make_link(bench), None, on_cycle=ctrl_z)
+        with stop_on_signals(runner):
+            result = runner.run_program(parse_program("G98\nG00 X50. Z50.\nG01 Z10. F3000\nM30\n", name="short.nc"))
+        assert not reached and not result.alarms and result.stopped_by is None, result.alarms
+        assert "Ctrl-Z" in capfd.readouterr().err
+        assert signal.getsignal(signal.SIGTSTP) is not signal.SIG_DFL  # the test's own again
+        os.kill(os.getpid(), signal.SIGTSTP)
+        assert reached == [signal.SIGTSTP]
+    finally:
+        signal.signal(signal.SIGTSTP, previous)
