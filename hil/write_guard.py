@@ -18,10 +18,6 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from nc.alarm_table import TRACE_WRITE
-
-__all__ = ["TRACE_WRITE", "TraceGuard"]
-
 
 class TraceGuard:
     def __init__(self, trace: Any, fail: Callable[[OSError], None]) -> None:

@@ -29,12 +29,21 @@ LONG = "G98\nG00 X58. Z98.\nG01 Z-300. F6000\n" + "G01 Z98.\nG01 Z-300.\n" * 63 
 OP_ENABLED = 0x27  # statusword & 0x6F (CiA 402)
 
 
-def start(tmp_path: Path, bus: str) -> tuple[subprocess.Popen, Path]:
+def start(tmp_path: Path, bus: str, ignore: tuple[int, ...] | None = None) -> tuple[subprocess.Popen, Path]:
+    """`hil run` on the long program, once it is under way. `ignore`: the stop signals start at their default but
+    these ignored, as nohup or a shell's `&` leave them (pytest's own parent may be a background job, whose SIGQUIT
+    is ignored); None: as this process has them."""
     prog = tmp_path / "long.nc"
     prog.write_text(LONG)
     trace = tmp_path / "run.parquet"
+
+    def dispositions() -> None:
+        for s in (signal.SIGINT, signal.SIGQUIT, signal.SIGHUP, signal.SIGTERM):
+            signal.signal(s, signal.SIG_IGN if s in (ignore or ()) else signal.SIG_DFL)
+
     p = subprocess.Popen([sys.executable, "-m", "hil.cli", "run", str(prog), "--bench", str(LATHE), "--bus", bus,
                           "--trace", str(trace), "--no-check", "--no-progress"],
+                         preexec_fn=dispositions if ignore is not None else None,
                          env={**os.environ, "PYTHONPATH": str(ROOT)}, stdout=subprocess.PIPE,
                          stderr=subprocess.PIPE, text=True)
     parts = trace.with_name(trace.name + ".part")

@@ -8,7 +8,6 @@ from __future__ import annotations
 import errno
 import os
 import signal
-import subprocess
 import sys
 import time
 from pathlib import Path
@@ -17,6 +16,7 @@ import numpy as np
 import pytest
 
 from hil.trace_read import TraceFile
+from tests.test_stop_signals import start
 
 ROOT = Path(__file__).resolve().parents[1]
 LATHE = ROOT / "benches" / "lathe-2axis.toml"
@@ -119,32 +119,10 @@ def test_closing_the_terminal_stops_the_run_like_a_hangup(tmp_path):
     assert_stopped_under_control(trace)
 
 
-def _start(tmp_path: Path, *, ignore: tuple[int, ...] = ()) -> tuple[subprocess.Popen, Path]:
-    """`hil run` on the long program with the signals an interactive shell leaves at their default (pytest's own
-    parent may be a background job, whose SIGQUIT is ignored), `ignore` ignored as nohup or `&` leave them."""
-    prog = tmp_path / "long.nc"
-    prog.write_text(LONG)
-    trace = tmp_path / "run.parquet"
-
-    def dispositions() -> None:
-        for s in (signal.SIGINT, signal.SIGQUIT, signal.SIGHUP, signal.SIGTERM):
-            signal.signal(s, signal.SIG_IGN if s in ignore else signal.SIG_DFL)
-
-    p = subprocess.Popen([sys.executable, "-m", "hil.cli", "run", str(prog), "--bench", str(LATHE),
-                          "--trace", str(trace), "--no-check", "--no-progress"], preexec_fn=dispositions,
-                         env={**os.environ, "PYTHONPATH": str(ROOT)}, stdout=subprocess.PIPE,
-                         stderr=subprocess.PIPE, text=True)
-    parts = trace.with_name(trace.name + ".part")
-    deadline = time.monotonic() + 60
-    while not list(parts.glob("*.parquet")) and time.monotonic() < deadline and p.poll() is None:
-        time.sleep(0.02)  # the run is under way (its first row group is on disk)
-    return p, trace
-
-
 def test_ctrl_backslash_stops_the_run_under_control(tmp_path):
     """SIGQUIT (Ctrl-\\) used to end `hil run` as Python leaves it, a core dump: no stop, no summary, the trace
     left as its .part (on a field bus the drives enabled until their watchdog). Now it is a stop like Ctrl-C's."""
-    p, trace = _start(tmp_path)
+    p, trace = start(tmp_path, "sim", ignore=())
     p.send_signal(signal.SIGQUIT)
     out, err = p.communicate(timeout=120)
     assert p.returncode == 131, out + err
@@ -155,7 +133,7 @@ def test_ctrl_backslash_stops_the_run_under_control(tmp_path):
 def test_a_hangup_nohup_ignores_does_not_stop_the_run(tmp_path):
     """`nohup hil run …` so that the run outlives the terminal: SIGHUP is ignored, and it used to stop the run
     all the same (the run's own handler replaced the ignore). The run now goes to its end; the README said so."""
-    p, trace = _start(tmp_path, ignore=(signal.SIGHUP,))
+    p, trace = start(tmp_path, "sim", ignore=(signal.SIGHUP,))
     p.send_signal(signal.SIGHUP)
     time.sleep(0.5)
     assert p.poll() is None  # still running

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from hil.commands.script import add_bench_options, finish, open_machine, stoppable
+from hil.commands.script import add_bench_options, finish, on_machine
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -18,13 +18,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def cmd_mpg(args: argparse.Namespace) -> int:
-    from hil.scripting import ScriptError
-
-    machine, code = open_machine(args)
-    if machine is None:
-        return code
-    with stoppable(machine):
-        return _mpg(args, machine)
+    return on_machine(args, _mpg)
 
 
 def _mpg(args: argparse.Namespace, machine) -> int:

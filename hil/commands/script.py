@@ -5,8 +5,9 @@ from __future__ import annotations
 
 import argparse
 import sys
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
+from typing import Any
 
 from hil.cli import EXIT_ALARM, EXIT_OK, EXIT_USAGE
 
@@ -75,6 +76,15 @@ def stoppable(machine) -> Iterator[None]:
             raise
 
 
+def on_machine(args: argparse.Namespace, work: Callable[[argparse.Namespace, Any], int]) -> int:
+    """`work(args, machine)` on the bench powered up for it, stoppable by a signal (B96)."""
+    machine, code = open_machine(args)
+    if machine is None:
+        return code
+    with stoppable(machine):
+        return work(args, machine)
+
+
 def finish(machine, ok: bool = True) -> int:
     machine.report()
     machine.close()
@@ -82,11 +92,7 @@ def finish(machine, ok: bool = True) -> int:
 
 
 def cmd_script(args: argparse.Namespace) -> int:
-    machine, code = open_machine(args)
-    if machine is None:
-        return code
-    with stoppable(machine):
-        return _script(args, machine)
+    return on_machine(args, _script)
 
 
 def _script(args: argparse.Namespace, machine) -> int:

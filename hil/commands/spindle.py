@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import argparse
 
-from hil.commands.script import add_bench_options, finish, open_machine, stoppable
+from hil.commands.script import add_bench_options, finish, on_machine
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -24,9 +24,10 @@ def cmd_spindle(args: argparse.Namespace) -> int:
         print(f"hil spindle: RPM {args.rpm:g} and --seconds {args.seconds:g} must be >= 0 (--ccw turns backwards)",
               file=__import__("sys").stderr)
         return 2
-    machine, code = open_machine(args)
-    if machine is None:
-        return code
+    return on_machine(args, _spindle)
+
+
+def _spindle(args: argparse.Namespace, machine) -> int:
     if not machine.bench.spindles:
         print("hil spindle: the bench has no spindle", file=__import__("sys").stderr)
         machine.close()
@@ -35,11 +36,6 @@ def cmd_spindle(args: argparse.Namespace) -> int:
         print(f"hil spindle: --override {args.override} is outside 0-65535 %", file=__import__("sys").stderr)
         machine.close()
         return 2
-    with stoppable(machine):
-        return _spindle(args, machine)
-
-
-def _spindle(args: argparse.Namespace, machine) -> int:
     machine.spindle_override(args.override)
     up = machine.spindle(args.rpm, -1 if args.ccw else 1)
     machine.wait(args.seconds)
