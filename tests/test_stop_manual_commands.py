@@ -110,3 +110,18 @@ def test_hil_spindle_and_mpg_stopped_by_a_signal_ramp_down(monkeypatch, capsys, 
     top = np.abs(v[t < 1.5]).max()
     assert top > 10 and abs(v[off - 1]) < 0.01 and not enabled[off:].any()
     assert np.abs(np.diff(v[t >= 1.5])).max() < 0.2 * top  # a ramp, no step
+
+
+def test_two_signals_at_once_disable_the_script_s_drives_at_once(tmp_path, capsys):
+    """Two Ctrl-C in the same cycle (before the script saw the first): the second's KeyboardInterrupt used to leave
+    the drives enabled; now they are disabled at once (B9), `hil: interrupted`, exit 130."""
+    from hil.cli import main
+
+    script = tmp_path / "s.py"
+    script.write_text(SCRIPT.replace("os.kill(os.getpid(), getattr(signal, sig))",
+                                     "os.kill(os.getpid(), signal.SIGINT); os.kill(os.getpid(), signal.SIGINT)"))
+    log = tmp_path / "log.jsonl"
+    assert main(["script", str(script), str(log), "SIGINT", "spindle"]) == 130
+    assert "interrupted" in capsys.readouterr().err
+    sw = _rows(log)[:, 2].astype(int)
+    assert (sw[-1] & 0x6F) != OP_ENABLED

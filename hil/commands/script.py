@@ -74,6 +74,10 @@ def stoppable(machine) -> Iterator[None]:
                 machine.close()  # standstill, then the drives disabled
             machine.report()  # where everything came to rest
             raise
+        except KeyboardInterrupt:  # two signals before a cycle saw the first: disabled at once (B9)
+            machine.runner._end_reason = "interrupted"
+            machine.close()
+            raise
 
 
 def on_machine(args: argparse.Namespace, work: Callable[[argparse.Namespace, Any], int]) -> int:
