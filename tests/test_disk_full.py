@@ -85,14 +85,14 @@ def test_a_parquet_trace_whose_part_cannot_be_written_stops_the_run_and_leaves_n
     """The Parquet writer thread's write of a part fails as on a full disk (pyarrow raises OSError, ENOSPC)."""
     import hil.trace_parquet as tp
 
-    real = tp.pq.write_table
+    real = tp.write_table
 
     def full(table, where, **kwargs):
         if not isinstance(where, (str, Path)):  # the warm-up's write into memory
             return real(table, where, **kwargs)
         raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
 
-    monkeypatch.setattr(tp.pq, "write_table", full)
+    monkeypatch.setattr(tp, "write_table", full)
     result, seen = _run(tmp_path / "run.parquet")
     assert result.alarms[0].code == 0xDE04
     _assert_stopped_under_control(result, seen)
