@@ -42,6 +42,7 @@ from nc.motion.planner_cruise import CruiseSampling
 from nc.motion.planner_runs import FittedRuns
 from nc.motion.spline_feed import NOTHING
 from nc.motion.planner_thread import ThreadStepping
+from nc.motion.hold_stop import crosses_too_fast
 from nc.motion.profile import clip, solve_axes, solve_position, solve_velocity
 from nc.motion.sample_rows import few_rows
 from nc.motion.share_zones import ShareZones
@@ -563,6 +564,15 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
                     self._flush()
                 return None  # at rest: wait for resume / override
             pw = solve_velocity(s, v, a, 0.0, b.a, b.j)
+            if pw.v_min() < -1e-7 or crosses_too_fast(pw, s, self.blocks):
+                # the stop would back up along the path (braking hard at low speed: a²/2j > v) or cross a junction
+                # faster than it allows (a corner, the queue's end): it cannot stop sooner, so the plan's own
+                # profile to that junction goes on (within the limits, no reversal) and the stop follows from
+                # there (motion 63)
+                dist, v1, ra, rj, vmax = self._run_target(max(cap, v, 1e-9), jf=self._jf)  # the running plan's jerk
+                to = solve_position(s, v, a, dist, v1, vmax, ra, rj)
+                if to is not None and to.p_max <= dist + 1e-7 and to.v_min() >= -1e-7:
+                    return _Plan("path", to, to.duration, t0, target=dist, queued=self._pushes)
             return _Plan("ramp", pw, pw.duration, t0, 0.0, 0.0)
         # The run: following blocks the profile may cross without a binding junction (same or
         # higher cap, end speed not below the cap); the target is the end of that run.

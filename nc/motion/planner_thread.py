@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from itertools import islice
+
 import numpy as np
 
 from nc.motion import threading as thr
@@ -42,9 +44,14 @@ class ThreadStepping:
             if st.v <= 1e-9 and not st.locked:
                 self._flush()
                 return Setpoint(self.position.copy(), self.line, 0.0, None)
-            thr.stop(st, b)
+            chain = [b]
+            for nb in islice(self.blocks, 1, None):  # the thread blocks the stop may run on into
+                if nb.kind != "thread":
+                    break
+                chain.append(nb)
+            thr.stop(st, chain)
         while True:
-            last = not (len(self.blocks) > 1 and self.blocks[1].kind == "thread") or st.stopping
+            last = not (len(self.blocks) > 1 and self.blocks[1].kind == "thread")  # a stop runs on too (motion 63)
             if not last:
                 thr.add_corner(st, b, self.blocks[1], self.lim.acc, self.lim.jerk)
             s = thr.advance(st, b, angle, T, last)

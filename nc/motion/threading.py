@@ -74,6 +74,9 @@ class ThreadState:
     last_angle: float = 0.0
     brake: Piecewise | None = None  # path profile of the final stop
     brake_t: float = 0.0
+    brake_in_u: bool = False  # an alarm's stop: `brake` is major-axis travel u, run on along the chain (motion 63)
+    stop_after: float | None = None  # an alarm's stop waits for u to pass this corner's end (motion 63)
+    stop_limits: tuple[float, float] = (0.0, 0.0)  # its limits on u: acceleration, jerk
     s: float = 0.0  # path position in the current block
     v: float = 0.0  # path speed (finite difference)
     stopping: bool = False  # a reset brakes the thread where it is
@@ -118,6 +121,12 @@ def advance(st: ThreadState, b: Block, angle: float, T: float, last_in_chain: bo
     if st.brake is not None:
         st.brake_t += T
         s = float(st.brake.sample(np.array([st.brake_t]))[0][0])
+        if st.brake_in_u:
+            if not last_in_chain and (s - st.u_block) * f >= b.length - 1e-9:
+                # the stop needs more room than this block has left: it runs on into the chain's next block
+                st.brake_t -= T  # whose call in this cycle advances the clock again
+                return _set(st, b.length, T, True, b)
+            st.u, s = s, (s - st.u_block) * f  # u: where the chain's corners are read from
         if st.brake_t >= st.brake.duration - 1e-12:
             if st.stopping:  # a reset: rest wherever the stop ended
                 st.halted = True
@@ -139,12 +148,16 @@ def advance(st: ThreadState, b: Block, angle: float, T: float, last_in_chain: bo
         n0 = st.direction * (st.last_angle - st.sync_angle) / 360.0
         k = float(mv.lead_change or 0.0)
         mid = 0.5 * (n0 + n) - st.n_block
-        st.u += (lead + k * mid) * (n - n0)  # G34: lead grows by K per revolution within the block
+        du = (lead + k * mid) * (n - n0)
+        st.u += du  # G34: lead grows by K per revolution within the block
+        if st.stop_after is not None and st.u >= st.stop_after:  # past the corner: the deferred stop starts
+            st.stop_after = None
+            _brake(st, st.u, du / T, 0.0)
     st.last_angle = angle
     s = (st.u - st.u_block) * f
     if s >= b.length - 1e-9 and not last_in_chain:
         return _set(st, b.length, T, True, b)
-    if last_in_chain and st.locked:
+    if last_in_chain and st.locked and st.brake is None:  # (a deferred alarm stop may have started above)
         v = st.v if st.v > 0.0 else lead * st.omega / 360.0 * f
         need = change_distance(v, 0.0, MARGIN * b.a, MARGIN * b.j)
         if b.length - s - v * T <= need:
@@ -157,9 +170,11 @@ def advance(st: ThreadState, b: Block, angle: float, T: float, last_in_chain: bo
 
 
 def _set(st: ThreadState, s: float, T: float, done: bool, b: Block) -> float | None:
+    if done:  # no position this cycle in b: the chain's next block gives it, from the last one (next_block)
+        return None
     st.v = (s - st.s) / T if s >= st.s else 0.0
     st.s = s
-    return None if done else s
+    return s
 
 
 def slope(b: Block) -> np.ndarray:
@@ -170,7 +185,7 @@ def slope(b: Block) -> np.ndarray:
 
 def add_corner(st: ThreadState, b: Block, nb: Block, acc: np.ndarray, jerk: np.ndarray) -> None:
     """Register the rounded corner from b into the chain's next block nb (once per junction)."""
-    if st.cornered >= st.block_no or st.stopping or b.seg is None or nb.seg is None \
+    if st.cornered >= st.block_no or b.seg is None or nb.seg is None \
             or b.seg.kind != "line" or nb.seg.kind != "line":
         return
     st.cornered = st.block_no
@@ -186,15 +201,46 @@ def add_corner(st: ThreadState, b: Block, nb: Block, acc: np.ndarray, jerk: np.n
 def next_block(st: ThreadState, b: Block, nb: Block) -> None:
     """The chain runs on from b into the next thread block nb: carry the travel over."""
     st.block_no += 1
-    st.u_block += b.length / major_factor(b)
+    f_b, f_nb = major_factor(b), major_factor(nb)
+    u_last = st.u_block + st.s / f_b  # the last cycle's position, on u
+    st.u_block += b.length / f_b
     st.u = max(st.u, st.u_block)
     st.n_block = st.direction * (st.last_angle - st.sync_angle) / 360.0
-    st.s = (st.u - st.u_block) * major_factor(nb)
+    # st.s: the last cycle's position in nb's path length (before nb's start): this cycle's speed is then its
+    # real one, not 0 (a stop asked in the cycle a chain changed blocks found the planner "at rest" and froze
+    # the axes at 27 mm/s: motion 63)
+    st.s = (u_last - st.u_block) * f_nb
 
 
-def stop(st: ThreadState, b: Block) -> None:
-    """Reset or alarm during a thread: jerk-limited stop along the path from the current state."""
+def stop(st: ThreadState, chain: list[Block]) -> None:
+    """Reset or alarm during a thread: a jerk-limited stop from the current state, planned on the major-axis
+    travel u, so that it runs on through the chain's next blocks where the current block (chain[0]) ends first
+    (motion 63). In the ramp the state is the ramp's own, its acceleration included. A stop that would brake
+    inside a rounded corner of the chain (shaped for the locked speed, its jerk near the limit already) runs on
+    locked through the corner and brakes after it. Before, the stop was planned in the current block's path
+    length from a = 0 and cut at its end: an alarm near a thread's end stopped the axes within 2-3 cycles
+    (acceleration ×3.5, jerk ×77 the limits)."""
     st.stopping = True
-    if st.brake is None:
-        st.brake = solve_velocity(st.s, st.v, 0.0, 0.0, b.a, b.j)
-        st.brake_t = 0.0
+    if st.brake is not None or st.stop_after is not None:
+        return
+    b = chain[0]
+    f = major_factor(b)
+    v, a = st.v / f, 0.0
+    t = st.direction * (st.last_angle - st.ramp_start) / st.omega
+    if not st.locked and 0.0 < t < st.ramp_time:
+        _, v, a = st.ramp.at(t)  # the ramp is on u already
+    # u's limits: every block's path limits over its path length per u, the tightest of the chain's
+    st.stop_limits = (min(nb.a / major_factor(nb) for nb in chain), min(nb.j / major_factor(nb) for nb in chain))
+    u0 = st.u_block + st.s / f
+    _brake(st, u0, v, a)
+    end = float(st.brake.at(st.brake.duration)[0])  # type: ignore[union-attr]
+    ahead = [k for k in st.corners if k.u + k.w > u0]
+    if st.locked and ahead and end > min(k.u - k.w for k in ahead):
+        st.brake, st.brake_in_u = None, False
+        st.stop_after = max(k.u + k.w for k in ahead)
+
+
+def _brake(st: ThreadState, u0: float, v: float, a: float) -> None:
+    st.brake = solve_velocity(u0, v, a, 0.0, *st.stop_limits)
+    st.brake_t = 0.0
+    st.brake_in_u = True
