@@ -17,10 +17,15 @@ where the run's p99 lands. Figures, not a test: the wrappers add ≈ 1-2 µs to 
 from __future__ import annotations
 
 import argparse
+import functools
+import gc
 import os
+import resource
 import sys
 import tempfile
+import time
 from collections import defaultdict
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -169,17 +174,309 @@ def report(cycles: list[tuple[str, int]], out=sys.stdout) -> None:
     print(f"stepped {stepped} ({stepped / len(us):.2%})", file=out)
 
 
+
+# ---- why each overrun happened (issue 17, session 19, decision bench B98) ---------------------------------------------
+# A period runs from a cycle's wake-up (its tick returning) to the next tick's call; the tick is late (an overrun)
+# when that call comes after its deadline. What each period spent is recorded: its thread CPU, the sleeps it asked
+# for and got (the B43 sleep before the warm-up), its run-queue wait (/proc/thread-self/schedstat), its context
+# switches, page faults and system time (getrusage RUSAGE_THREAD), the garbage collections (gc.callbacks), the
+# Parquet writer thread's busy time overlapping it (it shares the GIL), and the thread CPU of each piece of our work.
+_tt = time.thread_time_ns
+_now = time.monotonic_ns
+_SCHED = os.open("/proc/thread-self/schedstat", os.O_RDONLY) if os.path.exists("/proc/thread-self/schedstat") else -1
+
+
+def _probe() -> tuple:
+    ru = resource.getrusage(resource.RUSAGE_THREAD)
+    rd = int(os.pread(_SCHED, 128, 0).split()[1]) if _SCHED >= 0 else 0
+    return _tt(), rd, ru.ru_nvcsw, ru.ru_nivcsw, ru.ru_minflt + ru.ru_majflt  # (system time: tick-sampled here)
+
+
+@dataclass
+class Period:
+    start: int  # the wake-up (tick returned), monotonic ns
+    probe: tuple  # _probe() at the wake-up
+    late_start: int  # ns the wake-up came after its deadline
+    wait_from: int = 0  # the tick's call before the wake-up (its sleep and spin)
+    wait: tuple = ()  # _probe() differences over that wait
+    deadline: int = 0  # the next tick's deadline
+    written: int = 0  # outputs written: cycle work ends, the slack's work begins
+    call: int = 0  # the next tick called
+    over: int = 0  # ns the call came after the deadline (> 0: an overrun)
+    cpu: int = 0
+    run_delay: int = 0
+    vcsw: int = 0
+    ivcsw: int = 0
+    faults: int = 0
+    slept: int = 0  # ns in sleeps outside the tick (asked and got)
+    sleep_over: int = 0  # ns those sleeps overshot what they asked
+    sleeps: int = 0
+    gc_ns: int = 0
+    writer_ns: int = 0
+    pieces: dict = field(default_factory=lambda: defaultdict(int))  # "cycle:" / "slack:" + name → thread CPU ns
+    cause: str = ""
+
+
+PERIODS: list[Period] = []
+_cur: list[Period | None] = [None]
+_stack: list[str] = []
+_mark = [0]
+_phase = ["cycle"]
+_WRITER: list[tuple[int, int]] = []  # the Parquet writer's busy intervals (monotonic ns)
+_gc_t0 = [0]
+
+
+def _charge() -> None:
+    now = _tt()
+    p = _cur[0]
+    if p is not None and _stack:
+        p.pieces[_phase[0] + ": " + _stack[-1]] += now - _mark[0]
+    _mark[0] = now
+
+
+def _piece(label: str, f):
+    @functools.wraps(f)
+    def w(*a, **k):
+        _charge()
+        _stack.append(label)
+        try:
+            return f(*a, **k)
+        finally:
+            _charge()
+            _stack.pop()
+    return w
+
+
+def _piece_gen(label: str, f):
+    @functools.wraps(f)
+    def w(*a, **k):
+        g = f(*a, **k)
+
+        def steps():
+            while True:
+                _charge()
+                _stack.append(label)
+                try:
+                    next(g)
+                except StopIteration:
+                    return
+                finally:
+                    _charge()
+                    _stack.pop()
+                yield
+        return steps()
+    return w
+
+
+def install_causes() -> None:
+    from hil import cycle_lean, fit_ahead, stretch_ahead as SA, stretch_bulk as SB, stretch_realtime as SR
+    from hil import stretch_pass as SP, stretch_state as SS, trace_parquet as TP
+    from fieldbus.link import SimLink
+    from nc.channel import Channel
+    from nc.motion import fit_memo, planner_runs, spline_feed
+    from nc.motion.planner import Planner
+
+    tick, written, init = clock_mod.RealTimeClock.tick, clock_mod.RealTimeClock.written, clock_mod.RealTimeClock.__init__
+
+    def _tick(self):
+        if hasattr(self, "idle"):  # B98's idle work ends the slack: counted in it, as the tick's own call does
+            _charge()
+            _stack.append("idle work")
+            try:
+                self.idle()
+            finally:
+                _charge()
+                _stack.pop()
+        call = self.now_ns()
+        pr = _probe()
+        _charge()
+        p = _cur[0]
+        if p is not None:
+            p.call, p.deadline, p.over = call, self._deadline, call - self._deadline
+            p.cpu = pr[0] - p.probe[0]
+            p.run_delay, p.vcsw, p.ivcsw, p.faults = (x - y for x, y in zip(pr[1:], p.probe[1:]))
+            PERIODS.append(p)
+            _cur[0] = None
+        _phase[0] = "tick"
+        t = tick(self)
+        if PERIODS and t.overrun and PERIODS[-1].over <= 0:  # on time at the call, late once the probe above ran
+            PERIODS[-1].over, PERIODS[-1].cause = 1, "the census's own probe (instrumentation)"
+        q = _probe()
+        _cur[0] = Period(self._start_ns, q, int(t.late * 1e9), wait_from=call,
+                         wait=tuple(x - y for x, y in zip(q, pr)))
+        _phase[0] = "cycle"
+        _mark[0] = _tt()
+        return t
+
+    def _written(self):
+        written(self)
+        _charge()
+        if _cur[0] is not None:
+            _cur[0].written = self._done_ns
+        _phase[0] = "slack"
+
+    def _init(self, *a, **k):
+        init(self, *a, **k)
+        sleep = self.sleep
+
+        def timed_sleep(s):
+            if _phase[0] == "tick":
+                return sleep(s)
+            t0 = _now()
+            sleep(s)
+            dt = _now() - t0
+            p = _cur[0]
+            if p is not None:
+                p.slept += dt
+                p.sleep_over += max(0, dt - int(s * 1e9))
+                p.sleeps += 1
+        self.sleep = timed_sleep
+
+    clock_mod.RealTimeClock.tick, clock_mod.RealTimeClock.written = _tick, _written
+    clock_mod.RealTimeClock.__init__ = _init
+
+    def _gc(phase, info):
+        if phase == "start":
+            _gc_t0[0] = _now()
+        elif _cur[0] is not None:
+            _cur[0].gc_ns += _now() - _gc_t0[0]
+    gc.callbacks.append(_gc)
+
+    write_part = TP.ParquetTrace._write_part
+
+    def _write_part(self, *a, **k):
+        t0 = _now()
+        try:
+            return write_part(self, *a, **k)
+        finally:
+            _WRITER.append((t0, _now()))
+    TP.ParquetTrace._write_part = _write_part
+
+    # our pieces, each its exclusive thread CPU
+    for name in ("bulk_cycles", "first_change", "outputs_hold"):
+        w = _piece(name, getattr(SB, name))
+        for mod in (S, SR, SS, SB):
+            if hasattr(mod, name):
+                setattr(mod, name, w)
+    for name in ("sample_stretch", "stand_stretch", "csp_stretch", "csv_stretch"):  # compared by identity: one wrapper
+        w = _piece(name, getattr(S, name))
+        for mod in (S, SR, SS, SB):
+            if hasattr(mod, name):
+                setattr(mod, name, w)
+    for cls, names in ((S.Stretcher, ("run", "_refill_ahead", "_fill_next", "_spec_start", "_launch")),
+                       (Planner, ("_refill", "_start_plan", "push", "step")),
+                       (Channel, ("_feed_planner",)), (SimLink, ("exchange",)), (SP.Pass, ("run",)),
+                       (spline_feed.RunFeed, ("_fix",)),
+                       (fit_memo.FitReceiver, tuple(n for n in ("get", "work_part") if hasattr(fit_memo.FitReceiver, n))),
+                       (planner_runs.FittedRuns, ("_let_through",)),
+                       (R.BenchRunner, ("_row",))):
+        for n in names:
+            setattr(cls, n, _piece(f"{cls.__name__}.{n}", getattr(cls, n)))
+    S.Stretcher._prepare = _piece_gen("Stretcher._prepare", S.Stretcher._prepare)
+    S.Stretcher._cut_ahead = _piece_gen("Stretcher._cut_ahead", S.Stretcher._cut_ahead)
+    SA.step_ahead = _piece("step_ahead", SA.step_ahead)
+    R.warm = _piece("warm", cycle_lean.warm)
+    for cls in (TP.ParquetTrace,):
+        for n in ("write", "write_columns"):
+            setattr(cls, n, _piece(f"trace.{n}", getattr(cls, n)))
+    mlc_scan = []
+    for mod in ("mlc.basic", "mlc.machine"):
+        m = __import__(mod, fromlist=["x"])
+        for cname in ("BasicMlc", "Mlc"):
+            c = getattr(m, cname, None)
+            if c is not None and "scan" in c.__dict__ and c not in mlc_scan:
+                mlc_scan.append(c)
+                c.scan = _piece(f"{cname}.scan", c.scan)
+    del fit_ahead
+
+
+def _overlap(a: int, b: int) -> int:
+    """ns of the Parquet writer's busy time within [a, b]."""
+    return sum(max(0, min(y, b) - max(x, a)) for x, y in _WRITER if y > a and x < b)
+
+
+FAULT_NS = 2_000  # what a page fault is taken to cost (≈ 1-2 µs; few are expected once memory is locked)
+
+
+def _classify(p: Period) -> str:
+    """The cause of one late tick (the call `over` ns after its deadline): the first that alone accounts for it.
+    A wake-up already late by as much is the wait's (the tick's sleep and spin before it): the GIL held by the
+    writer (a voluntary switch beyond the sleep's), the host (the run queue, or a vCPU not running: steal)."""
+    over = p.over
+    if p.cause:
+        return p.cause
+    p.writer_ns = _overlap(p.start, p.call)
+    if p.late_start >= over and p.wait:
+        cpu, rd, vcsw, ivcsw = p.wait[:4]
+        if vcsw > 1 and _overlap(p.wait_from, p.start):
+            return "trace writer (GIL) at the wake-up"
+        if rd or ivcsw:
+            return "host: preempted (run queue) at the wake-up"
+        return "host: late wake-up (steal, interrupts)"
+    avail = p.deadline - p.start  # the period from its wake-up to the deadline
+    off = (p.call - p.start) - p.cpu - p.slept  # neither running nor asleep: preempted, stolen, waiting for the GIL
+    if p.gc_ns and p.gc_ns >= over:
+        return "garbage collection"
+    if p.writer_ns >= over and p.vcsw > p.sleeps:
+        return "trace writer (GIL)"
+    if p.cpu > avail:  # our own CPU alone passes the deadline
+        if p.faults * FAULT_NS >= p.cpu - avail:
+            return "page faults"
+        if not p.pieces:
+            return "ours: (unwrapped)"
+        name, _ = max(p.pieces.items(), key=lambda kv: kv[1])
+        return "ours: " + name
+    if p.sleep_over >= over:
+        return "host: late wake-up from a sleep"
+    if p.run_delay >= over or p.ivcsw:
+        return "host: preempted (run queue)"
+    if off >= over:
+        return "host: steal / interrupts"
+    return "mixed"
+
+
+def report_causes(periods: list[Period], out=sys.stdout, listing: int = 0) -> dict[str, int]:
+    late = [p for p in periods if p.over > 0]
+    counts: dict[str, list[Period]] = defaultdict(list)
+    for p in late:
+        p.cause = _classify(p)
+        counts[p.cause].append(p)
+    print(f"{len(late)} late ticks of {len(periods)} periods; by cause (late by µs p50 / max; the period's thread CPU, "
+          f"run-queue wait, off-CPU µs p50):", file=out)
+    for cause, ps in sorted(counts.items(), key=lambda kv: -len(kv[1])):
+        o = np.array([p.over for p in ps]) / 1e3
+        cpu = np.median([p.cpu for p in ps]) / 1e3
+        rd = np.median([p.run_delay for p in ps]) / 1e3
+        off = np.median([(p.call - p.start) - p.cpu - p.slept for p in ps]) / 1e3
+        print(f"  {cause:60s} {len(ps):4d}  late {np.median(o):6.0f} / {o.max():6.0f}  cpu {cpu:6.0f}  run queue "
+              f"{rd:5.0f}  off {off:6.0f}", file=out)
+    for p in sorted(late, key=lambda p: -p.over)[:listing]:
+        top = sorted(p.pieces.items(), key=lambda kv: -kv[1])[:4]
+        print(f"    late {p.over / 1e3:7.0f} µs: {p.cause}; period {(p.call - p.start) / 1e3:.0f} of "
+              f"{(p.deadline - p.start) / 1e3:.0f}, late start {p.late_start / 1e3:.0f}, cpu {p.cpu / 1e3:.0f}, cycle work "
+              f"{(p.written - p.start) / 1e3:.0f}, slept {p.slept / 1e3:.0f} (over {p.sleep_over / 1e3:.0f}), run queue "
+              f"{p.run_delay / 1e3:.0f}, ivcsw {p.ivcsw}, vcsw {p.vcsw}, faults {p.faults}, "
+              f"gc {p.gc_ns / 1e3:.0f}, writer {p.writer_ns / 1e3:.0f}; "
+              + ", ".join(f"{k} {v / 1e3:.0f}" for k, v in top), file=out)
+    return {c: len(v) for c, v in counts.items()}
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("program", nargs="?", default=str(ROOT / "examples" / "lathe_demo.nc"))
     ap.add_argument("bench", nargs="?", default=None)
     ap.add_argument("--runs", type=int, default=1)
+    ap.add_argument("--list", type=int, default=0, help="list the N latest ticks with what their period spent")
     args = ap.parse_args()
     from hil import api
 
     install()
+    install_causes()
+    total: dict[str, int] = defaultdict(int)
     for _ in range(args.runs):
         CYCLES.clear()
+        PERIODS.clear()
+        _WRITER.clear()
         with tempfile.TemporaryDirectory() as d:
             res = api.run(args.program, args.bench, trace=os.path.join(d, "rt.parquet"), realtime=True, check=False)
         r = res.run
@@ -188,6 +485,11 @@ def main() -> None:
               f"({r.stretched / max(1, r.cycles):.1%} in stretches), {r.overruns} overruns; cycle work p50 "
               f"{e.get('p50', 0) * 1e6:.0f} µs, p99 {e.get('p99', 0) * 1e6:.0f} µs")
         report(CYCLES)
+        for cause, n in report_causes(PERIODS,
+                                      listing=args.list).items():
+            total[cause] += n
+    if args.runs > 1:
+        print("all runs: " + ", ".join(f"{c} {n}" for c, n in sorted(total.items(), key=lambda kv: -kv[1])))
 
 
 if __name__ == "__main__":
