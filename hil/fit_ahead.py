@@ -49,7 +49,9 @@ class FitAhead:
     def prefetch(self, timeout: float) -> None:
         """Before the paced cycles: wait up to `timeout` s until the child is MARK_CYCLES into its run (or ended).
         The run's look-ahead completes its first windows within a few cycles of the start, before the child,
-        started at the same time, could have them; past those first cycles the child runs faster than real time."""
+        started at the same time, could have them; past those first cycles the child runs faster than real time.
+        The windows in hand then are decoded here too (B98): the first of them is needed a few cycles into the run,
+        before its slacks could have decoded it."""
         import time
 
         memo, deadline = self.memo, time.monotonic() + timeout
@@ -61,6 +63,8 @@ class FitAhead:
                 memo._read()
         except (EOFError, OSError):
             memo.closed = True
+        while time.monotonic() < deadline and memo.work_part(read=False):
+            pass
 
     def close(self) -> tuple[int, int]:
         """End the child (whatever it still has to do) and reap it; (windows taken from it, fitted in the cycle)."""
@@ -190,4 +194,5 @@ def _child(interp, program, cfg: MotionConfig, start: dict[str, float], start_r:
                 start = actual
                 continue
         break
+    sender.flush()
     sender.conn.close()

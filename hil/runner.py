@@ -229,6 +229,8 @@ class BenchRunner:
                     self.result.alarms.append(Alarm(retentive.RETENTIVE_ERROR, f"retentive variables {self.retain}: "
                                                                                 f"cannot be written ({exc.strerror})"))
             if self._fit_ahead is not None:
+                if paced:
+                    self.clock.idle_work = None
                 self.result.fits_ahead = self._fit_ahead.close()
                 self._fit_ahead = None
             if paced:
@@ -249,6 +251,8 @@ class BenchRunner:
         self._fit_ahead = fit_ahead.start(interp, program, planner.cfg, guess, wait=mode == "wait")
         if self._fit_ahead is not None:
             planner._runs.memo = self._fit_ahead.memo
+            if paced:  # its windows decoded a span at a time in the slacks (B98)
+                self.clock.idle_work = self._fit_ahead.memo.work_part
             if mode == "auto":  # paced cycles have no time to wait: the first windows now
                 self._fit_ahead.prefetch(PREFETCH_S)
 
@@ -420,6 +424,7 @@ class BenchRunner:
         if tx is not None and ahead is not None:
             step = ahead(tx)  # the channel step on this feedback, ahead too where nothing before it can tell (B46)
         if tx is not None:
+            self.clock.idle()  # B98: the lowest-rank work ahead, before the warm-up's reads (the tick does it too)
             left = self.clock.left_ns() - int(self.clock.config.busy_wait * 1e9) - WARM_AHEAD_NS
             if left > 0:  # sleep to just before the clock's own spin, so nothing runs between the reads and the tick
                 self.clock.sleep(left * 1e-9)

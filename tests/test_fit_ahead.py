@@ -125,3 +125,55 @@ def test_a_fork_that_fails_leaves_the_windows_to_the_cycle(monkeypatch, tmp_path
     _, cols_off = _run(monkeypatch, tmp_path, program_text, "0", tag="off")
     assert res.ok and res.run.fits_ahead is None
     _same(cols_off, cols)
+
+
+SPAN_NS = 40_000  # a span's unpickling, paced (a window's 80: 1.5-3.5 ms, decision bench B98)
+LIMITS_NS = 30_000  # a span's `span_limits` (B99)
+
+
+def test_windows_are_decoded_a_span_a_slack_and_their_cycle_misses_no_deadline(monkeypatch, tmp_path, program_text):
+    """B98-B99 on the fake clock, with a modelled cost: every span's unpickling and limits advance the clock. The run's
+    windows are decoded and their spans' limits worked out a span at a time in the slacks before they are needed, so
+    no cycle overruns (before: a window's 80 spans decoded and limited in its cycle, ≈ 5.6 ms modelled); the
+    setpoints are those of fitting in the cycle, bit for bit."""
+    from nc.motion import fit_memo, planner_runs
+    from nc.motion.spline_runs import SplineSpan
+
+    ft, _ = fake_clock(monkeypatch)
+    real_pickle, real_limits = fit_memo.pickle, planner_runs._span_limits or planner_runs._load_span_limits()
+
+    class CostlyPickle:
+        HIGHEST_PROTOCOL = real_pickle.HIGHEST_PROTOCOL
+        dumps = staticmethod(real_pickle.dumps)
+
+        @staticmethod
+        def loads(blob):
+            obj = real_pickle.loads(blob)
+            spans = sum(isinstance(x, SplineSpan) for x in obj) if isinstance(obj, list) else isinstance(obj, SplineSpan)
+            ft.t += SPAN_NS * spans
+            return obj
+
+    def costly_limits(*a):
+        ft.t += LIMITS_NS
+        return real_limits(*a)
+
+    memos: list = []
+    begin = fit_ahead.FitAhead.begin
+
+    def begin_then_read_all(self, start):  # every window in hand before the first cycle: the test does not race the child
+        begin(self, start)
+        self.memo.wait = True
+        self.memo._drain(b"\xff" * fit_memo.KEY_SIZE)  # (no such key: reads to the child's end)
+        self.memo.wait = False
+        memos.append(self.memo)
+
+    monkeypatch.setattr(fit_memo, "pickle", CostlyPickle)
+    monkeypatch.setattr(planner_runs, "_span_limits", costly_limits)
+    monkeypatch.setattr(fit_ahead.FitAhead, "begin", begin_then_read_all)
+    rt, cols_rt = _run(monkeypatch, tmp_path, program_text, "auto", realtime=True)
+    off, cols_off = _run(monkeypatch, tmp_path, program_text, "0", realtime=True, tag="rt")
+    assert off.run.overruns >= 5  # fitted in the cycle (whose fit itself costs nothing modelled here)
+    assert rt.run.overruns == 0  # (before B98-B99: 5, one a window: its's 80 spans decoded and limited in its cycle)
+    found, fitted = rt.run.fits_ahead
+    assert found == 5 and fitted == 0 and memos[0].decoded_ahead == 5  # every window decoded before its cycle
+    _same(cols_off, cols_rt)

@@ -12,6 +12,10 @@ same bits either way, only where the CPU is spent differs.
 
 The key of a window chains the key of the window that made its joint's span (`Held.key`): equal keys, equal
 spans before, so equal results.
+
+A window travels as one pickle per span (decision bench B98): unpickling a window's 80 spans is 1.5-3.5 ms, more
+than a period, so the run decodes them a span at a time in its slacks (`FitReceiver.work_part`, called by the
+real-time clock while time is left before the next tick) and the cycle that needs the window takes it decoded.
 """
 
 from __future__ import annotations
@@ -55,6 +59,7 @@ class FitSender:
         self.conn = conn
         self.capacity = capacity
         self.sent = 0
+        self._pending: tuple[bytes, Any, list | None] | None = None  # the window fitted last, sent at the next put
 
     def _room(self, size: int) -> None:
         import fcntl
@@ -72,10 +77,23 @@ class FitSender:
         return MISSING
 
     def put(self, key: bytes, result: Any) -> None:
+        """The window pickled now, as it was cut, a pickle per span (the run decodes a window a span at a time in
+        its slacks, B98); sent when the next window is fitted (or at `flush`): by then this process's look-ahead has
+        taken the window's spans, and their limits (`span_limits`, B99) go with them."""
+        self.flush()
         for sp in result or ():  # the ends the look-ahead asks for at every junction, worked out here (kept in the
             sp._end(True)  # span, so they travel with it): in the run's cycle they cost more than the fit
             sp._end(False)
-        msg = key + pickle.dumps(result, protocol=pickle.HIGHEST_PROTOCOL)
+        parts = None if result is None else [pickle.dumps(sp, protocol=pickle.HIGHEST_PROTOCOL) for sp in result]
+        self._pending = (key, result, parts)
+
+    def flush(self) -> None:
+        """The window held back by `put`, sent now with the limits this process's look-ahead left on its spans."""
+        if self._pending is None:
+            return
+        (key, result, parts), self._pending = self._pending, None
+        limits = None if result is None else [sp.__dict__.get("_limits") for sp in result]
+        msg = key + pickle.dumps((parts, limits), protocol=pickle.HIGHEST_PROTOCOL)
         if self.capacity:
             self._room(len(msg) + 8)  # (send_bytes' length header)
         self.conn.send_bytes(msg)
@@ -83,6 +101,7 @@ class FitSender:
 
     def mark(self) -> None:
         """Every window of the run's first cycles is sent (hil.fit_ahead: the run may start)."""
+        self.flush()
         self.conn.send_bytes(MARK)
 
 
@@ -98,6 +117,11 @@ class FitReceiver:
         self.fitted: set[bytes] = set()  # windows the cycle worked out itself
         self.closed = False  # the sender ended (its program done, or it failed)
         self.marked = False  # the sender is past the run's first cycles
+        # B98: windows decoded ahead, in the run's slacks (key → spans, or None), and the one being decoded (its
+        # key, its spans' pickles, those decoded so far); a window is handed out decoded once, then from its blob
+        self.ready: dict[bytes, list | None] = {}
+        self._part: tuple[bytes, tuple, list] | None = None
+        self.decoded_ahead = 0  # windows handed out decoded ahead
 
     def _read(self) -> None:
         msg = self.conn.recv_bytes()
@@ -106,7 +130,7 @@ class FitReceiver:
             return
         self.blobs[msg[:KEY_SIZE]] = msg[KEY_SIZE:]
         while len(self.blobs) > KEEP:
-            self.blobs.popitem(last=False)
+            self.ready.pop(self.blobs.popitem(last=False)[0], None)
 
     def _drain(self, key: bytes) -> None:
         """Read up to the key (the sender's windows come in the run's order: mostly the next message is it)."""
@@ -117,13 +141,56 @@ class FitReceiver:
             self.closed = True
 
     def get(self, key: bytes) -> Any:
+        if key in self.ready:  # decoded in the slacks before (B98)
+            self.found.add(key)
+            self.decoded_ahead += 1
+            return self.ready.pop(key)
         if key not in self.blobs:
             self._drain(key)
         blob = self.blobs.get(key)
         if blob is None:
             return MISSING
         self.found.add(key)
-        return pickle.loads(blob)  # new objects every time: the planner may change its spans
+        if self._part is not None and self._part[0] == key:
+            self._part = None
+        parts, limits = pickle.loads(blob)  # new objects every time: the planner may change its spans
+        return None if parts is None else [_span(parts, limits, i) for i in range(len(parts))]
+
+    def work_part(self, read: bool = True) -> bool:
+        """One small part of the work ahead (B98), in a slack: a message read from the connection (not without
+        `read`), or one span of the next window not handed out yet decoded. False: nothing to do."""
+        if read and not self.closed:
+            try:
+                if self.conn.poll():
+                    self._read()
+                    return True
+            except (EOFError, OSError):
+                self.closed = True
+        part = self._part
+        if part is None:
+            key = next((k for k in self.blobs if k not in self.found and k not in self.ready), None)
+            if key is None:
+                return False
+            parts, limits = pickle.loads(self.blobs[key])  # the spans' pickles (bytes: no span decoded yet)
+            if not parts:
+                self.ready[key] = parts
+                return True
+            self._part = part = (key, (parts, limits), [])
+        key, (parts, limits), done = part
+        done.append(_span(parts, limits, len(done)))
+        if len(done) == len(parts):
+            self._part = None
+            if key in self.blobs and key not in self.found:
+                self.ready[key] = done
+        return True
 
     def put(self, key: bytes, result: Any) -> None:
         self.fitted.add(key)
+
+
+def _span(parts: list[bytes], limits: list | None, i: int) -> Any:
+    """Span i of a window as sent: its pickle, with the limits the sender's look-ahead worked out (B99)."""
+    sp = pickle.loads(parts[i])
+    if limits is not None and limits[i] is not None:
+        sp.__dict__["_limits"] = limits[i]
+    return sp

@@ -112,7 +112,15 @@ class FittedRuns:
         # lowers the cap), not the curve's own, so the coupling term
         # 3·v·a_t·r'' leaves a_t more (decision 58)
         top = 1.5 * (self.dry_run_feed if self.dry_run else (move.feed or 0.0) / 60.0)
-        v, a, j = (_span_limits or _load_span_limits())(sp, np.minimum(lim.v, top * np.maximum(sp.dir_bound, 1e-12)), lim.acc, lim.jerk)
+        vel = np.minimum(lim.v, top * np.maximum(sp.dir_bound, 1e-12))
+        # the limits travel with a span the fit-ahead child let through its own look-ahead (decision bench B99):
+        # taken where they were worked out on these very inputs, else worked out here (an override, a dry run)
+        known = sp.__dict__.get("_limits")
+        if known is not None and known[1] == lim._acc and known[2] == lim._jerk and np.array_equal(known[0], vel):
+            v, a, j = known[3]
+        else:
+            v, a, j = (_span_limits or _load_span_limits())(sp, vel, lim.acc, lim.jerk)
+            sp.__dict__["_limits"] = (vel, lim._acc, lim._jerk, (v, a, j))
         v = min(v, sp.length / (self.cfg.min_segment_cycles * self.cfg.cycle))
         return Block(move, "path", sp, sp.length, v, a, j, (move.feed or 0.0) / 60.0)
 
