@@ -173,7 +173,7 @@ def test_windows_are_decoded_a_span_a_slack_and_their_cycle_misses_no_deadline(m
     rt, cols_rt = _run(monkeypatch, tmp_path, program_text, "auto", realtime=True)
     off, cols_off = _run(monkeypatch, tmp_path, program_text, "0", realtime=True, tag="rt")
     assert off.run.overruns >= 5  # fitted in the cycle (whose fit itself costs nothing modelled here)
-    assert rt.run.overruns == 0  # (before B98-B99: 5, one a window: its's 80 spans decoded and limited in its cycle)
+    assert rt.run.overruns == 0  # (before B98-B99: 5, one a window: its 80 spans decoded and limited in its cycle)
     found, fitted = rt.run.fits_ahead
     assert found == 5 and fitted == 0 and memos[0].decoded_ahead == 5  # every window decoded before its cycle
     _same(cols_off, cols_rt)
