@@ -1,7 +1,12 @@
 """Which cycles of a real-time run are stepped, why, and what each costs (issue 17, decision bench B38).
 
-Usage: python benchmarks/rt_census.py [PROGRAM [BENCH]] [--runs N]   (DELTAHIL_STRETCH as for `hil run`; default the
-lathe demo with the lathe MLC and a Parquet trace, 1 ms, stretches on)
+Usage: python benchmarks/rt_census.py [PROGRAM [BENCH]] [--runs N] [--list N]   (DELTAHIL_STRETCH as for `hil run`;
+default the lathe demo with the lathe MLC and a Parquet trace, 1 ms, stretches on)
+
+Then every late tick (an overrun: a period without a fresh setpoint on a real bus) is put down to one cause (decision
+bench B98): the host (the run queue, steal or a late wake-up; RT throttling), the Parquet writer thread holding the GIL,
+a garbage collection, page faults, or the piece of our own work (in the cycle or in its slack, by exclusive thread
+CPU) that took the period past its deadline; `--list N` prints the N latest with what their period spent.
 
 Every cycle's work (tick to outputs written, the figure `hil run --realtime` reports as cycle work) is put in one
 class: `paced` (a stretch's cycle, only its outputs), `stretch cycle` (a stretch's cycle through the runner's own
@@ -175,7 +180,7 @@ def report(cycles: list[tuple[str, int]], out=sys.stdout) -> None:
 
 
 
-# ---- why each overrun happened (issue 17, session 19, decision bench B98) ---------------------------------------------
+# ---- why each overrun happened (issue 17, session 19, decision bench B98) -------------------------------------------
 # A period runs from a cycle's wake-up (its tick returning) to the next tick's call; the tick is late (an overrun)
 # when that call comes after its deadline. What each period spent is recorded: its thread CPU, the sleeps it asked
 # for and got (the B43 sleep before the warm-up), its run-queue wait (/proc/thread-self/schedstat), its context
@@ -215,6 +220,7 @@ class Period:
     writer_ns: int = 0
     pieces: dict = field(default_factory=lambda: defaultdict(int))  # "cycle:" / "slack:" + name → thread CPU ns
     cause: str = ""
+    duty: float = 0.0  # the thread's CPU over the second before, a share of it (_duties)
 
 
 PERIODS: list[Period] = []
@@ -276,7 +282,8 @@ def install_causes() -> None:
     from nc.motion import fit_memo, planner_runs, spline_feed
     from nc.motion.planner import Planner
 
-    tick, written, init = clock_mod.RealTimeClock.tick, clock_mod.RealTimeClock.written, clock_mod.RealTimeClock.__init__
+    clk = clock_mod.RealTimeClock
+    tick, written, init = clk.tick, clk.written, clk.__init__
 
     def _tick(self):
         if hasattr(self, "idle"):  # B98's idle work ends the slack: counted in it, as the tick's own call does
@@ -367,7 +374,8 @@ def install_causes() -> None:
                        (Planner, ("_refill", "_start_plan", "push", "step")),
                        (Channel, ("_feed_planner",)), (SimLink, ("exchange",)), (SP.Pass, ("run",)),
                        (spline_feed.RunFeed, ("_fix",)),
-                       (fit_memo.FitReceiver, tuple(n for n in ("get", "work_part") if hasattr(fit_memo.FitReceiver, n))),
+                       (fit_memo.FitReceiver, tuple(n for n in ("get", "work_part")
+                                                    if hasattr(fit_memo.FitReceiver, n))),
                        (planner_runs.FittedRuns, ("_let_through",)),
                        (R.BenchRunner, ("_row",))):
         for n in names:
@@ -398,6 +406,22 @@ def _overlap(a: int, b: int) -> int:
 FAULT_NS = 2_000  # what a page fault is taken to cost (≈ 1-2 µs; few are expected once memory is locked)
 
 
+THROTTLE_NS = 10_000_000  # a run-queue wait this long at SCHED_FIFO is the kernel's RT throttling (50 ms a second)
+THROTTLE_DUTY = 0.85  # … where our thread's CPU over the second before was near the RT share (95 % by default)
+
+
+def _duties(periods: list[Period]) -> None:
+    """Each period's `duty`: the thread's CPU (its work and the pacer's spin) over the second before its wake-up."""
+    j, acc = 0, 0
+    for p in periods:
+        acc += p.cpu + (p.wait[0] if p.wait else 0)
+        while periods[j].start < p.start - 1_000_000_000:
+            q = periods[j]
+            acc -= q.cpu + (q.wait[0] if q.wait else 0)
+            j += 1
+        p.duty = acc / 1e9
+
+
 def _classify(p: Period) -> str:
     """The cause of one late tick (the call `over` ns after its deadline): the first that alone accounts for it.
     A wake-up already late by as much is the wait's (the tick's sleep and spin before it): the GIL held by the
@@ -408,6 +432,8 @@ def _classify(p: Period) -> str:
     p.writer_ns = _overlap(p.start, p.call)
     if p.late_start >= over and p.wait:
         cpu, rd, vcsw, ivcsw = p.wait[:4]
+        if rd >= THROTTLE_NS and p.duty >= THROTTLE_DUTY:
+            return "RT throttling (our thread's CPU over the last second near sched_rt_runtime_us)"
         if vcsw > 1 and _overlap(p.wait_from, p.start):
             return "trace writer (GIL) at the wake-up"
         if rd or ivcsw:
@@ -436,12 +462,14 @@ def _classify(p: Period) -> str:
 
 
 def report_causes(periods: list[Period], out=sys.stdout, listing: int = 0) -> dict[str, int]:
+    _duties(periods)
     late = [p for p in periods if p.over > 0]
     counts: dict[str, list[Period]] = defaultdict(list)
     for p in late:
         p.cause = _classify(p)
         counts[p.cause].append(p)
-    print(f"{len(late)} late ticks of {len(periods)} periods; by cause (late by µs p50 / max; the period's thread CPU, "
+    print(f"{len(late)} late ticks of {len(periods)} periods; by cause (late by µs p50 / max; the period's thread "
+          f"CPU, "
           f"run-queue wait, off-CPU µs p50):", file=out)
     for cause, ps in sorted(counts.items(), key=lambda kv: -len(kv[1])):
         o = np.array([p.over for p in ps]) / 1e3
@@ -452,9 +480,10 @@ def report_causes(periods: list[Period], out=sys.stdout, listing: int = 0) -> di
               f"{rd:5.0f}  off {off:6.0f}", file=out)
     for p in sorted(late, key=lambda p: -p.over)[:listing]:
         top = sorted(p.pieces.items(), key=lambda kv: -kv[1])[:4]
-        print(f"    late {p.over / 1e3:7.0f} µs: {p.cause}; period {(p.call - p.start) / 1e3:.0f} of "
-              f"{(p.deadline - p.start) / 1e3:.0f}, late start {p.late_start / 1e3:.0f}, cpu {p.cpu / 1e3:.0f}, cycle work "
-              f"{(p.written - p.start) / 1e3:.0f}, slept {p.slept / 1e3:.0f} (over {p.sleep_over / 1e3:.0f}), run queue "
+        print(f"    late {p.over / 1e3:7.0f} µs: {p.cause}; CPU share over the second before {p.duty:.0%}; period "
+              f"{(p.call - p.start) / 1e3:.0f} of {(p.deadline - p.start) / 1e3:.0f}, late start "
+              f"{p.late_start / 1e3:.0f}, cpu {p.cpu / 1e3:.0f}, cycle work {(p.written - p.start) / 1e3:.0f}, "
+              f"slept {p.slept / 1e3:.0f} (over {p.sleep_over / 1e3:.0f}), run queue "
               f"{p.run_delay / 1e3:.0f}, ivcsw {p.ivcsw}, vcsw {p.vcsw}, faults {p.faults}, "
               f"gc {p.gc_ns / 1e3:.0f}, writer {p.writer_ns / 1e3:.0f}; "
               + ", ".join(f"{k} {v / 1e3:.0f}" for k, v in top), file=out)

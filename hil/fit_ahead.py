@@ -166,6 +166,7 @@ def _child(interp, program, cfg: MotionConfig, start: dict[str, float], start_r:
     known: list[bool] = [False]  # the run's start position arrived
 
     def check(n: int, _ch) -> None:
+        sender.flush()  # a window fitted in the cycle before: its spans went through the look-ahead since (B99)
         if n == MARK_CYCLES:
             sender.mark()
         if not known[0] and n % 16 == 0 and start_r.poll():

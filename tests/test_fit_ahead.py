@@ -149,7 +149,8 @@ def test_windows_are_decoded_a_span_a_slack_and_their_cycle_misses_no_deadline(m
         @staticmethod
         def loads(blob):
             obj = real_pickle.loads(blob)
-            spans = sum(isinstance(x, SplineSpan) for x in obj) if isinstance(obj, list) else isinstance(obj, SplineSpan)
+            one = isinstance(obj, SplineSpan)
+            spans = sum(isinstance(x, SplineSpan) for x in obj) if isinstance(obj, list) else one
             ft.t += SPAN_NS * spans
             return obj
 
@@ -160,7 +161,7 @@ def test_windows_are_decoded_a_span_a_slack_and_their_cycle_misses_no_deadline(m
     memos: list = []
     begin = fit_ahead.FitAhead.begin
 
-    def begin_then_read_all(self, start):  # every window in hand before the first cycle: the test does not race the child
+    def begin_then_read_all(self, start):  # every window in hand before the first cycle: no race with the child
         begin(self, start)
         self.memo.wait = True
         self.memo._drain(b"\xff" * fit_memo.KEY_SIZE)  # (no such key: reads to the child's end)

@@ -59,7 +59,7 @@ class FitSender:
         self.conn = conn
         self.capacity = capacity
         self.sent = 0
-        self._pending: tuple[bytes, Any, list | None] | None = None  # the window fitted last, sent at the next put
+        self._pending: tuple[bytes, Any, list | None] | None = None  # the window fitted last, not sent yet
 
     def _room(self, size: int) -> None:
         import fcntl
@@ -78,8 +78,9 @@ class FitSender:
 
     def put(self, key: bytes, result: Any) -> None:
         """The window pickled now, as it was cut, a pickle per span (the run decodes a window a span at a time in
-        its slacks, B98); sent when the next window is fitted (or at `flush`): by then this process's look-ahead has
-        taken the window's spans, and their limits (`span_limits`, B99) go with them."""
+        its slacks, B98); sent at `flush` (hil.fit_ahead: at the start of this process's next cycle) or with the next
+        window: by then its look-ahead has taken the window's spans, and their limits (`span_limits`, B99) go with
+        them."""
         self.flush()
         for sp in result or ():  # the ends the look-ahead asks for at every junction, worked out here (kept in the
             sp._end(True)  # span, so they travel with it): in the run's cycle they cost more than the fit
