@@ -93,7 +93,8 @@ class FitSender:
         if self._pending is None:
             return
         (key, result, parts), self._pending = self._pending, None
-        limits = None if result is None else [sp.__dict__.get("_limits") for sp in result]
+        # each span's limits a pickle of its own, of plain floats: the run decodes them with their span, a part a slack
+        limits = None if result is None else [_plain(sp.__dict__.get("_limits")) for sp in result]
         msg = key + pickle.dumps((parts, limits), protocol=pickle.HIGHEST_PROTOCOL)
         if self.capacity:
             self._room(len(msg) + 8)  # (send_bytes' length header)
@@ -192,6 +193,16 @@ class FitReceiver:
 def _span(parts: list[bytes], limits: list | None, i: int) -> Any:
     """Span i of a window as sent: its pickle, with the limits the sender's look-ahead worked out (B99)."""
     sp = pickle.loads(parts[i])
-    if limits is not None and limits[i] is not None:
-        sp.__dict__["_limits"] = limits[i]
+    if limits is not None:
+        known = pickle.loads(limits[i])
+        if known is not None:
+            sp.__dict__["_limits"] = known
     return sp
+
+
+def _plain(limits: tuple | None) -> bytes:
+    """A span's limits as the look-ahead left them ((velocity caps, acceleration and jerk limits, (v, a, j))),
+    pickled with the caps as a tuple of floats (the look-ahead compares them element for element)."""
+    if limits is not None:
+        limits = (tuple(limits[0].tolist()), *limits[1:])
+    return pickle.dumps(limits, protocol=pickle.HIGHEST_PROTOCOL)
