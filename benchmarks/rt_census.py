@@ -22,7 +22,6 @@ where the run's p99 lands. Figures, not a test: the wrappers add ≈ 1-2 µs to 
 from __future__ import annotations
 
 import argparse
-import functools
 import gc
 import os
 import resource
@@ -39,6 +38,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 import hil.clock as clock_mod  # noqa: E402
+from benchmarks.rt_pieces import Pieces  # noqa: E402
 import hil.runner as R  # noqa: E402
 import hil.stretch as S  # noqa: E402
 from nc.channel import RunState  # noqa: E402
@@ -225,53 +225,19 @@ class Period:
 
 PERIODS: list[Period] = []
 _cur: list[Period | None] = [None]
-_stack: list[str] = []
-_mark = [0]
 _phase = ["cycle"]
 _WRITER: list[tuple[int, int]] = []  # the Parquet writer's busy intervals (monotonic ns)
 _gc_t0 = [0]
 
 
-def _charge() -> None:
-    now = _tt()
+def _account(label: str, ns: int) -> None:
     p = _cur[0]
-    if p is not None and _stack:
-        p.pieces[_phase[0] + ": " + _stack[-1]] += now - _mark[0]
-    _mark[0] = now
+    if p is not None:
+        p.pieces[_phase[0] + ": " + label] += ns
 
 
-def _piece(label: str, f):
-    @functools.wraps(f)
-    def w(*a, **k):
-        _charge()
-        _stack.append(label)
-        try:
-            return f(*a, **k)
-        finally:
-            _charge()
-            _stack.pop()
-    return w
-
-
-def _piece_gen(label: str, f):
-    @functools.wraps(f)
-    def w(*a, **k):
-        g = f(*a, **k)
-
-        def steps():
-            while True:
-                _charge()
-                _stack.append(label)
-                try:
-                    next(g)
-                except StopIteration:
-                    return
-                finally:
-                    _charge()
-                    _stack.pop()
-                yield
-        return steps()
-    return w
+_pieces = Pieces(_account)
+_charge, _piece, _piece_gen = _pieces.charge, _pieces.wrap, _pieces.wrap_gen
 
 
 def install_causes() -> None:
@@ -287,13 +253,7 @@ def install_causes() -> None:
 
     def _tick(self):
         if hasattr(self, "idle"):  # B98's idle work ends the slack: counted in it, as the tick's own call does
-            _charge()
-            _stack.append("idle work")
-            try:
-                self.idle()
-            finally:
-                _charge()
-                _stack.pop()
+            _piece("idle work", self.idle)()
         call = self.now_ns()
         pr = _probe()
         _charge()
@@ -312,7 +272,7 @@ def install_causes() -> None:
         _cur[0] = Period(self._start_ns, q, int(t.late * 1e9), wait_from=call,
                          wait=tuple(x - y for x, y in zip(q, pr)))
         _phase[0] = "cycle"
-        _mark[0] = _tt()
+        _pieces.restart()
         return t
 
     def _written(self):

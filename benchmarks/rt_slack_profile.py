@@ -16,11 +16,9 @@ test: the wrappers add ≈ 1 µs a call, and the load of the machine sets the ta
 
 from __future__ import annotations
 
-import functools
 import os
 import sys
 import tempfile
-import time
 from collections import defaultdict
 from pathlib import Path
 
@@ -30,6 +28,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 import hil.clock as clock_mod  # noqa: E402
+from benchmarks.rt_pieces import Pieces  # noqa: E402
 import hil.stretch as S  # noqa: E402
 import hil.stretch_ahead as SA  # noqa: E402
 import hil.stretch_bulk as SB  # noqa: E402
@@ -39,57 +38,18 @@ from mlc.nc_link import ChannelLink  # noqa: E402
 from nc.channel import Channel  # noqa: E402
 from nc.motion.planner import Planner  # noqa: E402
 
-_tt = time.thread_time_ns
-_stack = ["other"]
-_prep = [0]
 _acc: dict[str, int] = defaultdict(int)
-_mark = [0]
 _in_slack = [False]
 SLACKS: list[tuple[int, dict[str, int], list[bool]]] = []  # (thread CPU ns, by piece, [a late tick followed])
 
 
-def _charge() -> None:
-    now = _tt()
+def _account(label: str, ns: int) -> None:
     if _in_slack[0]:
-        _acc[_stack[-1]] += now - _mark[0]
-    _mark[0] = now
+        _acc[label] += ns
 
 
-def _wrap(label, f):
-    @functools.wraps(f)
-    def w(*a, **k):
-        _charge()
-        _stack.append("prep:" + label if _prep[0] else label)
-        try:
-            return f(*a, **k)
-        finally:
-            _charge()
-            _stack.pop()
-    return w
-
-
-def _wrap_gen(label, f):
-    """A generator whose every step is charged to `label` (the next start's parts, B22)."""
-    @functools.wraps(f)
-    def w(*a, **k):
-        g = f(*a, **k)
-
-        def steps():
-            while True:
-                _charge()
-                _stack.append(label)
-                _prep[0] += 1
-                try:
-                    next(g)
-                except StopIteration:
-                    return
-                finally:
-                    _charge()
-                    _stack.pop()
-                    _prep[0] -= 1
-                yield
-        return steps()
-    return w
+_pieces = Pieces(_account, base="other", gen_prefix="prep:")
+_charge, _wrap, _wrap_gen = _pieces.charge, _pieces.wrap, _pieces.wrap_gen
 
 
 def install() -> None:
@@ -100,7 +60,7 @@ def install() -> None:
         _charge()
         _acc.clear()
         _in_slack[0] = True
-        _mark[0] = _tt()
+        _pieces.restart()
 
     def _tick(self):
         late = [False]
