@@ -148,8 +148,9 @@ def _child(interp, program, cfg: MotionConfig, start: dict[str, float], start_r:
            sender: FitSender) -> None:
     """Run the program offline from `start`, sending every window; when the run's `begin` says the axes stood
     elsewhere, again from there (the windows already sent are keyed by their vertices: they stay unused)."""
-    for s in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):  # a Ctrl-C is the run's; the run ends this child
-        signal.signal(s, signal.SIG_IGN if s == signal.SIGINT else signal.SIG_DFL)
+    # a Ctrl-C or Ctrl-\ (the terminal's, to the whole group) is the run's to stop it (B94); the run ends this child
+    for s in (signal.SIGINT, signal.SIGQUIT, signal.SIGTERM, signal.SIGHUP):
+        signal.signal(s, signal.SIG_IGN if s in (signal.SIGINT, signal.SIGQUIT) else signal.SIG_DFL)
     try:
         os.nice(5)
     except OSError:

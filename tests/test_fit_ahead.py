@@ -178,3 +178,30 @@ def test_windows_are_decoded_a_span_a_slack_and_their_cycle_misses_no_deadline(m
     found, fitted = rt.run.fits_ahead
     assert found == 5 and fitted == 0 and memos[0].decoded_ahead == 5  # every window decoded before its cycle
     _same(cols_off, cols_rt)
+
+
+def test_the_terminals_ctrl_c_and_ctrl_backslash_leave_the_child_to_the_run(program_text):
+    """The terminal sends SIGINT (Ctrl-C) and SIGQUIT (Ctrl-\\) to the whole foreground group: the run stops on them
+    (B94) and ends the child itself; the child must not die of them first (it did of SIGQUIT, and the rest of the
+    run's windows were then fitted in the cycle)."""
+    import signal
+    import time
+
+    cfg = load_bench_file(MILL).motion_config()
+    prog = parse_program(program_text, name="cam.nc")
+    actual = {"X": 0.0, "Y": 0.0, "Z": 100.0}
+    child = fit_ahead.start(Interpreter(make_profile("nc5-mill", ("X", "Y", "Z"))), prog, cfg, dict(actual), wait=True)
+    assert child is not None
+    try:
+        time.sleep(0.5)  # the child has set its signals up (a signal in the fork's first instant: see B94's note)
+        for sig in (signal.SIGINT, signal.SIGQUIT):
+            os.kill(child.pid, sig)
+        time.sleep(0.2)
+        assert os.waitpid(child.pid, os.WNOHANG) == (0, 0)  # still running
+        child.begin(dict(actual))
+        it = Interpreter(make_profile("nc5-mill", ("X", "Y", "Z")))
+        it.take_position(actual)
+        offline_run(it.run(prog), cfg, actual, fit_memo=child.memo)
+    finally:
+        found, fitted = child.close()
+    assert found >= 4 and fitted == 0  # every window still came from the child
