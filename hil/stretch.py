@@ -54,8 +54,8 @@ from mlc.basic import BasicMlc
 from mlc.machine import Mlc
 from mlc.spindle_axis import SPINDLE
 from nc.channel import Channel, RunState
-from nc.motion.planner import Planner, Setpoint
-from nc.motion.stretch import Samples, sample_stretch, settle_stretch, stand_stretch
+from nc.motion.planner import Planner, Setpoint, feed_rpm, replans
+from nc.motion.stretch import Samples, sample_per_rev, sample_stretch, settle_stretch, stand_stretch
 from virtual_bus.drive import Cia402Drive
 from virtual_bus.drive_stretch import Stretch, can_stretch, csp_stretch, csv_stretch
 
@@ -71,6 +71,8 @@ PASS_CYCLES, PASS_OVER = 256, 32
 # before its first cycle, so that work must fit there; RT_CYCLES cycles of it cost ≈ 0.2 ms on the lathe demo
 RT_CYCLES = 16
 MODE_CSP, MODE_CSV = 8, 9
+# B103: after a start refused because the next sample changes the G96 rpm (X moving), none is tried for these cycles
+CSS_RETRY = 16
 
 
 def wanted(realtime: bool = False) -> bool:
@@ -87,6 +89,12 @@ def ahead_wanted() -> bool:
     it will make (`Stretcher.ahead`) and its in-process bus exchange worked out in the slack before its tick. In
     lock-step the value is the default (stretches on)."""
     return os.environ.get(ENV) == "ahead"
+
+
+def _spindle_linked(ch: Channel) -> bool:
+    """G96 or a feed per revolution: what the cycles read moves with the spindle (decision bench B103)."""
+    pl = ch.planner
+    return ch.css_rpm is not None or ch._css_surface is not None or (bool(pl.blocks) and pl.blocks[0].move.per_rev)
 
 
 class Stretcher(RealTimeStretches):
@@ -128,6 +136,7 @@ class Stretcher(RealTimeStretches):
         # finished and stands, only the drives settle; a stretch ends at the first cycle every axis is at rest
         self.settling = False
         self.steps_ahead = 0  # real time, the basic MLC: stepped cycles whose channel step ran before the tick (B46)
+        self._css_retry = 0  # B103: the cycle from which a start is tried again under G96
 
     @classmethod
     def for_runner(cls, runner: Any) -> "Stretcher | None":
@@ -160,8 +169,13 @@ class Stretcher(RealTimeStretches):
         if kind is None:
             return False
         pl = ch.planner
+        # B103: G96 or feed per revolution: the samples of the planner's buffer, ended where the spindle would change
+        # what a cycle reads (neither the NC's steps inside the stretch nor a cruise across blocks)
+        linked = _spindle_linked(ch)
+        if linked and r.cycle < self._css_retry:
+            return False  # B103: X moves under G96, the rpm changes every cycle: no start tried for a few cycles
         if kind == "run" and self.reads_ok and not self.paced and type(r.mlc) is BasicMlc and self._bulk_ok(r) \
-                and (may_read(ch, pl) or (no_reads(ch) and not ch.alarms and not pl.held)):
+                and not linked and (may_read(ch, pl) or (no_reads(ch) and not ch.alarms and not pl.held)):
             return self._run_pass(r, ch, pl, limit)  # B27: the NC's steps inside the stretch
         fill = None
         if kind in ("wait", "drain", "settle"):  # standing: an M/S/T code waits for its finish, the filter's tail,
@@ -169,7 +183,7 @@ class Stretcher(RealTimeStretches):
             if kind == "drain":  # the cycle that begins with the filter settled issues the waiting code: stepped
                 n = min(n, pl.filter.span - pl.filter._still)
             self._sampler = stand_stretch
-        elif type(r.mlc) is BasicMlc and pl._buf_blk is not None:  # a cruise, across its blocks (nothing reads
+        elif type(r.mlc) is BasicMlc and pl._buf_blk is not None and not linked:  # a cruise, across its blocks (nothing reads
             n = _across(ch, pl, min(limit, self.max_cycles))          # the queue's length in between)
             self._sampler = _sample_across
         elif pl.plan is None and pl._buf_done and pl.filter is not None and not pl.filter.settled and pl.at_rest:
@@ -179,7 +193,7 @@ class Stretcher(RealTimeStretches):
             self._sampler = _stand_queued
         else:  # to the buffer's end: the planner stays on its block (dropped at the refill, a stepped cycle)
             n = min(limit, self.max_cycles, pl._block_rows())  # a cruise's buffer spans blocks: this one's rows
-            self._sampler = sample_stretch
+            self._sampler = sample_per_rev if not self.paced and pl.per_rev_plan() is not None else sample_stretch
             if self.paced:  # real time: this start worked out in the slacks of the stretch before (B22)
                 started = self._spec_start(r, ch, pl, kind, limit, False)
                 if started is not None:
@@ -212,6 +226,12 @@ class Stretcher(RealTimeStretches):
             if n < 2:
                 _restore_planner(pl, saved_pl)
                 return False
+        if linked and (c := self._css_bound(ch, smp, n)) < n:  # B103: before the cycle whose step changes the G96 rpm
+            _restore_planner(pl, saved_pl)
+            if c < 2:
+                self._css_retry = r.cycle + CSS_RETRY
+                return False
+            smp, n = self._sampler(pl, c), c
         if kind not in ("wait", "settle"):  # (a finished channel's step feeds nothing either)
             _fed(ch, pl)
         rx0 = [copy.copy(rx) for rx in r.rx]  # what the drives are stepped with (the runner's change per cycle)
@@ -248,6 +268,8 @@ class Stretcher(RealTimeStretches):
         cycle a drive or the bench's overspeed check would fault in, then played."""
         saved_pl, saved_drives, rx0, targets = saved
         m = min(o.done for o in outs)
+        if pl.per_rev_plan() is not None:
+            m = min(m, self._rev_bound(r, pl, outs, m))
         if self.settling:  # B38: BenchRunner._settle stops after the first cycle every axis is at rest
             m = min(m, self._first_rest(r, outs, m))
         for i in range(self.n_axes):  # the bench's overspeed check (App. A 0x0602) fires in that cycle
@@ -374,6 +396,35 @@ class Stretcher(RealTimeStretches):
         self.cycles += k
         return True
 
+    def _css_bound(self, ch: Channel, smp: Samples, n: int) -> int:
+        """B103: of a stretch's n samples under G96, how many come before the first whose step changes the G96
+        speed (`Channel.css_state`): that cycle's trace row and spindle command have the new one, so it is stepped."""
+        if ch._css_surface is None and ch.css_rpm is None:
+            return n
+        now = (ch._css_surface, ch._css_origin, ch.css_rpm)
+        positions, moves, mv = smp.positions, smp.moves, smp.move
+        for c in range(n):
+            if ch.css_state(mv if moves is None else moves[c], positions[c]) != now:
+                return c
+        return n
+
+    def _rev_bound(self, r: Any, pl: Planner, outs: list[Stretch], m: int) -> int:
+        """B103: of a stretch's m cycles over a feed-per-revolution path, how many come before the first whose step
+        would re-plan the feed from the measured spindle speed (`nc.motion.planner.replans`, on each cycle's
+        feedback). The spindle command stays what it is at the start: anything that changes it changes what the
+        channel or the drives see, which ends the stretch on its own (`_signature`, `_still_quiet`)."""
+        p = pl.per_rev_plan()
+        assert p is not None
+        cmd = pl.spindle_command() if pl.spindle_command is not None else 0.0
+        n = self.n_axes
+        if len(r.scales) <= n:  # no spindle drive: the speed measured is the command (spindle_actual_rpm)
+            return 0 if replans(p, *feed_rpm(cmd, cmd)) else m
+        to_rpm, vel = r.scales[n].drive_to_rpm, outs[n].velocity_actual
+        for c in range(m):
+            if replans(p, *feed_rpm(to_rpm(vel[c]), cmd)):
+                return c
+        return m
+
     def _first_rest(self, r: Any, outs: list[Stretch], m: int) -> int:
         """B38: the cycles of a settle stretch up to and including the first one after which every axis is at rest
         (BenchRunner._at_rest on the rest counters feedback() would count, its following error); m if none."""
@@ -406,9 +457,11 @@ class Stretcher(RealTimeStretches):
         if (r.stop_request is not None or r._braking or r._winding_down or r._planner_failed or r._at_limit
                 or r._alarmed_drives or r.result.alarms or ch.alarms):
             return None
-        if (ch.emergency or ch.css_rpm is not None or ch._css_surface is not None or ch._interrupt is not None
-                or ch.skip_armed or _panel_state(r.on_cycle) is None or _event_due(r)):
+        if (ch.emergency or ch._interrupt is not None or ch.skip_armed or _panel_state(r.on_cycle) is None
+                or _event_due(r)):
             return None
+        if self.paced and _spindle_linked(ch):  # (lock-step: the stretch ends where G96 or the spindle would change
+            return None                          # what the cycles read, `_spindle_bound`, B103)
         pl = ch.planner
         mlc = r.mlc
         if isinstance(mlc, Mlc):
@@ -423,7 +476,7 @@ class Stretcher(RealTimeStretches):
             if (m.state is not State.OPERATION_ENABLED or m.target is not Target.ENABLED or rx.mode != mode
                     or d.params.home_switch is not None or not can_stretch(d, rx, mode)):
                 return None
-        if pl.held or pl._thread is not None or pl.threads_queued:
+        if pl.held or pl._thread is not None or (pl.threads_queued and (self.paced or not pl.blocks or pl.blocks[0].kind == "thread")):
             return None
         if ch.state is RunState.WAIT_AUX:
             # the code is handed (strobe up) and not finished: the NC's side of the handshake stands still
@@ -450,7 +503,7 @@ class Stretcher(RealTimeStretches):
                 return None
             budget = ch.statement_budget
             return None if budget is not None and budget.spent else "drain"
-        if pl.blocks[0].move.css is not None:
+        if self.paced and pl.blocks[0].move.css is not None:
             return None
         # Channel._feed_planner reads nothing in these cycles: the program has ended, the queue is full (asked as
         # its loop asks), or it waits for the queue to drain (an M/S/T code, a sync, a limit alarm, single block)

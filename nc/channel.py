@@ -389,21 +389,23 @@ class Channel:
         """G96: the active move's surface speed at the current X diameter; between moves the last
         S decides (an S under G96 is m/min, any other S ends it). The S aux of `G96 S_` carries the
         work centre, so the speed is right before the first move (motion decisions 30)."""
-        mv = sp.move
+        self._css_surface, self._css_origin, self.css_rpm = self.css_state(sp.move, sp.positions)
+
+    def css_state(self, mv: Move | None, positions: Any) -> tuple[float | None, float | None, float | None]:
+        """(surface speed, work centre, rpm) as `_update_css` leaves them after a setpoint of move `mv` at
+        `positions`, the channel unchanged (a stretch asks it for each of its samples, hil/stretch.py)."""
+        surface, origin = self._css_surface, self._css_origin
         if mv is not None:
-            self._css_surface = mv.css
-            if mv.css is None:
-                self.css_rpm = None
-                return
-            self._css_origin = x_origin(mv, "X", self.css_diameter)
+            surface = mv.css
+            if surface is None:
+                return None, origin, None
+            origin = x_origin(mv, "X", self.css_diameter)
         axes = self.planner.axes
-        if self._css_surface is None or self._css_origin is None:
-            self.css_rpm = None
-        elif "X" not in axes:
-            self.css_rpm = 0.0
-        else:
-            self.css_rpm = css_rpm_at(float(sp.positions[axes.index("X")]), self._css_origin,
-                                      self._css_surface, self.spindle_max)
+        if surface is None or origin is None:
+            return surface, origin, None
+        if "X" not in axes:
+            return surface, origin, 0.0
+        return surface, origin, css_rpm_at(float(positions[axes.index("X")]), origin, surface, self.spindle_max)
 
     @property
     def threading(self) -> bool:

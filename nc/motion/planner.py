@@ -55,6 +55,24 @@ OPEN_CHUNK = 4  # cycles sampled at a time (CHUNK otherwise) while the queue can
 MAX_SOLVES_PER_CYCLE = 1000  # plans one cycle may start and end before a sample is due (decisions B4)
 
 
+
+def feed_rpm(measured: float, command: float) -> tuple[float, bool]:
+    """Spindle speed for feed per revolution: the measured one, or the command once the measurement
+    is within 0.1 % of it (then noise cannot re-trigger planning). Second value: settled."""
+    rpm, cmd = abs(measured), abs(command)
+    if cmd > 0.0 and abs(rpm - cmd) <= 1e-3 * cmd:
+        return cmd, True
+    return rpm, False
+
+
+def replans(p: _Plan, rpm: float, settled: bool) -> bool:
+    """Does a feed-per-revolution plan made at p.rpm re-plan at this spindle speed? 2 % hides measurement
+    noise; a spindle that reaches its command re-plans once more, so a feed planned during the run-up does not
+    stay up to 2 % low (E-N11); only once: under G96 the command moves every cycle (motion decisions 30).
+    (A stretch asks it for each of its cycles, hil/stretch.py.)"""
+    return not (abs(rpm - p.rpm) <= 0.02 * max(p.rpm, 1.0) and (not settled or p.settled))
+
+
 class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedRuns):
     # True: every block of a run starts a new solve, also where the run cruises at its cap (the reference
     # tests compare the cruise sampling against, decision motion 44)
@@ -426,27 +444,26 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
         self.plan = None
         self._carry = self.cfg.cycle
 
-    def _check_spindle(self) -> None:
+    def per_rev_plan(self) -> _Plan | None:
+        """The running plan when it is a feed-per-revolution path, which each step checks against the measured
+        spindle speed (`_check_spindle`); None otherwise."""
         p = self.plan
         if p is None or p.kind != "path" or not self.blocks or not self.blocks[0].move.per_rev:
+            return None
+        return p
+
+    def _check_spindle(self) -> None:
+        p = self.per_rev_plan()
+        if p is None:
             return
         rpm, settled = self._feed_rpm()
-        # 2 % hides measurement noise; a spindle that reaches its command re-plans once more, so a feed
-        # planned during the run-up does not stay up to 2 % low (E-N11); only once: under G96 the
-        # command moves every cycle (motion decisions 30)
-        if abs(rpm - p.rpm) <= 0.02 * max(p.rpm, 1.0) and (not settled or p.settled):
+        if not replans(p, rpm, settled):
             return
         self._update_cap(self.blocks[0], rpm)
         self._replan()
 
     def _feed_rpm(self) -> tuple[float, bool]:
-        """Spindle speed for feed per revolution: the measured one, or the command once the measurement
-        is within 0.1 % of it (then noise cannot re-trigger planning). Second value: settled."""
-        rpm = abs(self.spindle_rpm())
-        cmd = abs(self.spindle_command()) if self.spindle_command is not None else 0.0
-        if cmd > 0.0 and abs(rpm - cmd) <= 1e-3 * cmd:
-            return cmd, True
-        return rpm, False
+        return feed_rpm(self.spindle_rpm(), self.spindle_command() if self.spindle_command is not None else 0.0)
 
     def _flush(self) -> None:
         self._thread = None

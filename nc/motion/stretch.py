@@ -8,7 +8,7 @@ cruise's across blocks, decision motion 44, of which a stretch takes the rows in
 out the next rows of that buffer at once — at most to its end, where the planner solves again — filtered by
 `PositionFilter.push_many`, and leaves the planner as that many `step()` calls would. It refuses (None) what
 a cycle-by-cycle step does differently: an empty buffer (refill, solve), a feed-per-revolution path (the
-measured speed re-plans it), a thread or G31 move (they bypass the filter), an offline planner that
+measured speed re-plans it; unless the caller bounds the stretch where it would, `per_rev`), a thread or G31 move (they bypass the filter), an offline planner that
 integrates its own spindle angle. `step()` also counts how long the measured spindle speed has been at its
 command (threads arm on it): with a stretch the caller reports the speeds afterwards, `settle_stretch`.
 """
@@ -37,11 +37,13 @@ class Samples:
     raw: np.ndarray | None = None  # the rows before the filter, where they span buffers (hil/stretch_pass.py)
 
 
-def sample_stretch(pl: Planner, n: int, across: bool = False) -> Samples | None:
+def sample_stretch(pl: Planner, n: int, across: bool = False, per_rev: bool = False) -> Samples | None:
     """The next min(n, rows left in the buffer) setpoints, or None where step() must run (module doc).
     `across`: a cruise's rows in its later blocks too, those blocks finished as step() finishes them (the
-    caller sees to it that nothing reads the queue in between, nor pushes to it)."""
-    rows = take_rows(pl, n, across)
+    caller sees to it that nothing reads the queue in between, nor pushes to it). `per_rev`: a
+    feed-per-revolution path too, the caller ending the stretch before the first cycle whose measured spindle
+    speed would re-plan it (`nc.motion.planner.replans`)."""
+    rows = take_rows(pl, n, across, per_rev)
     if rows is None:
         return None
     raw, lam, smp = rows
@@ -50,7 +52,8 @@ def sample_stretch(pl: Planner, n: int, across: bool = False) -> Samples | None:
     return smp
 
 
-def take_rows(pl: Planner, n: int, across: bool = False) -> tuple[np.ndarray, np.ndarray | None, Samples] | None:
+def take_rows(pl: Planner, n: int, across: bool = False,
+              per_rev: bool = False) -> tuple[np.ndarray, np.ndarray | None, Samples] | None:
     """sample_stretch's planner part: the rows taken (the planner left as after their steps), their filter
     shares λ (None: 1 throughout) and their Samples, whose positions are the raw rows until the caller filters
     them (hil/stretch_pass.py filters the rows of several takes at once)."""
@@ -59,7 +62,7 @@ def take_rows(pl: Planner, n: int, across: bool = False) -> tuple[np.ndarray, np
     blocks = pl.blocks
     mv = blocks[0].move if blocks else None
     p = pl.plan
-    if p is not None and p.kind == "path" and mv is not None and mv.per_rev:
+    if p is not None and p.kind == "path" and mv is not None and mv.per_rev and not per_rev:
         return None  # Planner._check_spindle re-plans it from the measured speed
     if mv is not None and (mv.kind == "thread" or "G31" in mv.tags):
         return None
@@ -78,6 +81,11 @@ def take_rows(pl: Planner, n: int, across: bool = False) -> tuple[np.ndarray, np
     pl._take(j)
     return raw, lam, Samples(raw, list(pl._buf_line[i:i + m]), np.array(pl._buf_vel[i:i + m], dtype=float), mv,
                              moves)
+
+
+def sample_per_rev(pl: Planner, n: int) -> Samples | None:
+    """sample_stretch over a feed-per-revolution path (its `per_rev`), as a stretch's sampler."""
+    return sample_stretch(pl, n, per_rev=True)
 
 
 def stand_stretch(pl: Planner, n: int, queued: bool = False) -> Samples | None:
