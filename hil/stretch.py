@@ -48,6 +48,7 @@ from hil.stretch_pass import Pass, _save as _save_nc, no_reads
 from hil.stretch_reads import may_read
 from hil import stretch_realtime
 from hil.stretch_realtime import COLD_CYCLES, FIRST_CHANGE_NS, RealTimeStretches, _fed
+from hil.stretch_thread import thread_running, thread_sampler
 from hil.stretch_state import (_across, _event_due, _panel_state, _refilled, _restore_planner, _sample_across,
                                _save_planner, _signature, _stand_queued)
 from mlc.basic import BasicMlc
@@ -186,6 +187,18 @@ class Stretcher(RealTimeStretches):
         elif type(r.mlc) is BasicMlc and pl._buf_blk is not None and not linked:  # a cruise, across its blocks (nothing reads
             n = _across(ch, pl, min(limit, self.max_cycles))          # the queue's length in between)
             self._sampler = _sample_across
+        elif pl._thread is not None:  # B104: a thread chain, on the spindle's feedback worked out first
+            if len(self.drives) <= self.n_axes:
+                return False
+            d = self.drives[self.n_axes]
+            was = dict(d.__dict__)
+            out = csv_stretch(d, r.rx[self.n_axes], min(limit, self.max_cycles), r.bench.cycle)
+            d.__dict__.clear()
+            d.__dict__.update(was)
+            n = out.done
+            if n < 2:
+                return False
+            self._sampler = thread_sampler(r, out, self.n_axes)
         elif pl.plan is None and pl._buf_done and pl.filter is not None and not pl.filter.settled and pl.at_rest:
             # an exact stop between blocks: the planner stands until its filter settled, the cycle that begins
             # settled starts the next block (stepped), as "drain" before a code
@@ -476,8 +489,9 @@ class Stretcher(RealTimeStretches):
             if (m.state is not State.OPERATION_ENABLED or m.target is not Target.ENABLED or rx.mode != mode
                     or d.params.home_switch is not None or not can_stretch(d, rx, mode)):
                 return None
-        if pl.held or pl._thread is not None or (pl.threads_queued and (self.paced or not pl.blocks or pl.blocks[0].kind == "thread")):
-            return None
+        if pl.held or (pl._thread is not None or (pl.threads_queued and pl.blocks[0].kind == "thread")) \
+                and (self.paced or not thread_running(pl)) or (self.paced and pl.threads_queued):
+            return None  # lock-step: a chain running through its block (B104), a rapid with a thread queued (B103)
         if ch.state is RunState.WAIT_AUX:
             # the code is handed (strobe up) and not finished: the NC's side of the handshake stands still
             link = getattr(mlc, "link", None)

@@ -81,3 +81,49 @@ def test_the_machine_after_a_g96_stretch_is_the_stepped_one(monkeypatch, turn):
     for cycle, state in stretched.items():
         assert state == stepped[cycle], cycle
     assert (a.run.cycles, a.run.final, a.run.max_ferr) == (b.run.cycles, b.run.final, b.run.max_ferr)
+
+
+# G32 with its chamfer pull-out (one chain of two blocks), G76's fifteen passes (its returns and infeeds between)
+THREADS = """G21 G18 G99
+T0303
+G97 S700 M03
+G00 X30. Z5.
+G32 Z-20. F1.5
+G32 X34. Z-21.5 F1.5
+G00 X40.
+Z5.
+G00 X28. Z5.
+G76 P021060 Q50 R0.05
+G76 X25.6 Z-18. P1200 Q300 F1.5
+G00 X60. Z20.
+M05
+M30
+"""
+
+
+@pytest.mark.parametrize("events", [
+    [],
+    ["t=4.0:reset"],  # inside the first G76 pass: the chain brakes on along the thread (motion 63)
+    ["t=13.5:estop"],  # inside a pass: the drives brake on their own ramps
+    ["t=1.2:set D21026=80", "t=5.6:feed-hold", "t=6.0:cycle-start"],  # override and hold inside threads
+    ["t=0.95:set D21026=120", "Z<-10:feed-hold", "t=9:cycle-start"],
+])
+def test_thread_chains_in_stretches_equal_stepping(monkeypatch, tmp_path, events):
+    """B104: a spindle-locked chain's cycles go in stretches, its setpoints stepped on the spindle feedback worked
+    out first; the trace is stepping's, column by column, with a reset, an E-stop, overrides and holds."""
+    p = tmp_path / "threads.nc"
+    p.write_text(THREADS)
+    a, b, r = _both(monkeypatch, tmp_path, str(p), events=events)
+    assert compare(a, b) == []
+    assert r.run.stretched > 0.75 * r.run.cycles  # before B103/B104: none (every pass and return stepped)
+
+
+def test_the_machine_after_a_thread_stretch_is_the_stepped_one(monkeypatch, tmp_path):
+    p = tmp_path / "threads.nc"
+    p.write_text(THREADS)
+    stepped, a = _states(monkeypatch, "0", str(p))
+    stretched, b = _states(monkeypatch, "1", str(p))
+    assert b.run.stretched > 0.75 * b.run.cycles
+    for cycle, state in stretched.items():
+        assert state == stepped[cycle], cycle
+    assert (a.run.cycles, a.run.final, a.run.max_ferr) == (b.run.cycles, b.run.final, b.run.max_ferr)
