@@ -405,7 +405,9 @@ class Channel:
             return surface, origin, None
         if "X" not in axes:
             return surface, origin, 0.0
-        return surface, origin, css_rpm_at(float(positions[axes.index("X")]), origin, surface, self.spindle_max)
+        # G00: the speed at the rapid's end point, not chased along it (decision motion 70, catalogue A40; Fanuc)
+        x = mv.end.get("X", 0.0) if mv is not None and mv.kind == "rapid" else float(positions[axes.index("X")])
+        return surface, origin, css_rpm_at(x, origin, surface, self.spindle_max)
 
     @property
     def threading(self) -> bool:

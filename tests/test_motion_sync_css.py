@@ -215,7 +215,8 @@ def test_g50_s_is_a_limit_not_an_s_code_for_the_mlc(hil, program, tmp_path):
 
 def run_override(text: str, percent: int, params: dict[str, float] | None = None):
     """As run_phases, with the operator's spindle override D21026 at `percent`; per cycle (aux value
-    or -1, X command, drive's commanded rpm, line, measured rpm, Z command, spindle angle)."""
+    or -1, X command, drive's commanded rpm, line, measured rpm, Z command, spindle angle, 1 while the
+    running move is a rapid else 0)."""
     bench = default_lathe()
     bench.params.update(params or {})
     mlc = build_mlc(bench, "lathe")
@@ -230,7 +231,8 @@ def run_override(text: str, percent: int, params: dict[str, float] | None = None
             aux = ch.pending_aux
             rows.append((aux.value if aux is not None else -1.0, r._commands[0],
                          sc.drive_to_rpm(r.rx[2].target_velocity), r.line, r.spindle_actual_rpm(),
-                         r._commands[1], r.spindle_actual_angle()))
+                         r._commands[1], r.spindle_actual_angle(),
+                         float(bool(ch.planner.blocks) and ch.planner.blocks[0].move.kind == "rapid")))
 
     runner.on_cycle = grab
     result = runner.run_program(parse_program(text))
@@ -319,9 +321,30 @@ def test_g96_holds_through_a_turning_cycle():
     text = "G21 G18 G99\nG00 X100. Z5.\nG96 S200 M03\nG90 X80. Z-10. F0.2\nM30\n"
     rows, _ = run_override(text, 100)
     cyc = rows[(rows[:, 3] == 4) & (np.abs(rows[:, 2]) > 0.5)]
-    d = 2.0 * cyc[:, 1]
-    assert np.allclose(cyc[:, 2], 1000.0 * 200.0 / (math.pi * d), rtol=1e-3, atol=RPM_RES)
+    cut = cyc[cyc[:, 7] == 0.0]  # the cut moves: the speed at the tool's diameter, every cycle
+    d = 2.0 * cut[:, 1]
+    assert np.allclose(cut[:, 2], 1000.0 * 200.0 / (math.pi * d), rtol=1e-3, atol=RPM_RES)
     assert cyc[:, 1].min() == pytest.approx(40.0)
+    # its rapids (in to X80, back to Z5 at X100): the speed at their end point (decision motion 70)
+    first_cut = np.flatnonzero(cyc[:, 7] == 0.0)[0]
+    inward, back = cyc[:first_cut], cyc[first_cut:][cyc[first_cut:, 7] == 1.0]
+    back = back[back[:, 1] > 50.0 - 1e-9]  # (the feed out's last setpoints come in its rows: blocks[0] moved on)
+    assert len(inward) > 20 and np.all(inward[:, 7] == 1.0) and len(back) > 20
+    assert np.allclose(inward[:, 2], 1000.0 * 200.0 / (math.pi * 80.0), rtol=0.0, atol=RPM_RES)
+    assert np.allclose(back[:, 2], 1000.0 * 200.0 / (math.pi * 100.0), rtol=0.0, atol=RPM_RES)
+
+
+def test_g96_rapids_take_the_speed_at_their_end_point():
+    """Decision motion 70 (catalogue A40; Fanuc "CSS for rapid traverse (G00)"): a G00 under G96 is given the speed
+    of its end point from its first cycle, which the spindle reaches while the tool moves; a G01 follows the tool."""
+    text = "G21 G18 G99\nG00 X100. Z5.\nG96 S200 M03\nG04 P50\nG00 X40.\nG01 X80. F0.2\nM30\n"
+    rows, _ = run_override(text, 100)
+    rapid = rows[(rows[:, 3] == 5) & (rows[:, 7] == 1.0)]
+    assert len(rapid) > 20 and rapid[0, 1] > 49.0 and rapid[-1, 1] < 21.0  # the rows span the whole rapid
+    assert np.allclose(rapid[:, 2], 1000.0 * 200.0 / (math.pi * 40.0), rtol=0.0, atol=RPM_RES)  # one: at D 40
+    feed = rows[(rows[:, 3] == 6) & (rows[:, 7] == 0.0)]
+    assert np.allclose(feed[:, 2], 1000.0 * 200.0 / (math.pi * 2.0 * feed[:, 1]), rtol=1e-3, atol=RPM_RES)
+    assert np.ptp(feed[:, 2]) > 300.0  # D 40 → 80: the speed halves along the cut
 
 
 def test_spindle_override_from_the_command_line(hil, tmp_path):
