@@ -1,7 +1,7 @@
 """Bench loop figures: lock-step cycles per second (with and without a Parquet trace), the work
 per cycle of a dense CAM program on the mill bench (position filter on), the issue-17 runs
 (examples/lathe_demo.nc with the lathe MLC and a Parquet trace, a 5,000-block CAM program on
-benches/mill-3axis.toml) as simulated time / wall time with the µs per cycle of each stage, and
+benches/mill-3axis.toml, and examples/lathe_part_g71_g70_g76.nc: G96, feed per revolution, G76) as simulated time / wall time with the µs per cycle of each stage, and
 the real-time pacer's jitter on this machine. Prints figures, asserts nothing.
 
 EtherCAT lock-step prints the virtual slaves' CPU per frame in-process, then (root: a veth pair and
@@ -168,6 +168,9 @@ def issue17(d: str) -> None:
     cam.write_text(cam_program(5000))
     staged("CAM 5,000 blocks, mill-3axis, Parquet trace", cam, root / "benches" / "mill-3axis.toml",
            os.path.join(d, "cam.parquet"))
+    # a lathe program as turned every day: G96 with feed per revolution through G71/G70, G76 (decisions B103/B104)
+    staged("lathe part G71/G70/G76 (G96, G99), lathe MLC, Parquet trace",
+           root / "examples" / "lathe_part_g71_g70_g76.nc", None, os.path.join(d, "part.parquet"))
 
 
 def ethercat_lockstep(cycles: int = 5000) -> None:
@@ -335,7 +338,7 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("pacer_seconds", nargs="?", type=float, default=5.0,
                         help="seconds of the bare real-time pacer run at the end (default 5)")
     only = parser.add_mutually_exclusive_group()
-    only.add_argument("--stages-only", action="store_true", help="only the issue-17 stage split (lathe demo, CAM)")
+    only.add_argument("--stages-only", action="store_true", help="only the issue-17 stage split (lathe demo, CAM, lathe part program)")
     only.add_argument("--ethercat-only", action="store_true", help="only EtherCAT lock-step (root: veth + hil sim)")
     only.add_argument("--realtime-only", action="store_true",
                       help="only `hil run --realtime` of the lathe demo and the CAM program, stepped and stretched")
