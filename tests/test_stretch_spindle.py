@@ -127,3 +127,14 @@ def test_the_machine_after_a_thread_stretch_is_the_stepped_one(monkeypatch, tmp_
     for cycle, state in stretched.items():
         assert state == stepped[cycle], cycle
     assert (a.run.cycles, a.run.final, a.run.max_ferr) == (b.run.cycles, b.run.final, b.run.max_ferr)
+
+
+@pytest.mark.parametrize("program", [TURN, THREADS])
+def test_the_basic_mlc_stretches_them_as_stepping_does(monkeypatch, tmp_path, program):
+    """With the basic MLC (every M/S/T finished at once; its stretches may run the NC's steps inside them, B27):
+    G96, feed per revolution and thread chains give stepping's trace too."""
+    p = tmp_path / "prog.nc"
+    p.write_text(program)
+    a, b, r = _both(monkeypatch, tmp_path, str(p), mlc="basic")
+    assert compare(a, b) == []
+    assert r.run.stretched > 0.5 * r.run.cycles
