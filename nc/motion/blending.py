@@ -73,6 +73,7 @@ class FilterCorners:
         self.kd = KernelDeviation(n1, n2, cfg.cycle)
         self._boost: dict[tuple[float, float], float] = {}  # braking's growth per (a, j)
         self.t2sum = t1 * t1 + t2 * t2
+        self._arc_k = (n1 * n1 + n2 * n2 - 2) * cfg.cycle * cfg.cycle  # arc_speed's shrink factor (s²)
         # One window of T1+T2 for both sums: a T1 window lies inside it.
         self.budget = tuple(min(ba, bj) for ba, bj in zip(self.budget_a, self.budget_j))
         self._axes = len(self.budget)
@@ -203,12 +204,18 @@ class FilterCorners:
     def arc_speed(self, radius: float) -> float:
         """Highest speed on an arc whose filtered radius shrinks by no more than the tolerance.
 
-        Two moving averages shrink a circle by about r·ω²·(T1² + T2²)/24 with ω = v/r; bounded
-        here with (T1+T2)² ≥ T1² + T2².
+        A moving average of n samples of a circle stepping x = v·T/r rad a cycle keeps the radius
+        times D_n(x) = (1/n)·Σ cos(m_k·x), m_k = k − (n−1)/2, and cos y ≥ 1 − y²/2 gives
+        D_n ≥ 1 − x²·(n²−1)/24 (Σ m_k² = n(n²−1)/12); two in cascade keep D_n1·D_n2 ≥ 1 − (sum of
+        both losses). So the shrink is at most v²·T²·(n1² + n2² − 2)/(24·r) at any speed up to v: an
+        upper bound, not the second-order estimate it was written from (decision motion 64; it used
+        (T1+T2)², 2× the T1² + T2² of equal windows, which cost arcs √2 of their speed).
         """
         if self.tol is None or radius <= 0.0:
             return math.inf
-        return math.sqrt(24.0 * self.tol * radius) / self.t_j
+        if self._arc_k <= 0.0:
+            return math.inf  # no filter: nothing shrinks
+        return math.sqrt(24.0 * self.tol * radius / self._arc_k)
 
     def window(self, blocks: Sequence["Block"]) -> int:
         """Cap the junctions within one filter window behind the newest junction J (the end of

@@ -32,6 +32,20 @@ from nc.moves import Move
 # orthogonal, so they share the axis jerk in quadrature: BLEND_NORMAL and √(1 − BLEND_NORMAL²).
 BLEND_CAP = 0.8
 BLEND_NORMAL = 0.9
+
+
+def arc_coupling(cfg: MotionConfig) -> float:
+    """Share of the axis jerk for an arc's coupling term 3·v·a_t/r (decision motion 65). An in-plane axis
+    sees (j_t − v³/r²)·t_i + (3·v·a_t/r + the curvature jump's step)·n_i with t_i² + n_i² ≤ 1, so at most
+    the hypot of the two parts, plus the filter's or a junction's corner (corner share, any direction).
+    The tangential part is at most share_tangential + 0.3·share_curvature, the jump 0.4·share_curvature;
+    the rest of the hypot goes to the coupling (defaults: 0.36 of the jerk; it was 0.3·share_curvature =
+    0.075, the parts added as if parallel), never less than that."""
+    sc = cfg.share_curvature
+    room = (1.0 - cfg.share_corner) ** 2 - (cfg.share_tangential + 0.3 * sc) ** 2
+    return max(0.3 * sc, math.sqrt(max(room, 0.0)) - 0.4 * sc) * 0.95  # 5 % kept back
+
+
 MARGIN = 0.98  # the passes plan with 98 % of the limits ruckig gets, so plans are never borderline
 
 
@@ -158,6 +172,7 @@ class Limits:
         self._corner_j = tuple(x * T * T / 2.0 for x in self._jerk)  # divided by |Δu| per junction
         self._corner_a = tuple(x * T for x in self._acc)
         self.blend = FilterCorners(cfg, self._acc, self._jerk) if cfg.filtered else None
+        self._coupling = arc_coupling(cfg)
 
     def block_limits(self, seg: Segment, short_ok: bool = False) -> tuple[float, float, float]:
         """(speed cap, tangential acceleration, tangential jerk) of a path segment. `short_ok`: no
@@ -186,8 +201,9 @@ class Limits:
             pj = min(self._jerk[seg.i1], self._jerk[seg.i2])
             sc = cfg.share_curvature
             v = min(v, math.sqrt(sc * pa * rc), (0.3 * sc * pj * rc * rc) ** (1.0 / 3.0))
-            # d/dt of the centripetal term couples tangential acceleration into jerk: 3·v·a_t/r.
-            a = min(a, 0.3 * sc * pj * rc / (3.0 * max(v, 1e-9)))
+            # d/dt of the centripetal term couples tangential acceleration into jerk: 3·v·a_t/r, along
+            # the normal n, square to the tangential part (j_t − v³/r²)·t: see arc_coupling.
+            a = min(a, self._coupling * pj * rc / (3.0 * max(v, 1e-9)))
         if self.blend is not None and seg.kind == "arc":
             v = min(v, self.blend.arc_speed(seg.radius))
         if seg.kind == "blend":
