@@ -5,8 +5,8 @@ drilling, feed override) prints the program time of hil and of LinuxCNC (simulat
 last change of commanded position), and two reference times of our own for the same path at the
 bench's limits: `ref_a` with the acceleration limit only (what a controller without a jerk limit, like
 LinuxCNC 2.9, could reach) and `ref_j` with the jerk limit too. ref_j / ref_a is the share of the gap the
-jerk limit explains; `ref_jf` adds what the bench's position filter (N1.036 + N1.037, as on an NC5) adds at
-every stop, n1 + n2 - 2 cycles, and `excess` = (hil / LinuxCNC) / (ref_jf / ref_a) - 1 is the part neither
+jerk limit explains; `ref_jf` adds what the bench's position filter (N1.036 + N1.037, as on an NC5) costs:
+n1 + n2 - 2 cycles at every stop and an arc's speed within its radius shrink bound (decision motion 64), and `excess` = (hil / LinuxCNC) / (ref_jf / ref_a) - 1 is the part neither
 explains. Asserts nothing (wall clock is not measured at all).
 
     python benchmarks/bench_lcnc_families.py [--only NAME] [--keep DIR] [--no-linuxcnc]
@@ -28,23 +28,22 @@ listed, and compared only on the total.
 
 from __future__ import annotations
 
-import argparse
 import math
 import os
 import re
 import shutil
 import subprocess
 import sys
-import tempfile
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from ruckig import InputParameter, OutputParameter, Result as RResult, Ruckig, Trajectory
+from ruckig import InputParameter, Result as RResult, Ruckig, Trajectory
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
-from benchmarks.bench_vs_linuxcnc import BENCH, LCNC_DIR, TOL, lcnc_available, motion_window  # noqa: E402
+from benchmarks.bench_vs_linuxcnc import (BENCH, LCNC_DIR, TOL, arguments, hil_trace, motion_window,  # noqa: E402
+                                          workplace)
 
 A_XY, J_XY, V_XY = 5000.0, 250_000.0, 500.0  # benches/mill-3axis.toml (X and Y alike)
 A_Z, J_Z, V_Z = 3000.0, 150_000.0, 300.0
@@ -63,6 +62,7 @@ class Piece:
     vmax_a: float | None = None  # the cap without a jerk limit (arcs: sqrt(A r) only), default vmax
     v0_a: float | None = None
     v1_a: float | None = None
+    radius: float = 0.0  # an arc's: the position filter caps its speed (ref_jf)
 
 
 def profile_time(length: float, vmax: float, amax: float, jmax: float, v0: float, v1: float) -> float:
@@ -83,9 +83,14 @@ def profile_time(length: float, vmax: float, amax: float, jmax: float, v0: float
 FILTER_S = 0.030  # N1.036 + N1.037 of the bench (16 + 16 ms): its moving averages lengthen a move by n1 + n2 - 2 cycles
 
 
-def filter_time(pieces: list[Piece]) -> float:
-    """What the bench's position filter adds: n1 + n2 - 2 cycles at every stop (a piece ending at rest)."""
-    return FILTER_S * sum(1 for p in pieces if p.v1 <= 0.0)
+def filter_ref(pieces: list[Piece]) -> float:
+    """ref_j with what the bench's position filter costs: n1 + n2 - 2 cycles at every stop (a piece ending at
+    rest), and an arc's speed within its radius shrink bound (decision motion 64: n = 16, N1.053 = TOL)."""
+    t = 0.0
+    for p in pieces:
+        cap = p.vmax if p.radius <= 0.0 else min(p.vmax, math.sqrt(24.0 * TOL * p.radius / (2 * 255 * 1e-6)))
+        t += profile_time(p.length, cap, p.amax, p.jmax, min(p.v0, cap), min(p.v1, cap))
+    return t + FILTER_S * sum(1 for p in pieces if p.v1 <= 0.0)
 
 
 def references(pieces: list[Piece]) -> tuple[float, float]:
@@ -132,7 +137,7 @@ def line_piece(p: np.ndarray, q: np.ndarray, feed: float | None, c0=(0.0, 0.0), 
 def arc_piece(r: float, sweep: float, feed: float, dz: float = 0.0, c0=(0.0, 0.0), c1=(0.0, 0.0)) -> Piece:
     vj, va = arc_cap(r, feed)
     length = math.hypot(r * sweep, dz)
-    return Piece(length, vj, math.sqrt(2) * A_XY, math.sqrt(2) * J_XY, c0[0], c1[0], va, c0[1], c1[1])
+    return Piece(length, vj, math.sqrt(2) * A_XY, math.sqrt(2) * J_XY, c0[0], c1[0], va, c0[1], c1[1], r)
 
 
 def polyline_pieces(pts: list[np.ndarray], feed: float | None, tol: float | None) -> list[Piece]:
@@ -295,7 +300,7 @@ def overridden(fam: Family, pct: float) -> Family:
     scale = pct / 100.0
     pieces = [Piece(p.length, min(p.vmax * scale, V_XY), p.amax, p.jmax, p.v0 * scale, p.v1 * scale,
                     None if p.vmax_a is None else min(p.vmax_a * scale, V_XY),
-                    None if p.v0_a is None else p.v0_a * scale, None if p.v1_a is None else p.v1_a * scale)
+                    None if p.v0_a is None else p.v0_a * scale, None if p.v1_a is None else p.v1_a * scale, p.radius)
               for p in fam.pieces]
     return Family(f"{fam.name} @{pct:g}%", fam.body, pieces, fam.lcnc_head, fam.hil_head, pct, fam.note)
 
@@ -316,27 +321,12 @@ def families() -> list[Family]:
 
 
 # ---- running -------------------------------------------------------------------------------------
-def trace_positions(trace: Path) -> np.ndarray:
-    import csv
-    with open(trace) as fh:
-        rows = list(csv.DictReader(fh))
-    return np.array([[float(r["X_cmd"]), float(r["Y_cmd"]), float(r["Z_cmd"])] for r in rows])
-
-
 def run_hil(fam: Family, work: Path) -> tuple[float, str]:
     src = work / (re.sub(r"\W+", "_", fam.name) + ".nc")
     src.write_text(fam.text(lcnc=False))
-    trace = src.with_suffix(".csv")
-    env = dict(os.environ, PYTHONPATH=str(ROOT))
-    cmd = [sys.executable, "-m", "hil.cli", "run", "--bench", str(BENCH), "--trace", str(trace), "--no-progress"]
-    if fam.override != 100.0:
-        cmd += ["--feed-override", f"{fam.override:g}"]
-    r = subprocess.run(cmd + [str(src)], capture_output=True, text=True, env=env, cwd=ROOT)
-    if not trace.exists():
-        return float("nan"), f"exit {r.returncode}: {r.stderr.strip()[-120:]}"
-    pos = trace_positions(trace)
+    r, pos = hil_trace(src, BENCH, ("--feed-override", f"{fam.override:g}") if fam.override != 100.0 else ())
     if not np.any(np.abs(np.diff(pos, axis=0)) > 1e-9):
-        return float("nan"), f"exit {r.returncode}: no motion {r.stdout.strip()[-120:]}"
+        return float("nan"), f"exit {r.returncode}: no motion {(r.stdout + r.stderr).strip()[-120:]}"
     i0, i1 = motion_window(pos)
     failed = [ln.strip() for ln in r.stdout.splitlines() if ln.strip().upper().startswith("FAIL")]
     return (i1 - i0) * 0.001, ("checks ok" if r.returncode == 0 else f"exit {r.returncode} {'; '.join(failed)[:90]}")
@@ -377,16 +367,8 @@ def run_lcnc(fam: Family, work: Path) -> tuple[float, str]:
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--only", help="run the families whose name contains this")
-    ap.add_argument("--keep", type=Path, help="keep programs, traces and samples in this folder")
-    ap.add_argument("--no-linuxcnc", action="store_true")
-    args = ap.parse_args()
-    skip = "skipped (--no-linuxcnc)" if args.no_linuxcnc else lcnc_available()
-    if skip:
-        print(f"LinuxCNC column: {skip}")
-    work = args.keep or Path(tempfile.mkdtemp(prefix="bench-lcnc-fam-"))
-    work.mkdir(parents=True, exist_ok=True)
+    args = arguments(__doc__)
+    skip, work = workplace(args, "bench-lcnc-fam-")
     print(f"bench {BENCH.name}, N1.053 = G64 P{TOL} mm; times in simulated 1 ms cycles (s)")
     print(f"{'family':44s} {'ref_a':>7s} {'ref_j':>7s} {'ref_jf':>7s} | {'hil':>7s} {'LinuxCNC':>8s} | {'hil/LC':>6s} "
           f"{'jf/a':>5s} {'excess':>6s}  notes")
@@ -397,7 +379,7 @@ def main() -> None:
             ref_a, ref_j = references(fam.pieces)
             h, hn = run_hil(fam, work)
             lc, ln = (float("nan"), "") if skip else run_lcnc(fam, work)
-            ref_jf = ref_j + filter_time(fam.pieces)
+            ref_jf = filter_ref(fam.pieces)
             ratio = h / lc if lc == lc and lc > 0 else float("nan")
             excess = ratio / (ref_jf / ref_a) - 1.0
             notes = "; ".join(x for x in (hn, ln, fam.note) if x)

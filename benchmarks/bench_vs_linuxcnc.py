@@ -181,16 +181,24 @@ def filter_off_bench(work: Path) -> Path:
     return out
 
 
-def run_hil(prog: Program, work: Path, bench: Path = BENCH) -> Result:
-    src = work / (re.sub(r"\W+", "_", prog.name) + ".nc")
-    src.write_text(prog.text(lcnc=False))
+def hil_trace(src: Path, bench: Path = BENCH, extra: tuple[str, ...] = ()) -> tuple[subprocess.CompletedProcess, np.ndarray]:
+    """`hil run --trace` of the program file `src` on `bench`: the finished process and the commanded X/Y/Z
+    of every cycle."""
     trace = src.with_suffix(".csv")
     env = dict(os.environ, PYTHONPATH=str(ROOT))
     r = subprocess.run([sys.executable, "-m", "hil.cli", "run", "--bench", str(bench), "--trace", str(trace),
-                        "--no-progress", str(src)], capture_output=True, text=True, env=env, cwd=ROOT)
+                        "--no-progress", *extra, str(src)], capture_output=True, text=True, env=env, cwd=ROOT)
+    if not trace.exists():
+        return r, np.empty((0, 3))
     with open(trace) as f:
         rows = list(csv.DictReader(f))
-    P = np.array([[float(r_["X_cmd"]), float(r_["Y_cmd"]), float(r_["Z_cmd"])] for r_ in rows])
+    return r, np.array([[float(r_["X_cmd"]), float(r_["Y_cmd"]), float(r_["Z_cmd"])] for r_ in rows]).reshape(-1, 3)
+
+
+def run_hil(prog: Program, work: Path, bench: Path = BENCH) -> Result:
+    src = work / (re.sub(r"\W+", "_", prog.name) + ".nc")
+    src.write_text(prog.text(lcnc=False))
+    r, P = hil_trace(src, bench)
     P = np.vstack([np.array(START)[None, :], P])
     failed = [ln.strip() for ln in r.stdout.splitlines() if "FAIL" in ln.upper()]
     note = f"exit {r.returncode}" + (f" ({'; '.join(failed)[:80]})" if failed else ", checks ok" if r.returncode == 0 else "")
@@ -225,18 +233,31 @@ def lcnc_available() -> str | None:
     return None
 
 
-def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+def arguments(doc: str, extra=None) -> argparse.Namespace:
+    """--only, --keep, --no-linuxcnc (and what `extra(parser)` adds)."""
+    ap = argparse.ArgumentParser(description=doc.splitlines()[0])
     ap.add_argument("--only", help="run the programs whose name contains this")
     ap.add_argument("--keep", type=Path, help="keep programs, traces and samples in this folder")
     ap.add_argument("--no-linuxcnc", action="store_true")
-    ap.add_argument("--filter-off", action="store_true", help="hil without the position filter (corner blends)")
-    args = ap.parse_args()
+    if extra is not None:
+        extra(ap)
+    return ap.parse_args()
+
+
+def workplace(args: argparse.Namespace, prefix: str) -> tuple[str | None, Path]:
+    """Why the LinuxCNC column is skipped (None: it runs), printed, and the folder the runs write to."""
     skip = "skipped (--no-linuxcnc)" if args.no_linuxcnc else lcnc_available()
     if skip:
         print(f"LinuxCNC column: {skip}")
-    work = args.keep or Path(tempfile.mkdtemp(prefix="bench-lcnc-"))
+    work = args.keep or Path(tempfile.mkdtemp(prefix=prefix))
     work.mkdir(parents=True, exist_ok=True)
+    return skip, work
+
+
+def main() -> None:
+    args = arguments(__doc__, lambda ap: ap.add_argument("--filter-off", action="store_true",
+                                                         help="hil without the position filter (corner blends)"))
+    skip, work = workplace(args, "bench-lcnc-")
     bench = filter_off_bench(work) if args.filter_off else BENCH
     print(f"bench {bench.name}, N1.053 = G64 P{TOL} mm; times in simulated 1 ms cycles; shares = peak v/a/j of the limits")
     print(f"{'program':32s} {'bound':>7s} | {'hil':>7s} {'dev mm':>7s} {'v/a/j':>15s} | {'LinuxCNC':>8s} {'dev mm':>7s} "

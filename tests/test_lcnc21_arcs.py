@@ -9,31 +9,21 @@ jerk: R10 at F6000 took 3.059 s for three circles (LinuxCNC 2.9: 2.065 s), R5 at
 
 from __future__ import annotations
 
-import csv
 import math
-import os
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-ROOT = Path(__file__).resolve().parent.parent
-BENCH = ROOT / "benches" / "mill-3axis.toml"
+from benchmarks.bench_vs_linuxcnc import BENCH, hil_trace
+
 TOL = 0.02  # N1.053 of the bench (mm)
 
 
 def run(tmp_path: Path, text: str) -> tuple[int, str, np.ndarray]:
     prog = tmp_path / "arc.nc"
     prog.write_text(text)
-    trace = tmp_path / "arc.csv"
-    env = dict(os.environ, PYTHONPATH=str(ROOT))
-    r = subprocess.run([sys.executable, "-m", "hil.cli", "run", "--bench", str(BENCH), "--trace", str(trace),
-                        "--no-progress", str(prog)], capture_output=True, text=True, env=env, cwd=ROOT)
-    with open(trace) as fh:
-        rows = list(csv.DictReader(fh))
-    pos = np.array([[float(x["X_cmd"]), float(x["Y_cmd"]), float(x["Z_cmd"])] for x in rows])
+    r, pos = hil_trace(prog, BENCH)
     return r.returncode, r.stdout, pos
 
 
