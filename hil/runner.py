@@ -187,7 +187,9 @@ class BenchRunner:
             interp.servo.handler = BusServoAccess(self.link, [self._name(i) for i in range(len(self.masters))],
                                                   getattr(self, "servo_modbus", None))
             self.profile = profile  # G10 L21 soft limits live in its params (issue 8)
-            if hasattr(self.mlc, "attach_variables"):  # MLC ↔ #25000–#25511 exchange (issue 8)
+            if hasattr(self.mlc, "attach_interpreter"):  # #25000–#25511 (issue 8), block skip M2x010 (M21-1)
+                self.mlc.attach_interpreter(interp)
+            elif hasattr(self.mlc, "attach_variables"):  # MLC ↔ #25000–#25511 exchange (issue 8)
                 self.mlc.attach_variables(interp.vars)
             planner = self.make_planner()
             self._start_fit_ahead(interp, program, planner, paced)

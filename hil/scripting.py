@@ -360,7 +360,7 @@ class Machine:
             raise ScriptError(str(exc.alarm)) from None
         here = dict(zip(r.axes, r.channel.planner.position.tolist()))
         interp = Interpreter(make_profile(self.bench.profile, r.axes, self.bench.params), here)
-        self.mlc.attach_variables(interp.vars)
+        self.mlc.attach_interpreter(interp)  # #25000–#25511 and the block skip switch M2x010
         ch = Channel(Planner(self.bench.motion_config(), here, spindle_rpm=lambda: self.mlc.spindle.rpm))
         r.channel = ch
         ch.soft_limits = SoftLimits.for_bench(self.bench, interp.profile)  # bench + this program's G10 L21

@@ -125,6 +125,17 @@ class Mlc:
         """Share the interpreter's # variable store (#25000–#25511, #20020)."""
         self.link.variables = variables
 
+    def attach_interpreter(self, interp: Any) -> None:
+        """The variable store, and the block skip switch M2x010 (App. B.2.1.1), which the MLC drives from here on:
+        a profile that presets the switch ON (parameter ``M2x010``, `hil path --block-skip`) sets the relay at
+        power-on, as a panel's switch left ON would (decision M21-1)."""
+        self.attach_variables(interp.vars)
+        self.link.interp = interp
+        if interp.block_skip:
+            self.mem.set_bit(m2(self.link.x, 10), True)
+        elif self.mem.bit(m2(self.link.x, 10)):  # set by the MLC's setup: the first block is read before a scan
+            interp.block_skip = True
+
     def bus_feedback(self, drives: list[DriveStatus]) -> None:
         self.drives = drives
         self.link.drives = drives  # the manual modes hold an axis its limit switch stopped (App. A 0x0A06)

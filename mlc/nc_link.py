@@ -46,6 +46,7 @@ class ChannelLink:
     tool_range: tuple[int, int] = (0, 9999)  # T codes inside the magazine range get a strobe (B.2.2.1)
     mode: int = AUTO
     variables: Any = None  # the interpreter's variable store, for #25000–#25511 and #20020
+    interp: Any = None  # the interpreter: its block skip switch follows M2x010 (decision M21-1)
     alarms: list[Alarm] = field(default_factory=list)  # raised by this layer (E-stop, user alarms …)
     # handshake state
     _handed: Aux | None = None  # the code the strobe currently stands for
@@ -252,6 +253,9 @@ class ChannelLink:
         v = bool(m[b2 + 8])
         if getattr(ch, "single_block", v) != v:
             ch.single_block = v
+        ip = self.interp  # M2x010: '/' blocks the interpreter reads from now on are skipped (decision M21-1)
+        if ip is not None and ip.block_skip != (v := bool(m[b2 + 10])):
+            ip.block_skip = v
 
     def _spindle_alarm(self, ch: Channel) -> None:
         m, prev = self.mem.m, self._prev
