@@ -47,8 +47,9 @@ def written_devices(x: int) -> set[tuple[int, int]]:
     for lo, hi in ((b3 + 96, b3 + 104), (b3 + 256, b3 + 288), (b3 + 352, b3 + 368), (b3 + 464, b3 + 512),
                    (b3 + 704, b3 + 832)):
         m.update(range(lo, hi))
-    d3 = 30000 + 100 * x  # d3(x, i) = D3x0ii: the spindle's rpm and angle (D3x026-D3x029)
-    words = set(range(30240, 30440)) | set(range(d3 + 26, d3 + 30))
+    # the spindle's rpm and angle D3x026-D3x029: d3(x, i) = 30000 + 1000·x + i, the block of the relays above
+    # (it read 30000 + 100·x, D3x1026…: a gated scan reading them was not woken in a stretch; decision M21-2)
+    words = set(range(30240, 30440)) | set(range(b3 + 26, b3 + 30))
     return {(AREA_M, i) for i in m} | {(AREA_WORDS, i) for i in words}
 
 
