@@ -43,7 +43,7 @@ def written_devices(x: int) -> set[tuple[int, int]]:
     """The devices a bulk stretch writes for its last cycle only (a superset of what changes cycle by cycle in
     a quiet stretch): the blink relays, the drive status (ChannelLink._drive_outputs), the axis-at-0 relays."""
     b3 = 30000 + 1000 * x
-    m = {29032, 29033, 30000, b3 + 34, b3 + 36}
+    m = {29032, 29033, 30000, b3 + 34, b3 + 35, b3 + 36}
     for lo, hi in ((b3 + 96, b3 + 104), (b3 + 256, b3 + 288), (b3 + 352, b3 + 368), (b3 + 464, b3 + 512),
                    (b3 + 704, b3 + 832)):
         m.update(range(lo, hi))

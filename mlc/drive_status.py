@@ -34,7 +34,7 @@ class DriveStatus:
 
 def write_drive_outputs(self: Any, drives: list[DriveStatus], ch: Any = None) -> None:
     """The drives' status into the NC→MLC area (`ChannelLink._drive_outputs`, every cycle): M30000,
-    M3x034/036, the per-axis relays M3x256…/464…, D30240… torque, D30272… velocity, D30336… rpm,
+    M3x034/035/036, the per-axis relays M3x256…/464…, D30240… torque, D30272… velocity, D30336… rpm,
     D30400… peak torque, and the spindle block M3x704… with D3x026/D3x028. `self` is the ChannelLink."""
     mem, x = self.mem, self.x
     m = mem.m
@@ -58,7 +58,7 @@ def write_drive_outputs(self: Any, drives: list[DriveStatus], ch: Any = None) ->
     order, spindles = split[2], split[3]
     m[30000] = connected  # M30000
     m[b3 + 34] = fault
-    m[b3 + 36] = servo
+    m[b3 + 35] = m[b3 + 36] = servo  # M3x035: the bench's power-up servo-ons every axis itself (N1.10 = 0, M21-4)
     w = mem.words  # D30240… written as words into the memory itself
     for k, d in enumerate(order):
         servo_on = d.servo_on

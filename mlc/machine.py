@@ -28,7 +28,7 @@ from mlc.nc_link import ChannelLink, DriveStatus
 from mlc.on_change import ScanGate, wants_gate
 from mlc.program import ScanContext
 from mlc.spindle_axis import MODE_CSV, SpindleAxisSwitch
-from mlc.signals import d2, m2
+from mlc.signals import d2, m2, m3
 from nc.alarms import Alarm, NcAlarm
 from nc.channel import Channel
 from nc.manual import ManualMotion
@@ -131,6 +131,10 @@ class Mlc:
         power-on, as a panel's switch left ON would (decision M21-1)."""
         self.attach_variables(interp.vars)
         self.link.interp = interp
+        # M3x512…: ON for the channel's axes the lathe programs in diameter (N2.001 Bit10; decision M21-3)
+        dia = getattr(getattr(interp, "profile", None), "diameter_axes", ())
+        for i, a in enumerate(self.link.axes[:16]):
+            self.mem.set_bit(m3(self.link.x, 512 + i), a in dia)
         if interp.block_skip:
             self.mem.set_bit(m2(self.link.x, 10), True)
         elif self.mem.bit(m2(self.link.x, 10)):  # set by the MLC's setup: the first block is read before a scan
