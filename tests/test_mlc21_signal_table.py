@@ -1,0 +1,57 @@
+"""docs/mlc_signals.md (the App. B.2 audit table) cannot drift: every row of mlc/signals.py has a status line in
+mlc/signal_status.py and none more, the files it names exist, every device on the page resolves to the same
+address through the device map an MLC uses (`mlc.signals.resolve`), the decisions it cites are recorded, and the
+page is what docs/build_mlc_signals.py renders now."""
+
+from __future__ import annotations
+
+import importlib.util
+import re
+
+from mlc.signal_status import STATUS, STATUSES, key
+from mlc.signals import ROWS, resolve, signal_table
+from tests.conftest import ROOT
+
+
+def _builder():
+    spec = importlib.util.spec_from_file_location("build_mlc_signals", ROOT / "docs" / "build_mlc_signals.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def test_every_app_b_row_has_one_status_line_and_no_line_is_left_over():
+    keys = {key(r) for r in ROWS}
+    assert keys == set(STATUS), (sorted(keys - set(STATUS)), sorted(set(STATUS) - keys))
+    assert {s.status for s in STATUS.values()} <= set(STATUSES)
+
+
+def test_the_files_named_as_where_exist_and_only_absent_or_hardware_rows_name_none():
+    for s in STATUS.values():
+        if s.status in ("absent", "hardware"):
+            assert s.where == "-", s
+        else:
+            assert (ROOT / s.where).is_file(), s
+
+
+def test_every_row_resolves_by_name_to_its_channel_1_address():
+    table = signal_table((1,))
+    for row in ROWS:
+        x = 0 if row.general else 1
+        address = f"{row.kind}{row.direction * 10000 + 1000 * x + row.index}"
+        assert address in table
+        sig = resolve(table[address].name, 1)
+        assert sig.address == address, (row.name, sig.address, address)
+
+
+def test_the_decisions_the_table_cites_are_recorded():
+    text = (ROOT / "docs" / "decisions" / "mlc.md").read_text()
+    cited = {m for s in STATUS.values() for m in re.findall(r"M21-\d+", s.note)}
+    assert cited
+    for d in cited:
+        assert f"**{d}" in text, d
+
+
+def test_the_page_is_current():
+    page = (ROOT / "docs" / "mlc_signals.md").read_text()
+    assert page == _builder().render(), "docs/mlc_signals.md is stale: run python docs/build_mlc_signals.py"
