@@ -23,7 +23,7 @@ NC_RESET | bench | mlc/nc_link.py | rising edge; flushes the program and the han
 DRY_RUN | bench | mlc/nc_link.py | level; cutting moves at the channel's dry-run feed × feed override
 MPG_SIMULATION | absent | - | MPG-paced program run not emulated
 DISABLE_HW_LIMIT | absent | - | the limit switches (0x60FD) always stop the axis (decision M21-5)
-SINGLE_BLOCK | bench | mlc/nc_link.py | level; M3x024/M3x039 while stopped after a block
+SINGLE_BLOCK | partial | mlc/nc_link.py | level; stops after motion blocks only, not after an M/S/T-only block (decision M21-6)
 OPTIONAL_STOP | bench | mlc/nc_link.py | level; M01 holds with M3x038 only while ON
 BLOCK_SKIP | bench | mlc/nc_link.py | level; '/' blocks read after the scan that saw it are skipped (decision M21-1)
 MST_LOCK | bench | mlc/nc_link.py | level; no strobe, the block's motion runs (H9)
