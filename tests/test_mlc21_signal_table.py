@@ -5,19 +5,12 @@ page is what docs/build_mlc_signals.py renders now."""
 
 from __future__ import annotations
 
-import importlib.util
 import re
+import runpy
 
 from mlc.signal_status import STATUS, STATUSES, key
 from mlc.signals import ROWS, resolve, signal_table
 from tests.conftest import ROOT
-
-
-def _builder():
-    spec = importlib.util.spec_from_file_location("build_mlc_signals", ROOT / "docs" / "build_mlc_signals.py")
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
 
 
 def test_every_app_b_row_has_one_status_line_and_no_line_is_left_over():
@@ -54,4 +47,4 @@ def test_the_decisions_the_table_cites_are_recorded():
 
 def test_the_page_is_current():
     page = (ROOT / "docs" / "mlc_signals.md").read_text()
-    assert page == _builder().render(), "docs/mlc_signals.md is stale: run python docs/build_mlc_signals.py"
+    assert page == runpy.run_path(str(ROOT / "docs" / "build_mlc_signals.py"))["render"](), "docs/mlc_signals.md is stale: run python docs/build_mlc_signals.py"
