@@ -1,12 +1,11 @@
 """Generate docs/mlc_signals.md: every special M / D row of NC5 App. B.2 (mlc/signals.py), where deltahil's NC side
-implements it (mlc/signal_status.py) and the test files that name it (its channel-1 address such as ``M21010``,
+implements it and the test files that name it (mlc/signal_status.py: its channel-1 address such as ``M21010``,
 the manual's ``M2x010`` or its App. B name). Run `python docs/build_mlc_signals.py`;
 tests/test_mlc21_signal_table.py fails when the page is stale.
 """
 
 from __future__ import annotations
 
-import re
 import sys
 from pathlib import Path
 
@@ -14,7 +13,7 @@ DOCS = Path(__file__).resolve().parent
 ROOT = DOCS.parent
 sys.path.insert(0, str(ROOT))
 
-from mlc.signal_status import STATUSES, key, status  # noqa: E402
+from mlc.signal_status import STATUSES, TESTS, key, status  # noqa: E402
 from mlc.signals import ROWS, Row  # noqa: E402
 
 PAGE = DOCS / "mlc_signals.md"
@@ -30,28 +29,7 @@ def device(row: Row) -> str:
     return f"{first}…{row.kind}{row.direction}{x}{row.index + (row.count - 1) * row.stride:03d}"
 
 
-def _words(text: str) -> set[str]:
-    """The file's words, and each word's heads before an underscore (``JOG_FWD_X`` also gives ``JOG`` and
-    ``JOG_FWD``): a family's name is named by its members' names."""
-    out = set()
-    for w in set(re.findall(r"\w+", text)):
-        out.add(w)
-        i = w.find("_", 1)
-        while i > 0:
-            out.add(w[:i])
-            i = w.find("_", i + 1)
-    return out
-
-
-def naming_tests(row: Row, tests: dict[str, set[str]]) -> list[str]:
-    x = 0 if row.general else 1
-    forms = (f"{row.kind}{row.direction * 10000 + 1000 * x + row.index}",
-             f"{row.kind}{row.direction}{'0' if row.general else 'x'}{row.index:03d}", row.name)
-    return sorted(n for n, words in tests.items() if any(f in words for f in forms))
-
-
 def render() -> str:
-    tests = {p.name: _words(p.read_text()) for p in sorted((ROOT / "tests").glob("test_*.py"))}
     counts = dict.fromkeys(STATUSES, 0)
     for row in ROWS:
         counts[status(row).status] += 1
@@ -64,7 +42,7 @@ def render() -> str:
            "ignores it or never writes it (the feature is not emulated); **hardware** a bench cannot have it.",
            "Per-axis families (16 wide) are indexed by the channel's axis slot: the bench's axis order, X Z on the",
            "lathe (slot 2 = Z = `M2x385`), X Y Z on the mill; App. B's letters name the default axes of slots 1–9",
-           "(decision M21-3). Tests: the test files naming the device (channel 1 address, `M2x…` form or name).",
+           "(decision M21-3). Tests: test files naming the device (channel 1 address, `M2x…` form or name), tests/test_<stem>.py.",
            "", "Rows: " + ", ".join(f"{counts[s]} {s}" for s in STATUSES) + f" (of {len(ROWS)}).", ""]
     for kind, direction, title in SECTIONS:
         out += [f"## {title}", "", "| device | name | App. B | status | where | note | tests |",
@@ -82,9 +60,7 @@ def render() -> str:
             if k != row.name:  # spindle k's rows: one line for spindles 1-8
                 dev, name, text = f"{dev} +16·k (k = 0…7)", k.replace("SPINDLE_", "SPINDLEk_"), \
                     text.replace("Spindle 1 ", "Spindle k ")
-            tests_ = naming_tests(row, tests)
-            cell = ", ".join(t.removeprefix("test_").removesuffix(".py") for t in tests_[:4]) + \
-                (f" (+{len(tests_) - 4})" if len(tests_) > 4 else "")
+            cell = ", ".join(TESTS.get(k, ()))
             where = f"`{st.where}`" if st.where != "-" else ""
             out.append(f"| `{dev}` | {name} | {text} | {st.status} | {where} | {st.note.replace('|', '/')} | {cell} |")
         out.append("")

@@ -4,8 +4,8 @@ One line per row (spindle rows of spindles 2–8 share spindle 1's line): ``NAME
 Status: ``bench`` the NC side reads or writes it as App. B says; ``partial`` it does, with the limit the note
 names; ``absent`` the NC ignores it / never writes it (the feature is not emulated: the note says which);
 ``hardware`` a bench cannot have it (a connector pin, a board's counter). `docs/mlc_signals.md` is rendered from
-this table and `mlc.signals` (``python docs/build_mlc_signals.py``); tests/test_mlc21_signal_table.py keeps the
-three in step and checks that every ``where`` file exists.
+this table, `TESTS` and `mlc.signals` (``python docs/build_mlc_signals.py``); tests/test_mlc21_signal_table.py keeps
+them in step, checks that every ``where`` file exists and that every test file `TESTS` cites still names the device.
 """
 
 from __future__ import annotations
@@ -228,3 +228,77 @@ def status(row: Row) -> Status:
 
 def rows_with_status() -> list[tuple[Row, Status]]:
     return [(row, status(row)) for row in ROWS]
+# test files (tests/test_<stem>.py) naming each row's device, channel 1 address, App. B form or name: chosen
+# when the table was written; tests/test_mlc21_signal_table.py checks that each still names it
+TESTS: dict[str, tuple[str, ...]] = {
+    'CYCLE_START': ('mlc_memory', 'run_stops_and_holds'),
+    'FEED_HOLD': ('hil_run_events', 'mlc_exchange_edges', 'mlc_manual'),
+    'NC_RESET': ('mlc_manual', 'run_stops_and_holds'),
+    'SINGLE_BLOCK': ('mlc21_program_switches',),
+    'OPTIONAL_STOP': ('formats_lathe_guide', 'run_stops_and_holds'),
+    'BLOCK_SKIP': ('mlc21_block_skip',),
+    'MST_LOCK': ('mlc21_program_switches',),
+    'EMERGENCY_STOP': ('campaign', 'mlc_manual', 'run_stops_and_holds', 'stop_matrix'),
+    'MST_FINISH': ('alarms_servo', 'bench_tools', 'mlc_caxis_drilling', 'mlc_cli'),
+    'M96_INTERRUPT': ('examples_benches', 'formats_mill', 'hil_run_events', 'lang_examples_mill'),
+    'ENABLE_3_MPG': ('mlc_memory',),
+    'MLC_TO_NC_BIT': ('mlc_exchange_edges',),
+    'OSCILLATION_ENABLE': ('mlc_manual',),
+    'HOME': ('alarms_manual_limits', 'mlc_manual'),
+    'LOCK_POS': ('mlc_manual',),
+    'DISABLE_SOFT_LIMIT': ('alarms_manual_limits', 'softlimits_inside'),
+    'JOG_FWD': ('mlc_memory', 'run_imports'),
+    'JOG_REV': ('mlc_memory',),
+    'SPINDLE_FWD': ('mlc_on_change',),
+    'SPINDLE_ORIENT': ('alarms_servo',),
+    'SPINDLE_CS_SWITCH': ('mlc_caxis',),
+    'SPINDLE_ALARM': ('alarms_servo', 'mlc_exchange_edges'),
+    'ETHERCAT_OK': ('ethercat_io', 'ethercat_io_modules', 'ethercat_status', 'mlc21_drive_status_devices'),
+    'HSI': ('alarms_appendix_a',),
+    'EIO_CONNECTED': ('canopen_io', 'ethercat_io', 'ethercat_io_modules', 'ethercat_status'),
+    'G900': ('formats_mill', 'lang_coords'),
+    'MODE_MPG': ('mlc_manual',),
+    'RUNNING': ('mlc21_program_switches', 'mlc_exchange_edges', 'mlc_handshake', 'mlc_manual'),
+    'FEED_HOLD_STATUS': ('mlc_exchange_edges', 'mlc_manual'),
+    'ESTOP_STATUS': ('mlc_manual',),
+    'RESET_FINISHED': ('mlc_manual',),
+    'PROGRAM_END': ('mlc_handshake',),
+    'M30_EXECUTED': ('mlc_handshake',),
+    'SINGLE_BLOCK_HOLD': ('mlc21_program_switches',),
+    'NC_ERROR': ('mlc_manual',),
+    'M96_ACTIVE': ('hil_run_events', 'mlc_interrupt'),
+    'SERVO_ERROR': ('mlc21_drive_status_devices',),
+    'AUTO_SERVO_ON': ('mlc21_status_relays',),
+    'SYSTEM_READY': ('mlc21_status_relays',),
+    'M00_HOLD': ('mlc_handshake', 'run_stops_and_holds'),
+    'SINGLE_BLOCK_DONE': ('mlc21_program_switches',),
+    'USER_ALARM': ('mlc_exchange_edges',),
+    'M_STROBE': ('alarms_servo', 'bench_tools', 'cli_bad_input', 'mlc21_program_switches'),
+    'S_STROBE': ('alarms_servo', 'mlc_handshake', 'mlc_on_change', 'motion_sync_css'),
+    'T_STROBE': ('alarms_servo', 'mlc_handshake', 'mlc_on_change', 'report_html'),
+    'NC_TO_MLC_BIT': ('lang_calls',),
+    'SERVO_CONNECTED': ('ethercat_status', 'mlc21_drive_status_devices'),
+    'HOMED': ('mlc_manual', 'motion_homing'),
+    'HOMING_DONE': ('mlc_memory', 'motion_homing'),
+    'DIAMETER_MODE': ('mlc21_status_relays',),
+    'SPINDLE_SPEED_REACHED': ('mlc21_drive_status_devices',),
+    'SPINDLE_TARGET_REACHED': ('mlc_caxis',),
+    'SPINDLE_POSITION_MODE': ('mlc_caxis', 'mlc_caxis_drilling'),
+    'SPINDLE_ANALOG_1': ('mlc_on_change',),
+    'MODE': ('drive_modes',),
+    'FEED_OVERRIDE': ('campaign_interrupt', 'hil_run_events', 'realtime_stretch', 'run_output'),
+    'JOG_OVERRIDE': ('hil_run_events', 'run_stops_and_holds', 'script_api_args'),
+    'SPINDLE1_OVERRIDE': ('motion_sync_css', 'motion_sync_thread', 'stretch_spindle'),
+    'MPG_PULSES': ('mlc_memory',),
+    'TORQUE_FB': ('drive_units', 'mlc21_drive_status_devices'),
+    'VELOCITY_FB_MM': ('mlc21_drive_status_devices', 'mlc_on_change'),
+    'VELOCITY_FB_RPM': ('mlc21_drive_status_devices', 'mlc_memory'),
+    'TORQUE_PEAK': ('mlc21_drive_status_devices',),
+    'SPINDLE1_SPEED_CMD': ('motion_sync_css',),
+    'SPINDLE1_SPEED_FB': ('mlc21_drive_status_devices',),
+    'SPINDLE1_DEGREE': ('mlc21_drive_status_devices',),
+    'M_CODE': ('bench_tools', 'hil_run_events', 'mlc21_program_switches', 'mlc_caxis_drilling'),
+    'S_CODE': ('mlc_handshake', 'mlc_memory', 'motion_sync_css', 'report_html'),
+    'T_CODE': ('mlc_handshake', 'mlc_memory', 'report_html'),
+    'LOOKAHEAD_REMAINING': ('bench_file',),
+}

@@ -8,7 +8,7 @@ from __future__ import annotations
 import re
 import runpy
 
-from mlc.signal_status import STATUS, STATUSES, key
+from mlc.signal_status import STATUS, STATUSES, TESTS, key
 from mlc.signals import ROWS, resolve, signal_table
 from tests.conftest import ROOT
 
@@ -35,6 +35,33 @@ def test_every_row_resolves_by_name_to_its_channel_1_address():
         assert address in table
         sig = resolve(table[address].name, 1)
         assert sig.address == address, (row.name, sig.address, address)
+
+
+def _words(text: str) -> set[str]:
+    """A file's words and each word's heads before an underscore (``JOG_FWD_X`` gives ``JOG_FWD`` too)."""
+    out = set()
+    for w in set(re.findall(r"\w+", text)):
+        out.add(w)
+        i = w.find("_", 1)
+        while i > 0:
+            out.add(w[:i])
+            i = w.find("_", i + 1)
+    return out
+
+
+def test_every_cited_test_file_still_names_its_device():
+    first = {}
+    for row in ROWS:
+        first.setdefault(key(row), row)
+    assert set(TESTS) <= set(first)
+    for k, stems in TESTS.items():
+        row = first[k]
+        x = 0 if row.general else 1
+        forms = {f"{row.kind}{row.direction * 10000 + 1000 * x + row.index}",
+                 f"{row.kind}{row.direction}{'0' if row.general else 'x'}{row.index:03d}", row.name}
+        for stem in stems:
+            path = ROOT / "tests" / f"test_{stem}.py"
+            assert path.is_file() and forms & _words(path.read_text()), (k, stem)
 
 
 def test_the_decisions_the_table_cites_are_recorded():
