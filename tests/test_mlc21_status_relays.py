@@ -43,3 +43,29 @@ def test_auto_servo_on_rises_with_system_ready_after_power_up(hil, tmp_path):
     first = on35.index(True)
     program = [i for i, r in enumerate(rows) if r["line"] == "1"]
     assert program and first <= program[0]  # ON by the first cycle of the program
+
+
+def test_per_axis_relays_count_the_lathe_axes_in_order():
+    """Decision M21-3: the 16-wide families index the channel's axis slots. On the lathe (X, Z) Z is slot 2: JOG+
+    M21385 moves Z (the relay App. B's default letters call the Y axis's), M21386 moves nothing."""
+    from hil.bench import default_lathe
+    from hil.scripting import Machine
+
+    m = Machine(default_lathe())
+    try:
+        m.power_up()
+        m.mode("JOG")
+        x0, z0 = m.position("X"), m.position("Z")
+        m.set("M21386", 1)
+        m.wait(0.3)
+        m.set("M21386", 0)
+        m.settle()
+        assert m.position("X") == x0 and m.position("Z") == z0
+        m.set("M21385", 1)
+        m.wait(0.3)
+        m.set("M21385", 0)
+        m.settle()
+        assert m.position("X") == x0 and m.position("Z") > z0 + 1.0
+        assert m.get("M31464") == 0 and m.get("M31465") == 0  # standing again: "moving" OFF for X and Z
+    finally:
+        m.close()
