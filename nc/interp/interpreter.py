@@ -107,6 +107,9 @@ class Interpreter(ExecuteMixin, ReadingMixin, ModalMixin, MotionMixin, NonModalM
     def take_position(self, start: dict[str, float]) -> None:
         """Start from where the axes stand (machine coordinates), before the program runs."""
         self.position.update({a: v for a, v in start.items() if a in self.position})
+        # the last block's end is where the axes stand too: a G43/G44/G49 block without Z keeps it
+        # (`_length_comp_move`) and #21032+ read it; left at 0 a first `G49` dived to Z0 (fuzz21)
+        self.last_target = self.work_position()
     def variable(self, number: int) -> float | None:
         return self.vars.get(number)
 

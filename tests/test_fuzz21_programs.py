@@ -1,0 +1,42 @@
+"""Bugs found by running seeded random programs through `hil run` (session 20, fuzz21).
+
+Each test is the minimised program of one finding; it runs the program on a shipped bench, lock-step, and
+checks what a user would: the run agrees with `hil path`, the bench's checks pass, alarms name their block.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import hil as hil_api
+
+ROOT = Path(__file__).resolve().parent.parent
+MILL = ROOT / "benches" / "mill-3axis.toml"
+LATHE = ROOT / "benches" / "lathe-2axis.toml"
+
+
+def _run(tmp_path: Path, text: str, bench: Path = MILL, **kw):
+    prog = tmp_path / "p.nc"
+    prog.write_text(text)
+    trace = tmp_path / "t.parquet"
+    return hil_api.run(prog, bench=bench, check=True, trace=trace, **kw), hil_api.path(prog, bench=bench)
+
+
+def test_g49_in_the_first_block_keeps_z_where_it_stands(tmp_path):
+    """A safety line `G49` before the first move (no length offset was active) must not move Z: the run
+    started from the bench's power-on Z 100 but took the programmed Z as 0 and dived to machine Z 0
+    before the first rapid, a move `hil path` does not have (and the contour check failed on it)."""
+    r, moves = _run(tmp_path, "G21 G17 G90 G40 G49 G80 G54\nG00 X0. Y0. Z30.\nM30\n")
+    assert r.ok, (r.alarms, [c for c in r.checks if not c.ok])
+    z = r.trace.load().column("Z_cmd").to_pylist()
+    assert min(z) >= 30.0 - 1e-9  # from 100 down to 30, never below
+    assert [m.end["Z"] for m in moves if hasattr(m, "end")] == [30.0]
+    assert r.final_position["Z"] == 30.0
+
+
+def test_block_end_variables_at_program_start_are_where_the_axes_stand(tmp_path):
+    """Block-end coordinates (#21032+, the Z one #21034) read before any move (Appendix B: the last block's end point) are
+    the power-on position in the run as in `hil path`."""
+    r, _ = _run(tmp_path, "#100=#21034\nG00 Z[#100-10.]\nM30\n")
+    assert r.ok, r.alarms
+    assert r.final_position["Z"] == 90.0
