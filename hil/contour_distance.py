@@ -70,6 +70,19 @@ def _unique(x: np.ndarray) -> np.ndarray:
     return x[np.concatenate(([True], x[1:] != x[:-1]))] if len(x) else x
 
 
+def _path_neighbours(moves: list[Move]) -> tuple[np.ndarray, np.ndarray]:
+    """Each move's nearest move before and after it that has a path (-1 / len(moves) where none): a zero-length
+    block (`X0. Y0.` where the tool stands) between two moves is no corner, the planner blends the moves around
+    it, and that blend is judged against both of them (fuzz21, decision in docs/decisions/bench.md)."""
+    n = len(moves)
+    has_path = np.array([m.kind not in ("line", "rapid") or m.start != m.end for m in moves], dtype=bool)
+    at = np.where(has_path, np.arange(n), -1)
+    prev_path = np.concatenate(([-1], np.maximum.accumulate(at)[:-1])) if n else at
+    at = np.where(has_path, np.arange(n), n)
+    next_path = np.concatenate((np.minimum.accumulate(at[::-1])[::-1][1:], [n])) if n else at
+    return prev_path, next_path
+
+
 def _run_moves(line: np.ndarray, moves: list[Move], lag_cycles: int):
     """The runs of cycles on one line (a line met again later, in a loop, starts a new run), the judged
     ones (their line holds a feed move), and each judged run's candidate moves as (run, move) pairs,
@@ -84,9 +97,10 @@ def _run_moves(line: np.ndarray, moves: list[Move], lag_cycles: int):
     # each line's candidates: its moves and their neighbours (a move's corner may be blended)
     mv_lid = np.searchsorted(lines, np.array([m.line for m in moves], dtype=np.int64))
     idx = np.arange(len(moves))
-    nb = np.concatenate([idx - 1, idx, idx + 1])
+    prev_path, next_path = _path_neighbours(moves)
+    nb = np.concatenate([idx - 1, idx, idx + 1, prev_path, next_path])
     ok = (nb >= 0) & (nb < len(moves))
-    lm = _unique(np.tile(mv_lid, 3)[ok] * len(moves) + nb[ok])
+    lm = _unique(np.tile(mv_lid, 5)[ok] * len(moves) + nb[ok])
     lm_count = np.bincount(lm // len(moves), minlength=len(lines))
     lm_first = np.cumsum(lm_count) - lm_count
     feed_lids = _unique(mv_lid[[m.kind in FEED_KINDS for m in moves]])

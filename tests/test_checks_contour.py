@@ -16,8 +16,9 @@ from tests.test_bench_checks import base, write
 LAG = 6
 
 
-def zigzag(n: int, arcs: bool = True) -> list[Move]:
-    """n short lines (0.1–0.3 mm, turning), a quarter arc after every 40th, a dwell and a rapid."""
+def zigzag(n: int, arcs: bool = True, stalls: bool = False) -> list[Move]:
+    """n short lines (0.1–0.3 mm, turning), a quarter arc after every 40th, a dwell and a rapid; with
+    `stalls` a zero-length line (a block to where the tool stands, its own line) after every 37th."""
     rng = np.random.default_rng(7)
     moves, p, heading = [], (0.0, 0.0), 0.0
     for k in range(n):
@@ -31,6 +32,9 @@ def zigzag(n: int, arcs: bool = True) -> list[Move]:
             moves.append(Move("arc", k + 1, "G02", {"X": p[0], "Z": p[1]}, {"X": q[0], "Z": q[1]}, {}, feed=600.0,
                               center={"X": c[0], "Z": c[1]}, dir="cw", plane=("Z", "X")))
             p = q
+        if stalls and k % 37 == 36:
+            moves.append(Move("line", 10_000 + k, "G01", {"X": p[0], "Z": p[1]}, {"X": p[0], "Z": p[1]}, {},
+                              feed=600.0))
     moves.append(Move("dwell", n + 1, "G04", {"X": p[0], "Z": p[1]}, {"X": p[0], "Z": p[1]}, {}))
     moves.append(Move("rapid", n + 2, "G00", {"X": p[0], "Z": p[1]}, {"X": p[0] + 5.0, "Z": p[1] + 3.0}, {}))
     return moves
@@ -55,8 +59,12 @@ def move_segments(m: Move):
 def reference(act, line, moves, lag):
     """Each cycle by the rule, in plain Python."""
     by_line: dict[int, set[int]] = {}
+    has_path = [m.kind not in ("line", "rapid") or m.start != m.end for m in moves]
     for i, m in enumerate(moves):
         by_line.setdefault(m.line, set()).update(j for j in (i - 1, i, i + 1) if 0 <= j < len(moves))
+        # and the nearest moves before and after with a path: a zero-length block is no corner
+        by_line[m.line].update(next((j for j in range(i - 1, -1, -1) if has_path[j]), i) for _ in (0,))
+        by_line[m.line].update(next((j for j in range(i + 1, len(moves)) if has_path[j]), i) for _ in (0,))
     judged = {m.line for m in moves if m.kind in ("line", "arc", "thread")}
     segs = [move_segments(m) for m in moves]
     out = np.zeros(len(line))
@@ -94,10 +102,12 @@ def trace_along(moves, seed: int = 3):
     return np.array(act), np.array(line, dtype=np.int64)
 
 
-@pytest.mark.parametrize("arcs, within", [(False, 1e-15), (True, 1.01e-4)])
-def test_every_cycle_has_the_distance_its_rule_gives(arcs, within):
-    """Lines to the last bits; arcs within the check's chord error (1e-4 mm, the reference's ≈ 0)."""
-    moves = zigzag(300, arcs)
+@pytest.mark.parametrize("arcs, within, stalls", [(False, 1e-15, False), (True, 1.01e-4, False),
+                                                  (True, 1.01e-4, True)])
+def test_every_cycle_has_the_distance_its_rule_gives(arcs, within, stalls):
+    """Lines to the last bits; arcs within the check's chord error (1e-4 mm, the reference's ≈ 0); zero-length
+    blocks between moves leave the moves on either side each other's neighbours (fuzz21)."""
+    moves = zigzag(300, arcs, stalls)
     act, line = trace_along(moves)
     got = contour_distances(act, line, moves, ["X", "Z"], LAG, False)
     want = reference(act, line, moves, LAG)

@@ -8,6 +8,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import pytest
+
 import hil as hil_api
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -40,3 +42,16 @@ def test_block_end_variables_at_program_start_are_where_the_axes_stand(tmp_path)
     r, _ = _run(tmp_path, "#100=#21034\nG00 Z[#100-10.]\nM30\n")
     assert r.ok, r.alarms
     assert r.final_position["Z"] == 90.0
+
+
+def test_a_zero_length_block_at_a_blended_corner_is_not_contour_error(tmp_path):
+    """`X0. Y0.` where the tool already is, between a Z plunge and an XY cut at another feed: the drives stay
+    within 0.02 mm of the programmed corner, but the contour check judged the corner's blend (the plunge's
+    line) only against the plunge and the zero-length move, not the cut after it, and failed at 0.056 mm."""
+    text = "G00 X0. Y0. Z30.\nG01 Z1.379 F300.\nX0. Y0.\nX-35.514 Y-36.25 F120.\nM30\n"
+    r, _ = _run(tmp_path, text)
+    contour = next(c for c in r.checks if c.name == "contour error")
+    assert contour.ok and contour.value < 0.03, contour
+    # the same corner without the zero-length block is judged the same
+    r2, _ = _run(tmp_path, text.replace("X0. Y0.\n", "", 1))
+    assert next(c for c in r2.checks if c.name == "contour error").value == pytest.approx(contour.value, abs=2e-3)
