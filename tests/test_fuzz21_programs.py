@@ -11,6 +11,7 @@ from pathlib import Path
 import pytest
 
 import hil as hil_api
+from nc.alarms import NcAlarm
 
 ROOT = Path(__file__).resolve().parent.parent
 MILL = ROOT / "benches" / "mill-3axis.toml"
@@ -55,3 +56,21 @@ def test_a_zero_length_block_at_a_blended_corner_is_not_contour_error(tmp_path):
     # the same corner without the zero-length block is judged the same
     r2, _ = _run(tmp_path, text.replace("X0. Y0.\n", "", 1))
     assert next(c for c in r2.checks if c.name == "contour error").value == pytest.approx(contour.value, abs=2e-3)
+
+
+def test_a_compensated_block_that_runs_backwards_names_its_line(tmp_path):
+    """G70 finishing under G42 (nose 0.8) whose last element, a 1.086 mm face, is shorter than the inner
+    corner's trim toward the return to the start point: the interference alarm 0x120B is right, but it came
+    with no line and no block (`hil path --json` printed `"line": null`). It names the block that runs backwards."""
+    text = ("G10 L10 P1 R0.8 Q3\nG21 G99\nT0101\nG96 S180 M03\nG00 X60. Z20.\nG00 X45. Z5.\n"
+            "G71 U1. R0.9\nG71 P100 Q150 U0.03 W0.1 F0.3\nN100 G00 X13.438\nG01 Z0. F0.15\nZ-6.44\nX21.956\n"
+            "X23.699 Z-7.867\nX32.419\nZ-12.328\nN150 X34.591\nG42 G00 X45. Z2.\nG70 P100 Q150\nG40 G00 X60. Z20.\n"
+            "M30\n")
+    prog = tmp_path / "p.nc"
+    prog.write_text(text)
+    with pytest.raises(NcAlarm) as exc:
+        hil_api.path(prog, bench=LATHE)
+    a = exc.value.alarm
+    assert (a.code, a.line, a.block) == (0x120B, 16, "N150 X34.591"), a
+    r = hil_api.run(prog, bench=LATHE)
+    assert not r.completed and [(x.code, x.line, x.block) for x in r.alarms] == [(0x120B, 16, "N150 X34.591")]

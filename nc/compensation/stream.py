@@ -127,7 +127,10 @@ class Compensator:
         """Emit the pending element ending at `end` (centre), then what it held."""
         p = self.pending
         assert p is not None
-        geo.check_trimmed(p.seg, p.start, end, p.off)
+        try:
+            geo.check_trimmed(p.seg, p.start, end, p.off)
+        except NcAlarm as alarm:  # the element that runs backwards is this block's (fuzz21: it had no line)
+            raise alarm.at(p.move.line, p.move.block, p.move.program)
         if p.startup:
             out_move = self._with_plane(p.move, p.seg.p0, end, None, tip=True, tip_start=False)
         else:
