@@ -74,3 +74,15 @@ def test_a_compensated_block_that_runs_backwards_names_its_line(tmp_path):
     assert (a.code, a.line, a.block) == (0x120B, 16, "N150 X34.591"), a
     r = hil_api.run(prog, bench=LATHE)
     assert not r.completed and [(x.code, x.line, x.block) for x in r.alarms] == [(0x120B, 16, "N150 X34.591")]
+
+
+def test_a_negative_f_in_a_cycle_block_is_the_negative_f_alarm(tmp_path):
+    """`G94 X14.416 Z-2.42 F0.2 F-1` (a repeated F, the last wins, A9): a negative F is 0x0223 "F must not be
+    negative" in a G01 block, but in a cycle's block it was dropped and the cycle said 0x1001 "no F programmed"."""
+    for bench, text in ((LATHE, "G00 X42. Z2.\nG94 X14.416 Z-2.42 F0.2 F-1\nM30\n"),
+                        (MILL, "G99 G81 X10. Y10. Z-5. R2. F-300.\nG80\nM30\n")):
+        prog = tmp_path / "p.nc"
+        prog.write_text(text)
+        with pytest.raises(NcAlarm) as exc:
+            hil_api.path(prog, bench=bench)
+        assert (exc.value.alarm.code, exc.value.alarm.line) == (0x0223, 2 if bench == LATHE else 1), exc.value

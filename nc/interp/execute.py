@@ -77,9 +77,9 @@ def step_feed_d(ip, run: BlockRun) -> None:
     """F (not for G31 or a cycle, whose F is its own) and the D number."""
     block, funcs, st = run.block, run.funcs, ip.state
     f = block.get("F")
+    if f is not None and f.value < 0:  # a feed or a lead alike, in a cycle's block too (fuzz21: it said 0x1001)
+        raise NcAlarm(0x0223, "F must not be negative")
     if f is not None and "G31" not in funcs and not (st.cycle or ip._cycle_fn(funcs)):
-        if f.value < 0:
-            raise NcAlarm(0x0223, "F must not be negative")
         st.feed = f.value
     elif f is not None and f.value >= 0 and "G31" not in funcs and not ip._is_thread(funcs):
         st.feed = f.value
