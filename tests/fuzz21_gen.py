@@ -157,27 +157,27 @@ class Mill:
                 self.emit(f"G01 X{f(px)} Y{f(py)} {self.feed()}")
             self.emit(f"G00 X{f(cx)} Y{f(cy)}", f"G92 X{f(self.x)} Y{f(self.y)}")
 
+    def _transformed(self, on, span: float, last: float, arc) -> None:
+        """A few lines and an arc between a transform's `on(cx, cy)` block and its cancel."""
+        cx, cy = self.pt(10)
+        self.emit(on(cx, cy))
+        for _ in range(self.r.randint(1, 4)):
+            x, y = self.pt(span)
+            self.emit(f"G01 X{f(x)} Y{f(y)} {self.feed()}")
+        end = arc(*self.pt(last))
+        if end:
+            self.emit(end)
+
     def rotate(self) -> None:
         r = self.r
-        cx, cy = self.pt(10)
-        self.emit(f"G68 X{f(cx)} Y{f(cy)} R{f(r.uniform(-180, 360))}")
-        for _ in range(r.randint(1, 4)):
-            x, y = self.pt(25)
-            self.emit(f"G01 X{f(x)} Y{f(y)} {self.feed()}")
-        x, y = self.pt(25)
-        if r.random() < 0.5:
-            self.emit(f"G02 X{f(x)} Y{f(y)} R{f(60.)}")
+        self._transformed(lambda cx, cy: f"G68 X{f(cx)} Y{f(cy)} R{f(r.uniform(-180, 360))}", 25, 25,
+                          lambda x, y: f"G02 X{f(x)} Y{f(y)} R{f(60.)}" if r.random() < 0.5 else None)
         self.emit("G69", f"G00 X{f(self.x)} Y{f(self.y)}")
 
     def scale(self) -> None:
         r = self.r
-        cx, cy = self.pt(10)
-        self.emit(f"G51 X{f(cx)} Y{f(cy)} P{r.choice([500, 1000, 1500, 2000, 250])}")
-        for _ in range(r.randint(1, 4)):
-            x, y = self.pt(20)
-            self.emit(f"G01 X{f(x)} Y{f(y)} {self.feed()}")
-        x, y = self.pt(15)
-        self.emit(f"G03 X{f(x)} Y{f(y)} R{f(40.)}")
+        self._transformed(lambda cx, cy: f"G51 X{f(cx)} Y{f(cy)} P{r.choice([500, 1000, 1500, 2000, 250])}", 20, 15,
+                          lambda x, y: f"G03 X{f(x)} Y{f(y)} R{f(40.)}")
         self.emit("G50", f"G00 X{f(self.x)} Y{f(self.y)}")
 
     def cycle(self) -> None:
