@@ -73,7 +73,7 @@ def _unique(x: np.ndarray) -> np.ndarray:
 def _path_neighbours(moves: list[Move]) -> tuple[np.ndarray, np.ndarray]:
     """Each move's nearest move before and after it that has a path (-1 / len(moves) where none): a zero-length
     block (`X0. Y0.` where the tool stands) between two moves is no corner, the planner blends the moves around
-    it, and that blend is judged against both of them (fuzz21, decision in docs/decisions/bench.md)."""
+    it, and that blend is judged against both of them (fuzz21, decision B105)."""
     n = len(moves)
     has_path = np.array([m.kind not in ("line", "rapid") or m.start != m.end for m in moves], dtype=bool)
     at = np.where(has_path, np.arange(n), -1)
