@@ -189,6 +189,11 @@ def arc_cw(host: Any, plane: tuple[str, str], cw: bool) -> bool:
     return (not cw) if ts.reflected(plane) else cw
 
 
+def radius_scale(host: Any, plane: tuple[str, str]) -> float:
+    """The ratio an arc's R is scaled by under G51 (equal on both plane axes, else arc_cw raised 0x025F)."""
+    return stack(host).radius_scale(plane)
+
+
 def comp_code(host: Any, plane: tuple[str, str], code: str | None) -> str | None:
     if code not in ("G41", "G42") or not stack(host).reflected(plane):
         return code

@@ -86,3 +86,16 @@ def test_a_negative_f_in_a_cycle_block_is_the_negative_f_alarm(tmp_path):
         with pytest.raises(NcAlarm) as exc:
             hil_api.path(prog, bench=bench)
         assert (exc.value.alarm.code, exc.value.alarm.line) == (0x0223, 2 if bench == LATHE else 1), exc.value
+
+
+@pytest.mark.parametrize("p, k", [("P500", 0.5), ("P2000", 2.0)])
+def test_an_r_arc_under_g51_scales_its_radius_with_its_end_points(tmp_path, p, k):
+    """N§3.12.3: G51 scales the programmed path about its centre. An R-form arc's end points were scaled but its R
+    was not: at P2000 a half circle `G03 X-10. Y0. R10.` from X10. became 0x0259 (R10 < half the scaled chord 20),
+    at P500 a 10 mm arc over a 10 mm chord, centre off by 8.66 mm. The scaled arc is the programmed one, scaled."""
+    text = f"G00 X0. Y0.\nG51 X0. Y0. {p}\nG01 X10. Y0. F600.\nG03 X-10. Y0. R10.\nG50\nG00 X0. Y0.\nM30\n"
+    r, moves = _run(tmp_path, text)
+    arc = next(m for m in moves if getattr(m, "kind", "") == "arc")
+    assert (arc.start["X"], arc.end["X"]) == pytest.approx((10.0 * k, -10.0 * k))
+    assert (arc.center["X"], arc.center["Y"]) == pytest.approx((0.0, 0.0), abs=1e-9)
+    assert r.ok, (r.alarms, [c for c in r.checks if not c.ok])

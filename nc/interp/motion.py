@@ -314,7 +314,9 @@ class MotionMixin:
         if r is not None:  # R wins over I/J/K (N§3.3.3)
             if math.hypot(e[0] - s[0], e[1] - s[1]) < 1e-9:
                 return None  # full circle in R format: the tool does not move (A30)
-            c = center_from_radius(s, e, self.distance(r), cw, tol)
+            # G51 scales the arc with its end points: R too (fuzz21; unequal plane ratios are 0x025F)
+            k = tr.radius_scale(self, (a1, a2)) if tr is not None else 1.0
+            c = center_from_radius(s, e, self.distance(r) * k, cw, tol)
         elif ci is not None or cj is not None:
             # I/J/K are always radius values from the start point (decisions A6)
             c = (s[0] + (self.distance(ci) if ci else 0.0), s[1] + (self.distance(cj) if cj else 0.0))
