@@ -184,8 +184,9 @@ class Stretcher(RealTimeStretches):
             if kind == "drain":  # the cycle that begins with the filter settled issues the waiting code: stepped
                 n = min(n, pl.filter.span - pl.filter._still)
             self._sampler = stand_stretch
-        elif type(r.mlc) is BasicMlc and pl._buf_blk is not None and not linked:  # a cruise, across its blocks (nothing reads
-            n = _across(ch, pl, min(limit, self.max_cycles))          # the queue's length in between)
+        elif type(r.mlc) is BasicMlc and pl._buf_blk is not None and not linked:
+            # a cruise, across its blocks (nothing reads the queue's length in between)
+            n = _across(ch, pl, min(limit, self.max_cycles))
             self._sampler = _sample_across
         elif pl._thread is not None:  # B104: a thread chain, on the spindle's feedback worked out first
             if len(self.drives) <= self.n_axes:
@@ -474,7 +475,7 @@ class Stretcher(RealTimeStretches):
                 or _event_due(r)):
             return None
         if self.paced and _spindle_linked(ch):  # (lock-step: the stretch ends where G96 or the spindle would change
-            return None                          # what the cycles read, `_spindle_bound`, B103)
+            return None                          # what the cycles read, `_css_bound` and `_rev_bound`, B103)
         pl = ch.planner
         mlc = r.mlc
         if isinstance(mlc, Mlc):
@@ -489,9 +490,12 @@ class Stretcher(RealTimeStretches):
             if (m.state is not State.OPERATION_ENABLED or m.target is not Target.ENABLED or rx.mode != mode
                     or d.params.home_switch is not None or not can_stretch(d, rx, mode)):
                 return None
-        if pl.held or (pl._thread is not None or (pl.threads_queued and pl.blocks[0].kind == "thread")) \
-                and (self.paced or not thread_running(pl)) or (self.paced and pl.threads_queued):
-            return None  # lock-step: a chain running through its block (B104), a rapid with a thread queued (B103)
+        if pl.held:
+            return None
+        if pl._thread is not None or pl.threads_queued:
+            # lock-step: a chain running through its block (B104), a move with a thread queued behind it (B103)
+            if self.paced or ((pl._thread is not None or pl.blocks[0].kind == "thread") and not thread_running(pl)):
+                return None
         if ch.state is RunState.WAIT_AUX:
             # the code is handed (strobe up) and not finished: the NC's side of the handshake stands still
             link = getattr(mlc, "link", None)
