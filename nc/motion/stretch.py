@@ -10,7 +10,8 @@ out the next rows of that buffer at once — at most to its end, where the plann
 a cycle-by-cycle step does differently: an empty buffer (refill, solve), a feed-per-revolution path (the
 measured speed re-plans it; unless the caller bounds the stretch where it would, `per_rev`), a thread or G31
 move (they bypass the filter), an offline planner that integrates its own spindle angle. `step()` also counts
-how long the measured spindle speed has been at its command (threads arm on it): with a stretch the caller reports the speeds afterwards, `settle_stretch`.
+how long the measured spindle speed has been at its command (threads arm on it): with a stretch the caller
+reports the speeds afterwards, `settle_stretch`.
 """
 
 from __future__ import annotations
