@@ -18,6 +18,7 @@ from fieldbus.pdo import RxPdo, TxPdo
 from fieldbus.units import DELTA_UNITS, DriveUnits
 from virtual_bus.drive_modes import CST, HM, PROFILE_MODES, DriveModes
 from virtual_bus.servo_params import ServoParams
+from virtual_bus.kernels import drive_kernel
 from virtual_bus.drive_params import DriveParams  # noqa: F401  (its home before; the settings alone load light)
 
 # Delta ASDA alarm numbers as the drive reports them in 0x603F (the NC shows 0xF002 + this code)
@@ -283,23 +284,29 @@ class Cia402Drive:
         ramp, want, tv = p.csv_accel * h, self._want_cps, self.target_velocity
         # an armed probe that has latched stays latched while armed: `_probe` would return at once each sub-step
         latch = probing and not self._probe_latched
-        for k in range(1, n + 1):
+        if not latch:  # the usual cycle: the kernel's sub-steps (virtual_bus/drive_kernel.py, compiled)
             if csp:
-                cmd = prev + span * k / n
-                v_cmd = kff_ff + kp * (cmd - pos)
+                cmd, pos, vel, t = drive_kernel.csp_substeps(n, h, prev, span, kff_ff, kp, pos, vel, t, max_cps, alpha)
             else:
-                tv += max(-ramp, min(ramp, want - tv))
-                v_cmd, cmd = tv, pos  # CSV: the command follows the actual position
-            if not -max_cps <= v_cmd <= max_cps:
-                v_cmd = max(-max_cps, min(max_cps, v_cmd))
-            if v_cmd != vel:
-                vel += (v_cmd - vel) * alpha
-            new_pos = pos + vel * h
-            if latch:
-                self._probe(pos, new_pos)
-                latch = not self._probe_latched
-            pos = new_pos
-            t += h
+                cmd, pos, vel, t, tv = drive_kernel.csv_substeps(n, h, ramp, want, tv, pos, vel, t, max_cps, alpha)
+        else:
+            for k in range(1, n + 1):  # the same sub-steps, the encoder index's edge tested on each
+                if csp:
+                    cmd = prev + span * k / n
+                    v_cmd = kff_ff + kp * (cmd - pos)
+                else:
+                    tv += max(-ramp, min(ramp, want - tv))
+                    v_cmd, cmd = tv, pos  # CSV: the command follows the actual position
+                if not -max_cps <= v_cmd <= max_cps:
+                    v_cmd = max(-max_cps, min(max_cps, v_cmd))
+                if v_cmd != vel:
+                    vel += (v_cmd - vel) * alpha
+                new_pos = pos + vel * h
+                if latch:
+                    self._probe(pos, new_pos)
+                    latch = not self._probe_latched
+                pos = new_pos
+                t += h
         if not csp:
             self.target_velocity = tv
         self.command = cmd

@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 
 from fieldbus.cia402 import SW_FOLLOWING, SW_TARGET_REACHED, State
 from fieldbus.pdo import RxPdo, TxPdo
+from virtual_bus.kernels import drive_kernel
 from virtual_bus.drive import AL_FORWARD_LIMIT, AL_REVERSE_LIMIT, _STATUS_BASE, Cia402Drive, DriveParams
 
 ENABLE_HELD = 0x0F  # controlword bits 0-3 (and not 7) of enable operation
@@ -90,12 +91,11 @@ class CspRun:
         self.state = (drive.position, drive.velocity, drive.time, drive.command, drive._prev_target,
                       drive.acceleration, drive.torque)
         self.still: int | None = None  # the target of a cycle that left the drive as it found it (_same)
-        n, max_cps, (lo, hi) = self.model[0], self.model[2], self.limits
-        # step()'s constants in one tuple (a CAM pass steps a drive every few cycles: its set-up counts); the sub-step
-        # factors as the loop computed them each time, the speed limits, whether a limit switch is set
+        lo, hi = self.limits
+        # drive_kernel.csp_cycles' constants in one tuple (a CAM pass steps a drive every few cycles: its set-up
+        # counts): the sub-step factors, gains, units, load, the limit switches' range and whether one is set
         self.consts = (*self.model, *self.gains, *self.units, *self.load, lo, hi,
-                       _STATUS_BASE[State.OPERATION_ENABLED] | SW_FOLLOWING, range(1, n + 1), -max_cps,
-                       1.2 * max_cps, lo > -math.inf or hi < math.inf)
+                       _STATUS_BASE[State.OPERATION_ENABLED] | SW_FOLLOWING, dt, lo > -math.inf or hi < math.inf)
 
     def step(self, targets: Sequence[int]) -> None:
         """The next cycles, one per target; stops (for good) before a cycle that would fault."""
@@ -108,62 +108,8 @@ class CspRun:
             return
         if self.lag:
             self._settle()
-        (n, h, max_cps, alpha, rad, reached_v, kp, kff, window, origin, k_raw, t_pct, inertia, viscous, coulomb, rated,
-         lo, hi, base, ks, neg, over, limited) = self.consts
-        pos, vel, t, command, prev_target, acc, torque = self.state
-        dt = self.dt
-        out = self.out
-        pa, va, ta, fe, sws = (out.position_actual, out.velocity_actual, out.torque_actual, out.following_error,
-                               out.statusword)
-        rep = 0  # still cycles not written yet: a run of them is written at once (_repeat)
-        for tgt in targets:
-            if tgt == still:  # the same target again after a cycle that changed nothing: the same cycle, the time on
-                rep += 1
-                continue
-            if rep:
-                t, rep = _repeat(out, t, h, n, True, rep), 0
-            target = float(tgt) - origin
-            prev = prev_target if prev_target is not None else command
-            ff_vel = (target - prev) / dt
-            kff_ff, span = kff * ff_vel, target - prev
-            c_pos, c_vel, c_t, cmd = pos, vel, t, command
-            inside = True
-            for k in ks:  # Cia402Drive._step_following (_step_general with limits), csp, no probe
-                cmd = prev + span * k / n
-                v_cmd = kff_ff + kp * (cmd - c_pos)
-                if not neg <= v_cmd <= max_cps:
-                    v_cmd = max(neg, min(max_cps, v_cmd))
-                if v_cmd != c_vel:
-                    c_vel += (v_cmd - c_vel) * alpha
-                c_pos = c_pos + c_vel * h
-                if limited and not lo < c_pos < hi:
-                    inside = False
-                c_t += h
-            if not inside or abs(cmd - c_pos) > window or abs(c_vel) > over:
-                self.ok = False
-                break  # a limit switch, or Cia402Drive._supervise would fault in this cycle: exchange() takes it
-            # (a moving drive fails the cheap comparisons: no tuples and no _same call a cycle)
-            before = (pos, vel, command, prev_target, acc, torque) \
-                if c_pos == pos and c_vel == vel and target == prev_target else None
-            c_acc = (c_vel - vel) / dt
-            # Cia402Drive.step's torque of an energised drive (0.1 % of rated) and DriveUnits.velocity_to_raw
-            # inline, the same expressions: a call each per cycle cost a fifth of the loop
-            torque = (inertia * c_acc * rad + viscous * c_vel * rad
-                      + (math.copysign(coulomb, c_vel) if abs(c_vel) > 1 else 0.0)) / rated * 1000.0
-            pos, vel, t, command, acc, prev_target = c_pos, c_vel, c_t, cmd, c_acc, target
-            gap = command - pos
-            sws.append(base | SW_TARGET_REACHED if abs(vel) < reached_v and abs(gap) < 10 else base)
-            pa.append(round(pos + origin))  # (round of a float: an int)
-            raw = round(vel * k_raw)
-            va.append(raw if -0x7FFFFFFF <= raw <= 0x7FFFFFFF else max(-0x7FFFFFFF, min(0x7FFFFFFF, raw)))
-            ta.append(round(torque * 0.1 / t_pct))
-            fe.append(round(gap))
-            still = tgt if before is not None and _same(before, (pos, vel, command, prev_target, acc, torque)) else None
-        if rep:
-            t = _repeat(out, t, h, n, True, rep)
-        self.state = (pos, vel, t, command, prev_target, acc, torque)
-        self.still = still
-        out.done = len(pa)
+        self.state, self.still, self.ok = drive_kernel.csp_cycles(targets, self.consts, self.state, still, self.out)
+        self.out.done = len(self.out.position_actual)
 
     def _settle(self) -> None:
         """The still cycles counted (`lag`) written: the cycle that left the drive as it found it (_same), again."""
@@ -204,7 +150,9 @@ class CsvRun:
         self.every = (p.index_pulse_every or cpr) if rx.touch_probe_function & 1 and not drive._probe_latched else 0
         self.state = (drive.position, drive.velocity, drive.time, drive.command, drive.target_velocity,
                       drive.acceleration, drive.torque)
-        self.still = False  # the last cycle left the drive as it found it (_same): the next ones are the same
+        self.still = False  # the last cycle left the drive as it found it (`same`): the next ones are the same
+        self.consts = (*self.model, self.origin, self.ramp, self.want, self.every, *self.units, *self.load,
+                       _STATUS_BASE[State.OPERATION_ENABLED] | SW_FOLLOWING, dt)  # drive_kernel.csv_cycles'
 
     def step(self, cycles: int) -> None:
         """The next `cycles` cycles; stops (for good) before a cycle that would fault or latch the index."""
@@ -214,74 +162,9 @@ class CsvRun:
             self.lag += cycles
             self.out.done += cycles
             return
-        n, h, max_cps, alpha, rad, reached_v = self.model
-        origin, ramp, want, every = self.origin, self.ramp, self.want, self.every
-        k_raw, t_pct = self.units
-        inertia, viscous, coulomb, rated = self.load
-        base = _STATUS_BASE[State.OPERATION_ENABLED] | SW_FOLLOWING
-        pos, vel, t, command, tv, acc, torque = self.state
-        dt = self.dt
+        self.state, self.still, self.ok = drive_kernel.csv_cycles(cycles, self.consts, self.state, False, self.out)
         out = self.out
-        pa, va, ta, sws = out.position_actual, out.velocity_actual, out.torque_actual, out.statusword
-        floor = math.floor
-        still = self.still
-        ks, neg, over, neg_ramp = range(n), -max_cps, 1.2 * max_cps, -ramp  # (the values the loop computed each time)
-        c = 0
-        while c < cycles:
-            if still:  # a standing spindle (a mill's CAM program): the same cycle from here on, the time on
-                t = _repeat(out, t, h, n, False, cycles - c)
-                break
-            v_cmd = tv if neg <= tv <= max_cps else max(neg, min(max_cps, tv))
-            if tv == want and tv != 0.0 and vel != 0.0 and ramp >= 0.0 and abs(vel) <= over \
-                    and (v_cmd == vel or vel + (v_cmd - vel) * alpha == vel):
-                # at its speed (the ramp's step 0, the velocity loop's step none, or under half an ulp: a velocity
-                # 7e-9 short of 2.56e7 counts/s stays): only the position and the time move, as far as the cycles
-                # move it and pass no index edge
-                c_acc = (vel - vel) / dt
-                c_torque = (inertia * c_acc * rad + viscous * vel * rad
-                            + (math.copysign(coulomb, vel) if abs(vel) > 1 else 0.0)) / rated * 1000.0
-                raw = round(vel * k_raw)
-                fb = (raw if -0x7FFFFFFF <= raw <= 0x7FFFFFFF else max(-0x7FFFFFFF, min(0x7FFFFFFF, raw)),
-                      round(c_torque * 0.1 / t_pct), base, abs(vel) < reached_v, origin)
-                done, pos, t, command = _at_speed(out, cycles - c, pos, t, command, vel * h, h, n, every, fb)
-                if done:
-                    acc, torque = c_acc, c_torque
-                    c += done
-                    if c == cycles:
-                        break
-            c += 1
-            c_pos, c_vel, c_t, c_tv, cmd = pos, vel, t, tv, command
-            edge = False
-            # The velocity-loop lines below, and the feedback lines after them, repeat CspRun's on purpose: a call
-            # per sub-step (or cycle) would cost about a third of what the stretch saves.
-            for _k in ks:  # Cia402Drive._step_following, csv
-                c_tv += max(neg_ramp, min(ramp, want - c_tv))
-                v_cmd, cmd = c_tv, c_pos
-                if not neg <= v_cmd <= max_cps:
-                    v_cmd = max(neg, min(max_cps, v_cmd))
-                if v_cmd != c_vel:
-                    c_vel += (v_cmd - c_vel) * alpha
-                new_pos = c_pos + c_vel * h
-                if every and floor(c_pos / every) != floor(new_pos / every):
-                    edge = True
-                c_pos = new_pos
-                c_t += h
-            if edge or abs(c_vel) > over:
-                self.ok = False
-                break  # the index latches in this cycle, or overspeed: exchange() takes it
-            before = (pos, vel, command, tv, acc, torque) if c_pos == pos and c_vel == vel and c_tv == tv else None
-            c_acc = (c_vel - vel) / dt
-            torque = (inertia * c_acc * rad + viscous * c_vel * rad
-                      + (math.copysign(coulomb, c_vel) if abs(c_vel) > 1 else 0.0)) / rated * 1000.0
-            pos, vel, t, command, tv, acc = c_pos, c_vel, c_t, cmd, c_tv, c_acc
-            sws.append(base | SW_TARGET_REACHED if abs(vel) < reached_v and abs(command - pos) < 10 else base)
-            pa.append(round(pos + origin))  # (round of a float: an int)
-            raw = round(vel * k_raw)
-            va.append(raw if -0x7FFFFFFF <= raw <= 0x7FFFFFFF else max(-0x7FFFFFFF, min(0x7FFFFFFF, raw)))
-            ta.append(round(torque * 0.1 / t_pct))
-            still = before is not None and _same(before, (pos, vel, command, tv, acc, torque))
-        self.state = (pos, vel, t, command, tv, acc, torque)
-        self.still = still
+        pa = out.position_actual
         out.following_error += [0] * (len(pa) - len(out.following_error))  # 0x60F4 is a CSP object: 0 in CSV
         out.done = len(pa)
 
@@ -298,67 +181,16 @@ class CsvRun:
         return out
 
 
-def _repeat(out: Stretch, t: float, h: float, n: int, csp: bool, times: int) -> float:
-    """The last cycle's feedback `times` more times (_same), and the time after their n sub-steps each (summed one
-    sub-step at a time, as they sum it)."""
-    for col in (out.statusword, out.position_actual, out.velocity_actual, out.torque_actual):
-        col += [col[-1]] * times
-    if csp:  # (CSV fills 0x60F4 after the part)
-        out.following_error += [out.following_error[-1]] * times
-    for _k in range(n * times):
-        t += h
-    return t
-
-
-def _at_speed(out: Stretch, cycles: int, pos: float, t: float, command: float, dp: float, h: float, n: int,
-              every: int, fb: tuple) -> tuple[int, float, float, float]:
-    """CsvRun.step's cycles of a spindle at its speed: each sub-step moves the position by dp (its velocity × h, the
-    same product) and the time by h; velocity, torque and status bits stay. As many cycles as move the position
-    and pass no index edge (that cycle is CsvRun.step's): (cycles done, position, time, command after them)."""
-    va_raw, ta_raw, base, slow, origin = fb
-    pa, va, ta, sws = out.position_actual, out.velocity_actual, out.torque_actual, out.statusword
-    floor = math.floor
-    done = 0
-    ks = range(n)
-    while done < cycles:
-        c_pos, c_t, cmd = pos, t, command
-        edge = False
-        for _k in ks:
-            cmd = c_pos
-            new_pos = c_pos + dp
-            if every and floor(c_pos / every) != floor(new_pos / every):
-                edge = True
-            c_pos = new_pos
-            c_t += h
-        if edge or c_pos == pos:
-            break
-        pos, t, command = c_pos, c_t, cmd
-        sws.append(base | SW_TARGET_REACHED if slow and abs(command - pos) < 10 else base)
-        pa.append(round(pos + origin))
-        va.append(va_raw)
-        ta.append(ta_raw)
-        done += 1
-    return done, pos, t, command
-
-
 def _stand(run: "CspRun | CsvRun", cycles: int, csp: bool) -> None:
     """A still drive's next cycles (`lag`, written by CspRun._settle, CsvRun.finish): its feedback repeated, its time
     summed on."""
     n, h = run.model[0], run.model[1]
     state = run.state
     out = run.out
-    run.state = (*state[:2], _repeat(out, state[2], h, n, csp, cycles), *state[3:])
+    run.state = (*state[:2], drive_kernel.repeat(out, state[2], h, n, csp, cycles), *state[3:])
     if not csp:  # 0x60F4 is a CSP object: 0 in CSV (as CsvRun.step fills it)
         out.following_error += [0] * (len(out.position_actual) - len(out.following_error))
     out.done = len(out.position_actual)
-
-
-def _same(a: tuple, b: tuple) -> bool:
-    """The same values bit for bit (a zero's sign too): a cycle that starts from `b` as it did from `a` computes the
-    same (the time aside, which only adds up), so a cycle that ended where it started repeats itself exactly."""
-    return all(type(x) is type(y) and x == y
-               and (type(x) is not float or x != 0.0 or math.copysign(1.0, x) == math.copysign(1.0, y))
-               for x, y in zip(a, b))
 
 
 def _model(p: DriveParams, dt: float) -> tuple[int, float, float, float, float, float]:

@@ -1,0 +1,23 @@
+"""Compiles virtual_bus/drive_kernel.py with Cython where a C compiler is at hand (issue 17); pyproject.toml holds
+the rest of the build. The extension is optional: without a compiler (or without Cython, in a build without
+isolation) the install goes on and the same module runs as Python (virtual_bus/kernels.py says which runs)."""
+
+from setuptools import Extension, setup
+
+KERNELS = ["virtual_bus/drive_kernel.py"]
+
+
+def _extensions() -> list[Extension]:
+    try:
+        from Cython.Build import cythonize
+    except ImportError:  # a build without isolation in an environment without Cython: pure Python
+        return []
+    exts = [Extension(path[:-3].replace("/", "."), [path], optional=True,
+                      # each operation rounds as Python's does: no fused multiply-add, no fast-math
+                      extra_compile_args=["-O2", "-ffp-contract=off", "-fno-fast-math"]) for path in KERNELS]
+    return cythonize(exts, language_level=3, quiet=True, build_dir="build/cython",
+                     compiler_directives={"annotation_typing": False, "cdivision": False, "boundscheck": True,
+                                          "wraparound": True, "embedsignature": True})
+
+
+setup(ext_modules=_extensions())

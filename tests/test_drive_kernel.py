@@ -1,0 +1,127 @@
+"""The sim drive's kernels (virtual_bus/drive_kernel.py) compiled by setup.py give the same bits as their Python
+source (issue 17): a compiled build may only be faster. Random drives, targets and stretches through both."""
+
+from __future__ import annotations
+
+import importlib.util
+import math
+import os
+import struct
+from pathlib import Path
+
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import virtual_bus.kernels as kernels
+from virtual_bus.drive_stretch import Stretch
+
+SOURCE = Path(kernels.__file__).with_name("drive_kernel.py")
+
+
+def _source_module():
+    spec = importlib.util.spec_from_file_location("drive_kernel_source", SOURCE)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+PY = _source_module()
+BUILT = kernels.drive_kernel
+needs_build = pytest.mark.skipif(kernels.BUILD != "compiled",
+                                 reason=f"the kernel is not compiled here ({kernels.BUILD})")
+
+
+def _bits(x):
+    """A value's exact bits: floats by their IEEE image (a zero's sign too), ints as they are, tuples item by item."""
+    if isinstance(x, float):
+        return ("f", struct.pack("<d", x))
+    if isinstance(x, (tuple, list)):
+        return tuple(_bits(v) for v in x)
+    return x
+
+
+finite = st.floats(min_value=-1e7, max_value=1e7, allow_nan=False, allow_infinity=False)
+
+
+@needs_build
+@settings(max_examples=300, deadline=None)
+@given(n=st.integers(1, 8), prev=finite, span=st.floats(-5e4, 5e4), kff=st.floats(0.0, 1.0),
+       kp=st.floats(0.0, 2000.0), pos=finite, vel=st.floats(-1e6, 1e6), max_cps=st.floats(1e3, 1e6),
+       bw=st.floats(10.0, 5000.0))
+def test_csp_substeps_compiled_equal_their_source(n, prev, span, kff, kp, pos, vel, max_cps, bw):
+    h = 0.001 / n
+    alpha = 1.0 - math.exp(-bw * h)
+    args = (n, h, prev, span, kff * span / 0.001, kp, pos, vel, 12.5, max_cps, alpha)
+    assert _bits(BUILT.csp_substeps(*args)) == _bits(PY.csp_substeps(*args))
+
+
+@needs_build
+@settings(max_examples=300, deadline=None)
+@given(n=st.integers(1, 8), ramp=st.floats(0.0, 5e4), want=st.floats(-1e6, 1e6), tv=st.floats(-1e6, 1e6),
+       pos=finite, vel=st.floats(-1e6, 1e6), max_cps=st.floats(1e3, 1e6), bw=st.floats(10.0, 5000.0))
+def test_csv_substeps_compiled_equal_their_source(n, ramp, want, tv, pos, vel, max_cps, bw):
+    h = 0.001 / n
+    args = (n, h, ramp, want, tv, pos, vel, 3.0, max_cps, 1.0 - math.exp(-bw * h))
+    assert _bits(BUILT.csv_substeps(*args)) == _bits(PY.csv_substeps(*args))
+
+
+def _csp_consts(n, window, limits, bw):
+    h = 0.001 / n
+    max_cps = 3000.0 / 60.0 * 1280000
+    return (n, h, max_cps, 1.0 - math.exp(-bw * h), 2.0 * math.pi / 1280000, 0.001 * max_cps, 300.0, 1.0,
+            window, 17.0, 600.0 / 1280000, 0.1, 2e-4, 1e-3, 0.05, 1.27, limits[0], limits[1], 0x1237, 0.001,
+            limits[0] > -math.inf or limits[1] < math.inf)
+
+
+@needs_build
+@settings(max_examples=150, deadline=None)
+@given(n=st.integers(1, 6), steps=st.lists(st.integers(-3000, 3000), min_size=1, max_size=60),
+       window=st.sampled_from([5e3, 1e5, 1e9]), lim=st.sampled_from([(-math.inf, math.inf), (-2e4, 2e4)]),
+       bw=st.floats(200.0, 3000.0), start=st.integers(-10_000, 10_000))
+def test_csp_cycles_compiled_equal_their_source(n, steps, window, lim, bw, start):
+    # targets that move, stop (repeat: the still cycles), fault on the window or run into a limit switch
+    targets, x = [], start
+    for s in steps:
+        x += s if s % 7 else 0
+        targets.append(x)
+    consts = _csp_consts(n, window, lim, bw)
+    state = (float(start) - 17.0, 0.0, 1.5, float(start) - 17.0, None, 0.0, 0.0)
+    outs = []
+    for mod in (BUILT, PY):
+        out = Stretch()
+        res = mod.csp_cycles(targets, consts, state, None, out)
+        outs.append((_bits(res), out.position_actual, out.velocity_actual, out.torque_actual,
+                     out.following_error, out.statusword))
+    assert outs[0] == outs[1]
+
+
+@needs_build
+@settings(max_examples=150, deadline=None)
+@given(n=st.integers(1, 6), cycles=st.integers(1, 400), want=st.floats(-2e6, 2e6), tv=st.floats(-2e6, 2e6),
+       vel=st.floats(-2e6, 2e6), every=st.sampled_from([0, 1280000, 4096]), ramp=st.floats(0.0, 3e4))
+def test_csv_cycles_compiled_equal_their_source(n, cycles, want, tv, vel, every, ramp):
+    h = 0.001 / n
+    max_cps = 6000.0 / 60.0 * 1280000
+    consts = (n, h, max_cps, 1.0 - math.exp(-1500.0 * h), 2.0 * math.pi / 1280000, 0.001 * max_cps, 3.0, ramp,
+              want, every, 600.0 / 1280000, 0.1, 2e-4, 1e-3, 0.05, 1.27, 0x1237, 0.001)
+    state = (123.25, vel, 0.5, 123.25, tv, 0.0, 0.0)
+    outs = []
+    for mod in (BUILT, PY):
+        out = Stretch()
+        res = mod.csv_cycles(cycles, consts, state, False, out)
+        outs.append((_bits(res), out.position_actual, out.velocity_actual, out.torque_actual, out.statusword))
+    assert outs[0] == outs[1]
+
+
+def test_a_build_older_than_its_source_is_not_run(tmp_path):
+    src, built = tmp_path / "drive_kernel.py", tmp_path / "drive_kernel.cpython-311-x86_64-linux-gnu.so"
+    src.write_text("")
+    built.write_bytes(b"")
+    os.utime(src, (1_000, 1_000))
+    os.utime(built, (2_000, 2_000))
+    assert kernels.build_of(str(built), str(src)) == "compiled"
+    os.utime(src, (3_000, 3_000))  # the source edited (or checked out) after the build
+    assert kernels.build_of(str(built), str(src)).startswith("python (the compiled build is older")
+    assert kernels.build_of(str(src), str(src)).startswith("python (not compiled")
+    assert kernels.build_of(None, str(src)).startswith("python (not compiled")

@@ -1,0 +1,238 @@
+"""The sim drive's per-cycle arithmetic, compiled where it can be (issue 17).
+
+A drive's cycle is four sub-steps of a position loop and a first-order velocity loop (virtual_bus/drive.py), then
+its feedback as integers. On the shared 2-vCPU box that arithmetic, run in the interpreter, was the largest part
+of a stretched cycle (≈ 2-3 µs a drive a cycle: the lathe demo's "bus + drives" 4.5 µs of its 16). Here it is
+plain Python, and `setup.py` compiles this very file with Cython (typed by `drive_kernel.pxd`, floats as C
+doubles, no fused multiply-add: `-ffp-contract=off`), so each operation rounds as in Python: the compiled module
+and this source give the same bits (tests/test_drive_kernel.py runs both). Without a compiler the install keeps
+the source (`virtual_bus.kernels` says which one runs).
+
+- `csp_substeps` / `csv_substeps`: one cycle's sub-steps of an enabled drive following CSP targets or its CSV
+  ramp, off its limit switches (Cia402Drive._step_following, and CspRun/CsvRun below);
+- `csp_cycles` / `csv_cycles`: a stretch's cycles of CspRun.step / CsvRun.step (virtual_bus/drive_stretch.py): the
+  sub-steps, the supervision's two tests, the torque and the feedback columns, cycle after cycle;
+- `repeat`, `at_speed`, `same`: a cycle repeated, a spindle at its speed, two states equal bit for bit.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+SW_TARGET_REACHED = 0x0400  # fieldbus.cia402.SW_TARGET_REACHED (statusword bit 10); not imported: no import here
+RAW_MAX = 0x7FFFFFFF  # 0x606C is an s32
+
+
+def csp_substeps(n: int, h: float, prev: float, span: float, kff_ff: float, kp: float, pos: float, vel: float,
+                 t: float, max_cps: float, alpha: float) -> tuple[float, float, float, float]:
+    """One CSP cycle's n sub-steps: the interpolated command, the position loop, the velocity loop; returns
+    (command, position, velocity, time)."""
+    neg = -max_cps
+    cmd = prev
+    for k in range(1, n + 1):
+        cmd = prev + span * k / n
+        v_cmd = kff_ff + kp * (cmd - pos)
+        if not neg <= v_cmd <= max_cps:
+            v_cmd = max(neg, min(max_cps, v_cmd))
+        if v_cmd != vel:
+            vel += (v_cmd - vel) * alpha
+        pos = pos + vel * h
+        t += h
+    return cmd, pos, vel, t
+
+
+def csv_substeps(n: int, h: float, ramp: float, want: float, tv: float, pos: float, vel: float, t: float,
+                 max_cps: float, alpha: float) -> tuple[float, float, float, float, float]:
+    """One CSV cycle's n sub-steps: the ramp towards 0x60FF, the velocity loop; the command follows the actual
+    position. Returns (command, position, velocity, time, ramped target velocity)."""
+    neg = -max_cps
+    cmd = pos
+    for _k in range(n):
+        tv += max(-ramp, min(ramp, want - tv))
+        v_cmd = tv
+        cmd = pos
+        if not neg <= v_cmd <= max_cps:
+            v_cmd = max(neg, min(max_cps, v_cmd))
+        if v_cmd != vel:
+            vel += (v_cmd - vel) * alpha
+        pos = pos + vel * h
+        t += h
+    return cmd, pos, vel, t, tv
+
+
+def csp_cycles(targets: Sequence[int], consts: tuple, state: tuple, still: object, out: object
+               ) -> tuple[tuple, object, bool]:
+    """CspRun.step's loop: one cycle per target, feedback appended to `out`'s columns; stops before a cycle that
+    would fault (a limit switch, the following error window, overspeed: exchange() takes it). Returns (state,
+    the target of a cycle that left the drive as it found it or None, whether it ran to the end)."""
+    (n, h, max_cps, alpha, rad, reached_v, kp, kff, window, origin, k_raw, t_pct, inertia, viscous, coulomb, rated,
+     lo, hi, base, dt, limited) = consts
+    pos, vel, t, command, prev_target, acc, torque = state
+    pa, va, ta, fe, sws = out.position_actual, out.velocity_actual, out.torque_actual, out.following_error, \
+        out.statusword
+    neg, over = -max_cps, 1.2 * max_cps
+    ok = True
+    rep = 0  # still cycles not written yet: a run of them is written at once (repeat)
+    for tgt in targets:
+        if tgt == still:  # the same target again after a cycle that changed nothing: the same cycle, the time on
+            rep += 1
+            continue
+        if rep:
+            t = repeat(out, t, h, n, True, rep)
+            rep = 0
+        target = float(tgt) - origin
+        prev = prev_target if prev_target is not None else command
+        ff_vel = (target - prev) / dt
+        kff_ff = kff * ff_vel
+        span = target - prev
+        c_pos, c_vel, c_t, cmd = pos, vel, t, command
+        inside = True
+        for k in range(1, n + 1):  # csp_substeps, with the limit switches' test (Cia402Drive._step_general)
+            cmd = prev + span * k / n
+            v_cmd = kff_ff + kp * (cmd - c_pos)
+            if not neg <= v_cmd <= max_cps:
+                v_cmd = max(neg, min(max_cps, v_cmd))
+            if v_cmd != c_vel:
+                c_vel += (v_cmd - c_vel) * alpha
+            c_pos = c_pos + c_vel * h
+            if limited and not lo < c_pos < hi:
+                inside = False
+            c_t += h
+        if not inside or abs(cmd - c_pos) > window or abs(c_vel) > over:
+            ok = False
+            break
+        moved = not (c_pos == pos and c_vel == vel and target == prev_target)
+        before = None if moved else (pos, vel, command, prev_target, acc, torque)
+        c_acc = (c_vel - vel) / dt
+        # Cia402Drive.step's torque of an energised drive (0.1 % of rated), DriveUnits.velocity_to_raw
+        torque = (inertia * c_acc * rad + viscous * c_vel * rad
+                  + (math.copysign(coulomb, c_vel) if abs(c_vel) > 1 else 0.0)) / rated * 1000.0
+        pos, vel, t, command, acc, prev_target = c_pos, c_vel, c_t, cmd, c_acc, target
+        gap = command - pos
+        sws.append(base | SW_TARGET_REACHED if abs(vel) < reached_v and abs(gap) < 10 else base)
+        pa.append(round(pos + origin))  # (round of a float: an int)
+        raw = round(vel * k_raw)
+        va.append(raw if -RAW_MAX <= raw <= RAW_MAX else max(-RAW_MAX, min(RAW_MAX, raw)))
+        ta.append(round(torque * 0.1 / t_pct))
+        fe.append(round(gap))
+        still = tgt if before is not None and same(before, (pos, vel, command, prev_target, acc, torque)) else None
+    if rep:
+        t = repeat(out, t, h, n, True, rep)
+    return (pos, vel, t, command, prev_target, acc, torque), still, ok
+
+
+def csv_cycles(cycles: int, consts: tuple, state: tuple, still: bool, out: object) -> tuple[tuple, bool, bool]:
+    """CsvRun.step's loop: `cycles` cycles of a CSV drive at its 0x60FF speed; stops before a cycle that would
+    latch the encoder index or overspeed. Returns (state, whether the last cycle left the drive as it found it,
+    whether it ran to the end)."""
+    n, h, max_cps, alpha, rad, reached_v, origin, ramp, want, every, k_raw, t_pct, inertia, viscous, coulomb, \
+        rated, base, dt = consts
+    pos, vel, t, command, tv, acc, torque = state
+    pa, va, ta, sws = out.position_actual, out.velocity_actual, out.torque_actual, out.statusword
+    neg, over = -max_cps, 1.2 * max_cps
+    ok = True
+    c = 0
+    while c < cycles:
+        if still:  # a standing spindle (a mill's CAM program): the same cycle from here on, the time on
+            t = repeat(out, t, h, n, False, cycles - c)
+            break
+        v_cmd = tv if neg <= tv <= max_cps else max(neg, min(max_cps, tv))
+        if tv == want and tv != 0.0 and vel != 0.0 and ramp >= 0.0 and abs(vel) <= over \
+                and (v_cmd == vel or vel + (v_cmd - vel) * alpha == vel):
+            # at its speed (the ramp's step 0, the velocity loop's step none, or under half an ulp: a velocity
+            # 7e-9 short of 2.56e7 counts/s stays): only the position and the time move, as far as the cycles
+            # move it and pass no index edge
+            c_acc = (vel - vel) / dt
+            c_torque = (inertia * c_acc * rad + viscous * vel * rad
+                        + (math.copysign(coulomb, vel) if abs(vel) > 1 else 0.0)) / rated * 1000.0
+            raw = round(vel * k_raw)
+            done, pos, t, command = at_speed(out, cycles - c, pos, t, command, vel * h, h, n, every,
+                                             raw if -RAW_MAX <= raw <= RAW_MAX else max(-RAW_MAX, min(RAW_MAX, raw)),
+                                             round(c_torque * 0.1 / t_pct), base, abs(vel) < reached_v, origin)
+            if done:
+                acc, torque = c_acc, c_torque
+                c += done
+                if c == cycles:
+                    break
+        c += 1
+        c_pos, c_vel, c_t, c_tv, cmd = pos, vel, t, tv, command
+        edge = False
+        for _k in range(n):  # csv_substeps, with the encoder index's edge test (Cia402Drive._probe)
+            c_tv += max(-ramp, min(ramp, want - c_tv))
+            v_cmd = c_tv
+            cmd = c_pos
+            if not neg <= v_cmd <= max_cps:
+                v_cmd = max(neg, min(max_cps, v_cmd))
+            if v_cmd != c_vel:
+                c_vel += (v_cmd - c_vel) * alpha
+            new_pos = c_pos + c_vel * h
+            if every and math.floor(c_pos / every) != math.floor(new_pos / every):
+                edge = True
+            c_pos = new_pos
+            c_t += h
+        if edge or abs(c_vel) > over:
+            ok = False
+            break  # the index latches in this cycle, or overspeed: exchange() takes it
+        moved = not (c_pos == pos and c_vel == vel and c_tv == tv)
+        before = None if moved else (pos, vel, command, tv, acc, torque)
+        c_acc = (c_vel - vel) / dt
+        torque = (inertia * c_acc * rad + viscous * c_vel * rad
+                  + (math.copysign(coulomb, c_vel) if abs(c_vel) > 1 else 0.0)) / rated * 1000.0
+        pos, vel, t, command, tv, acc = c_pos, c_vel, c_t, cmd, c_tv, c_acc
+        sws.append(base | SW_TARGET_REACHED if abs(vel) < reached_v and abs(command - pos) < 10 else base)
+        pa.append(round(pos + origin))
+        raw = round(vel * k_raw)
+        va.append(raw if -RAW_MAX <= raw <= RAW_MAX else max(-RAW_MAX, min(RAW_MAX, raw)))
+        ta.append(round(torque * 0.1 / t_pct))
+        still = before is not None and same(before, (pos, vel, command, tv, acc, torque))
+    return (pos, vel, t, command, tv, acc, torque), still, ok
+
+
+def repeat(out: object, t: float, h: float, n: int, csp: bool, times: int) -> float:
+    """The last cycle's feedback `times` more times (`same`), and the time after their n sub-steps each (summed one
+    sub-step at a time, as they sum it)."""
+    for col in (out.statusword, out.position_actual, out.velocity_actual, out.torque_actual):
+        col += [col[-1]] * times
+    if csp:  # (CSV fills 0x60F4 after the part)
+        out.following_error += [out.following_error[-1]] * times
+    for _k in range(n * times):
+        t += h
+    return t
+
+
+def at_speed(out: object, cycles: int, pos: float, t: float, command: float, dp: float, h: float, n: int,
+             every: int, va_raw: int, ta_raw: int, base: int, slow: bool, origin: float
+             ) -> tuple[int, float, float, float]:
+    """csv_cycles' cycles of a spindle at its speed: each sub-step moves the position by dp (its velocity × h, the
+    same product) and the time by h; velocity, torque and status bits stay. As many cycles as move the position
+    and pass no index edge (that cycle is csv_cycles' own): (cycles done, position, time, command after them)."""
+    pa, va, ta, sws = out.position_actual, out.velocity_actual, out.torque_actual, out.statusword
+    done = 0
+    while done < cycles:
+        c_pos, c_t, cmd = pos, t, command
+        edge = False
+        for _k in range(n):
+            cmd = c_pos
+            new_pos = c_pos + dp
+            if every and math.floor(c_pos / every) != math.floor(new_pos / every):
+                edge = True
+            c_pos = new_pos
+            c_t += h
+        if edge or c_pos == pos:
+            break
+        pos, t, command = c_pos, c_t, cmd
+        sws.append(base | SW_TARGET_REACHED if slow and abs(command - pos) < 10 else base)
+        pa.append(round(pos + origin))
+        va.append(va_raw)
+        ta.append(ta_raw)
+        done += 1
+    return done, pos, t, command
+
+
+def same(a: tuple, b: tuple) -> bool:
+    """The same values bit for bit (a zero's sign too): a cycle that starts from `b` as it did from `a` computes the
+    same (the time aside, which only adds up), so a cycle that ended where it started repeats itself exactly."""
+    return all(type(x) is type(y) and x == y
+               and (type(x) is not float or x != 0.0 or math.copysign(1.0, x) == math.copysign(1.0, y))
+               for x, y in zip(a, b))
