@@ -160,6 +160,11 @@ def staged(label: str, program: Path, bench_file: Path | None, trace: str | None
 def issue17(d: str) -> None:
     root = Path(__file__).resolve().parent.parent
     sys.path.insert(0, str(root))
+    try:
+        from virtual_bus.kernels import BUILD
+    except ImportError:  # a tree from before the kernel (session 21)
+        BUILD = "none (a tree without virtual_bus/kernels.py)"
+    print(f"drive kernel: {BUILD}")  # virtual_bus/drive_kernel: compiled by the install, or its Python source
     from benchmarks.bench_motion import cam_program
 
     staged("lathe demo, lathe MLC, Parquet trace", root / "examples" / "lathe_demo.nc", None,
