@@ -121,6 +121,8 @@ def test_a_build_older_than_its_source_is_not_run(tmp_path):
     os.utime(src, (1_000, 1_000))
     os.utime(built, (2_000, 2_000))
     assert kernels.build_of(str(built), str(src)) == "compiled"
+    os.utime(src, (2_001, 2_001))  # written a moment after it: pip extracting a wheel
+    assert kernels.build_of(str(built), str(src)) == "compiled"
     os.utime(src, (3_000, 3_000))  # the source edited (or checked out) after the build
     assert kernels.build_of(str(built), str(src)).startswith("python (the compiled build is older")
     assert kernels.build_of(str(src), str(src)).startswith("python (not compiled")
