@@ -166,15 +166,15 @@ class Stretcher(RealTimeStretches):
         if self.paced and r.clock.left_ns() < stretch_realtime.START_LEFT_NS:
             self.starts_skipped += 1  # B36: too near the next tick for a start's checks and set-up: step
             return False
-        kind = self._quiet(r, ch)
-        if kind is None:
-            return False
-        pl = ch.planner
         # B103: G96 or feed per revolution: the samples of the planner's buffer, ended where the spindle would change
         # what a cycle reads (neither the NC's steps inside the stretch nor a cruise across blocks)
         linked = _spindle_linked(ch)
         if linked and r.cycle < self._css_retry:
             return False  # B103: X moves under G96, the rpm changes every cycle: no start tried for a few cycles
+        kind = self._quiet(r, ch)  # (after the back-off: `_quiet` only reads, and a start there is refused anyway)
+        if kind is None:
+            return False
+        pl = ch.planner
         if kind == "run" and self.reads_ok and not self.paced and type(r.mlc) is BasicMlc and self._bulk_ok(r) \
                 and not linked and (may_read(ch, pl) or (no_reads(ch) and not ch.alarms and not pl.held)):
             return self._run_pass(r, ch, pl, limit)  # B27: the NC's steps inside the stretch
