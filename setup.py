@@ -12,12 +12,15 @@ def _extensions() -> list[Extension]:
         from Cython.Build import cythonize
     except ImportError:  # a build without isolation in an environment without Cython: pure Python
         return []
-    exts = [Extension(path[:-3].replace("/", "."), [path], optional=True,
+    exts = [Extension(path[:-3].replace("/", "."), [path],
                       # each operation rounds as Python's does: no fused multiply-add, no fast-math
                       extra_compile_args=["-O2", "-ffp-contract=off", "-fno-fast-math"]) for path in KERNELS]
-    return cythonize(exts, language_level=3, quiet=True, build_dir="build/cython",
-                     compiler_directives={"annotation_typing": False, "cdivision": False, "boundscheck": True,
-                                          "wraparound": True, "embedsignature": True})
+    built = cythonize(exts, language_level=3, quiet=True, build_dir="build/cython",
+                      compiler_directives={"annotation_typing": False, "cdivision": False, "boundscheck": True,
+                                           "wraparound": True, "embedsignature": True})
+    for ext in built:  # cythonize makes new Extensions and drops the flag: a failed compile must not fail the install
+        ext.optional = True
+    return built
 
 
 setup(ext_modules=_extensions())
