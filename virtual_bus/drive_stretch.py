@@ -2,8 +2,8 @@
 
 `csp_stretch(drive, rx, targets, dt)` (and `csv_stretch(drive, rx, cycles, dt)` for a spindle) does what `drive.exchange(rx, dt)` does once per target, for an
 enabled CSP drive whose master holds enable operation, without limit switches, touch probe or injected
-fault: the same arithmetic in the same order (Cia402Drive.step → _step_following, feedback), on local
-variables, with no PDO objects per cycle. It stops before the first cycle that would fault (following
+fault: the same arithmetic in the same order (Cia402Drive.step → _step_following, feedback), in
+virtual_bus/drive_kernel.py's loops (compiled at install, decision bench B113), with no PDO objects per cycle. It stops before the first cycle that would fault (following
 error window, overspeed): that cycle is left to `exchange`, which takes the fault as always. The CSP
 model's sub-step recurrence is sequential, so this is a loop, not a filter: a filter over the stretch
 (lfilter) would round differently and could flip an integer count.
@@ -15,7 +15,7 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
-from fieldbus.cia402 import SW_FOLLOWING, SW_TARGET_REACHED, State
+from fieldbus.cia402 import SW_FOLLOWING, State
 from fieldbus.pdo import RxPdo, TxPdo
 from virtual_bus.kernels import drive_kernel
 from virtual_bus.drive import AL_FORWARD_LIMIT, AL_REVERSE_LIMIT, _STATUS_BASE, Cia402Drive, DriveParams
