@@ -67,6 +67,11 @@ class NonModalMixin:
 
     def _g_G52(self, block: Block) -> None:
         words = self._axis_words(block)
+        # N§3.6.2: "only valid in G90 absolute mode and cannot be used in G91"; L§G52: "valid only when set with
+        # absolute values": a shift given incrementally (G91 or U/W) is refused, not taken as absolute (language.md)
+        inc = [w.text for w, i in words.values() if i or not self.state.absolute]
+        if inc:
+            raise NcAlarm(0x0207, f"G52 takes absolute values only (G90); {' '.join(inc)} is incremental")
         for a, (w, _inc) in words.items():
             v = self.distance(w, a)
             self.frames.local_shift[a] = v / 2.0 if a in self.profile.diameter_axes else v

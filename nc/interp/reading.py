@@ -15,6 +15,10 @@ from nc.program.blocks import Block, Word
 from nc.program.expr_compiled import evaluate
 from nc.interp.records import LETTERS
 
+# letters outside a macro call that functions read on every profile (axes A/B/C/X/Y/Z checked below)
+_COMMON_LETTERS = frozenset("ABCDFGHIJKLMNPQRSTXYZ")
+_READ_LETTERS: dict[tuple[tuple[str, ...], bool], frozenset[str]] = {}
+
 
 class ReadingMixin:
     def _resolve(self, block: Block) -> Block:
@@ -64,13 +68,25 @@ class ReadingMixin:
         return out
 
     def _check_letters(self, block: Block, funcs: set[str]) -> None:
+        call = "G65" in funcs or "G66" in funcs  # a macro call's arguments take any letter (A-Z but G L N O P)
         for w in block.words:
-            if w.letter in LETTERS or w.letter in self.axes:
+            if w.letter in self.axes or w.letter in LETTERS and (call or w.letter in self._read_letters()):
                 continue
             raise NcAlarm(0x0201, f"address {w.letter} is not defined on this machine ({w.text})")
         for a in ("Y", "A", "B", "C", "X", "Z"):
             if a not in self.axes and block.has(a) and not self._letter_is_arg(a, funcs):
                 raise NcAlarm(0x0201, f"axis {a} is not defined on this machine")
+
+    def _read_letters(self) -> frozenset[str]:
+        """Letters some NC5 function reads on this machine (language.md, session 21): E is read by none, and
+        U/V/W only as the lathe's incremental X/Y/Z and its cycles' depths (N§3.3 note 3, §3.15), so a stray
+        `E5` or `V5.` on a mill is 0x0201 as App. A's `G01O100.` rather than silently dropped."""
+        key = (self.axes, self.profile.is_lathe)
+        got = _READ_LETTERS.get(key)
+        if got is None:
+            extra = {"U", "W"} | ({"V"} if "Y" in self.axes else set()) if self.profile.is_lathe else set()
+            got = _READ_LETTERS[key] = frozenset(_COMMON_LETTERS | extra)
+        return got
 
     def _letter_is_arg(self, a: str, funcs: set[str]) -> bool:
         return bool(funcs & {"G65", "G66", "G10", "G51", "G68", "G16", "G52"}) or self._cycle_fn(funcs) is not None \
