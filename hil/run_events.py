@@ -45,9 +45,11 @@ class EventSpecError(ValueError):
 
 # ---- parsing ---------------------------------------------------------------------------------------
 _NUM = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
-_TIME = re.compile(rf"^t\s*=\s*({_NUM})$", re.IGNORECASE)
-_COUNT = re.compile(r"^(line|cycle)\s*=\s*(\d+)$", re.IGNORECASE)
-_AXIS = re.compile(rf"^([A-Za-z][A-Za-z0-9]*)\s*([<>])\s*({_NUM})$")
+# ASCII digits only (B106): `\d` and float() also take '٥' and '1_0', which no NC5 screen or manual writes
+_TIME = re.compile(rf"^t\s*=\s*({_NUM})$", re.IGNORECASE | re.ASCII)
+_COUNT = re.compile(r"^(line|cycle)\s*=\s*(\d+)$", re.IGNORECASE | re.ASCII)
+_AXIS = re.compile(rf"^([A-Za-z][A-Za-z0-9]*)\s*([<>])\s*({_NUM})$", re.ASCII)
+_VALUE = re.compile(_NUM, re.ASCII)
 _SET = re.compile(r"^set\s+(\S+?)\s*=\s*(\S+)$", re.IGNORECASE)
 _ONE = re.compile(r"^(pulse|reset)\s+(\S+)$", re.IGNORECASE)
 
@@ -128,13 +130,10 @@ def _value(text: str, sig: Signal) -> float | int:
         if word in ("0", "off", "false"):
             return 0
         raise EventSpecError(f"{sig.address} is a bit: its value is 0/1 or on/off, not {text!r}")
-    try:
-        v = float(text)
-    except ValueError:
-        raise EventSpecError(f"{sig.address}: {text!r} is not a number") from None
+    v = float(text) if _VALUE.fullmatch(text.strip()) else math.nan  # nan, inf, '٥', '1_0': not a number
+    if not math.isfinite(v):  # 1e400 too; int() of it was an internal error (0x0000) at the run's first scan
+        raise EventSpecError(f"{sig.address}: {text!r} is not a finite number")
     if sig.width == "f32":
-        if not math.isfinite(v):
-            raise EventSpecError(f"{sig.address}: {text!r} is not a finite number")
         return v
     if v != int(v):
         raise EventSpecError(f"{sig.address} holds an integer ({sig.width}); {text!r} has a fraction")
