@@ -10,6 +10,8 @@ from __future__ import annotations
 import os
 import random
 import re
+import shlex
+import shutil
 import signal
 import subprocess
 import sys
@@ -21,6 +23,8 @@ ROOT = Path(__file__).resolve().parent.parent
 MILL = ROOT / "benches" / "mill-3axis.toml"
 PROGRAM = "G00 X10. Y10.\nG01 Z-1. F3000.\nX20. Y-5.\nG02 X0. Y-5. R10.\nG00 Z30.\nM30\n"
 EXIT_CODES = {0, 1, 2, 3, 130, 143}
+# root with unshare: a tiny or read-only tmpfs in a private mount namespace (nothing to clean up afterwards)
+MOUNTS = os.geteuid() == 0 and shutil.which("unshare") is not None
 GOOD: list[Path] = []  # a complete trace of PROGRAM on the mill, made once by `prepare`
 KINDS = ("bench", "program", "at", "trace", "check", "campaign")
 
@@ -159,8 +163,11 @@ def at_case(r: random.Random, d: Path) -> Case:
 def trace_case(r: random.Random, d: Path) -> Case:
     prog = d / "p.nc"
     prog.write_text(PROGRAM)
-    kind = r.choice(("read-only dir", "missing dir", "is a directory", "file as parent", "csv", "signal",
-                     "signal", "signal", "existing trace", "dev-null"))
+    kinds = ["read-only dir", "missing dir", "is a directory", "file as parent", "csv", "signal", "signal", "signal",
+             "existing trace", "dev-null"]
+    if MOUNTS:
+        kinds += ["disk full", "disk full", "read-only fs"]
+    kind = r.choice(kinds)
     trace = d / "t.parquet"
     c = Case("trace", [], trace, kind)
     if kind == "read-only dir":
@@ -188,6 +195,17 @@ def trace_case(r: random.Random, d: Path) -> Case:
         c.note = f"{signal.Signals(c.signum).name} after {c.signal_after:.2f} s"
     c.argv = _hil("run", str(prog), "--bench", str(MILL), "--trace", str(trace))
     c.trace = None if kind == "dev-null" else trace
+    if kind in ("disk full", "read-only fs"):  # a tmpfs in a private mount namespace: gone when the run ends
+        mnt = d / "mnt"
+        mnt.mkdir()
+        opts = f"size={r.choice((8, 64, 200))}k" if kind == "disk full" else "ro"
+        c.trace = mnt / "t.parquet"
+        run = " ".join(shlex.quote(a) for a in _hil("run", str(prog), "--bench", str(MILL), "--trace", str(c.trace)))
+        c.argv = ["unshare", "-m", "sh", "-c", f"mount -t tmpfs -o {opts} fuzz22 {shlex.quote(str(mnt))} && "
+                  f"{{ {run}; rc=$?; cp {shlex.quote(str(c.trace))} {shlex.quote(str(d / 'copy.parquet'))} 2>/dev/null; "
+                  f"echo LEFT:$(ls -A {shlex.quote(str(mnt))} | grep -vx t.parquet); exit $rc; }}"]
+        c.trace = d / "copy.parquet"  # what was on the small disk when the run ended: judged whole or absent
+        c.note = f"{kind} ({opts})"
     return c
 
 
@@ -221,14 +239,25 @@ _CAMPAIGNS = [
     "",
     "not toml [",
     '[campaign]\nname = "c"\n',
-    '[campaign]\nbench = "{bench}"\nprograms = ["{prog}"]\n',
-    '[campaign]\nbench = "{bench}"\nprograms = []\n',
-    '[campaign]\nbench = "{bench}"\nprograms = ["{d}/missing.nc"]\n',
-    '[campaign]\nbench = 5\nprograms = ["{prog}"]\n',
-    '[campaign]\nbench = "{bench}"\nprograms = "{prog}"\n',
-    '[campaign]\nbench = "{bench}"\nprograms = ["{prog}"]\n[campaign.vary]\nfeed_override = [-10, "x"]\n',
-    '[campaign]\nbench = "{bench}"\nprograms = ["{prog}"]\n[campaign.vary]\nnosuch = [1, 2]\n',
-    '[campaign]\nbench = "{d}/bad.toml"\nprograms = ["{prog}"]\n',
+    '[campaign]\nprograms = ["{prog}"]\nbenches = ["{bench}"]\n',
+    '[campaign]\nprograms = []\nbenches = ["{bench}"]\n',
+    '[campaign]\nprograms = ["{d}/missing*.nc"]\nbenches = ["{bench}"]\n',
+    '[campaign]\nprograms = ["{prog}"]\nbenches = 5\n',
+    '[campaign]\nprograms = "{prog}"\nbenches = ["{bench}"]\n',
+    '[campaign]\nprograms = ["{prog}"]\nbenches = ["{d}/bad.toml"]\n',
+    '[campaign]\nprograms = ["{prog}"]\nbenches = ["{bench}"]\noverrides = [-10, "x"]\n',
+    '[campaign]\nprograms = ["{prog}"]\nbenches = ["{bench}"]\noverrides = [0]\n',
+    '[campaign]\nprograms = ["{prog}"]\nbenches = ["{bench}"]\nmax_time = -1\n',
+    '[campaign]\nprograms = ["{prog}"]\nbenches = ["{bench}"]\nmax_time = 0.05\ntrace = true\n',
+    '[campaign]\nprograms = ["{prog}"]\nbenches = ["{bench}"]\nretries = -1\n',
+    '[campaign]\nprograms = ["{prog}"]\nbenches = ["{bench}"]\nbuses = ["nonsense"]\n',
+    '[campaign]\nprograms = ["{prog}"]\nbenches = ["{bench}"]\nfaults = ["nosuch"]\n',
+    '[campaign]\nprograms = ["{prog}"]\nbenches = ["{bench}"]\nfaults = ["f"]\n[faults]\nf = ["{at}"]\n',
+    '[campaign]\nprograms = ["{prog}"]\nbenches = ["{bench}"]\nfaults = ["f"]\ntrace = true\n[faults]\nf = ["{good_at}"]\n',
+    '[campaign]\nprograms = ["{prog}"]\nbenches = ["{bench}"]\n[params]\n"N1.053" = ["x", -1e300]\n',
+    '[campaign]\nprograms = ["{prog}"]\nbenches = ["{bench}"]\n[checks]\nmax_following_error = -1\n',
+    '[campaign]\nprograms = ["{prog}"]\nbenches = ["{bench}"]\n[[case]]\nprogram = "{d}/nope.nc"\n',
+    '[campaign]\nprograms = ["{prog}"]\nbenches = ["{bench}"]\nmystery = 1\n',
 ]
 
 
@@ -236,12 +265,12 @@ def campaign_case(r: random.Random, d: Path) -> Case:
     prog = d / "p.nc"
     prog.write_text(PROGRAM)
     (d / "bad.toml").write_text(MILL.read_text().replace("lead = 10.0", "lead = -1.0", 1))
-    text = r.choice(_CAMPAIGNS).format(bench=MILL, prog=prog, d=d)
+    text = r.choice(_CAMPAIGNS).format(bench=MILL, prog=prog, d=d, at=r.choice(_AT_BAD), good_at=r.choice(_AT_GOOD))
     f = d / "c.toml"
     f.write_text(text)
     out = d / "out"
     return Case("campaign", _hil("campaign", str(f), "--out", str(out), "--workers", "0", "--quiet",
-                                 "--no-reports"), None, text.replace("\n", " | ")[:80])
+                                 "--no-reports"), None, text.replace("\n", " | ")[-90:])
 
 
 _MAKERS = {"bench": bench_case, "program": program_case, "at": at_case, "trace": trace_case, "check": check_case,
@@ -289,11 +318,18 @@ def judge(c: Case, timeout: float = 120.0) -> list[str]:
         bad.append(f"exit code {p.returncode}")
     if p.returncode != 0 and not err.strip() and "result" not in out.decode(errors="replace"):
         bad.append("non-zero exit with no message")
-    if c.argv[3] == "run" and p.returncode in (0, 1, 3, 130, 143) and "program" in out.decode(errors="replace")[:200]:
+    left = re.search(r"^LEFT:(.*)$", out.decode(errors="replace"), re.M)
+    if left and left.group(1).strip():  # beside the trace on a full/read-only disk: nothing
+        bad.append(f"left on the small filesystem: {left.group(1).strip()}")
+    if "run" in c.argv[:4] and p.returncode in (0, 1, 3, 130, 143) and "program" in out.decode(errors="replace")[:200]:
         if not re.search(r"^result ", out.decode(errors="replace"), re.M):
             bad.append("a started run printed no result line")
     if c.trace is not None and c.trace.suffix == ".parquet" and not c.trace.is_dir():
         bad += _trace_state(c.trace)
+    if c.kind == "campaign":  # every trace a campaign kept reads whole
+        out_dir = Path(c.argv[c.argv.index("--out") + 1])
+        for t in sorted(out_dir.rglob("*.parquet")) if out_dir.is_dir() else []:
+            bad += _trace_state(t)
     if c.trace is not None and c.trace.parent.is_dir():
         left = [q.name for q in c.trace.parent.iterdir() if q.name.startswith(".") or q.name.endswith((".tmp", ".part"))]
         if left:
