@@ -62,3 +62,46 @@ def test_a_good_event_value_still_sets_its_register(tmp_path):
     p = _run(tmp_path, "--at", "t=0.2:set D21002=+5.0e1")
     assert p.returncode == 0, p.stderr
     assert "result         completed" in p.stdout
+
+
+@pytest.mark.parametrize("signum, code", [(2, 130), (15, 143)])
+def test_a_signal_during_a_serial_campaign_interrupts_it_and_no_cut_run_is_a_completed_row(tmp_path, signum, code):
+    """Ctrl-C during `hil campaign --workers 0` reached the case's run, which stopped under control as `hil run`
+    does; the campaign then wrote that case as `completed` (with a third of its cycles and a trace cut short),
+    went on with the next cases and exited 0. Decision B107: the stopped run ends the campaign as interrupted
+    (130 for SIGINT, 143 for SIGTERM, README), its row is not written, and the same command resumes it."""
+    import signal
+    import time
+
+    import pyarrow.parquet as pq
+
+    prog = tmp_path / "long.nc"
+    prog.write_text("G00 X-200. Y0.\nG01 X200. F600.\nX-200.\nG00 X0.\nM30\n")
+    camp = tmp_path / "c.toml"
+    camp.write_text(f'[campaign]\nprograms = ["{prog}"]\nbenches = ["{gen.MILL}"]\noverrides = [100, 150]\n')
+    out = tmp_path / "out"
+    argv = [sys.executable, "-m", "hil.cli", "campaign", str(camp), "--out", str(out), "--workers", "0", "--quiet",
+            "--no-reports"]
+    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    # as from a terminal: Ctrl-C's default action (a shell's background job would start it ignored)
+    p = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=ROOT, env=env,
+                         preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+    deadline = time.monotonic() + 60
+    while not any(out.glob("*")) and time.monotonic() < deadline:  # the campaign has begun its first case
+        time.sleep(0.05)
+    time.sleep(1.0)
+    p.send_signal(signum)
+    _, err = p.communicate(timeout=120)
+    assert p.returncode == code, (p.returncode, err[-500:])
+    assert "Traceback" not in err and "resume" in err
+    rows = pq.read_table(out / "results.parquet").to_pylist() if (out / "results.parquet").exists() else []
+    full = {100.0: None, 150.0: None}
+    for r in rows:  # whatever was written is a whole run
+        assert r["status"] == "completed" and r["program_time_s"] > 50, r  # 81 s at 100 %, 54 s at 150 %
+    # the same command resumes and finishes every case
+    p2 = subprocess.run(argv, capture_output=True, text=True, cwd=ROOT, env=env, timeout=300)
+    assert p2.returncode == 0, p2.stderr[-500:]
+    rows = pq.read_table(out / "results.parquet").to_pylist()
+    assert sorted(r["override"] for r in rows) == sorted(full) and all(r["status"] == "completed" for r in rows)
+    times = {r["override"]: r["program_time_s"] for r in rows}
+    assert times[100.0] > 80 and times[150.0] > 50

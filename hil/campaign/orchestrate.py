@@ -20,6 +20,7 @@ class CampaignOutcome:
     rows: list[dict[str, Any]] = field(default_factory=list)
     skipped: int = 0  # cases whose result was already there (resume)
     interrupted: bool = False
+    signal: str = "SIGINT"  # what interrupted it: Ctrl-C, or the signal that stopped a serial case's run (B107)
     lost: str = ""  # why the cluster went away mid-campaign (SchedulerLost), else ""
     unrun: int = 0  # cases to run that never finished (an interrupted or lost campaign)
     results: Path | None = None
@@ -67,8 +68,9 @@ def run_campaign(path: str | Path, out: str | Path, engine: Engine | None = None
             outcome.rows.append(row)
             progress.update(row)
             ran += 1
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as exc:
         outcome.interrupted = True
+        outcome.signal = getattr(exc, "signal_name", "SIGINT")
     except SchedulerLost as exc:  # what finished is written and the journal kept: the same command resumes (B76)
         outcome.interrupted = True
         outcome.lost = str(exc)

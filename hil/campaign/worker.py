@@ -18,6 +18,15 @@ from hil.campaign.inputs import CaseInputs, materialise
 from hil.version import version
 
 
+class CaseStopped(KeyboardInterrupt):
+    """A signal stopped the case's run under control (a serial campaign's run holds the signal handlers): the case
+    did not finish, so it is no row and the campaign is interrupted as by Ctrl-C between cases (B107)."""
+
+    def __init__(self, signal_name: str):
+        super().__init__(signal_name)
+        self.signal_name = signal_name
+
+
 def base_row(case: CaseInputs) -> dict[str, Any]:
     return {**case.key, "input_hash": case.input_hash, "deltahil_version": version(),
             "worker": f"{socket.gethostname()}:{os.getpid()}", "attempts": 1}
@@ -62,6 +71,9 @@ def _execute(case: CaseInputs, scratch: Path) -> dict[str, Any]:
     result = hil_run(where[case.program], bench=bench, trace=str(trace), mlc=mlc, events=case.events,
                      libs=[where[x] for x in case.libs], feed_override=case.override,
                      rapid_override=case.rapid_override, spindle_override=case.spindle_override)
+    stopped_by = getattr(result.run, "stopped_by", None)
+    if stopped_by:  # a cut run is no `completed` row (B107)
+        raise CaseStopped(stopped_by)
     if result.runner is None:  # the program could not be read or parsed
         a = result.alarms[0]
         return {"status": "alarm", "alarm": a.code_text, "alarm_line": a.line, "message": a.message[:500]}

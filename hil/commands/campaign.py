@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import argparse
+import signal
 import sys
 
 EXIT_OK, EXIT_FAIL, EXIT_USAGE = 0, 1, 2
@@ -88,8 +89,9 @@ def cmd_campaign(args: argparse.Namespace) -> int:
               "run the same command again (with a scheduler) to resume", file=sys.stderr)
         return EXIT_CLUSTER
     if outcome.interrupted:
-        print("hil campaign: interrupted; run the same command again to resume", file=sys.stderr)
-        return 130
+        how = "interrupted" if outcome.signal == "SIGINT" else f"stopped by {outcome.signal}"
+        print(f"hil campaign: {how}; run the same command again to resume", file=sys.stderr)
+        return 128 + int(getattr(signal, outcome.signal, signal.SIGINT))  # 130, 143 ... as README "Exit codes"
     return EXIT_OK if outcome.ok else EXIT_FAIL
 
 
