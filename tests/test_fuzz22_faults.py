@@ -49,12 +49,12 @@ def _run(tmp_path: Path, *args: str) -> subprocess.CompletedProcess:
                                 "t=1:set D21002=\u0665", "t=1:set D21002=1_0", "t=\u0661:reset",
                                 "line=\u0663:reset", "Z<-\u0660.5:reset"])
 def test_an_event_value_that_is_not_an_ascii_finite_number_is_refused_before_the_run(tmp_path, at):
-    """`--at "t=1:set D21002=1e400"` (or nan) started the run and ended it at 1 s in `ALARM 0x0000 NC internal
+    """`--at "t=1:set D21002=1e400"` (or nan) started the run and ended it at 1 s in `ALARM ... NC internal
     error: OverflowError` (exit 1); `D21002=٥` and `t=١` were taken as 5 and 1 (Python's float() reads any
     script's digits, and `1_0` as 10). Decision B106: refused with exit 2 naming the event, no cycle run."""
     p = _run(tmp_path, "--at", at)
     assert p.returncode == 2, (p.returncode, p.stdout[-400:], p.stderr[-400:])
-    assert "--at" in p.stderr and "Traceback" not in p.stderr + p.stdout and "0x0000" not in p.stdout
+    assert "--at" in p.stderr and "Traceback" not in p.stderr + p.stdout and "NC internal error" not in p.stdout
     assert "cycles" not in p.stdout  # nothing ran
 
 
