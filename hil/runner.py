@@ -25,7 +25,7 @@ from hil.bench import Bench
 from hil.bus_work import BusWork
 from hil.clock import CycleTiming, LockStepClock, RealTimeClock
 from hil.cycle_lean import OVERSPEED, RESET_CYCLES, WARM_AHEAD_NS, WARM_MIN_NS, factors, feedback, row, setpoints, warm
-from hil import fit_ahead, retentive
+from hil import fit_ahead, retentive, servo_relays
 from hil.drive_homing import home_axes
 from hil.mlc_bridge import drive_status
 from hil import stretch_ahead
@@ -138,6 +138,9 @@ class BenchRunner:
         self._seen_alarms: set[int] = set()
         self._planner_failed = False
         self._braking = False  # every drive was told its quick stop (E-stop, failed planner)
+        # axes the MLC's servo relays hold OFF (bit i; servo_relays.RESYNC: a re-enable whose position the NC is
+        # still to take), M22-1
+        self._servo_off = 0
         self._winding_down = False  # the run is over; the stop path brings everything to rest
         self._bus_closed = False
         self.stop_request: str | None = None  # a signal's name (hil/stop_signals.py): stop, then end
@@ -452,7 +455,9 @@ class BenchRunner:
         if hooks is None or hooks[0] is not self.link or hooks[1] is not self.mlc:  # what they offer, asked once
             hooks = self._hooks = (self.link, self.mlc, callable(getattr(self.link, "status", None)),
                                    hasattr(self.mlc, "bus_feedback"), hasattr(self.mlc, "bus_status"),
-                                   callable(getattr(self.mlc, "spindle_drive", None)))
+                                   callable(getattr(self.mlc, "spindle_drive", None)),
+                                   getattr(self.mlc, "link", None) if hasattr(getattr(self.mlc, "link", None),
+                                                                              "servo_off") else None)
         if ch is not None:
             # The link's state is read once per cycle: the drive status and the bus relays share it.
             status = self.link.status() if hooks[2] else None
@@ -463,9 +468,13 @@ class BenchRunner:
             self.mlc.scan(ch)
             self._skip_probe(ch)
             sp = ch.step() if step is None else step(ch)
+            relays = hooks[6]
+            last = self._commands.tolist() if relays is not None and (relays.servo_off or self._servo_off) else None
             self._commands[:] = sp.positions  # type: ignore[attr-defined]
             if not self._winding_down:
                 self.line = sp.line or self.line  # type: ignore[attr-defined]
+            if last is not None:
+                servo_relays.obey(self, ch, relays, last)  # the MLC's servo relays (decision M22-1)
             if ch.emergency and not self._braking:
                 self._begin_quick_stop()  # E-stop: stop category 1, the drives brake on their own ramp
             elif self._braking and not ch.emergency and not self._planner_failed:
@@ -564,8 +573,9 @@ class BenchRunner:
             return
         ch.planner.reset_position(dict(zip(self.axes, self.actual.tolist())))
         self._braking = False
-        for m in self.masters:
-            m.request(Target.ENABLED)
+        for i, m in enumerate(self.masters):
+            if not self._servo_off >> i & 1:  # an axis the MLC holds servo OFF stays off (M22-1)
+                m.request(Target.ENABLED)
 
     def _quick_stop(self) -> None:
         """The planner itself failed: leave it alone and command every drive's quick stop; _shutdown

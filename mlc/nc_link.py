@@ -62,6 +62,12 @@ class ChannelLink:
     _var_plan: tuple | None = None  # (exchange, legacy, ((lo, kind, first, count), …)): fixed per exchange
     _drive_split: tuple | None = None  # (drives list, its length, axes + spindles (32 at most), spindles (8 at most)): mlc/drive_status.py
     _cmd_levels: bytes | None = None  # M2x000…M2x019 of the last cycle whose edges fired nothing
+    # the servo relays (decision M22-1), obeyed by the runner (hil/servo_relays.py): bit i = axis i asked OFF, by
+    # M2x012 OFF (`servo_all`) or its M2x272+i; M2x007 Disable Hardware Limit (`hw_limit_off`, decision M22-2)
+    servo_off: int = 0
+    servo_all: bool = False
+    hw_limit_off: bool = False
+    _servo_levels: bytes | None = None  # M2x272… of the channel's axes as last read
     _spindle_levels: bytes = bytes(8)  # M2x711, M2x727, … as the last scan saw them (== their `_prev`)
     _program_end: int | None = None
     _mode_switch_cycles: int = 0
@@ -123,6 +129,12 @@ class ChannelLink:
                     ch.interrupt()  # M2x019: M96 program interruption (nc.interrupt)
             # kept only when no handler ran in between: then `_prev` holds exactly these levels
             self._cmd_levels = None if fired else bytes(levels)
+            self.servo_all, self.hw_limit_off = not levels[12], bool(levels[7])
+            self._servo_levels = None
+        per_axis = m[b2 + 272:b2 + 272 + len(self.axes)]  # M2x272+i: one slice compare per scan
+        if per_axis != self._servo_levels:
+            self._servo_levels = bytes(per_axis)
+            self.servo_off = sum(1 << i for i, on in enumerate(per_axis) if on or self.servo_all)
         self._overrides(ch)
         self._spindle_alarm(ch)
         self._user_alarms(ch)

@@ -1,0 +1,61 @@
+"""The MLC's servo relays obeyed by the bench's drive control (decision M22-1): M2x012 "Servo ON/OFF" (OFF: every
+axis of the channel) and M2x272+i "Servo OFF" of the channel's i-th axis (App. B.2.1.1 / B.2.1.8).
+
+An axis asked OFF is disabled through its CiA 402 master (shutdown: operation enabled → ready to switch on), the
+same on the simulated, EtherCAT and CANopen buses, but only where it stands: the NC never drops the torque of a
+moving axis. If the NC moves it (a program or an MDI block still commands it) the channel raises App. A 0x0A07
+"Servo is not ready" and stops along the path, jerk-limited (the project's one stop path); the drive is disabled
+once the axis stands. Asked ON again, the drive is enabled where the axis stands and the NC takes that position.
+
+The runner calls `obey` only while a relay asks an axis OFF or one just went back ON (`BenchRunner._servo_off`,
+one int compare per cycle otherwise); a stretch never starts meanwhile (hil/stretch.py `_quiet`)."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from fieldbus.cia402 import Target
+from nc.alarms import Alarm
+from nc.channel import RunState
+
+SERVO_NOT_READY = 0x0A07  # App. A: "Servo is not ready. The axis is not servo ON."
+RESYNC = 40  # BenchRunner._servo_off bit RESYNC + i: axis i back ON, its position for the NC still to take
+_STOPPED = (RunState.STOPPING, RunState.ALARM, RunState.RESETTING)
+
+
+def obey(r: Any, ch: Any, link: Any, last_cmds: list[float]) -> None:
+    """One cycle of the relays' effect: `link.servo_off` bit i = the MLC asks axis i OFF (`link.servo_all`: by
+    M2x012); `last_cmds` the axes' commands of the cycle before (an axis whose command changed, the NC moves)."""
+    prev, want = r._servo_off, link.servo_off
+    cmds = r._commands.tolist()
+    for i, m in enumerate(r.masters[: len(r.axes)]):
+        bit = 1 << i
+        if want & bit:
+            moving = cmds[i] != last_cmds[i]
+            if moving and ch.state not in _STOPPED:
+                # the NC moves an axis the MLC turned off: controlled stop along the path, then disabled
+                relay = f"M2{link.x}012 OFF" if link.servo_all else f"M2{link.x}{272 + i} ON"
+                r._alarm(Alarm(SERVO_NOT_READY, f"servo is not ready: axis {r._name(i)} was turned servo OFF "
+                                                f"({relay}) while the NC moves it", line=r.line or None,
+                               axis=r._name(i)))
+            if m.target is Target.ENABLED and not moving and r._at_rest(i) and not r._braking:
+                m.request(Target.DISABLED)  # standing, its command too: shutdown (CiA 402 ready to switch on)
+        elif prev & bit and not r._braking and not r._winding_down and m.target is Target.DISABLED:
+            m.request(Target.ENABLED)  # back ON: enabled where it stands
+            prev |= bit << RESYNC
+    resync = prev >> RESYNC
+    if resync:
+        # once enabled: a standing NC takes the axis's actual position (a command the NC ran on before the 0x0A07
+        # stop is dropped; nothing held the axis while off). A running one never moved it while it was off.
+        pos = dict(zip(ch.planner.axes, ch.planner.position.tolist()))
+        took = False
+        for i, m in enumerate(r.masters[: len(r.axes)]):
+            if resync >> i & 1 and (m.enabled or m.target is not Target.ENABLED):
+                prev &= ~(1 << (RESYNC + i))
+                if m.enabled and ch.planner.idle:
+                    pos[r.axes[i]] = float(r.actual[i])
+                    r._commands[i] = r.actual[i]
+                    took = True
+        if took:
+            ch.planner.reset_position(pos)
+    r._servo_off = want | (prev >> RESYNC << RESYNC)
