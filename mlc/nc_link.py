@@ -63,10 +63,9 @@ class ChannelLink:
     _drive_split: tuple | None = None  # (drives list, its length, axes + spindles (32 at most), spindles (8 at most)): mlc/drive_status.py
     _cmd_levels: bytes | None = None  # M2x000…M2x019 of the last cycle whose edges fired nothing
     # the servo relays (decision M22-1), obeyed by the runner (hil/servo_relays.py): bit i = axis i asked OFF, by
-    # M2x012 OFF (`servo_all`) or its M2x272+i; M2x007 Disable Hardware Limit (`hw_limit_off`, decision M22-2)
+    # M2x012 OFF (`servo_all`) or its M2x272+i
     servo_off: int = 0
     servo_all: bool = False
-    hw_limit_off: bool = False
     _servo_levels: bytes | None = None  # M2x272… of the channel's axes as last read
     _spindle_levels: bytes = bytes(8)  # M2x711, M2x727, … as the last scan saw them (== their `_prev`)
     _program_end: int | None = None
@@ -129,8 +128,8 @@ class ChannelLink:
                     ch.interrupt()  # M2x019: M96 program interruption (nc.interrupt)
             # kept only when no handler ran in between: then `_prev` holds exactly these levels
             self._cmd_levels = None if fired else bytes(levels)
-            self.servo_all, self.hw_limit_off = not levels[12], bool(levels[7])
-            self._servo_levels = None
+            if self.servo_all is bool(levels[12]):  # M2x012 changed: the mask below is worked out again
+                self.servo_all, self._servo_levels = not levels[12], None
         per_axis = m[b2 + 272:b2 + 272 + len(self.axes)]  # M2x272+i: one slice compare per scan
         if per_axis != self._servo_levels:
             self._servo_levels = bytes(per_axis)
@@ -209,6 +208,7 @@ class ChannelLink:
             self._set3(37, False)
             self._set3(38, False)
             self._complete(ch, aux)
+            ch.released_by_cycle_start()
             return
         aux = ch.pending_aux
         if aux is not None and aux is not self._last_done and aux.kind == "M" \
@@ -216,6 +216,7 @@ class ChannelLink:
             # the NC holds at M00/M01 since its last step; this scan's outputs would publish M3x037/M3x038.
             # A press in this very scan releases it too, as the NC itself is on hold (decision bench B56)
             self._complete(ch, aux)
+            ch.released_by_cycle_start()
             return
         ch.cycle_start()  # starts, resumes after feed hold, or runs the next single block
 

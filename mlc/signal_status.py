@@ -22,8 +22,8 @@ FEED_HOLD | bench | mlc/nc_link.py | rising edge; also stops manual motion in th
 NC_RESET | bench | mlc/nc_link.py | rising edge; flushes the program and the handshake, M3x019 when the axes stand
 DRY_RUN | bench | mlc/nc_link.py | level; cutting moves at the channel's dry-run feed × feed override
 MPG_SIMULATION | absent | - | MPG-paced program run not emulated
-DISABLE_HW_LIMIT | absent | - | the limit switches (0x60FD) always stop the axis (decision M21-5)
-SINGLE_BLOCK | partial | mlc/nc_link.py | level; stops after motion blocks only, not after an M/S/T-only block (decision M21-6)
+DISABLE_HW_LIMIT | absent | - | the limit switches (0x60FD) always stop the axis (decisions M21-5, M22-3)
+SINGLE_BLOCK | bench | nc/channel.py | level; stops after every block, an M/S/T-only one after its handshake (decision M22-2)
 OPTIONAL_STOP | bench | mlc/nc_link.py | level; M01 holds with M3x038 only while ON
 BLOCK_SKIP | bench | mlc/nc_link.py | level; '/' blocks read after the scan that saw it are skipped (decision M21-1)
 MST_LOCK | bench | mlc/nc_link.py | level; no strobe, the block's motion runs (H9)
@@ -234,7 +234,7 @@ TESTS: dict[str, tuple[str, ...]] = {
     'CYCLE_START': ('mlc_memory', 'run_stops_and_holds'),
     'FEED_HOLD': ('hil_run_events', 'mlc_exchange_edges', 'mlc_manual'),
     'NC_RESET': ('mlc_manual', 'run_stops_and_holds'),
-    'SINGLE_BLOCK': ('mlc21_program_switches',),
+    'SINGLE_BLOCK': ('mlc21_program_switches', 'mlc22_single_block'),
     'SERVO_ON': ('mlc22_servo_relays',),
     'SERVO_OFF': ('mlc22_servo_relays',),
     'OPTIONAL_STOP': ('formats_lathe_guide', 'run_stops_and_holds'),

@@ -74,6 +74,12 @@ class Channel:
     # forced to 100 % while a thread runs or waits in the look-ahead (`spindle_factor`, decisions 32)
     spindle_override: float = 1.0
     _block_moves: int = 0  # moves pushed since the last single-block stop
+    # single block after an M/S/T-only block (decision M22-2): the line of the code issued since the last stop
+    # (None: none), the event read after its handshake that begins the next block (held for the next cycle
+    # start), and the line the channel last stopped after (a code on a motion block's line is that block's tail)
+    _aux_line: int | None = None
+    _next_ev: Event | None = None
+    _stop_line: int = -1
     soft_limits: SoftLimits | None = None  # checked before a move reaches the planner (issue 8)
     _limit_alarm: Alarm | None = None  # raised once the moves before the offending one have run out
     # G31 skip (issue 5): the runner feeds the probe latch through skip(); on_skip(latched, stop)
@@ -100,6 +106,7 @@ class Channel:
         self.end = None
         self.state = RunState.IDLE
         self._interrupt, self._m96_running = None, False
+        self._aux_line, self._next_ev, self._stop_line, self._block_moves = None, None, -1, 0
 
     def cycle_start(self) -> None:
         """Start the loaded program, resume after a feed hold, or run the next single block."""
@@ -110,6 +117,7 @@ class Channel:
             self.state = RunState.RUNNING if self.pending_aux is None else RunState.WAIT_AUX
         elif self.state is RunState.BLOCK_STOP:
             self._block_moves = 0
+            self._aux_line = None
             self.state = RunState.RUNNING
 
     @property
@@ -159,6 +167,7 @@ class Channel:
         self._interrupt, self._m96_running = None, False  # a reset ends an interrupt program too
         self.events = None
         self._fed = False
+        self._aux_line, self._next_ev, self._block_moves = None, None, 0
         self.state = RunState.RESETTING if not self.planner.idle else RunState.IDLE
 
     # ---- MLC side ---------------------------------------------------------------------
@@ -168,6 +177,11 @@ class Channel:
             self.pending_aux = None
             if self.state is RunState.WAIT_AUX:
                 self.state = RunState.RUNNING
+
+    def released_by_cycle_start(self) -> None:
+        """The pending code's hold (M00, M01) ended with a cycle start: under single block that press was the
+        block's stop, the next block runs on without another (decision M22-2)."""
+        self._aux_line = None
 
     # ---- G31 skip -----------------------------------------------------------------------
     @property
@@ -289,8 +303,11 @@ class Channel:
             self.state = RunState.ALARM
         if self.state is RunState.RESETTING and self.planner.idle:
             self.state = RunState.IDLE
-        if self.state is RunState.RUNNING and self.single_block and self._block_moves and self.planner.idle:
+        if self.state is RunState.RUNNING and self.single_block and self.planner.idle \
+                and (self._block_moves or self._next_ev is not None):
             self.state = RunState.BLOCK_STOP
+            # a motion block's stop: a code on its line still belongs to it (`G01 X10 M08`, M22-2)
+            self._stop_line = self.planner.line if self._block_moves else -1
         if self.state is RunState.RUNNING and self.planner.idle and self.end is not None \
                 and self.pending_aux is None:
             self.state = RunState.FINISHED
@@ -340,20 +357,31 @@ class Channel:
             if self.single_block and self._block_moves:
                 pl.release_run()  # nothing more is read: a run held back runs now (nc.motion.spline_feed)
                 return
-            if reads == 0:
+            if self._next_ev is not None:  # the block after a single-block stop at an M/S/T-only block
+                if self.single_block and self._aux_line is not None:
+                    return
+                ev, self._next_ev = self._next_ev, None
+                self._aux_line = None
+            elif reads == 0:
                 return  # the rest next cycle
-            try:
-                ev = next(self.events)  # type: ignore[arg-type]
-            except StopIteration:
-                self.end = ProgramEnd(0, "", 0)
-                pl.closed = True
-                return
-            except NcAlarm as exc:
-                self.raise_alarm(exc.alarm)
-                return
-            except Exception as exc:  # a bug must still stop the machine with an alarm
-                self.raise_alarm(internal_error(exc))
-                return
+            else:
+                try:
+                    ev = next(self.events)  # type: ignore[arg-type]
+                except StopIteration:
+                    self.end = ProgramEnd(0, "", 0)
+                    pl.closed = True
+                    return
+                except NcAlarm as exc:
+                    self.raise_alarm(exc.alarm)
+                    return
+                except Exception as exc:  # a bug must still stop the machine with an alarm
+                    self.raise_alarm(internal_error(exc))
+                    return
+                if self._aux_line is not None and self.single_block and getattr(ev, "line", None) != self._aux_line:
+                    # an M/S/T-only block has run, its handshake finished: stop before the next block (M22-2);
+                    # a code on the same line (`M03 S1000`) is the same block and is read on
+                    self._next_ev = ev
+                    return
             if isinstance(ev, Busy):
                 if len(pl.blocks) < 2:
                     pl.release_run()  # the queue runs dry while the interpreter works: what is held runs
@@ -451,6 +479,11 @@ class Channel:
         if aux.kind == "S" and not aux.args.get("max"):
             self.spindle_rpm = aux.value
         self.pending_aux = aux
+        if self.single_block:
+            if aux.line == self._stop_line:
+                self._stop_line = -1  # the tail of the motion block the channel stopped after
+            else:
+                self._aux_line = aux.line  # stop once its handshake is done and the next block is read (M22-2)
         if aux.wait and aux.line:
             # an M/S/T block is the current block while the NC waits on it (its MLC finish, an M00 hold): the
             # trace's line and `--at line=N` name it, until the next block starts (decisions bench B56, B79)

@@ -30,20 +30,22 @@ def _run(hil, tmp_path, signals: str, *at: str):
     return r, list(csv.DictReader(trace.open()))
 
 
-def test_single_block_stops_after_each_motion_block_until_cycle_start(hil, tmp_path):
+def test_single_block_stops_after_each_block_until_cycle_start(hil, tmp_path):
+    # Revised by decision M22-2 (it pinned M21-6's stop after motion blocks only): the M08-only line 2 is a block
+    # too, so the channel now stops after lines 1, 2 (its handshake finished first) and 3.
     r, rows = _run(hil, tmp_path, "M31024,M31039,M31016", "cycle=1:set M21008=1", "t=1.0:cycle-start",
-                   "t=2.0:cycle-start")
+                   "t=2.0:cycle-start", "t=3.0:cycle-start")
     assert "result         completed" in r.out
     stops = [(t, line) for t, line, hold, done, run in _changes(rows, ("M31024", "M31039", "M31016"))
              if hold == "1"]
-    # stopped after line 1 (X40) and after line 3 (Z90); M3x024 and M3x039 together, "running" OFF meanwhile
-    assert [line for _, line in stops] == [1, 3]
+    # stopped after line 1 (X40), line 2 (M08) and line 3 (Z90); M3x024 and M3x039 together, "running" OFF meanwhile
+    assert [line for _, line in stops] == [1, 2, 3]
     for r_ in rows:
         if r_["M31024"] == "1":
             assert r_["M31039"] == "1" and r_["M31016"] == "0"
-    # each stop lasts until the cycle start of the panel (1.0 s, 2.0 s): the next block starts in that scan
+    # each stop lasts until the cycle start of the panel (1.0 s, 2.0 s, 3.0 s): the next block starts in that scan
     ends = [float(r_["t"]) for a, r_ in zip(rows, rows[1:]) if a["M31024"] == "1" and r_["M31024"] == "0"]
-    assert [round(t, 3) for t in ends] == [1.0, 2.0]
+    assert [round(t, 3) for t in ends] == [1.0, 2.0, 3.0]
 
 
 def test_mst_lock_hands_no_code_to_the_mlc_and_the_motion_runs(hil, tmp_path):
