@@ -48,21 +48,22 @@ finite = st.floats(min_value=-1e7, max_value=1e7, allow_nan=False, allow_infinit
 @settings(max_examples=300, deadline=None)
 @given(n=st.integers(1, 8), prev=finite, span=st.floats(-5e4, 5e4), kff=st.floats(0.0, 1.0),
        kp=st.floats(0.0, 2000.0), pos=finite, vel=st.floats(-1e6, 1e6), max_cps=st.floats(1e3, 1e6),
-       bw=st.floats(10.0, 5000.0))
-def test_csp_substeps_compiled_equal_their_source(n, prev, span, kff, kp, pos, vel, max_cps, bw):
+       bw=st.floats(10.0, 5000.0), limited=st.booleans(), lo=finite)
+def test_csp_substeps_compiled_equal_their_source(n, prev, span, kff, kp, pos, vel, max_cps, bw, limited, lo):
     h = 0.001 / n
     alpha = 1.0 - math.exp(-bw * h)
-    args = (n, h, prev, span, kff * span / 0.001, kp, pos, vel, 12.5, max_cps, alpha)
+    args = (n, h, prev, span, kff * span / 0.001, kp, pos, vel, 12.5, max_cps, alpha, limited, lo, lo + 5e4)
     assert _bits(BUILT.csp_substeps(*args)) == _bits(PY.csp_substeps(*args))
 
 
 @needs_build
 @settings(max_examples=300, deadline=None)
 @given(n=st.integers(1, 8), ramp=st.floats(0.0, 5e4), want=st.floats(-1e6, 1e6), tv=st.floats(-1e6, 1e6),
-       pos=finite, vel=st.floats(-1e6, 1e6), max_cps=st.floats(1e3, 1e6), bw=st.floats(10.0, 5000.0))
-def test_csv_substeps_compiled_equal_their_source(n, ramp, want, tv, pos, vel, max_cps, bw):
+       pos=finite, vel=st.floats(-1e6, 1e6), max_cps=st.floats(1e3, 1e6), bw=st.floats(10.0, 5000.0),
+       every=st.sampled_from([0, 4096, 1280000]))
+def test_csv_substeps_compiled_equal_their_source(n, ramp, want, tv, pos, vel, max_cps, bw, every):
     h = 0.001 / n
-    args = (n, h, ramp, want, tv, pos, vel, 3.0, max_cps, 1.0 - math.exp(-bw * h))
+    args = (n, h, ramp, want, tv, pos, vel, 3.0, max_cps, 1.0 - math.exp(-bw * h), every)
     assert _bits(BUILT.csv_substeps(*args)) == _bits(PY.csv_substeps(*args))
 
 

@@ -286,9 +286,10 @@ class Cia402Drive:
         latch = probing and not self._probe_latched
         if not latch:  # the usual cycle: the kernel's sub-steps (virtual_bus/drive_kernel.py, compiled)
             if csp:
-                cmd, pos, vel, t = drive_kernel.csp_substeps(n, h, prev, span, kff_ff, kp, pos, vel, t, max_cps, alpha)
+                cmd, pos, vel, t, _ = drive_kernel.csp_substeps(n, h, prev, span, kff_ff, kp, pos, vel, t, max_cps,
+                                                                alpha, False, 0.0, 0.0)
             else:
-                cmd, pos, vel, t, tv = drive_kernel.csv_substeps(n, h, ramp, want, tv, pos, vel, t, max_cps, alpha)
+                cmd, pos, vel, t, tv, _ = drive_kernel.csv_substeps(n, h, ramp, want, tv, pos, vel, t, max_cps, alpha, 0)
         else:
             for k in range(1, n + 1):  # the same sub-steps, the encoder index's edge tested on each
                 if csp:

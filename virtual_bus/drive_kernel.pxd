@@ -6,20 +6,20 @@ cimport cython
 cdef long SW_TARGET_REACHED
 cdef long RAW_MAX
 
-@cython.locals(k=int, cmd=double, v_cmd=double, neg=double)
+@cython.locals(k=int, cmd=double, v_cmd=double, neg=double, inside=bint)
 cpdef tuple csp_substeps(int n, double h, double prev, double span, double kff_ff, double kp, double pos,
-                         double vel, double t, double max_cps, double alpha)
+                         double vel, double t, double max_cps, double alpha, bint limited, double lo, double hi)
 
-@cython.locals(_k=int, cmd=double, v_cmd=double, neg=double)
+@cython.locals(_k=int, cmd=double, v_cmd=double, neg=double, edge=bint, new_pos=double)
 cpdef tuple csv_substeps(int n, double h, double ramp, double want, double tv, double pos, double vel, double t,
-                         double max_cps, double alpha)
+                         double max_cps, double alpha, long every)
 
 @cython.locals(n=int, h=double, max_cps=double, alpha=double, rad=double, reached_v=double, kp=double, kff=double,
                window=double, origin=double, k_raw=double, t_pct=double, inertia=double, viscous=double,
                coulomb=double, rated=double, lo=double, hi=double, base=long, dt=double, limited=bint,
-               pos=double, vel=double, t=double, command=double, acc=double, torque=double, neg=double, over=double,
+               pos=double, vel=double, t=double, command=double, acc=double, torque=double, over=double,
                ok=bint, rep=Py_ssize_t, target=double, prev=double, ff_vel=double, kff_ff=double, span=double,
-               c_pos=double, c_vel=double, c_t=double, cmd=double, inside=bint, k=int, v_cmd=double, c_acc=double,
+               c_pos=double, c_vel=double, c_t=double, cmd=double, inside=bint, c_acc=double,
                gap=double, moved=bint, pa=list, va=list, ta=list, fe=list, sws=list)
 cpdef tuple csp_cycles(object targets, tuple consts, tuple state, object still, object out)
 
@@ -28,7 +28,7 @@ cpdef tuple csp_cycles(object targets, tuple consts, tuple state, object still, 
                coulomb=double, rated=double, base=long, dt=double, pos=double, vel=double, t=double,
                command=double, tv=double, acc=double, torque=double, neg=double, over=double, ok=bint,
                c=Py_ssize_t, v_cmd=double, c_acc=double, c_torque=double, done=Py_ssize_t, c_pos=double,
-               c_vel=double, c_t=double, c_tv=double, cmd=double, edge=bint, _k=int, new_pos=double, moved=bint,
+               c_vel=double, c_t=double, c_tv=double, cmd=double, edge=bint, moved=bint,
                pa=list, va=list, ta=list, sws=list)
 cpdef tuple csv_cycles(Py_ssize_t cycles, tuple consts, tuple state, bint still, object out)
 

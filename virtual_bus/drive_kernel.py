@@ -25,11 +25,14 @@ RAW_MAX = 0x7FFFFFFF  # 0x606C is an s32
 
 
 def csp_substeps(n: int, h: float, prev: float, span: float, kff_ff: float, kp: float, pos: float, vel: float,
-                 t: float, max_cps: float, alpha: float) -> tuple[float, float, float, float]:
+                 t: float, max_cps: float, alpha: float, limited: bool, lo: float, hi: float
+                 ) -> tuple[float, float, float, float, bool]:
     """One CSP cycle's n sub-steps: the interpolated command, the position loop, the velocity loop; returns
-    (command, position, velocity, time)."""
+    (command, position, velocity, time, whether every sub-step stayed inside the limit switches' range (lo, hi),
+    tested only when `limited`: Cia402Drive._step_general's test))."""
     neg = -max_cps
     cmd = prev
+    inside = True
     for k in range(1, n + 1):
         cmd = prev + span * k / n
         v_cmd = kff_ff + kp * (cmd - pos)
@@ -38,16 +41,20 @@ def csp_substeps(n: int, h: float, prev: float, span: float, kff_ff: float, kp: 
         if v_cmd != vel:
             vel += (v_cmd - vel) * alpha
         pos = pos + vel * h
+        if limited and not lo < pos < hi:
+            inside = False
         t += h
-    return cmd, pos, vel, t
+    return cmd, pos, vel, t, inside
 
 
 def csv_substeps(n: int, h: float, ramp: float, want: float, tv: float, pos: float, vel: float, t: float,
-                 max_cps: float, alpha: float) -> tuple[float, float, float, float, float]:
+                 max_cps: float, alpha: float, every: int) -> tuple[float, float, float, float, float, bool]:
     """One CSV cycle's n sub-steps: the ramp towards 0x60FF, the velocity loop; the command follows the actual
-    position. Returns (command, position, velocity, time, ramped target velocity)."""
+    position. Returns (command, position, velocity, time, ramped target velocity, whether a sub-step passed an
+    encoder index edge, tested only when `every` (counts between index pulses) is not 0: Cia402Drive._probe)."""
     neg = -max_cps
     cmd = pos
+    edge = False
     for _k in range(n):
         tv += max(-ramp, min(ramp, want - tv))
         v_cmd = tv
@@ -56,9 +63,12 @@ def csv_substeps(n: int, h: float, ramp: float, want: float, tv: float, pos: flo
             v_cmd = max(neg, min(max_cps, v_cmd))
         if v_cmd != vel:
             vel += (v_cmd - vel) * alpha
-        pos = pos + vel * h
+        new_pos = pos + vel * h
+        if every and math.floor(pos / every) != math.floor(new_pos / every):
+            edge = True
+        pos = new_pos
         t += h
-    return cmd, pos, vel, t, tv
+    return cmd, pos, vel, t, tv, edge
 
 
 def csp_cycles(targets: Sequence[int], consts: tuple, state: tuple, still: object, out: object
@@ -71,7 +81,7 @@ def csp_cycles(targets: Sequence[int], consts: tuple, state: tuple, still: objec
     pos, vel, t, command, prev_target, acc, torque = state
     pa, va, ta, fe, sws = out.position_actual, out.velocity_actual, out.torque_actual, out.following_error, \
         out.statusword
-    neg, over = -max_cps, 1.2 * max_cps
+    over = 1.2 * max_cps
     ok = True
     rep = 0  # still cycles not written yet: a run of them is written at once (repeat)
     for tgt in targets:
@@ -86,19 +96,8 @@ def csp_cycles(targets: Sequence[int], consts: tuple, state: tuple, still: objec
         ff_vel = (target - prev) / dt
         kff_ff = kff * ff_vel
         span = target - prev
-        c_pos, c_vel, c_t, cmd = pos, vel, t, command
-        inside = True
-        for k in range(1, n + 1):  # csp_substeps, with the limit switches' test (Cia402Drive._step_general)
-            cmd = prev + span * k / n
-            v_cmd = kff_ff + kp * (cmd - c_pos)
-            if not neg <= v_cmd <= max_cps:
-                v_cmd = max(neg, min(max_cps, v_cmd))
-            if v_cmd != c_vel:
-                c_vel += (v_cmd - c_vel) * alpha
-            c_pos = c_pos + c_vel * h
-            if limited and not lo < c_pos < hi:
-                inside = False
-            c_t += h
+        cmd, c_pos, c_vel, c_t, inside = csp_substeps(n, h, prev, span, kff_ff, kp, pos, vel, t, max_cps, alpha,
+                                                      limited, lo, hi)
         if not inside or abs(cmd - c_pos) > window or abs(c_vel) > over:
             ok = False
             break
@@ -156,21 +155,7 @@ def csv_cycles(cycles: int, consts: tuple, state: tuple, still: bool, out: objec
                 if c == cycles:
                     break
         c += 1
-        c_pos, c_vel, c_t, c_tv, cmd = pos, vel, t, tv, command
-        edge = False
-        for _k in range(n):  # csv_substeps, with the encoder index's edge test (Cia402Drive._probe)
-            c_tv += max(-ramp, min(ramp, want - c_tv))
-            v_cmd = c_tv
-            cmd = c_pos
-            if not neg <= v_cmd <= max_cps:
-                v_cmd = max(neg, min(max_cps, v_cmd))
-            if v_cmd != c_vel:
-                c_vel += (v_cmd - c_vel) * alpha
-            new_pos = c_pos + c_vel * h
-            if every and math.floor(c_pos / every) != math.floor(new_pos / every):
-                edge = True
-            c_pos = new_pos
-            c_t += h
+        cmd, c_pos, c_vel, c_t, c_tv, edge = csv_substeps(n, h, ramp, want, tv, pos, vel, t, max_cps, alpha, every)
         if edge or abs(c_vel) > over:
             ok = False
             break  # the index latches in this cycle, or overspeed: exchange() takes it
