@@ -1,10 +1,13 @@
-"""Compiles virtual_bus/drive_kernel.py with Cython where a C compiler is at hand (issue 17); pyproject.toml holds
-the rest of the build. The extension is optional: without a compiler (or without Cython, in a build without
-isolation) the install goes on and the same module runs as Python (virtual_bus/kernels.py says which runs)."""
+"""Compiles with Cython, where a C compiler is at hand (issue 17): virtual_bus/drive_kernel.py (the simulated drive's
+arithmetic, B113) and the planner's hot modules (B115); pyproject.toml holds the rest of the build. The extensions are
+optional: without a compiler (or without Cython, in a build without isolation) the install goes on and the same
+modules run as Python (virtual_bus/kernels.py and nc/motion/compiled.py say which runs)."""
 
 from setuptools import Extension, setup
 
-KERNELS = ["virtual_bus/drive_kernel.py"]
+# The planner's hot modules (decision bench B115): one unit, nc/motion/compiled.py's MODULES, in the same order.
+PLANNER = ["block", "blending", "lookahead", "shares"]
+KERNELS = ["virtual_bus/drive_kernel.py"] + [f"nc/motion/{name}.py" for name in PLANNER]
 
 
 def _extensions() -> list[Extension]:

@@ -31,7 +31,7 @@ import numpy as np
 
 from benchmarks.bench_vs_linuxcnc import BENCH, START, Program, cam_polyline, cam_surface, measure
 from hil.bench_file import load_bench_file
-from nc.motion.lookahead import Block
+from nc.motion.block import Block
 from nc.motion.offline import Stream, run
 from nc.motion.planner import Planner
 from nc.motion.spline_runs import LAM, Cost, FitError, fit_run, polyline_distance, span_limits, spans

@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 
 import nc.motion.blending as blending
+import nc.motion.lookahead as lookahead
 from benchmarks.bench_motion import cam_program
 from hil.bench_file import load_bench_file
 from nc.interp import Interpreter
@@ -25,23 +26,24 @@ def _run(trim: int) -> tuple[np.ndarray, int, int, int]:
     cfg = load_bench_file(BENCH).motion_config()
     events = Interpreter(make_profile("nc5-mill", ("X", "Y", "Z"))).run(
         parse_program(cam_program(5000), name="cam.nc"))
-    window = blending.FilterCorners.window
     seen = {"held": 0, "drop": 0, "bulk": 0}
 
-    def watched(fc, blocks):
-        seq0 = fc._seq0
-        out = window(fc, blocks)
-        seen["held"] = max(seen["held"], len(fc._hist))
-        seen["drop"] = max(seen["drop"], fc._seq0 - seq0)
-        seen["bulk"] = max(seen["bulk"], fc._seq_v)
-        return out
+    # A subclass the look-ahead makes instead (the compiled FilterCorners' methods cannot be replaced, B115)
+    class Watched(blending.FilterCorners):
+        def window(self, blocks):
+            seq0 = self._seq0
+            out = super().window(blocks)
+            seen["held"] = max(seen["held"], len(self._hist))
+            seen["drop"] = max(seen["drop"], self._seq0 - seq0)
+            seen["bulk"] = max(seen["bulk"], self._seq_v)
+            return out
 
     old = blending.TRIM
-    blending.TRIM, blending.FilterCorners.window = trim, watched
+    blending.TRIM, lookahead.FilterCorners = trim, Watched
     try:
         st = run(events, cfg, {"X": 0.0, "Y": 0.0, "Z": 100.0})
     finally:
-        blending.TRIM, blending.FilterCorners.window = old, window
+        blending.TRIM, lookahead.FilterCorners = old, blending.FilterCorners
     assert not st.alarms
     return st.positions, seen["held"], seen["drop"], seen["bulk"]
 

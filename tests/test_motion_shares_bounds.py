@@ -11,7 +11,7 @@ import numpy as np
 
 from hil.bench_file import load_bench_file
 from nc.motion.blending import FilterCorners
-from nc.motion.lookahead import Block
+from nc.motion.block import Block
 from nc.motion.shares import RATIO_BOUND, _tolerance_free
 from nc.moves import Move
 

@@ -1,5 +1,6 @@
 """Motion: path geometry, jerk-limited profiles along the path (ruckig, 1 DoF), per-cycle setpoints."""
 
+import nc.motion.compiled  # noqa: F401  (first: it decides whether the planner's builds or sources load, B115)
 from nc.motion.limits import AxisLimits, MotionConfig
 
 

@@ -27,9 +27,13 @@ import math
 from collections import deque
 from itertools import islice
 from collections.abc import Sequence
-from typing import TYPE_CHECKING
 
 import numpy as np
+
+try:
+    import cython  # compiled: the types below (setup.py, decision bench B115)
+except ImportError:  # run as Python without Cython: they do nothing
+    from nc.motion import cython_shadow as cython
 
 from nc.motion.deviation import KernelDeviation
 from nc.motion.limits import MotionConfig
@@ -41,8 +45,7 @@ USAGE_SCALE = 4.0  # below this many times the top speed a junction's budget use
 TRIM = 32
 BULK = 4096
 
-if TYPE_CHECKING:
-    from nc.motion.lookahead import Block
+from nc.motion.block import Block
 
 
 
@@ -138,6 +141,7 @@ class FilterCorners:
                 v = min(v, ba / d, bj / d)
         return v
 
+    @cython.locals(v=cython.double, d=cython.double, x=cython.double, du_n=cython.double, acc=cython.double, room=cython.double, lines=cython.bint)
     def corner_caps(self, du: Sequence[float], du_n: float, lines: bool, acc: float) -> tuple[float, float]:
         """(corner_budget(du, lines), corner_tolerance(du_n, acc)): one call a pushed junction, 3 axes spelt out
         (issue 17; min(a, b) / d is min(a / d, b / d) exactly, so `_bmin` serves for the two budgets)."""
@@ -217,6 +221,16 @@ class FilterCorners:
             return math.inf  # no filter: nothing shrinks
         return math.sqrt(24.0 * self.tol * radius / self._arc_k)
 
+    @cython.locals(j_new=Block, tail=Block, b=Block, h0=cython.Py_ssize_t, last=cython.Py_ssize_t,
+                   m=cython.Py_ssize_t, m0=cython.Py_ssize_t, k=cython.Py_ssize_t, idx=cython.Py_ssize_t,
+                   seq=cython.Py_ssize_t, seq_m=cython.Py_ssize_t, seq0=cython.Py_ssize_t, cut=cython.Py_ssize_t,
+                   lo_q=cython.Py_ssize_t, stop=cython.Py_ssize_t, mono=cython.Py_ssize_t, lim=cython.Py_ssize_t,
+                   depth=cython.Py_ssize_t, axes=cython.Py_ssize_t, s_j=cython.double, span_max=cython.double,
+                   t_w=cython.double, top=cython.double, t_w2=cython.double, pad=cython.double,
+                   two_al=cython.double, v_hi=cython.double, c=cython.double, c_bud=cython.double,
+                   c2=cython.double, inf=cython.double, bm0=cython.double, bm1=cython.double, bm2=cython.double,
+                   cj0=cython.double, cj1=cython.double, cj2=cython.double, lines=cython.bint, fast=cython.bint,
+                   hist=list, hist_s=list)
     def window(self, blocks: Sequence["Block"]) -> int:
         """Cap the junctions within one filter window behind the newest junction J (the end of
         blocks[-2]); returns how many blocks from the tail need a new backward pass.
@@ -343,6 +357,9 @@ class FilterCorners:
             bm0, bm1, bm2 = bmin
             cj0, cj1, cj2 = cum_j[0], cum_j[1], cum_j[2]
 
+        @cython.locals(m=cython.Py_ssize_t, k=cython.Py_ssize_t, i=cython.Py_ssize_t, c=cython.double,
+                       si=cython.double, x=cython.double, d=cython.double, sg=cython.double, ja=cython.double,
+                       base=tuple, pk=tuple)
         def cap(m: int) -> float:
             """Cap from the junctions hist[m..last] (inf when there are none): per axis, the
             acceleration budget over the largest signed sum of any run of them that ends at J,
@@ -399,6 +416,7 @@ class FilterCorners:
                             c = x
             return c
 
+        @cython.locals(k=cython.Py_ssize_t, c=cython.double, d=cython.double)
         def taken(k: int) -> bool:
             """Whether a window ending at J can reach back to junction k when the junctions after
             it run at no more than their common cap c: it covers no more path than J's speed
@@ -443,9 +461,8 @@ class FilterCorners:
             while len_q[0][0] < sm:
                 len_q.popleft()
         self._m = m
-        c = capped.get(m)
-        if c is None:
-            c = cap(m)
+        c_known = capped.get(m)
+        c = cap(m) if c_known is None else c_known
         c_bud = c  # the budgets' cap not held to top (nc.motion.shares)
         if c < top:
             # The sums over the whole stretch bound the filter's acceleration and jerk from
@@ -575,6 +592,7 @@ class FilterCorners:
                 v = 0.5 * (best + v)
         return best, max(bud, best)
 
+    @cython.locals(h0=cython.Py_ssize_t, last=cython.Py_ssize_t, s_j=cython.double, vt=cython.double, half=cython.double, lo=cython.Py_ssize_t, k=cython.Py_ssize_t, x=cython.double, top=cython.double, hs=list, vts=list)
     def _reach_back(self, h0: int, last: int, s_j: float, vt: float, half: float) -> tuple[int, float]:
         """`_tolerance`'s reach behind J: the junction walk
             lo = last
@@ -608,6 +626,9 @@ class FilterCorners:
             lo -= 1
         return lo, vt
 
+    @cython.locals(h0=cython.Py_ssize_t, last=cython.Py_ssize_t, s_j=cython.double, half=cython.double, vt=cython.double, h=cython.double, k=cython.Py_ssize_t, axes=cython.Py_ssize_t, sum_n=cython.double, lo=cython.Py_ssize_t,
+                   nseg=cython.Py_ssize_t, i=cython.Py_ssize_t, i0=cython.Py_ssize_t, depth=cython.Py_ssize_t, lim=cython.double, c=cython.double, v=cython.double, vt_i=cython.double, t2sum=cython.double, b=Block, nx=Block,
+                   hist=list, seg=list)
     def _tolerance(self, blocks: Sequence["Block"], v_hi: float) -> int:
         """Evaluate the deviation model (nc.motion.deviation) at the junctions within half a
         window (at the fastest speed nearby) behind the newest one J, with every junction known

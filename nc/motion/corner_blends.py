@@ -12,7 +12,8 @@ from __future__ import annotations
 import math
 
 from nc.motion.clothoid import ClothoidBlend, corner_blend
-from nc.motion.lookahead import Block, Limits, change_distance, reach
+from nc.motion.block import Block
+from nc.motion.lookahead import Limits, change_distance, reach
 
 MIN_SPEED = 1e-3  # mm/s (and mm/s², mm/s³): below it no blend is built
 KEEP = 1e-6  # mm a line keeps between two blends (a block of zero length would stall nothing, but

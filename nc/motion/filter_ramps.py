@@ -28,7 +28,8 @@ import math
 
 import numpy as np
 
-from nc.motion.lookahead import MARGIN, Block, change_distance
+from nc.motion.block import Block
+from nc.motion.lookahead import MARGIN, change_distance
 from nc.motion.plan_state import _Plan
 from nc.motion.profile import Piecewise, solve_position, solve_velocity
 from nc.motion.shares import MAX_FACTOR

@@ -12,7 +12,7 @@ from collections.abc import Iterable
 
 import numpy as np
 
-from nc.motion.lookahead import Block
+from nc.motion.block import Block
 from nc.motion.profile import Piecewise
 
 SAMPLES = 256  # points of the ramp's speed over its path: only read when a hold is planned

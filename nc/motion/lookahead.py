@@ -17,15 +17,19 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
 from itertools import islice
 
 import numpy as np
 
+try:
+    import cython  # compiled: the types below (setup.py, decision bench B115)
+except ImportError:  # run as Python without Cython: they do nothing
+    from nc.motion import cython_shadow as cython
+
 from nc.motion.blending import FilterCorners
+from nc.motion.block import Block
 from nc.motion.limits import MotionConfig
 from nc.motion.path import Segment
-from nc.moves import Move
 
 # A corner blend's jerk (Limits._blend_limits, decision motion 47): its cap keeps v³·|(dκ/ds, κ²)| within
 # BLEND_CAP of the axis jerk; its normal part v³·dκ/ds + 3·v·a_t·κ and its tangential part j_t + v³·κ² are
@@ -49,58 +53,9 @@ def arc_coupling(cfg: MotionConfig) -> float:
 MARGIN = 0.98  # the passes plan with 98 % of the limits ruckig gets, so plans are never borderline
 
 
-@dataclass(slots=True)
-class Block:
-    move: Move
-    kind: str  # "path" (line/arc/interpolated rapid), "indep" (independent rapid), "dwell", "thread"
-    seg: Segment | None
-    length: float
-    cap_hard: float  # geometric cap: axis speeds, centripetal limits, minimum duration (mm/s)
-    a: float  # tangential path acceleration limit (mm/s²)
-    j: float  # tangential path jerk limit (mm/s³)
-    feed: float | None  # programmed feed in mm/s (mm/rev when per_rev); None for rapids
-    rapid: bool = False
-    cap: float = 0.0  # effective cap with feed, override and spindle speed applied
-    vjunc: float = 0.0  # speed allowed at the junction to the next block
-    vend: float = 0.0  # planned end speed after the backward pass
-    anchor_v: float = 0.0  # nearest binding speed downstream of this block's end ...
-    anchor_d: float = 0.0  # ... and the path length to it
-    anchor_a: float = 0.0  # least tangential acceleration and jerk over that stretch
-    anchor_j: float = 0.0
-    binding: bool = True  # vend is this junction's own limit, not a downstream one
-    # Post-interpolation filter corners (nc.motion.blending): path length at this block's end,
-    # |Δu| per axis and its norm at the junction to the next block (None = a stop there).
-    s_end: float = 0.0
-    du: tuple[float, ...] | None = None
-    du_n: float = 0.0
-    cum: tuple[float, ...] = ()  # running Σ|Δu| per axis and Σ|Δu| norms up to this junction
-    vtop: float = 0.0  # the fastest this block can ever run (feed × the top override, or its geometric cap)
-    # Path tolerance under the filter (nc.motion.deviation): the signed tangent step at the end
-    # junction, the junction speed without the tolerance, the speed the deviation model allows
-    # when evaluated at this junction, and the least of those of the junctions whose window
-    # holds this one (vjunc = min(vbase, vtol); vtol is replaced, not only lowered, as the
-    # windows fill).
-    dv: tuple[float, ...] = ()
-    scum: tuple[float, ...] = ()  # running signed Σ Δu per axis up to this junction
-    vbase: float = math.inf
-    ctol: float = math.inf
-    vtol: float = math.inf
-    # The least cap the filter's acceleration/jerk budgets alone gave this junction (its corner and
-    # every window that held it; not the tolerance): vjunc / vbud is the share of the corner budget
-    # the junction can use (nc.motion.shares, decision motion 39).
-    vbud: float = math.inf
-    vctol: float = math.inf  # the tolerance's cap of this junction's corner alone (FilterCorners.corner_tolerance)
-    # nc.motion.shares._tolerance_free's verdict, kept between solves with the inputs it was found
-    # for (the caps beside the junction and min(vtol, vctol)): it is found again only when one changed.
-    tf_cap: float = math.nan
-    tf_tcap: float = math.nan
-    tf_ok: bool = False
-    trim0: float = 0.0  # path its start gave to a corner blend before it (nc.motion.corner_blends)
-    # A path block that is not an arc (the jerk-factor scan's walk reads this one field for the three it
-    # tests, session 13): set as the block joins the queue; False means "test them" (nc.motion.shares._scan).
-    scan_plain: bool = False
-
-
+@cython.ccall
+@cython.returns(cython.double)
+@cython.locals(v0=cython.double, v1=cython.double, a=cython.double, j=cython.double, dv=cython.double)
 def change_distance(v0: float, v1: float, a: float, j: float) -> float:
     """Path length a jerk-limited speed change v0 → v1 needs, zero acceleration at both ends."""
     dv = abs(v1 - v0)
@@ -109,6 +64,9 @@ def change_distance(v0: float, v1: float, a: float, j: float) -> float:
     return 0.5 * (v0 + v1) * (dv / a + a / j)
 
 
+@cython.ccall
+@cython.returns(cython.double)
+@cython.locals(v0=cython.double, length=cython.double, a=cython.double, j=cython.double, q=cython.double, p=cython.double, disc=cython.double, x=cython.double, dv=cython.double, qa=cython.double, qb=cython.double, qc=cython.double)
 def reach(v0: float, length: float, a: float, j: float) -> float:
     """Highest speed reachable from v0 within `length` (zero acceleration at both ends).
 
@@ -174,6 +132,7 @@ class Limits:
         self.blend = FilterCorners(cfg, self._acc, self._jerk) if cfg.filtered else None
         self._coupling = arc_coupling(cfg)
 
+    @cython.locals(v=cython.double, a=cython.double, j=cython.double, x=cython.double, d=cython.double, vl=cython.double, al=cython.double, jl=cython.double)
     def block_limits(self, seg: Segment, short_ok: bool = False) -> tuple[float, float, float]:
         """(speed cap, tangential acceleration, tangential jerk) of a path segment. `short_ok`: no
         minimum duration (a line whose both ends are blends has no corner for it to protect)."""
@@ -240,6 +199,8 @@ class Limits:
         a = min(a, (cn * pj - v3 * dk) / (3.0 * max(v, 1e-9) * km))
         return v, a, min(j, ct * pj - v3 * km * km)
 
+    @cython.locals(b1=Block, b2=Block, v=cython.double, d0=cython.double, d1=cython.double, d2=cython.double, sq_sum=cython.double, du_n=cython.double, a=cython.double, vb=cython.double, vc=cython.double,
+                   lines=cython.bint)
     def junction(self, b1: Block, b2: Block, raw: bool = False) -> float:
         """Highest speed at the junction b1 → b2. `raw`: as without the filter (a junction where its
         share λ is below 1, nc.motion.share_zones); the filter's fields of b1 are then left alone."""
@@ -295,6 +256,9 @@ class Limits:
         return 0.0 if 0.0 > v else v  # max(v, 0.0)
 
 
+@cython.locals(n=cython.Py_ssize_t, k=cython.Py_ssize_t, k_stop=cython.Py_ssize_t, lo=cython.Py_ssize_t, depth=cython.Py_ssize_t, nx=Block, b=Block, nx_vend=cython.double, nx_binding=cython.bint,
+               nx_cap=cython.double, nx_length=cython.double, nx_a=cython.double, nx_j=cython.double, nx_av=cython.double, nx_ad=cython.double, nx_aa=cython.double, nx_aj=cython.double, b_cap=cython.double,
+               local=cython.double, v=cython.double, av=cython.double, ad=cython.double, aa=cython.double, aj=cython.double, r=cython.double, binding=cython.bint)
 def backward(blocks: Sequence[Block], lo: int = 0, full: bool = False, depth: int = 0) -> None:
     """Backward pass from the queue tail (which ends at rest) down to index lo.
 

@@ -33,7 +33,8 @@ import numpy as np
 from nc.alarm_table import PLANNING_STALL
 from nc.alarms import NcAlarm
 from nc.motion.limits import MotionConfig
-from nc.motion.lookahead import MARGIN, Block, Limits, backward, change_distance, max_speed_at, reach
+from nc.motion.block import Block
+from nc.motion.lookahead import MARGIN, Limits, backward, change_distance, max_speed_at, reach
 from nc.motion.path import Segment
 from nc.motion.plan_state import CHUNK, Setpoint, _near, _Plan
 from nc.motion.filter_ramps import HISTORY, FilterStops

@@ -6,7 +6,8 @@ from __future__ import annotations
 import numpy as np
 
 from nc.motion.corner_blends import blend_block
-from nc.motion.lookahead import Block, change_distance
+from nc.motion.block import Block
+from nc.motion.lookahead import change_distance
 
 
 class CornerShares:

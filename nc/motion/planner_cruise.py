@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 
-from nc.motion.lookahead import Block
+from nc.motion.block import Block
 from nc.motion.plan_state import CHUNK, _Plan
 
 # Rows a cruise samples at a refill: whole blocks until at least this many. Its cost is per block (~45 blocks for

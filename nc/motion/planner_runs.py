@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING, Callable
 
 import numpy as np
 
-from nc.motion.lookahead import Block
+from nc.motion.block import Block
 from nc.motion.path import Segment
 from nc.motion.spline_feed import NOTHING, Held, RunFeed
 from nc.moves import Move

@@ -24,7 +24,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from nc.alarms import NcAlarm
-from nc.motion.lookahead import MARGIN, Block, change_distance
+from nc.motion.block import Block
+from nc.motion.lookahead import MARGIN, change_distance
 from nc.motion.profile import Piecewise, solve_position, solve_velocity
 from nc.motion.thread_corners import ThreadCorner, make_corner
 
