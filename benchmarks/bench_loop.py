@@ -165,6 +165,8 @@ def issue17(d: str) -> None:
     except ImportError:  # a tree from before the kernel (session 21)
         BUILD = "none (a tree without virtual_bus/kernels.py)"
     print(f"drive kernel: {BUILD}")  # virtual_bus/drive_kernel: compiled by the install, or its Python source
+    from nc.motion.compiled import BUILD as PLANNER_BUILD
+    print(f"planner: {PLANNER_BUILD}")  # nc/motion's hot modules (B115): compiled by the install, or their sources
     from benchmarks.bench_motion import cam_program
 
     staged("lathe demo, lathe MLC, Parquet trace", root / "examples" / "lathe_demo.nc", None,

@@ -26,6 +26,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.append(str(ROOT))  # PYTHONPATH first: a tree it names is measured
 
 import nc.motion.planner as planner_mod  # noqa: E402
+from nc.motion.compiled import BUILD  # noqa: E402
 from benchmarks.bench_motion import cam_program  # noqa: E402
 from hil.bench_file import load_bench_file  # noqa: E402
 from nc.interp import Interpreter  # noqa: E402
@@ -83,7 +84,8 @@ def opcodes(n: int) -> None:
         sys.settrace(None)
     digest = hashlib.sha1(st.positions.tobytes()).hexdigest()[:12]
     print(f"CAM {n} blocks offline, {len(st.positions) - 1} cycles: Python opcodes a block: Planner.push "
-          f"{count['push'] / n:.0f}, the whole run {count['all'] / n:.0f}; setpoints {digest}")
+          f"{count['push'] / n:.0f}, the whole run {count['all'] / n:.0f}; setpoints {digest}; planner {BUILD} (compiled "
+          "modules run no opcodes: DELTAHIL_PYTHON_PLANNER=1 counts the sources)")
 
 
 def main() -> None:
@@ -118,7 +120,7 @@ def main() -> None:
     digest = hashlib.sha1(st.positions.tobytes()).hexdigest()[:12]
     print(f"CAM {BLOCKS} blocks offline, {cycles} cycles: run {best[0] / cycles * 1e6:.1f} µs a cycle, "
           f"Planner.push {best[1] / BLOCKS * 1e6:.1f} µs a block, jerk-factor scans {best[2] / BLOCKS * 1e6:.1f} µs "
-          f"a block (CPU, best of 3); setpoints {digest}")
+          f"a block (CPU, best of 3); setpoints {digest}; planner {BUILD}")
 
 
 if __name__ == "__main__":
