@@ -30,6 +30,11 @@ from collections.abc import Callable
 
 import numpy as np
 
+try:
+    import cython  # compiled: the types below (setup.py, decision bench B115)
+except ImportError:  # run as Python without Cython: they do nothing
+    from nc.motion import cython_shadow as cython
+
 from nc.alarm_table import PLANNING_STALL
 from nc.alarms import NcAlarm
 from nc.motion.limits import MotionConfig
@@ -180,6 +185,7 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
         else:
             self._push(move)
 
+    @cython.locals(b=Block, prev=Block, x=cython.double, added=cython.Py_ssize_t, need=cython.Py_ssize_t, w=cython.Py_ssize_t)
     def _push(self, move: Move, span: Segment | None = None, line: Segment | None = None) -> None:
         self._pushes += 1
         if span is not None:
@@ -396,6 +402,7 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
         kind = "thread" if move.kind == "thread" else "path"
         return Block(move, kind, seg, seg.length, v, a, j, feed, move.kind == "rapid")  # the 9th field: rapid
 
+    @cython.locals(b=Block, cap=cython.double, x=cython.double, feed=cython.double)
     def _update_cap(self, b: Block, rpm: float | None = None) -> float:
         if b.kind != "path" and b.kind != "thread":
             b.cap = 0.0
@@ -668,6 +675,8 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
             return 1.0, False  # λ < 1 there: the raw path keeps the tangential share (decision motion 45)
         return jerk_factor(self.cfg, blend, self.blocks, start + s, start + dist, self.closed)
 
+    @cython.locals(b=Block, nx=Block, dist=cython.double, ra=cython.double, rj=cython.double, vmax=cython.double, cap=cython.double, cap_lo=cython.double, x=cython.double, jf=cython.double,
+                   cruise_from=cython.double, k=cython.Py_ssize_t, k_max=cython.Py_ssize_t, extend=cython.bint)
     def _run_target(self, cap: float, extend: bool = False, cruise_from: float = math.inf,
                     jf: float = 1.0) -> tuple[float, float, float, float, float]:
         """(distance, end speed, acceleration, jerk, top speed) of the run that starts with blocks[0].
