@@ -676,7 +676,8 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
         return jerk_factor(self.cfg, blend, self.blocks, start + s, start + dist, self.closed)
 
     @cython.locals(b=Block, nx=Block, dist=cython.double, ra=cython.double, rj=cython.double, vmax=cython.double, cap=cython.double, cap_lo=cython.double, x=cython.double, jf=cython.double,
-                   cruise_from=cython.double, k=cython.Py_ssize_t, k_max=cython.Py_ssize_t, extend=cython.bint)
+                   cruise_from=cython.double, k=cython.Py_ssize_t, extend=cython.bint)
+    # (k_max stays a Python int: the look-ahead depth of absurd limits exceeds a C integer, tests/test_harden_budgets.py)
     def _run_target(self, cap: float, extend: bool = False, cruise_from: float = math.inf,
                     jf: float = 1.0) -> tuple[float, float, float, float, float]:
         """(distance, end speed, acceleration, jerk, top speed) of the run that starts with blocks[0].
