@@ -141,7 +141,8 @@ class FilterCorners:
                 v = min(v, ba / d, bj / d)
         return v
 
-    @cython.locals(v=cython.double, d=cython.double, x=cython.double, du_n=cython.double, acc=cython.double, room=cython.double, lines=cython.bint)
+    @cython.locals(v=cython.double, d=cython.double, x=cython.double, du_n=cython.double, acc=cython.double,
+                   room=cython.double, lines=cython.bint)
     def corner_caps(self, du: Sequence[float], du_n: float, lines: bool, acc: float) -> tuple[float, float]:
         """(corner_budget(du, lines), corner_tolerance(du_n, acc)): one call a pushed junction, 3 axes spelt out
         (issue 17; min(a, b) / d is min(a / d, b / d) exactly, so `_bmin` serves for the two budgets)."""
@@ -226,11 +227,10 @@ class FilterCorners:
                    seq=cython.Py_ssize_t, seq_m=cython.Py_ssize_t, seq0=cython.Py_ssize_t, cut=cython.Py_ssize_t,
                    lo_q=cython.Py_ssize_t, stop=cython.Py_ssize_t, mono=cython.Py_ssize_t, lim=cython.Py_ssize_t,
                    depth=cython.Py_ssize_t, axes=cython.Py_ssize_t, s_j=cython.double, span_max=cython.double,
-                   t_w=cython.double, top=cython.double, t_w2=cython.double, pad=cython.double,
-                   two_al=cython.double, v_hi=cython.double, c=cython.double, c_bud=cython.double,
-                   c2=cython.double, inf=cython.double, bm0=cython.double, bm1=cython.double, bm2=cython.double,
-                   cj0=cython.double, cj1=cython.double, cj2=cython.double, lines=cython.bint, fast=cython.bint,
-                   hist=list, hist_s=list)
+                   t_w=cython.double, top=cython.double, t_w2=cython.double, pad=cython.double, two_al=cython.double,
+                   v_hi=cython.double, c=cython.double, c_bud=cython.double, c2=cython.double, inf=cython.double,
+                   bm0=cython.double, bm1=cython.double, bm2=cython.double, cj0=cython.double, cj1=cython.double,
+                   cj2=cython.double, lines=cython.bint, fast=cython.bint, hist=list, hist_s=list)
     def window(self, blocks: Sequence["Block"]) -> int:
         """Cap the junctions within one filter window behind the newest junction J (the end of
         blocks[-2]); returns how many blocks from the tail need a new backward pass.
@@ -592,7 +592,9 @@ class FilterCorners:
                 v = 0.5 * (best + v)
         return best, max(bud, best)
 
-    @cython.locals(h0=cython.Py_ssize_t, last=cython.Py_ssize_t, s_j=cython.double, vt=cython.double, half=cython.double, lo=cython.Py_ssize_t, k=cython.Py_ssize_t, x=cython.double, top=cython.double, hs=list, vts=list)
+    @cython.locals(h0=cython.Py_ssize_t, last=cython.Py_ssize_t, s_j=cython.double, vt=cython.double,
+                   half=cython.double, lo=cython.Py_ssize_t, k=cython.Py_ssize_t, x=cython.double, top=cython.double,
+                   hs=list, vts=list)
     def _reach_back(self, h0: int, last: int, s_j: float, vt: float, half: float) -> tuple[int, float]:
         """`_tolerance`'s reach behind J: the junction walk
             lo = last
@@ -626,9 +628,11 @@ class FilterCorners:
             lo -= 1
         return lo, vt
 
-    @cython.locals(h0=cython.Py_ssize_t, last=cython.Py_ssize_t, s_j=cython.double, half=cython.double, vt=cython.double, h=cython.double, k=cython.Py_ssize_t, axes=cython.Py_ssize_t, sum_n=cython.double, lo=cython.Py_ssize_t,
-                   nseg=cython.Py_ssize_t, i=cython.Py_ssize_t, i0=cython.Py_ssize_t, depth=cython.Py_ssize_t, lim=cython.double, c=cython.double, v=cython.double, vt_i=cython.double, t2sum=cython.double, b=Block, nx=Block,
-                   hist=list, seg=list)
+    @cython.locals(h0=cython.Py_ssize_t, last=cython.Py_ssize_t, s_j=cython.double, half=cython.double,
+                   vt=cython.double, h=cython.double, k=cython.Py_ssize_t, axes=cython.Py_ssize_t,
+                   sum_n=cython.double, lo=cython.Py_ssize_t, nseg=cython.Py_ssize_t, i=cython.Py_ssize_t,
+                   i0=cython.Py_ssize_t, depth=cython.Py_ssize_t, lim=cython.double, c=cython.double, v=cython.double,
+                   vt_i=cython.double, t2sum=cython.double, b=Block, nx=Block, hist=list, seg=list)
     def _tolerance(self, blocks: Sequence["Block"], v_hi: float) -> int:
         """Evaluate the deviation model (nc.motion.deviation) at the junctions within half a
         window (at the fastest speed nearby) behind the newest one J, with every junction known

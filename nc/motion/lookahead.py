@@ -66,7 +66,9 @@ def change_distance(v0: float, v1: float, a: float, j: float) -> float:
 
 @cython.ccall
 @cython.returns(cython.double)
-@cython.locals(v0=cython.double, length=cython.double, a=cython.double, j=cython.double, q=cython.double, p=cython.double, disc=cython.double, x=cython.double, dv=cython.double, qa=cython.double, qb=cython.double, qc=cython.double)
+@cython.locals(v0=cython.double, length=cython.double, a=cython.double, j=cython.double, q=cython.double,
+               p=cython.double, disc=cython.double, x=cython.double, dv=cython.double, qa=cython.double,
+               qb=cython.double, qc=cython.double)
 def reach(v0: float, length: float, a: float, j: float) -> float:
     """Highest speed reachable from v0 within `length` (zero acceleration at both ends).
 
@@ -132,7 +134,8 @@ class Limits:
         self.blend = FilterCorners(cfg, self._acc, self._jerk) if cfg.filtered else None
         self._coupling = arc_coupling(cfg)
 
-    @cython.locals(v=cython.double, a=cython.double, j=cython.double, x=cython.double, d=cython.double, vl=cython.double, al=cython.double, jl=cython.double)
+    @cython.locals(v=cython.double, a=cython.double, j=cython.double, x=cython.double, d=cython.double,
+                   vl=cython.double, al=cython.double, jl=cython.double)
     def block_limits(self, seg: Segment, short_ok: bool = False) -> tuple[float, float, float]:
         """(speed cap, tangential acceleration, tangential jerk) of a path segment. `short_ok`: no
         minimum duration (a line whose both ends are blends has no corner for it to protect)."""
@@ -199,7 +202,8 @@ class Limits:
         a = min(a, (cn * pj - v3 * dk) / (3.0 * max(v, 1e-9) * km))
         return v, a, min(j, ct * pj - v3 * km * km)
 
-    @cython.locals(b1=Block, b2=Block, v=cython.double, d0=cython.double, d1=cython.double, d2=cython.double, sq_sum=cython.double, du_n=cython.double, a=cython.double, vb=cython.double, vc=cython.double,
+    @cython.locals(b1=Block, b2=Block, v=cython.double, d0=cython.double, d1=cython.double, d2=cython.double,
+                   sq_sum=cython.double, du_n=cython.double, a=cython.double, vb=cython.double, vc=cython.double,
                    lines=cython.bint)
     def junction(self, b1: Block, b2: Block, raw: bool = False) -> float:
         """Highest speed at the junction b1 → b2. `raw`: as without the filter (a junction where its
@@ -256,9 +260,12 @@ class Limits:
         return 0.0 if 0.0 > v else v  # max(v, 0.0)
 
 
-@cython.locals(n=cython.Py_ssize_t, k=cython.Py_ssize_t, k_stop=cython.Py_ssize_t, lo=cython.Py_ssize_t, depth=cython.Py_ssize_t, nx=Block, b=Block, nx_vend=cython.double, nx_binding=cython.bint,
-               nx_cap=cython.double, nx_length=cython.double, nx_a=cython.double, nx_j=cython.double, nx_av=cython.double, nx_ad=cython.double, nx_aa=cython.double, nx_aj=cython.double, b_cap=cython.double,
-               local=cython.double, v=cython.double, av=cython.double, ad=cython.double, aa=cython.double, aj=cython.double, r=cython.double, binding=cython.bint)
+@cython.locals(n=cython.Py_ssize_t, k=cython.Py_ssize_t, k_stop=cython.Py_ssize_t, lo=cython.Py_ssize_t,
+               depth=cython.Py_ssize_t, nx=Block, b=Block, nx_vend=cython.double, nx_binding=cython.bint,
+               nx_cap=cython.double, nx_length=cython.double, nx_a=cython.double, nx_j=cython.double,
+               nx_av=cython.double, nx_ad=cython.double, nx_aa=cython.double, nx_aj=cython.double,
+               b_cap=cython.double, local=cython.double, v=cython.double, av=cython.double, ad=cython.double,
+               aa=cython.double, aj=cython.double, r=cython.double, binding=cython.bint)
 def backward(blocks: Sequence[Block], lo: int = 0, full: bool = False, depth: int = 0) -> None:
     """Backward pass from the queue tail (which ends at rest) down to index lo.
 

@@ -185,7 +185,8 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
         else:
             self._push(move)
 
-    @cython.locals(b=Block, prev=Block, x=cython.double, added=cython.Py_ssize_t, need=cython.Py_ssize_t, w=cython.Py_ssize_t)
+    @cython.locals(b=Block, prev=Block, x=cython.double, added=cython.Py_ssize_t, need=cython.Py_ssize_t,
+                   w=cython.Py_ssize_t)
     def _push(self, move: Move, span: Segment | None = None, line: Segment | None = None) -> None:
         self._pushes += 1
         if span is not None:
@@ -675,9 +676,10 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
             return 1.0, False  # λ < 1 there: the raw path keeps the tangential share (decision motion 45)
         return jerk_factor(self.cfg, blend, self.blocks, start + s, start + dist, self.closed)
 
-    @cython.locals(b=Block, nx=Block, dist=cython.double, ra=cython.double, rj=cython.double, vmax=cython.double, cap=cython.double, cap_lo=cython.double, x=cython.double, jf=cython.double,
+    @cython.locals(b=Block, nx=Block, dist=cython.double, ra=cython.double, rj=cython.double, vmax=cython.double,
+                   cap=cython.double, cap_lo=cython.double, x=cython.double, jf=cython.double,
                    cruise_from=cython.double, k=cython.Py_ssize_t, extend=cython.bint)
-    # (k_max stays a Python int: the look-ahead depth of absurd limits exceeds a C integer, tests/test_harden_budgets.py)
+    # (k_max stays a Python int: absurd limits give a look-ahead depth beyond a C integer, test_harden_budgets)
     def _run_target(self, cap: float, extend: bool = False, cruise_from: float = math.inf,
                     jf: float = 1.0) -> tuple[float, float, float, float, float]:
         """(distance, end speed, acceleration, jerk, top speed) of the run that starts with blocks[0].

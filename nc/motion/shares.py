@@ -47,7 +47,8 @@ if TYPE_CHECKING:
     from nc.motion.blending import FilterCorners
 
 
-@cython.locals(st=cython.double, pool=cython.double, t_w=cython.double, v_hi=cython.double, x=cython.double, reach=cython.double, use=cython.double, seen=cython.double, f=cython.double, saturates=cython.bint)
+@cython.locals(st=cython.double, pool=cython.double, t_w=cython.double, v_hi=cython.double, x=cython.double,
+               reach=cython.double, use=cython.double, seen=cython.double, f=cython.double, saturates=cython.bint)
 def jerk_factor(cfg: MotionConfig, fc: "FilterCorners", blocks: Sequence["Block"], pos: float,
                 run_end: float, closed: bool) -> tuple[float, bool]:
     """Factor (1 … MAX_FACTOR) on the tangential jerk of a solve over path positions
@@ -90,8 +91,10 @@ UNKNOWN = (-1.0, -1.0)  # _scan: the queue ends before the reach does
 RATIO_BOUND = 2.001
 
 
-@cython.locals(hi=cython.double, seen=cython.double, stop_s=cython.double, s_end=cython.double, vt=cython.double, use=cython.double, top=cython.double, x=cython.double, m=cython.double, covered=cython.bint,
-               plain=cython.bint, stop=cython.bint, i=cython.Py_ssize_t, k=cython.Py_ssize_t, k_lo=cython.Py_ssize_t, k_hi=cython.Py_ssize_t, q_lo=cython.Py_ssize_t, q_hi=cython.Py_ssize_t, b=Block, last=Block)
+@cython.locals(hi=cython.double, seen=cython.double, stop_s=cython.double, s_end=cython.double, vt=cython.double,
+               use=cython.double, top=cython.double, x=cython.double, m=cython.double, covered=cython.bint,
+               plain=cython.bint, stop=cython.bint, i=cython.Py_ssize_t, k=cython.Py_ssize_t, k_lo=cython.Py_ssize_t,
+               k_hi=cython.Py_ssize_t, q_lo=cython.Py_ssize_t, q_hi=cython.Py_ssize_t, b=Block, last=Block)
 def _scan(fc: "FilterCorners", blocks: Sequence["Block"], pos: float, run_end: float, reach: float,
           closed: bool, v_stop: float = -1.0) -> tuple[float, float] | None:
     """(largest vjunc / vbud, fastest vtop) over the junctions within `reach` of [pos, run_end];
@@ -196,8 +199,10 @@ SKIP = -1.0
 WALK = False  # True: _scan walks every junction as before the kept verdicts (the reference tests compare with)
 
 
-@cython.locals(n=cython.Py_ssize_t, d=cython.Py_ssize_t, ok_lo=cython.Py_ssize_t, ok_hi=cython.Py_ssize_t, k=cython.Py_ssize_t, i=cython.Py_ssize_t, n_ends=cython.Py_ssize_t, h=cython.Py_ssize_t, j=Block, head=Block,
-               vbud=cython.double, cap=cython.double, c2=cython.double, tcap=cython.double, r=cython.double, sc=list, part=list, ends=list, hist=list)
+@cython.locals(n=cython.Py_ssize_t, d=cython.Py_ssize_t, ok_lo=cython.Py_ssize_t, ok_hi=cython.Py_ssize_t,
+               k=cython.Py_ssize_t, i=cython.Py_ssize_t, n_ends=cython.Py_ssize_t, h=cython.Py_ssize_t, j=Block,
+               head=Block, vbud=cython.double, cap=cython.double, c2=cython.double, tcap=cython.double,
+               r=cython.double, sc=list, part=list, ends=list, hist=list)
 def _verdicts(fc: "FilterCorners", blocks: Sequence["Block"], k_lo: int, k_hi: int,
               n_pre: int | None) -> list[float]:
     """Each junction hist[k_lo:k_hi]'s verdict for _scan: NONE, SKIP or its use min(1, vjunc / vbud), kept in
@@ -328,7 +333,8 @@ def _walk(fc: "FilterCorners", blocks: Sequence["Block"], lo: float, hi: float, 
     return use, seen
 
 
-@cython.locals(j=Block, k=cython.Py_ssize_t, cap=cython.double, c2=cython.double, tcap=cython.double, unb=cython.double, x=cython.double, ok=cython.bint)
+@cython.locals(j=Block, k=cython.Py_ssize_t, cap=cython.double, c2=cython.double, tcap=cython.double,
+               unb=cython.double, x=cython.double, ok=cython.bint)
 def _tolerance_free(fc: "FilterCorners", j: "Block", blocks: Sequence["Block"], ends: Sequence[float]) -> bool:
     """Whether junction j keeps N1.053 with the raised jerk at the fastest its blocks may pass it.
 
