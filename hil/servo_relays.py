@@ -15,10 +15,10 @@ from __future__ import annotations
 from typing import Any
 
 from fieldbus.cia402 import Target
+from mlc.manual_alarms import SERVO_NOT_READY
 from nc.alarms import Alarm
 from nc.channel import RunState
 
-SERVO_NOT_READY = 0x0A07  # App. A: "Servo is not ready. The axis is not servo ON."
 RESYNC = 40  # BenchRunner._servo_off bit RESYNC + i: axis i back ON, its position for the NC still to take
 _STOPPED = (RunState.STOPPING, RunState.ALARM, RunState.RESETTING)
 

@@ -10,6 +10,10 @@ reset while the axis still stands on the switch leaves the limit alarm (0x0402) 
 search (HOME mode) ran into the switch, the hit is also 0x1601, and a reset on the switch shows 0x1602 ("triggered
 after clearing 0x1601"); moving off and a reset clear it as above.
 
+An axis the MLC holds servo OFF (M2x012 OFF, M2x272+i ON; decision M22-1) takes no manual command: a JOG key, an
+INC press, MPG pulses or a home trigger of it is refused with App. A 0x0A07 "Servo is not ready. The axis is not
+servo ON", and a manual move of it in progress when its relay falls stops jerk-limited (decision M23-1).
+
 M2x264 (axes oscillation enable) is "only available on modes other than HOME and EDIT": ON in HOME mode it stops
 the homing under way and refuses new ones with 0x1603 "Oscillation function is not allowed in the home mode"."""
 
@@ -32,6 +36,7 @@ HARD_LIMIT_TO_CLEAR = 0x0A06
 OSCILLATION_IN_HOME = 0x1603
 LIMIT_IN_HOMING = 0x1601  # "The hardware limit is triggered during execution of home mode 4 ..."
 LIMIT_AFTER_HOMING = 0x1602  # "The hardware limit alarm not cleared of the home mode 4."
+SERVO_NOT_READY = 0x0A07  # App. A: "Servo is not ready. The axis is not servo ON."
 PRESS = 0.01  # mm (deg) beyond the switch edge the held command stands
 
 
@@ -87,6 +92,30 @@ class HardLimitLatch:
                 for a, (side, _) in self.latched.items()]
 
 
+def servo_refused(link: ChannelLink, ch: Channel, i: int, what: str) -> None:
+    """A manual command of axis i, which the MLC holds servo OFF, is not carried out: App. A 0x0A07, raised once
+    while the axis stays OFF (a held key or a turning handwheel is one refusal; a reset or the axis back ON re-arms
+    it)."""
+    bit = 1 << i
+    if link._servo_refused & bit:
+        return
+    link._servo_refused |= bit
+    x, a = link.x, link.axes[i]
+    relay = f"M2{x}012 OFF" if link.servo_all else f"M2{x}{272 + i} ON"
+    link._raise(ch, Alarm(SERVO_NOT_READY, f"servo is not ready: {what} of axis {a} refused, the MLC holds it "
+                                           f"servo OFF ({relay})", axis=a))
+
+
+def servo_off_stop(link: ChannelLink, ch: Channel, mm: ManualMotion, off: int) -> None:
+    """Axes held OFF that a manual move still drives: stopped jerk-limited where they are (the runner disables
+    each drive once its axis stands, hil/servo_relays.py)."""
+    link._servo_refused &= off  # an axis back ON: its next refusal raises again
+    for i, a in enumerate(link.axes):
+        if off >> i & 1 and mm.moving(a):
+            mm.stop(a)
+            servo_refused(link, ch, i, "the manual move")
+
+
 def home_mode(link: ChannelLink, ch: Channel, mm: ManualMotion) -> None:
     """One HOME-mode cycle: a rising M2x320+i homes axis i, unless M2x264 is on (App. A 0x1603)."""
     x = link.x
@@ -94,9 +123,12 @@ def home_mode(link: ChannelLink, ch: Channel, mm: ManualMotion) -> None:
     if link._rising(m2(x, 264)):
         mm.stop()
         link._raise(ch, Alarm(OSCILLATION_IN_HOME, "M2x264 oscillation enable is ON in HOME mode"))
+    off = link.servo_off
     for i, a in enumerate(link.axes):
         if link._rising(m2(x, 320 + i)):
-            if osc:
+            if off >> i & 1:
+                servo_refused(link, ch, i, "homing")
+            elif osc:
                 link._raise(ch, Alarm(OSCILLATION_IN_HOME, f"{a} homing refused: M2x264 oscillation enable is ON "
                                                            f"in HOME mode", axis=a))
             else:

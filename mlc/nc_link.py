@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from mlc.manual_alarms import HardLimitLatch, home_mode
+from mlc.manual_alarms import HardLimitLatch, home_mode, servo_off_stop, servo_refused
 from mlc.drive_status import DriveStatus, write_drive_outputs
 from mlc.memory import DeviceMemory
 from mlc.signals import d2, d3, m2, m3
@@ -67,6 +67,7 @@ class ChannelLink:
     servo_off: int = 0
     servo_all: bool = False
     _servo_levels: bytes | None = None  # M2x272… of the channel's axes as last read
+    _servo_refused: int = 0  # bit i: a manual command of axis i, held OFF, was refused with 0x0A07 (M23-1)
     _spindle_levels: bytes = bytes(8)  # M2x711, M2x727, … as the last scan saw them (== their `_prev`)
     _program_end: int | None = None
     _mode_switch_cycles: int = 0
@@ -187,6 +188,7 @@ class ChannelLink:
             ch.emergency = False  # E-stop released, then reset: the bench enables the drives again
         self.alarms.clear()
         self._alarms_seen.clear()
+        self._servo_refused = 0
         self._reset_pending = True
         for alarm in self.limit_latch.reset() + self.hard_limits.reset():  # still on a limit: reset does not clear
             self._raise(ch, alarm)
@@ -352,19 +354,31 @@ class ChannelLink:
                 self._raise(ch, alarm)
         if self._estop or self.mode not in MANUAL_MODES or ch.busy:
             return
+        off = self.servo_off  # axes the MLC holds servo OFF take no manual command (App. A 0x0A07, M23-1)
+        if off or self._servo_refused:
+            servo_off_stop(self, ch, mm, off)
         pct = self.mem.u16(d2(x, 6))
         jog = self.jog_speed * pct / 100.0
         if self.mode in (JOG, RAPID):
             for i, a in enumerate(self.axes):
                 fwd, rev = self._m2(384 + i), self._m2(400 + i)
+                if off >> i & 1:
+                    if fwd or rev:
+                        servo_refused(self, ch, i, "JOG")
+                    continue
                 speed = jog if self.mode == JOG else mm.cfg.limit(a).max_velocity * self.mem.u16(d2(x, 4)) / 100.0
                 mm.jog(a, (1 if fwd else 0) - (1 if rev else 0), speed)
         elif self.mode == INC:
             step = self.mem.u32(d2(x, 14)) * self.unit
             for i, a in enumerate(self.axes):
-                if self._rising(m2(x, 384 + i)):
+                fwd, rev = self._rising(m2(x, 384 + i)), self._rising(m2(x, 400 + i))
+                if off >> i & 1:
+                    if fwd or rev:
+                        servo_refused(self, ch, i, "an INC step")
+                    continue
+                if fwd:
                     mm.move_by(a, step, jog)
-                if self._rising(m2(x, 400 + i)):
+                if rev:
                     mm.move_by(a, -step, jog)
         elif self.mode == MPG:
             count = self.mem.u16(d3(0, 4))
@@ -373,7 +387,9 @@ class ChannelLink:
             delta = (count - self._mpg_last + 0x8000) % 0x10000 - 0x8000  # 16-bit counter wraps
             self._mpg_last = count
             i = self.mem.u16(d2(x, 8))
-            if delta and i < len(self.axes):
+            if delta and i < len(self.axes) and off >> i & 1:
+                servo_refused(self, ch, i, "MPG pulses")
+            elif delta and i < len(self.axes):
                 mm.move_by(self.axes[i], delta * self.mem.u16(d2(x, 9)) * self.unit)
         elif self.mode == HOME:
             home_mode(self, ch, mm)  # the home triggers, and App. A 0x1603 (mlc/manual_alarms.py)

@@ -27,7 +27,7 @@ SINGLE_BLOCK | bench | nc/channel.py | level; stops after every block, an M/S/T-
 OPTIONAL_STOP | bench | mlc/nc_link.py | level; M01 holds with M3x038 only while ON
 BLOCK_SKIP | bench | mlc/nc_link.py | level; '/' blocks read after the scan that saw it are skipped (decision M21-1)
 MST_LOCK | bench | mlc/nc_link.py | level; no strobe, the block's motion runs (H9)
-SERVO_ON | bench | hil/servo_relays.py | level, power-on image ON; OFF disables every axis at standstill, 0x0A07 if the NC moves one (decision M22-1)
+SERVO_ON | bench | hil/servo_relays.py | level, power-on image ON; OFF disables every axis at standstill, 0x0A07 if the NC moves one, a JOG/INC/MPG/HOME command refused (decisions M22-1, M23-1)
 EMERGENCY_STOP | bench | mlc/nc_link.py | level; App. A 0x0401 on the rising edge, M3x018 follows it
 SYNC_ADJUST | absent | - | gantry synchronisation not emulated
 MST_FINISH | bench | mlc/nc_link.py | level; completes the handed code; the next strobe waits for it to drop (H1-H9)
@@ -53,7 +53,7 @@ MLC_TO_NC_BIT | bench | mlc/nc_link.py | #25000+n, re-sent when changed (C1)
 SYNC_ENABLE | absent | - | synchronous control not emulated
 TRANSFER_ENABLE | absent | - | command transfer not emulated
 OSCILLATION_ENABLE | partial | mlc/manual_alarms.py | only App. A 0x1603 in HOME mode; no oscillation motion
-SERVO_OFF | bench | hil/servo_relays.py | level, per axis slot; as SERVO_ON for one axis (decision M22-1)
+SERVO_OFF | bench | hil/servo_relays.py | level, per axis slot; as SERVO_ON for one axis (decisions M22-1, M23-1)
 SYNC_SLAVE | absent | - | synchronous control not emulated
 TRANSFER_RECEIVE | absent | - | command transfer not emulated
 HOME | bench | mlc/manual_alarms.py | HOME mode, per axis slot (decision M21-3)
