@@ -42,7 +42,9 @@ def stop_on_signals(runner: Any) -> Iterator[None]:
     def handler(signum: int, frame: Any) -> None:
         name = signal.Signals(signum).name
         if getattr(runner, "disabling", False):  # the drives stand and are being disabled, a few cycles: what a
-            return  # second signal asks for is under way, and cutting it would leave them enabled (B95)
+            if runner.stop_request is None:  # signal asks for is under way, and cutting it would leave them enabled
+                runner.request_stop(name)  # (B95); a first one still ends the run as its stop (a campaign's, B114)
+            return
         if runner.stop_request is not None:
             raise KeyboardInterrupt(f"second {name} during the stop")
         runner.request_stop(name)

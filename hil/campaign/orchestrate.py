@@ -4,6 +4,10 @@ reports, and summary.html."""
 
 from __future__ import annotations
 
+import signal
+import threading
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -36,10 +40,33 @@ class CampaignOutcome:
         return out
 
 
+@contextmanager
+def _sigint_taken() -> Iterator[None]:
+    """B114: SIGINT is the campaign's even when it was ignored at start (a non-interactive shell's background job
+    `hil campaign … &`), as it is a run's (B94). Ignored, it was taken only inside each case's run (stop_on_signals)
+    and lost between runs: `kill -INT` then let the campaign run on to its end. Here it raises KeyboardInterrupt as
+    Ctrl-C from a terminal does, for the whole campaign; the local cluster's workers still start ignoring it (B55)."""
+    if threading.current_thread() is not threading.main_thread() or \
+            signal.getsignal(signal.SIGINT) is not signal.SIG_IGN:
+        yield
+        return
+    signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
 def run_campaign(path: str | Path, out: str | Path, engine: Engine | None = None, *, rerun: bool = False,
                  quiet: bool = True, reports: bool = True,
                  report_html: bool = True) -> CampaignOutcome:
     """Raises CampaignFileError (an InputError) for a bad campaign file, naming the field."""
+    with _sigint_taken():
+        return _run_campaign(path, out, engine, rerun=rerun, quiet=quiet, reports=reports, report_html=report_html)
+
+
+def _run_campaign(path: str | Path, out: str | Path, engine: Engine | None, *, rerun: bool, quiet: bool,
+                  reports: bool, report_html: bool) -> CampaignOutcome:
     campaign = load_campaign(path)
     engine = engine or Engine()
     engine.retries = campaign.retries
