@@ -498,6 +498,8 @@ class BenchRunner:
                     rx.target_position = sc.to_counts(deg)
                 if vel is not None:
                     rx.target_velocity = sc.rpm_to_drive(vel)
+        if self._servo_off >> n_axes:  # a spindle the MLC holds servo OFF gets no speed (M2x012, decision M23-2)
+            servo_relays.hold_spindles(self)
         self.clock.written()  # the outputs the next exchange sends: the end of the cycle's work (decision B21)
         bus_work = self._bus_work
         if bus_work is not None and bus_work.realtime:  # where the clock ends the cycle's work: here in real time

@@ -27,7 +27,7 @@ SINGLE_BLOCK | bench | nc/channel.py | level; stops after every block, an M/S/T-
 OPTIONAL_STOP | bench | mlc/nc_link.py | level; M01 holds with M3x038 only while ON
 BLOCK_SKIP | bench | mlc/nc_link.py | level; '/' blocks read after the scan that saw it are skipped (decision M21-1)
 MST_LOCK | bench | mlc/nc_link.py | level; no strobe, the block's motion runs (H9)
-SERVO_ON | bench | hil/servo_relays.py | level, power-on image ON; OFF disables every axis at standstill, 0x0A07 if the NC moves one, a JOG/INC/MPG/HOME command refused (decisions M22-1, M23-1)
+SERVO_ON | bench | hil/servo_relays.py | level, power-on image ON; OFF disables every axis at standstill, 0x0A07 if the NC moves one, a JOG/INC/MPG/HOME command refused; the spindle drives too: no speed, disabled below 1 rpm, 0x0C06 if the program turns one (decisions M22-1, M23-1, M23-2)
 EMERGENCY_STOP | bench | mlc/nc_link.py | level; App. A 0x0401 on the rising edge, M3x018 follows it
 SYNC_ADJUST | absent | - | gantry synchronisation not emulated
 MST_FINISH | bench | mlc/nc_link.py | level; completes the handed code; the next strobe waits for it to drop (H1-H9)
@@ -69,7 +69,7 @@ MLC_AXIS_INCREMENTAL | absent | - | MLC axes not emulated
 SPINDLE_FWD | partial | mlc/nc_link.py | spindle 1 drives the bench spindle; spindles 2-8 have no drive
 SPINDLE_REV | partial | mlc/nc_link.py | as SPINDLE_FWD
 SPINDLE_ORIENT | partial | mlc/spindle_axis.py | spindle 1 (M19), through the C-axis switch
-SPINDLE_TAP_RETRACT | absent | - | retraction after an interrupted tap not emulated
+SPINDLE_TAP_RETRACT | absent | - | retraction after an interrupted tap not emulated (decision M23-3)
 SPINDLE_CS_SWITCH | partial | mlc/spindle_axis.py | spindle 1 only
 SPINDLE_CMD_SOURCE | partial | mlc/nc_link.py | spindle 1 only (D2x024 as source)
 SPINDLE_ALARM | bench | mlc/nc_link.py | rising edge raises App. A 0x0C0A, spindles 1-8
