@@ -14,7 +14,9 @@ import errno
 import importlib
 import os
 import pkgutil
+import signal
 import sys
+import threading
 from collections.abc import Sequence
 
 import hil.commands
@@ -66,7 +68,18 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         return _main(sys.argv[1:])
     finally:  # the `hil` command itself: the process ends when this returns
+        _late_interrupts_ignored()
         _end_without_collections()
+
+
+def _late_interrupts_ignored() -> None:
+    """Once the command has decided its exit code (and printed its summary), a Ctrl-C in the last milliseconds of the
+    process (the teardown, the interpreter's finalization, which puts SIGINT back to the default) would kill it by
+    the signal: an exit of -2 to a caller's subprocess, after a summary that said `completed` (the fault sweep,
+    tests/fuzz22_gen.py, hit it). The outcome stands: SIGINT is ignored from here on. SIGTERM keeps its default, so a
+    supervisor can still end a teardown that hangs."""
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
 def _end_without_collections() -> None:

@@ -191,7 +191,9 @@ def trace_case(r: random.Random, d: Path) -> Case:
     elif kind == "signal":
         c.signal_after = r.uniform(0.3, 3.0)
         c.signum = r.choice((signal.SIGINT, signal.SIGTERM))
-        prog.write_text("G00 X10. Y10.\nG01 Z-1. F300.\nX200. Y-50.\nX-200.\nY100.\nG00 Z30.\nM30\n")
+        # ≈ 1,100 s simulated: still running when the signal comes at ≤ 3 s at any speed the cycle reaches (its
+        # one pass, 170 s, ended after 1.8 s once the planner was compiled, B115: the signal then hit the exit)
+        prog.write_text("G00 X10. Y10.\nG01 Z-1. F300.\n" + "X200. Y-50.\nX-200.\nY100.\n" * 6 + "G00 Z30.\nM30\n")
         c.note = f"{signal.Signals(c.signum).name} after {c.signal_after:.2f} s"
     c.argv = _hil("run", str(prog), "--bench", str(MILL), "--trace", str(trace))
     c.trace = None if kind == "dev-null" else trace

@@ -8,6 +8,7 @@ is 128 + the signal's number."""
 from __future__ import annotations
 
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -264,3 +265,27 @@ def test_an_ignored_hangup_stays_ignored(monkeypatch, capsys):
         assert signal.getsignal(signal.SIGHUP) is signal.SIG_IGN
     finally:
         signal.signal(signal.SIGHUP, previous)
+
+
+def test_a_ctrl_c_after_the_command_decided_its_exit_code_does_not_change_it(tmp_path):
+    """A Ctrl-C in the `hil` process's last milliseconds (its summary printed, the teardown under way, the
+    interpreter's finalization putting SIGINT back to the default) killed it by the signal: exit -2 to a caller's
+    subprocess after `result completed` (found by tests/fuzz22_gen.py's signals once runs got faster). The outcome
+    stands: SIGINT is ignored once main has its exit code."""
+    prog = tmp_path / "short.nc"
+    prog.write_text("G98\nG00 X58. Z98.\nG01 Z90. F6000\nM30\n")
+    script = (
+        "import os, signal, sys\n"
+        "import hil.cli as cli\n"
+        "real = cli._end_without_collections\n"
+        "def late():\n"
+        "    os.kill(os.getpid(), signal.SIGINT)  # Ctrl-C once the command has its exit code\n"
+        "    real()\n"
+        "cli._end_without_collections = late\n"
+        f"sys.argv = ['hil', 'run', {str(prog)!r}, '--bench', {str(LATHE)!r}, '--no-progress']\n"
+        "sys.exit(cli.main())\n")
+    out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120,
+                         env=dict(os.environ, PYTHONPATH=str(ROOT)))
+    assert out.returncode == 0, (out.returncode, out.stderr[-1500:])
+    assert re.search(r"^result +completed", out.stdout, re.M)
+    assert "Traceback" not in out.stderr
