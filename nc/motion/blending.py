@@ -35,6 +35,7 @@ try:
 except ImportError:  # run as Python without Cython: they do nothing
     from nc.motion import cython_shadow as cython
 
+from nc.motion.block import Block
 from nc.motion.deviation import KernelDeviation
 from nc.motion.limits import MotionConfig
 from nc.motion.shares import MAX_FACTOR
@@ -44,8 +45,6 @@ USAGE_SCALE = 4.0  # below this many times the top speed a junction's budget use
 # 18 (every junction before _h0 once 4,096 were), whose cut nc.motion.shares still answers by (FilterCorners._seq_v)
 TRIM = 32
 BULK = 4096
-
-from nc.motion.block import Block
 
 
 

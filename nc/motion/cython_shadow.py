@@ -1,12 +1,12 @@
 """The few names of Cython's pure-Python mode the planner's compiled modules use (decision bench B115), for the
 same modules run as Python without Cython installed: `import cython` fails there and this stands in. Compiled,
-Cython reads the decorators as types; run as Python they do nothing."""
+Cython reads the decorators as types; run as Python they do nothing. Each compiled module spells out its own
+`try: import cython` (Cython recognises the literal import only: it cannot come through a shared helper)."""
 
 from __future__ import annotations
 
 from typing import Any, Callable
 
-compiled = False
 double = float
 Py_ssize_t = int
 bint = bool
