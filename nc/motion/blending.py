@@ -177,6 +177,13 @@ class FilterCorners:
         raised jerk (shares.MAX_FACTOR times theirs); 0 where it cannot be shown alone."""
         if self.tol is None:
             return 0.0
+        # Where the leg after it holds a filter start (nc.motion.filter_ramps: a ramp far above the axis limits to
+        # the block's top speed, a filter window's cruise at it, then braking), that start, checked against
+        # N1.053 itself, needs the room a faster corner would take: it gains more there (a 100 mm square, session
+        # 23: the corner 2 cycles sooner, the start 20 later). The old cap stays there, any lower one being safe.
+        top = b2.vtop
+        if b2.length >= top * self.t_j + top * top / (2.0 * b2.a) + top * b2.a / (2.0 * b2.j):
+            return 0.0
         return self.cb.cap(self.tol, du_n, acc, MAX_FACTOR * jerk, b1.length, b2.length, b1.vtop, b2.vtop)
 
     def corner_tolerance(self, du_n: float, acc: float) -> float:
