@@ -74,6 +74,7 @@ class FilterCorners:
         self.tol = cfg.path_tolerance
         self.kd = KernelDeviation(n1, n2, cfg.cycle)
         self.cb = CornerBound(self.kd)  # the proved isolated-corner cap (decision motion 73)
+        self._iso_k = 0.25 * self.cb.span * self.cb.span  # isolated_cap's quick test (s²)
         self._boost: dict[tuple[float, float], float] = {}  # braking's growth per (a, j)
         self.t2sum = t1 * t1 + t2 * t2
         self._arc_k = (n1 * n1 + n2 * n2 - 2) * cfg.cycle * cfg.cycle  # arc_speed's shrink factor (s²)
@@ -171,11 +172,16 @@ class FilterCorners:
         room = tol - du_n * acc * self.t2sum / 192.0  # `braking` without a jerk
         return v, 0.0 if room <= 0.0 else room / (du_n * self.kd.g0)
 
+    @cython.locals(leg=cython.double, top=cython.double)
     def isolated_cap(self, du_n: float, acc: float, jerk: float, b1: Block, b2: Block) -> float:
         """The proved cap of the line-line corner b1 → b2 alone in its filter windows (decision motion 73:
         nc.motion.deviation.CornerBound), for any raw profile within the blocks' acceleration and the solves'
         raised jerk (shares.MAX_FACTOR times theirs); 0 where it cannot be shown alone."""
-        if self.tol is None:
+        leg = b1.length if b1.length < b2.length else b2.length
+        if self.tol is None or leg < self._iso_k * acc:
+            # (a quarter of acc·span² is less than the path a window reaches from rest at zero acceleration under the
+            # raised jerk whenever that reaches acc within 0.63 of the span: CornerBound.cap's 0, found cheaply
+            # for the CAM programs' short blocks; 0 is always safe, the old cap stays)
             return 0.0
         # Where the leg after it holds a filter start (nc.motion.filter_ramps: a ramp far above the axis limits to
         # the block's top speed, a filter window's cruise at it, then braking), that start, checked against
