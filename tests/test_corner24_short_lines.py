@@ -1,15 +1,16 @@
-"""Short lines at corners run at the proved isolated-corner cap (session 23, decision motion 73).
+"""Zig-zags of short lines keep N1.053 measured from the trace (session 23, decisions motion 73, 74).
 
-What a user checks: `hil run` of the LinuxCNC families' zig-zags (20 lines of 2 mm at F3000,
-benchmarks/bench_lcnc_families.py) on benches/mill-3axis.toml, timed in simulated cycles (first to last
-change of the commanded position), every bench check passing (velocity, acceleration, jerk, contour,
-following error), and the commanded path (the filter's output) within N1.053 of the programmed polyline.
-Main before decision 73 (the fitted |Δu|·a·(T1²+T2²)/192 braking term, the displacement from the vertex):
-60° 1.479 s, 90° 1.515 s, 120° 1.544 s, 150° 1.634 s; LinuxCNC 2.9 0.915, 0.947, 0.987, 1.010 s.
+What a user checks: `hil run` on benches/mill-3axis.toml of seeded random zig-zags (angles 10–170°, lengths
+0.2–5 mm, feeds 500–6000 mm/min) and of sharp corners after 5 mm legs at F6000, every bench check passing
+(velocity, acceleration, jerk, contour, following error), and the commanded path (the filter's output, what
+N1.053 bounds) within 0.02 mm of the programmed polyline. The bench's own contour check judges the drives'
+actual position, which lags and rounds the corner further: it passed runs whose commanded path left the
+polyline by 0.0297 mm (decision 74), so the distance is measured here on the commanded columns.
 
-The random zig-zags (seeded: angles 10–170°, lengths 0.2–5 mm, feeds 500–6000 mm/min) check the bound
-itself from the trace: with the path term of the bound dropped (CornerBound judging the corner at
-constant speed, v·G(0)·sin θ) the 150° corners after 5 mm legs leave the legs by more than N1.053.
+The corner caps' braking term is what keeps these within N1.053: with main's fitted |Δu|·a·(T1²+T2²)/192 set
+to 0 (in corner_caps, corner_tolerance and the windows' `_tolerance`) the four random zig-zags and the 90° one
+leave the polyline by 0.0201–0.0215 mm and fail; with decision 74's wiring and CornerBound's path term dropped
+(the corner judged at constant speed, v·G(0)·sin θ) by 0.022–0.030 mm.
 """
 
 from __future__ import annotations
@@ -57,14 +58,6 @@ def family(turn_deg: float, seg: float = 2.0, n: int = 20) -> list[np.ndarray]:
         ang = half if k % 2 == 0 else -half
         pts.append(pts[-1] + seg * np.array([math.cos(ang), math.sin(ang), 0.0]))
     return pts
-
-
-@pytest.mark.parametrize("turn, limit, before", [(90.0, 1.36, 1.515), (120.0, 1.35, 1.544), (150.0, 1.38, 1.634)])
-def test_zigzag_of_2mm_lines_runs_at_the_proved_corner_cap(tmp_path, turn, limit, before):
-    pts = family(turn)
-    t, dev = run(tmp_path, pts, [3000.0] * (len(pts) - 1))
-    assert t <= limit, f"{turn:g}° zig-zag: {t:.3f} s (main before decision 73: {before} s)"
-    assert dev <= TOL
 
 
 def random_zigzag(seed: int, n: int = 16) -> tuple[list[np.ndarray], list[float]]:
