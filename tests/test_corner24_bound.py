@@ -79,7 +79,8 @@ def test_the_cap_keeps_the_bound_within_the_tolerance_and_grows_past_the_old_one
         du_n = 2.0 * math.sin(th / 2.0)
         c = cb.cap(0.02, du_n, ACC, JERK, 2.0, 2.0, 50.0, 50.0)
         assert c > 1.3 * old
-        assert math.sin(th) * ACC * cb.bound(c / ACC, 2.0 ** (math.ceil(math.log2(JERK / ACC) * 16 - 1e-9) / 16)) <= 0.02
+        ratio = 2.0 ** (math.ceil(math.log2(JERK / ACC) * 16 - 1e-9) / 16)  # the grid's jerk/acc, rounded up
+        assert math.sin(th) * ACC * cb.bound(c / ACC, ratio) <= 0.02
         assert c * g0 * math.sin(th) < 0.02
     # a neighbour within a window's reach: no cap (0.3 mm legs), nor where the foot leaves a short leg
     assert cb.cap(0.02, math.sqrt(2.0), ACC, JERK, 0.3, 0.3, 50.0, 50.0) == 0.0

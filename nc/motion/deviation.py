@@ -105,7 +105,8 @@ def gained_path(x: float, v: float, a0: float, acc: float, jerk: float) -> float
     ta = (acc - a0) / jerk if a0 < acc else 0.0  # until the acceleration reaches acc
     xa = x if x < ta else ta
     xb = x - xa
-    return v * x + a0 * xa * xa / 2.0 + jerk * xa ** 3 / 6.0 + (a0 * ta + jerk * ta * ta / 2.0) * xb + acc * xb * xb / 2.0
+    return (v * x + a0 * xa * xa / 2.0 + jerk * xa ** 3 / 6.0 + (a0 * ta + jerk * ta * ta / 2.0) * xb
+            + acc * xb * xb / 2.0)
 
 
 class CornerBound:
@@ -113,16 +114,18 @@ class CornerBound:
     motion 73), whatever the raw profile does inside the window: crossed at speed v, any acceleration there.
 
     Near a lone corner C (directions u1 → u2, turn θ) the output at time t_c − τ is C − u1·m1 + u2·m2 with
-    m1 = Σ_{z<τ} k_z·P1(τ − z), m2 = Σ_{z>τ} k_z·P2(z − τ) (P1, P2 the path covered in that time before and after
-    the crossing), and its distance from the legs is at most min(m1, m2)·sin θ (the foot on the longer side's
-    leg, within it when m·(1 + |cos θ|) is shorter than the leg). With the acceleration a0 at the crossing, a
-    speed change within (acc, jerk) covers at most `gained_path(x, v, ∓a0, acc, jerk)`; a0² ≤ 2·jerk·v, or the
-    speed on the other side would have to fall below zero. m1 rises and m2 falls with τ, so on a τ interval
-    [τ_i, τ_i+1] min(m1, m2) ≤ min(U1(τ_i+1), U2(τ_i)), and on an a0 interval [a_k, a_k+1] U1 takes −a_k, U2
-    a_k+1: the largest of those over the grids bounds the deviation (per unit sin θ) from above.
+    m1 = Σ_{z<τ} k_z·P1(τ − z), m2 = Σ_{z>τ} k_z·P2(z − τ) (P1, P2 the path covered in that time before and
+    after the crossing), and its distance from the legs is at most min(m1, m2)·sin θ (the foot on the longer
+    side's leg, within it when m·(1 + |cos θ|) is shorter than the leg). With the acceleration a0 at the
+    crossing, each side covers at most `gained_path(x, v, ∓a0, acc, jerk)` (U1, U2 in place of m1, m2);
+    a0² ≤ 2·jerk·v, or the speed on the other side would have to fall below zero. U1 rises and U2 falls with τ,
+    so their crossing, bisected to [lo, hi], bounds min(U1, U2) at every τ by min(U1(hi), U2(lo)); on an a0
+    interval [a_k, a_k+1] U1 takes −a_k and U2 a_k+1: the largest over the intervals bounds the deviation
+    (per unit sin θ) from above.
 
-    Everything scales with acc (v, a0, acc and jerk times λ: the path times λ), so one table over u = v/acc per
-    jerk/acc ratio (rounded up: more jerk, more path) serves every corner; a cap read from it is a grid point.
+    Everything scales with acc (v, a0, acc and jerk times λ: the path times λ), so one grid over u = v/acc per
+    jerk/acc ratio (rounded up: more jerk, more path) serves every corner, its bounds found when first asked;
+    a cap is a grid point.
     """
 
     U0, U_STEP, U_N = 1e-5, 1.01, 1050  # u = v/acc grid (s): 10 µs … 0.35 s
@@ -150,19 +153,20 @@ class CornerBound:
         k, z = self._k, self._z
         am = min(1.0, math.sqrt(2.0 * jerk * u))
         ag = np.linspace(-am, am, self.A_N + 1)[:, None]
-        a_lo, a_hi = -ag[:-1], ag[1:]  # the before side gains from −a0 ≤ −a_lo, the after side from a0 ≤ a_hi
+        g1, g2 = -ag[:-1], ag[1:]  # for a0 in [a_k, a_k+1]: the before side gains from −a0 ≤ −a_k, the after side
+        # from a0 ≤ a_k+1
 
         def u1(tau: np.ndarray) -> np.ndarray:
             d = tau - z
-            return (np.where(d > 0.0, self._path(np.maximum(d, 0.0), u, a_lo, jerk), 0.0) * k).sum(axis=1)
+            return (np.where(d > 0.0, self._path(np.maximum(d, 0.0), u, g1, jerk), 0.0) * k).sum(axis=1)
 
         def u2(tau: np.ndarray) -> np.ndarray:
             d = z - tau
-            return (np.where(d > 0.0, self._path(np.maximum(d, 0.0), u, a_hi, jerk), 0.0) * k).sum(axis=1)
+            return (np.where(d > 0.0, self._path(np.maximum(d, 0.0), u, g2, jerk), 0.0) * k).sum(axis=1)
 
-        # U1 rises and U2 falls with τ: their crossing is bisected, and min(U1(hi), U2(lo)) bounds min(m1, m2)
-        # at every τ (left of lo: U1(τ) ≤ U1(lo) < U2(lo) and U1(lo) ≤ U1(hi); right of hi: U2(τ) ≤ U2(hi) ≤ U1(hi),
-        # and U2(hi) ≤ U2(lo); between them min ≤ min(U1(hi), U2(lo)))
+        # U1 rises and U2 falls with τ: their crossing is bisected, and min(U1(hi), U2(lo)) bounds min(U1, U2) at
+        # every τ (left of lo: U1(τ) ≤ U1(lo) < U2(lo), U1(lo) ≤ U1(hi); right of hi: U2(τ) ≤ U2(hi) ≤ U1(hi),
+        # U2(hi) ≤ U2(lo); between them U1 ≤ U1(hi), U2 ≤ U2(lo))
         lo, hi = np.full((self.A_N, 1), z[0]), np.full((self.A_N, 1), z[-1])
         for _ in range(self.BISECT):
             mid = 0.5 * (lo + hi)
