@@ -330,6 +330,7 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
         """Reset: controlled stop along the path, then flush the queue once at rest."""
         self._stopping = True
         self.held = True
+        self.end_dwell()  # the axes stand in a dwell: nothing to brake, the stop is at once (decision M24-1)
         self._replan()
         if self.at_rest and self.plan is None:
             self._flush()
