@@ -88,13 +88,14 @@ class SignalStop(KeyboardInterrupt):
     def __init__(self, name: str) -> None:
         super().__init__(name)
         self.name = name
+        self.signal_name = name  # as a stopped campaign case's (CaseStopped): the campaign ends with its code (B117)
 
 
 @contextmanager
 def signals_end_command() -> Iterator[None]:
     """For the whole `hil` command (main thread): SIGTERM, SIGHUP and SIGQUIT whose handling is the default raise
-    SignalStop (a run's own stop_on_signals takes them over while it runs). An ignored signal (nohup) stays
-    ignored; the previous handlers come back at the end."""
+    SignalStop (a run's own stop_on_signals takes them over while it runs), and SIGTERM ignored at start too (B117).
+    An ignored SIGHUP (nohup) or SIGQUIT stays ignored; the previous handlers come back at the end."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return
@@ -103,8 +104,8 @@ def signals_end_command() -> Iterator[None]:
         raise SignalStop(signal.Signals(signum).name)
 
     previous = {}
-    for s in STOP_SIGNALS:
-        if s != signal.SIGINT and signal.getsignal(s) is signal.SIG_DFL:
+    for s in STOP_SIGNALS:  # SIGTERM ignored at start too: B94 makes it the command's always (B117)
+        if s != signal.SIGINT and _taken(s) and signal.getsignal(s) in (signal.SIG_DFL, signal.SIG_IGN):
             previous[s] = signal.signal(s, handler)
     try:
         yield
