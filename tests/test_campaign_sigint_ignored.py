@@ -72,6 +72,17 @@ print("interrupted:", outcome.interrupted, "rows:", len(outcome.rows), flush=Tru
 """
 
 
+def short_campaign(tmp_path: Path, script_text: str) -> tuple[Path, Path]:
+    """A script (`script_text`) and the campaign it runs: three short cases on the mill (overrides 50/100/150 %)."""
+    prog = tmp_path / "short.nc"
+    prog.write_text("G00 X10. Y0.\nG01 X30. F600.\nM30\n")
+    camp = tmp_path / "c.toml"
+    camp.write_text(f'[campaign]\nprograms = ["{prog}"]\nbenches = ["{MILL}"]\noverrides = [50, 100, 150]\n')
+    script = tmp_path / "between.py"
+    script.write_text(script_text)
+    return script, camp
+
+
 @pytest.mark.parametrize("when, rows", [("between", 1), ("disabling", 0)])
 def test_kill_int_between_two_runs_of_a_serial_campaign_started_with_sigint_ignored_is_not_lost(tmp_path, when, rows):
     """Between two cases (its row written, the next case not yet running) SIGINT, ignored at start, was lost: the
@@ -79,12 +90,7 @@ def test_kill_int_between_two_runs_of_a_serial_campaign_started_with_sigint_igno
     last cycles, while its standing drives are disabled: the run's handler let the disable finish (B95) and dropped
     it. The signal is sent by the campaign's process to itself at that moment, so the moment is exact. In the
     disable the first case's run ends as stopped by the signal: no row (B107), the same command runs it again."""
-    prog = tmp_path / "short.nc"
-    prog.write_text("G00 X10. Y0.\nG01 X30. F600.\nM30\n")
-    camp = tmp_path / "c.toml"
-    camp.write_text(f'[campaign]\nprograms = ["{prog}"]\nbenches = ["{MILL}"]\noverrides = [50, 100, 150]\n')
-    script = tmp_path / "between.py"
-    script.write_text(BETWEEN)
+    script, camp = short_campaign(tmp_path, BETWEEN)
     p = subprocess.run([sys.executable, str(script), str(camp), str(tmp_path / "out"), when], capture_output=True,
                        text=True, cwd=ROOT, env=dict(os.environ, PYTHONPATH=str(ROOT)), timeout=300,
                        preexec_fn=_ignoring_sigint)
@@ -119,26 +125,35 @@ def test_kill_int_during_a_run_of_a_serial_campaign_started_with_sigint_ignored_
 def test_kill_int_of_a_dask_campaign_started_with_sigint_ignored_stops_it_with_130(tmp_path):
     """The local cluster's campaign: its process ignored SIGINT from the start, so no KeyboardInterrupt ever came and
     it ran to its end. Now `kill -INT` of it (not of its group: a script's `kill -INT $!`) ends it as Ctrl-C does."""
-    from test_campaign_interrupt import DATA, _group_left, _workers
+    from test_campaign_interrupt import _group_left
 
-    for name in ("bench.toml", "short_turn.nc"):
-        shutil.copy(DATA / name, tmp_path / name)
-    # the stalled cases (feed override 0) run to max_time: the campaign is still busy at the signal
-    (tmp_path / "c.toml").write_text(
-        '[campaign]\nprograms = ["short_turn.nc"]\nbenches = ["bench.toml"]\nfaults = ["stall"]\nmax_time = 60\n'
-        'overrides = [50, 60, 70, 80]\n[faults]\nstall = ["t=0.2:set FEED_OVERRIDE=0"]\n')
-    out = tmp_path / "out"
-    p = subprocess.Popen([sys.executable, "-m", "hil.cli", "campaign", "c.toml", "--out", str(out), "--workers", "1"],
-                         cwd=tmp_path, env=dict(os.environ, PYTHONPATH=str(ROOT)), stdout=subprocess.PIPE,
-                         stderr=subprocess.PIPE, text=True, start_new_session=True, preexec_fn=_ignoring_sigint)
-    deadline = time.monotonic() + 120
-    while time.monotonic() < deadline and p.poll() is None and not _workers(p.pid):
-        time.sleep(0.1)
-    time.sleep(1.0)  # the worker takes its first case
-    assert p.poll() is None, p.communicate()
+    p = busy_dask_campaign(tmp_path, _ignoring_sigint)
     p.send_signal(signal.SIGINT)
     stdout, stderr = p.communicate(timeout=120)
     assert p.returncode == 130, stdout + stderr
     assert "Traceback" not in stderr and "hil campaign: interrupted; run the same command again to resume" in stderr
     assert int(stdout.split("cases", 1)[1].split()[0]) < 4
     assert _group_left(p.pid, 20) == []  # no worker outlives the campaign
+
+
+def busy_dask_campaign(tmp_path: Path, preexec) -> subprocess.Popen:
+    """`hil campaign --workers 1` in its own process group, started with `preexec` (the signal dispositions it
+    inherits), once its worker has taken its first case: the stalled cases (feed override 0) run to max_time, so
+    the campaign is still busy at a signal sent now."""
+    from test_campaign_interrupt import DATA, _workers
+
+    for name in ("bench.toml", "short_turn.nc"):
+        shutil.copy(DATA / name, tmp_path / name)
+    (tmp_path / "c.toml").write_text(
+        '[campaign]\nprograms = ["short_turn.nc"]\nbenches = ["bench.toml"]\nfaults = ["stall"]\nmax_time = 60\n'
+        'overrides = [50, 60, 70, 80]\n[faults]\nstall = ["t=0.2:set FEED_OVERRIDE=0"]\n')
+    p = subprocess.Popen([sys.executable, "-m", "hil.cli", "campaign", "c.toml", "--out", str(tmp_path / "out"),
+                          "--workers", "1"], cwd=tmp_path, env=dict(os.environ, PYTHONPATH=str(ROOT)),
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True,
+                         preexec_fn=preexec)
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline and p.poll() is None and not _workers(p.pid):
+        time.sleep(0.1)
+    time.sleep(1.0)  # the worker takes its first case
+    assert p.poll() is None, p.communicate()
+    return p

@@ -7,11 +7,9 @@ let the command run on to its end. Each test fails without B117."""
 from __future__ import annotations
 
 import os
-import shutil
 import signal
 import subprocess
 import sys
-import time
 from pathlib import Path
 
 import pyarrow.parquet as pq
@@ -21,12 +19,19 @@ import hil
 sys.path.insert(0, str(Path(__file__).resolve().parent))  # test_campaign_interrupt's helpers
 
 ROOT = Path(hil.__file__).resolve().parents[1]  # the deltahil under test, for the command's process
-MILL = ROOT / "benches" / "mill-3axis.toml"
 ENV = dict(os.environ, PYTHONPATH=str(ROOT))
 
 
 def _ignoring_sigterm() -> None:
     signal.signal(signal.SIGTERM, signal.SIG_IGN)
+
+
+def _script(script: Path, *args: Path) -> subprocess.CompletedProcess:
+    """The script in a process started with SIGTERM ignored."""
+    p = subprocess.run([sys.executable, str(script), *map(str, args)], capture_output=True, text=True, cwd=ROOT,
+                       env=ENV, timeout=300, preexec_fn=_ignoring_sigterm)
+    assert "Traceback" not in p.stderr, p.stderr[-800:]
+    return p
 
 
 def _rows(out: Path) -> list[dict]:
@@ -55,9 +60,7 @@ def test_kill_term_of_hil_run_outside_its_run_with_sigterm_ignored_at_start_stop
     script = tmp_path / "run.py"
     script.write_text(RUN)
     trace = tmp_path / "t.parquet"
-    p = subprocess.run([sys.executable, str(script), str(prog), str(trace)], capture_output=True, text=True,
-                       cwd=ROOT, env=ENV, timeout=300, preexec_fn=_ignoring_sigterm)
-    assert "Traceback" not in p.stderr, p.stderr[-800:]
+    p = _script(script, prog, trace)
     assert p.stdout.splitlines()[0] == "ignored at start: True"
     assert p.stdout.splitlines()[-1] == "code: 143", p.stdout + p.stderr[-500:]
     assert "hil run: stopped by SIGTERM" in p.stderr
@@ -83,16 +86,11 @@ print("code:", code, "ignored after:", signal.getsignal(signal.SIGTERM) is signa
 
 
 def test_kill_term_between_two_runs_of_a_serial_campaign_with_sigterm_ignored_at_start_stops_it_resumably(tmp_path):
-    prog = tmp_path / "short.nc"
-    prog.write_text("G00 X10. Y0.\nG01 X30. F600.\nM30\n")
-    camp = tmp_path / "c.toml"
-    camp.write_text(f'[campaign]\nprograms = ["{prog}"]\nbenches = ["{MILL}"]\noverrides = [50, 100, 150]\n')
-    script = tmp_path / "between.py"
-    script.write_text(BETWEEN)
+    from test_campaign_sigint_ignored import short_campaign
+
+    script, camp = short_campaign(tmp_path, BETWEEN)
     out = tmp_path / "out"
-    p = subprocess.run([sys.executable, str(script), str(camp), str(out)], capture_output=True, text=True,
-                       cwd=ROOT, env=ENV, timeout=300, preexec_fn=_ignoring_sigterm)
-    assert "Traceback" not in p.stderr, p.stderr[-800:]
+    p = _script(script, camp, out)
     lines = p.stdout.splitlines()
     assert lines[0] == "ignored at start: True" and lines[-1] == "code: 143 ignored after: True", p.stdout
     assert "hil campaign: stopped by SIGTERM; run the same command again to resume" in p.stderr
@@ -109,23 +107,10 @@ def test_kill_term_of_a_dask_campaign_with_sigterm_ignored_at_start_stops_it_wit
     """The local cluster: its runs are the workers', so the campaign's process never took SIGTERM and ran to its
     end (its workers, inheriting SIG_IGN, ignored the nanny's terminate too). Now `kill -TERM` of its pid ends it:
     143, no worker left, resumable."""
-    from test_campaign_interrupt import DATA, _group_left, _workers
+    from test_campaign_interrupt import _group_left
+    from test_campaign_sigint_ignored import busy_dask_campaign
 
-    for name in ("bench.toml", "short_turn.nc"):
-        shutil.copy(DATA / name, tmp_path / name)
-    # the stalled cases (feed override 0) run to max_time: the campaign is still busy at the signal
-    (tmp_path / "c.toml").write_text(
-        '[campaign]\nprograms = ["short_turn.nc"]\nbenches = ["bench.toml"]\nfaults = ["stall"]\nmax_time = 60\n'
-        'overrides = [50, 60, 70, 80]\n[faults]\nstall = ["t=0.2:set FEED_OVERRIDE=0"]\n')
-    out = tmp_path / "out"
-    p = subprocess.Popen([sys.executable, "-m", "hil.cli", "campaign", "c.toml", "--out", str(out), "--workers", "1"],
-                         cwd=tmp_path, env=ENV, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                         start_new_session=True, preexec_fn=_ignoring_sigterm)
-    deadline = time.monotonic() + 120
-    while time.monotonic() < deadline and p.poll() is None and not _workers(p.pid):
-        time.sleep(0.1)
-    time.sleep(1.0)  # the worker takes its first case
-    assert p.poll() is None, p.communicate()
+    p = busy_dask_campaign(tmp_path, _ignoring_sigterm)
     p.send_signal(signal.SIGTERM)
     try:
         stdout, stderr = p.communicate(timeout=120)
