@@ -6,7 +6,8 @@ modules run as Python (virtual_bus/kernels.py and nc/motion/compiled.py say whic
 from setuptools import Extension, setup
 
 # The planner's hot modules (decision bench B115): one unit, nc/motion/compiled.py's MODULES, in the same order.
-PLANNER = ["block", "blending", "lookahead", "shares", "planner"]
+PLANNER = ["block", "blending", "lookahead", "shares", "planner",
+           "profile", "sample_rows", "planner_cruise", "planner_runs", "smoothing"]
 KERNELS = ["virtual_bus/drive_kernel.py"] + [f"nc/motion/{name}.py" for name in PLANNER]
 
 

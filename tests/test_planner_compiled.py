@@ -6,6 +6,7 @@ for the modules together, and a stale build gives way to its source."""
 
 from __future__ import annotations
 
+import ast
 import json
 import os
 import subprocess
@@ -73,8 +74,9 @@ def test_one_stale_or_missing_build_makes_every_module_run_its_source(tmp_path, 
 
 
 def test_setup_compiles_the_modules_the_loader_decides_for():
-    text = (ROOT / "setup.py").read_text()
-    line = next(ln for ln in text.splitlines() if ln.startswith("PLANNER = "))
-    assert tuple(json.loads(line.split("=", 1)[1].strip().replace("'", '"'))) == compiled.MODULES
+    tree = ast.parse((ROOT / "setup.py").read_text())
+    planner = next(node.value for node in tree.body if isinstance(node, ast.Assign)
+                   and any(isinstance(t, ast.Name) and t.id == "PLANNER" for t in node.targets))
+    assert tuple(ast.literal_eval(planner)) == compiled.MODULES
     pxd = sorted(p.stem for p in (ROOT / "nc" / "motion").glob("*.pxd"))
     assert pxd == sorted(compiled.MODULES)
