@@ -7,6 +7,11 @@ import math
 
 import numpy as np
 
+try:
+    import cython  # compiled: the types below (setup.py, decision bench B115)
+except ImportError:  # run as Python without Cython: they do nothing
+    from nc.motion import cython_shadow as cython
+
 from nc.motion.block import Block
 from nc.motion.plan_state import CHUNK, _Plan
 
@@ -87,6 +92,10 @@ class CruiseSampling:
             return None
         return _Plan("cruise", None, math.inf, t0, queued=self._pushes)
 
+    @cython.locals(b=Block, T=cython.double, v=cython.double, s0=cython.double, t_next=cython.double,
+                   duration=cython.double, length=cython.double, seg_len=cython.double, x=cython.double,
+                   u=cython.double, k=cython.Py_ssize_t, nb=cython.Py_ssize_t, n=cython.Py_ssize_t,
+                   i=cython.Py_ssize_t, a=cython.Py_ssize_t, m=cython.Py_ssize_t, rows=cython.Py_ssize_t, line=cython.bint)
     def _sample_cruise(self, p: _Plan) -> None:
         """The rows of a cruise, whole blocks up to at least ROWS rows: each block as its own solve gives them
         (a constant-speed profile from s0 at the plan time t0, s = s0 + v·t, sampled a CHUNK at a time while
@@ -109,7 +118,7 @@ class CruiseSampling:
             start = seg.start.tolist()
             # _near(seg.start, the last block's end) on the lists, and the snap (session 12: each block's points
             # read once as floats)
-            if k and all(abs(x - y) <= 1e-6 + 1e-5 * abs(y) for x, y in zip(start, end)):
+            if k and all(abs(q - r) <= 1e-6 + 1e-5 * abs(r) for q, r in zip(start, end)):
                 seg.start = blocks[k - 1].seg.end.copy()
                 start = end
             end = seg.end.tolist()
@@ -122,18 +131,33 @@ class CruiseSampling:
                 if CHUNK < n:  # min(n, CHUNK)
                     n = CHUNK
                 # t = t_next + T·arange(n), s = s0 + clip(t, 0, duration)·v and a line's points at clip(s, 0,
-                # length) element by element: the same operations, so the same bits (nc.motion.sample_rows)
-                s = [s0 + (duration if duration <= x else x) * v
-                     for x in [0.0 if 0.0 >= x else x for x in [t_next + T * i for i in range(n)]]]
-                t_next = (t_next + T * (n - 1)) + T
+                # length) element by element: the same operations, so the same bits (nc.motion.sample_rows);
+                # loops, not comprehensions, so that compiled the floats stay C doubles
                 length = b.length
-                sc = [length if length <= x else x for x in [0.0 if 0.0 >= x else x for x in s]]
-                if seg.kind == "line" and seg.length > 0.0:
-                    seg_len = seg.length
-                    pos += [[q + u * e for q, e in zip(start, d)] for u in [x / seg_len for x in sc]]
-                else:
+                line = seg.kind == "line" and seg.length > 0.0
+                seg_len = seg.length if line else 1.0
+                m = len(start)
+                sc = []
+                for i in range(n):
+                    x = t_next + T * i
+                    if 0.0 >= x:
+                        x = 0.0
+                    if duration <= x:
+                        x = duration
+                    x = s0 + x * v
+                    st.append(x)
+                    if 0.0 >= x:
+                        x = 0.0
+                    if length <= x:
+                        x = length
+                    if line:
+                        u = x / seg_len
+                        pos.append([start[a] + u * d[a] for a in range(m)])
+                    else:
+                        sc.append(x)
+                if not line:
                     pos += seg.points(np.array(sc)).tolist()
-                st += s
+                t_next = (t_next + T * (n - 1)) + T
                 offs += [k] * n
                 lines += [b.move.line] * n
                 rows += n

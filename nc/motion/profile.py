@@ -9,10 +9,14 @@ Never pass intermediate positions to ruckig: the community build sends those to 
 
 from __future__ import annotations
 
-from bisect import bisect_right
 from dataclasses import dataclass
 
 import numpy as np
+
+try:
+    import cython  # compiled: the types below (setup.py, decision bench B115)
+except ImportError:  # run as Python without Cython: they do nothing
+    from nc.motion import cython_shadow as cython
 from ruckig import ControlInterface, InputParameter, Result, Ruckig, Synchronization, Trajectory
 
 from nc.alarms import NcAlarm
@@ -101,6 +105,9 @@ class Piecewise:
         """DoF 0's velocity at the end of its last phase."""
         return float(self.v[0][-1])
 
+    @cython.locals(t=cython.double, dur=cython.double, dt=cython.double, jk=cython.double, ak=cython.double,
+                   vk=cython.double, k=cython.Py_ssize_t, lo=cython.Py_ssize_t, hi=cython.Py_ssize_t,
+                   mid=cython.Py_ssize_t, x=cython.double, pk=cython.double)
     def at(self, t: float) -> tuple[float, float, float]:
         """sample(np.array([t])) of DoF 0 on plain floats: the same operations in the same order, so the same
         bits (numpy's maximum/minimum keep their first operand on a tie, searchsorted is bisect_right), without
@@ -113,12 +120,22 @@ class Piecewise:
         _, t0, p, v, a, j = c
         t = 0.0 if 0.0 >= t else t
         t = dur if dur <= t else t
-        k = bisect_right(t0, t) - 1
+        # bisect_right(t0, t) - 1, at least 0, its bisection spelt out (compiled: on C doubles)
+        lo, hi = 0, len(t0)
+        while lo < hi:
+            mid = (lo + hi) // 2
+            x = t0[mid]
+            if t < x:
+                hi = mid
+            else:
+                lo = mid + 1
+        k = lo - 1
         if k < 0:
             k = 0
-        dt = t - t0[k]
-        jk, ak, vk = j[k], a[k], v[k]
-        return (p[k] + dt * (vk + dt * (ak / 2.0 + dt * jk / 6.0)), vk + dt * (ak + dt * jk / 2.0), ak + dt * jk)
+        x = t0[k]
+        dt = t - x
+        jk, ak, vk, pk = j[k], a[k], v[k], p[k]
+        return (pk + dt * (vk + dt * (ak / 2.0 + dt * jk / 6.0)), vk + dt * (ak + dt * jk / 2.0), ak + dt * jk)
 
     def sample(self, t: np.ndarray, dof: int = 0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(position, velocity, acceleration) of one DoF at times t (clamped to [0, duration])."""
@@ -167,6 +184,8 @@ class _OneDof(Piecewise):
         return self._rows[2][-1] if self._m is None else float(self._m[2, -1])
 
 
+@cython.locals(t=cython.double, h=cython.double, k=cython.Py_ssize_t, pl=cython.double, vl=cython.double,
+               al=cython.double, jl=cython.double, pe=cython.double, ve=cython.double, ae=cython.double)
 def _phases(pr) -> tuple[list, list, list, list, list]:
     t0, p, v, a, j = [], [], [], [], []
     t = 0.0
@@ -191,9 +210,10 @@ def _phases(pr) -> tuple[list, list, list, list, list]:
     # The final state, integrated from the last phase (pf is not kept for velocity control).
     if len(t0) > 0:
         h = t - t0[-1]
-        pe = p[-1] + h * (v[-1] + h * (a[-1] / 2.0 + h * j[-1] / 6.0))
-        ve = v[-1] + h * (a[-1] + h * j[-1] / 2.0)
-        ae = a[-1] + h * j[-1]
+        pl, vl, al, jl = p[-1], v[-1], a[-1], j[-1]
+        pe = pl + h * (vl + h * (al / 2.0 + h * jl / 6.0))
+        ve = vl + h * (al + h * jl / 2.0)
+        ae = al + h * jl
     else:
         pe, ve, ae = pp[0], pv[0], pa[0]
     t0.append(t), p.append(pe), v.append(ve), a.append(ae), j.append(0.0)

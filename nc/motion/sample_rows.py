@@ -17,6 +17,11 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+try:
+    import cython  # compiled: the types below (setup.py, decision bench B115)
+except ImportError:  # run as Python without Cython: they do nothing
+    from nc.motion import cython_shadow as cython
+
 from nc.motion.plan_state import _Plan
 
 if TYPE_CHECKING:
@@ -25,6 +30,10 @@ if TYPE_CHECKING:
 FEW = 6  # rows kept up to which plain floats beat numpy (a row ≈ 1 µs, numpy's sample ≈ 25 µs a call)
 
 
+@cython.locals(T=cython.double, t_next=cython.double, base=cython.double, length=cython.double, x=cython.double,
+               s=cython.double, u=cython.double, seg_len=cython.double, n=cython.Py_ssize_t, keep=cython.Py_ssize_t,
+               lo=cython.Py_ssize_t, hi=cython.Py_ssize_t, mid=cython.Py_ssize_t, i=cython.Py_ssize_t,
+               m=cython.Py_ssize_t, k=cython.Py_ssize_t)
 def few_rows(pl: "Planner", p: _Plan, n: int) -> bool:
     """`Planner._sample(p, n)` for a path or ramp plan, when it keeps at most FEW rows or re-solves at the next
     block; False (nothing changed) where `_sample` must run."""
@@ -35,6 +44,7 @@ def few_rows(pl: "Planner", p: _Plan, n: int) -> bool:
     length = b.length
     rows: dict[int, tuple[float, float, float]] = {}
 
+    @cython.locals(i=cython.Py_ssize_t, s=cython.double)
     def row(i: int) -> tuple[float, float, float]:
         r = rows.get(i)
         if r is None:
@@ -61,7 +71,8 @@ def few_rows(pl: "Planner", p: _Plan, n: int) -> bool:
         lo, hi = 0, n
         while lo < hi:
             mid = (lo + hi) >> 1
-            if x < row(mid)[0]:
+            s = row(mid)[0]
+            if x < s:
                 hi = mid
             else:
                 lo = mid + 1
@@ -76,11 +87,13 @@ def few_rows(pl: "Planner", p: _Plan, n: int) -> bool:
     start = seg.start.tolist()
     d = (seg.end - seg.start).tolist()
     seg_len = seg.length
+    m = len(start)
     pos = []
-    for s, _, _ in got:
+    for r in got:
+        s = r[0]
         s = 0.0 if 0.0 >= s else s
         u = (length if length <= s else s) / seg_len
-        pos.append([q + u * e for q, e in zip(start, d)])
+        pos.append([start[k] + u * d[k] for k in range(m)])
     p.emitted = True
     pl._buf_pos = np.array(pos)
     pl._buf_vel = np.array([r[1] for r in got])

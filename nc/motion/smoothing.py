@@ -18,6 +18,11 @@ from collections import deque
 
 import numpy as np
 
+try:
+    import cython  # compiled: the types below (setup.py, decision bench B115)
+except ImportError:  # run as Python without Cython: they do nothing
+    from nc.motion import cython_shadow as cython
+
 
 class PositionFilter:
     def __init__(self, n1: int, n2: int, position: np.ndarray) -> None:
@@ -78,6 +83,9 @@ class PositionFilter:
             return [p(row, 1.0) for row in rows]
         return [p(row, lam) for row, lam in zip(rows, lams)]
 
+    @cython.locals(n1=cython.Py_ssize_t, n2=cython.Py_ssize_t, x0=cython.double, x1=cython.double,
+                   x2=cython.double, s0=cython.double, s1=cython.double, s2=cython.double, o0=cython.double,
+                   o1=cython.double, o2=cython.double, t0=cython.double, t1=cython.double, t2=cython.double)
     def _push(self, row: list[float], lam: float) -> list[float]:
         same = row == self._last
         if same and self._still >= self.span:
@@ -99,16 +107,17 @@ class PositionFilter:
             s2 += x2 - o2
             self._s1 = [s0, s1, s2]
             self._w1.append(row)
-            x0, x1, x2 = y1 = [s0 / n1, s1 / n1, s2 / n1]
+            x0, x1, x2 = s0 / n1, s1 / n1, s2 / n1
+            y1 = [x0, x1, x2]
             t0, t1, t2 = self._s2
             o0, o1, o2 = self._w2[0]
-            self._s2 = s2 = [t0 + (x0 - o0), t1 + (x1 - o1), t2 + (x2 - o2)]
+            self._s2 = sums = [t0 + (x0 - o0), t1 + (x1 - o1), t2 + (x2 - o2)]
             self._w2.append(y1)
         else:
-            self._s1 = s1 = [s + (a - b) for s, a, b in zip(self._s1, row, self._w1[0])]
+            self._s1 = sums1 = [s + (a - b) for s, a, b in zip(self._s1, row, self._w1[0])]
             self._w1.append(row)
-            y1 = [s / n1 for s in s1]
-            self._s2 = s2 = [s + (a - b) for s, a, b in zip(self._s2, y1, self._w2[0])]
+            y1 = [s / n1 for s in sums1]
+            self._s2 = sums = [s + (a - b) for s, a, b in zip(self._s2, y1, self._w2[0])]
             self._w2.append(y1)
         if self._still >= self.span:
             # Constant input for a whole window: the exact value, free of summation round-off.
@@ -116,7 +125,7 @@ class PositionFilter:
             self.reset(row)
             self._recent = (recent[1], recent[2], row)
             return row
-        out = [s2[0] / n2, s2[1] / n2, s2[2] / n2] if len(s2) == 3 else [s / n2 for s in s2]
+        out = [sums[0] / n2, sums[1] / n2, sums[2] / n2] if len(sums) == 3 else [s / n2 for s in sums]
         if lam != 1.0 and self.lag is not None:
             d = self._w1[n1 - 1 - self.lag]
             out = [p + lam * (f - p) for p, f in zip(d, out)]
