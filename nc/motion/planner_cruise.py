@@ -95,7 +95,8 @@ class CruiseSampling:
     @cython.locals(b=Block, T=cython.double, v=cython.double, s0=cython.double, t_next=cython.double,
                    duration=cython.double, length=cython.double, seg_len=cython.double, x=cython.double,
                    u=cython.double, k=cython.Py_ssize_t, nb=cython.Py_ssize_t, n=cython.Py_ssize_t,
-                   i=cython.Py_ssize_t, a=cython.Py_ssize_t, m=cython.Py_ssize_t, rows=cython.Py_ssize_t, line=cython.bint)
+                   i=cython.Py_ssize_t, a=cython.Py_ssize_t, m=cython.Py_ssize_t, rows=cython.Py_ssize_t,
+                   line=cython.bint)
     def _sample_cruise(self, p: _Plan) -> None:
         """The rows of a cruise, whole blocks up to at least ROWS rows: each block as its own solve gives them
         (a constant-speed profile from s0 at the plan time t0, s = s0 + v·t, sampled a CHUNK at a time while

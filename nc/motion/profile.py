@@ -12,12 +12,12 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from ruckig import ControlInterface, InputParameter, Result, Ruckig, Synchronization, Trajectory
 
 try:
     import cython  # compiled: the types below (setup.py, decision bench B115)
 except ImportError:  # run as Python without Cython: they do nothing
     from nc.motion import cython_shadow as cython
-from ruckig import ControlInterface, InputParameter, Result, Ruckig, Synchronization, Trajectory
 
 from nc.alarms import NcAlarm
 
