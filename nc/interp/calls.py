@@ -260,6 +260,7 @@ class CallsMixin:
         self.interrupt_program = int(p.value)
 
     def _start_interrupt(self) -> Iterator[Event]:
+        self._lean_origin = None
         st = self.state
         if st.comp in (41, 42) or st.scaling:
             raise NcAlarm(0x0005, "M96 interrupt while G41/G42 or G51 is active")

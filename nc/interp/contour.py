@@ -67,4 +67,5 @@ class ContourMixin:
         twin.stack = list(self.stack)
         twin.on_statement = None
         twin._lean = None  # the lane holds the interpreter it runs for (nc.interp.lean)
+        twin._lean_origin = None  # found again from the twin's own state
         return twin

@@ -49,6 +49,7 @@ class ControlMixin:
         """Run one macro statement; the Sync it calls for (a write to a live # variable), else None.
         A plain function, not a generator: statements are most blocks of a macro program (issue 16)."""
         s = block.stmt
+        self._lean_origin = None  # the lean lane asks for its plain state again (nc.interp.lean)
         if self.on_statement is not None:
             self.on_statement(block, self.stack[-1].program.name)
         if self.budget is not None:

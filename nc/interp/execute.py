@@ -300,6 +300,7 @@ _PLAN_LIMIT = 4096  # blocks whose plan is remembered; then the memo starts over
 class ExecuteMixin:
     # ---- one block -----------------------------------------------------------------------------
     def _execute(self, raw: Block) -> Iterator[Event]:
+        self._lean_origin = None  # the lean lane asks for its plain state again (nc.interp.lean)
         if raw.stmt is not None:  # a macro statement (ControlMixin); `_run` runs most of them itself
             ev = self._statement(raw)
             if ev is not None:
@@ -394,6 +395,7 @@ class ExecuteMixin:
 
     def _reset_at_end(self) -> None:
         """M02/M30: G92/G50 shift, length comp, scaling and the tool offset number are cancelled."""
+        self._lean_origin = None
         self.frames.set_shift = {}
         st = self.state
         st.length_comp = 49

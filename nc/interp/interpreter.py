@@ -101,6 +101,9 @@ class Interpreter(ExecuteMixin, ReadingMixin, ModalMixin, MotionMixin, NonModalM
         self.corner_pending = False  # a ,C/,R block waits for its motion block (set by expand_corners)
         self._bulk_skip: tuple | None = None  # (blocks, first, end): a run nc.interp.bulk found too short
         self._lean: LeanLane | None = None  # plain motion lines run from their text (nc.interp.lean)
+        # the lean lane's work origin while the state is its plain one, None when anything may have changed
+        # that (every block `_execute` or `_statement` runs, a system variable written, a run begun)
+        self._lean_origin: dict[str, float] | None = None
 
     # ---- public ---------------------------------------------------------------------------
 
@@ -143,6 +146,7 @@ class Interpreter(ExecuteMixin, ReadingMixin, ModalMixin, MotionMixin, NonModalM
 
     def _run(self, program: Program) -> Iterator[Event]:
         self.program_name = program.name
+        self._lean_origin = None
         self.stack = [Frame(program)]
         if not self._own_store and program.store is not None:
             self.store = program.store

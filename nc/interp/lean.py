@@ -40,20 +40,22 @@ _G_MOTION = {"0": 0, "00": 0, "000": 0, "1": 1, "01": 1, "001": 1}  # G00 / G01 
 _UNSEEN = object()
 _TEXTS = 4096  # line texts whose shape is kept; then the memo starts over (memory flat)
 NOTHING = object()  # `take`: the line ran and moved nothing (`G1 F100`): no event, as block by block
+MISS = object()  # a shape's `run`: the line is not of that shape
 
 
 class _Shape:
     """The letters of a line in order and what each is: one compiled pattern reads a line of that
     shape (a CAM run is mostly one shape)."""
 
-    __slots__ = ("match", "letters", "n", "g", "f", "axes")
+    __slots__ = ("match", "letters", "n", "g", "f", "axes", "run")
 
     def __init__(self, letters: tuple[str, ...], n: bool, g: int | None, f: int | None,
-                 axes: tuple[tuple[str, int], ...]) -> None:
+                 axes: tuple[tuple[str, int], ...], run: Callable[..., object]) -> None:
         body = r"[ \t]*" + "".join((r"[Nn]([0-9]+)[ \t]*" if c == "N" else f"[{c}{c.lower()}]" + _NUM)
                                     for c in letters)
         self.match = re.compile(body).fullmatch
         self.letters, self.n, self.g, self.f, self.axes = letters, n, g, f, axes
+        self.run = run  # `_compiled`: the line of this shape run, straight-line code
 
 
 class LeanLane:
@@ -116,7 +118,10 @@ class LeanLane:
                 axes.append((c, k))
             else:
                 return None
-        return _Shape(letters, bool(letters) and letters[0] == "N", g, f, tuple(axes))
+        shape = _Shape(letters, bool(letters) and letters[0] == "N", g, f, tuple(axes),
+                       _compiled(letters, g, f, tuple(axes), self.ip.axes, self.diameter))
+        shape.run.__globals__.update(SHAPE=shape, MATCH=shape.match)  # the LineBlock's words are read from SHAPE
+        return shape
 
     def _eligible(self) -> bool:
         """The modal state in which such a line does nothing but set F / G00-G01 and move."""
@@ -130,96 +135,126 @@ class LeanLane:
         """Run the plain line `raw` at `fr.pc == pc`: its Move, NOTHING when it moved nothing, or None
         (nothing done) when the general path must run it."""
         shape = self.last
-        m = shape.match(raw) if shape is not None else None
-        if m is None:
-            # a line of another shape: its shape by its text (a line the lane refuses, `M99` of a macro
-            # called 5,000 times, is refused by one look-up), else by its letters
-            shape = self.texts.get(raw, _UNSEEN)
+        if shape is not None:  # a CAM run is mostly lines of one shape: tried first
+            ev = shape.run(self, self.ip, fr, pc, raw, limit)
+            if ev is not MISS:
+                return ev
+        # a line of another shape: its shape by its text (a line the lane refuses, `M99` of a macro
+        # called 5,000 times, is refused by one look-up), else by its letters
+        shape = self.texts.get(raw, _UNSEEN)
+        if shape is _UNSEEN:
+            letters = tuple(c.upper() for c in _LETTER.findall(raw))
+            shape = self.shapes.get(letters, _UNSEEN)
             if shape is _UNSEEN:
-                letters = tuple(c.upper() for c in _LETTER.findall(raw))
-                shape = self.shapes.get(letters, _UNSEEN)
-                if shape is _UNSEEN:
-                    shape = self.shapes[letters] = self._shape(letters)
-                if len(self.texts) >= _TEXTS:
-                    self.texts.clear()
-                self.texts[raw] = shape
-            if shape is None:
-                self.lines(fr.program.blocks)[1].add(pc)  # never taken: `_run` no longer asks
-                return None
-            m = shape.match(raw)  # type: ignore[union-attr]
-            if m is None:
-                return None
-            self.last = shape  # type: ignore[assignment]
-        ip = self.ip
-        if ip._executed >= limit or not self._eligible():
+                shape = self.shapes[letters] = self._shape(letters)
+            if len(self.texts) >= _TEXTS:
+                self.texts.clear()
+            self.texts[raw] = shape
+        if shape is None:
+            self.lines(fr.program.blocks)[1].add(pc)  # never taken: `_run` no longer asks
             return None
-        vals = m.groups()
-        st = ip.state
-        motion = st.motion
-        if shape.g is not None:
-            motion = _G_MOTION.get(vals[shape.g])
-            if motion is None or not self._g_ok():
-                return None
-        feed = st.feed
-        if shape.f is not None:
-            feed = float(vals[shape.f])
-            if feed < 0:
-                return None  # 0x0223 from the general path
-        # ---- the target: `_plain_geometry`'s arithmetic, step for step
-        axes = ip.axes
-        origin = ip.frames.origins(st.wcs, axes)
-        diameter = self.diameter
-        position = ip.position
-        if diameter:
-            work = {}
-            for a in axes:
-                v = position.get(a, 0.0) - origin[a]
-                work[a] = v * 2.0 if a in diameter else v
-        else:  # a mill: no axis in diameter (the same sums, without asking per axis)
-            work = {a: position.get(a, 0.0) - origin[a] for a in axes}
-        for a, k in shape.axes:
-            text = vals[k]
-            if "." in text:
-                work[a] = float(text)
-            else:  # the decimal-point rule (N8.018 Bit10, decisions A4)
-                work[a] = ip.distance(Word(a, float(text), a + text, False), a)
-        moved = bool(shape.axes)
-        if moved:
-            if motion == 1:
-                if feed is None or feed == 0.0:
-                    return None  # N1.042's default F, or 0x1001: the general path
-                mfeed = feed * 1.0
-            machine = {}
-            for a in axes:
-                v = work[a]
-                v = (v / 2.0 if diameter and a in diameter else v) + origin[a]
-                if not -1e9 <= v <= 1e9:  # NaN, an infinity, or |v| > 1e9 (isfinite, abs): the general path's
-                    return None  # 0x120E
-                machine[a] = v
-        # ---- committed: the state the general path leaves
-        fr.pc = pc + 1
-        ip._executed += 1
-        ip.program_name = fr.program.name
-        ip.block = LineBlock(fr.program.blocks.line(pc), raw, shape, vals)
-        if shape.g is not None:
-            st.groups[1] = float(vals[shape.g])
-            st.motion = motion
-        if shape.f is not None:
-            st.feed = feed
-        if not moved:
-            return NOTHING
-        ip.unit_locked = True
-        if motion == 0:
-            mv = Move("rapid", ip.block.line, raw, dict(position), machine, work, None, None, None, None, False,
-                      PLANES[st.plane], st.exact_stop_modal, None, 0.0, 0.0, 0.0, ip.program_name)
-        else:
-            mv = Move("line", ip.block.line, raw, dict(position), machine, work, None, None, mfeed, None,
-                      st.per_rev, PLANES[st.plane], st.exact_stop_modal, None, 0.0, 0.0, 0.0, ip.program_name)
-        if st.css:
-            mv.css = st.surface_speed
-        ip.position = dict(machine)
-        ip.last_target = dict(work)
-        return mv
+        ev = shape.run(self, self.ip, fr, pc, raw, limit)  # type: ignore[union-attr]
+        if ev is MISS:
+            return None
+        self.last = shape  # type: ignore[assignment]
+        return ev
+
+    def origin(self) -> dict[str, float] | None:
+        """The work origin while the state is the plain one (`_eligible`), else None. Kept until anything
+        else may have changed either: a block the general path ran (`_execute`, `_statement`), a system
+        variable written, a run begun (they clear `Interpreter._lean_origin`)."""
+        ip = self.ip
+        if not self._eligible():
+            return None
+        origin = ip._lean_origin = ip.frames.origins(ip.state.wcs, ip.axes)
+        return origin
+
+
+def _compiled(letters: tuple[str, ...], g: int | None, f: int | None, programmed: tuple[tuple[str, int], ...],
+              axes: tuple[str, ...], diameter: frozenset[str] | tuple[str, ...]) -> Callable[..., object]:
+    """The line of one shape run as straight-line code, built once per shape and profile (as dataclasses
+    builds `__init__`): what a loop over the axes did for every line (which axis is programmed, which
+    in diameter, a dict per step) is decided here. Step for step the general path's arithmetic
+    (`_plain_geometry`): work = where the axis stands (doubled in diameter) or the word, machine =
+    work (halved in diameter) + origin, refused out of +-1e9; the same refusals, then the same state."""
+    words = dict(programmed)
+    moved = bool(programmed)
+    src = ["def run(lane, ip, fr, pc, raw, limit):",
+           "    m = MATCH(raw)",
+           "    if m is None:",
+           "        return MISS  # another shape",
+           "    if ip._executed >= limit or ip.corner_pending:",
+           "        return None",
+           "    origin = ip._lean_origin",
+           "    if origin is None:",
+           "        origin = lane.origin()",
+           "        if origin is None:",
+           "            return None",
+           "    vals = m.groups()",
+           "    st = ip.state"]
+    if g is None:
+        src.append("    motion = st.motion")
+    else:
+        src += [f"    motion = _G_MOTION.get(vals[{g}])",
+                "    if motion is None or not lane._g_ok():",
+                "        return None"]
+    if f is None:
+        src.append("    feed = st.feed")
+    else:
+        src += [f"    feed = float(vals[{f}])",
+                "    if feed < 0:",
+                "        return None  # 0x0223 from the general path"]
+    if moved:
+        src.append("    position = ip.position")
+        for i, a in enumerate(axes):
+            src.append(f"    o{i} = origin[{a!r}]")
+            if a in words:
+                src += [f"    t = vals[{words[a]}]",
+                        f"    w{i} = float(t) if '.' in t else "  # the decimal-point rule (N8.018 Bit10, decisions A4)
+                        f"ip.distance(Word({a!r}, float(t), {a!r} + t, False), {a!r})"]
+            elif a in diameter:
+                src.append(f"    w{i} = (position.get({a!r}, 0.0) - o{i}) * 2.0")
+            else:
+                src.append(f"    w{i} = position.get({a!r}, 0.0) - o{i}")
+        src += ["    if motion == 1:",
+                "        if feed is None or feed == 0.0:",
+                "            return None  # N1.042's default F, or 0x1001: the general path",
+                "        mfeed = feed * 1.0"]
+        for i, a in enumerate(axes):
+            src += [f"    m{i} = " + (f"w{i} / 2.0 + o{i}" if a in diameter else f"w{i} + o{i}"),
+                    f"    if not -1e9 <= m{i} <= 1e9:",
+                    "        return None  # NaN, an infinity or |v| > 1e9: the general path's 0x120E"]
+    src += ["    fr.pc = pc + 1",
+            "    ip._executed += 1",
+            "    program = fr.program",
+            "    name = ip.program_name = program.name",
+            "    line = program.blocks.line(pc)",
+            "    ip.block = LineBlock(line, raw, SHAPE, vals)"]
+    if g is not None:
+        src += [f"    st.groups[1] = float(vals[{g}])", "    st.motion = motion"]
+    if f is not None:
+        src.append("    st.feed = feed")
+    if not moved:
+        src.append("    return NOTHING")
+    else:
+        def cols(p: str) -> str:
+            return "{" + ", ".join(f"{a!r}: {p}{i}" for i, a in enumerate(axes)) + "}"
+        src += ["    ip.unit_locked = True",
+                "    if motion == 0:",
+                f"        mv = Move('rapid', line, raw, dict(position), {cols('m')}, {cols('w')}, None, None, None,"
+                " None, False, PLANES[st.plane], st.exact_stop_modal, None, 0.0, 0.0, 0.0, name)",
+                "    else:",
+                f"        mv = Move('line', line, raw, dict(position), {cols('m')}, {cols('w')}, None, None, mfeed,"
+                " None, st.per_rev, PLANES[st.plane], st.exact_stop_modal, None, 0.0, 0.0, 0.0, name)",
+                "    if st.css:",
+                "        mv.css = st.surface_speed",
+                f"    ip.position = {cols('m')}",
+                f"    ip.last_target = {cols('w')}",
+                "    return mv"]
+    space = {"_G_MOTION": _G_MOTION, "Word": Word, "Move": Move, "PLANES": PLANES, "NOTHING": NOTHING,
+             "LineBlock": LineBlock, "SHAPE": None, "MATCH": None, "MISS": MISS}
+    exec(compile("\n".join(src) + "\n", f"<lean line {''.join(letters)}>", "exec"), space)
+    return space["run"]
 
 
 _WORDS = Block.__dict__["words"]  # Block's slots: LineBlock fills them when first read

@@ -222,6 +222,7 @@ class SystemVariables:
     def write(self, n: int, v: float | None) -> bool:
         val = 0.0 if v is None else float(v)
         i = self.i
+        i._lean_origin = None  # offsets and tool data: the lean lane's origin is found again (nc.interp.lean)
         if i.profile.legacy:
             if 3000 <= n <= 3646:
                 a_idx, off = divmod(n - 3000, 128)
