@@ -21,8 +21,9 @@ see the same events at the same moments. tests/test_interp_lean.py compares both
 from __future__ import annotations
 
 import re
-from collections.abc import Callable
-from typing import TYPE_CHECKING
+from collections.abc import Callable, Mapping
+from types import MappingProxyType
+from typing import TYPE_CHECKING, Any
 
 from nc.interp.gcodes import lookup
 from nc.interp.records import _transforms
@@ -249,7 +250,7 @@ def _compiled(letters: tuple[str, ...], g: int | None, f: int | None, programmed
                 "    if st.css:",
                 "        mv.css = st.surface_speed",
                 f"    ip.position = {cols('m')}",
-                f"    ip.last_target = {cols('w')}",
+                "    ip.last_target = mv.work  # never changed in place (rebound by every block that moves)",
                 "    return mv"]
     space = {"_G_MOTION": _G_MOTION, "Word": Word, "Move": Move, "PLANES": PLANES, "NOTHING": NOTHING,
              "LineBlock": LineBlock, "SHAPE": None, "MATCH": None, "MISS": MISS}
@@ -257,6 +258,7 @@ def _compiled(letters: tuple[str, ...], g: int | None, f: int | None, programmed
     return space["run"]
 
 
+_NO_COMMA: Mapping[str, Any] = MappingProxyType({})  # LineBlock's comma and comma_expr
 _WORDS = Block.__dict__["words"]  # Block's slots: LineBlock fills them when first read
 _N = Block.__dict__["n"]
 
@@ -267,16 +269,18 @@ class LineBlock(Block):
     text, the empty comma: nc.interp.corners, alarms, M96) needs none, and making them was a fifth
     of the lane's time. Equal to, and printed as, the Block the parser makes of the line."""
 
-    __slots__ = ("_match",)  # (shape, groups) until the words are made, then None
+    __slots__ = ("_shape", "_vals")  # the shape and groups until the words are made, then None
 
     def __init__(self, line: int, text: str, shape: _Shape, vals: tuple[str, ...]) -> None:
         self.line, self.text, self.skip, self.comment, self.stmt = line, text, False, "", None
-        self.comma, self.comma_expr = {}, {}
-        self._match = (shape, vals)
+        # a plain line has no ,C/,R/,A: one empty mapping for all, read-only (nothing writes a block's comma
+        # but the parser and `_resolve`, on blocks of their own)
+        self.comma = self.comma_expr = _NO_COMMA  # type: ignore[assignment]
+        self._shape, self._vals = shape, vals
 
     def _read(self) -> None:
-        shape, vals = self._match
-        self._match = None
+        shape, vals = self._shape, self._vals
+        self._vals = None
         words = []
         n = None
         for c, v in zip(shape.letters, vals):
@@ -289,32 +293,32 @@ class LineBlock(Block):
 
     @property  # type: ignore[override]
     def words(self) -> list[Word]:
-        if self._match is not None:
+        if self._vals is not None:
             self._read()
         return _WORDS.__get__(self)
 
     @words.setter
     def words(self, value: list[Word]) -> None:
-        if self._match is not None:
+        if self._vals is not None:
             self._read()  # N as read
         _WORDS.__set__(self, value)
 
     @property  # type: ignore[override]
     def n(self) -> int | None:
-        if self._match is not None:
+        if self._vals is not None:
             self._read()
         return _N.__get__(self)
 
     @n.setter
     def n(self, value: int | None) -> None:
-        if self._match is not None:
+        if self._vals is not None:
             self._read()
         _N.__set__(self, value)
 
     def plain(self) -> Block:
         """The same block as a Block."""
-        return Block(self.line, self.text, self.words, self.n, self.skip, self.comma, self.comment, self.stmt,
-                     self.comma_expr)
+        return Block(self.line, self.text, self.words, self.n, self.skip, dict(self.comma), self.comment, self.stmt,
+                     dict(self.comma_expr))
 
     def __eq__(self, other: object) -> bool:
         return self.plain() == (other.plain() if isinstance(other, LineBlock) else other)
