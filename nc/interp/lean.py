@@ -40,6 +40,7 @@ _LETTER = re.compile(r"[A-Za-z]")
 _G_MOTION = {"0": 0, "00": 0, "000": 0, "1": 1, "01": 1, "001": 1}  # G00 / G01 as programs write them
 _UNSEEN = object()
 _TEXTS = 4096  # line texts whose shape is kept; then the memo starts over (memory flat)
+_SHAPES: dict[tuple, "_Shape | None"] = {}  # `LeanLane._shape`, for all interpreters
 NOTHING = object()  # `take`: the line ran and moved nothing (`G1 F100`): no event, as block by block
 MISS = object()  # a shape's `run`: the line is not of that shape
 
@@ -100,7 +101,17 @@ class LeanLane:
 
     def _shape(self, letters: tuple[str, ...]) -> _Shape | None:
         """The shape of a line with these letters, None if the lane does not take it: each letter once
-        (a repeated one is for the general path: last wins, or 0x0202 for two G), N only first."""
+        (a repeated one is for the general path: last wins, or 0x0202 for two G), N only first. Kept for every
+        interpreter of the same axes (a shape holds no interpreter's state; building one compiles its code)."""
+        key = (letters, self.axes, self.ip.axes, self.diameter, self.g_codes)
+        shape = _SHAPES.get(key, _UNSEEN)
+        if shape is _UNSEEN:
+            if len(_SHAPES) >= _TEXTS:
+                _SHAPES.clear()
+            shape = _SHAPES[key] = self._new_shape(letters)
+        return shape  # type: ignore[return-value]
+
+    def _new_shape(self, letters: tuple[str, ...]) -> _Shape | None:
         if len(set(letters)) != len(letters):
             return None
         g = f = None
