@@ -18,6 +18,7 @@ from __future__ import annotations
 import re
 from array import array
 from bisect import bisect_left
+from itertools import accumulate
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from typing import Any, overload
@@ -52,6 +53,9 @@ class Program:
 # MAX_DIGITS + 3 characters. Such lines are kept as text and read when the interpreter needs them.
 _WORD_OK = r"[A-MP-Za-mp-z](?=[-+.0-9]{1,12}(?![.0-9]))[+-]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)[ \t]*"
 _PLAIN_OK = re.compile(r"[ \t]*(?:[Nn]([0-9]{1,12})[ \t]*)?(?:" + _WORD_OK + ")*")
+# `_PLAIN_OK` but for a blank line (no N, no word): a line `_parse` keeps as text
+_PLAIN_ITEM = re.compile(r"[ \t]*(?:[Nn]([0-9]{1,12})[ \t]*(?:" + _WORD_OK + ")*|(?:" + _WORD_OK + ")+)")
+_CHUNK = 1 << 16  # characters of program text `_parse` reads at a time
 _CACHE_LIMIT = 4096  # parsed plain lines kept (loops and GOTO come back to them); then the cache starts over
 
 
@@ -164,44 +168,66 @@ def parse_program(text: str, name: str = "program", number: int | None = None, *
 
 
 def _parse(text: str, name: str, number: int | None, start: int, stop: int | None, line0: int) -> Program:
-    """`parse_program` of a text whose only line break is "\n"."""
+    """`parse_program` of a text whose only line break is "\n". Read a chunk of lines at a time (issue 17): the
+    lines of a chunk are split, measured and matched against `_PLAIN_ITEM` in C (`str.split`, `map`), and only
+    the lines that are not plain motion text (a block to parse, a blank line, an N to index) are looked at one
+    by one, in order; a run of plain lines between them is added to the BlockList at once. The items, their
+    lines and labels, and the first alarm are those of reading line by line; memory stays a chunk's lines."""
     blocks = BlockList(text)
-    add_text, n_items = blocks._add_text, blocks._lines
+    starts, lengths, n_items = blocks._starts, blocks._lengths, blocks._lines
     labels: dict[int, list[int]] = {}
-    plain_ok = _PLAIN_OK.fullmatch
+    plain_ok = _PLAIN_ITEM.fullmatch
     stop = len(text) if stop is None else stop
     idx, pos = line0, start
-    while pos < stop:  # line by line without a list of lines (a 1M-block program, issue 16)
-        end = text.find("\n", pos, stop)
-        if end < 0:
-            end = stop
-        idx += 1
-        m = plain_ok(text, pos, end)
-        if m is not None and end > pos:  # kept as text (BlockList): no block object per line
-            if m.group(1) is not None:
+    while pos < stop:  # a chunk at a time, not a list of all lines (a 1M-block program, issue 16)
+        cut = stop if pos + _CHUNK >= stop else text.rfind("\n", pos, pos + _CHUNK) + 1
+        if cut <= pos:  # a line longer than a chunk: up to its end
+            cut = text.find("\n", pos + _CHUNK, stop) + 1 or stop
+        chunk = text[pos:cut]
+        lines = chunk.split("\n")
+        if not lines[-1]:
+            lines.pop()  # the chunk's last line break ends its last line (no empty line after it)
+        sizes = list(map(len, lines))
+        offsets = list(accumulate([size + 1 for size in sizes], initial=pos))
+        found = list(map(plain_ok, lines))
+        # the lines to look at one by one: not plain items (None), and plain ones with an N (a label)
+        if "N" in chunk or "n" in chunk:
+            odd = [i for i, m in enumerate(found) if m is None or m.lastindex]
+        else:
+            odd = [i for i, m in enumerate(found) if m is None]
+        done = 0  # lines of the chunk added or skipped
+        for i in odd + [len(lines)]:
+            if i > done:  # plain lines: kept as text, no block object per line
+                starts.extend(offsets[done:i])
+                lengths.extend(sizes[done:i])
+                n_items.extend(range(idx + done + 1, idx + i + 1))
+            if i == len(lines):
+                break
+            done = i + 1
+            m = found[i]
+            if m is not None:  # a plain line with N: kept as text, indexed by its N
                 labels.setdefault(int(m.group(1)), []).append(len(n_items))
-            elif text[pos:end].isspace():
-                pos = end + 1
+                starts.append(offsets[i])
+                lengths.append(sizes[i])
+                n_items.append(idx + i + 1)
                 continue
-            add_text(pos, end, idx)
-            pos = end + 1
-            continue
-        raw = text[pos:end]
-        pos = end + 1
-        stripped = raw.strip()
-        if not stripped:
-            continue
-        m = _O_LINE.match(stripped)
-        if m and not blocks and number is None:
-            number = o_number(m.group(1), idx, raw)
-            continue
-        if m and not blocks:
-            continue
-        block = parse_block(idx, raw)
-        if block.words or block.n is not None or block.comma or block.stmt is not None or block.comma_expr:
-            if block.n is not None:
-                labels.setdefault(block.n, []).append(len(blocks))
-            blocks._add(block, idx)
+            raw = lines[i]
+            stripped = raw.strip()
+            if not stripped:
+                continue
+            o = _O_LINE.match(stripped)
+            if o and not blocks and number is None:
+                number = o_number(o.group(1), idx + i + 1, raw)
+                continue
+            if o and not blocks:
+                continue
+            block = parse_block(idx + i + 1, raw)
+            if block.words or block.n is not None or block.comma or block.stmt is not None or block.comma_expr:
+                if block.n is not None:
+                    labels.setdefault(block.n, []).append(len(blocks))
+                blocks._add(block, idx + i + 1)
+        idx += len(lines)
+        pos = cut
     return Program(name=name, blocks=blocks, number=number, labels=labels)
 
 
