@@ -35,7 +35,10 @@ if TYPE_CHECKING:  # pragma: no cover
     from nc.interp.interpreter import Interpreter
     from nc.interp.records import Frame
 
-_NUM = r"([+-]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+))[ \t]*"  # a number as nc.program.parser reads one
+# A word's number. The lane reads only lines the parser kept as plain text (nc.program.blocks `_PLAIN_ITEM`: every
+# word a letter and a valid number), so a shape's pattern only splits them: the run of number characters after
+# the letter is the number (a third of the time of matching the number's form again, issue 17)
+_NUM = r"([-+.0-9]+)[ \t]*"
 _LETTER = re.compile(r"[A-Za-z]")
 _G_MOTION = {"0": 0, "00": 0, "000": 0, "1": 1, "01": 1, "001": 1}  # G00 / G01 as programs write them
 _UNSEEN = object()
