@@ -169,3 +169,16 @@ def test_cam_program_with_statements_and_corners_same_setpoints() -> None:
             + "\nG10 L2 P1 X0.5\n" + _cam(40) + "\nM30\n")
     a, b = _setpoints(text, True), _setpoints(text, False)
     assert np.array_equal(a[0], b[0]) and np.array_equal(a[1], b[1]) and a[2:] == b[2:]
+
+
+def test_a_shape_kept_for_all_interpreters_reads_each_profile_its_own_way() -> None:
+    """The same line texts in one process through profiles that read them differently (mill, lathe X in
+    diameter, the decimal-point rule N8.018 Bit10 on and off): a shape built for one is never another's."""
+    text = "G90 G1 F500\nX1 Z2\nX1.5 Z-2\nx3 z.5\nX4. Z-1\nM30\n"
+    ends = {}
+    for profile, params in (("nc5-mill", {}), ("nc5-lathe-a", {}), ("nc5-mill", {"N8.018 Bit10": 1.0}),
+                            ("nc5-lathe-a", {"N8.018 Bit10": 1.0}), ("nc5-mill", {})):
+        lean, general = (_run(profile, text, on, params=params) for on in (True, False))
+        assert lean == general
+        ends.setdefault((profile, tuple(params.items())), lean[0])
+    assert len({tuple(v) for v in ends.values()}) == 4  # four readings of the same text
