@@ -9,13 +9,20 @@ and its Move built in one call, while the modal state is the plain one (`_eligib
 radius compensation, no canned cycle, no transforms, no G16, no G66, no code call on G00/G01,
 no ,A or G2.4 waiting for its partner, no corner waiting for its motion block).
 
+Each shape's line runs as straight-line code built once per shape and profile (`_compiled`, kept for
+all interpreters in `_SHAPES`), and the plain state and the work origin are found once, then kept in
+`Interpreter._lean_origin` until anything else may change them: every block `_execute` and every
+statement `_statement` runs, any system variable written (an offset, tool data, from a program or
+from outside), a run begun, M02/M30's reset, an M96 program started (decisions bench B121).
+
 The Move, the state it leaves (position, last target, F, group 01, `unit_locked`, the block
 counter, `block`, `program_name`) and the alarms are those of the general path: any line it
 would refuse or treat otherwise (F < 0, a cutting move without F, a target out of range, the
 `max blocks` limit, a word without a decimal point) is left to it untouched, and it raises the
 alarm at the same block. Unlike nc.interp.bulk (runs of lines as one `MoveBatch` for `hil path`),
 it yields Move by Move, so the channel's look-ahead, statement budget, M96 and the preview window
-see the same events at the same moments. tests/test_interp_lean.py compares both paths.
+see the same events at the same moments. tests/test_interp_lean.py and tests/test_lean25_equivalence.py
+compare both paths.
 """
 
 from __future__ import annotations
