@@ -305,18 +305,21 @@ class Channel:
             self.raise_alarm(exc.alarm)
             sp = self.planner.step()
         self._update_css(sp)
-        if self.state is _STOPPING and self.planner.idle:
-            self.state = _ALARM
-        if self.state is _RESETTING and self.planner.idle:
-            self.state = _IDLE
-        if self.state is _RUNNING and self.single_block and self.planner.idle \
-                and (self._block_moves or self._next_ev is not None):
-            self.state = _BLOCK_STOP
-            # a motion block's stop: a code on its line still belongs to it (`G01 X10 M08`, M22-2)
-            self._stop_line = self.planner.line if self._block_moves else -1
-        if self.state is _RUNNING and self.planner.idle and self.end is not None \
-                and self.pending_aux is None:
-            self.state = _FINISHED
+        state = self.state  # what changes it below happens once the queue has run out (`idle`)
+        if state is _RUNNING:
+            if self.planner.idle:
+                if self.single_block and (self._block_moves or self._next_ev is not None):
+                    self.state = _BLOCK_STOP
+                    # a motion block's stop: a code on its line still belongs to it (`G01 X10 M08`, M22-2)
+                    self._stop_line = self.planner.line if self._block_moves else -1
+                elif self.end is not None and self.pending_aux is None:
+                    self.state = _FINISHED
+        elif state is _STOPPING:
+            if self.planner.idle:
+                self.state = _ALARM
+        elif state is _RESETTING:
+            if self.planner.idle:
+                self.state = _IDLE
         return sp
 
     def _feed_planner(self) -> None:
@@ -388,11 +391,7 @@ class Channel:
                     # a code on the same line (`M03 S1000`) is the same block and is read on
                     self._next_ev = ev
                     return
-            if isinstance(ev, Busy):
-                if len(pl.blocks) < 2:
-                    pl.release_run()  # the queue runs dry while the interpreter works: what is held runs
-                return  # the statement budget is spent: the interpreter reads on next cycle
-            if isinstance(ev, Move):
+            if type(ev) is Move or isinstance(ev, Move):  # the usual event first (Move has no subclass)
                 if self.soft_limits is not None and ev is not self._checked \
                         and (crossing := self.soft_limits.check(ev)) is not None:
                     self._limit_alarm = crossing
@@ -403,6 +402,10 @@ class Channel:
                 pl.push(ev)
                 self._block_moves += 1
                 reads -= 1
+            elif isinstance(ev, Busy):
+                if len(pl.blocks) < 2:
+                    pl.release_run()  # the queue runs dry while the interpreter works: what is held runs
+                return  # the statement budget is spent: the interpreter reads on next cycle
             elif isinstance(ev, Aux):
                 if pl.idle:
                     self._issue(ev)
