@@ -583,7 +583,9 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
             raise NcAlarm(0x1001, "feed per revolution with the spindle stopped (S0)", line=b.move.line,
                           block=b.move.block, program=b.move.program)
         self.solves += 1
-        if self.filter is not None and (fr := self._filter_ramp(b, s, v, a, cap, t0)) is not None:
+        # (the reference mode solves what a cruise samples: a cruise comes before any filter ramp, _start_plan)
+        cruises = self.per_block and not self._deferred() and self._cruise(b, t0) is not None
+        if self.filter is not None and not cruises and (fr := self._filter_ramp(b, s, v, a, cap, t0)) is not None:
             return fr
         if self.held or cap <= 1e-9:
             if abs(v) < 1e-9 and abs(a) < 1e-9:
@@ -608,8 +610,15 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
         # A profile continued at nonzero acceleration was solved with the previous factor: when
         # the new one cannot meet its target from that state, the previous one still can.
         for f in (jf, self._jf) if self._jf > jf and abs(a) > 1e-9 else (jf,):
-            for extend in (False, True):
-                dist, v1, ra, rj, vmax = self._run_target(cap, extend, cruise, f)
+            for extend in (0, 1, 2):
+                if extend < 2:
+                    dist, v1, ra, rj, vmax = self._run_target(cap, extend == 1, cruise, f)
+                else:  # neither met: on through lower caps the braking state does not reach (motion 77)
+                    # (with this solve's own factor only: a cruise leaves self._jf as it was, decision 44)
+                    run = self._run_through(b, s, v, cap, cruise, f) if a <= 0.0 and f == jf else None
+                    if run is None or run[0] <= dist:
+                        break  # not braking, or no such cap ahead: the same run
+                    dist, v1, ra, rj, vmax = run
                 # Forward pass: no more than the entry state can reach (a braking state first ramps
                 # its deceleration out, losing a²/2j of speed over v·|a|/j of path).
                 ve, de = (v - a * a / (2.0 * rj), dist - s - v * abs(a) / rj) if a < 0.0 else (v, dist - s)
@@ -625,9 +634,12 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
                 break
         if pw is None or pw.p_max > dist + 1e-7 or pw.v_min() < -1e-7:
             # Cannot meet the target from this state (an override just cut the cap): ramp down
-            # to the cap first, then plan the rest from there.
+            # to the cap first, then plan the rest from there. Within the run's least acceleration:
+            # the ramp runs on into the run's next blocks, whose solves start from the state it
+            # leaves there (with the block's own, higher one it left a block at 3x that block's
+            # acceleration limit, decision motion 77).
             target = min(cap, max(v1, 0.0))
-            pw = solve_velocity(s, v, a, target, b.a, b.j)
+            pw = solve_velocity(s, v, a, target, ra if ra < b.a else b.a, b.j)
             if target > 1e-9:
                 # after the ramp, cruise at the target speed to the end of the run
                 pw.duration = max(pw.duration, (dist - s) / target)
@@ -664,14 +676,33 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
             return None
         return _Plan("ramp", pw, pw.duration, t0, 0.0, cap)
 
+    def _run_through(self, b: Block, s: float, v: float, cap: float, cruise: float,
+                     f: float) -> tuple[float, float, float, float, float]:
+        """The extended run carried on through blocks whose cap is a little lower than b's (the cap of a
+        chain of corner-blend pieces falls by 1e-4 mm/s a piece) but not below v, the speed of a state that
+        is not speeding up: the ordinary runs end at each such junction, with zero acceleration at a speed
+        the braking state cannot meet that soon, while the braking over the whole chain (the backward pass's
+        end speeds) can be met (decision motion 77). Its jerk factor is f where f holds over the longer run."""
+        dist, v1, ra, rj, vmax = self._run_target(cap, True, cruise, 1.0, v)
+        if f > 1.0:
+            g, unknown = self._factor_over(b, s, dist)
+            if unknown or g < f:
+                f = 1.0 if unknown else g
+        return dist, v1, ra, rj * f, vmax
+
     def _jerk_factor(self, b: Block, s: float, cap: float, cruise: float) -> tuple[float, bool]:
         """The tangential jerk factor for a solve from s in b, and whether the queue could not
         tell it yet (nc.motion.shares): over the longest run any solve from here may take (the
         extended one: a higher jerk only ends runs sooner)."""
+        if self.lim.blend is None:
+            return 1.0, False
+        return self._factor_over(b, s, self._run_target(cap, True, cruise)[0])
+
+    def _factor_over(self, b: Block, s: float, dist: float) -> tuple[float, bool]:
+        """`_jerk_factor` over a run from s in b to `dist` (measured from b's start)."""
         blend = self.lim.blend
         if blend is None:
             return 1.0, False
-        dist = self._run_target(cap, True, cruise)[0]
         start = b.s_end - b.length
         if self._zones is not None and self._zones.near(start + s - blend.span_max, start + dist + blend.span_max):
             return 1.0, False  # λ < 1 there: the raw path keeps the tangential share (decision motion 45)
@@ -679,10 +710,10 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
 
     @cython.locals(b=Block, nx=Block, dist=cython.double, ra=cython.double, rj=cython.double, vmax=cython.double,
                    cap=cython.double, cap_lo=cython.double, x=cython.double, jf=cython.double,
-                   cruise_from=cython.double, k=cython.Py_ssize_t, extend=cython.bint)
+                   cruise_from=cython.double, k=cython.Py_ssize_t, extend=cython.bint, through=cython.double)
     # (k_max stays a Python int: absurd limits give a look-ahead depth beyond a C integer, test_harden_budgets)
     def _run_target(self, cap: float, extend: bool = False, cruise_from: float = math.inf,
-                    jf: float = 1.0) -> tuple[float, float, float, float, float]:
+                    jf: float = 1.0, through: float = math.inf) -> tuple[float, float, float, float, float]:
         """(distance, end speed, acceleration, jerk, top speed) of the run that starts with blocks[0].
 
         A run ends at the first junction slower than the cap. With `extend` it carries on through
@@ -691,7 +722,9 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
         held to the slowest of them so the profile crosses each at no more than it allows.
         A junction past `cruise_from` (where the cap is reached) that may be crossed at the cap
         ends the run too: the profile cruises there, so nothing beyond it changes this solve.
-        `jf`: factor on the run's tangential jerk (nc.motion.shares).
+        `jf`: factor on the run's tangential jerk (nc.motion.shares). `through`: a block whose cap is lower
+        than `cap` but not below `through` (the speed the present state reaches) does not end the run; the
+        top speed drops to its cap instead (`_run_through`, decision motion 77).
         """
         self.lookahead()
         it = iter(self.blocks)  # the queue walked in order (a deque indexes in O(k)); b is blocks[k], nx blocks[k + 1]
@@ -701,9 +734,11 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
         cap_lo = cap - 1e-9
         k_max = 2 * self.depth
         for k, nx in enumerate(it):
-            if nx.kind != "path" or nx.cap < cap_lo or b.vend <= 0.0 or k >= k_max \
+            if nx.kind != "path" or (nx.cap < cap_lo and nx.cap < through) or b.vend <= 0.0 or k >= k_max \
                     or (b.vend >= vmax - 1e-9 and dist >= cruise_from):
                 return dist, vmax if vmax < b.vend else b.vend, ra, rj * jf, vmax  # min(b.vend, vmax)
+            if nx.cap < cap_lo and nx.cap < vmax:  # only with `through`: its cap holds the whole run (motion 77)
+                vmax = nx.cap
             if b.vjunc < cap_lo:
                 if b.binding and b.vend >= max_speed_at(self.v, self.a, dist - self.s, ra, rj * jf):
                     # Not reachable faster than it allows from the present state (a rising
