@@ -5,8 +5,8 @@
 from nc.motion.block cimport Block
 
 cdef class FilterCorners:
-    cdef public double t_a, t_j, t2sum, _arc_k, span_max, amax, _sc_head, _lim_s, _arc_s
-    cdef public object tol, kd, _vq, _bud
+    cdef public double t_a, t_j, t2sum, _iso_k, _arc_k, span_max, amax, _sc_head, _lim_s, _arc_s
+    cdef public object tol, kd, cb, _vq, _bud
     cdef public tuple budget_a, budget_j, budget_al, budget_jl, _bmin, budget, _zero, _sc_ok, _vq_at, _maxima
     cdef public dict _boost
     cdef public list _hist, _hist_s, _vt, _sc

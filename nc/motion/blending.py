@@ -36,7 +36,7 @@ except ImportError:  # run as Python without Cython: they do nothing
     from nc.motion import cython_shadow as cython
 
 from nc.motion.block import Block
-from nc.motion.deviation import KernelDeviation
+from nc.motion.deviation import CornerBound, KernelDeviation
 from nc.motion.limits import MotionConfig
 from nc.motion.shares import MAX_FACTOR
 
@@ -73,6 +73,8 @@ class FilterCorners:
                       tuple(a if a < j else j for a, j in zip(self.budget_a, self.budget_j)))
         self.tol = cfg.path_tolerance
         self.kd = KernelDeviation(n1, n2, cfg.cycle)
+        self.cb = CornerBound(self.kd)  # the proved isolated-corner cap (decision motion 73)
+        self._iso_k = 0.25 * self.cb.span * self.cb.span  # isolated_cap's quick test (s²)
         self._boost: dict[tuple[float, float], float] = {}  # braking's growth per (a, j)
         self.t2sum = t1 * t1 + t2 * t2
         self._arc_k = (n1 * n1 + n2 * n2 - 2) * cfg.cycle * cfg.cycle  # arc_speed's shrink factor (s²)
@@ -169,6 +171,26 @@ class FilterCorners:
             return v, math.inf
         room = tol - du_n * acc * self.t2sum / 192.0  # `braking` without a jerk
         return v, 0.0 if room <= 0.0 else room / (du_n * self.kd.g0)
+
+    @cython.locals(leg=cython.double, top=cython.double)
+    def isolated_cap(self, du_n: float, acc: float, jerk: float, b1: Block, b2: Block) -> float:
+        """The proved cap of the line-line corner b1 → b2 alone in its filter windows (decision motion 73:
+        nc.motion.deviation.CornerBound), for any raw profile within the blocks' acceleration and the solves'
+        raised jerk (shares.MAX_FACTOR times theirs); 0 where it cannot be shown alone."""
+        leg = b1.length if b1.length < b2.length else b2.length
+        if self.tol is None or leg < self._iso_k * acc:
+            # (a quarter of acc·span² is less than the path a window reaches from rest at zero acceleration under the
+            # raised jerk whenever that reaches acc within 0.63 of the span: CornerBound.cap's 0, found cheaply
+            # for the CAM programs' short blocks; 0 is always safe, the old cap stays)
+            return 0.0
+        # Where the leg after it holds a filter start (nc.motion.filter_ramps: a ramp far above the axis limits to
+        # the block's top speed, a filter window's cruise at it, then braking), that start, checked against
+        # N1.053 itself, needs the room a faster corner would take: it gains more there (a 100 mm square, session
+        # 23: the corner 2 cycles sooner, the start 20 later). The old cap stays there, any lower one being safe.
+        top = b2.vtop
+        if b2.length >= top * self.t_j + top * top / (2.0 * b2.a) + top * b2.a / (2.0 * b2.j):
+            return 0.0
+        return self.cb.cap(self.tol, du_n, acc, MAX_FACTOR * jerk, b1.length, b2.length, b1.vtop, b2.vtop)
 
     def corner_tolerance(self, du_n: float, acc: float) -> float:
         """The path tolerance's cap of one isolated tangent jump of norm du_n: the deviation model
@@ -680,6 +702,8 @@ class FilterCorners:
         lim = vt * (1.0 - 1e-9)
         for i, c in zip(ev_l, caps.tolist()):
             b = seg[i]
+            if b.viso > c:
+                c = b.viso  # alone in its windows at up to viso, which keeps N1.053 proved (decision motion 73)
             b.ctol = c
             if c < lim and b.s_end > self._lim_s:
                 self._lim_s = b.s_end

@@ -32,6 +32,7 @@ cdef class Block:
     cdef public double vtol
     cdef public double vbud
     cdef public double vctol
+    cdef public double viso
     cdef public double tf_cap
     cdef public double tf_tcap
     cdef public bint tf_ok

@@ -56,6 +56,9 @@ class Block:
     # the junction can use (nc.motion.shares, decision motion 39).
     vbud: float = math.inf
     vctol: float = math.inf  # the tolerance's cap of this junction's corner alone (FilterCorners.corner_tolerance)
+    # The proved cap of a line-line corner alone in its filter windows where it raised vctol (FilterCorners.isolated_cap,
+    # decision motion 73), else 0: crossed at no more, any raw profile within the raised jerk keeps N1.053.
+    viso: float = 0.0
     # nc.motion.shares._tolerance_free's verdict, kept between solves with the inputs it was found
     # for (the caps beside the junction and min(vtol, vctol)): it is found again only when one changed.
     tf_cap: float = math.nan

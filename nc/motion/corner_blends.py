@@ -47,6 +47,7 @@ def blend_block(lim: Limits, prev: Block, b: Block, tol: float) -> Block | None:
     blk = Block(prev.move, "path", seg, seg.length, v, a, j, prev.feed)
     prev.vjunc = lim.junction(prev, blk)  # tangent, no curvature jump: the caps alone
     prev.vbud = prev.vctol = math.inf  # the filter's corner there is gone (nc.motion.shares reads them)
+    prev.viso = 0.0
     blk.vjunc = lim.junction(blk, b)
     return blk
 

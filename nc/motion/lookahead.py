@@ -204,6 +204,7 @@ class Limits:
 
     @cython.locals(b1=Block, b2=Block, v=cython.double, d0=cython.double, d1=cython.double, d2=cython.double,
                    sq_sum=cython.double, du_n=cython.double, a=cython.double, vb=cython.double, vc=cython.double,
+                   vp=cython.double,
                    lines=cython.bint)
     def junction(self, b1: Block, b2: Block, raw: bool = False) -> float:
         """Highest speed at the junction b1 → b2. `raw`: as without the filter (a junction where its
@@ -232,6 +233,11 @@ class Limits:
                 lines = s1.kind == "line" and s2.kind == "line"
                 a = b2.a if b2.a > b1.a else b1.a  # max(b1.a, b2.a) and min(v, vb, vc) spelt out (session 15)
                 b1.vbud, b1.vctol = vb, vc = self.blend.corner_caps(du, du_n, lines, a)
+                b1.viso = 0.0
+                if lines:  # the proved cap of a corner alone in its windows, where it is higher (decision motion 73)
+                    vp = self.blend.isolated_cap(du_n, a, b2.j if b2.j > b1.j else b1.j, b1, b2)
+                    if vp > vc:
+                        b1.viso = b1.vctol = vc = vp
                 if vb < v:
                     v = vb
                 if vc < v:
