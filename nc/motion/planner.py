@@ -734,11 +734,14 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
         cap_lo = cap - 1e-9
         k_max = 2 * self.depth
         for k, nx in enumerate(it):
-            if nx.kind != "path" or (nx.cap < cap_lo and nx.cap < through) or b.vend <= 0.0 or k >= k_max \
+            if nx.kind != "path" or nx.cap < cap_lo or b.vend <= 0.0 or k >= k_max \
                     or (b.vend >= vmax - 1e-9 and dist >= cruise_from):
-                return dist, vmax if vmax < b.vend else b.vend, ra, rj * jf, vmax  # min(b.vend, vmax)
-            if nx.cap < cap_lo and nx.cap < vmax:  # only with `through`: its cap holds the whole run (motion 77)
-                vmax = nx.cap
+                # (asked here, once a call: the loop's own test stays as it was for every other solve)
+                if not (through <= nx.cap < cap_lo and nx.kind == "path" and b.vend > 0.0 and k < k_max
+                        and not (b.vend >= vmax - 1e-9 and dist >= cruise_from)):
+                    return dist, vmax if vmax < b.vend else b.vend, ra, rj * jf, vmax  # min(b.vend, vmax)
+                if nx.cap < vmax:  # a lower cap `through` goes on past: it holds the whole run (motion 77)
+                    vmax = nx.cap
             if b.vjunc < cap_lo:
                 if b.binding and b.vend >= max_speed_at(self.v, self.a, dist - self.s, ra, rj * jf):
                     # Not reachable faster than it allows from the present state (a rising
