@@ -172,6 +172,7 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
         # last path solve (nc.motion.shares).
         self.closed = False
         self._jf = 1.0
+        self._end_cap = -1.0  # the cap of the block that ended the last `_run_target` run (-1: none, not a path)
         self._pushes = 0  # moves pushed so far (an open plan re-solves when more came)
         self.output = self.position.copy()  # the last setpoint handed out (filtered)
         self._init_filter_stops()
@@ -615,7 +616,10 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
                     dist, v1, ra, rj, vmax = self._run_target(cap, extend == 1, cruise, f)
                 else:  # neither met: on through lower caps the braking state does not reach (motion 77)
                     # (with this solve's own factor only: a cruise leaves self._jf as it was, decision 44)
-                    run = self._run_through(b, s, v, cap, cruise, f) if a <= 0.0 and f == jf else None
+                    # (only where the extended run ended at such a cap: 12 of 211 in the CAM program)
+                    x = self._end_cap
+                    run = self._run_through(b, s, v, cap, cruise, f) \
+                        if a <= 0.0 and f == jf and v <= x and x < cap - 1e-9 else None
                     if run is None or run[0] <= dist:
                         break  # not braking, or no such cap ahead: the same run
                     dist, v1, ra, rj, vmax = run
@@ -739,6 +743,7 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
                 # (asked here, once a call: the loop's own test stays as it was for every other solve)
                 if not (through <= nx.cap < cap_lo and nx.kind == "path" and b.vend > 0.0 and k < k_max
                         and not (b.vend >= vmax - 1e-9 and dist >= cruise_from)):
+                    self._end_cap = nx.cap if nx.kind == "path" else -1.0
                     return dist, vmax if vmax < b.vend else b.vend, ra, rj * jf, vmax  # min(b.vend, vmax)
                 if nx.cap < vmax:  # a lower cap `through` goes on past: it holds the whole run (motion 77)
                     vmax = nx.cap
@@ -761,6 +766,7 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
             if x < rj:
                 rj = x
             b = nx
+        self._end_cap = -1.0
         return dist, vmax if vmax < b.vend else b.vend, ra, rj * jf, vmax  # b is the queue's last block
 
     def _plan_indep(self, b: Block, t0: float) -> _Plan | None:
