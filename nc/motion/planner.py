@@ -616,7 +616,7 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
                     dist, v1, ra, rj, vmax = self._run_target(cap, extend == 1, cruise, f)
                 else:  # neither met: on through lower caps the braking state does not reach (motion 77)
                     # (with this solve's own factor only: a cruise leaves self._jf as it was, decision 44)
-                    # (only where the extended run ended at such a cap: 12 of 211 solves that got here in 3000 CAM blocks)
+                    # (only where the extended run ended at such a cap: 12 of 211 that got here in 3000 CAM blocks)
                     x = self._end_cap
                     run = self._run_through(b, s, v, cap, cruise, f) \
                         if a <= 0.0 and f == jf and v <= x and x < cap - 1e-9 else None
