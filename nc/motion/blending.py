@@ -577,11 +577,20 @@ class FilterCorners:
         vb = np.fromiter((b.vbase for b in seg), float, len(seg))
         ba = np.array(budget_a)
         bj = np.array(budget_j)
+        # The blocks between the stretch's junctions: on one of length L whose junctions are crossed at <= v the
+        # profile reaches at most sqrt(v² + a·L) (speeding up from one, braking to the other), and its vtop
+        between = seg[1:]
+        al = np.fromiter((b.a * b.length for b in between), float, len(between))
+        vt = np.fromiter((b.vtop for b in between), float, len(between))
 
         def sums(v: float) -> tuple[np.ndarray, np.ndarray]:
             """Largest |Σ v_i·Δu_i| per axis over T1 windows, and over their differences."""
             pre = np.vstack([np.zeros((1, du.shape[1])), np.cumsum(np.minimum(vb, v)[:, None] * du, axis=0)])
-            w1, w2 = v * t1, v * t2
+            # The windows are T1 and T2 of time: at the highest speed the profile may reach between the junctions,
+            # not at theirs (decision motion 82: two corners around a short block it speeds up on fell in one)
+            peak = float(np.max(np.minimum(vt, np.sqrt(v * v + al)))) if len(al) else v
+            vw = peak if peak > v else v
+            w1, w2 = vw * t1, vw * t2
             ev = np.concatenate(([s_j], s + w1, s + w1 - 1e-9, s + w1 + w2, s + w1 + w2 - 1e-9))
             ev = ev[(ev >= s_j) & (ev <= s_j + w1 + w2)]
 
