@@ -586,20 +586,29 @@ class FilterCorners:
         def sums(v: float) -> tuple[np.ndarray, np.ndarray]:
             """Largest |Σ v_i·Δu_i| per axis over T1 windows, and over their differences."""
             pre = np.vstack([np.zeros((1, du.shape[1])), np.cumsum(np.minimum(vb, v)[:, None] * du, axis=0)])
-            # The windows are T1 and T2 of time: at the highest speed the profile may reach between the junctions,
-            # not at theirs (decision motion 82: two corners around a short block it speeds up on fell in one)
-            peak = float(np.max(np.minimum(vt, np.sqrt(v * v + al)))) if len(al) else v
-            vw = peak if peak > v else v
-            w1, w2 = vw * t1, vw * t2
-            ev = np.concatenate(([s_j], s + w1, s + w1 - 1e-9, s + w1 + w2, s + w1 + w2 - 1e-9))
-            ev = ev[(ev >= s_j) & (ev <= s_j + w1 + w2)]
 
-            def at(x: np.ndarray) -> np.ndarray:
-                return pre[np.searchsorted(s, x, side="right")]
-            mid = at(ev - w1)
-            a = at(ev) - mid
-            b = mid - at(ev - w1 - w2)
-            return np.abs(a).max(axis=0), np.abs(a - b).max(axis=0)
+            def windows(vw: float) -> tuple[np.ndarray, np.ndarray]:
+                w1, w2 = vw * t1, vw * t2
+                ev = np.concatenate(([s_j], s + w1, s + w1 - 1e-9, s + w1 + w2, s + w1 + w2 - 1e-9))
+                ev = ev[(ev >= s_j) & (ev <= s_j + w1 + w2)]
+
+                def at(x: np.ndarray) -> np.ndarray:
+                    return pre[np.searchsorted(s, x, side="right")]
+                mid = at(ev - w1)
+                a = at(ev) - mid
+                b = mid - at(ev - w1 - w2)
+                return np.abs(a).max(axis=0), np.abs(a - b).max(axis=0)
+
+            sa, sd = windows(v)
+            # The windows are T1 and T2 of time, crossed at up to the highest speed the profile may reach between the
+            # junctions, not only at theirs (decision motion 82: two corners around a short block it speeds up on
+            # fell in one window pair): the sums at that speed and halfway there count too (never fewer than at v)
+            peak = float(np.max(np.minimum(vt, np.sqrt(v * v + al)))) if len(al) else v
+            if peak > v * (1.0 + 1e-9):
+                for vw in (0.5 * (v + peak), peak):
+                    xa, xd = windows(vw)
+                    sa, sd = np.maximum(sa, xa), np.maximum(sd, xd)
+            return sa, sd
 
         def cap_at(v: float) -> float:
             """v scaled to the budgets (≥ v: v meets them with its own windows)."""
