@@ -1,7 +1,10 @@
-"""The motion sweep: seeded random programs with an operator at the panel (tests/motion_sweep.py), each run
-checked as a drive sees it — velocity, acceleration and jerk within the axis limits on every cycle, no setpoint
-going back along the path, the program's end point reached. A fast share of the seeds runs in CI; the wide sweep
-with `-m slow`."""
+"""The motion sweep (decision motion 81): seeded random programs with an operator at the panel
+(tests/motion_sweep.py), each run checked as a drive sees it — velocity, acceleration and jerk within the axis limits
+on every cycle, no setpoint going back along the path, the program's end point reached. Seeds 1–40 and the seeds that
+found a bug since fixed run in CI; 41–600 with `-m slow`.
+
+KNOWN: the seeds still over a limit, each with what takes it there. They are `xfail(strict=True)`: a fix that makes
+one pass fails the run until its entry is taken off, so the table only ever shrinks with the bugs."""
 
 from __future__ import annotations
 
@@ -11,6 +14,10 @@ from tests.motion_sweep import make_case, run_case
 
 TOL = 1.0 + 1e-6
 BACK = 1e-9  # mm: float noise of the path position, not a step back
+FIXED = [167]  # found a bug, fixed since (decision motion 82)
+FIT = "a fitted run (issue 18): a plan braking into spans of lower tangential limits (decisions motion 77, 81)"
+RESUME = "a resume from a feed hold accelerating through a corner nearby (decision motion 81)"
+KNOWN: dict[int, str] = {}
 
 
 def _check(seed: int) -> None:
@@ -22,12 +29,17 @@ def _check(seed: int) -> None:
     assert out.end_error <= 1e-9, f"{case.describe()}: ends {out.end_error} mm from the program's end"
 
 
-@pytest.mark.parametrize("seed", range(1, 41))
+def _seeds(seeds) -> list:
+    return [pytest.param(s, marks=pytest.mark.xfail(strict=True, reason=KNOWN[s])) if s in KNOWN else s
+            for s in seeds]
+
+
+@pytest.mark.parametrize("seed", _seeds(list(range(1, 41)) + FIXED))
 def test_random_programs_keep_every_cycle_within_the_limits(seed):
     _check(seed)
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("seed", range(41, 601))
+@pytest.mark.parametrize("seed", _seeds([s for s in range(41, 601) if s not in FIXED]))
 def test_random_programs_keep_every_cycle_within_the_limits_wide(seed):
     _check(seed)
