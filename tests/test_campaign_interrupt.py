@@ -77,28 +77,49 @@ def _group_left(pgid: int, within: float) -> list[str]:
         time.sleep(0.2)
 
 
-def test_a_ctrl_c_while_the_local_cluster_starts_is_held_not_lost(tmp_path):
-    """Decision B77: while the local cluster's workers are spawned the campaign ignores SIGINT, so that they inherit
-    SIG_IGN (B55); a Ctrl-C in that window (seconds on a loaded machine) was lost, and the campaign ran to its end.
-    Now it ends the campaign once the window closes, and a child spawned in the window still ignores it."""
+WINDOW = (
+    "import multiprocessing, signal, sys, time\n"
+    "from hil.campaign.engine import _sigint_held\n"
+    "def report(q):\n"
+    "    q.put(signal.getsignal(signal.SIGINT) == signal.SIG_IGN)\n"
+    "if __name__ == '__main__':\n"
+    "    ctx = multiprocessing.get_context('spawn')  # as Dask's Nanny spawns a worker\n"
+    "    q = ctx.Queue()\n"
+    "    try:\n"
+    "        with _sigint_held():\n"
+    "            child = ctx.Process(target=report, args=(q,))\n"
+    "            child.start()\n"
+    "            print('window', flush=True)\n"
+    "            time.sleep(3)\n"
+    "            print('child', q.get(timeout=30), flush=True)\n"
+    "            child.join()\n"
+    "        print('lost', flush=True)\n"
+    "    except KeyboardInterrupt:\n"
+    "        print('interrupted', signal.getsignal(signal.SIGINT) is signal.default_int_handler, flush=True)\n")
+
+
+def _window(tmp_path, send) -> list[str]:
     script = tmp_path / "window.py"
-    script.write_text(
-        "import signal, subprocess, sys, time\n"
-        "from hil.campaign.engine import _sigint_ignored\n"
-        "try:\n"
-        "    with _sigint_ignored():\n"
-        "        child = subprocess.Popen([sys.executable, '-c', 'import signal; print(signal.getsignal(signal.SIGINT) == signal.SIG_IGN)'],"
-        " stdout=subprocess.PIPE, text=True)\n"
-        "        print('window', flush=True)\n"
-        "        time.sleep(3)\n"
-        "        print('child', child.communicate()[0].strip(), flush=True)\n"
-        "    print('lost', flush=True)\n"
-        "except KeyboardInterrupt:\n"
-        "    print('interrupted', flush=True)\n")
+    script.write_text(WINDOW)
     p = subprocess.Popen([sys.executable, str(script)], env=dict(os.environ, PYTHONPATH=str(ROOT)),
                          stdout=subprocess.PIPE, text=True, start_new_session=True)
     assert p.stdout.readline().strip() == "window"
-    time.sleep(0.5)  # (the witness is up)
-    os.killpg(p.pid, signal.SIGINT)  # the terminal's Ctrl-C, mid-start
-    out = p.communicate(timeout=60)[0].split()
-    assert out == ["child", "True", "interrupted"], out  # the child ignores it; this process was told
+    time.sleep(0.5)
+    send(p.pid)
+    return p.communicate(timeout=60)[0].split()
+
+
+def test_a_ctrl_c_while_the_local_cluster_starts_is_held_not_lost(tmp_path):
+    """Decision B77: a Ctrl-C while the local cluster's workers are spawned (seconds on a loaded machine) was lost,
+    and the campaign ran to its end. Now it ends the campaign once the window closes, and a worker spawned in the
+    window (multiprocessing's spawn, as Dask's) ignores it (B55, B126)."""
+    out = _window(tmp_path, lambda pid: os.killpg(pid, signal.SIGINT))  # the terminal's Ctrl-C, mid-start
+    assert out == ["child", "True", "interrupted", "True"], out  # the child ignores it; this process was told
+
+
+def test_a_kill_int_of_the_campaign_alone_while_the_local_cluster_starts_is_held_not_lost(tmp_path):
+    """Decision B126 (B77's and B117's "Left"): `kill -INT` of the campaign's pid alone in that window was discarded
+    (it ignored SIGINT there so that its workers would inherit SIG_IGN). It now ends the campaign as a Ctrl-C does;
+    the worker still comes up ignoring SIGINT, and the handler the campaign had is back."""
+    out = _window(tmp_path, lambda pid: os.kill(pid, signal.SIGINT))
+    assert out == ["child", "True", "interrupted", "True"], out

@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import signal
 import socket
-import subprocess
 import sys
 import threading
 import time
@@ -61,8 +60,8 @@ def _dask(cases: Sequence[CaseInputs], engine: Engine) -> Iterator[dict[str, Any
                 # this one (which stops the cluster and writes what finished), not die with a traceback
                 # each (bench B55). They are spawned ignoring SIGINT (SIG_IGN survives exec; Python and
                 # asyncio then keep it), and _QuietWorker keeps a restarted worker the same. A Ctrl-C while
-                # they start is held, not lost (B77): it ends the campaign once the cluster is there to close.
-                with _sigint_ignored():
+                # they start is held, not lost (B77, B126): it ends the campaign once the cluster is there to close.
+                with _sigint_held():
                     cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
                                            dashboard_address=None, host="127.0.0.1", silence_logs=50)
             yield from _on_cluster(cases, engine, cluster)
@@ -153,29 +152,44 @@ def _quiet_client() -> Iterator[None]:
             log.setLevel(level)
 
 
-# the witness of a Ctrl-C while the local cluster starts (_sigint_ignored): SIGINT's default action ends it
-WITNESS = "import signal, time; signal.signal(signal.SIGINT, signal.SIG_DFL); time.sleep(3600)"
+# Python started through this ignores SIGINT from its first instruction: SIG_IGN survives exec, and Python then keeps it
+SHIM = "#!/bin/sh\ntrap '' INT\nexec {python} \"$@\"\n"
 
 
 @contextmanager
-def _sigint_ignored() -> Iterator[None]:
+def _sigint_held() -> Iterator[None]:
+    """While the local cluster's workers are spawned: they come up ignoring SIGINT, and a SIGINT this process gets
+    meanwhile is held and raised as KeyboardInterrupt once the window closes.
+
+    The terminal's Ctrl-C reaches the whole process group; it is the campaign's to handle, not the workers' (B55).
+    The workers are spawned by multiprocessing from Dask's threads, through `multiprocessing.set_executable`'s
+    program: for the window it is a shim that ignores SIGINT and execs this Python. This process notes the signal
+    (a handler, not SIG_IGN: a `kill -INT` of its pid alone was discarded in the window, B77's "Left", B126)."""
     if threading.current_thread() is not threading.main_thread():
         yield  # only the main thread sets handlers (a campaign run from a library thread)
         return
-    # The Ctrl-C is the whole process group's: this process ignores it here so that the workers it spawns inherit
-    # SIG_IGN (B55). A child started first, which does not ignore it, is the witness of one that came meanwhile:
-    # it dies by it, and the Ctrl-C is raised here once the window closes instead of being lost (B77).
-    witness = subprocess.Popen([sys.executable, "-c", WITNESS], stdin=subprocess.DEVNULL,
-                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    old = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    import multiprocessing
+    import multiprocessing.spawn
+    import os
+    import shlex
+    import tempfile
+
+    came: list[int] = []
+    folder = tempfile.mkdtemp(prefix="hil-campaign-")
+    shim = os.path.join(folder, "python")
+    with open(shim, "w") as f:
+        f.write(SHIM.format(python=shlex.quote(sys.executable)))
+    os.chmod(shim, 0o700)
+    executable = multiprocessing.spawn.get_executable()
+    old = signal.signal(signal.SIGINT, lambda signum, frame: came.append(signum))
+    multiprocessing.set_executable(shim)
     try:
         yield
     finally:
+        multiprocessing.set_executable(executable)
         signal.signal(signal.SIGINT, old)
-        came = witness.poll() is not None
-        if not came:
-            witness.kill()
-        witness.wait()
+        os.remove(shim)
+        os.rmdir(folder)
     if came:
         raise KeyboardInterrupt
 
