@@ -8,7 +8,8 @@ runs it, in its own process. Each cell checks what a controller engineer checks 
 - the bus was closed, and the trace is whole, with an end record naming the reason.
 
 Reasons: program end, an alarm (MLC user alarm A1), E-stop (M2x013), an internal error injected
-into the NC channel, SIGINT, SIGTERM (SIGHUP and the second Ctrl-C: tests/test_stop_signals.py).
+into the NC channel, SIGINT, SIGTERM, SIGHUP, the run's --max-time (the second Ctrl-C:
+tests/test_stop_signals.py).
 Buses: the in-process sim, canopen:virtual, and EtherCAT over a veth pair (root only)."""
 
 from __future__ import annotations
@@ -45,6 +46,8 @@ REASONS = {
     "internal": (LONG, [], 1, "internal error", "0x0000"),
     "SIGINT": (LONG, [], 130, "SIGINT", None),
     "SIGTERM": (LONG, [], 143, "SIGTERM", None),
+    "SIGHUP": (LONG, [], 129, "SIGHUP", None),  # the terminal hung up (B93)
+    "max_time": (LONG, ["--max-time", "2"], 1, "max_time", "0xDE03"),  # the run's time budget (B13)
 }
 
 
