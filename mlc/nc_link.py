@@ -268,6 +268,9 @@ class ChannelLink:
         v = bool(m[b2 + 8])
         if getattr(ch, "single_block", v) != v:
             ch.single_block = v
+        v = bool(m[b2 + 26])  # M2x026 M99 Call Stop: a level, read when the main program's M99 is (M25-1)
+        if getattr(ch, "m99_call_stop", v) != v:
+            ch.m99_call_stop = v
         ip = self.interp  # M2x010: '/' blocks the interpreter reads from now on are skipped (decision M21-1)
         if ip is not None and ip.block_skip != (v := bool(m[b2 + 10])):
             ip.block_skip = v
@@ -432,9 +435,10 @@ class ChannelLink:
         if state is RunState.FINISHED and ch.end is not None and self._program_end is None:
             self._program_end = ch.end.code
         end = self._program_end
-        m[b3 + 21] = 1 if end is not None else 0
+        m[b3 + 21] = 1 if end is not None and end != 99 else 0
         m[b3 + 22] = 1 if end == 2 else 0
         m[b3 + 23] = 1 if end == 30 else 0
+        m[b3 + 47] = 1 if end == 99 else 0  # M3x047: stopped at M99 by M2x026, until cycle start or reset (M25-1)
         m[30080 + x - 1] = 1  # M3008x: this channel exists
         if drives is not None:
             self._drive_outputs(drives, ch)

@@ -34,7 +34,7 @@ MST_FINISH | bench | mlc/nc_link.py | level; completes the handed code; the next
 M96_INTERRUPT | bench | mlc/nc_link.py | rising edge, after M96 P_ (nc/interrupt.py)
 MST_MACRO_LOCK | absent | - | M/S/T macro calls (N1.123…) always run
 MACRO_CALL_ACTIVATE | absent | - | MLC-triggered macro calls not emulated
-M99_CALL_STOP | absent | - | M99 call stop not emulated
+M99_CALL_STOP | bench | mlc/nc_link.py | level, read when the main program's M99 is reached at rest: ON ends the program there (M25-1)
 SPINDLE1_DO | hardware | - | pin 9 of the controller's spindle connector
 SPINDLE2_DO | hardware | - | pin 9 of the controller's spindle connector
 ENABLE_3_MPG | absent | - | only the 1st MPG (D2x008/D2x009) moves an axis
@@ -113,7 +113,7 @@ SINGLE_BLOCK_DONE | bench | mlc/nc_link.py | as SINGLE_BLOCK_HOLD
 USER_ALARM | bench | mlc/nc_link.py | any A device ON
 PROGRAM_SCANNING | absent | - | the HMI's program check not emulated
 PROGRAM_SCANNED | absent | - | the HMI's program check not emulated
-M99_STOP_STATUS | absent | - | M99 call stop not emulated
+M99_STOP_STATUS | bench | mlc/nc_link.py | ON once the program ended at its M99 under M2x026, until reset / cycle start (M25-1)
 MACRO_INIT_DONE | absent | - | MLC-triggered macro calls not emulated
 M_STROBE | bench | mlc/nc_link.py | with D3x048 until the finish (H1-H9)
 S_STROBE | bench | mlc/nc_link.py | with D3x050 and D3x024 until the finish
@@ -238,6 +238,8 @@ TESTS: dict[str, tuple[str, ...]] = {
     'SERVO_ON': ('mlc22_servo_relays',),
     'SERVO_OFF': ('mlc22_servo_relays',),
     'OPTIONAL_STOP': ('formats_lathe_guide', 'run_stops_and_holds'),
+    'M99_CALL_STOP': ('mlc25_m99_call_stop',),
+    'M99_STOP_STATUS': ('mlc25_m99_call_stop',),
     'BLOCK_SKIP': ('mlc21_block_skip',),
     'MST_LOCK': ('mlc21_program_switches',),
     'EMERGENCY_STOP': ('campaign', 'mlc_manual', 'run_stops_and_holds', 'stop_matrix'),

@@ -29,7 +29,7 @@ from nc.interrupt import M96Link, interrupt_stream
 from nc.motion.css import css_rpm_at, x_origin
 from nc.motion.planner import Planner, Setpoint
 from nc.budget import StatementBudget
-from nc.moves import Aux, Busy, Event, Move, ProgramEnd, Sync
+from nc.moves import Aux, Busy, Event, MainLoop, Move, ProgramEnd, Sync
 from nc.softlimits import SoftLimits
 
 # Moves read from the interpreter into the look-ahead per cycle (M/S/T codes and preview stops do
@@ -69,7 +69,7 @@ class Channel:
     end: ProgramEnd | None = None
     single_block: bool = False
     dry_run_feed: float = 5000.0  # mm/min
-    _deferred: Aux | Sync | None = None
+    _deferred: Aux | Sync | MainLoop | None = None
     # G96 (issue 5): the spindle speed constant surface speed asks for now (rpm), None under G97;
     # the runner/MLC sends it to the spindle drive. spindle_max is the G50/G92 S clamp.
     css_rpm: float | None = None
@@ -107,6 +107,9 @@ class Channel:
     _checked: Move | None = None
     # the stream read ahead (hil.stretch_reads.Ahead) while it is `events`: its `plain` moves were checked when read
     _ahead: Any = None
+    # M2x026 M99 Call Stop, set by the MLC link: at the main program's M99 (an M code: the motion before it runs out
+    # to rest) the program ends while it is ON (ProgramEnd code 99) instead of running again (decision mlc M25-1)
+    m99_call_stop: bool = False
 
     def load(self, events: Iterator[Event]) -> None:
         self.events = events
@@ -360,6 +363,8 @@ class Channel:
                 if isinstance(ev, Aux):
                     self._issue(ev)
                     return
+                if type(ev) is MainLoop and self._main_loop(ev):
+                    return
                 if self._skip_move is not None:
                     self._skip_done()
                 continue  # a Sync: motion has drained, read on
@@ -415,12 +420,28 @@ class Channel:
             elif isinstance(ev, ProgramEnd):
                 self.end = ev
                 pl.closed = True
+            elif type(ev) is MainLoop:  # an M code: motion before it runs out to rest, then M2x026 decides
+                if not pl.idle:
+                    self._deferred = ev
+                    pl.closed = True
+                elif self._main_loop(ev):
+                    return
             elif isinstance(ev, Sync):
                 if not pl.idle:
                     self._deferred = ev
                     pl.closed = True
                 elif self._skip_move is not None:
                     self._skip_done()
+
+    def _main_loop(self, ev: MainLoop) -> bool:
+        """The main program's M99 reached, the axes at rest: with M2x026 M99 Call Stop ON the program ends here
+        (N App. B: "slow down to stop and then stop all process when executing M99"; M3x047 follows the end code
+        99), else it runs again. True when it ended."""
+        if not self.m99_call_stop:
+            return False
+        self.end = ProgramEnd(ev.line, ev.block, 99)
+        self.planner.closed = True
+        return True
 
     def _update_css(self, sp: Setpoint) -> None:
         """G96: the active move's surface speed at the current X diameter; between moves the last

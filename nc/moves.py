@@ -99,15 +99,28 @@ class Sync:
 
 @dataclass(slots=True)
 class ProgramEnd:
-    """M02 / M30 (or end of file): the channel finishes once motion drains."""
+    """M02 / M30 (or end of file; a main program's M99 under M99 Call Stop): the channel finishes once motion drains."""
 
     line: int
     block: str
-    code: int  # 2, 30, or 0 for the end of the text
+    code: int  # 2, 30, 99 (M99 Call Stop), or 0 for the end of the text
     rewind: bool = True
 
     def as_dict(self) -> dict:
         return {"kind": "end", "line": self.line, "block": self.block, "code": self.code}
+
+
+@dataclass(slots=True)
+class MainLoop:
+    """M99 of the main program: it runs again from its start (or from the label M99 P names). An M code: the motion
+    before it runs out to rest, and the program ends there when the MLC's M99 Call Stop (M2x026) is ON
+    (nc.channel, decision mlc M25-1)."""
+
+    line: int
+    block: str
+
+    def as_dict(self) -> dict:
+        return {"kind": "m99", "line": self.line, "block": self.block}
 
 
 @dataclass(slots=True)
@@ -121,7 +134,7 @@ class Busy:
 
 BUSY = Busy()
 
-Event = Union[Move, Aux, Sync, ProgramEnd, Busy]
+Event = Union[Move, Aux, Sync, ProgramEnd, MainLoop, Busy]
 
 
 @dataclass(slots=True)

@@ -214,22 +214,24 @@ class CallsMixin:
         fr.entry = fr.pc
         self.stack.append(fr)
 
-    def _m99(self, block: Block) -> None:
+    def _m99(self, block: Block) -> bool:
+        """M99: a subprogram returns; the main program runs again (True: it loops, where M2x026 may end it)."""
         p = block.get("P")
         if len(self.stack) == 1:
             fr = self.frame
             if p is not None and not self.profile.legacy:
                 self._jump_label(int(p.value))
-                return
+                return True
             limit = int(self.profile.param("M99 main restarts", 1))
             if fr.restarts >= limit:
                 fr.pc = len(fr.program.blocks)  # the emulator stops the endless main loop (A22)
-                return
+                return False
             fr.restarts += 1
             fr.pc = 0
             fr.loops, fr.ifs = [], []
-            return
+            return True
         self._return(None if self.profile.legacy or p is None else int(p.value))
+        return False
 
     def _return(self, label: int | None) -> None:
         fr = self.frame

@@ -19,7 +19,7 @@ from nc.interp import context
 from nc.interp.gcodes import STOP_PREVIEW
 from nc.interp.records import (INCREMENTAL, MAX_M_PER_BLOCK, M_BEFORE_MOTION, M_END, NO_MOTION_FUNCS,
                                REFUSED_UNDER_G68, TRANSFORM_ARG_FUNCS, _transforms)
-from nc.moves import Aux, Event, Move, MoveList, ProgramEnd, Sync
+from nc.moves import Aux, Event, MainLoop, Move, MoveList, ProgramEnd, Sync
 from nc.program.blocks import Block, Word
 
 
@@ -226,7 +226,8 @@ def step_m_after(ip, run: BlockRun) -> Iterator[Event]:
             run.done = True
             return
         if m == 99:
-            ip._m99(block)
+            if ip._m99(block):
+                yield MainLoop(block.line, block.text)  # the MLC's M99 Call Stop may end the program here
             if ip._interrupt_resume is not None and not any(f.kind == "m96" for f in ip.stack):
                 yield ip._resume_after_interrupt()
             run.done = True
