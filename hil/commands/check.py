@@ -30,6 +30,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("check", help="check a trace: following/contour error, v/a/j limits, thread phase, jitter")
     p.add_argument("trace", help="trace file (CSV or Parquet) from hil run --trace")
     add_check_options(p)
+    p.add_argument("--against", metavar="REF", help="a reference trace of the same program (a run kept as good): "
+                   "the commanded path, the program's time, how the run ended and the recorded MLC signals compared")
+    p.add_argument("--path-tol", type=float, default=0.001, metavar="MM",
+                   help="with --against: the paths' largest distance from each other, mm (default 0.001)")
+    p.add_argument("--time-tol", type=float, metavar="S",
+                   help="with --against: the program times' largest difference, s (default 1 %% of the reference's)")
     p.add_argument("--json", action="store_true", help="one JSON object per check")
     p.set_defaults(func=cmd_check)
 
@@ -154,12 +160,18 @@ def cmd_check(args: argparse.Namespace) -> int:
     if isinstance(ready, int):
         return ready
     bench, checks, tf, moves, origin, why = ready
-    if not checks.any:
-        print("hil check: no checks to run: give a --bench with [checks] or limits such as --max-ferr", file=sys.stderr)
+    if not checks.any and not args.against:
+        print("hil check: no checks to run: give a --bench with [checks], limits such as --max-ferr, or --against "
+              "a reference trace", file=sys.stderr)
         return EXIT_USAGE
     try:  # the trace is read here: damage past its header shows now
         results = run_checks(tf, checks, bench, moves, why)
+        if args.against:
+            results += _against(args, tf)
     except TraceReadError as exc:
+        print(f"hil check: {exc}", file=sys.stderr)
+        return EXIT_USAGE
+    except ValueError as exc:  # a bad --against pairing or tolerance (_against)
         print(f"hil check: {exc}", file=sys.stderr)
         return EXIT_USAGE
     if origin and not args.json:
@@ -183,3 +195,20 @@ def cmd_check(args: argparse.Namespace) -> int:
         print(f"hil check: {len(unjudged)} check(s) skipped ({'; '.join(r.detail for r in unjudged)}): "
               "nothing was judged there", file=sys.stderr)
     return EXIT_ALARM if failed or unjudged else EXIT_OK
+
+
+def _against(args: argparse.Namespace, tf: TraceFile) -> list:
+    """`--against REF` (decision B127): REF read as a trace; the two must have run on the same axes."""
+    from hil.trace import axes_of
+    from hil.trace_against import check_against
+    from hil.trace_read import TraceFile
+
+    for opt, v in (("--path-tol", args.path_tol), ("--time-tol", args.time_tol)):
+        if v is not None and not 0.0 <= v < float("inf"):
+            raise ValueError(f"{opt} {v:g}: a tolerance must be >= 0")
+    ref = TraceFile(args.against)
+    mine, theirs = axes_of(tf.columns), axes_of(ref.columns)
+    if sorted(mine) != sorted(theirs):
+        raise ValueError(f"{args.against} ran on axes {', '.join(theirs) or 'none'}, {args.trace} on "
+                         f"{', '.join(mine) or 'none'}: a reference must be a run of the same bench's axes")
+    return check_against(tf, ref, args.path_tol, args.time_tol)
