@@ -130,9 +130,11 @@ def feed():
     from nc.budget import StatementBudget
     from nc.channel import Channel, RunState
     from nc.softlimits import SoftLimits
+    from nc.motion.limits import MotionConfig
     class Taker:
         closed = idle = True
         held = False
+        cfg = MotionConfig()
         threads_queued = 0
         def __init__(self):
             self.blocks = []

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING
 
 from fieldbus.units import AxisScaling
@@ -43,8 +43,20 @@ class SpindleConfig:
 
 
 LOCKSTEP_PLACEMENTS = ("default", "fifo")  # [realtime] lockstep: scheduled as any process / SCHED_FIFO on one CPU
+# Axis limit bounds (mm or deg per s, s², s³): a 100 m/s axis or a jerk of 1e10 is no machine tool.
+LIMIT_BOUNDS = {"velocity": (1e-3, 1e5), "acceleration": (1e-3, 1e7), "jerk": (1e-3, 1e10)}
+LIMIT_FIELDS = {"velocity": "max_velocity", "acceleration": "max_acceleration", "jerk": "max_jerk"}  # bench -> AxisLimits
 FILTER_MS = 16.0  # default N1.036 and N1.037 (ms)
 PATH_DEVIATION = 0.02  # default N1.053 (mm)
+
+
+@dataclass
+class ParamGroup:
+    """A G05 parameter group ([param_groups.N] in a bench file, N§3.8.2 "recipes" 1-20): the values it sets;
+    what it leaves out keeps the bench's own (decision language L25-1)."""
+
+    params: dict[str, float] = field(default_factory=dict)  # N1.033, N1.036, N1.037, N1.053
+    limits: dict[str, dict[str, float]] = field(default_factory=dict)  # axis -> {velocity, acceleration, jerk}
 
 
 @dataclass
@@ -113,6 +125,7 @@ class Bench:
     io: list[IoStationConfig] = field(default_factory=list)  # remote I/O stations, EIO 501, 502, …
     canopen_bitrate: int = 1_000_000  # bit/s of a CANopen bus: the bus budget, and python-can where it sets it
     canopen_eds: str = ""  # EDS/DCF of every CANopen drive without its own (AxisConfig.canopen_eds)
+    param_groups: dict[int, ParamGroup] = field(default_factory=dict)  # G05 P1-P20 (decision language L25-1)
     source: str = ""  # the bench file this came from, for messages
 
     @property
@@ -125,20 +138,32 @@ class Bench:
         (mlc/lathe.py, the M/S/T handshake) on a lathe, BasicMlc on a mill (no mill MLC is shipped)."""
         return self.mlc or ("basic" if self.profile == "nc5-mill" else "lathe")
 
-    def motion_config(self) -> MotionConfig:
+    def motion_config(self, group: int = 0) -> MotionConfig:
+        """The planner's settings: the bench's own (`group` 0), or with G05 parameter group `group`'s values
+        over them (KeyError: no such group)."""
         # N1.036 / N1.037 look-ahead filter and S-curve times (ms), N1.053 path smoothing
         # deviation (mm; 0 = no limit but the filter's own budget): see docs/decisions/motion.md.
-        p = self.params
+        p, limits = self.params, {a.name: a.limits for a in self.axes}
+        if group:
+            g = self.param_groups[group]
+            p = {**p, **g.params}
+            limits = {a: replace(lim, **{LIMIT_FIELDS[k]: v for k, v in g.limits.get(a, {}).items()})
+                      for a, lim in limits.items()}
         filt = p.get("N1.036", FILTER_MS) / 1000.0
         scurve = p.get("N1.037", FILTER_MS) / 1000.0
         dev = p.get("N1.053", PATH_DEVIATION)
-        cfg = MotionConfig(cycle=self.cycle, axes=self.axis_names, limits={a.name: a.limits for a in self.axes},
+        cap = p.get("N1.033", 0.0)  # mm/min; 0 = none
+        cfg = MotionConfig(cycle=self.cycle, axes=self.axis_names, limits=limits,
                            filter_time=filt, filter_scurve=scurve, path_tolerance=dev if dev > 0.0 else None,
-                           lookahead=self.lookahead)
+                           lookahead=self.lookahead, max_feed=cap if cap > 0.0 else None)
         if cfg.filtered:
             # The filter spreads what several blocks in one cycle do; a block need not last a cycle.
             cfg.min_segment_cycles = 0.25
         return cfg
+
+    def motion_configs(self) -> dict[int, MotionConfig]:
+        """G05 P0 (the bench's own settings) and every parameter group's, for the channel (nc.channel)."""
+        return {n: self.motion_config(n) for n in (0, *sorted(self.param_groups))}
 
 
 def default_lathe() -> Bench:

@@ -17,8 +17,9 @@ from fieldbus.factory import parse_bus
 from fieldbus.pdo import ASDA_CSP, ASDA_CSP_CSV
 from fieldbus.devices import DEFAULT_MODEL, MODELS
 from fieldbus.units import AxisScaling
+from hil.bench_groups import parse_groups
 from hil.bench_params import check_param
-from hil.bench import LOCKSTEP_PLACEMENTS, AxisConfig, Bench, ChecksConfig, IoStationConfig, RealtimeConfig, SpindleConfig
+from hil.bench import LIMIT_BOUNDS, LOCKSTEP_PLACEMENTS, AxisConfig, Bench, ChecksConfig, IoStationConfig, RealtimeConfig, SpindleConfig
 from hil.drive_homing import DriveHoming
 from hil.toml_fields import BenchFileError, FieldReader, kind_of, read_text_file
 from nc.motion.limits import AxisLimits
@@ -32,8 +33,6 @@ MODEL_ALIASES = {"asda-a3": "asda-a3-e"}  # the name benches used before the mod
 # DriveParams fields a bench may override, with whether they are integers (counts) or reals.
 _DRIVE_INT = {"following_error_window", "negative_limit", "positive_limit", "home_switch", "index_pulse_every",
               "substeps", "probe_position"}
-# Axis limit bounds (mm or deg per s, s², s³): a 100 m/s axis or a jerk of 1e10 is no machine tool.
-LIMIT_BOUNDS = {"velocity": (1e-3, 1e5), "acceleration": (1e-3, 1e7), "jerk": (1e-3, 1e10)}
 _DRIVE_KEYS = {f.name for f in fields(DriveParams)} - {"counts_per_rev", "units"}
 
 
@@ -117,8 +116,10 @@ def parse_bench(text: str, source: str = "bench.toml") -> Bench:
     b.realtime = _realtime(r, r.table(data, "realtime", "realtime"))
     b.checks = _checks(r, r.table(data, "checks", "checks"), b.axis_names)
     b.io = _io_stations(r, data.pop("io", []), len(b.axes) + len(b.spindles))
+    b.param_groups = parse_groups(r, data.pop("param_groups", {}), b.axes)
     r.unknown(data, "", {"name", "profile", "cycle_ms", "bus", "mlc", "enable_timeout", "settle_time", "max_time",
-                         "lookahead", "params", "axes", "spindles", "realtime", "checks", "io", "canopen_bitrate"})
+                         "lookahead", "params", "axes", "spindles", "realtime", "checks", "io", "canopen_bitrate",
+                         "param_groups"})
 
     names = b.axis_names
     if b.axes and b.profile != "nc5-mill" and "X" not in names:

@@ -32,6 +32,7 @@ PARAMS: dict[str, ParamSpec] = {
     "N1.08": ParamSpec(0, 2, True, "lathe type A/B/C"),
     "P306": ParamSpec(0, 2, True, "lathe type A/B/C (lathe-2018)"),
     "N1.027": ParamSpec(0, 1e6, False, "mm/min"),
+    "N1.033": ParamSpec(0, 1e6, False, "mm/min, cutting command maximum feed, 0: none"),
     "N1.036": ParamSpec(0, 1000, False, "ms"), "N1.037": ParamSpec(0, 1000, False, "ms"),
     "N1.040": ParamSpec(0, 10, False, "mm"), "N1.042": ParamSpec(0, 1e6, False, "mm/min"),
     "N1.053": ParamSpec(0, 10, False, "mm"),

@@ -156,7 +156,9 @@ def run_checks(trace: TraceFile, checks: ChecksConfig, bench: Bench | None = Non
             lag, independent = LAG_CYCLES, False
             if bench is not None:
                 cfg = bench.motion_config()
-                lag, independent = sum(cfg.filter_cycles()) + SERVO_LAG_CYCLES, cfg.rapid_independent
+                # the longest filter of the settings G05 may switch to (decision language L25-1)
+                span = max(sum(c.filter_cycles()) for c in bench.motion_configs().values())
+                lag, independent = span + SERVO_LAG_CYCLES, cfg.rapid_independent
             out.append(check_contour(cols, axes, moves, checks.contour_error, lag, independent))
     if checks.limits:
         if bench is None:

@@ -50,6 +50,7 @@ def as_dict(result: Any, allow_unfired: bool = False) -> dict[str, Any]:
         "power_up_fault_resets": [{"drive": a, "error_code": c}
                                   for a, c in getattr(result.run, "power_up_resets", ())],
         "fitted_windows": _fits(getattr(result.run, "fits_ahead", None)),
+        "param_groups": [{"line": line, "group": n} for line, n in getattr(result.run, "param_groups", ())],
         "program_time_s": result.program_time, "sim_time_s": result.sim_time, "cycles": result.cycles,
         "max_following_error": result.max_following_error, "final_position": result.final_position,
         "trace": str(result.trace.path) if result.trace is not None else None,

@@ -78,6 +78,7 @@ class RunResult:
     stopped_by: str | None = None  # the signal (SIGINT, SIGTERM, SIGHUP, SIGQUIT) whose stop ended the run
     stretched: int = 0  # cycles run in stretches (hil/stretch.py), not stepped one by one
     fits_ahead: tuple[int, int] | None = None  # B86: fitted windows (taken from the second process, fitted in a cycle)
+    param_groups: list[tuple[int, int]] = field(default_factory=list)  # (line, group) of each G05 applied (L25-1)
 
     @property
     def ok(self) -> bool:
@@ -305,6 +306,8 @@ class BenchRunner:
         else:
             planner.reset_position(dict(zip(self.axes, self.actual.tolist())))
         self.channel = ch = Channel(planner)
+        if self.bench.param_groups:  # G05 P1-P20 switch to these, P0 back to the planner's own (language L25-1)
+            ch.param_groups = {**self.bench.motion_configs(), 0: planner.cfg}
         ch.soft_limits = SoftLimits.for_bench(self.bench, getattr(self, "profile", None))
         ch.css_diameter = "X" in getattr(getattr(self, "profile", None), "diameter_axes", ("X",))  # G96 D
         if getattr(self, "_interp", None) is not None:  # G31 skip (issue 5)
@@ -354,6 +357,7 @@ class BenchRunner:
                                          **where))
         finally:
             self.result.program_time = self.time - t0
+            self.result.param_groups = list(ch.group_log)
         self.result.finished = ch.state is RunState.FINISHED
         self._settle()
         self.result.stretched = stretcher.cycles if stretcher is not None else 0  # the settle's too (B38)

@@ -362,6 +362,7 @@ class Machine:
         interp = Interpreter(make_profile(self.bench.profile, r.axes, self.bench.params), here)
         self.mlc.attach_interpreter(interp)  # #25000–#25511 and the block skip switch M2x010
         ch = Channel(Planner(self.bench.motion_config(), here, spindle_rpm=lambda: self.mlc.spindle.rpm))
+        ch.param_groups = {**self.bench.motion_configs(), 0: ch.planner.cfg}  # G05 (decision language L25-1)
         r.channel = ch
         ch.soft_limits = SoftLimits.for_bench(self.bench, interp.profile)  # bench + this program's G10 L21
         ch.m96 = m96_link(interp)  # the MLC's M2x019 interrupts it (machine.interrupt())

@@ -11,7 +11,7 @@ from dataclasses import asdict, fields
 from pathlib import Path
 from typing import Any
 
-from hil.bench import AxisConfig, Bench, ChecksConfig, SpindleConfig
+from hil.bench import AxisConfig, Bench, ChecksConfig, ParamGroup, SpindleConfig
 from nc.motion.limits import AxisLimits
 from hil.version import version
 
@@ -54,7 +54,9 @@ def run_meta(bench: Bench, program: str, libs: Sequence[str] = ()) -> dict[str, 
                   "spindles": {s.name: {"max_rpm": s.max_rpm} for s in bench.spindles},
                   # what `hil check TRACE` needs to judge it as the run did: the NC parameters (the
                   # position filter sets the contour check's lag) and the bench's [checks]
-                  "params": dict(bench.params), "checks": asdict(bench.checks)},
+                  "params": dict(bench.params), "checks": asdict(bench.checks),
+                  # G05's parameter groups (decision language L25-1): the contour check's lag spans their filters
+                  "param_groups": {str(n): asdict(g) for n, g in sorted(bench.param_groups.items())}},
     }
 
 
@@ -105,9 +107,12 @@ def bench_from_meta(meta: dict[str, Any]) -> Bench | None:
         raw = b.get("checks") or {}
         known = {f.name for f in fields(ChecksConfig)}
         checks = ChecksConfig(**{k: v for k, v in raw.items() if k in known})
+        groups = {int(n): ParamGroup({k: float(v) for k, v in (g.get("params") or {}).items()},
+                                     {a: {k: float(v) for k, v in lim.items()} for a, lim in (g.get("limits") or {}).items()})
+                  for n, g in (b.get("param_groups") or {}).items()}
         return Bench(name=str(b.get("name", "")), profile=str(b.get("profile", "nc5-lathe-a")), axes=axes,
                      spindles=spindles, cycle=float(b.get("cycle_s", 0.001)), bus=str(b.get("bus", "sim")),
                      params={k: float(v) for k, v in (b.get("params") or {}).items()}, checks=checks,
-                     source=str(b.get("source", "")))
-    except (KeyError, TypeError, ValueError):
+                     source=str(b.get("source", "")), param_groups=groups)
+    except (KeyError, TypeError, ValueError, AttributeError):
         return None  # metadata from another tool or damaged: as if there were none

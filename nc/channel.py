@@ -27,9 +27,11 @@ from enum import Enum
 from nc.alarms import Alarm, NcAlarm, internal_error
 from nc.interrupt import M96Link, interrupt_stream
 from nc.motion.css import css_rpm_at, x_origin
+from nc.motion.limits import MotionConfig
 from nc.motion.planner import Planner, Setpoint
 from nc.budget import StatementBudget
 from nc.moves import Aux, Busy, Event, MainLoop, Move, ProgramEnd, Sync
+from nc.param_switch import capped, rebuilt
 from nc.softlimits import SoftLimits
 
 # Moves read from the interpreter into the look-ahead per cycle (M/S/T codes and preview stops do
@@ -110,6 +112,13 @@ class Channel:
     # M2x026 M99 Call Stop, set by the MLC link: at the main program's M99 (an M code: the motion before it runs out
     # to rest) the program ends while it is ON (ProgramEnd code 99) instead of running again (decision mlc M25-1)
     m99_call_stop: bool = False
+    # G05 (N§3.8.2, decision language L25-1): the planner's settings by parameter group, 0 the original ones (a
+    # bench's `motion_configs()`); a G05 P of a group not here is 0x120D. Empty: only G05 P0 runs.
+    param_groups: dict[int, MotionConfig] = field(default_factory=dict)
+    group_log: list[tuple[int, int]] = field(default_factory=list)  # (G05 line, group) of every switch applied
+
+    def __post_init__(self) -> None:
+        self._feed_cap = self.planner.cfg.max_feed  # N1.033 of the settings in force (None: no limit)
 
     def load(self, events: Iterator[Event]) -> None:
         self.events = events
@@ -340,7 +349,7 @@ class Channel:
         # Nothing comes before the queue has run out to rest: its tail is a stop (nc.motion.shares).
         pl.closed = self.end is not None or self._deferred is not None or self._limit_alarm is not None
         src = self.events
-        if src is self._ahead and src is not None and src.plain and self.state is _RUNNING \
+        if src is self._ahead and src is not None and src.plain and self.state is _RUNNING and self._feed_cap is None \
                 and self.end is None and self._limit_alarm is None and self._deferred is None and not self.single_block:
             # plain moves read ahead (hil.stretch_reads.Ahead: no G31, limits checked, no statement): the loop
             # below would only push them, with nothing else to check between two (issue 17)
@@ -367,6 +376,10 @@ class Channel:
                     return
                 if self._skip_move is not None:
                     self._skip_done()
+                if ev.group is not None:  # type: ignore[union-attr]
+                    if not self._switch_group(ev):  # type: ignore[arg-type]
+                        return
+                    pl = self.planner
                 continue  # a Sync: motion has drained, read on
             if self.single_block and self._block_moves:
                 pl.release_run()  # nothing more is read: a run held back runs now (nc.motion.spline_feed)
@@ -401,6 +414,8 @@ class Channel:
                         and (crossing := self.soft_limits.check(ev)) is not None:
                     self._limit_alarm = crossing
                     continue
+                if self._feed_cap is not None:
+                    ev = capped(ev, self._feed_cap)
                 if "G31" in ev.tags:
                     self._skip_move = ev
                     self.skip_latched = None
@@ -432,6 +447,29 @@ class Channel:
                     pl.closed = True
                 elif self._skip_move is not None:
                     self._skip_done()
+                elif ev.group is not None:
+                    if not self._switch_group(ev):
+                        return
+                    pl = self.planner
+
+    def _switch_group(self, ev: Sync) -> bool:
+        """G05 P at rest (its Sync drained: the queue empty, the filter settled): the planner rebuilt with the
+        group's settings, P0 the original ones (N§3.8.2 "immediately apply"). A group the channel does not hold
+        is 0x120D at the G05 block; False then (the channel stops)."""
+        n = ev.group or 0
+        cfg = self.param_groups.get(n)
+        if cfg is None:
+            if n == 0:
+                return True  # no groups: the settings in force are the original ones
+            self.raise_alarm(Alarm(0x120D, f"parameter group {n} is not set on this bench "
+                                           f"([param_groups.{n}] in the bench file)",
+                                   line=ev.line, block=ev.block, program=ev.program or None))
+            return False
+        if cfg is not self.planner.cfg:
+            self.planner = rebuilt(self.planner, cfg)
+            self._feed_cap = cfg.max_feed
+        self.group_log.append((ev.line, n))
+        return True
 
     def _main_loop(self, ev: MainLoop) -> bool:
         """The main program's M99 reached, the axes at rest: with M2x026 M99 Call Stop ON the program ends here

@@ -87,14 +87,20 @@ class Aux:
 @dataclass(slots=True)
 class Sync:
     """A preview stop: the interpreter may not read further until motion has finished
-    (G05, G10, G31, G53, halt M codes, reads of live positions)."""
+    (G05, G10, G31, G53, halt M codes, reads of live positions). G05's carries its group: the channel
+    switches the planner's settings there, at rest (decision language L25-1)."""
 
     line: int
     block: str
     reason: str
+    group: int | None = None  # G05 P: the parameter group the motion after it uses (0: the original settings)
+    program: str | None = None
 
     def as_dict(self) -> dict:
-        return {"kind": "sync", "line": self.line, "block": self.block, "reason": self.reason}
+        d = {"kind": "sync", "line": self.line, "block": self.block, "reason": self.reason}
+        if self.group is not None:
+            d["group"] = self.group
+        return d
 
 
 @dataclass(slots=True)

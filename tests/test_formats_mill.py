@@ -74,10 +74,14 @@ def test_g30_p2_p3_p4_return_through_the_intermediate_point(capsys, tmp_path, p,
 
 def test_g05_p_selects_a_parameter_group_and_checks_its_range(capsys, tmp_path):
     """N3.8.2-1 `G05`, N3.8.2-2 `[G05] P_` (N§3.8.2, "P_ parameter group ID, range P1-P20"): the block is
-    accepted with P1-P20 (group 0 shows G05 in #20300) and a P outside the range is an argument error. The
-    parameter sets themselves (N1.030-N2.029 per group) are not modelled: the planner keeps the bench's."""
-    r = _ok(run_path(capsys, tmp_path, "G05 P20\n#100=#20300\nG05 P1\nG90 G00 X1.\nM30\n", "--vars", "100"))
+    accepted with P1-P20 (group 0 shows G05 in #20300) and a P outside the range is an argument error. `hil path`
+    runs no planner: the group a G05 selects takes effect in the channel (`hil run`, tests/test_g05_groups.py;
+    decision language L25-1), and its preview stop carries it."""
+    r = _ok(run_path(capsys, tmp_path, "G05 P20\n#100=#20300\nG05 P1\nG90 G00 X1.\nM30\n", "--vars", "100",
+                     "--preview-log"))
     assert r.vars["100"] == 5.0 and r.ends("X") == [(1.0,)]
+    assert [(e["line"], e["reason"], e["group"]) for e in r.other if e["kind"] == "sync"] == [(1, "G05", 20),
+                                                                                             (3, "G05", 1)]
     bad = run_path(capsys, tmp_path, "G05 P21\nM30\n")
     assert bad.code == 1 and bad.alarm["code"] == "0x0243"
 

@@ -231,6 +231,9 @@ def print_summary(program: str, bench: Bench, r: RunResult, out=None) -> None:
     print(f"max following error  {ferr}", file=out)
     final = "  ".join(f"{a} {v:.4f}" for a, v in r.final.items())
     print(f"final machine position  {final}", file=out)
+    groups = getattr(r, "param_groups", ())
+    if groups:  # G05 (decision language L25-1): which parameter group the motion used from where
+        print("parameter groups  " + ", ".join(f"G05 P{n} at line {line}" for line, n in groups), file=out)
     if r.alarms:
         print(f"alarms         {len(r.alarms)}", file=out)
         for a in r.alarms:

@@ -54,7 +54,8 @@ def step_preview_stop(ip, run: BlockRun) -> Iterator[Event]:
     """Codes that stop the preview (G31, G53, G10 L40 …) and the halt M codes of N1.118/N1.119."""
     block, funcs = run.block, run.funcs
     if not funcs.isdisjoint(STOP_PREVIEW):
-        yield Sync(block.line, block.text, next(fn for fn in funcs if fn in STOP_PREVIEW))
+        group = ip._g05_group(block) if "G05" in funcs else None  # checked here: its Sync carries it
+        yield Sync(block.line, block.text, next(fn for fn in funcs if fn in STOP_PREVIEW), group, ip.program_name)
     halt_m = ip._halt_m(run.mvals) if run.mvals else None
     if halt_m is not None:
         yield Sync(block.line, block.text, f"M{halt_m}")

@@ -40,12 +40,17 @@ class NonModalMixin:
     def _computed(self, w: Word) -> bool:
         return not any(ch == "." for ch in w.text) and w.text[1:2] in ("#", "[", "-", "=")
 
-    def _g_G05(self, block: Block) -> None:
+    def _g05_group(self, block: Block) -> int:
+        """G05 P: the parameter group 1-20, 0 the original settings (N§3.8.2); its Sync carries it to the
+        channel, which switches the planner's settings at rest or raises 0x120D (decision language L25-1)."""
         p = block.get("P")
         if p is None or p.value != int(p.value) or not 0 <= p.value <= 20:
             raise NcAlarm(0x0243, "G05 P must be 0-20")
+        return int(p.value)
+
+    def _g_G05(self, block: Block) -> None:
         self.state.groups[0] = 5
-        self.param_group = int(p.value)
+        self.param_group = self._g05_group(block)
 
     def _g_G09(self, block: Block) -> None:
         return None

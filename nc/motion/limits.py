@@ -41,6 +41,9 @@ class MotionConfig:
     filter_scurve: float = 0.0
     # Runs of short feed lines fitted as one curve within path_tolerance (nc.motion.spline_feed, issue 18).
     fit_runs: bool = True
+    # N1.033 cutting command maximum feed (mm/min): the programmed F of a G94 feed move is limited to it before
+    # the feed override (the channel applies it: nc.channel; decision language L25-1). None: no limit.
+    max_feed: float | None = None
 
     def filter_cycles(self) -> tuple[int, int]:
         """Window lengths (cycles) of the two moving averages; (1, 1) = no filter."""

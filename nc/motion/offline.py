@@ -61,15 +61,19 @@ class _Collector:
 
 def run(events: Iterable[Event] | Iterator[Event], cfg: MotionConfig, start: dict[str, float] | None = None,
         spindle_rpm: Callable[[], float] | None = None, max_cycles: int = 10_000_000, keep: bool = True,
-        on_cycle: Callable[[int, Channel], None] | None = None, fit_memo=None) -> Stream:
+        on_cycle: Callable[[int, Channel], None] | None = None, fit_memo=None,
+        param_groups: dict[int, MotionConfig] | None = None) -> Stream:
     """Step the channel until the program ends; `keep=False` keeps only the last position (streaming).
-    `fit_memo`: where the planner's fitted runs take and leave their windows (nc.motion.fit_memo)."""
+    `fit_memo`: where the planner's fitted runs take and leave their windows (nc.motion.fit_memo).
+    `param_groups`: the settings G05 P1-P20 switch to (`cfg` is P0's; decision language L25-1)."""
     ch: Channel
     rpm_box = {"rpm": 0.0}
     planner = Planner(cfg, start, spindle_rpm=spindle_rpm or (lambda: rpm_box["rpm"]))
     if fit_memo is not None and planner._runs is not None:
         planner._runs.memo = fit_memo
     ch = Channel(planner)
+    if param_groups:
+        ch.param_groups = {**param_groups, 0: cfg}
     ch.load(iter(events))
     ch.cycle_start()
     rows = [planner.position.copy()]
