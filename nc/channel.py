@@ -376,8 +376,8 @@ class Channel:
                     return
                 if self._skip_move is not None:
                     self._skip_done()
-                if ev.group is not None:  # type: ignore[union-attr]
-                    if not self._switch_group(ev):  # type: ignore[arg-type]
+                if type(ev) is Sync and ev.group is not None:  # G05: motion has drained, its group applies here
+                    if not self._switch_group(ev):
                         return
                     pl = self.planner
                 continue  # a Sync: motion has drained, read on
