@@ -16,7 +16,7 @@ from __future__ import annotations
 from typing import Any
 
 from hil.bench import LIMIT_BOUNDS, LIMIT_FIELDS, AxisConfig, ParamGroup
-from hil.bench_params import PARAMS, check_param
+from hil.bench_params import check_param, param_spec
 from hil.toml_fields import FieldReader, kind_of
 
 GROUPS = range(1, 21)  # G05 P1-P20
@@ -95,9 +95,9 @@ def _not_switched(k: str) -> str | None:
         instead = f"; set {INSTEAD[base]} in the group instead" if base in INSTEAD else ""
         return (f"G05 switches {base} on an NC5 (N§3.8.2), but this bench does not model it: a group sets "
                 f"{', '.join(MODELLED)} and limits.<axis> {{ velocity, acceleration, jerk }}{instead}")
-    if k in PARAMS:
+    if param_spec(k) is not None:
         return f"G05 does not switch {k} (N§3.8.2 lists {LISTED}); set it in [params]"
-    return check_param(k, 0.0) or f"unknown parameter; a group sets {', '.join(MODELLED)} and limits.<axis>"
+    return check_param(k, 0.0)  # unknown: its message, with the closest name
 
 
 def _axis_limits(r: FieldReader, d: dict, p: str, ax: AxisConfig) -> dict[str, float]:
