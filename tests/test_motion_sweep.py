@@ -14,12 +14,10 @@ from tests.motion_sweep import make_case, run_case
 
 TOL = 1.0 + 1e-6
 BACK = 1e-9  # mm: float noise of the path position, not a step back
-FIXED = [167]  # found a bug, fixed since (decision motion 82)
-FIT = "a fitted run (issue 18): a plan braking into spans of lower tangential limits (decisions motion 77, 81)"
-RESUME = "a resume from a feed hold accelerating through a corner nearby (decision motion 81)"
-KNOWN: dict[int, str] = {
-    1: RESUME, 15: FIT, 96: FIT, 220: FIT, 226: FIT, 294: FIT, 360: FIT, 469: FIT, 498: RESUME,
-}
+# found a bug, fixed since: 167 (decision motion 82); 96, 220, 226, 294, 360, 469 (motion 83), 498 (motion 84)
+FIXED = [96, 167, 220, 226, 294, 360, 469, 498]
+# (empty since decisions motion 83 and 84: seeds 1, 15, 96, 220, 226, 294, 360, 469, 498 were here)
+KNOWN: dict[int, str] = {}
 
 
 def _check(seed: int) -> None:

@@ -13,7 +13,7 @@ from collections.abc import Iterable
 import numpy as np
 
 from nc.motion.block import Block
-from nc.motion.profile import Piecewise
+from nc.motion.profile import Piecewise, _OneDof
 
 SAMPLES = 256  # points of the ramp's speed over its path: only read when a hold is planned
 
@@ -32,3 +32,73 @@ def crosses_too_fast(ramp: Piecewise, s: float, blocks: Iterable[Block]) -> bool
         if at >= s and float(np.interp(at, p, v)) > b.vend * (1.0 + 1e-6) + 1e-6:
             return True
     return end > at + 1e-9  # past the queue's last point
+
+
+def brakes_below(pw: Piecewise, s: float, dist: float, blocks: Iterable[Block]) -> bool:
+    """True when a braking solve (path position from s in blocks[0] to dist, its acceleration nowhere above
+    zero) crosses every junction before dist no faster than the junction and the block after it allow (its
+    `vjunc` and `cap`): a state above the caps of the blocks ahead, solved with its own speed as the top speed,
+    gets below each before it reaches it (decision motion 83). Rare (a plan that no ordinary run could meet),
+    so the crossing times are bisected on the profile."""
+    if max(pw.a[0].tolist()) > 1e-9:
+        return False  # it speeds up somewhere: the junction speeds alone do not bound it in the blocks
+    it = iter(blocks)
+    b = next(it)
+    at = 0.0  # the path position of b's end, in blocks[0]'s coordinates
+    lo = 0.0
+    for nx in it:
+        at += b.length
+        if at >= dist - 1e-12:
+            return True
+        if at > s:
+            hi = pw.duration
+            for _ in range(60):  # the time the profile reaches `at` (its position rises with time)
+                mid = 0.5 * (lo + hi)
+                if pw.at(mid)[0] < at:
+                    lo = mid
+                else:
+                    hi = mid
+            lim = nx.cap if nx.cap < b.vjunc else b.vjunc
+            if pw.at(hi)[1] > lim * (1.0 + 1e-9) + 1e-12:
+                return False
+        b = nx
+    return True
+
+
+def peak_speed(pw: Piecewise, t: float) -> float:
+    """The highest speed of the profile from time t on: at a phase's ends or where its acceleration passes zero."""
+    t0, a, j = pw.t0[0].tolist(), pw.a[0].tolist(), pw.j[0].tolist()
+    dur = pw.duration
+    top = max(pw.at(t)[1], pw.at(dur)[1])
+    for k in range(len(t0)):
+        lo, hi = max(t0[k], t), min(t0[k + 1] if k + 1 < len(t0) else dur, dur)
+        if lo >= hi:
+            continue
+        top = max(top, pw.at(lo)[1], pw.at(hi)[1])
+        if j[k] != 0.0 and lo < t0[k] - a[k] / j[k] < hi:
+            top = max(top, pw.at(t0[k] - a[k] / j[k])[1])
+    return top
+
+
+def fits_queue(pw: Piecewise, t: float, base: float, end: float, blocks: Iterable[Block]) -> bool:
+    """True when a path profile followed from time t (its position minus `base` the path position in blocks[0])
+    still fits the queue up to `end`: `end` a junction whose planned end speed (`vend`) allows the profile's end
+    speed, and no speed of it from t on above a cap of the blocks or a junction speed before `end` (decision
+    motion 83: a profile kept where its re-solve in the next block missed)."""
+    top = peak_speed(pw, t) * (1.0 - 1e-9) - 1e-12
+    at = 0.0
+    for b in blocks:
+        if b.kind != "path" or b.cap < top:
+            return False
+        at += b.length
+        if abs(at - end) <= 1e-9:
+            return pw.v_end() <= b.vend * (1.0 + 1e-9) + 1e-12
+        if at > end or b.vjunc < top:
+            return False
+    return False
+
+
+def later(pw: Piecewise, t: float) -> Piecewise:
+    """A path profile from time t on, its clock starting there (its phases before t start at negative times)."""
+    rows = (pw.t0[0] - t).tolist(), pw.p[0].tolist(), pw.v[0].tolist(), pw.a[0].tolist(), pw.j[0].tolist()
+    return _OneDof(rows, pw.duration - t, pw.p_max)
