@@ -4,7 +4,11 @@ A feed hold, a reset or an alarm stops the path with one jerk-limited velocity r
 which may run on across the queue's junctions. Where it would cross a junction faster than the look-ahead allows
 there (a corner's end speed, the queue's end), the planner brakes for that junction as a plan would, and stops
 from there. Before, the ramp ran through a sharp corner at speed (a G76's return into its infeed: 110 mm/s round a
-90° corner, X at 2× its acceleration after the filter) or past the queue's last point (clipped there)."""
+90° corner, X at 2× its acceleration after the filter) or past the queue's last point (clipped there).
+
+The same question for path profiles (decision motion 83): does a braking solve through lower caps get below each
+before it reaches it (`brakes_below`), and does the profile a plan was following still fit the queue where its
+re-solve missed (`fits_queue`, `later`)."""
 
 from __future__ import annotations
 
@@ -34,57 +38,77 @@ def crosses_too_fast(ramp: Piecewise, s: float, blocks: Iterable[Block]) -> bool
     return end > at + 1e-9  # past the queue's last point
 
 
+
+def _phases(pw: Piecewise) -> tuple[list[float], list[float], list[float], list[float], list[float]]:
+    """DoF 0's phases as plain lists (start times, position, speed, acceleration, jerk): `Piecewise.at`'s own."""
+    pw.at(0.0)  # (brings its lists up to date with the duration)
+    return pw._lists[1:]
+
+
+def time_at(pw: Piecewise, x: float, lo: float = 0.0) -> float:
+    """The time at or after lo the profile reaches position x (its position rising from lo to its end): Newton
+    steps on the position, bisection where one leaves the bracket."""
+    hi = pw.duration
+    t = lo
+    for _ in range(60):
+        p, v, _ = pw.at(t)
+        if p < x:
+            lo = t
+        else:
+            hi = t
+        if abs(p - x) <= 1e-13 or hi - lo <= 1e-15:
+            break
+        t = t - (p - x) / v if v > 1e-12 else -1.0
+        if not lo < t < hi:
+            t = 0.5 * (lo + hi)
+    return t
+
+
 def brakes_below(pw: Piecewise, s: float, dist: float, blocks: Iterable[Block]) -> bool:
     """True when a braking solve (path position from s in blocks[0] to dist, its acceleration nowhere above
     zero) crosses every junction before dist no faster than the junction and the block after it allow (its
     `vjunc` and `cap`): a state above the caps of the blocks ahead, solved with its own speed as the top speed,
-    gets below each before it reaches it (decision motion 83). Rare (a plan that no ordinary run could meet),
-    so the crossing times are bisected on the profile."""
-    if max(pw.a[0].tolist()) > 1e-9:
+    gets below each before it reaches it (decision motion 83). Rare (a plan that no ordinary run could meet)."""
+    if max(_phases(pw)[3]) > 1e-9:
         return False  # it speeds up somewhere: the junction speeds alone do not bound it in the blocks
     it = iter(blocks)
     b = next(it)
     at = 0.0  # the path position of b's end, in blocks[0]'s coordinates
-    lo = 0.0
+    t = 0.0
     for nx in it:
         at += b.length
         if at >= dist - 1e-12:
             return True
         if at > s:
-            hi = pw.duration
-            for _ in range(60):  # the time the profile reaches `at` (its position rises with time)
-                mid = 0.5 * (lo + hi)
-                if pw.at(mid)[0] < at:
-                    lo = mid
-                else:
-                    hi = mid
             lim = nx.cap if nx.cap < b.vjunc else b.vjunc
-            if pw.at(hi)[1] > lim * (1.0 + 1e-9) + 1e-12:
-                return False
+            if pw.at(t)[1] > lim:  # (its speed only falls: where it is below the limit already, so it is there)
+                t = time_at(pw, at, t)
+                if pw.at(t)[1] > lim * (1.0 + 1e-9) + 1e-12:
+                    return False
         b = nx
     return True
 
 
 def peak_speed(pw: Piecewise, t: float) -> float:
     """The highest speed of the profile from time t on: at a phase's ends or where its acceleration passes zero."""
-    t0, a, j = pw.t0[0].tolist(), pw.a[0].tolist(), pw.j[0].tolist()
+    t0, _, _, a, j = _phases(pw)
     dur = pw.duration
     top = max(pw.at(t)[1], pw.at(dur)[1])
     for k in range(len(t0)):
         lo, hi = max(t0[k], t), min(t0[k + 1] if k + 1 < len(t0) else dur, dur)
         if lo >= hi:
             continue
-        top = max(top, pw.at(lo)[1], pw.at(hi)[1])
+        top = max(top, pw.at(hi)[1])
         if j[k] != 0.0 and lo < t0[k] - a[k] / j[k] < hi:
             top = max(top, pw.at(t0[k] - a[k] / j[k])[1])
     return top
 
 
-def fits_queue(pw: Piecewise, t: float, base: float, end: float, blocks: Iterable[Block]) -> bool:
-    """True when a path profile followed from time t (its position minus `base` the path position in blocks[0])
-    still fits the queue up to `end`: `end` a junction whose planned end speed (`vend`) allows the profile's end
-    speed, and no speed of it from t on above a cap of the blocks or a junction speed before `end` (decision
-    motion 83: a profile kept where its re-solve in the next block missed)."""
+def fits_queue(pw: Piecewise, t: float, end: float, blocks: Iterable[Block]) -> bool:
+    """True when a path profile followed from time t still fits the queue up to `end` (the path position in
+    blocks[0]): `end` a junction whose planned end speed (`vend`) allows the profile's end speed, and no speed
+    of it from t on above a cap of the blocks or a junction speed before `end` (decision motion 83: a profile
+    kept where its re-solve in the next block missed)."""
     top = peak_speed(pw, t) * (1.0 - 1e-9) - 1e-12
     at = 0.0
     for b in blocks:
@@ -100,5 +124,5 @@ def fits_queue(pw: Piecewise, t: float, base: float, end: float, blocks: Iterabl
 
 def later(pw: Piecewise, t: float) -> Piecewise:
     """A path profile from time t on, its clock starting there (its phases before t start at negative times)."""
-    rows = (pw.t0[0] - t).tolist(), pw.p[0].tolist(), pw.v[0].tolist(), pw.a[0].tolist(), pw.j[0].tolist()
-    return _OneDof(rows, pw.duration - t, pw.p_max)
+    t0, p, v, a, j = _phases(pw)
+    return _OneDof(([x - t for x in t0], p, v, a, j), pw.duration - t, pw.p_max)
