@@ -57,6 +57,9 @@ from nc.motion.smoothing import PositionFilter
 from nc.motion import threading as thr
 from nc.moves import Move
 
+# blocks a run through every lower cap takes at most (decision motion 83: its end then the junction there at its end
+# speed; the fitted spans' chains the sweep found take 4-5; unbounded, the walk cost 1 % of the CAM instructions)
+THROUGH = 16
 OPEN_CHUNK = 4  # cycles sampled at a time (CHUNK otherwise) while the queue cannot tell the jerk factor yet (the channel reads 4 blocks a cycle)
 MAX_SOLVES_PER_CYCLE = 1000  # plans one cycle may start and end before a sample is due (decisions B4)
 
@@ -693,7 +696,7 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
         return _Plan("ramp", pw, pw.duration, t0, 0.0, cap)
 
     def _run_through(self, b: Block, s: float, v: float, cap: float, cruise: float,
-                     f: float, through: float) -> tuple[float, float, float, float, float]:
+                     f: float, through: float) -> tuple[float, float, float, float, float] | None:
         """The extended run carried on through blocks whose cap is a little lower than b's (the cap of a
         chain of corner-blend pieces falls by 1e-4 mm/s a piece) but not below v, the speed of a state that
         is not speeding up: the ordinary runs end at each such junction, with zero acceleration at a speed
@@ -704,7 +707,9 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
         the caller checks the solve against junction by junction instead, with the plain jerk (factor 1: always
         within the shares; the scan over the longer run cost 1 % of the CAM program's instructions, for 15 of 176
         such solves met there)."""
-        dist, v1, ra, rj, vmax = self._run_target(cap, True, cruise, 1.0, through)
+        dist, v1, ra, rj, vmax = self._run_target(cap, True, cruise, 1.0, through, 0 if through > 0.0 else THROUGH)
+        if through == 0.0 and v > max_speed_at(v1, 0.0, dist - s, ra, rj):
+            return None  # no profile brakes from v to v1 there (time reversed, none reaches v): 56 of 176 in CAM
         if f > 1.0 and through > 0.0:  # (through every lower cap: the plain jerk, no scan; rarely met, motion 83)
             g, unknown = self._factor_over(b, s, dist)
             if unknown or g < f:
@@ -734,7 +739,7 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
                    cruise_from=cython.double, k=cython.Py_ssize_t, extend=cython.bint, through=cython.double)
     # (k_max stays a Python int: absurd limits give a look-ahead depth beyond a C integer, test_harden_budgets)
     def _run_target(self, cap: float, extend: bool = False, cruise_from: float = math.inf,
-                    jf: float = 1.0, through: float = math.inf) -> tuple[float, float, float, float, float]:
+                    jf: float = 1.0, through: float = math.inf, limit: int = 0) -> tuple[float, float, float, float, float]:
         """(distance, end speed, acceleration, jerk, top speed) of the run that starts with blocks[0].
 
         A run ends at the first junction slower than the cap. With `extend` it carries on through
@@ -753,7 +758,7 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
         dist, ra, rj = b.length, b.a, b.j
         vmax = cap
         cap_lo = cap - 1e-9
-        k_max = 2 * self.depth
+        k_max = limit if limit else 2 * self.depth
         for k, nx in enumerate(it):
             if nx.kind != "path" or nx.cap < cap_lo or b.vend <= 0.0 or k >= k_max \
                     or (b.vend >= vmax - 1e-9 and dist >= cruise_from):
