@@ -371,8 +371,8 @@ class BenchRunner:
         rpm = self.mlc.spindle.signed_rpm
         if ch is None:
             return rpm
-        if ch.state is RunState.ALARM:
-            return 0.0
+        if ch.state is RunState.ALARM or ch.tap.record is not None:
+            return 0.0  # the tapping interrupt status holds the spindle (0x0C09, decision M26-2)
         top = self.bench.spindles[0].max_rpm if self.bench.spindles else float("inf")
         return spindle_speed(rpm, ch.css_rpm, ch.spindle_max, top, ch.spindle_factor)
 

@@ -362,6 +362,9 @@ class Machine:
         interp = Interpreter(make_profile(self.bench.profile, r.axes, self.bench.params), here)
         self.mlc.attach_interpreter(interp)  # #25000–#25511 and the block skip switch M2x010
         ch = Channel(Planner(self.bench.motion_config(), here, spindle_rpm=lambda: self.mlc.spindle.rpm))
+        if r.channel is not None:  # the tapping interrupt status outlives the program (N§3.13.2 note (6), M26-2)
+            ch.tap = r.channel.tap
+        ch.on_retracted = lambda pos: interp.position.update({a: v for a, v in pos.items() if a in interp.position})
         ch.param_groups = {**self.bench.motion_configs(), 0: ch.planner.cfg}  # G05 (decision language L25-1)
         r.channel = ch
         ch.soft_limits = SoftLimits.for_bench(self.bench, interp.profile)  # bench + this program's G10 L21

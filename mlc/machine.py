@@ -27,7 +27,7 @@ from mlc.memory import DeviceMemory
 from mlc.nc_link import ChannelLink, DriveStatus
 from mlc.on_change import ScanGate, wants_gate
 from mlc.program import ScanContext
-from mlc.spindle_axis import MODE_CSV, SpindleAxisSwitch
+from mlc.spindle_axis import MODE_CSP, MODE_CSV, SpindleAxisSwitch
 from mlc.signals import d2, m2, m3
 from nc.alarms import Alarm, NcAlarm
 from nc.channel import Channel
@@ -182,7 +182,12 @@ class Mlc:
 
     def spindle_drive(self, runner: Any) -> tuple[int, float | None, float | None]:
         """The first spindle drive's (mode, position setpoint deg, speed override rpm) this cycle:
-        CSV as a spindle, CSP while positioning (M29/M19) or while it is the channel's C axis."""
+        CSV as a spindle, CSP while positioning (M29/M19) or while it is the channel's C axis, CSP following the
+        channel's G84.48 / M2x707 retraction of an interrupted tap (nc.tap_interrupt, decision M26-4)."""
+        ch = runner.channel
+        rt = ch.tap_retraction if ch is not None else None
+        if rt is not None:
+            return MODE_CSP, rt.spindle_setpoint(runner.spindle_actual_angle()), None
         if self.caxis.idle():  # the usual cycle: a spindle that stays one, its feedback not read
             if not self.caxis.failed or self.caxis_alarmed:  # _caxis_checked would only pass it on
                 return MODE_CSV, None, None

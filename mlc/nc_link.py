@@ -69,6 +69,7 @@ class ChannelLink:
     _servo_levels: bytes | None = None  # M2x272… of the channel's axes as last read
     _servo_refused: int = 0  # bit i: a manual command of axis i, held OFF, was refused with 0x0A07 (M23-1)
     _spindle_levels: bytes = bytes(8)  # M2x711, M2x727, … as the last scan saw them (== their `_prev`)
+    _tap_levels: bool = False  # M2x080 or M2x707 was ON last scan (their edges are looked for then)
     _program_end: int | None = None
     _mode_switch_cycles: int = 0
     handshake_log: list[tuple[int, str, float]] = field(default_factory=list)  # (cycle, kind, value)
@@ -136,6 +137,8 @@ class ChannelLink:
             self._servo_levels = bytes(per_axis)
             self.servo_off = sum(1 << i for i, on in enumerate(per_axis) if on or self.servo_all)
         self._overrides(ch)
+        if m[b2 + 80] or m[b2 + 707] or self._tap_levels:
+            self._tap_input(ch)
         self._spindle_alarm(ch)
         self._user_alarms(ch)
         self._exchange_variables(ch)
@@ -274,6 +277,22 @@ class ChannelLink:
         ip = self.interp  # M2x010: '/' blocks the interpreter reads from now on are skipped (decision M21-1)
         if ip is not None and ip.block_skip != (v := bool(m[b2 + 10])):
             ip.block_skip = v
+
+    def _tap_input(self, ch: Channel) -> None:
+        """App. B M2x080 "Canceling Tapping Interrupt Status" (rising edge: the status ends, nothing moves) and
+        M2x707 "1st Spindle Retraction After Tapping" (rising edge: the G84.48 retraction, the channel idle in
+        AUTO/MDI, no E-stop). Decisions M26-6, M26-7."""
+        b2 = 20000 + 1000 * self.x
+        cancel, retract = self._rising(b2 + 80), self._rising(b2 + 707)
+        self._tap_levels = bool(self.mem.m[b2 + 80] or self.mem.m[b2 + 707])
+        tap = getattr(ch, "tap", None)
+        if tap is None or not tap.holds or self._estop:
+            return
+        if cancel and ch.tap_retraction is None:
+            tap.clear("M2x080")
+        elif retract and not ch.busy and ch.state is not RunState.ALARM and self.mode in (AUTO, MDI) \
+                and (self.manual is None or not self.manual.busy):
+            ch.tap_retract()
 
     def _spindle_alarm(self, ch: Channel) -> None:
         m, prev = self.mem.m, self._prev
@@ -428,6 +447,7 @@ class ChannelLink:
         elif not self._reset_pending:
             m[b3 + 19] = 0
         m[b3 + 31] = 1 if getattr(ch, "interrupt_active", False) else 0  # M3x031: M96 in execution
+        m[b3 + 707] = 1 if getattr(ch, "rigid_tapping", False) else 0  # M3x707: rigid tapping (decision M26-5)
         m[b3 + 25] = 1 if state is RunState.ALARM or self.alarms and any(not isinstance(a.code, str) for a in self.alarms) else 0
         m[b3 + 40] = 0 if mem.no_alarms() else 1  # any user alarm active
         block_stop = state is RunState.BLOCK_STOP

@@ -33,6 +33,8 @@ from nc.budget import StatementBudget
 from nc.moves import Aux, Busy, Event, MainLoop, Move, ProgramEnd, Sync
 from nc.param_switch import capped, rebuilt
 from nc.softlimits import SoftLimits
+from nc.tap_interrupt import (TAP_TAGS, Retraction, TapStatus, guarded, interruption_alarms, plan_retraction,
+                              record_of)
 
 # Moves read from the interpreter into the look-ahead per cycle (M/S/T codes and preview stops do
 # not count). Filling a 100-block queue at once takes ≈ 4 ms of interpretation and planning, which
@@ -116,11 +118,19 @@ class Channel:
     # bench's `motion_configs()`); a G05 P of a group not here is 0x120D. Empty: only G05 P0 runs.
     param_groups: dict[int, MotionConfig] = field(default_factory=dict)
     group_log: list[tuple[int, int]] = field(default_factory=list)  # (G05 line, group) of every switch applied
+    # N§3.13.2 G84 note (6) (decisions mlc M26-1 ... M26-9): the tapping interrupt status, kept from program to
+    # program (hil.scripting hands it on), and the G84.48 / M2x707 retraction while it runs
+    tap: TapStatus = field(default_factory=TapStatus)
+    _retract: Retraction | None = None
+    _tap_line: int | None = None  # line of the last tapping move started (M3x707 through its spindle reversal)
+    on_retracted: Callable[[dict[str, float]], None] | None = None  # the interpreter's position after G84.48
 
     def __post_init__(self) -> None:
         self._feed_cap = self.planner.cfg.max_feed  # N1.033 of the settings in force (None: no limit)
 
     def load(self, events: Iterator[Event]) -> None:
+        if self.tap.holds:  # axis moves and spindle starts are refused until G84.48 / M2x080 (M26-2)
+            events = guarded(events, self.tap)
         self.events = events
         self.end = None
         self.state = RunState.IDLE
@@ -141,7 +151,7 @@ class Channel:
 
     @property
     def busy(self) -> bool:
-        return self.state in _BUSY
+        return self.state in _BUSY or self._retract is not None
 
     # ---- operator controls --------------------------------------------------------------
     @property
@@ -175,8 +185,13 @@ class Channel:
 
     def reset(self) -> None:
         """Controlled stop, then flush motion, the pending M/S/T and the rest of the program."""
+        if self._retract is not None and not self._retract.braking:
+            # a reset interrupts the retraction too: it brakes short of R under control, the status stays (M26-8)
+            self._retract.brake()
+            self.alarms += interruption_alarms(self._retract.record, "reset")
         if self.state in (RunState.IDLE, RunState.FINISHED):
             return
+        self._interrupt_tap("reset")  # N§3.13.2 note (6): a reset interrupts a tap as an E-stop does (M26-1)
         self.planner.stop()
         self.pending_aux = None
         self._deferred = None
@@ -293,19 +308,92 @@ class Channel:
         does the braking (stop category 1)."""
         self.emergency = True
         self.alarms.append(alarm)
-        blk = self.planner.active
-        if blk is not None and {"tap", "tap_out"} & set(blk.move.tags):  # N§3.13 G84 note (6)
-            where = dict(line=blk.move.line or None, block=blk.move.block or None, program=blk.move.program)
-            self.alarms += [Alarm(0x0270, "axis movement prohibited: the E-stop interrupted a tapping cycle "
-                                          "(N§3.13 G84 note 6: retract to R after the reset)", **where),
-                            Alarm(0x0C09, "spindle movement prohibited: the E-stop interrupted a tapping cycle",
-                                  **where)]
+        self._interrupt_tap("emergency stop")  # N§3.13 G84 note (6)
         self.planner.abort()
         self.state = RunState.ALARM
         self.pending_aux = None
 
+    # ---- the tapping interruption (N§3.13.2 G84 note (6), nc.tap_interrupt) -----------------------------
+    def _interrupt_tap(self, cause: str) -> None:
+        """A tapping move is active (or a retraction runs): keep its record, raise 0x0270 + 0x0C09 (M26-1)."""
+        rt = self._retract
+        if rt is not None:  # the retraction itself interrupted: the status stays, from where the axis stands
+            if cause != "reset":  # (a reset brakes it: `reset`)
+                self._retract = None
+                self.planner.reset_position(dict(zip(self.planner.axes, self.planner.position.tolist())))
+                self.alarms += interruption_alarms(rt.record, cause)
+            return
+        blk = self.planner.active
+        if blk is None or not (TAP_TAGS[0] in blk.move.tags or TAP_TAGS[1] in blk.move.tags):
+            return
+        here = dict(zip(self.planner.axes, self.planner.output.tolist()))
+        rec = record_of(blk.move, here, self.spindle_rpm, cause)
+        if rec is not None:
+            self.tap.record = rec
+            self.alarms += interruption_alarms(rec)
+
+    def tap_retract(self, line: int = 0, program: str | None = None) -> bool:
+        """G84.48 (at rest, its Sync drained) or M2x707: the drilling axis back to R with the spindle reversed and
+        locked to the pitch; the status ends when R is reached. Nothing without the status (M26-3). False: refused
+        (alarm raised)."""
+        rec = self.tap.record
+        if rec is None or self._retract is not None:
+            return True
+        pl = self.planner
+        i = pl.axes.index(rec.axis)
+        try:
+            self._retract = plan_retraction(rec, float(pl.position[i]), pl.cfg.limit(rec.axis), pl.cfg.cycle, line)
+        except NcAlarm as exc:
+            exc.alarm.program = exc.alarm.program or program
+            self.raise_alarm(exc.alarm)
+            return False
+        return True
+
+    @property
+    def tap_retraction(self) -> Retraction | None:
+        """The retraction running now: the spindle drive follows its setpoint in position mode (mlc.machine)."""
+        return self._retract
+
+    @property
+    def rigid_tapping(self) -> bool:
+        """M3x707 (M26-5): a G74/G84 tapping stroke runs, or the channel waits at its spindle reversal, or the
+        G84.48 / M2x707 retraction runs."""
+        if self._retract is not None:
+            return True
+        blk = self.planner.active
+        if blk is not None:
+            tags = blk.move.tags
+            if TAP_TAGS[0] in tags or TAP_TAGS[1] in tags:
+                self._tap_line = blk.move.line
+                return True
+            self._tap_line = None
+            return False
+        aux = self.pending_aux
+        return aux is not None and aux.line == self._tap_line and aux.kind == "M" and aux.value in (3, 4)
+
+    def _retract_step(self) -> Setpoint:
+        rt = self._retract
+        assert rt is not None
+        pl = self.planner
+        i = pl.axes.index(rt.record.axis)
+        rt.step(pl.cfg.cycle)
+        pl.position[i] = pl.output[i] = rt.axis_position()
+        if rt.done and rt.braking:  # stopped by a reset: the status holds, from where the axis stands
+            self._retract = None
+            pl.reset_position(dict(zip(pl.axes, pl.position.tolist())))
+        elif rt.done:
+            pl.position[i] = pl.output[i] = rt.record.r_level  # at R exactly
+            self._retract = None
+            pl.reset_position(dict(zip(pl.axes, pl.position.tolist())))
+            self.tap.clear("M2x707" if not rt.line else "G84.48")
+            if self.on_retracted is not None:
+                self.on_retracted(dict(zip(pl.axes, pl.position.tolist())))
+        return Setpoint(pl.position.copy(), rt.line or pl.line, abs(rt.v), None)
+
     # ---- per cycle --------------------------------------------------------------------
     def step(self) -> Setpoint:
+        if self._retract is not None:
+            return self._retract_step()
         if self._interrupt is not None:
             self._interrupt_step()
         fed, self._fed = self._fed, False
@@ -376,6 +464,9 @@ class Channel:
                     return
                 if self._skip_move is not None:
                     self._skip_done()
+                if type(ev) is Sync and ev.reason == "G84.48":
+                    self.tap_retract(ev.line, ev.program)
+                    return  # the retraction runs from the next cycle; the program reads on after it
                 if type(ev) is Sync and ev.group is not None:  # G05: motion has drained, its group applies here
                     if not self._switch_group(ev):
                         return
@@ -447,6 +538,9 @@ class Channel:
                     pl.closed = True
                 elif self._skip_move is not None:
                     self._skip_done()
+                elif ev.reason == "G84.48":
+                    self.tap_retract(ev.line, ev.program)
+                    return
                 elif ev.group is not None:
                     if not self._switch_group(ev):
                         return

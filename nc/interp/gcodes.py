@@ -32,7 +32,8 @@ def _table(name: str, machine: str, lathe_type: str | None, legacy: bool) -> dic
                   21: (6, "metric"), 24: (18, "mirror"), 25: (18, "mirror_off"), 43: (8, "G43"), 44: (8, "G44"),
                   49: (8, "G49"), 50: (11, "scale_off"), 51: (11, "scale"), 68: (15, "G68"), 69: (15, "G69"),
                   90: (3, "abs"), 91: (3, "inc"), 92: (0, "set"), 94: (5, "permin"), 95: (5, "perrev"),
-                  98: (10, "ret98"), 99: (10, "ret99")})
+                  98: (10, "ret98"), 99: (10, "ret99"),
+                  84.48: (0, "G84.48")})  # N§3.13.2 note (6): retraction of an interrupted tap (M26-3)
         for n, fn in MILL_CYCLES.items():
             t[n] = (9, fn)
         return t
@@ -57,5 +58,5 @@ def g_table(profile: Profile) -> dict[float, tuple[int, str]]:
 
 
 def lookup(profile: Profile, value: float) -> tuple[int, str] | None:
-    code = round(value, 1)
+    code = round(value, 2)  # two decimals: G84.48
     return g_table(profile).get(code if code != int(code) else int(code))

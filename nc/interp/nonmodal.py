@@ -55,6 +55,13 @@ class NonModalMixin:
     def _g_G09(self, block: Block) -> None:
         return None
 
+    def _g_G84_48(self, block: Block) -> Iterator[Event]:
+        """G84.48 (N§3.13.2 G84 note (6)): the channel retracts an interrupted tap to its R point at rest, the
+        spindle reversed and locked to the pitch, and ends the tapping interrupt status; without the status it does
+        nothing (decision mlc M26-3). A preview stop: the blocks after it start from where the retraction ends
+        (`Channel.on_retracted` updates `position`)."""
+        yield Sync(block.line, block.text, "G84.48", None, self.program_name)
+
     def _g_G10(self, block: Block) -> Iterator[Event]:
         from nc.interp.datasetting import g10
         yield from g10(self, block)

@@ -19,7 +19,7 @@ CHORD_TOL_3D = 0.0005  # mm: G2.4/G3.4 chords deviate from the arc by at most 0.
 REFUSED_UNDER_G68 = frozenset({"G54", "G55", "G56", "G57", "G58", "G59", "G28", "G29", "G30", "G2.4", "G3.4"})
 # Non-modal codes whose block runs no motion of the current motion mode (the code itself moves or not).
 NO_MOTION_FUNCS = frozenset({"G04", "G10", "G11", "G28", "G29", "G30", "G31", "G52", "G53", "set", "G05",
-                             "G70", "G71", "G72", "G73", "G74", "G75", "G76", "G900"})
+                             "G70", "G71", "G72", "G73", "G74", "G75", "G76", "G900", "G84.48"})
 MAX_M_PER_BLOCK = 4
 MAX_MACRO_DEPTH = 8  # G65/G66/G-M-T calls (0x0212)
 MAX_SUB_DEPTH = 8  # M98 (0x022D)
