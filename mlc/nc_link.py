@@ -292,7 +292,7 @@ class ChannelLink:
             tap.clear("M2x080")
         elif retract and not ch.busy and ch.state is not RunState.ALARM and self.mode in (AUTO, MDI) \
                 and (self.manual is None or not self.manual.busy):
-            ch.tap_retract()
+            ch.tap_retract(how="M2x707")
 
     def _spindle_alarm(self, ch: Channel) -> None:
         m, prev = self.mem.m, self._prev

@@ -332,7 +332,7 @@ class Channel:
             self.tap.record = rec
             self.alarms += interruption_alarms(rec)
 
-    def tap_retract(self, line: int = 0, program: str | None = None) -> bool:
+    def tap_retract(self, line: int = 0, program: str | None = None, how: str = "G84.48") -> bool:
         """G84.48 (at rest, its Sync drained) or M2x707: the drilling axis back to R with the spindle reversed and
         locked to the pitch; the status ends when R is reached. Nothing without the status (M26-3). False: refused
         (alarm raised)."""
@@ -342,7 +342,7 @@ class Channel:
         pl = self.planner
         i = pl.axes.index(rec.axis)
         try:
-            self._retract = plan_retraction(rec, float(pl.position[i]), pl.cfg.limit(rec.axis), pl.cfg.cycle, line)
+            self._retract = plan_retraction(rec, float(pl.position[i]), pl.cfg.limit(rec.axis), line, how)
         except NcAlarm as exc:
             exc.alarm.program = exc.alarm.program or program
             self.raise_alarm(exc.alarm)
@@ -385,7 +385,7 @@ class Channel:
             pl.position[i] = pl.output[i] = rt.record.r_level  # at R exactly
             self._retract = None
             pl.reset_position(dict(zip(pl.axes, pl.position.tolist())))
-            self.tap.clear("M2x707" if not rt.line else "G84.48")
+            self.tap.clear(rt.how)
             if self.on_retracted is not None:
                 self.on_retracted(dict(zip(pl.axes, pl.position.tolist())))
         return Setpoint(pl.position.copy(), rt.line or pl.line, abs(rt.v), None)

@@ -138,6 +138,7 @@ class Retraction:
     traj: Trajectory
     limits: tuple[float, float, float] = (0.0, 0.0, 0.0)  # velocity, acceleration, jerk of u
     line: int = 0
+    how: str = "G84.48"  # what asked for it: "G84.48" or "M2x707"
     braking: bool = False  # a reset stops it short of R: the status stays
     t: float = 0.0
     u: float = 0.0
@@ -185,7 +186,7 @@ class Retraction:
         return deg
 
 
-def plan_retraction(rec: TapRecord, here: float, axis_limits, cycle: float, line: int = 0) -> Retraction:
+def plan_retraction(rec: TapRecord, here: float, axis_limits, line: int = 0, how: str = "G84.48") -> Retraction:
     """The retraction of `rec` from `here` (the drilling axis now) to R within the axis' limits, the spindle's
     (SPINDLE_*) and the tapping speed (M26-4). Raises NcAlarm 0x0270 when the record has no pitch."""
     if rec.pitch is None or rec.pitch <= 0:
@@ -206,6 +207,6 @@ def plan_retraction(rec: TapRecord, here: float, axis_limits, cycle: float, line
     otg.calculate(inp, traj)
     # exit in reverse: the spindle turns against the hand it tapped in with, one pitch per revolution
     rt = Retraction(rec, here, length, sense, -rec.hand * 360.0 / rec.pitch, traj, (vmax, acc, jerk),
-                    line=line or (rec.line or 0))
+                    line=line or (rec.line or 0), how=how)
     release_at_exit(rt, "traj")  # a native object in the bench's reference cycles (decision B83)
     return rt
