@@ -48,7 +48,7 @@ MAG2_FORWARD | absent | - | as MAG1_FORWARD
 MAG2_BACKWARD | absent | - | as MAG1_FORWARD
 MAG2_EXCHANGE | absent | - | as MAG1_FORWARD
 MAG2_RESET | absent | - | as MAG1_FORWARD
-CANCEL_TAP_INTERRUPT | absent | - | tapping interrupt status not emulated
+CANCEL_TAP_INTERRUPT | bench | mlc/nc_link.py | rising edge: the tapping interrupt status ends, nothing moves (M26-6)
 MLC_TO_NC_BIT | bench | mlc/nc_link.py | #25000+n, re-sent when changed (C1)
 SYNC_ENABLE | absent | - | synchronous control not emulated
 TRANSFER_ENABLE | absent | - | command transfer not emulated
@@ -69,7 +69,7 @@ MLC_AXIS_INCREMENTAL | absent | - | MLC axes not emulated
 SPINDLE_FWD | partial | mlc/nc_link.py | spindle 1 drives the bench spindle; spindles 2-8 have no drive
 SPINDLE_REV | partial | mlc/nc_link.py | as SPINDLE_FWD
 SPINDLE_ORIENT | partial | mlc/spindle_axis.py | spindle 1 (M19), through the C-axis switch
-SPINDLE_TAP_RETRACT | absent | - | retraction after an interrupted tap not emulated (decision M23-3)
+SPINDLE_TAP_RETRACT | partial | mlc/nc_link.py | 1st spindle: rising edge, channel idle in AUTO/MDI: the G84.48 retraction to R (M26-7)
 SPINDLE_CS_SWITCH | partial | mlc/spindle_axis.py | spindle 1 only
 SPINDLE_CMD_SOURCE | partial | mlc/nc_link.py | spindle 1 only (D2x024 as source)
 SPINDLE_ALARM | bench | mlc/nc_link.py | rising edge raises App. A 0x0C0A, spindles 1-8
@@ -135,7 +135,7 @@ DIAMETER_MODE | bench | mlc/machine.py | the profile's diameter axes (N2.001 Bit
 SPINDLE_SPEED_REACHED | partial | mlc/drive_status.py | spindle drives of the bench (within 2 % or 1 rpm)
 SPINDLE_ZERO_SPEED | partial | mlc/drive_status.py | spindle drives of the bench (below 1 rpm)
 SPINDLE_TARGET_REACHED | partial | mlc/spindle_axis.py | spindle 1 orientation / C axis
-SPINDLE_RIGID_TAPPING | absent | - | not published
+SPINDLE_RIGID_TAPPING | partial | mlc/nc_link.py | 1st spindle: G74/G84 tapping strokes, their reversal, the G84.48 / M2x707 retraction (M26-5)
 SPINDLE_POSITION_MODE | partial | mlc/drive_status.py | spindle drives of the bench (CSP)
 SPINDLE_READY | partial | mlc/drive_status.py | spindle drives of the bench (operation enabled)
 CHANNEL_SELECT | absent | - | one channel per bench
@@ -257,6 +257,9 @@ TESTS: dict[str, tuple[str, ...]] = {
     'SPINDLE_ORIENT': ('alarms_servo',),
     'SPINDLE_CS_SWITCH': ('mlc_caxis',),
     'SPINDLE_ALARM': ('alarms_servo', 'mlc_exchange_edges'),
+    'CANCEL_TAP_INTERRUPT': ('tap27_interrupted_tap',),
+    'SPINDLE_TAP_RETRACT': ('tap27_interrupted_tap',),
+    'SPINDLE_RIGID_TAPPING': ('tap27_interrupted_tap',),
     'ETHERCAT_OK': ('ethercat_io', 'ethercat_io_modules', 'ethercat_status', 'mlc21_drive_status_devices'),
     'HSI': ('alarms_appendix_a',),
     'EIO_CONNECTED': ('canopen_io', 'ethercat_io', 'ethercat_io_modules', 'ethercat_status'),

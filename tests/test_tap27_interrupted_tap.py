@@ -147,7 +147,7 @@ def test_m2x080_cancels_the_status_without_motion(machine):
     interrupt(machine)
     machine.set("M21704", False)  # the ladder drops M03's relay, or the spindle turns again once the status ends
     z, deg = machine.position("Z"), machine.runner.spindle_actual_angle()
-    machine.pulse(21080)  # M2x080 Canceling Tapping Interrupt Status
+    machine.pulse(21080)  # M21080: M2x080 Canceling Tapping Interrupt Status
     machine.wait(0.2)
     ch = machine.runner.channel
     assert not ch.tap.holds and ch.tap.log[-1][0] == "M2x080"
@@ -162,7 +162,7 @@ def test_m2x707_from_the_mlc_retracts_as_g84_48_does(machine):
     n = len(machine.runner.axes)
     modes = []
     machine.watchers.append(lambda m: modes.append((m.runner.rx[n].mode, m.get("M31707"))))
-    machine.pulse(21707)  # M2x707 1st Spindle Retraction After Tapping
+    machine.pulse(21707)  # M21707: M2x707 1st Spindle Retraction After Tapping
     t = machine.wait_until(lambda: not machine.runner.channel.busy, 5.0, "the retraction")
     ch = machine.runner.channel
     assert t > 0.3 and not ch.tap.holds and ch.tap.log[-1][0] == "M2x707"
