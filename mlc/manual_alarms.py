@@ -14,6 +14,10 @@ An axis the MLC holds servo OFF (M2x012 OFF, M2x272+i ON; decision M22-1) takes 
 INC press, MPG pulses or a home trigger of it is refused with App. A 0x0A07 "Servo is not ready. The axis is not
 servo ON", and a manual move of it in progress when its relay falls stops jerk-limited (decision M23-1).
 
+While a tap's interrupt status holds (N§3.13.2 G84 note (6), nc.tap_interrupt), no manual command moves an axis:
+a JOG/RAPID/INC key, MPG pulses or a home trigger is refused with 0x0270 "Axis movement prohibition during tapping
+interruption", once until a reset (decision mlc M26-2).
+
 M2x264 (axes oscillation enable) is "only available on modes other than HOME and EDIT": ON in HOME mode it stops
 the homing under way and refuses new ones with 0x1603 "Oscillation function is not allowed in the home mode"."""
 
@@ -114,6 +118,30 @@ def servo_off_stop(link: ChannelLink, ch: Channel, mm: ManualMotion, off: int) -
         if off >> i & 1 and mm.moving(a):
             mm.stop(a)
             servo_refused(link, ch, i, "the manual move")
+
+
+def tap_locked(link: ChannelLink, ch: Channel) -> None:
+    """A manual-mode scan while the tapping interrupt status holds: nothing moves; a command asked for is 0x0270,
+    raised once until a reset (a held key or a turning handwheel is one refusal, as 0x0A07's)."""
+    from mlc.nc_link import HOME, MPG
+    from mlc.signals import d3
+
+    m, b2, n = link.mem.m, 20000 + 1000 * link.x, len(link.axes)
+    asked = any(m[b2 + 384:b2 + 384 + n]) or any(m[b2 + 400:b2 + 400 + n])  # JOG/RAPID held, INC pressed
+    if link.mode == HOME:
+        asked = asked or any(m[b2 + 320:b2 + 320 + n])
+    if link.mode == MPG:
+        count = link.mem.u16(d3(0, 4))
+        asked = asked or (link._mpg_last is not None and count != link._mpg_last)
+        link._mpg_last = count  # the detents turned meanwhile are dropped, not run later
+    if asked and not link._tap_refused:
+        link._tap_refused = True
+        link._raise(ch, Alarm(0x0270, f"axis movement prohibited during the tapping interruption: the "
+                                      f"{MODE_TEXT.get(link.mode, 'manual')} command is refused; retract with G84.48 "
+                                      f"(or M2x707), or cancel with M2x080"))
+
+
+MODE_TEXT = {3: "MPG", 4: "JOG", 5: "RAPID", 6: "INC", 7: "HOME"}
 
 
 def home_mode(link: ChannelLink, ch: Channel, mm: ManualMotion) -> None:

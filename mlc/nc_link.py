@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from mlc.manual_alarms import HardLimitLatch, home_mode, servo_off_stop, servo_refused
+from mlc.manual_alarms import HardLimitLatch, home_mode, servo_off_stop, servo_refused, tap_locked
 from mlc.drive_status import DriveStatus, write_drive_outputs
 from mlc.memory import DeviceMemory
 from mlc.signals import d2, d3, m2, m3
@@ -70,6 +70,7 @@ class ChannelLink:
     _servo_refused: int = 0  # bit i: a manual command of axis i, held OFF, was refused with 0x0A07 (M23-1)
     _spindle_levels: bytes = bytes(8)  # M2x711, M2x727, … as the last scan saw them (== their `_prev`)
     _tap_levels: bool = False  # M2x080 or M2x707 was ON last scan (their edges are looked for then)
+    _tap_refused: bool = False  # a manual command was refused under the tapping interrupt status (until a reset)
     _program_end: int | None = None
     _mode_switch_cycles: int = 0
     handshake_log: list[tuple[int, str, float]] = field(default_factory=list)  # (cycle, kind, value)
@@ -192,6 +193,7 @@ class ChannelLink:
         self.alarms.clear()
         self._alarms_seen.clear()
         self._servo_refused = 0
+        self._tap_refused = False
         self._reset_pending = True
         for alarm in self.limit_latch.reset() + self.hard_limits.reset():  # still on a limit: reset does not clear
             self._raise(ch, alarm)
@@ -375,6 +377,9 @@ class ChannelLink:
             for alarm in self.hard_limits.step(mm, self.axes, self.drives):
                 self._raise(ch, alarm)
         if self._estop or self.mode not in MANUAL_MODES or ch.busy:
+            return
+        if ch.tap.record is not None:  # an interrupted tap: no manual motion (0x0270, decision M26-2)
+            tap_locked(self, ch)
             return
         off = self.servo_off  # axes the MLC holds servo OFF take no manual command (App. A 0x0A07, M23-1)
         if off or self._servo_refused:

@@ -94,6 +94,24 @@ def test_axis_moves_and_spindle_starts_are_refused_while_the_status_holds(machin
     assert ch.tap.holds  # refusing is no recovery
 
 
+def test_jog_and_mpg_are_refused_while_the_status_holds(machine):
+    interrupt(machine)
+    z = machine.position("Z")
+    machine.jog("Z", 1, 0.3)  # the JOG key of Z held 0.3 s
+    ch = machine.runner.channel
+    assert codes(ch.alarms)[-1] == ("0x0270", None) and "JOG command is refused" in ch.alarms[-1].message
+    assert machine.position("Z") == pytest.approx(z, abs=1e-6)
+    machine.reset()
+    machine.mpg("Z", pulses=50, ratio=10)  # 0.5 mm of detents: none is run, one alarm
+    # one more 0x0270 (after the E-stop's and the JOG's): a turning handwheel is one refusal
+    assert [a.code_text for a in machine.runner.channel.alarms].count("0x0270") == 3
+    assert machine.position("Z") == pytest.approx(z, abs=1e-6)
+    machine.reset()
+    machine.pulse(21080)  # M21080 cancels: the same keys move Z again
+    machine.jog("Z", 1, 0.3)
+    assert machine.position("Z") > z + 1.0
+
+
 def trace_retraction(machine: Machine, program: str) -> dict[str, np.ndarray]:
     """Run `program` (MDI) recording every cycle: Z command and actual, the spindle's position setpoint and actual
     angle (degrees), its drive mode, M3x707."""
