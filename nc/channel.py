@@ -356,11 +356,13 @@ class Channel:
 
     @property
     def rigid_tapping(self) -> bool:
-        """M3x707 (M26-5): a G74/G84 tapping stroke runs, or the channel waits at its spindle reversal, or the
-        G84.48 / M2x707 retraction runs."""
+        """M3x707 (M26-5): from a G74/G84 tapping stroke's start until the next motion block that is no tapping
+        stroke starts or the program stops (its reversals and its tail through the position filter included), and
+        while the G84.48 / M2x707 retraction runs."""
         if self._retract is not None:
             return True
-        blk = self.planner.active
+        pl = self.planner
+        blk = pl.active
         if blk is not None:
             tags = blk.move.tags
             if TAP_TAGS[0] in tags or TAP_TAGS[1] in tags:
@@ -368,8 +370,7 @@ class Channel:
                 return True
             self._tap_line = None
             return False
-        aux = self.pending_aux
-        return aux is not None and aux.line == self._tap_line and aux.kind == "M" and aux.value in (3, 4)
+        return self._tap_line is not None and self.state in _M96_LATCHED  # running, held, waiting on M/S/T
 
     def _retract_step(self) -> Setpoint:
         rt = self._retract

@@ -202,6 +202,24 @@ def test_a_reset_during_the_retraction_stops_it_short_and_the_status_stays(machi
     assert not machine.runner.channel.tap.holds and machine.command("Z") == 2.0
 
 
+def test_hil_run_traces_m3x707_through_the_whole_tapping_cycle(hil, program, tmp_path):
+    # M26-5: ON from the first stroke into the hole until the G80 G00 after the cycle; every cycle with Z in the
+    # hole is ON (the reversal at the bottom included), before the cycle and after it OFF
+    trace = tmp_path / "t.csv"
+    r = hil("run", program(TAP.replace("M30", "M05\nM30")), "--bench", MILL, "--trace-signals", "M31707",
+            "--trace", trace)
+    assert r.code == 0, r.out + r.err
+    c = np.genfromtxt(trace, delimiter=",", names=True)
+    on = c["M31707"] == 1
+    k = np.flatnonzero(on)
+    assert len(k) > 2000 and np.all(np.diff(k) == 1)  # one span
+    below = np.flatnonzero(c["Z_cmd"] < 2.0 - 1e-6)
+    # the NC's outputs of a cycle are written before its step: ON from the scan after Z's first step below R
+    assert np.all(on[below + 1]) and k[0] == below[0] + 1 and c["line"][k[0]] == 3
+    assert c["line"][k[-1] + 1] == 4 and c["Z_cmd"][-1] == pytest.approx(10.0, abs=1e-6)  # until G80 G00 Z10.
+    assert not np.any(on[k[-1] + 1:])
+
+
 SCRIPT = """def main(machine):
     ch = machine.start_program({program!r})
     machine.wait_until(lambda: machine.command("Z") < -5.0, 20.0, "Z in the hole")
