@@ -144,7 +144,6 @@ class Retraction:
     u: float = 0.0
     v: float = 0.0
     angle0: float | None = None  # the spindle's angle at u = 0 (taken by the spindle drive's first cycle)
-    log: list[tuple[float, float]] = field(default_factory=list)  # (u, spindle setpoint) every cycle
 
     @property
     def done(self) -> bool:
@@ -181,9 +180,7 @@ class Retraction:
         read once when the spindle takes the retraction over (it stands there: the status holds it at 0 rpm)."""
         if self.angle0 is None:
             self.angle0 = actual_angle - self.deg_per_mm * self.u
-        deg = self.angle0 + self.deg_per_mm * self.u
-        self.log.append((self.u, deg))
-        return deg
+        return self.angle0 + self.deg_per_mm * self.u
 
 
 def plan_retraction(rec: TapRecord, here: float, axis_limits, line: int = 0, how: str = "G84.48") -> Retraction:

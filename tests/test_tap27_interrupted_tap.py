@@ -220,24 +220,12 @@ def test_hil_run_traces_m3x707_through_the_whole_tapping_cycle(hil, program, tmp
     assert not np.any(on[k[-1] + 1:])
 
 
-SCRIPT = """def main(machine):
-    ch = machine.start_program({program!r})
-    machine.wait_until(lambda: machine.command("Z") < -5.0, 20.0, "Z in the hole")
-    machine.estop()
-    machine.wait(0.5)
-    machine.estop(False)
-    machine.reset()
-    machine.wait(0.5)
-    print("interrupted", [(a.code_text, a.line) for a in ch.alarms], ch.tap.record.reached < -5.0)
-    machine.mdi("G84.48\\nG00 Z10.\\nM05")
-    print("after", round(machine.command("Z"), 3), machine.runner.channel.tap.holds)
-"""
-
-
-def test_a_script_interrupts_a_tap_and_recovers_with_g84_48(hil, tmp_path):
-    script = tmp_path / "tap.py"
-    script.write_text(SCRIPT.format(program=TAP))
-    r = hil("script", str(script), "--bench", MILL)
-    assert r.code == 0, r.out + r.err
-    assert "interrupted [('0x0401', None), ('0x0270', 3), ('0x0C09', 3)] True" in r.out
-    assert "after 10.0 False" in r.out and "alarms  none" in r.out  # retracted, the status ended, Z away
+def test_the_example_script_interrupts_a_tap_and_recovers_with_g84_48(hil):
+    r = hil("script", ROOT / "examples" / "scripts" / "tap_recovery.py", "--bench", MILL)
+    assert r.code == 0, r.out + r.err  # every alarm met was cleared by a reset
+    assert "interrupted: 0x0401 (line None), 0x0270 (line 3), 0x0C09 (line 3)" in r.out
+    assert "record: Z setpoint -5.00" in r.out and "R 2.0000, pitch 1.5000 mm, G94 F900 S600, line 3" in r.out
+    assert "G01 while the status holds: 0x0270 Z -5.1" in r.out
+    # Z from where the E-stop braked it (-5.1555) to R: 7.1555 mm = 4.770 turns of 1.5 mm, against M03
+    assert "G84.48: Z 2.0000 after 0.5" in r.out and "the spindle -4.77" in r.out and "status ended" in r.out
+    assert "Z      100.0000 →    10.0000" in r.out and "modes CSV/CSP/CSV" in r.out
