@@ -123,6 +123,7 @@ class Channel:
     tap: TapStatus = field(default_factory=TapStatus)
     _retract: Retraction | None = None
     _tap_line: int | None = None  # line of the last tapping move started (M3x707 through its spindle reversal)
+    _tap_mv: Move | None = None  # the active move `rigid_tapping` looked at last
     on_retracted: Callable[[dict[str, float]], None] | None = None  # the interpreter's position after G84.48
 
     def __post_init__(self) -> None:
@@ -361,15 +362,15 @@ class Channel:
         while the G84.48 / M2x707 retraction runs."""
         if self._retract is not None:
             return True
-        pl = self.planner
-        blk = pl.active
+        blk = self.planner.active
         if blk is not None:
-            tags = blk.move.tags
-            if TAP_TAGS[0] in tags or TAP_TAGS[1] in tags:
-                self._tap_line = blk.move.line
-                return True
-            self._tap_line = None
-            return False
+            mv = blk.move
+            if mv is self._tap_mv:  # the move of the last scan: its answer (a scan per cycle, issue 17)
+                return self._tap_line is not None
+            self._tap_mv = mv
+            tags = mv.tags  # () for a plain move: one test
+            self._tap_line = mv.line if tags and (TAP_TAGS[0] in tags or TAP_TAGS[1] in tags) else None
+            return self._tap_line is not None
         return self._tap_line is not None and self.state in _M96_LATCHED  # running, held, waiting on M/S/T
 
     def _retract_step(self) -> Setpoint:
