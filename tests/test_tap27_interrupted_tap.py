@@ -189,6 +189,46 @@ def test_m2x707_from_the_mlc_retracts_as_g84_48_does(machine):
     assert machine.position("Z") == pytest.approx(2.0, abs=1e-3)
 
 
+PANEL_MLC = """from mlc import lathe
+
+SCAN_ON_CHANGE = False
+
+
+def setup(mlc):
+    lathe.setup(mlc)
+
+
+def scan(mlc):
+    lathe.scan(mlc)
+    # the machine's panel: key M100 retracts an interrupted tap, key M101 cancels the status; the lamp Y0 shows
+    # that the spindle is in the rigid tapping
+    mlc.set("SPINDLE1_TAP_RETRACT", mlc.m("M100"))
+    mlc.set("CANCEL_TAP_INTERRUPT", mlc.m("M101"))
+    mlc.set("Y0", mlc.m("SPINDLE1_RIGID_TAPPING"))
+"""
+
+
+def test_a_user_mlc_drives_the_recovery_by_name(tmp_path):
+    module = tmp_path / "panel_mlc.py"
+    module.write_text(PANEL_MLC)
+    bench = load_bench(MILL, None, None)
+    mlc, _, _ = mlc_setup(bench, str(module), None, 0.5)
+    m = Machine(bench, mlc, make_link(bench))
+    m.power_up()
+    try:
+        lamp = []
+        m.watchers.append(lambda mm: lamp.append(mm.get("Y0")))
+        interrupt(m)
+        assert 1 in lamp and m.get("Y0") == 0
+        m.set("M100", 1)  # the key pressed: the user scan raises M2x707, the NC retracts
+        m.wait_until(lambda: m.runner.channel.busy, 0.1, "the retraction to start")
+        m.wait_until(lambda: not m.runner.channel.busy, 5.0, "the retraction to end")
+        m.set("M100", 0)
+        assert m.runner.channel.tap.log[-1][0] == "M2x707" and m.command("Z") == pytest.approx(2.0, abs=1e-6)
+    finally:
+        m.close()
+
+
 def test_a_reset_during_the_retraction_stops_it_short_and_the_status_stays(machine):
     interrupt(machine)
     machine.pulse(21707)
