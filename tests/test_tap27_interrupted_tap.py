@@ -6,6 +6,7 @@ pitch 900 / 600 = 1.5 mm) to Z-15 from R2; the E-stop hits while Z is in the hol
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import numpy as np
@@ -79,6 +80,14 @@ def test_a_reset_mid_tap_interrupts_it_too(machine):
     ch = interrupt(machine, how="reset")
     assert codes(ch.alarms) == [("0x0270", 3), ("0x0C09", 3)]
     assert ch.tap.record is not None and ch.tap.record.cause == "reset"
+
+
+def test_hil_run_reset_mid_tap_ends_with_both_alarms_at_the_cycle_line(hil, program):
+    # before: a reset in the hole ended the run "STOPPED: ... a reset flushes it" with no alarm
+    r = hil("run", program(TAP), "--bench", MILL, "--at", "Z<-5:reset", "--no-check", "--json", "--no-progress")
+    out = json.loads(r.out.strip().splitlines()[-1])
+    assert r.code == 1 and [(a["code"], a["line"]) for a in out["alarms"]] == [("0x0270", 3), ("0x0C09", 3)]
+    assert "the reset interrupted a tapping cycle" in out["alarms"][0]["message"]
 
 
 def test_axis_moves_and_spindle_starts_are_refused_while_the_status_holds(machine):
