@@ -145,8 +145,13 @@ def test_long_passes_end_before_a_cycle_that_reads_nothing(monkeypatch, tmp_path
     """Decision B68: a stretch that runs the NC's steps is not bound by the planner's 64-cycle buffer. Past
     PASS_CYCLES it goes on to the first cycle whose feed reads nothing, at most PASS_OVER more, so the next
     stretch can start there (none starts at a reading cycle). Small values here, for many ends in a short run: the
-    trace is stepping's, and no pass that ended past PASS_CYCLES before its limit left a cycle whose feed reads."""
+    trace is stepping's, and no pass that ended past PASS_CYCLES before its limit left a cycle whose feed reads
+    plain moves only. (A feed that would read another event, the program's M30, ends a pass before its cycle
+    whatever its length (B27, `Ahead.peek`): with decision motion 83 (c)'s setpoints one pass past PASS_CYCLES
+    meets the M30's feed.)"""
     import hil.stretch
+    from hil.stretch_reads import ahead, may_read
+    from nc.channel import READS_PER_CYCLE
 
     monkeypatch.setattr(hil.stretch, "PASS_CYCLES", 40)
     monkeypatch.setattr(hil.stretch, "PASS_OVER", 8)
@@ -155,7 +160,8 @@ def test_long_passes_end_before_a_cycle_that_reads_nothing(monkeypatch, tmp_path
 
     def ended(self, n):
         m = real(self, n)
-        ends.append((n, m, hil.stretch_pass._feed_due(self.pl) and hil.stretch_pass.may_read(self.ch, self.pl)))
+        ends.append((n, m, hil.stretch_pass._feed_due(self.pl) and may_read(self.ch, self.pl)
+                     and ahead(self.ch).peek(READS_PER_CYCLE)))  # (the pass peeked there too: nothing new read)
         return m
 
     monkeypatch.setattr(hil.stretch_pass.Pass, "run", ended)

@@ -6,8 +6,9 @@ there (a corner's end speed, the queue's end), the planner brakes for that junct
 from there. Before, the ramp ran through a sharp corner at speed (a G76's return into its infeed: 110 mm/s round a
 90° corner, X at 2× its acceleration after the filter) or past the queue's last point (clipped there).
 
-The same question for a path solve (decision motion 83): does a braking solve through lower caps get below each
-before it reaches it (`brakes_below`)."""
+The same question for path profiles (decision motion 83): does a braking solve through lower caps get below each
+before it reaches it (`brakes_below`), and does the profile a plan was following still fit the queue where its
+re-solve missed (`fits_queue`, `later`)."""
 
 from __future__ import annotations
 
@@ -16,7 +17,7 @@ from collections.abc import Iterable
 import numpy as np
 
 from nc.motion.block import Block
-from nc.motion.profile import Piecewise
+from nc.motion.profile import Piecewise, _OneDof
 
 SAMPLES = 256  # points of the ramp's speed over its path: only read when a hold is planned
 
@@ -87,3 +88,41 @@ def brakes_below(pw: Piecewise, s: float, dist: float, blocks: Iterable[Block]) 
         b = nx
     return True
 
+
+def peak_speed(pw: Piecewise, t: float) -> float:
+    """The highest speed of the profile from time t on: at a phase's ends or where its acceleration passes zero."""
+    t0, _, _, a, j = _phases(pw)
+    dur = pw.duration
+    top = max(pw.at(t)[1], pw.at(dur)[1])
+    for k in range(len(t0)):
+        lo, hi = max(t0[k], t), min(t0[k + 1] if k + 1 < len(t0) else dur, dur)
+        if lo >= hi:
+            continue
+        top = max(top, pw.at(hi)[1])
+        if j[k] != 0.0 and lo < t0[k] - a[k] / j[k] < hi:
+            top = max(top, pw.at(t0[k] - a[k] / j[k])[1])
+    return top
+
+
+def fits_queue(pw: Piecewise, t: float, end: float, blocks: Iterable[Block]) -> bool:
+    """True when a path profile followed from time t still fits the queue up to `end` (the path position in
+    blocks[0]): `end` a junction whose planned end speed (`vend`) allows the profile's end speed, and no speed
+    of it from t on above a cap of the blocks or a junction speed before `end` (decision motion 83: a profile
+    kept where its re-solve in the next block missed)."""
+    top = peak_speed(pw, t) * (1.0 - 1e-9) - 1e-12
+    at = 0.0
+    for b in blocks:
+        if b.kind != "path" or b.cap < top:
+            return False
+        at += b.length
+        if abs(at - end) <= 1e-9:
+            return pw.v_end() <= b.vend * (1.0 + 1e-9) + 1e-12
+        if at > end or b.vjunc < top:
+            return False
+    return False
+
+
+def later(pw: Piecewise, t: float) -> Piecewise:
+    """A path profile from time t on, its clock starting there (its phases before t start at negative times)."""
+    t0, p, v, a, j = _phases(pw)
+    return _OneDof(([x - t for x in t0], p, v, a, j), pw.duration - t, pw.p_max)

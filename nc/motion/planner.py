@@ -48,7 +48,7 @@ from nc.motion.planner_cruise import CruiseSampling
 from nc.motion.planner_runs import FittedRuns
 from nc.motion.spline_feed import NOTHING
 from nc.motion.planner_thread import ThreadStepping
-from nc.motion.hold_stop import brakes_below, crosses_too_fast
+from nc.motion.hold_stop import brakes_below, crosses_too_fast, fits_queue, later, time_at
 from nc.motion.profile import clip, solve_axes, solve_position, solve_velocity
 from nc.motion.sample_rows import few_rows
 from nc.motion.share_zones import ShareZones
@@ -63,6 +63,26 @@ THROUGH = 16
 OPEN_CHUNK = 4  # cycles sampled at a time (CHUNK otherwise) while the queue cannot tell the jerk factor yet (the channel reads 4 blocks a cycle)
 MAX_SOLVES_PER_CYCLE = 1000  # plans one cycle may start and end before a sample is due (decisions B4)
 
+
+
+def fastest_state(v0: float, a0: float, d: float, a: float, j: float) -> tuple[float, float]:
+    """Speed and acceleration after path length d of `lookahead.max_speed_at`'s profile from (v0, a0) (full jerk up
+    to a, then a constant a): the fastest any profile within a and j can be there, and (from a state below a) the
+    highest acceleration it can have there with that speed (decision motion 84: a corner's acceleration step)."""
+    a0 = a0 if a0 < a else a
+    t1 = (a - a0) / j
+    d1 = v0 * t1 + a0 * t1 * t1 / 2.0 + j * t1 ** 3 / 6.0
+    if d >= d1:
+        v1 = v0 + a0 * t1 + j * t1 * t1 / 2.0
+        return math.sqrt(v1 * v1 + 2.0 * a * (d - d1)), a
+    lo, hi = 0.0, t1  # the time d is reached in the jerk phase (distance grows with t), as max_speed_at's
+    for _ in range(40):
+        t = 0.5 * (lo + hi)
+        if v0 * t + a0 * t * t / 2.0 + j * t ** 3 / 6.0 < d:
+            lo = t
+        else:
+            hi = t
+    return v0 + a0 * hi + j * hi * hi / 2.0, a0 + j * hi
 
 
 def feed_rpm(measured: float, command: float) -> tuple[float, bool]:
@@ -176,6 +196,12 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
         self.closed = False
         self._jf = 1.0
         self._end_cap = -1.0  # the cap of the block that ended the last `_run_target` run (-1: none, not a path)
+        # The path plan a block boundary just ended (to re-solve in the next block) and the path length since its
+        # blocks[0] start: kept where that re-solve misses (`_kept`, decision motion 83); None once a plan started
+        self._cont: tuple[_Plan, float] | None = None
+        # an acceleration step a·Δu at a corner under the filter has the jerk of a velocity step a·T·Δu, T the
+        # shorter window (`_unbound`, decision motion 84)
+        self._t_step = min(cfg.filter_cycles()) * cfg.cycle if self.filter is not None else 0.0
         self._pushes = 0  # moves pushed so far (an open plan re-solves when more came)
         self.output = self.position.copy()  # the last setpoint handed out (filtered)
         self._init_filter_stops()
@@ -456,6 +482,7 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
         self._buf_pos = None
         self._buf_i = 0
         self.plan = None
+        self._cont = None
         self._carry = self.cfg.cycle
 
     def per_rev_plan(self) -> _Plan | None:
@@ -501,6 +528,7 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
                 return  # exact stop: the filtered setpoint reaches the point before anything starts
             if self.plan is None:
                 self.plan = self._start_plan()
+                self._cont = None
                 if self.plan is None:
                     return
             p = self.plan
@@ -649,6 +677,9 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
             if pw is not None and pw.p_max <= dist + 1e-7 and pw.v_min() >= -1e-7:
                 self._jf = f
                 break
+        if (pw is None or pw.p_max > dist + 1e-7 or pw.v_min() < -1e-7) and self._cont is not None \
+                and (kept := self._kept(s, v, a, t0)) is not None:
+            return kept
         if pw is None or pw.p_max > dist + 1e-7 or pw.v_min() < -1e-7:
             # Cannot meet the target from this state (an override just cut the cap): ramp down
             # to the cap first, then plan the rest from there. Within the run's least acceleration:
@@ -671,6 +702,28 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
                 return ramp
         return _Plan("path", pw, pw.duration, t0, target=dist, rpm=rpm, settled=settled, open=unknown,
                      queued=self._pushes)
+
+    def _kept(self, s: float, v: float, a: float, t0: float) -> _Plan | None:
+        """The profile the last path plan followed, on from the state it left at the block boundary where it was
+        to be solved again, when that solve missed: ruckig, solving from a state on its own time-optimal profile
+        (one cycle after the acceleration turned, as a braking run's), can miss the same target it met before
+        (seed 360 of the motion sweep: p_max 0.6 µm past it, v down to −1.1 mm/s), and the fallback ramp then
+        crossed a stop between two fitted runs at 0.55 mm/s (decision motion 83). Kept only where the state lies
+        on it and it still fits the queue: its end a junction whose end speed allows its own, no speed on the
+        way above a cap or junction speed it crosses (`fits_queue`)."""
+        p, done = self._cont
+        pw = p.pw
+        base = p.base + done  # the old profile's position of blocks[0]'s start
+        x = s + base
+        t = time_at(pw, x)  # the state's time on it
+        ps, pv, pa = pw.at(t)
+        if abs(ps - x) > 1e-9 or abs(pv - v) > 1e-6 * (1.0 + abs(v)) or abs(pa - a) > 1e-6 * (1.0 + abs(a)):
+            return None
+        end = p.target - done
+        if not fits_queue(pw, t, end, self.blocks):
+            return None
+        pw = later(pw, t)  # its clock from the state on, as a solve's from its start state
+        return _Plan("path", pw, pw.duration, t0, base, end, p.rpm, p.settled, queued=self._pushes)
 
     def _speed_up(self, b: Block, s: float, v: float, a: float, cap: float, cruise: float, dist: float,
                   v1: float, ra: float, rj: float, t0: float) -> _Plan | None:
@@ -770,7 +823,7 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
                 if nx.cap < vmax:  # a lower cap `through` goes on past: it holds the whole run (motion 77)
                     vmax = nx.cap
             if b.vjunc < cap_lo:
-                if b.binding and b.vend >= max_speed_at(self.v, self.a, dist - self.s, ra, rj * jf):
+                if b.binding and self._unbound(b, nx, dist, ra, rj * jf):
                     # Not reachable faster than it allows from the present state (a rising
                     # chain of caps behind a corner): it cannot bind, and a profile that ended
                     # there at zero acceleration would only lose time.
@@ -790,6 +843,28 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
             b = nx
         self._end_cap = -1.0
         return dist, vmax if vmax < b.vend else b.vend, ra, rj * jf, vmax  # b is the queue's last block
+
+    def _unbound(self, b: Block, nx: Block, dist: float, ra: float, rj: float) -> bool:
+        """The junction b → nx, `dist` from blocks[0]'s start, that no profile from the present state within ra
+        and rj reaches faster than its end speed: it cannot bind the run (issue 18). Under the filter a tangent
+        jump crossed accelerating steps each axis' acceleration by a·Δu as well as its velocity by v·Δu: through
+        the two windows their jerk adds to (v + |a|·min(T1, T2))·Δu/(T1·T2) on the first (or last) T2, so the
+        corner's own jerk budget (alone in its windows: budget_j over Δu per axis) must hold v + a·min(T1, T2) of
+        the fastest profile from the state there, or the run ends at the junction at zero acceleration as at any
+        binding one (decision motion 84: a resume from a feed hold a few µm before a sharp corner crossed it at
+        ≈ 900 mm/s², jerk 1.11× the limit). (The step moves an axis' acceleration from a·u1 to a·u2, both within
+        the tangential share: the acceleration budget is not charged.)"""
+        blend = self.lim.blend
+        if blend is None or b.du_n <= 1e-9 or self._t_step <= 0.0:
+            return b.vend >= max_speed_at(self.v, self.a, dist - self.s, ra, rj)
+        v, acc = fastest_state(self.v, self.a, dist - self.s, ra, rj)
+        if b.vend < v:
+            return False
+        v += acc * self._t_step
+        for d, bj in zip(b.du, blend.budget_jl if b.seg.kind == "line" and nx.seg.kind == "line" else blend.budget_j):
+            if d * v > bj:
+                return False
+        return True
 
     def _plan_indep(self, b: Block, t0: float) -> _Plan | None:
         assert b.seg is not None
@@ -924,6 +999,12 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
             self.threads_queued -= done.kind == "thread"
             if done.seg is not None:
                 self._seg_hist = self._seg_hist[1 - HISTORY:] + (done.seg,)
+            if keep_plan:  # a path plan on into the next block (re-solved there), or the blocks after it
+                p = self.plan
+                if p is not None:
+                    self._cont = (p, done.length) if p.kind == "path" and not p.open else None
+                elif self._cont is not None:
+                    self._cont = (self._cont[0], self._cont[1] + done.length)
         self._started = False
         if not keep_plan:
             self.s = 0.0
