@@ -197,10 +197,10 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
         self._jf = 1.0
         self._end_cap = -1.0  # the cap of the block that ended the last `_run_target` run (-1: none, not a path)
         # The path plan a block boundary just ended (to re-solve in the next block) and the path length since its
-        # blocks[0] start: kept where that re-solve misses (`_kept`, decision motion 83); None once a plan started
+        # blocks[0] start: kept where that re-solve misses (`_kept`, decision motion 85); None once a plan started
         self._cont: tuple[_Plan, float] | None = None
         # an acceleration step a·Δu at a corner under the filter has the jerk of a velocity step a·T·Δu, T the
-        # shorter window (`_unbound`, decision motion 84)
+        # shorter window (`_unbound`, decisions motion 84, 86)
         self._t_step = min(cfg.filter_cycles()) * cfg.cycle if self.filter is not None else 0.0
         self._pushes = 0  # moves pushed so far (an open plan re-solves when more came)
         self.output = self.position.copy()  # the last setpoint handed out (filtered)
@@ -708,7 +708,7 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
         to be solved again, when that solve missed: ruckig, solving from a state on its own time-optimal profile
         (one cycle after the acceleration turned, as a braking run's), can miss the same target it met before
         (seed 360 of the motion sweep: p_max 0.6 µm past it, v down to −1.1 mm/s), and the fallback ramp then
-        crossed a stop between two fitted runs at 0.55 mm/s (decision motion 83). Kept only where the state lies
+        crossed a stop between two fitted runs at 0.55 mm/s (decisions motion 83 (c), 85). Kept only where the state lies
         on it and it still fits the queue: its end a junction whose end speed allows its own, no speed on the
         way above a cap or junction speed it crosses (`fits_queue`)."""
         p, done = self._cont
@@ -851,7 +851,7 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
         the two windows their jerk adds to (v + |a|·min(T1, T2))·Δu/(T1·T2) on the first (or last) T2, so the
         corner's own jerk budget (alone in its windows: budget_j over Δu per axis) must hold v + a·min(T1, T2) of
         the fastest profile from the state there, or the run ends at the junction at zero acceleration as at any
-        binding one (decision motion 84: a resume from a feed hold a few µm before a sharp corner crossed it at
+        binding one (decisions motion 84, 86: a resume from a feed hold a few µm before a sharp corner crossed it at
         ≈ 900 mm/s², jerk 1.11× the limit). (The step moves an axis' acceleration from a·u1 to a·u2, both within
         the tangential share: the acceleration budget is not charged.)"""
         blend = self.lim.blend
