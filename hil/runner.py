@@ -25,7 +25,7 @@ from hil.bench import Bench
 from hil.bus_work import BusWork
 from hil.clock import CycleTiming, LockStepClock, RealTimeClock
 from hil.cycle_lean import OVERSPEED, RESET_CYCLES, WARM_AHEAD_NS, WARM_MIN_NS, factors, feedback, row, setpoints, warm
-from hil import fit_ahead, retentive, servo_relays
+from hil import fit_ahead, mlc_axes, retentive, servo_relays
 from hil.drive_homing import home_axes
 from hil.mlc_bridge import drive_status
 from hil import stretch_ahead
@@ -142,6 +142,7 @@ class BenchRunner:
         # axes the MLC's servo relays hold OFF (bit i; servo_relays.RESYNC: a re-enable whose position the NC is
         # still to take), M22-1
         self._servo_off = 0
+        self._mlc_axes = 0  # bit i: axis i under MLC control or switching (hil/mlc_axes.py)
         self._winding_down = False  # the run is over; the stop path brings everything to rest
         self._bus_closed = False
         self.stop_request: str | None = None  # a signal's name (hil/stop_signals.py): stop, then end
@@ -477,6 +478,8 @@ class BenchRunner:
             self._commands[:] = sp.positions  # type: ignore[attr-defined]
             if not self._winding_down:
                 self.line = sp.line or self.line  # type: ignore[attr-defined]
+            if relays is not None and (relays.mlc_axes or self._mlc_axes):
+                mlc_axes.step(self, ch, relays)  # NC / MLC axis switching, the MLC's axis moves (M26-20)
             if last is not None:
                 servo_relays.obey(self, ch, relays, last)  # the MLC's servo relays (decision M22-1)
             if ch.emergency and not self._braking:

@@ -469,7 +469,7 @@ class Stretcher(RealTimeStretches):
         the MLC exchange and the drives (module doc): "run" (the channel runs a planned move), "wait" (an
         M/S/T code handed to the MLC waits for its finish, nothing moving but the drives settling), else None."""
         if (r.stop_request is not None or r._braking or r._winding_down or r._planner_failed or r._at_limit
-                or r._servo_off or r._alarmed_drives or r.result.alarms or ch.alarms):
+                or r._servo_off or r._mlc_axes or r._alarmed_drives or r.result.alarms or ch.alarms):
             return None
         if (ch.emergency or ch._interrupt is not None or ch.skip_armed or _panel_state(r.on_cycle) is None
                 or _event_due(r)):

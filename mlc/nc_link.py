@@ -67,6 +67,10 @@ class ChannelLink:
     servo_off: int = 0
     servo_all: bool = False
     _servo_levels: bytes | None = None  # M2x272… of the channel's axes as last read
+    # NC / MLC axis switching (hil/mlc_axes.py): bit i = M2x432+i ON, the MLC asks for axis i
+    mlc_axes: int = 0
+    _mlc_levels: bytes | None = None  # M2x432… of the channel's axes as last read
+    resets: int = 0  # NC resets taken (M2x004 edges): an MLC axis's move stops at each (decision M26-24)
     _servo_refused: int = 0  # bit i: a manual command of axis i, held OFF, was refused with 0x0A07 (M23-1)
     _spindle_levels: bytes = bytes(8)  # M2x711, M2x727, … as the last scan saw them (== their `_prev`)
     _tap_levels: bool = False  # M2x080 or M2x707 was ON last scan (their edges are looked for then)
@@ -137,6 +141,10 @@ class ChannelLink:
         if per_axis != self._servo_levels:
             self._servo_levels = bytes(per_axis)
             self.servo_off = sum(1 << i for i, on in enumerate(per_axis) if on or self.servo_all)
+        switch = m[b2 + 432:b2 + 432 + len(self.axes)]  # M2x432+i: one slice compare per scan
+        if switch != self._mlc_levels:
+            self._mlc_levels = bytes(switch)
+            self.mlc_axes = sum(1 << i for i, on in enumerate(switch) if on)
         self._overrides(ch)
         if m[b2 + 80] or m[b2 + 707] or self._tap_levels:
             self._tap_input(ch)
@@ -173,6 +181,7 @@ class ChannelLink:
             self._mpg_last = None
 
     def _reset(self, ch: Channel) -> None:
+        self.resets += 1
         self._drop_handshake()
         self._program_end = None
         if self.manual is not None:

@@ -1,0 +1,178 @@
+"""NC / MLC axis switching and the MLC's own axis moves (NC5 App. B.2: M2x432+i, M3x432+i, M2x416+i, M2x448+i,
+M2x464+i, D2x256+2i, D2x288+2i, M3x448+i; decisions M26-20 … M26-27), on the mill bench (X is axis 0: M21432 …).
+Read from the trace: X's setpoints and positions, the relays, the alarms, the summary."""
+
+from __future__ import annotations
+
+import csv
+import io
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+SIGNALS = "M21432,M31432,M21448,M31448"
+X_LIMITS = (500.0, 5000.0, 250000.0)  # benches/mill-3axis.toml: X velocity, acceleration, jerk
+DT = 0.001
+
+# M50 (a preview-halt M code follows it, M51: App. A §3.2.2 (2)): X to the MLC, to 30.5 absolute at 6000 mm/min,
+# then 5 incremental, back to the NC; M50 finishes after that. Any other code finishes at once.
+USER_MLC = '''SCAN_ON_CHANGE = True
+
+
+def scan(mlc):
+    st = mlc.state
+    step = st.get("step", 0)
+    if not step and mlc.m("M_STROBE") and int(mlc.d("M_CODE")) != 50:
+        mlc.set("MST_FINISH")
+    elif not step and not mlc.m("M_STROBE"):
+        mlc.set("MST_FINISH", False)
+    if mlc.m("M_STROBE") and int(mlc.d("M_CODE")) == 50 and not step:
+        st["step"] = 1
+        mlc.set("M21432")  # NC / MLC Axis Switching (X)
+    elif step == 1 and mlc.m("M31432"):  # Axis Switch to MLC Axis Finished
+        mlc.put("D21256", 30.5)
+        mlc.put("D21288", 6000.0)
+        mlc.set("M21448")  # trigger
+        st["step"] = 2
+    elif step == 2 and mlc.m("M31448"):  # target reached
+        mlc.set("M21448", False)
+        mlc.set("M21464")  # incremental
+        mlc.put("D21256", 5.0)
+        st["step"] = 3
+    elif step == 3:
+        mlc.set("M21448")
+        st["step"] = 4
+    elif step == 4 and mlc.m("M31448"):
+        mlc.set("M21448", False)
+        mlc.set("M21432", False)  # back to the NC
+        st["step"] = 5
+    elif step == 5 and not mlc.m("M31432"):
+        mlc.set("MST_FINISH")
+        st["step"] = 6
+    elif step == 6 and not mlc.m("M_STROBE"):
+        mlc.set("MST_FINISH", False)
+        st["step"] = 0
+'''
+
+
+def _bench(tmp_path: Path) -> Path:
+    """The shipped mill with M51 as the preview-halt M code (N1.118/N1.119)."""
+    text = (ROOT / "benches" / "mill-3axis.toml").read_text()
+    text = text.replace('mlc = "basic"\n', 'mlc = "basic"\n\n[params]\n"N1.118" = 51\n"N1.119" = 1\n', 1)
+    path = tmp_path / "mill.toml"
+    path.write_text(text)
+    return path
+
+
+def _run(hil, tmp_path, text: str, *args: str, name: str = "t"):
+    prog = tmp_path / f"{name}.nc"
+    prog.write_text(text)
+    trace = tmp_path / f"{name}.csv"
+    r = hil("run", str(prog), "--bench", str(_bench(tmp_path)), "--no-check", "--trace", str(trace),
+            "--trace-signals", SIGNALS, *args)
+    return r, trace.read_text()
+
+
+def _rows(text: str) -> list[dict]:
+    return list(csv.DictReader(io.StringIO(text)))
+
+
+def _within_limits(xs: list[float], limits=X_LIMITS) -> None:
+    """Velocity, acceleration and jerk of the setpoints, cycle by cycle, within the axis's limits."""
+    v = [(b - a) / DT for a, b in zip(xs, xs[1:])]
+    acc = [(b - a) / DT for a, b in zip(v, v[1:])]
+    jerk = [(b - a) / DT for a, b in zip(acc, acc[1:])]
+    assert max(map(abs, v)) <= limits[0] * (1 + 1e-9)
+    assert max(map(abs, acc)) <= limits[1] * (1 + 1e-6)
+    assert max(map(abs, jerk)) <= limits[2] * (1 + 1e-6)
+
+
+@pytest.mark.parametrize("stretch", ["0", "1"])
+def test_the_mlc_switches_x_moves_it_absolute_then_incremental_and_hands_it_back(hil, tmp_path, monkeypatch,
+                                                                              stretch):
+    (tmp_path / "axis_mlc.py").write_text(USER_MLC)
+    text = "G90 G01 X10. F3000\nM50\nM51\nG01 X20. Y5.\nM30\n"
+    monkeypatch.setenv("DELTAHIL_STRETCH", stretch)
+    r, trace = _run(hil, tmp_path, text, "--mlc", str(tmp_path / "axis_mlc.py"), name=f"s{stretch}")
+    assert r.code == 0 and "alarms         none" in r.out, r.out + r.err
+    assert "final machine position  X 20.0000  Y 5.0000" in r.out
+    rows = _rows(trace)
+    ask = next(i for i, row in enumerate(rows) if row["M21432"] == "1")
+    done = next(i for i, row in enumerate(rows) if row["M31432"] == "1")
+    assert done - ask == 2  # X stood: the NC's command of it is seen standing one cycle later, then Finished
+    assert float(rows[ask]["X_cmd"]) == 10.0 and rows[ask]["line"] == "2"
+    # the absolute move: the setpoint exactly on 30.5 when M3x448 comes on, at 6000 mm/min (100 mm/s) at most
+    first = next(i for i, row in enumerate(rows) if row["M31448"] == "1")
+    assert float(rows[first]["X_cmd"]) == 30.5 and float(rows[first - 1]["X_cmd"]) != 30.5
+    xs = [float(row["X_cmd"]) for row in rows[done:first + 1]]
+    _within_limits(xs, (100.0, 5000.0, 250000.0))
+    assert max(abs(b - a) for a, b in zip(xs, xs[1:])) / DT == pytest.approx(100.0, rel=1e-6)
+    # the incremental one: +5 from 30.5, reached exactly
+    second = next(i for i, row in enumerate(rows) if i > first + 2 and row["M31448"] == "1")
+    assert float(rows[second]["X_cmd"]) == 35.5
+    # back to the NC: M3x432 drops, then the program's next move runs from 35.5 to 20 (not from 10)
+    back = next(i for i, row in enumerate(rows) if i > second and row["M31432"] == "0")
+    line4 = [float(row["X_cmd"]) for row in rows if row["line"] == "4"]
+    assert int(rows[back]["cycle"]) < int(next(row["cycle"] for row in rows if row["line"] == "4"))
+    assert line4[0] == pytest.approx(35.5, abs=1e-3) and line4[-1] == pytest.approx(20.0, abs=1e-9)
+    assert all(b <= a + 1e-12 for a, b in zip(line4, line4[1:]))  # straight from 35.5 down to 20
+    _within_limits([float(row["X_cmd"]) for row in rows])
+    if stretch == "1":  # stretched or stepped, the same run cycle by cycle
+        monkeypatch.setenv("DELTAHIL_STRETCH", "0")
+        _, plain = _run(hil, tmp_path, text, "--mlc", str(tmp_path / "axis_mlc.py"), name="plain")
+        assert [(row["X_cmd"], row["M31448"]) for row in _rows(plain)] == [(row["X_cmd"], row["M31448"])
+                                                                            for row in rows]
+
+
+def test_a_program_moving_an_mlc_axis_is_0x141C_and_stops(hil, tmp_path):
+    r, trace = _run(hil, tmp_path, "G90 G01 X10. F3000\nG04 X0.5\nG01 X20. Y5.\nM30\n",
+                    "--at", "t=0.3:set M21432=1")
+    assert r.code == 1, r.out + r.err
+    assert "ALARM 0x141C axis X at line 3" in r.out and "M21432 ON" in r.out and "result         STOPPED" in r.out
+    rows = _rows(trace)
+    assert all(float(row["X_cmd"]) == 10.0 for row in rows if int(row["cycle"]) >= 300)  # X never moved again
+    assert float(rows[-1]["Y_cmd"]) < 5.0  # the channel stopped the block
+
+
+def test_a_switch_asked_while_the_nc_moves_the_axis_waits_for_it_to_stand(hil, tmp_path):
+    r, trace = _run(hil, tmp_path, "G90 G01 X10. F3000\nG04 X0.5\nM30\n", "--at", "t=0.1:set M21432=1")
+    assert r.code == 0, r.out + r.err
+    rows = _rows(trace)
+    done = next(i for i, row in enumerate(rows) if row["M31432"] == "1")
+    assert float(rows[done]["X_cmd"]) == 10.0  # the NC's move ran to its end first
+    # Finished the cycle after the NC's command of X first stood (the same value two cycles running)
+    assert float(rows[done - 1]["X_cmd"]) == 10.0 and float(rows[done - 2]["X_cmd"]) != 10.0
+    assert int(rows[done]["cycle"]) > 200
+
+
+def test_speed_mode_runs_at_the_velocity_follows_a_change_and_stops_when_the_trigger_drops(hil, tmp_path):
+    at = ["t=0.05:set M21432=1", "t=0.05:set M21416=1", "t=0.05:set D21288=3000", "t=0.1:set M21448=1",
+          "t=0.3:set D21288=-1500", "t=0.5:set M21448=0"]
+    r, trace = _run(hil, tmp_path, "G04 X0.8\nM30\n", *[a for e in at for a in ("--at", e)])
+    assert r.code == 0 and "alarms         none" in r.out, r.out + r.err
+    rows = _rows(trace)
+    xs = [float(row["X_cmd"]) for row in rows]
+    _within_limits(xs)
+    v = {int(row["cycle"]): (float(b["X_cmd"]) - float(row["X_cmd"])) / DT for row, b in zip(rows, rows[1:])}
+    reached = [int(row["cycle"]) for row in rows if row["M31448"] == "1"]
+    # 50 mm/s reached (M3x448 ON) within the ramp's time, held until the velocity changes
+    assert 100 < reached[0] < 130 and v[reached[0] + 5] == pytest.approx(50.0, rel=1e-9)
+    assert v[290] == pytest.approx(50.0, rel=1e-9)
+    assert not any(302 <= c <= 320 for c in reached)  # the new speed not yet there: OFF
+    assert v[450] == pytest.approx(-25.0, rel=1e-9) and 450 in reached
+    # the trigger dropped: a controlled stop, then X stands where it stopped; M3x448 OFF
+    end = xs[-2]  # (the last row: the drive disabled, its command follows the measured position)
+    assert all(x == end for x in xs[-100:-1]) and rows[-1]["M31448"] == "0"
+    assert rows[-1]["M31432"] == "1"  # still the MLC's axis
+
+
+def test_an_nc_reset_stops_an_mlc_move_under_control_short_of_its_target(hil, tmp_path):
+    at = ["t=0.05:set M21432=1", "t=0.05:set D21256=200", "t=0.05:set D21288=30000", "t=0.1:set M21448=1",
+          "t=0.3:pulse M21004"]
+    r, trace = _run(hil, tmp_path, "G04 X0.8\nM30\n", *[a for e in at for a in ("--at", e)])
+    rows = _rows(trace)
+    xs = [float(row["X_cmd"]) for row in rows]
+    _within_limits(xs)
+    assert 20.0 < xs[-2] < 190.0 and all(x == xs[-2] for x in xs[-50:-1])  # stopped short of 200, standing
+    assert all(row["M31448"] == "0" for row in rows)
