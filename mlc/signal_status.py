@@ -62,10 +62,10 @@ LOCK_NEG | bench | mlc/nc_link.py | manual modes, per axis slot
 DISABLE_SOFT_LIMIT | bench | mlc/nc_link.py | the 1st software limit segment only, manual modes
 JOG_FWD | bench | mlc/nc_link.py | JOG/RAPID level, INC rising edge, per axis slot
 JOG_REV | bench | mlc/nc_link.py | as JOG_FWD
-MLC_AXIS_SPEED_MODE | absent | - | MLC axes not emulated
-MLC_AXIS_SWITCH | absent | - | MLC axes not emulated
-MLC_AXIS_TRIGGER | absent | - | MLC axes not emulated
-MLC_AXIS_INCREMENTAL | absent | - | MLC axes not emulated
+MLC_AXIS_SPEED_MODE | bench | hil/mlc_axes.py | level: the trigger's level runs the axis at D2x288+2i, its drop stops it (M26-26)
+MLC_AXIS_SWITCH | bench | hil/mlc_axes.py | level; taken where the NC's command stands, back at rest with the NC's queue empty; a program moving the axis meanwhile is 0x141C (M26-21, M26-22, M26-23)
+MLC_AXIS_TRIGGER | bench | hil/mlc_axes.py | position mode: rising edge (a new edge mid-move re-plans); speed mode: level (M26-25, M26-26)
+MLC_AXIS_INCREMENTAL | bench | hil/mlc_axes.py | read at the trigger's edge: from the last target (M26-25)
 SPINDLE_FWD | partial | mlc/nc_link.py | spindle 1 drives the bench spindle; spindles 2-8 have no drive
 SPINDLE_REV | partial | mlc/nc_link.py | as SPINDLE_FWD
 SPINDLE_ORIENT | partial | mlc/spindle_axis.py | spindle 1 (M19), through the C-axis switch
@@ -126,8 +126,8 @@ OSCILLATING | absent | - | oscillation not emulated
 HOMED | bench | mlc/nc_link.py | per axis slot (manual homing or drive homing)
 HOMING_DONE | bench | mlc/nc_link.py | per axis slot
 AT_ORIGIN | bench | mlc/nc_link.py | machine position 0, per axis slot
-MLC_AXIS_SWITCHED | absent | - | MLC axes not emulated
-MLC_AXIS_REACHED | absent | - | MLC axes not emulated
+MLC_AXIS_SWITCHED | bench | hil/mlc_axes.py | ON the cycle the axis is the MLC's, OFF the cycle the NC has it back (M26-21, M26-23)
+MLC_AXIS_REACHED | bench | hil/mlc_axes.py | position exactly on the target at rest / speed at D2x288+2i; OFF from the trigger on, stays OFF after a stop (M26-24, M26-25)
 MOVING | bench | mlc/drive_status.py | |velocity| > 1e-4 per axis slot
 MOVING_FWD | bench | mlc/drive_status.py | velocity > 1e-4
 MOVING_REV | bench | mlc/drive_status.py | velocity < -1e-4
@@ -169,8 +169,8 @@ MAG1_TOOL | partial | mlc/lathe.py | written by the lathe MLC; the NC does not r
 MAG2_TOOL | absent | - | as MAG1_FORWARD
 MACRO_NUMBER | absent | - | MLC-triggered macro calls not emulated
 MLC_TO_NC_WORD | bench | mlc/nc_link.py | #25128+n, signed 16 bit
-MLC_AXIS_TARGET | absent | - | MLC axes not emulated
-MLC_AXIS_VELOCITY | absent | - | MLC axes not emulated
+MLC_AXIS_TARGET | partial | hil/mlc_axes.py | machine coordinates (a lathe's X as a radius); the software limits are not checked (M26-25)
+MLC_AXIS_VELOCITY | bench | hil/mlc_axes.py | mm/min, rotary axes rpm; capped at the axis's velocity, 0 starts no position move (M26-25)
 SPINDLE1_PULSES | hardware | - | the controller's spindle encoder counter
 SPINDLE2_PULSES | hardware | - | the controller's spindle encoder counter
 MPG_PULSES | bench | mlc/nc_link.py | the MPG's 16-bit counter (hil mpg, machine.mpg)
@@ -254,6 +254,14 @@ TESTS: dict[str, tuple[str, ...]] = {
     'JOG_FWD': ('mlc_memory', 'run_imports'),
     'JOG_REV': ('mlc_memory',),
     'SPINDLE_FWD': ('mlc_on_change',),
+    'MLC_AXIS_SPEED_MODE': ('mlcaxis27_axes',),
+    'MLC_AXIS_SWITCH': ('mlcaxis27_axes',),
+    'MLC_AXIS_TRIGGER': ('mlcaxis27_axes',),
+    'MLC_AXIS_INCREMENTAL': ('mlcaxis27_axes',),
+    'MLC_AXIS_SWITCHED': ('mlcaxis27_axes',),
+    'MLC_AXIS_REACHED': ('mlcaxis27_axes',),
+    'MLC_AXIS_TARGET': ('mlcaxis27_axes',),
+    'MLC_AXIS_VELOCITY': ('mlcaxis27_axes',),
     'SPINDLE_ORIENT': ('alarms_servo',),
     'SPINDLE_CS_SWITCH': ('mlc_caxis',),
     'SPINDLE_ALARM': ('alarms_servo', 'mlc_exchange_edges'),

@@ -176,3 +176,19 @@ def test_an_nc_reset_stops_an_mlc_move_under_control_short_of_its_target(hil, tm
     _within_limits(xs)
     assert 20.0 < xs[-2] < 190.0 and all(x == xs[-2] for x in xs[-50:-1])  # stopped short of 200, standing
     assert all(row["M31448"] == "0" for row in rows)
+
+
+def test_an_estop_brakes_an_mlc_move_like_every_axis_and_disables_it_only_at_standstill(hil, tmp_path):
+    at = ["t=0.05:set M21432=1", "t=0.05:set D21256=200", "t=0.05:set D21288=30000", "t=0.1:set M21448=1",
+          "t=0.3:estop"]
+    r, trace = _run(hil, tmp_path, "G04 X0.8\nM30\n", *[a for e in at for a in ("--at", e)])
+    assert "ALARM 0x0401" in r.out and "result         STOPPED" in r.out, r.out + r.err
+    rows = _rows(trace)
+    k = next(i for i, row in enumerate(rows) if int(row["cycle"]) == 301)
+    assert float(rows[k]["X_vel"]) > 400.0  # X ran at the axis's 500 mm/s (30000 mm/min asked, capped)
+    speeds = [float(row["X_vel"]) for row in rows[k:]]
+    assert all(b <= a + 1.0 for a, b in zip(speeds, speeds[1:])) and sum(1 for v in speeds if v > 1.0) > 100
+    off = next(i for i, row in enumerate(rows) if i > k and int(row["X_sw"]) & 0x6F != 0x27 and
+               int(row["X_sw"]) & 0x6F != 0x07)  # neither operation enabled nor quick stop active
+    assert abs(float(rows[off - 1]["X_vel"])) < 0.01
+    assert 100.0 < float(rows[-1]["X_act"]) < 200.0 and all(row["M31448"] == "0" for row in rows)
