@@ -192,3 +192,12 @@ def test_an_estop_brakes_an_mlc_move_like_every_axis_and_disables_it_only_at_sta
                int(row["X_sw"]) & 0x6F != 0x07)  # neither operation enabled nor quick stop active
     assert abs(float(rows[off - 1]["X_vel"])) < 0.01
     assert 100.0 < float(rows[-1]["X_act"]) < 200.0 and all(row["M31448"] == "0" for row in rows)
+
+
+def test_the_example_script_drives_x_as_an_mlc_axis_and_the_nc_takes_it_back(hil):
+    r = hil("script", ROOT / "examples" / "scripts" / "mlc_axis.py", "--bench", ROOT / "benches" / "mill-3axis.toml")
+    assert r.code == 0, r.out + r.err
+    assert "absolute: X 30.5000" in r.out and "incremental: X 35.5000" in r.out
+    # 0.5 s at -1200 mm/min from 35.5 plus the ramps: -20 mm/s reached at 5000 mm/s² and 250000 mm/s³
+    assert "speed mode: X 25.1400" in r.out
+    assert "NC again: G01 X0. from X 25.1400 to X 0.0000, alarms 0" in r.out
