@@ -26,6 +26,7 @@ from typing import Any
 from nc.alarms import Alarm
 from nc.channel import RunState
 from nc.mlc_axis import MlcAxis, velocity_units
+from nc.motion.profile import solve_velocity
 
 AXIS_TYPE_ERROR = 0x141C  # App. A: "Setting error of the axis type. … such as NC axis or PLC axis" (M26-22)
 NC, SWITCHING, MLC, RETURNING = 0, 1, 2, 3
@@ -137,6 +138,8 @@ def _drive(r: Any, ch: Any, st: MlcAxes, i: int, ax: MlcAxis, m: Any, b2: int, d
             if rising or v != st.velocity[i] or ax.stopping:
                 st.velocity[i] = v
                 ax.run_at(v)
+            if ax.v != 0.0 and not ax.stopping:
+                _speed_limit(r, ch, i, ax)
         elif ax.moving and not ax.stopping:
             ax.stop()
         return
@@ -147,8 +150,46 @@ def _drive(r: Any, ch: Any, st: MlcAxes, i: int, ax: MlcAxis, m: Any, b2: int, d
         if m[b2 + 464 + i]:
             target += ax.goal if ax.goal is not None else ax.p  # incremental: from the last target (M26-25)
         v = velocity_units(mem.f32(d2 + 288 + 2 * i), rotary)
-        if ax.move_to(target, v):
+        alarm = _outside(ch, r.axes[i], target, target)
+        if alarm is not None:
+            r._alarm(alarm)  # a target past a software limit: App. A 0x0A01/0x0A03, the move is not started
+        elif ax.move_to(target, v):
             st.log.append((r.cycle, r.axes[i], f"move {target:g}"))
+
+
+def _outside(ch: Any, axis: str, lo: float, hi: float, what: str = "target") -> Alarm | None:
+    """The software-limit alarm (App. A 0x0A01 1st segment, 0x0A03 2nd) when [lo, hi] leaves the axis's window."""
+    lims = getattr(ch, "soft_limits", None)
+    if lims is None:
+        return None
+    for segment, code in ((1, 0x0A01), (2, 0x0A03)):
+        if segment == 1 and axis in lims.disabled:
+            continue
+        low, high = lims.window(axis, segment)
+        side = ("+", hi, high) if high is not None and hi > high + 1e-9 else \
+            ("-", lo, low) if low is not None and lo < low - 1e-9 else None
+        if side is not None:
+            return Alarm(code, f"software limit {segment} {side[0]} of MLC axis {axis}: the {what} {side[1]:.4f} is "
+                               f"past the limit {side[2]:.4f} (machine coordinates)", axis=axis)
+    return None
+
+
+def _speed_limit(r: Any, ch: Any, i: int, ax: MlcAxis) -> None:
+    """Speed mode: the axis stops short of a software limit it runs towards, and the limit's alarm is raised
+    (M26-25). A cheap generous estimate of where a stop begun next cycle would end first; only near a limit the
+    exact one (ruckig's velocity interface from the current state, as `MlcAxis.stop` will plan it)."""
+    v, a, lim = ax.v, ax.a, ax.limits
+    ahead = v + 2.0 * a * lim.max_acceleration / lim.max_jerk if v * a > 0 else v
+    rough = ax.p + 2.0 * (ahead * abs(ahead) / (2.0 * lim.max_acceleration) + ahead * lim.max_acceleration
+                          / lim.max_jerk + 2.0 * ahead * ax.cycle)
+    if _outside(ch, r.axes[i], min(ax.p, rough), max(ax.p, rough)) is None:
+        return
+    prof = solve_velocity(ax.p, v, a, 0.0, lim.max_acceleration, lim.max_jerk)
+    end = prof.at(prof.duration)[0] + 2.0 * v * ax.cycle  # the stop begins next cycle: a cycle's travel, twice
+    alarm = _outside(ch, r.axes[i], min(ax.p, end), max(ax.p, end), "stop point")
+    if alarm is not None:
+        ax.stop()
+        r._alarm(alarm)
 
 
 def _hand_back(r: Any, ch: Any, i: int, position: float) -> None:

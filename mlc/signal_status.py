@@ -169,7 +169,7 @@ MAG1_TOOL | partial | mlc/lathe.py | written by the lathe MLC; the NC does not r
 MAG2_TOOL | absent | - | as MAG1_FORWARD
 MACRO_NUMBER | absent | - | MLC-triggered macro calls not emulated
 MLC_TO_NC_WORD | bench | mlc/nc_link.py | #25128+n, signed 16 bit
-MLC_AXIS_TARGET | partial | hil/mlc_axes.py | machine coordinates (a lathe's X as a radius); the software limits are not checked (M26-25)
+MLC_AXIS_TARGET | bench | hil/mlc_axes.py | machine coordinates (a lathe's X as a radius); past a software limit: 0x0A01/0x0A03, not started (M26-25)
 MLC_AXIS_VELOCITY | bench | hil/mlc_axes.py | mm/min, rotary axes rpm; capped at the axis's velocity, 0 starts no position move (M26-25)
 SPINDLE1_PULSES | hardware | - | the controller's spindle encoder counter
 SPINDLE2_PULSES | hardware | - | the controller's spindle encoder counter

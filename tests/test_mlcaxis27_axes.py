@@ -201,3 +201,17 @@ def test_the_example_script_drives_x_as_an_mlc_axis_and_the_nc_takes_it_back(hil
     # 0.5 s at -1200 mm/min from 35.5 plus the ramps: -20 mm/s reached at 5000 mm/s² and 250000 mm/s³
     assert "speed mode: X 25.1400" in r.out
     assert "NC again: G01 X0. from X 25.1400 to X 0.0000, alarms 0" in r.out
+
+
+def test_software_limits_refuse_a_target_past_them_and_stop_a_speed_mode_run_short_of_them(hil, tmp_path):
+    # X's window on the mill: -300 … 300 (1st segment, App. A 0x0A01)
+    at = ["t=0.05:set M21432=1", "t=0.05:set D21256=-300.5", "t=0.05:set D21288=24000", "t=0.1:set M21448=1"]
+    r, trace = _run(hil, tmp_path, "G04 X2.\nM30\n", *[a for e in at for a in ("--at", e)], name="pos")
+    assert "ALARM 0x0A01 axis X" in r.out and "target -300.5000 is past the limit -300.0000" in r.out, r.out
+    assert all(float(row["X_cmd"]) == 0.0 for row in _rows(trace))  # the move was not started
+    at = ["t=0.05:set M21432=1", "t=0.05:set M21416=1", "t=0.05:set D21288=24000", "t=0.1:set M21448=1"]
+    r, trace = _run(hil, tmp_path, "G04 X2.\nM30\n", *[a for e in at for a in ("--at", e)], name="speed")
+    assert "ALARM 0x0A01 axis X" in r.out and "software limit 1 + of MLC axis X" in r.out, r.out
+    xs = [float(row["X_cmd"]) for row in _rows(trace)]
+    _within_limits(xs)
+    assert 290.0 < max(xs) <= 300.0 and xs[-2] == max(xs)  # at 400 mm/s towards +300: stopped short of it
