@@ -109,7 +109,7 @@ def step(r: Any, ch: Any, link: Any) -> None:
             elif s == RETURNING and asked:
                 s = MLC
             if s == RETURNING and not ax.moving and ch.planner.idle:
-                _hand_back(r, ch, i, ax.p)
+                _hand_back(r, ch, link, i, ax.p)
                 m[b3 + 432 + i] = m[b3 + 448 + i] = 0
                 st.log.append((r.cycle, r.axes[i], "nc"))
                 s = NC
@@ -192,8 +192,11 @@ def _speed_limit(r: Any, ch: Any, i: int, ax: MlcAxis) -> None:
         r._alarm(alarm)
 
 
-def _hand_back(r: Any, ch: Any, i: int, position: float) -> None:
-    """The NC's position of axis i is where the MLC left it: planner and interpreter (M26-23)."""
+def _hand_back(r: Any, ch: Any, link: Any, i: int, position: float) -> None:
+    """The NC's position of axis i is where the MLC left it: planner, interpreter and manual motion (M26-23)."""
+    manual = getattr(link, "manual", None)
+    if manual is not None and r.axes[i] in manual.axes:
+        manual.hold_at(r.axes[i], position)  # a JOG/INC/MPG after the hand-back starts there
     pl = ch.planner
     pl.position[i] = pl.output[i] = position
     if pl.filter is not None:

@@ -382,6 +382,10 @@ class ChannelLink:
             if limits is not None:  # the bench's soft_limits and G10 L21 clamp the manual moves too
                 windows[a] = low, high = self.limit_latch.window(limits, a, not self._m2(368 + i))
                 st.soft_min, st.soft_max = (low[0] if low else None), (high[0] if high else None)
+        if self.mlc_axes:  # an axis the MLC asks for takes no manual command: both ways interlocked (M26-29)
+            for i, a in enumerate(self.axes):
+                if self.mlc_axes >> i & 1:
+                    mm.axes[a].lock_pos = mm.axes[a].lock_neg = True
         if self.drives is not None:
             for alarm in self.hard_limits.step(mm, self.axes, self.drives):
                 self._raise(ch, alarm)

@@ -215,3 +215,33 @@ def test_software_limits_refuse_a_target_past_them_and_stop_a_speed_mode_run_sho
     xs = [float(row["X_cmd"]) for row in _rows(trace)]
     _within_limits(xs)
     assert 290.0 < max(xs) <= 300.0 and xs[-2] == max(xs)  # at 400 mm/s towards +300: stopped short of it
+
+
+JOG_SCRIPT = '''def main(machine):
+    mem = machine.mlc.mem
+    machine.mode("JOG")
+    machine.set("M21432")
+    machine.wait_until(lambda: machine.get("M31432") == 1, 1.0, "X switched")
+    machine.jog("X", 1, 0.3)
+    print(f"JOG of the MLC axis: X {machine.command('X'):.4f}")
+    mem.set_f32(21256, 10.0)
+    mem.set_f32(21288, 6000.0)
+    machine.set("M21448")
+    machine.cycle(2)
+    machine.wait_until(lambda: machine.get("M31448") == 1, 2.0, "X at 10")
+    machine.set("M21432", False)
+    machine.wait_until(lambda: machine.get("M31432") == 0, 1.0, "X back")
+    machine.jog("X", 1, 0.3)
+    machine.wait(0.3)
+    print(f"JOG as an NC axis again: X {machine.command('X'):.4f}, alarms {len(machine.all_alarms())}")
+'''
+
+
+def test_a_jog_of_an_mlc_axis_does_nothing_and_after_the_hand_back_it_jogs_from_the_mlc_position(hil, tmp_path):
+    script = tmp_path / "jog.py"
+    script.write_text(JOG_SCRIPT)
+    r = hil("script", script, "--bench", ROOT / "benches" / "mill-3axis.toml")
+    assert r.code == 0, r.out + r.err
+    assert "JOG of the MLC axis: X 0.0000" in r.out  # 0.3 s of JOG+ (N2.030 speed): interlocked, X stood
+    # JOG mode all along: the manual motion takes X at 10 from the MLC, 0.3 s of JOG at 1000 mm/min = +5
+    assert "JOG as an NC axis again: X 15.0000, alarms 0" in r.out
