@@ -245,3 +245,25 @@ def test_a_jog_of_an_mlc_axis_does_nothing_and_after_the_hand_back_it_jogs_from_
     assert "JOG of the MLC axis: X 0.0000" in r.out  # 0.3 s of JOG+ (N2.030 speed): interlocked, X stood
     # JOG mode all along: the manual motion takes X at 10 from the MLC, 0.3 s of JOG at 1000 mm/min = +5
     assert "JOG as an NC axis again: X 15.0000, alarms 0" in r.out
+
+
+def test_a_rotary_mlc_axis_takes_its_velocity_in_rpm(hil, tmp_path):
+    """App. B.2 D2x288: rotary axes (A/B/C) in rpm. A 4th axis A (units deg, axis 3: M21435, D21262/D21294):
+    to 90° at 10 rpm = 60 °/s."""
+    bench = (ROOT / "benches" / "mill-3axis.toml").read_text()
+    bench = bench.replace("[[spindles]]", '[[axes]]\nname = "A"\nunits = "deg"\nlead = 360.0\n'
+                                          'limits = { velocity = 3600.0, acceleration = 36000.0, jerk = 1800000.0 }\n\n'
+                                          "[[spindles]]", 1)
+    (tmp_path / "mill4.toml").write_text(bench)
+    prog = tmp_path / "a.nc"
+    prog.write_text("G04 X2.\nM30\n")
+    trace = tmp_path / "a.csv"
+    at = ["t=0.05:set M21435=1", "t=0.05:set D21262=90", "t=0.05:set D21294=10", "t=0.1:set M21451=1"]
+    r = hil("run", str(prog), "--bench", str(tmp_path / "mill4.toml"), "--no-check", "--trace", str(trace),
+            "--trace-signals", "M31435,M31451", *[a for e in at for a in ("--at", e)])
+    assert r.code == 0, r.out + r.err
+    rows = _rows(trace.read_text())
+    xs = [float(row["A_cmd"]) for row in rows]
+    assert max(abs(b - a) for a, b in zip(xs, xs[1:])) / DT == pytest.approx(60.0, rel=1e-6)
+    done = next(i for i, row in enumerate(rows) if row["M31451"] == "1")
+    assert xs[done] == 90.0 and 1.5 < float(rows[done]["t"]) - 0.1 < 1.52  # 90° at 60 °/s: 1.5 s and the ramps
