@@ -47,6 +47,7 @@ def per_cycle_cost() -> None:
     base = best(lambda: None)
     parts = {
         "M2x432+i levels: slice and compare (ChannelLink.nc_inputs)": lambda: mem[b2 + 432:b2 + 432 + n] != levels,
+        "ChannelLink._manual: link.mlc_axes": lambda: link.mlc_axes,
         "BenchRunner._cycle: link.mlc_axes or _mlc_axes": lambda: link is not None and (link.mlc_axes or r._mlc_axes),
         "stretch _quiet: r._mlc_axes": lambda: r._mlc_axes,
     }
