@@ -199,6 +199,7 @@ def _hand_back(r: Any, ch: Any, link: Any, i: int, position: float) -> None:
         manual.hold_at(r.axes[i], position)  # a JOG/INC/MPG after the hand-back starts there
     pl = ch.planner
     pl.position[i] = pl.output[i] = position
+    ch.handed_back[r.axes[i]] = position  # the next move must start here (read ahead before it: 0x141C, M26-30)
     if pl.filter is not None:
         pl.filter.reset(pl.position)
     interp = getattr(r, "_interp", None)

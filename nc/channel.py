@@ -125,6 +125,9 @@ class Channel:
     _tap_line: int | None = None  # line of the last tapping move started (M3x707 through its spindle reversal)
     _tap_mv: Move | None = None  # the active move `rigid_tapping` looked at last
     on_retracted: Callable[[dict[str, float]], None] | None = None  # the interpreter's position after G84.48
+    # Axes the MLC handed back (hil/mlc_axes.py, decision M26-23) and where they stand: the next move pushed must start
+    # there, else the preview read it before the hand-back and it would step the axis back (0x141C, decision M26-30)
+    handed_back: dict[str, float] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         self._feed_cap = self.planner.cfg.max_feed  # N1.033 of the settings in force (None: no limit)
@@ -446,6 +449,8 @@ class Channel:
             plain = src.plain
             while reads and plain and not pl.full:
                 ev = self._checked = plain.popleft()
+                if self.handed_back and self._read_ahead(ev):
+                    return
                 pl.push(ev)
                 self._block_moves += 1
                 reads -= 1
@@ -512,6 +517,8 @@ class Channel:
                 if "G31" in ev.tags:
                     self._skip_move = ev
                     self.skip_latched = None
+                if self.handed_back and self._read_ahead(ev):
+                    return
                 pl.push(ev)
                 self._block_moves += 1
                 reads -= 1
@@ -547,6 +554,24 @@ class Channel:
                     if not self._switch_group(ev):
                         return
                     pl = self.planner
+
+    def _read_ahead(self, mv: Move) -> bool:
+        """The first move after an MLC axis came back (decision M26-30): True (alarm raised, the move never starts)
+        where it starts elsewhere than the axis stands, read by the preview before the hand-back (NC5 §3.2.2 (2):
+        the preview interpolates as if the axes had not been switched; an M code that halts it, N1.118/N1.119, after
+        the one that hands the axis back avoids that). Planned from its stale start it would step the axis back
+        in one cycle (a setpoint jump the drive would meet as a following-error or overspeed fault)."""
+        back, self.handed_back = self.handed_back, {}
+        for axis, pos in back.items():
+            x = mv.start.get(axis)
+            if x is not None and abs(x - pos) > 1e-6:
+                self.raise_alarm(Alarm(
+                    0x141C, f"line {mv.line} was read ahead before axis {axis} came back from the MLC: it starts at "
+                            f"{axis}{x:.4f}, the axis stands at {pos:.4f} (NC5 §3.2.2 (2): put an M code that halts the "
+                            f"preview, N1.118/N1.119, after the one that hands the axis back)",
+                    line=mv.line or None, block=mv.block or None, program=mv.program, axis=axis))
+                return True
+        return False
 
     def _switch_group(self, ev: Sync) -> bool:
         """G05 P at rest (its Sync drained: the queue empty, the filter settled): the planner rebuilt with the

@@ -267,3 +267,19 @@ def test_a_rotary_mlc_axis_takes_its_velocity_in_rpm(hil, tmp_path):
     assert max(abs(b - a) for a, b in zip(xs, xs[1:])) / DT == pytest.approx(60.0, rel=1e-6)
     done = next(i for i, row in enumerate(rows) if row["M31451"] == "1")
     assert xs[done] == 90.0 and 1.5 < float(rows[done]["t"]) - 0.1 < 1.52  # 90° at 60 °/s: 1.5 s and the ramps
+
+
+def test_a_move_read_ahead_before_the_hand_back_is_refused_not_stepped(hil, tmp_path):
+    """Decision M26-30: without the preview-halt M code after M50 (App. A §3.2.2 (2)), line 3 is read while X is the
+    MLC's and starts at X10, where X stood when it was switched; X comes back at 35.5. Planned from X10 it stepped X
+    back 25 mm in a cycle (setpoints at 1,591 mm/s, 0x0602 overspeed). Now the move never starts: 0x141C at line 3,
+    X stays at 35.5 and no setpoint exceeds X's velocity."""
+    (tmp_path / "axis_mlc.py").write_text(USER_MLC)
+    r, trace = _run(hil, tmp_path, "G90 G01 X10. F3000\nM50\nG01 X20. Y5.\nM30\n", "--mlc",
+                    str(tmp_path / "axis_mlc.py"), name="ahead")
+    assert r.code != 0
+    assert "ALARM 0x141C axis X in ahead.nc at line 3: G01 X20. Y5." in r.out and "0x0602" not in r.out, r.out
+    assert "final machine position  X 35.5000  Y 0.0000" in r.out, r.out
+    xs = [float(row["X_cmd"]) for row in _rows(trace)]
+    assert max(abs(b - a) for a, b in zip(xs, xs[1:])) / DT <= X_LIMITS[0]
+    assert xs[-1] == 35.5
