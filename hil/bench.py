@@ -6,7 +6,7 @@ from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING
 
 from fieldbus.units import AxisScaling
-from nc.motion.limits import AxisLimits, MotionConfig
+from nc.motion.limits import AxisLimits, MotionConfig, MoveKindLimits
 from hil.drive_homing import DriveHoming
 from virtual_bus.drive_params import DriveParams
 
@@ -55,7 +55,7 @@ class ParamGroup:
     """A G05 parameter group ([param_groups.N] in a bench file, N§3.8.2 "recipes" 1-20): the values it sets;
     what it leaves out keeps the bench's own (decision language L25-1)."""
 
-    params: dict[str, float] = field(default_factory=dict)  # N1.033, N1.036, N1.037, N1.053
+    params: dict[str, float] = field(default_factory=dict)  # N1.030-N1.037, N1.053, "N2.020 X" ... (MODELLED)
     limits: dict[str, dict[str, float]] = field(default_factory=dict)  # axis -> {velocity, acceleration, jerk}
 
 
@@ -155,7 +155,11 @@ class Bench:
         cap = p.get("N1.033", 0.0)  # mm/min; 0 = none
         cfg = MotionConfig(cycle=self.cycle, axes=self.axis_names, limits=limits,
                            filter_time=filt, filter_scurve=scurve, path_tolerance=dev if dev > 0.0 else None,
-                           lookahead=self.lookahead, max_feed=cap if cap > 0.0 else None)
+                           lookahead=self.lookahead, max_feed=cap if cap > 0.0 else None,
+                           rapid=_kind_limits(p, "N1.030", "N1.031", "N1.032"),
+                           cutting=_kind_limits(p, "N1.033", "N1.034", "N1.035"),
+                           axis_rapid={a: k for a in self.axis_names
+                                       if (k := _kind_limits(p, *(f"N2.02{i} {a}" for i in range(3)))).set})
         if cfg.filtered:
             # The filter spreads what several blocks in one cycle do; a block need not last a cycle.
             cfg.min_segment_cycles = 0.25
@@ -164,6 +168,15 @@ class Bench:
     def motion_configs(self) -> dict[int, MotionConfig]:
         """G05 P0 (the bench's own settings) and every parameter group's, for the channel (nc.channel)."""
         return {n: self.motion_config(n) for n in (0, *sorted(self.param_groups))}
+
+
+def _kind_limits(p: dict[str, float], speed: str, acc: str, scurve: str) -> MoveKindLimits:
+    """A kind of move's NC5 limits from [params] (mm/min and ms) in the planner's units (mm/s, s); an absent key
+    stays None (the planner's own limits, unchanged), 0 a speed of none (decisions language L26-1, motion 90)."""
+    v = p.get(speed)
+    return MoveKindLimits(speed=v / 60.0 if v else None,
+                          acc_time=None if acc not in p else p[acc] / 1000.0,
+                          scurve_time=None if scurve not in p else p[scurve] / 1000.0)
 
 
 def default_lathe() -> Bench:

@@ -18,7 +18,7 @@ from fieldbus.pdo import ASDA_CSP, ASDA_CSP_CSV
 from fieldbus.devices import DEFAULT_MODEL, MODELS
 from fieldbus.units import AxisScaling
 from hil.bench_groups import parse_groups
-from hil.bench_params import check_param
+from hil.bench_params import check_param, check_together
 from hil.bench import LIMIT_BOUNDS, LOCKSTEP_PLACEMENTS, AxisConfig, Bench, ChecksConfig, IoStationConfig, RealtimeConfig, SpindleConfig
 from hil.drive_homing import DriveHoming
 from hil.toml_fields import BenchFileError, FieldReader, kind_of, read_text_file
@@ -116,7 +116,9 @@ def parse_bench(text: str, source: str = "bench.toml") -> Bench:
     b.realtime = _realtime(r, r.table(data, "realtime", "realtime"))
     b.checks = _checks(r, r.table(data, "checks", "checks"), b.axis_names)
     b.io = _io_stations(r, data.pop("io", []), len(b.axes) + len(b.spindles))
-    b.param_groups = parse_groups(r, data.pop("param_groups", {}), b.axes)
+    for k, problem in check_together(b.params, b.axis_names):
+        r.err(f"params.{k!r}" if " " in k else f"params.{k}", problem)
+    b.param_groups = parse_groups(r, data.pop("param_groups", {}), b.axes, b.params)
     r.unknown(data, "", {"name", "profile", "cycle_ms", "bus", "mlc", "enable_timeout", "settle_time", "max_time",
                          "lookahead", "params", "axes", "spindles", "realtime", "checks", "io", "canopen_bitrate",
                          "param_groups"})

@@ -16,7 +16,7 @@ from __future__ import annotations
 from typing import Any
 
 from hil.bench import LIMIT_BOUNDS, LIMIT_FIELDS, AxisConfig, ParamGroup
-from hil.bench_params import check_param, param_spec
+from hil.bench_params import check_param, check_together, param_spec
 from hil.toml_fields import FieldReader, kind_of
 
 GROUPS = range(1, 21)  # G05 P1-P20
@@ -24,19 +24,21 @@ GROUPS = range(1, 21)  # G05 P1-P20
 G05_CHANNEL = frozenset([*(f"N1.{n:03d}" for n in range(30, 40)), "N1.041", *(f"N1.{n:03d}" for n in range(50, 55)),
                          *(f"N1.{n:03d}" for n in range(96, 100))])
 G05_AXIS = frozenset([*(f"N2.{n:03d}" for n in range(20, 28)), "N2.029"])
-# Those the bench's motion model has: the planner's settings (hil.bench.Bench.motion_config).
-MODELLED = ("N1.033", "N1.036", "N1.037", "N1.053")
+# Those the bench's motion model has: the planner's settings (hil.bench.Bench.motion_config); the axis ones
+# spelt with their axis, "N2.020 X" (decision language L26-1).
+MODELLED = ("N1.030", "N1.031", "N1.032", "N1.033", "N1.034", "N1.035", "N1.036", "N1.037", "N1.053")
+MODELLED_AXIS = ("N2.020", "N2.021", "N2.022")
 # What the bench has instead of an NC5 parameter it does not model, for the message.
-INSTEAD = {"N1.034": "limits.<axis>.acceleration", "N1.035": "limits.<axis>.jerk",
-           "N1.030": "limits.<axis>.velocity", "N1.031": "limits.<axis>.acceleration", "N1.032": "limits.<axis>.jerk",
-           "N2.020": "limits.<axis>.velocity", "N2.023": "limits.<axis>.velocity",
-           "N2.021": "limits.<axis>.acceleration", "N2.024": "limits.<axis>.acceleration",
-           "N2.022": "limits.<axis>.jerk", "N2.025": "limits.<axis>.jerk"}
+INSTEAD = {"N2.023": "limits.<axis>.velocity", "N2.024": "limits.<axis>.acceleration",
+           "N2.025": "limits.<axis>.jerk"}
 LISTED = "N1.030-N1.039, N1.041, N1.050-N1.054, N1.096-N1.099, N2.020-N2.027, N2.029"
 
 
-def parse_groups(r: FieldReader, raw: Any, axes: list[AxisConfig]) -> dict[int, ParamGroup]:
-    """The bench file's `param_groups` table (popped by the caller) as groups by number; errors go to `r`."""
+def parse_groups(r: FieldReader, raw: Any, axes: list[AxisConfig],
+                 params: dict[str, float] | None = None) -> dict[int, ParamGroup]:
+    """The bench file's `param_groups` table (popped by the caller) as groups by number; errors go to `r`.
+    `params`: the bench's `[params]`, which a group's values stand over (an acc. and dec. time needs its speed
+    from either, decision language L26-1)."""
     if not isinstance(raw, dict):
         r.err("param_groups", f"must be a table of groups ([param_groups.1] ... [param_groups.20]), got {kind_of(raw)}")
         return {}
@@ -53,7 +55,20 @@ def parse_groups(r: FieldReader, raw: Any, axes: list[AxisConfig]) -> dict[int, 
             r.err(p, f"must be a table of parameters, got {kind_of(body)}")
             continue
         out[n] = _group(r, dict(body), p, axes)
+        _check_over(r, out[n], p, axes, params or {})
     return out
+
+
+def _check_over(r: FieldReader, g: ParamGroup, p: str, axes: list[AxisConfig], params: dict[str, float]) -> None:
+    """What the group's values make of the bench's [params] (an N1.031 without N1.030 in either) that the bench's
+    own did not already: the group's key, or the bench's parameter it leaves without its speed."""
+    names = tuple(a.name for a in axes)
+    known = {k for k, _ in check_together(params, names)}
+    for k, problem in check_together({**params, **g.params}, names):
+        if k in g.params:
+            r.err(f"{p}.{k!r}" if " " in k else f"{p}.{k}", problem)
+        elif k not in known:
+            r.err(p, f"[params] {k} under this group: {problem}")
 
 
 def _group(r: FieldReader, d: dict, p: str, axes: list[AxisConfig]) -> ParamGroup:
@@ -91,10 +106,13 @@ def _not_switched(k: str) -> str | None:
     base = k.split(" ")[0]
     if k in MODELLED:
         return None
+    if base in MODELLED_AXIS:  # its axis is checked by check_param and _check_over
+        return None if k != base else check_param(k, 0.0)
     if base in G05_CHANNEL or base in G05_AXIS:
         instead = f"; set {INSTEAD[base]} in the group instead" if base in INSTEAD else ""
         return (f"G05 switches {base} on an NC5 (N§3.8.2), but this bench does not model it: a group sets "
-                f"{', '.join(MODELLED)} and limits.<axis> {{ velocity, acceleration, jerk }}{instead}")
+                f"{', '.join(MODELLED)}, {', '.join(a + ' <axis>' for a in MODELLED_AXIS)} and "
+                f"limits.<axis> {{ velocity, acceleration, jerk }}{instead}")
     if param_spec(k) is not None:
         return f"G05 does not switch {k} (N§3.8.2 lists {LISTED}); set it in [params]"
     return check_param(k, 0.0)  # unknown: its message, with the closest name

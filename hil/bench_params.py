@@ -20,6 +20,7 @@ class ParamSpec:
 
 
 _BIT = ParamSpec(0, 1, True, "bit switch")
+ACC_MS, SCURVE_MS = 10_000.0, 1000.0  # acc. and dec. times and S-curve times (decision language L26-1)
 _CODE = ParamSpec(0, 9999, True, "code number")
 _ONUM = ParamSpec(0, 9999, True, "program number")
 
@@ -33,6 +34,12 @@ PARAMS: dict[str, ParamSpec] = {
     "P306": ParamSpec(0, 2, True, "lathe type A/B/C (lathe-2018)"),
     "N1.027": ParamSpec(0, 1e6, False, "mm/min"),
     "N1.033": ParamSpec(0, 1e6, False, "mm/min, cutting command maximum feed, 0: none"),
+    # G00 and cutting acceleration (decision language L26-1; the manual gives no units or ranges): 0: none
+    "N1.030": ParamSpec(0, 1e6, False, "mm/min, G00 rapid command maximum speed, 0: none"),
+    "N1.031": ParamSpec(0, ACC_MS, False, "ms from rest to N1.030, 0: none"),
+    "N1.032": ParamSpec(0, SCURVE_MS, False, "ms, G00 rapid command S curve time, 0: none"),
+    "N1.034": ParamSpec(0, ACC_MS, False, "ms from rest to N1.033, 0: none"),
+    "N1.035": ParamSpec(0, SCURVE_MS, False, "ms, cutting command S curve time, 0: none"),
     "N1.036": ParamSpec(0, 1000, False, "ms"), "N1.037": ParamSpec(0, 1000, False, "ms"),
     "N1.040": ParamSpec(0, 10, False, "mm"), "N1.042": ParamSpec(0, 1e6, False, "mm/min"),
     "N1.053": ParamSpec(0, 10, False, "mm"),
@@ -56,17 +63,49 @@ PARAMS.update({f"N1.{n}": _CODE for n in range(200, 300)})
 PARAMS.update({f"O{n}": _CODE for n in range(9010, 9030)})
 _SOFT = re.compile(r"soft limit ([1-9]\d?) ([A-Z])")  # G10 L21 values a bench may preset
 _SOFT_SPEC = ParamSpec(-1e6, 1e6, False, "mm")
+# An axis's G00 rapid parameters, "N2.020 X" (decision language L26-1); the axis must be on the bench.
+AXIS_RAPID = re.compile(r"(N2\.02[012]) ([A-Z])")
+_AXIS_RAPID_SPECS = {
+    "N2.020": ParamSpec(0, 1e6, False, "mm/min (deg/min), axis G00 rapid command maximum speed, 0: none"),
+    "N2.021": ParamSpec(0, ACC_MS, False, "ms from rest to the axis's N2.020, 0: none"),
+    "N2.022": ParamSpec(0, SCURVE_MS, False, "ms, axis G00 rapid command S curve time, 0: none"),
+}
+# An acceleration time is relative to its maximum speed (acceleration = speed / time): the time needs it.
+NEEDS = {"N1.031": "N1.030", "N1.034": "N1.033", "N2.021": "N2.020"}
 
 
 def param_spec(name: str) -> ParamSpec | None:
     if _SOFT.fullmatch(name):
         return _SOFT_SPEC
+    if (m := AXIS_RAPID.fullmatch(name)) is not None:
+        return _AXIS_RAPID_SPECS[m.group(1)]
     return PARAMS.get(name)
+
+
+def check_together(params: dict[str, float], axes: tuple[str, ...]) -> list[tuple[str, str]]:
+    """(key, message) for each parameter that cannot stand with the others: an axis parameter of an axis the
+    bench lacks, an acc. and dec. time > 0 without the maximum speed it is relative to (decision language L26-1)."""
+    out = []
+    for k, v in params.items():
+        m = AXIS_RAPID.fullmatch(k)
+        base, axis = (m.group(1), m.group(2)) if m else (k, "")
+        if m and axis not in axes:
+            out.append((k, f"no axis {axis!r} on this bench (axes: {', '.join(axes)})"))
+            continue
+        need = NEEDS.get(base)
+        if need is None or not v:
+            continue
+        ref = f"{need} {axis}" if axis else need
+        if not params.get(ref):
+            out.append((k, f"needs {ref} > 0: the acceleration is {ref} / {base}; set {ref} or leave {base} out"))
+    return out
 
 
 def check_param(name: str, value: object) -> str | None:
     """None when `name = value` is acceptable, else the message for the bench error."""
     spec = param_spec(name)
+    if spec is None and name in _AXIS_RAPID_SPECS:
+        return f'an axis parameter: name the axis, "{name} X" (decision language L26-1)'
     if spec is None:
         # "N1.O40" is N1.040 typed with the letter O: read O as zero after the group dot first.
         zeroed = name[:3] + name[3:].replace("O", "0").replace("o", "0")

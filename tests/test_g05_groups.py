@@ -183,7 +183,7 @@ def test_the_channel_switches_the_planner_at_rest():
     ('[param_groups.0]\n"N1.036" = 1.0\n', "param_groups.0", "numbered 1-20"),
     ("[param_groups.21]\n", "param_groups.21", "numbered 1-20"),
     ('[param_groups.2]\n"N1.040" = 0.1\n', "param_groups.2.N1.040", "G05 does not switch N1.040"),
-    ('[param_groups.2]\n"N1.034" = 100\n', "param_groups.2.N1.034", "limits.<axis>.acceleration"),
+    ('[param_groups.2]\n"N2.024 X" = 100\n', "param_groups.2.'N2.024 X'", "limits.<axis>.acceleration"),
     ('[param_groups.2]\n"N1.O36" = 3\n', "param_groups.2.N1.O36", "did you mean N1.036"),
     ('[param_groups.2]\n"N1.036" = 5000\n', "param_groups.2.N1.036", "within [0, 1000]"),
     ("[param_groups.2]\nlimits.Q = { velocity = 1.0 }\n", "param_groups.2.limits.Q", "no axis 'Q'"),

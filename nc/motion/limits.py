@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 
@@ -10,6 +11,39 @@ class AxisLimits:
     max_velocity: float = 400.0  # mm/s (or deg/s) — also the interpolated rapid speed of the axis
     max_acceleration: float = 4000.0  # mm/s²
     max_jerk: float = 200_000.0  # mm/s³
+
+
+@dataclass(frozen=True)
+class MoveKindLimits:
+    """An NC5 channel's limits for one kind of move (decision motion 90): G00 N1.030-N1.032, cutting
+    N1.033-N1.035 (its speed is `MotionConfig.max_feed`, applied to the programmed F). None: not set, the
+    planner's own (the axis limits) in force; a time of 0 sets no limit either."""
+
+    speed: float | None = None  # mm/s along the path (N1.030 / 60)
+    acc_time: float | None = None  # s from rest to `speed` (N1.031, N1.034): acceleration = speed / acc_time
+    scurve_time: float | None = None  # s the acceleration takes to build up (N1.032, N1.035): jerk = acc / it
+
+    @property
+    def set(self) -> bool:
+        return self.speed is not None or self.acc_time is not None or self.scurve_time is not None
+
+    @property
+    def own_budget(self) -> bool:
+        """An acceleration or S-curve time is given: the move's acceleration is the parameters' (decision 91)."""
+        return self.acc_time is not None or self.scurve_time is not None
+
+
+def acceleration(speed: float | None, acc_time: float | None) -> float:
+    """speed / acc_time (the manual's own reading of an "acc. and dec. time", N§3.5.4 (4)-(5): N1.033 / N1.028,
+    N2.020 / N2.021); inf where either is missing or the time is 0."""
+    if speed is None or not acc_time:
+        return math.inf
+    return speed / acc_time
+
+
+def jerk_factor(scurve_time: float | None) -> float:
+    """1 / S-curve time: jerk = acceleration · this; inf (no limit) where missing or 0."""
+    return 1.0 / scurve_time if scurve_time else math.inf
 
 
 @dataclass
@@ -44,6 +78,11 @@ class MotionConfig:
     # N1.033 cutting command maximum feed (mm/min): the programmed F of a G94 feed move is limited to it before
     # the feed override (the channel applies it: nc.channel; decision language L25-1). None: no limit.
     max_feed: float | None = None
+    # NC5 G00 rapid (N1.030-N1.032) and cutting (N1.034/N1.035 over N1.033 = max_feed) limits, and each axis's
+    # G00 rapid limits N2.020-N2.022 (speed mm/s, times s): decisions motion 90-94. Unset: today's planning.
+    rapid: MoveKindLimits = field(default_factory=MoveKindLimits)
+    cutting: MoveKindLimits = field(default_factory=MoveKindLimits)
+    axis_rapid: dict[str, MoveKindLimits] = field(default_factory=dict)
 
     def filter_cycles(self) -> tuple[int, int]:
         """Window lengths (cycles) of the two moving averages; (1, 1) = no filter."""

@@ -28,7 +28,7 @@ except ImportError:  # run as Python without Cython: they do nothing
 
 from nc.motion.blending import FilterCorners
 from nc.motion.block import Block
-from nc.motion.limits import MotionConfig
+from nc.motion.limits import MotionConfig, acceleration, jerk_factor
 from nc.motion.path import Segment
 
 # A corner blend's jerk (Limits._blend_limits, decision motion 47): its cap keeps v³·|(dκ/ds, κ²)| within
@@ -114,6 +114,10 @@ def max_speed_at(v0: float, a0: float, d: float, a: float, j: float) -> float:
 
 _sqrt, _cbrt = math.sqrt, math.cbrt  # reach() runs ≈ 10 times per pushed block
 
+# What a block is, for its limits (Limits.block_limits): cutting (G01/G02/G03, cycles' feed moves, corner
+# blends, fitted spans), G00 rapid, or a thread (spindle-synchronised: neither parameter set, decision motion 92).
+CUT, RAPID, THREAD = 0, 1, 2
+
 
 class Limits:
     """Axis limits (plain float tuples: per-block math on 3 axes is faster without numpy) and
@@ -133,13 +137,72 @@ class Limits:
         self._corner_a = tuple(x * T for x in self._acc)
         self.blend = FilterCorners(cfg, self._acc, self._jerk) if cfg.filtered else None
         self._coupling = arc_coupling(cfg)
+        self._rapid_limits(cfg)
+        # Cutting N1.034 / N1.035 (decision motion 90): a path acceleration cap and a jerk per unit of the block's
+        # acceleration; inf (nothing changes, bit for bit) where not set.
+        cut = cfg.cutting
+        self.cut_a = acceleration(cut.speed, cut.acc_time)
+        self.cut_js = jerk_factor(cut.scurve_time)
+        self.cut_on = self.cut_a < math.inf or self.cut_js < math.inf
+
+    def _rapid_limits(self, cfg: MotionConfig) -> None:
+        """The G00 limits (decisions motion 90, 91): each axis's within its N2.020-N2.022 and its own limits
+        (`rv`, `racc`, `rjerk`: also the independent rapids', N1.20 bit 18), the path's N1.030-N1.032."""
+        rv, ra, rj = [], [], []
+        own = cfg.rapid.own_budget
+        for a, v, acc, jerk in zip(cfg.axes, self._v, self._acc, self._jerk):
+            ar = cfg.axis_rapid.get(a)
+            if ar is not None:
+                own = own or ar.own_budget
+                v = min(v, ar.speed) if ar.speed else v
+                acc = min(acc, acceleration(ar.speed, ar.acc_time))
+                jerk = min(jerk, acc * jerk_factor(ar.scurve_time))
+            rv.append(v)
+            ra.append(acc)
+            rj.append(jerk)
+        self._rv, self._racc, self._rjerk = tuple(rv), tuple(ra), tuple(rj)
+        self.rv, self.racc, self.rjerk = np.array(rv), np.array(ra), np.array(rj)
+        # An acceleration or S-curve time given: a G00's budget is the axes' whole (a rapid has no corner or
+        # arc to share it with, decision motion 71's analysis); none: today's tangential share (decision 91).
+        self.rapid_share = 1.0 if own else cfg.share_tangential
+        self.rapid_v = cfg.rapid.speed if cfg.rapid.speed else math.inf
+        self.rapid_a = acceleration(cfg.rapid.speed, cfg.rapid.acc_time)
+        self.rapid_js = jerk_factor(cfg.rapid.scurve_time)
+
+    def _rapid_block(self, seg: Segment) -> tuple[float, float, float]:
+        """(speed cap, acceleration, jerk) of an interpolated G00 (decisions motion 90, 91): the least of the
+        path's N1.030-N1.032 and each axis's rapid limits projected on the direction."""
+        v = a = j = math.inf
+        for d, vl, al, jl in zip(seg.direction_cosines(), self._rv, self._racc, self._rjerk):
+            if d > 1e-12:
+                v, a, j = min(v, vl / d), min(a, al / d), min(j, jl / d)
+        if v == math.inf:
+            return 0.0, 1.0, 1.0
+        s = self.rapid_share
+        a, j = min(a * s, self.rapid_a), j * s
+        return min(v, self.rapid_v), a, min(j, a * self.rapid_js)
+
+    def cut_caps(self, a: float, j: float) -> tuple[float, float]:
+        """A cutting block's (acceleration, jerk) under N1.034 / N1.035 (decision motion 90)."""
+        if a > self.cut_a:
+            a = self.cut_a
+        x = a * self.cut_js
+        return a, (x if x < j else j)
 
     @cython.locals(v=cython.double, a=cython.double, j=cython.double, x=cython.double, d=cython.double,
-                   vl=cython.double, al=cython.double, jl=cython.double)
-    def block_limits(self, seg: Segment, short_ok: bool = False) -> tuple[float, float, float]:
+                   vl=cython.double, al=cython.double, jl=cython.double, what=cython.Py_ssize_t)
+    def block_limits(self, seg: Segment, short_ok: bool = False, what: int = CUT) -> tuple[float, float, float]:
         """(speed cap, tangential acceleration, tangential jerk) of a path segment. `short_ok`: no
-        minimum duration (a line whose both ends are blends has no corner for it to protect)."""
+        minimum duration (a line whose both ends are blends has no corner for it to protect). `what`: CUT,
+        RAPID or THREAD, whose parameters apply (decision motion 90)."""
         cfg = self.cfg
+        if what == 1:  # RAPID (a C int compared with a C constant where compiled)
+            v, a, j = self._rapid_block(seg)
+            if not short_ok:
+                x = seg.length / (cfg.min_segment_cycles * self.T)
+                if x < v:
+                    v = x
+            return v, a, j
         v = a = j = math.inf
         for d, vl, al, jl in zip(seg.direction_cosines(), self._v, self._acc, self._jerk):
             if d > 1e-12:  # v = min(v, vl / d) etc., spelt out: this runs per axis of every block
@@ -156,6 +219,8 @@ class Limits:
             return 0.0, 1.0, 1.0
         a *= cfg.share_tangential
         j *= cfg.share_tangential
+        if what == 0 and self.cut_on:  # CUT
+            a, j = self.cut_caps(a, j)
         if seg.kind == "arc" and seg.radius > 0.0:
             k = seg.arc_len / seg.length
             rc = seg.radius / max(k * k, 1e-12)  # radius of curvature of the (helical) path

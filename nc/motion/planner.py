@@ -39,7 +39,7 @@ from nc.alarm_table import PLANNING_STALL
 from nc.alarms import NcAlarm
 from nc.motion.limits import MotionConfig
 from nc.motion.block import Block
-from nc.motion.lookahead import MARGIN, Limits, backward, change_distance, max_speed_at, reach
+from nc.motion.lookahead import CUT, MARGIN, RAPID, THREAD, Limits, backward, change_distance, max_speed_at, reach
 from nc.motion.path import Segment
 from nc.motion.plan_state import CHUNK, Setpoint, _near, _Plan
 from nc.motion.filter_ramps import HISTORY, FilterStops
@@ -429,7 +429,9 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
             return None
         if move.kind == "rapid" and self.cfg.rapid_independent:
             return Block(move, "indep", seg, seg.length, 0.0, 1.0, 1.0, None, rapid=True)
-        v, a, j = self.lim.block_limits(seg)
+        # G00 and cutting moves each under their own NC5 parameters (decision motion 90)
+        v, a, j = self.lim.block_limits(seg, False, RAPID if move.kind == "rapid" else
+                                        THREAD if move.kind == "thread" else CUT)
         feed = None if move.kind == "rapid" else (move.feed or 0.0) / (1.0 if move.per_rev else 60.0)
         kind = "thread" if move.kind == "thread" else "path"
         return Block(move, kind, seg, seg.length, v, a, j, feed, move.kind == "rapid")  # the 9th field: rapid
@@ -870,17 +872,17 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
         assert b.seg is not None
         lim = self.lim
         ovr = self._rapid_ovr
-        vmax = lim.v * ovr if ovr > 0 else np.minimum(lim.v, self.cfg.slow_rapid)
+        vmax = lim.rv * ovr if ovr > 0 else np.minimum(lim.rv, self.cfg.slow_rapid)  # N2.020 (decision motion 90)
         self.solves += 1
         if self.held:
             if not np.any(np.abs(self._axis_v) > 1e-9):
                 if self._stopping:
                     self._flush()
                 return None
-            pw = solve_axes(self.position, self._axis_v, self._axis_a, self.position, vmax, lim.acc, lim.jerk,
+            pw = solve_axes(self.position, self._axis_v, self._axis_a, self.position, vmax, lim.racc, lim.rjerk,
                             velocity=True)
         else:
-            pw = solve_axes(self.position, self._axis_v, self._axis_a, b.seg.end, vmax, lim.acc, lim.jerk)
+            pw = solve_axes(self.position, self._axis_v, self._axis_a, b.seg.end, vmax, lim.racc, lim.rjerk)
         return _Plan("indep", pw, pw.duration, t0)
 
     def _sample(self, p: _Plan, n: int) -> None:

@@ -121,6 +121,8 @@ class FittedRuns:
         else:
             v, a, j = (_span_limits or _load_span_limits())(sp, vel, lim.acc, lim.jerk)
             sp.__dict__["_limits"] = (vel, lim._acc, lim._jerk, (v, a, j))
+        if lim.cut_on:  # N1.034 / N1.035 (decision motion 90)
+            a, j = lim.cut_caps(a, j)
         v = min(v, sp.length / (self.cfg.min_segment_cycles * self.cfg.cycle))
         return Block(move, "path", sp, sp.length, v, a, j, (move.feed or 0.0) / 60.0)
 
