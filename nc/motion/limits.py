@@ -41,7 +41,7 @@ def acceleration(speed: float | None, acc_time: float | None) -> float:
     return speed / acc_time
 
 
-def jerk_factor(scurve_time: float | None) -> float:
+def jerk_per_acc(scurve_time: float | None) -> float:
     """1 / S-curve time: jerk = acceleration · this; inf (no limit) where missing or 0."""
     return 1.0 / scurve_time if scurve_time else math.inf
 
@@ -83,6 +83,12 @@ class MotionConfig:
     rapid: MoveKindLimits = field(default_factory=MoveKindLimits)
     cutting: MoveKindLimits = field(default_factory=MoveKindLimits)
     axis_rapid: dict[str, MoveKindLimits] = field(default_factory=dict)
+
+    @property
+    def rapid_whole(self) -> bool:
+        """A G00 runs on the axes' whole acceleration and jerk, not the tangential share (decision motion 91):
+        an acc. and dec. or S-curve time is set, for the path (N1.031/N1.032) or an axis (N2.021/N2.022)."""
+        return self.rapid.own_budget or any(k.own_budget for k in self.axis_rapid.values())
 
     def filter_cycles(self) -> tuple[int, int]:
         """Window lengths (cycles) of the two moving averages; (1, 1) = no filter."""

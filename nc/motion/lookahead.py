@@ -28,7 +28,7 @@ except ImportError:  # run as Python without Cython: they do nothing
 
 from nc.motion.blending import FilterCorners
 from nc.motion.block import Block
-from nc.motion.limits import MotionConfig, acceleration, jerk_factor
+from nc.motion.limits import MotionConfig, acceleration, jerk_per_acc
 from nc.motion.path import Segment
 
 # A corner blend's jerk (Limits._blend_limits, decision motion 47): its cap keeps v³·|(dκ/ds, κ²)| within
@@ -142,21 +142,19 @@ class Limits:
         # acceleration; inf (nothing changes, bit for bit) where not set.
         cut = cfg.cutting
         self.cut_a = acceleration(cut.speed, cut.acc_time)
-        self.cut_js = jerk_factor(cut.scurve_time)
+        self.cut_js = jerk_per_acc(cut.scurve_time)
         self.cut_on = self.cut_a < math.inf or self.cut_js < math.inf
 
     def _rapid_limits(self, cfg: MotionConfig) -> None:
         """The G00 limits (decisions motion 90, 91): each axis's within its N2.020-N2.022 and its own limits
         (`rv`, `racc`, `rjerk`: also the independent rapids', N1.20 bit 18), the path's N1.030-N1.032."""
         rv, ra, rj = [], [], []
-        own = cfg.rapid.own_budget
         for a, v, acc, jerk in zip(cfg.axes, self._v, self._acc, self._jerk):
             ar = cfg.axis_rapid.get(a)
             if ar is not None:
-                own = own or ar.own_budget
                 v = min(v, ar.speed) if ar.speed else v
                 acc = min(acc, acceleration(ar.speed, ar.acc_time))
-                jerk = min(jerk, acc * jerk_factor(ar.scurve_time))
+                jerk = min(jerk, acc * jerk_per_acc(ar.scurve_time))
             rv.append(v)
             ra.append(acc)
             rj.append(jerk)
@@ -164,10 +162,10 @@ class Limits:
         self.rv, self.racc, self.rjerk = np.array(rv), np.array(ra), np.array(rj)
         # An acceleration or S-curve time given: a G00's budget is the axes' whole (a rapid has no corner or
         # arc to share it with, decision motion 71's analysis); none: today's tangential share (decision 91).
-        self.rapid_share = 1.0 if own else cfg.share_tangential
+        self.rapid_share = 1.0 if cfg.rapid_whole else cfg.share_tangential
         self.rapid_v = cfg.rapid.speed if cfg.rapid.speed else math.inf
         self.rapid_a = acceleration(cfg.rapid.speed, cfg.rapid.acc_time)
-        self.rapid_js = jerk_factor(cfg.rapid.scurve_time)
+        self.rapid_js = jerk_per_acc(cfg.rapid.scurve_time)
 
     def _rapid_block(self, seg: Segment) -> tuple[float, float, float]:
         """(speed cap, acceleration, jerk) of an interpolated G00 (decisions motion 90, 91): the least of the
