@@ -251,3 +251,14 @@ def test_a_group_may_hold_the_axis_rapid_parameters():
     cfg = b.motion_config(4)
     assert cfg.axis_rapid["X"] == MoveKindLimits(100.0, 0.04, None) and "Y" not in cfg.axis_rapid
     assert b.motion_config(0).axis_rapid == {}
+
+
+def test_the_guides_group_example_is_a_valid_group():
+    """docs/guide/bench-file.md's `[param_groups.1]` example, over a bench with "N2.020 X": what it says it does."""
+    from tests.conftest import ROOT
+    text = (ROOT / "docs" / "guide" / "bench-file.md").read_text()
+    snippet = text.split("```toml\n[param_groups.1]", 1)[1].split("```", 1)[0]
+    b = parse_bench(HEAD + '"N2.020 X" = 12000.0\n' + AXES + "[param_groups.1]" + snippet, "guide.toml")
+    cfg = b.motion_config(1)
+    assert cfg.cutting == MoveKindLimits(50.0, 0.2, None)  # N1.033 3000 mm/min, N1.034 200 ms: 250 mm/s²
+    assert cfg.axis_rapid["X"] == MoveKindLimits(200.0, 0.08, None)
