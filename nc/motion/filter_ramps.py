@@ -156,7 +156,10 @@ class FilterStops:
 
     def _plain(self, b: Block) -> bool:
         mv = b.move
-        return b.kind == "path" and not mv.per_rev and mv.css is None and "G31" not in mv.tags
+        # Under an NC5 acc. and dec. or S-curve time the move ramps at its own limits, which the filter only
+        # smooths, not as a velocity step the filter shapes (decision motion 94)
+        return b.kind == "path" and not mv.per_rev and mv.css is None and "G31" not in mv.tags \
+            and not (self.lim.rapid_whole if b.rapid else self.lim.cut_on)
 
     def _filter_start(self, b: Block, s: float, v0: float, cap: float, t0: float) -> _Plan | None:
         """From v0 at zero acceleration (rest, or the speed a slow junction was crossed at): a ramp to

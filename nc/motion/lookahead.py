@@ -144,6 +144,10 @@ class Limits:
         self.cut_a = acceleration(cut.speed, cut.acc_time)
         self.cut_js = jerk_per_acc(cut.scurve_time)
         self.cut_on = self.cut_a < math.inf or self.cut_js < math.inf
+        # The least tangential acceleration and jerk of any line (a cutting one, under N1.034/N1.035): the braking
+        # Planner._may_blend allows for (half of these) must not assume more.
+        self.line_a_lo = min(cfg.share_tangential * float(self.acc.min()), self.cut_a)
+        self.line_j_lo = min(cfg.share_tangential * float(self.jerk.min()), self.line_a_lo * self.cut_js)
 
     def _rapid_limits(self, cfg: MotionConfig) -> None:
         """The G00 limits (decisions motion 90, 91): each axis's within its N2.020-N2.022 and its own limits
@@ -162,7 +166,8 @@ class Limits:
         self.rv, self.racc, self.rjerk = np.array(rv), np.array(ra), np.array(rj)
         # An acceleration or S-curve time given: a G00's budget is the axes' whole (a rapid has no corner or
         # arc to share it with, decision motion 71's analysis); none: today's tangential share (decision 91).
-        self.rapid_share = 1.0 if cfg.rapid_whole else cfg.share_tangential
+        self.rapid_whole = cfg.rapid_whole
+        self.rapid_share = 1.0 if self.rapid_whole else cfg.share_tangential
         self.rapid_v = cfg.rapid.speed if cfg.rapid.speed else math.inf
         self.rapid_a = acceleration(cfg.rapid.speed, cfg.rapid.acc_time)
         self.rapid_js = jerk_per_acc(cfg.rapid.scurve_time)

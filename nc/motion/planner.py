@@ -188,8 +188,8 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
             self._zones = ShareZones(cfg.filter_time + cfg.filter_scurve)
         self._share_s = 0.0
         self._lam = 1.0
-        self._a_lo = 0.5 * cfg.share_tangential * float(self.lim.acc.min())
-        self._j_lo = 0.5 * cfg.share_tangential * float(self.lim.jerk.min())
+        self._a_lo = 0.5 * self.lim.line_a_lo  # N1.034/N1.035 lower them (decision motion 94)
+        self._j_lo = 0.5 * self.lim.line_j_lo
         # The channel sets `closed` when no move comes before the queue has run out to rest (program
         # end, an M/S/T or preview barrier); a push clears it. _jf: tangential jerk factor of the
         # last path solve (nc.motion.shares).
