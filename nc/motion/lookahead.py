@@ -115,7 +115,7 @@ def max_speed_at(v0: float, a0: float, d: float, a: float, j: float) -> float:
 _sqrt, _cbrt = math.sqrt, math.cbrt  # reach() runs ≈ 10 times per pushed block
 
 # What a block is, for its limits (Limits.block_limits): cutting (G01/G02/G03, cycles' feed moves, corner
-# blends, fitted spans), G00 rapid, or a thread (spindle-synchronised: neither parameter set, decision motion 92).
+# blends, fitted spans), G00 rapid, or a thread (spindle-synchronised: neither parameter set, decision motion 90).
 CUT, RAPID, THREAD = 0, 1, 2
 
 
