@@ -58,7 +58,7 @@ def jerk_factor(cfg: MotionConfig, fc: "FilterCorners", blocks: Sequence["Block"
     pool = cfg.share_corner + cfg.share_curvature
     if st <= 0.0 or st + pool > 1.0 + 1e-9 or not blocks:
         return 1.0, False
-    if cfg.rapid_whole and blocks[0].rapid:  # a G00 on the axes' whole budget: no share to take (motion 93)
+    if blocks[0].rapid and cfg.rapid_whole:  # a G00 on the axes' whole budget: no share to take (motion 93)
         return 1.0, False
     t_w = fc.t_j
     v_hi = blocks[0].vtop  # max() of the two, spelt out (no generator a scan, session 13)
