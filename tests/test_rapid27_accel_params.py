@@ -282,3 +282,18 @@ def test_under_the_look_ahead_filter_the_acceleration_time_still_holds(tmp_path,
     # the filter's averages round a short plateau off (2000: 9 ms at it between 16 ms jerk phases), never more
     assert 0.9 * peak <= a <= 1.002 * peak
     assert t >= 30.0 / 50.0 + 50.0 / peak  # at least L/v + v/a
+
+
+def test_a_campaign_sweep_of_a_time_without_its_speed_is_refused_naming_the_key():
+    """A `[params]` sweep applies over the bench file (hil/campaign/variant.py): the sweep's N1.034 over a bench
+    without N1.033 is the bench error the file would give, not a G01 planned without a cutting acceleration."""
+    from types import SimpleNamespace
+
+    from hil.campaign.variant import apply_variant
+
+    case = SimpleNamespace(bus="sim", params=(("N1.034", 50.0),), events=())
+    with pytest.raises(BenchFileError) as e:
+        apply_variant(HEAD + AXES, "benches/accel.toml", case, None, None)
+    assert "benches/accel.toml with the campaign's [params]: params.N1.034: needs N1.033 > 0" in str(e.value)
+    ok = SimpleNamespace(bus="sim", params=(("N1.033", 3000.0), ("N1.034", 50.0)), events=())
+    assert apply_variant(HEAD + AXES, "benches/accel.toml", ok, None, None).motion_config().cutting.acc_time == 0.05

@@ -8,6 +8,7 @@ from typing import Any
 
 from hil.bench import Bench
 from hil.bench_file import _checks, parse_bench
+from hil.bench_params import check_together
 from hil.toml_fields import BenchFileError, FieldReader
 from hil.campaign.spec import Case
 
@@ -19,6 +20,11 @@ def apply_variant(text: str, source: str, case: Case | Any, checks: dict[str, An
     bench.bus = case.bus
     for name, value in case.params:
         bench.params[name] = value
+    # A swept acc. and dec. time needs its speed in the bench or the sweep; an axis parameter, its axis (L26-1)
+    together = check_together(bench.params, bench.axis_names)
+    if together:
+        raise BenchFileError(f"{source} with the campaign's [params]",
+                             [f"params.{k!r}: {why}" if " " in k else f"params.{k}: {why}" for k, why in together])
     if max_time is not None:
         bench.max_time = max_time
     if isinstance(checks, str):
