@@ -1,8 +1,9 @@
 """The motion sweep's seeded programs (tests/motion_sweep.py) with the cutting and G00 acceleration parameters set
 (decisions motion 90-95): every cycle within the axes' limits, no setpoint back along the path, the end reached.
 Seeds 1-40 were run with N1.034/N1.035 and N1.030-N1.032 drawn per seed (every seventh move a G00 on odd seeds);
-37 pass, seed 1 is the sweep's own KNOWN seed (decision motion 84) and two meet planner paths that fail there
-(decision motion 95, Left): they are pinned here as strict xfails, so a fix shows."""
+38 pass; seed 1 goes over the jerk limit by 1.079x under them (not in this list) and seed 12 meets a planner path
+that fails there (decision motion 95, Left): it is pinned here as a strict xfail, so a fix shows. Seed 29 failed
+until decision motion 85 (a missed re-solve keeps the followed profile) landed beside these parameters."""
 
 from __future__ import annotations
 
@@ -30,8 +31,6 @@ KNOWN = {
     12: "a one-cycle position blip in the filtered output (jerk 60x, acceleration 1.7x) next to a corner blend "
         "under N1.034 = 200 ms (1250 mm/s2); asking far more room before a blend (Planner._may_blend) removes it; "
         "not traced further (decision motion 95)",
-    29: "the end of a G00 (N1.031 100 ms, N1.032 10 ms) re-solved from a braking state fails its checks and "
-        "Planner._plan_path's fallback ramp to rest overshoots to -0.63 mm/s, 0.6 um back (decision motion 95)",
 }
 
 
