@@ -74,6 +74,11 @@ class FilterCorners:
         self.tol = cfg.path_tolerance
         self.kd = KernelDeviation(n1, n2, cfg.cycle)
         self.cb = CornerBound(self.kd)  # the proved isolated-corner cap (decision motion 73)
+        # G's table and np.interp's slopes between its points, for `_held_caps` (decision bench B133)
+        gy, gg = self.kd._y, self.kd._g
+        self._gy, self._gg = gy.copy(), gg.copy()
+        self._gs = np.array([(float(gg[i + 1]) - float(gg[i])) / (float(gy[i + 1]) - float(gy[i]))
+                             for i in range(len(gy) - 1)] or [0.0])
         self._iso_k = 0.25 * self.cb.span * self.cb.span  # isolated_cap's quick test (s²)
         self._boost: dict[tuple[float, float], float] = {}  # braking's growth per (a, j)
         self.t2sum = t1 * t1 + t2 * t2
@@ -696,50 +701,171 @@ class FilterCorners:
             if vt * self.kd.g0 * sum_n + sum_n * self.amax * self.t2sum / 192.0 <= self.tol:
                 return 0
         lo, vt = self._reach_back(h0, last, s_j, vt, half)
-        h = vt * half
         if lo < self._sc_dirty:
             self._sc_dirty = lo  # vtol and vjunc change over hist[lo:] below
-        seg = hist[lo:]
-        s = np.array(self._hist_s[lo:])
-        du = np.array([b.dv for b in seg], dtype=float)
-        vb = np.fromiter((b.vbase for b in seg), float, len(seg))
-        ev = np.nonzero(s >= s_j - h - 1e-12)[0]
-        # The loops below run over Python lists, not numpy scalars (issue 17: ~70 junctions a call)
-        ev_l = ev.tolist()
-        nseg = len(seg)
-        tol = self.tol
-        t2sum = self.t2sum
-        room_l = []
-        for i in ev_l:
-            b = seg[i]
-            nx = seg[i + 1] if i + 1 < nseg else blocks[-1]
-            room_l.append(tol - b.du_n * (b.a if b.a > nx.a else nx.a) * t2sum / 192.0)  # `braking` inline
-        room = np.array(room_l, dtype=float)
-        near = s >= s_j - 2.0 * h - 1e-12
-        caps = self.kd.caps(s[ev], room, vt, s[near], du[near], vb[near])
-        lim = vt * (1.0 - 1e-9)
-        for i, c in zip(ev_l, caps.tolist()):
-            b = seg[i]
-            if b.viso > c:
-                c = b.viso  # alone in its windows at up to viso, which keeps N1.053 proved (decision motion 73)
-            b.ctol = c
-            if c < lim and b.s_end > self._lim_s:
-                self._lim_s = b.s_end
-        ctol = np.fromiter((b.ctol for b in seg), float, nseg)
-        reach = np.minimum(ctol, vt) * half + 1e-12
-        upd = np.nonzero(near)[0]
-        held = np.abs(s[upd][:, None] - s[None, :]) <= reach[None, :]
-        vtol = np.where(held, ctol[None, :], math.inf).min(axis=1)
-        depth = 0
-        i0 = nseg + 1 - len(blocks)  # seg[i] is blocks[i - nseg - 1]: queued from i0 on
-        for i, vt_i in zip(upd.tolist(), vtol.tolist()):
-            b = seg[i]
-            b.vtol = vt_i
-            if i >= i0:
-                v = b.vbase if b.vbase < vt_i else vt_i
-                if abs(v - b.vjunc) > 1e-9 * (1.0 if 1.0 > v else v):  # max(v, 1.0) spelt out
-                    b.vjunc = v
-                    k = nseg - i + 1  # seg[-1] is blocks[-2]
-                    if k > depth:
-                        depth = k
-        return depth
+        return _held_caps(self, blocks, lo, last, s_j, vt, half)
+
+
+def _held_caps(fc: FilterCorners, blocks: Sequence[Block], lo: int, last: int, s_j: float, vt: float,
+               half: float) -> int:
+    """`FilterCorners._tolerance`'s evaluation over the junctions hist[lo..last] (decision bench B133): the numpy
+    form it had, one C loop an array (issue 17: ~60 numpy calls on arrays of ~50 ended in ~900k instructions a
+    call). Each value is the same IEEE operation in the same order as the numpy form's elementwise one: np.interp's
+    own arithmetic (slopes (g[j+1] − g[j]) / (y[j+1] − y[j]), then slope·(x − y[j]) + g[j]), np.minimum's and
+    np.abs'. What is no elementwise operation stays numpy's: the product with the steps (BLAS's summation order) and
+    its row norms, on the same matrices. `KernelDeviation.caps`' first pass tries the top speed at every junction
+    with room; where that deviates too far somewhere, caps itself runs (it tries the same first). The types are in
+    blending.pxd (memoryviews: nc.motion.cython_shadow has none). Returns how many blocks from the tail need a new
+    backward pass."""
+    hist, hs = fc._hist, fc._hist_s
+    nseg = last + 1 - lo
+    h = vt * half
+    sv = np.empty(nseg)
+    s = sv  # (compiled: a memoryview of sv)
+    for i in range(nseg):
+        s[i] = hs[lo + i]
+    # The junctions near J and those evaluated: suffixes of hist[lo:] (s_end only grows)
+    t_near = s_j - 2.0 * h - 1e-12
+    t_ev = s_j - h - 1e-12
+    n0 = nseg
+    while n0 > 0 and s[n0 - 1] >= t_near:
+        n0 -= 1
+    e0 = nseg
+    while e0 > 0 and s[e0 - 1] >= t_ev:
+        e0 -= 1
+    ne, nn, axes = nseg - e0, nseg - n0, fc._axes
+    tol, t2sum = fc.tol, fc.t2sum
+    room_a = np.empty(ne)
+    room = room_a
+    nl = 0  # junctions with room left
+    for i in range(ne):
+        b = hist[lo + e0 + i]
+        nx = hist[lo + e0 + i + 1] if e0 + i + 1 < nseg else blocks[-1]
+        rr = tol - b.du_n * (b.a if b.a > nx.a else nx.a) * t2sum / 192.0  # `braking` inline
+        room[i] = rr
+        if rr > 0.0:
+            nl += 1
+    fits = True
+    if nl > 0:
+        du_a = np.empty((nn, axes))
+        du = du_a
+        vb_a = np.empty(nn)
+        vb = vb_a
+        for k in range(nn):
+            b = hist[lo + n0 + k]
+            dv = b.dv
+            for a in range(axes):
+                du[k, a] = dv[a]
+            vb[k] = b.vbase
+        # KernelDeviation.deviation at the top speed for the junctions with room
+        se_a = np.empty(nl)
+        se = se_a
+        r = 0
+        for i in range(ne):
+            if room[i] > 0.0:
+                se[r] = s[e0 + i]
+                r += 1
+        w_a = np.empty((nl, nn))
+        _kernel_matrix(w_a, se_a, sv[n0:], vb_a, vt, fc._gy, fc._gg, fc._gs)
+        e = np.linalg.norm(w_a @ du_a, axis=1).tolist()
+        r = 0
+        for i in range(ne):
+            if room[i] > 0.0:
+                if e[r] > room[i]:
+                    fits = False
+                    break
+                r += 1
+        if not fits:  # caps from its first pass on (rare: about never on the CAM program)
+            caps = fc.kd.caps(sv[e0:], room_a, vt, sv[n0:], du_a, vb_a).tolist()
+    lim = vt * (1.0 - 1e-9)
+    for i in range(ne):
+        if fits:
+            c = vt if room[i] > 0.0 else 0.0
+        else:
+            c = caps[i]
+        b = hist[lo + e0 + i]
+        if b.viso > c:
+            c = b.viso  # alone in its windows at up to viso, which keeps N1.053 proved (decision motion 73)
+        b.ctol = c
+        if c < lim and b.s_end > fc._lim_s:
+            fc._lim_s = b.s_end
+    # Each junction near J: the least ctol of the junctions whose reach (min(ctol, vt)·half) holds it
+    ct_a = np.empty(nseg)
+    ct = ct_a
+    rc_a = np.empty(nseg)
+    rc = rc_a
+    for k in range(nseg):
+        c = hist[lo + k].ctol
+        rc[k] = (c if c < vt or c != c else vt) * half + 1e-12
+        ct[k] = c
+    depth = 0
+    i0 = nseg + 1 - len(blocks)  # hist[lo + i] is blocks[i - nseg - 1]: queued from i0 on
+    inf = math.inf
+    far = vt * half + 1e-12  # no reach is longer (each rounding is monotonic): the junctions past it, on either
+    # side (s sorted), are held by none
+    for u in range(n0, nseg):
+        su = s[u]
+        vt_i = inf
+        k = u
+        while k >= 0 and su - s[k] <= far:
+            k -= 1
+        for k in range(k + 1, nseg):
+            x = su - s[k]
+            if x < 0.0:
+                x = -x
+                if x > far:
+                    break
+            if x <= rc[k]:
+                c = ct[k]
+                if c < vt_i or c != c:
+                    vt_i = c
+        b = hist[lo + u]
+        b.vtol = vt_i
+        if u >= i0:
+            v = b.vbase if b.vbase < vt_i else vt_i
+            if abs(v - b.vjunc) > 1e-9 * (1.0 if 1.0 > v else v):  # max(v, 1.0) spelt out
+                b.vjunc = v
+                k = nseg - u + 1  # hist[last] is blocks[-2]
+                if k > depth:
+                    depth = k
+    return depth
+
+
+def _kernel_matrix(w: np.ndarray, s_rows: np.ndarray, s_all: np.ndarray, vb: np.ndarray, c: float, gy: np.ndarray,
+                   gg: np.ndarray, gs: np.ndarray) -> None:
+    """Fill w (rows × junctions) with `KernelDeviation.deviation`'s weighted steps at the speed c for every row,
+    G(|(s_all[k] − s_rows[r]) / c|)·min(vb[k], c), G the table (gy, gg) as np.interp(..., right=0.0) reads it, gs its
+    slopes: the same IEEE operations as the numpy form, element by element (decision bench B133)."""
+    ny = gy.shape[0]
+    ymax = gy[ny - 1]
+    inv = (ny - 1) / ymax  # G's table is evenly spaced: a first guess of the index, made exact below
+    for r in range(w.shape[0]):
+        sr = s_rows[r]
+        for k in range(w.shape[1]):
+            x = (s_all[k] - sr) / c
+            if x < 0.0:
+                x = -x
+            if x != x:
+                g = x  # np.interp: nan stays
+            elif x > ymax:
+                g = 0.0  # right=0.0
+            elif x < gy[0]:
+                g = gg[0]
+            else:
+                j0 = int(x * inv)  # then the last j with gy[j] <= x, as np.interp's search finds it
+                if j0 > ny - 1:
+                    j0 = ny - 1
+                while j0 > 0 and gy[j0] > x:
+                    j0 -= 1
+                while j0 < ny - 1 and gy[j0 + 1] <= x:
+                    j0 += 1
+                if j0 == ny - 1 or gy[j0] == x:
+                    g = gg[j0]
+                else:
+                    g = gs[j0] * (x - gy[j0]) + gg[j0]
+                    if g != g:  # np.interp's other side
+                        g = gs[j0] * (x - gy[j0 + 1]) + gg[j0 + 1]
+                        if g != g and gg[j0] == gg[j0 + 1]:
+                            g = gg[j0]
+            v = vb[k]
+            w[r, k] = g * (v if v < c or v != v else c)  # np.minimum(vb, c): nan propagates
