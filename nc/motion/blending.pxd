@@ -31,3 +31,28 @@ cdef Py_ssize_t _held_caps(FilterCorners fc, object blocks, Py_ssize_t lo, Py_ss
                v=double)
 cpdef void _kernel_matrix(double[:, ::1] w, double[::1] s_rows, double[::1] s_all, double[::1] vb, double c,
                           double[::1] gy, double[::1] gg, double[::1] gs)
+
+# `_refined` and its helpers (decision bench B133)
+@cython.locals(t1=double, t2=double, s_j=double, lo=Py_ssize_t, reach=double, n=Py_ssize_t, axes=Py_ssize_t,
+               s=double[::1], vb=double[::1], du=double[:, ::1], al=double[::1], vt=double[::1], i=Py_ssize_t,
+               k=Py_ssize_t, b=Block, dv=tuple, best=double, bud=double, nxt=double, v=double)
+cdef tuple _refined(FilterCorners fc, list hist, Py_ssize_t h0, Py_ssize_t last, double c, double top,
+                    tuple budget_a, tuple budget_j)
+
+@cython.locals(n=Py_ssize_t, axes=Py_ssize_t, i=Py_ssize_t, k=Py_ssize_t, j=Py_ssize_t, x=double, m=double,
+               peak=double, q=double, r=double, vw=double, ca=double, cd=double)
+cdef double _cap_at(double v, double t1, double t2, double s_j, double[::1] s, double[::1] vb, double[:, ::1] du,
+                    double[::1] al, double[::1] vt, double[::1] ba, double[::1] bj, double[:, ::1] pre,
+                    double[:, ::1] sums) except? -1.0
+
+@cython.locals(w1=double, w2=double, top=double, k=Py_ssize_t, i=Py_ssize_t, e=double)
+cdef int _window_sums(double vw, double t1, double t2, double s_j, double[::1] s, double[:, ::1] pre,
+                      double[:, ::1] sums, Py_ssize_t row) except -1
+
+@cython.locals(x=double, i0=Py_ssize_t, i1=Py_ssize_t, i2=Py_ssize_t, k=Py_ssize_t, mid=double, a=double, d=double,
+               q=double)
+cdef int _window_at(double e, double s_j, double top, double w1, double w2, double[::1] s, double[:, ::1] pre,
+                    double[:, ::1] sums, Py_ssize_t row) except -1
+
+@cython.locals(lo=Py_ssize_t, hi=Py_ssize_t, mid=Py_ssize_t)
+cdef Py_ssize_t _count_at_or_below(double[::1] s, double x) except -1

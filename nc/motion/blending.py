@@ -568,73 +568,7 @@ class FilterCorners:
         such windows T2 apart, divided by T1·T2 (the two moving averages' derivatives, exactly, at
         constant speed), v_i the least of v and the junction's cap so far (vbase only ever falls).
         Second: the cap the budgets give with the windows taken at that speed, not held to top."""
-        t1, t2 = self.t_a, self.t_j - self.t_a
-        s_j = hist[last].s_end
-        lo = last
-        reach = top * self.t_j * 2.0
-        while lo > h0 and s_j - hist[lo - 1].s_end <= reach:
-            lo -= 1
-        seg = hist[lo:last + 1]
-        s = np.fromiter((b.s_end for b in seg), float, len(seg))
-        du = np.array([b.dv for b in seg], dtype=float)
-        # A junction's velocity step is its own speed times Δu: no more than the cap it already
-        # has (vbase only ever falls), nor than the speed the windows are taken at.
-        vb = np.fromiter((b.vbase for b in seg), float, len(seg))
-        ba = np.array(budget_a)
-        bj = np.array(budget_j)
-        # The blocks between the stretch's junctions: on one of length L whose junctions are crossed at <= v the
-        # profile reaches at most sqrt(v² + a·L) (speeding up from one, braking to the other), and its vtop
-        between = seg[1:]
-        al = np.fromiter((b.a * b.length for b in between), float, len(between))
-        vt = np.fromiter((b.vtop for b in between), float, len(between))
-
-        def sums(v: float) -> tuple[np.ndarray, np.ndarray]:
-            """Largest |Σ v_i·Δu_i| per axis over T1 windows, and over their differences."""
-            pre = np.vstack([np.zeros((1, du.shape[1])), np.cumsum(np.minimum(vb, v)[:, None] * du, axis=0)])
-
-            def windows(vw: float) -> tuple[np.ndarray, np.ndarray]:
-                w1, w2 = vw * t1, vw * t2
-                ev = np.concatenate(([s_j], s + w1, s + w1 - 1e-9, s + w1 + w2, s + w1 + w2 - 1e-9))
-                ev = ev[(ev >= s_j) & (ev <= s_j + w1 + w2)]
-
-                def at(x: np.ndarray) -> np.ndarray:
-                    return pre[np.searchsorted(s, x, side="right")]
-                mid = at(ev - w1)
-                a = at(ev) - mid
-                b = mid - at(ev - w1 - w2)
-                return np.abs(a).max(axis=0), np.abs(a - b).max(axis=0)
-
-            sa, sd = windows(v)
-            # The windows are T1 and T2 of time, crossed at up to the highest speed the profile may reach between the
-            # junctions, not only at theirs (decision motion 82: two corners around a short block it speeds up on
-            # fell in one window pair): the sums at that speed and halfway there count too (never fewer than at v)
-            peak = float(np.max(np.minimum(vt, np.sqrt(v * v + al)))) if len(al) else v
-            if peak > v * (1.0 + 1e-9):
-                for vw in (0.5 * (v + peak), peak):
-                    xa, xd = windows(vw)
-                    sa, sd = np.maximum(sa, xa), np.maximum(sd, xd)
-            return sa, sd
-
-        def cap_at(v: float) -> float:
-            """v scaled to the budgets (≥ v: v meets them with its own windows)."""
-            sa, sd = sums(v)
-            with np.errstate(divide="ignore", over="ignore"):  # a tiny sum: inf, the min drops it
-                return v * min(float(np.min(np.where(sa > 1e-12, ba / sa, math.inf))),
-                               float(np.min(np.where(sd > 1e-12, bj / sd, math.inf))))
-
-        best = c
-        bud = nxt = cap_at(c)  # with the windows at `best`, the budgets allow `bud` (≥ best)
-        v = min(nxt, top)
-        for _ in range(3):
-            if v <= best * (1.0 + 1e-6):
-                break
-            nxt = cap_at(v)
-            if nxt >= v * (1.0 - 1e-9):  # v meets the budgets with its own windows
-                best, bud = v, nxt
-                v = min(nxt, top)
-            else:
-                v = 0.5 * (best + v)
-        return best, max(bud, best)
+        return _refined(self, hist, h0, last, c, top, budget_a, budget_j)
 
     @cython.locals(h0=cython.Py_ssize_t, last=cython.Py_ssize_t, s_j=cython.double, vt=cython.double,
                    half=cython.double, lo=cython.Py_ssize_t, k=cython.Py_ssize_t, x=cython.double, top=cython.double,
@@ -869,3 +803,154 @@ def _kernel_matrix(w: np.ndarray, s_rows: np.ndarray, s_all: np.ndarray, vb: np.
                             g = gg[j0]
             v = vb[k]
             w[r, k] = g * (v if v < c or v != v else c)  # np.minimum(vb, c): nan propagates
+
+
+def _refined(fc: FilterCorners, hist: list[Block], h0: int, last: int, c: float, top: float,
+             budget_a: tuple[float, ...], budget_j: tuple[float, ...]) -> tuple[float, float]:
+    """`FilterCorners._refine` in C loops (decision bench B133: it was numpy on the stretch's few hundred junctions,
+    ~1.2M instructions a call): each value the same IEEE operation as its numpy form's, np.cumsum's running sums
+    in their order, np.searchsorted(side="right") as the count of positions at or below, np.minimum's, np.maximum's
+    and np.max's nan propagation."""
+    t1, t2 = fc.t_a, fc.t_j - fc.t_a
+    s_j = hist[last].s_end
+    lo = last
+    reach = top * fc.t_j * 2.0
+    while lo > h0 and s_j - hist[lo - 1].s_end <= reach:
+        lo -= 1
+    n, axes = last + 1 - lo, fc._axes
+    s_a, vb_a = np.empty(n), np.empty(n)
+    du_a = np.empty((n, axes))
+    # The blocks between the stretch's junctions: on one of length L whose junctions are crossed at <= v the
+    # profile reaches at most sqrt(v² + a·L) (speeding up from one, braking to the other), and its vtop
+    al_a, vt_a = np.empty(n - 1), np.empty(n - 1)
+    s, vb, du, al, vt = s_a, vb_a, du_a, al_a, vt_a
+    for i in range(n):
+        b = hist[lo + i]
+        s[i] = b.s_end
+        dv = b.dv
+        for k in range(axes):
+            du[i, k] = dv[k]
+        # A junction's velocity step is its own speed times Δu: no more than the cap it already
+        # has (vbase only ever falls), nor than the speed the windows are taken at.
+        vb[i] = b.vbase
+        if i > 0:
+            al[i - 1] = b.a * b.length
+            vt[i - 1] = b.vtop
+    ba_a, bj_a = np.array(budget_a, dtype=float), np.array(budget_j, dtype=float)
+    pre_a = np.empty((n + 1, axes))
+    sums_a = np.empty((4, axes))  # sa, sd, then one window's pair
+    best = c
+    bud = nxt = _cap_at(c, t1, t2, s_j, s_a, vb_a, du_a, al_a, vt_a, ba_a, bj_a, pre_a, sums_a)
+    v = top if top < nxt else nxt  # min(nxt, top)
+    for _ in range(3):
+        if v <= best * (1.0 + 1e-6):
+            break
+        nxt = _cap_at(v, t1, t2, s_j, s_a, vb_a, du_a, al_a, vt_a, ba_a, bj_a, pre_a, sums_a)
+        if nxt >= v * (1.0 - 1e-9):  # v meets the budgets with its own windows
+            best, bud = v, nxt
+            v = top if top < nxt else nxt
+        else:
+            v = 0.5 * (best + v)
+    return best, (best if best > bud else bud)  # max(bud, best)
+
+
+def _cap_at(v: float, t1: float, t2: float, s_j: float, s: np.ndarray, vb: np.ndarray, du: np.ndarray,
+            al: np.ndarray, vt: np.ndarray, ba: np.ndarray, bj: np.ndarray, pre: np.ndarray,
+            sums: np.ndarray) -> float:
+    """v scaled to the budgets (≥ v: v meets them with its own windows): per axis the budget over the largest
+    |Σ v_i·Δu_i| over T1 windows (sums[0]) and over their differences (sums[1]), the windows taken at v and at up
+    to the highest speed the profile may reach between the junctions (decision motion 82: two corners around a
+    short block it speeds up on fell in one window pair), the sums there and halfway there counting too."""
+    n, axes = du.shape[0], du.shape[1]
+    for k in range(axes):  # pre: zeros, then the running sums of min(vb, v)·du (np.cumsum's order)
+        pre[0, k] = 0.0
+    for i in range(n):
+        x = vb[i]
+        m = x if x < v or x != x else v  # np.minimum(vb, v)
+        for k in range(axes):
+            pre[i + 1, k] = m * du[i, k] if i == 0 else pre[i, k] + m * du[i, k]
+    _window_sums(v, t1, t2, s_j, s, pre, sums, 0)
+    peak = v
+    if al.shape[0] > 0:
+        peak = -math.inf
+        for i in range(al.shape[0]):
+            q = v * v + al[i]
+            r = math.sqrt(q) if q >= 0.0 else math.nan
+            x = vt[i]
+            r = x if x < r or x != x else r  # np.minimum(vt, ·)
+            if r > peak or r != r:
+                peak = r
+            if peak != peak:
+                break
+    if peak > v * (1.0 + 1e-9):
+        for vw in (0.5 * (v + peak), peak):
+            _window_sums(vw, t1, t2, s_j, s, pre, sums, 2)
+            for k in range(axes):  # np.maximum(sa, xa), np.maximum(sd, xd)
+                for j in range(2):
+                    x, r = sums[j, k], sums[j + 2, k]
+                    sums[j, k] = x if x >= r or x != x else r
+    ca, cd = math.inf, math.inf  # the least of where(sa > 1e-12, ba / sa, inf), np.min's nan kept; the same for sd
+    for k in range(axes):
+        x = sums[0, k]
+        r = ba[k] / x if x > 1e-12 else math.inf
+        if r < ca or r != r:
+            ca = r
+        x = sums[1, k]
+        r = bj[k] / x if x > 1e-12 else math.inf
+        if r < cd or r != r:
+            cd = r
+    return v * (cd if cd < ca else ca)  # min(ca, cd)
+
+
+def _window_sums(vw: float, t1: float, t2: float, s_j: float, s: np.ndarray, pre: np.ndarray, sums: np.ndarray,
+                 row: int) -> int:
+    """sums[row] and sums[row + 1]: per axis the largest |Σ| over T1 windows (path vw·T1) ending at every
+    position where a sum may change (J, each junction plus a window, and just before), within one window pair
+    after J, and the largest |difference| of it and the T1 window T2 before."""
+    w1, w2 = vw * t1, vw * t2
+    top = s_j + w1 + w2
+    for k in range(pre.shape[1]):
+        sums[row, k] = -math.inf
+        sums[row + 1, k] = -math.inf
+    _window_at(s_j, s_j, top, w1, w2, s, pre, sums, row)
+    for i in range(s.shape[0]):
+        e = s[i] + w1
+        _window_at(e, s_j, top, w1, w2, s, pre, sums, row)
+        _window_at(e - 1e-9, s_j, top, w1, w2, s, pre, sums, row)
+        e = e + w2
+        _window_at(e, s_j, top, w1, w2, s, pre, sums, row)
+        _window_at(e - 1e-9, s_j, top, w1, w2, s, pre, sums, row)
+    return 0
+
+
+def _window_at(e: float, s_j: float, top: float, w1: float, w2: float, s: np.ndarray, pre: np.ndarray,
+               sums: np.ndarray, row: int) -> int:
+    """The window ending at path position e, when J ≤ e ≤ top, into the maxima sums[row], sums[row + 1]."""
+    if not (e >= s_j and e <= top):
+        return 0
+    x = e - w1
+    i0, i1, i2 = _count_at_or_below(s, e), _count_at_or_below(s, x), _count_at_or_below(s, x - w2)
+    for k in range(pre.shape[1]):
+        mid = pre[i1, k]
+        a = pre[i0, k] - mid
+        d = abs(a - (mid - pre[i2, k]))
+        a = abs(a)
+        q = sums[row, k]
+        if q == q and (a > q or a != a):  # np.max: nan kept
+            sums[row, k] = a
+        q = sums[row + 1, k]
+        if q == q and (d > q or d != d):
+            sums[row + 1, k] = d
+    return 0
+
+
+def _count_at_or_below(s: np.ndarray, x: float) -> int:
+    """np.searchsorted(s, x, side="right") for s sorted: the first index whose position is above x (nan: none)."""
+    lo, hi = 0, s.shape[0]
+    while lo < hi:
+        mid = (lo + hi) // 2
+        if x < s[mid]:
+            hi = mid
+        else:
+            lo = mid + 1
+    return lo
