@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from hil.bench_file import load_bench_file
+from nc.motion.block import Block
 from nc.motion.blending import FilterCorners, _kernel_matrix
 
 BENCH = Path(__file__).resolve().parent.parent / "benches" / "mill-3axis.toml"
@@ -68,3 +69,100 @@ def test_deviation_from_the_kernel_matrix_is_kernel_deviations():
         ref = fc.kd.deviation(np.full(len(s_rows), c), s_rows, s_all, du, vb)
         assert got.min() > 0.0
         assert np.array_equal(got, ref)
+
+
+def _refine_numpy(fc: FilterCorners, hist: list[Block], h0: int, last: int, c: float, top: float,
+                  budget_a: tuple[float, ...], budget_j: tuple[float, ...]) -> tuple[float, float]:
+    """FilterCorners._refine as numpy had it before decision bench B133 (session 25's main), the reference."""
+    t1, t2 = fc.t_a, fc.t_j - fc.t_a
+    s_j = hist[last].s_end
+    lo = last
+    reach = top * fc.t_j * 2.0
+    while lo > h0 and s_j - hist[lo - 1].s_end <= reach:
+        lo -= 1
+    seg = hist[lo:last + 1]
+    s = np.fromiter((b.s_end for b in seg), float, len(seg))
+    du = np.array([b.dv for b in seg], dtype=float)
+    vb = np.fromiter((b.vbase for b in seg), float, len(seg))
+    ba, bj = np.array(budget_a), np.array(budget_j)
+    between = seg[1:]
+    al = np.fromiter((b.a * b.length for b in between), float, len(between))
+    vt = np.fromiter((b.vtop for b in between), float, len(between))
+
+    def sums(v: float) -> tuple[np.ndarray, np.ndarray]:
+        pre = np.vstack([np.zeros((1, du.shape[1])), np.cumsum(np.minimum(vb, v)[:, None] * du, axis=0)])
+
+        def windows(vw: float) -> tuple[np.ndarray, np.ndarray]:
+            w1, w2 = vw * t1, vw * t2
+            ev = np.concatenate(([s_j], s + w1, s + w1 - 1e-9, s + w1 + w2, s + w1 + w2 - 1e-9))
+            ev = ev[(ev >= s_j) & (ev <= s_j + w1 + w2)]
+
+            def at(x: np.ndarray) -> np.ndarray:
+                return pre[np.searchsorted(s, x, side="right")]
+            mid = at(ev - w1)
+            a = at(ev) - mid
+            b = mid - at(ev - w1 - w2)
+            return np.abs(a).max(axis=0), np.abs(a - b).max(axis=0)
+
+        sa, sd = windows(v)
+        peak = float(np.max(np.minimum(vt, np.sqrt(v * v + al)))) if len(al) else v
+        if peak > v * (1.0 + 1e-9):
+            for vw in (0.5 * (v + peak), peak):
+                xa, xd = windows(vw)
+                sa, sd = np.maximum(sa, xa), np.maximum(sd, xd)
+        return sa, sd
+
+    def cap_at(v: float) -> float:
+        sa, sd = sums(v)
+        with np.errstate(divide="ignore", over="ignore"):
+            return v * min(float(np.min(np.where(sa > 1e-12, ba / sa, np.inf))),
+                           float(np.min(np.where(sd > 1e-12, bj / sd, np.inf))))
+
+    best = c
+    bud = nxt = cap_at(c)
+    v = min(nxt, top)
+    for _ in range(3):
+        if v <= best * (1.0 + 1e-6):
+            break
+        nxt = cap_at(v)
+        if nxt >= v * (1.0 - 1e-9):
+            best, bud = v, nxt
+            v = min(nxt, top)
+        else:
+            v = 0.5 * (best + v)
+    return best, max(bud, best)
+
+
+def _stretch(rng: np.random.Generator, n: int, curve: bool) -> list[Block]:
+    """n junctions of short blocks: a gentle curve's small steps of one sign, or a zig-zag's of both; some slow
+    blocks (vbase below the speeds tried), some short blocks with a high vtop (their peak above the junctions)."""
+    out, s = [], 0.0
+    for i in range(n):
+        length = float(rng.uniform(0.05, 1.5))
+        s += length
+        b = Block(None, "path", None, length, 500.0, float(rng.uniform(500.0, 3000.0)), 5e4, None)
+        b.s_end = s
+        step = rng.uniform(0.0, 0.02, 3) if curve else rng.uniform(-0.2, 0.2, 3)
+        b.dv = tuple(float(x) for x in step)
+        b.vbase = float(rng.choice([np.inf, rng.uniform(5.0, 400.0)]))
+        b.vtop = float(rng.uniform(50.0, 600.0))
+        out.append(b)
+    return out
+
+
+def test_refine_is_the_numpy_forms_bit_for_bit():
+    fc = _corners()
+    rng = np.random.default_rng(19)
+    seen = set()
+    for case in range(40):
+        hist = _stretch(rng, int(rng.integers(2, 120)), curve=case % 2 == 0)
+        last = len(hist) - 1
+        h0 = int(rng.integers(0, last + 1))
+        top = float(rng.uniform(20.0, 500.0))
+        c = float(rng.uniform(0.1, 1.0)) * top
+        for budgets in ((fc.budget_a, fc.budget_j), (fc.budget_al, fc.budget_jl)):
+            got = fc._refine(hist, h0, last, c, top, *budgets)
+            ref = _refine_numpy(fc, hist, h0, last, c, top, *budgets)
+            assert got == ref
+            seen.add("raised" if got[0] > c else "kept")
+    assert seen == {"raised", "kept"}  # both outcomes of the search compared
