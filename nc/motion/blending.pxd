@@ -13,6 +13,13 @@ cdef class FilterCorners:
     cdef public list _hist, _hist_s, _vt, _sc
     cdef public Py_ssize_t _axes, _sc_dirty, _h0, _m, _seq0, _seq_v, _mono
     cdef public object _gy, _gg, _gs
+    # window's search state for _cap and _taken (decision bench B133)
+    cdef public Py_ssize_t _w_last, _w_h0
+    cdef public double _w_s_j, _w_top, _w_pad, _w_two_al, _w_t_w2, _w_v_hi
+    cdef public tuple _w_cum, _w_sj, _w_ba, _w_bj, _w_bmin
+    cdef public dict _w_capped
+    cdef double _cap(self, Py_ssize_t m) except? -1.0
+    cdef bint _taken(self, Py_ssize_t k) except -1
 
 # `_held_caps` and `_kernel_matrix` (decision bench B133): C loops over memoryviews, declared here as nc.motion.cython_shadow has no
 # memoryview types for the .py's decorators.

@@ -90,6 +90,7 @@ class FilterCorners:
         # Junctions still inside some filter window, executed or not (for the sums).
         self._hist: list[Block] = []
         self._hist_s: list[float] = []  # their s_end, side by side: bisected without a key (issue 17)
+        self._w_capped: dict[int, float] = {}  # window's search: _cap(k) by k
         self._clear()
         # The longest any window can be: no path speed or acceleration exceeds the norm of the
         # axis limits (a path direction can use every axis at once).
@@ -252,11 +253,10 @@ class FilterCorners:
                    m=cython.Py_ssize_t, m0=cython.Py_ssize_t, k=cython.Py_ssize_t, idx=cython.Py_ssize_t,
                    seq=cython.Py_ssize_t, seq_m=cython.Py_ssize_t, seq0=cython.Py_ssize_t, cut=cython.Py_ssize_t,
                    lo_q=cython.Py_ssize_t, stop=cython.Py_ssize_t, mono=cython.Py_ssize_t, lim=cython.Py_ssize_t,
-                   depth=cython.Py_ssize_t, axes=cython.Py_ssize_t, s_j=cython.double, span_max=cython.double,
-                   t_w=cython.double, top=cython.double, t_w2=cython.double, pad=cython.double, two_al=cython.double,
-                   v_hi=cython.double, c=cython.double, c_bud=cython.double, c2=cython.double, inf=cython.double,
-                   bm0=cython.double, bm1=cython.double, bm2=cython.double, cj0=cython.double, cj1=cython.double,
-                   cj2=cython.double, lines=cython.bint, fast=cython.bint, hist=list, hist_s=list)
+                   depth=cython.Py_ssize_t, s_j=cython.double, span_max=cython.double, t_w=cython.double,
+                   top=cython.double, t_w2=cython.double, pad=cython.double, two_al=cython.double, v_hi=cython.double,
+                   c=cython.double, c_bud=cython.double, c2=cython.double, lines=cython.bint, fast=cython.bint,
+                   hist=list, hist_s=list, capped=dict)
     def window(self, blocks: Sequence["Block"]) -> int:
         """Cap the junctions within one filter window behind the newest junction J (the end of
         blocks[-2]); returns how many blocks from the tail need a new backward pass.
@@ -296,8 +296,8 @@ class FilterCorners:
             cum_j = (prev[0] + du[0], prev[1] + du[1], prev[2] + du[2], prev[3] + j_new.du_n)
             sj = (sprev[0] + dv[0], sprev[1] + dv[1], sprev[2] + dv[2])
         else:
-            cum_j = tuple(p + d for p, d in zip(prev, du + (j_new.du_n,)))
-            sj = tuple(p + d for p, d in zip(sprev, dv))
+            cum_j = tuple([p + d for p, d in zip(prev, du + (j_new.du_n,))])  # (lists: no closure scope a push)
+            sj = tuple([p + d for p, d in zip(sprev, dv)])
         j_new.cum = cum_j
         j_new.scum = sj
         hist.append(j_new)
@@ -374,92 +374,17 @@ class FilterCorners:
         # blocks it spans (and the tail's) are lines when the newest arc ended before that.
         lines = self._arc_s < s_j - span_max
         budget_a, budget_j = (self.budget_al, self.budget_jl) if lines else (self.budget_a, self.budget_j)
-        axes = self._axes
-        zero = self._zero
-        rng = range(axes)
-        bmin = self._bmin[0 if lines else 1]
-        inf = math.inf
-        if axes == 3:
-            bm0, bm1, bm2 = bmin
-            cj0, cj1, cj2 = cum_j[0], cum_j[1], cum_j[2]
-
-        @cython.locals(m=cython.Py_ssize_t, k=cython.Py_ssize_t, i=cython.Py_ssize_t, c=cython.double,
-                       si=cython.double, x=cython.double, d=cython.double, sg=cython.double, ja=cython.double,
-                       base=tuple, pk=tuple)
-        def cap(m: int) -> float:
-            """Cap from the junctions hist[m..last] (inf when there are none): per axis, the
-            acceleration budget over the largest signed sum of any run of them that ends at J,
-            the jerk budget over the smaller of their unsigned sum and twice that."""
-            if m > last:
-                return inf
-            base = hist[m - 1].cum if m > h0 else zero
-            c = inf  # first from the unsigned sums: a lower bound of the signed cap
-            if axes == 3:  # spelt out: ~3 calls a push (issue 17)
-                si = cj0 - base[0]
-                if si > 1e-12:
-                    c = bm0 / si
-                si = cj1 - base[1]
-                if si > 1e-12:
-                    x = bm1 / si
-                    if x < c:
-                        c = x
-                si = cj2 - base[2]
-                if si > 1e-12:
-                    x = bm2 / si
-                    if x < c:
-                        c = x
-            else:
-                for i in rng:
-                    si = cum_j[i] - base[i]
-                    if si > 1e-12:
-                        x = bmin[i] / si
-                        if x < c:
-                            c = x
-            if c >= v_hi:
-                return c  # no junction of the stretch runs as fast: the signed sums change nothing
-            smax = [0.0] * axes
-            for k in range(m - 1, last):
-                pk = hist[k].scum if k >= h0 and k >= m - 1 and (k > m - 1 or m > h0) else zero
-                for i in rng:
-                    d = sj[i] - pk[i]
-                    if d < 0.0:
-                        d = -d
-                    if d > smax[i]:
-                        smax[i] = d
-            c = math.inf
-            for i in rng:
-                si = cum_j[i] - base[i]
-                if si > 1e-12:
-                    sg = smax[i]
-                    ja = si if si < 2.0 * sg else 2.0 * sg
-                    if ja > 1e-12:
-                        x = budget_j[i] / ja
-                        if x < c:
-                            c = x
-                    if sg > 1e-12:
-                        x = budget_a[i] / sg
-                        if x < c:
-                            c = x
-            return c
-
-        @cython.locals(k=cython.Py_ssize_t, c=cython.double, d=cython.double)
-        def taken(k: int) -> bool:
-            """Whether a window ending at J can reach back to junction k when the junctions after
-            it run at no more than their common cap c: it covers no more path than J's speed
-            plus what the acceleration adds going back, nor than the highest speed anywhere in
-            the stretch (a block between junctions ≤ c reaches √(c² + 2·A·L)) allows in T."""
-            c = capped[k + 1] = cap(k + 1)
-            d = s_j - hist_s[k]
-            if (c if c < top else top) * t_w + pad < d:
-                return False
-            return (c * c + two_al) * t_w2 >= d * d and v_hi * t_w >= d
-
-        # cap(k) of the searches below, by k (valid while v_hi stays): the search mostly ends one junction past
-        # where it began, whose cap the first `taken` found (issue 17: one `cap` a push fewer)
-        capped: dict[int, float] = {}
+        # The search's state for `_cap` and `_taken` (C fields: a closure scope, two function objects and a dict a
+        # push were ≈ 5k instructions, decision bench B133)
+        self._w_last, self._w_h0, self._w_s_j, self._w_top = last, h0, s_j, top
+        self._w_pad, self._w_two_al, self._w_t_w2, self._w_v_hi = pad, two_al, t_w2, v_hi
+        self._w_cum, self._w_sj, self._w_ba, self._w_bj = cum_j, sj, budget_a, budget_j
+        self._w_bmin = self._bmin[0 if lines else 1]
+        capped = self._w_capped
+        capped.clear()
         m0 = m
-        if taken(m):
-            while m > h0 and taken(m - 1):
+        if self._taken(m):
+            while m > h0 and self._taken(m - 1):
                 m -= 1
             while m < m0:
                 # The stretch grew backwards past the maxima's start: take its blocks into them;
@@ -472,12 +397,13 @@ class FilterCorners:
                 pad = 0.5 * acc_q[0][1] * t_w2
                 two_al = 2.0 * acc_q[0][1] * len_q[0][1]
                 v_hi = top_q[0][1]
-                capped.clear()  # cap() reads v_hi
-                while m > h0 and taken(m - 1):
+                self._w_pad, self._w_two_al, self._w_v_hi = pad, two_al, v_hi
+                capped.clear()  # _cap reads v_hi
+                while m > h0 and self._taken(m - 1):
                     m -= 1
         else:
             m += 1
-            while not taken(m):
+            while not self._taken(m):
                 m += 1
             sm = self._seq0 + m  # what fell out front, queue by queue
             while acc_q[0][0] < sm:
@@ -488,7 +414,7 @@ class FilterCorners:
                 len_q.popleft()
         self._m = m
         c_known = capped.get(m)
-        c = cap(m) if c_known is None else c_known
+        c = self._cap(m) if c_known is None else c_known
         c_bud = c  # the budgets' cap not held to top (nc.motion.shares)
         if c < top:
             # The sums over the whole stretch bound the filter's acceleration and jerk from
@@ -559,6 +485,89 @@ class FilterCorners:
             idx -= 1
         self._mono = self._seq0 + last  # not followed through this walk: from J on
         return depth
+
+    @cython.locals(m=cython.Py_ssize_t, k=cython.Py_ssize_t, i=cython.Py_ssize_t, c=cython.double,
+                   si=cython.double, x=cython.double, d=cython.double, sg=cython.double, ja=cython.double,
+                   base=tuple, pk=tuple, last=cython.Py_ssize_t, h0=cython.Py_ssize_t, axes=cython.Py_ssize_t,
+                   hist=list, cum_j=tuple, sj=tuple, bmin=tuple, budget_a=tuple, budget_j=tuple, cj=cython.double,
+                   bm=cython.double)
+    def _cap(self, m: int) -> float:
+        """`window`'s cap from the junctions hist[m..last] (inf when there are none): per axis, the
+        acceleration budget over the largest signed sum of any run of them that ends at J,
+        the jerk budget over the smaller of their unsigned sum and twice that."""
+        last, h0, hist = self._w_last, self._w_h0, self._hist
+        if m > last:
+            return math.inf
+        base = hist[m - 1].cum if m > h0 else self._zero
+        cum_j, bmin, axes = self._w_cum, self._w_bmin, self._axes
+        c = math.inf  # first from the unsigned sums: a lower bound of the signed cap
+        if axes == 3:  # spelt out: ~3 calls a push (issue 17)
+            cj, bm = cum_j[0], bmin[0]
+            si = cj - base[0]
+            if si > 1e-12:
+                c = bm / si
+            cj, bm = cum_j[1], bmin[1]
+            si = cj - base[1]
+            if si > 1e-12:
+                x = bm / si
+                if x < c:
+                    c = x
+            cj, bm = cum_j[2], bmin[2]
+            si = cj - base[2]
+            if si > 1e-12:
+                x = bm / si
+                if x < c:
+                    c = x
+        else:
+            for i in range(axes):
+                si = cum_j[i] - base[i]
+                if si > 1e-12:
+                    x = bmin[i] / si
+                    if x < c:
+                        c = x
+        if c >= self._w_v_hi:
+            return c  # no junction of the stretch runs as fast: the signed sums change nothing
+        sj, zero = self._w_sj, self._zero
+        smax = [0.0] * axes
+        for k in range(m - 1, last):
+            pk = hist[k].scum if k >= h0 and k >= m - 1 and (k > m - 1 or m > h0) else zero
+            for i in range(axes):
+                d = sj[i] - pk[i]
+                if d < 0.0:
+                    d = -d
+                if d > smax[i]:
+                    smax[i] = d
+        budget_a, budget_j = self._w_ba, self._w_bj
+        c = math.inf
+        for i in range(axes):
+            si = cum_j[i] - base[i]
+            if si > 1e-12:
+                sg = smax[i]
+                ja = si if si < 2.0 * sg else 2.0 * sg
+                if ja > 1e-12:
+                    x = budget_j[i] / ja
+                    if x < c:
+                        c = x
+                if sg > 1e-12:
+                    x = budget_a[i] / sg
+                    if x < c:
+                        c = x
+        return c
+
+    @cython.locals(k=cython.Py_ssize_t, c=cython.double, d=cython.double, top=cython.double, t_w=cython.double)
+    def _taken(self, k: int) -> bool:
+        """Whether a window ending at J can reach back to junction k when the junctions after
+        it run at no more than their common cap c: it covers no more path than J's speed
+        plus what the acceleration adds going back, nor than the highest speed anywhere in
+        the stretch (a block between junctions ≤ c reaches √(c² + 2·A·L)) allows in T. Keeps the cap in
+        `_w_capped`, by k + 1 (valid while v_hi stays)."""
+        c = self._cap(k + 1)
+        self._w_capped[k + 1] = c
+        d = self._w_s_j - self._hist_s[k]
+        top, t_w = self._w_top, self.t_j
+        if (c if c < top else top) * t_w + self._w_pad < d:
+            return False
+        return (c * c + self._w_two_al) * self._w_t_w2 >= d * d and self._w_v_hi * t_w >= d
 
     def _refine(self, hist: list["Block"], h0: int, last: int, c: float, top: float,
                 budget_a: tuple[float, ...], budget_j: tuple[float, ...]) -> tuple[float, float]:
