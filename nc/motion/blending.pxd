@@ -21,21 +21,20 @@ cdef class FilterCorners:
     cdef double _cap(self, Py_ssize_t m) except? -1.0
     cdef bint _taken(self, Py_ssize_t k) except -1
 
-# `_held_caps` and `_kernel_matrix` (decision bench B133): C loops over memoryviews, declared here as nc.motion.cython_shadow has no
-# memoryview types for the .py's decorators.
+# `_held_caps` and `_kernel_matrix` (decision bench B133): C loops over memoryviews, declared here as
+# nc.motion.cython_shadow has no memoryview types for the .py's decorators.
 @cython.locals(hist=list, hs=list, nseg=Py_ssize_t, h=double, s=double[::1], t_near=double, t_ev=double,
                n0=Py_ssize_t, e0=Py_ssize_t, ne=Py_ssize_t, nn=Py_ssize_t, axes=Py_ssize_t, tol=double,
                t2sum=double, room=double[::1], nl=Py_ssize_t, i=Py_ssize_t, b=Block, nx=Block, rr=double,
                fits=bint, du=double[:, ::1], vb=double[::1], k=Py_ssize_t, a=Py_ssize_t, dv=tuple,
                se=double[::1], c=double, r=Py_ssize_t, e=list, caps=list, v=double, x=double, lim=double,
-               ct=double[::1], rc=double[::1], depth=Py_ssize_t, i0=Py_ssize_t, inf=double, u=Py_ssize_t, su=double, vt_i=double,
-               far=double)
+               ct=double[::1], rc=double[::1], depth=Py_ssize_t, i0=Py_ssize_t, inf=double, u=Py_ssize_t, su=double,
+               vt_i=double, far=double)
 cdef Py_ssize_t _held_caps(FilterCorners fc, object blocks, Py_ssize_t lo, Py_ssize_t last, double s_j, double vt,
                            double half) except -1
 
 @cython.locals(ny=Py_ssize_t, ymax=double, inv=double, r=Py_ssize_t, k=Py_ssize_t, sr=double, x=double, g=double,
-               j0=Py_ssize_t,
-               v=double)
+               j0=Py_ssize_t, v=double)
 cpdef void _kernel_matrix(double[:, ::1] w, double[::1] s_rows, double[::1] s_all, double[::1] vb, double c,
                           double[::1] gy, double[::1] gg, double[::1] gs)
 
