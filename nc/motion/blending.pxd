@@ -5,6 +5,19 @@
 cimport cython
 from nc.motion.block cimport Block
 
+cdef double _INF  # math.inf as a C constant (decision bench B134)
+
+# window's sliding maxima (decision bench B134): C methods, the entries in two lists read from `head` on
+cdef class _MaxQ:
+    cdef public list seqs, vals
+    cdef public Py_ssize_t head
+    @cython.locals(n=Py_ssize_t)
+    cdef int push(self, Py_ssize_t seq, double x) except -1
+    cdef int push_front(self, Py_ssize_t seq, double x) except -1
+    @cython.locals(h=Py_ssize_t)
+    cdef int drop(self, Py_ssize_t seq_m) except -1
+    cdef double front(self) except? -1.0
+
 cdef class FilterCorners:
     cdef public double t_a, t_j, t2sum, _iso_k, _arc_k, span_max, amax, _sc_head, _lim_s, _arc_s
     cdef public object tol, kd, cb, _vq, _bud
@@ -17,7 +30,8 @@ cdef class FilterCorners:
     cdef public Py_ssize_t _w_last, _w_h0
     cdef public double _w_s_j, _w_top, _w_pad, _w_two_al, _w_t_w2, _w_v_hi
     cdef public tuple _w_cum, _w_sj, _w_ba, _w_bj, _w_bmin
-    cdef public dict _w_capped
+    cdef public Py_ssize_t _w_k1, _w_k2  # the last two caps `_taken` found (decision bench B134)
+    cdef public double _w_c1, _w_c2
     cdef double _cap(self, Py_ssize_t m) except? -1.0
     cdef bint _taken(self, Py_ssize_t k) except -1
 

@@ -42,6 +42,8 @@ from nc.motion.deviation import CornerBound, KernelDeviation
 from nc.motion.limits import MotionConfig
 from nc.motion.shares import MAX_FACTOR
 
+_INF = math.inf  # a C double where compiled (blending.pxd): math.inf is a module attribute lookup
+
 USAGE_SCALE = 4.0  # below this many times the top speed a junction's budget use is worth refining
 # The junction history's front: TRIM junctions dropped at a time once no scan reads them; BULK the drop before session
 # 18 (every junction before _h0 once 4,096 were), whose cut nc.motion.shares still answers by (FilterCorners._seq_v)
@@ -50,10 +52,50 @@ BULK = 4096
 
 
 
-def _push_front_max(q: deque[tuple[int, float]], seq: int, value: float) -> None:
-    """Extend a sliding maximum backwards by an entry older than all it holds."""
-    if not q or value > q[0][1]:
-        q.appendleft((seq, value))
+class _MaxQ:
+    """A sliding maximum: (sequence number, value) entries, values falling from the front, in two lists read from
+    `head` on (a cdef class with C methods where compiled, blending.pxd: the deque of tuples it replaces cost a
+    method call, a tuple and generic indexing per operation, decision bench B134)."""
+
+    def __init__(self) -> None:
+        self.seqs: list[int] = []
+        self.vals: list[float] = []
+        self.head = 0
+
+    def push(self, seq: int, x: float) -> None:
+        """Append (seq, x), dropping the entries at the back no larger than x."""
+        n = len(self.vals)
+        while n > self.head and self.vals[n - 1] <= x:
+            self.vals.pop()
+            self.seqs.pop()
+            n -= 1
+        self.vals.append(x)
+        self.seqs.append(seq)
+
+    def push_front(self, seq: int, x: float) -> None:
+        """Extend it backwards by an entry older than all it holds."""
+        if len(self.vals) == self.head or x > self.vals[self.head]:
+            if self.head > 0:
+                self.head -= 1
+                self.seqs[self.head] = seq
+                self.vals[self.head] = x
+            else:
+                self.seqs.insert(0, seq)
+                self.vals.insert(0, x)
+
+    def drop(self, seq_m: int) -> None:
+        """Drop the entries older than seq_m from the front."""
+        h = self.head
+        while self.seqs[h] < seq_m:
+            h += 1
+        if h >= 64 and 2 * h >= len(self.vals):  # the dropped entries' room, given back now and then
+            del self.seqs[:h]
+            del self.vals[:h]
+            h = 0
+        self.head = h
+
+    def front(self) -> float:
+        return self.vals[self.head]
 
 
 class FilterCorners:
@@ -92,7 +134,10 @@ class FilterCorners:
         # Junctions still inside some filter window, executed or not (for the sums).
         self._hist: list[Block] = []
         self._hist_s: list[float] = []  # their s_end, side by side: bisected without a key (issue 17)
-        self._w_capped: dict[int, float] = {}  # window's search: _cap(k) by k
+        # window's search: the last two _cap(k) `_taken` found, as (k, cap) (C fields, no dict: decision bench B134;
+        # _cap is a function of the search's state, so a value not kept is found again the same)
+        self._w_k1 = self._w_k2 = -1
+        self._w_c1 = self._w_c2 = 0.0
         self._clear()
         # The longest any window can be: no path speed or acceleration exceeds the norm of the
         # axis limits (a path direction can use every axis at once).
@@ -131,7 +176,7 @@ class FilterCorners:
         self._mono = 0
         # Sliding maxima over _hist[_m:] as (sequence number, value) of the blocks' tangential
         # acceleration, vtop and length.
-        self._maxima: tuple[deque[tuple[int, float]], ...] = (deque(), deque(), deque())
+        self._maxima = (_MaxQ(), _MaxQ(), _MaxQ())
 
     def touch(self) -> None:
         """Every junction's caps may have changed (an override, dry run): nc.motion.shares finds its verdicts
@@ -258,7 +303,7 @@ class FilterCorners:
                    depth=cython.Py_ssize_t, s_j=cython.double, span_max=cython.double, t_w=cython.double,
                    top=cython.double, t_w2=cython.double, pad=cython.double, two_al=cython.double, v_hi=cython.double,
                    c=cython.double, c_bud=cython.double, c2=cython.double, lines=cython.bint, fast=cython.bint,
-                   hist=list, hist_s=list, capped=dict)
+                   hist=list, hist_s=list, acc_q=_MaxQ, top_q=_MaxQ, len_q=_MaxQ)
     def window(self, blocks: Sequence["Block"]) -> int:
         """Cap the junctions within one filter window behind the newest junction J (the end of
         blocks[-2]); returns how many blocks from the tail need a new backward pass.
@@ -349,23 +394,22 @@ class FilterCorners:
         acc_q, top_q, len_q = maxima
         seq, seq_m = self._seq0 + last, self._seq0 + m
         # the sliding maxima: append (dropping the smaller values before) and drop what fell out front
-        # (inline, once per pushed block; a loop over the three, not spelt out queue by queue: the same
-        # operations, and the unrolled form saved no measurable time, session 15)
-        for q, x in ((acc_q, j_new.a), (top_q, j_new.vtop), (len_q, j_new.length)):
-            while q and q[-1][1] <= x:
-                q.pop()
-            q.append((seq, x))
-            while q[0][0] < seq_m:
-                q.popleft()
+        # (_MaxQ's C methods where compiled, decision bench B134)
+        acc_q.push(seq, j_new.a)
+        acc_q.drop(seq_m)
+        top_q.push(seq, j_new.vtop)
+        top_q.drop(seq_m)
+        len_q.push(seq, j_new.length)
+        len_q.drop(seq_m)
         tail = blocks[-1]
         t_w = self.t_j
         # J is crossed no faster than either block beside it can run.
         top = tail.vtop if tail.vtop < j_new.vtop else j_new.vtop
         t_w2 = t_w * t_w
         # Going back in time from J the speed rises by at most the tangential acceleration.
-        pad = 0.5 * acc_q[0][1] * t_w2
-        two_al = 2.0 * acc_q[0][1] * len_q[0][1]
-        v_hi = top_q[0][1]
+        pad = 0.5 * acc_q.front() * t_w2
+        two_al = 2.0 * acc_q.front() * len_q.front()
+        v_hi = top_q.front()
         # J's block is the tail of the previous call, unless a stop cleared; `scan_plain` (set as a block joins the
         # queue): a path block that is no arc, so the arc test is False for it (session 15)
         if not j_new.scan_plain and j_new.seg is not None and j_new.seg.kind == "arc" and j_new.s_end > self._arc_s:
@@ -382,8 +426,7 @@ class FilterCorners:
         self._w_pad, self._w_two_al, self._w_t_w2, self._w_v_hi = pad, two_al, t_w2, v_hi
         self._w_cum, self._w_sj, self._w_ba, self._w_bj = cum_j, sj, budget_a, budget_j
         self._w_bmin = self._bmin[0 if lines else 1]
-        capped = self._w_capped
-        capped.clear()
+        self._w_k1 = self._w_k2 = -1
         m0 = m
         if self._taken(m):
             while m > h0 and self._taken(m - 1):
@@ -393,14 +436,15 @@ class FilterCorners:
                 # a higher acceleration widens the span, which may take more junctions still.
                 for k in range(m0 - 1, m - 1, -1):
                     b = hist[k]
-                    for q, x in zip(maxima, (b.a, b.vtop, b.length)):
-                        _push_front_max(q, self._seq0 + k, x)
+                    acc_q.push_front(self._seq0 + k, b.a)
+                    top_q.push_front(self._seq0 + k, b.vtop)
+                    len_q.push_front(self._seq0 + k, b.length)
                 m0 = m
-                pad = 0.5 * acc_q[0][1] * t_w2
-                two_al = 2.0 * acc_q[0][1] * len_q[0][1]
-                v_hi = top_q[0][1]
+                pad = 0.5 * acc_q.front() * t_w2
+                two_al = 2.0 * acc_q.front() * len_q.front()
+                v_hi = top_q.front()
                 self._w_pad, self._w_two_al, self._w_v_hi = pad, two_al, v_hi
-                capped.clear()  # _cap reads v_hi
+                self._w_k1 = self._w_k2 = -1  # _cap reads v_hi
                 while m > h0 and self._taken(m - 1):
                     m -= 1
         else:
@@ -408,15 +452,16 @@ class FilterCorners:
             while not self._taken(m):
                 m += 1
             sm = self._seq0 + m  # what fell out front, queue by queue
-            while acc_q[0][0] < sm:
-                acc_q.popleft()
-            while top_q[0][0] < sm:
-                top_q.popleft()
-            while len_q[0][0] < sm:
-                len_q.popleft()
+            acc_q.drop(sm)
+            top_q.drop(sm)
+            len_q.drop(sm)
         self._m = m
-        c_known = capped.get(m)
-        c = self._cap(m) if c_known is None else c_known
+        if m == self._w_k1:
+            c = self._w_c1
+        elif m == self._w_k2:
+            c = self._w_c2
+        else:
+            c = self._cap(m)
         c_bud = c  # the budgets' cap not held to top (nc.motion.shares)
         if c < top:
             # The sums over the whole stretch bound the filter's acceleration and jerk from
@@ -434,7 +479,7 @@ class FilterCorners:
         depth = self._tolerance(blocks, v_hi) if self.tol is not None else 0
         if m < self._sc_dirty:
             self._sc_dirty = m  # the walks below lower vbud (and vjunc) over hist[m..last]
-        fast = c >= top_q[0][1]  # no junction of the stretch can run as fast as this cap
+        fast = c >= top_q.front()  # no junction of the stretch can run as fast as this cap
         seq_m = self._seq0 + m
         bud, self._bud = self._bud, (j_new, seq_m, c_bud)
         if fast:
@@ -492,17 +537,23 @@ class FilterCorners:
                    si=cython.double, x=cython.double, d=cython.double, sg=cython.double, ja=cython.double,
                    base=tuple, pk=tuple, last=cython.Py_ssize_t, h0=cython.Py_ssize_t, axes=cython.Py_ssize_t,
                    hist=list, cum_j=tuple, sj=tuple, bmin=tuple, budget_a=tuple, budget_j=tuple, cj=cython.double,
-                   bm=cython.double)
+                   bm=cython.double, b=Block)
     def _cap(self, m: int) -> float:
         """`window`'s cap from the junctions hist[m..last] (inf when there are none): per axis, the
         acceleration budget over the largest signed sum of any run of them that ends at J,
         the jerk budget over the smaller of their unsigned sum and twice that."""
         last, h0, hist = self._w_last, self._w_h0, self._hist
         if m > last:
-            return math.inf
-        base = hist[m - 1].cum if m > h0 else self._zero
+            return _INF
+        if m > h0:
+            b = hist[m - 1]
+            base = b.cum
+        else:
+            base = self._zero
         cum_j, bmin, axes = self._w_cum, self._w_bmin, self._axes
-        c = math.inf  # first from the unsigned sums: a lower bound of the signed cap
+        # (base typed: the differences below are C subtractions of the same doubles, no float objects; _INF a C
+        # constant, not math's attribute a call: decision bench B134)
+        c = _INF  # first from the unsigned sums: a lower bound of the signed cap
         if axes == 3:  # spelt out: ~3 calls a push (issue 17)
             cj, bm = cum_j[0], bmin[0]
             si = cj - base[0]
@@ -540,7 +591,7 @@ class FilterCorners:
                 if d > smax[i]:
                     smax[i] = d
         budget_a, budget_j = self._w_ba, self._w_bj
-        c = math.inf
+        c = _INF
         for i in range(axes):
             si = cum_j[i] - base[i]
             if si > 1e-12:
@@ -562,9 +613,10 @@ class FilterCorners:
         it run at no more than their common cap c: it covers no more path than J's speed
         plus what the acceleration adds going back, nor than the highest speed anywhere in
         the stretch (a block between junctions ≤ c reaches √(c² + 2·A·L)) allows in T. Keeps the cap in
-        `_w_capped`, by k + 1 (valid while v_hi stays)."""
+        `_w_k1`/`_w_c1` as (k + 1, cap), the one before in `_w_k2`/`_w_c2` (valid while v_hi stays)."""
         c = self._cap(k + 1)
-        self._w_capped[k + 1] = c
+        self._w_k2, self._w_c2 = self._w_k1, self._w_c1
+        self._w_k1, self._w_c1 = k + 1, c
         d = self._w_s_j - self._hist_s[k]
         top, t_w = self._w_top, self.t_j
         if (c if c < top else top) * t_w + self._w_pad < d:
