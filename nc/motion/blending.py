@@ -10,8 +10,8 @@ allow at the speed the windows are crossed (`_refine`). The deviation from the p
 model of nc.motion.deviation, evaluated per junction (`_tolerance`).
 
 Why this file is over 500 lines: it is one class whose `window` runs on every push of a dense program;
-its 3-axis sums and sliding maxima are spelt out inline (issue 17: calls and numpy on 3-element arrays
-cost more than the arithmetic), and splitting the class would put its shared per-push state behind
+its 3-axis sums are spelt out inline (issue 17: calls and numpy on 3-element arrays cost more than the
+arithmetic), its sliding maxima are `_MaxQ`'s C methods (decision bench B134), and splitting the class would put its shared per-push state behind
 attribute hops on that path. The module-level helpers at the end (`_held_caps`, `_refined` and theirs: typed loops
 over memoryviews, decision bench B133) stay here because this module is in the compiled unit (setup.py) and
 a new one would run as Python.
