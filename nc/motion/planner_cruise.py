@@ -96,8 +96,7 @@ class CruiseSampling:
                    duration=cython.double, length=cython.double, seg_len=cython.double, x=cython.double,
                    u=cython.double, k=cython.Py_ssize_t, nb=cython.Py_ssize_t, n=cython.Py_ssize_t,
                    i=cython.Py_ssize_t, a=cython.Py_ssize_t, m=cython.Py_ssize_t, rows=cython.Py_ssize_t,
-                   line=cython.bint, q0=cython.double, q1=cython.double, q2=cython.double, d0=cython.double,
-                   d1=cython.double, d2=cython.double)
+                   line=cython.bint)
     def _sample_cruise(self, p: _Plan) -> None:
         """The rows of a cruise, whole blocks up to at least ROWS rows: each block as its own solve gives them
         (a constant-speed profile from s0 at the plan time t0, s = s0 + v·t, sampled a CHUNK at a time while
@@ -139,9 +138,6 @@ class CruiseSampling:
                 line = seg.kind == "line" and seg.length > 0.0
                 seg_len = seg.length if line else 1.0
                 m = len(start)
-                if m == 3:
-                    q0, q1, q2 = start
-                    d0, d1, d2 = d
                 sc = []
                 for i in range(n):
                     x = t_next + T * i
@@ -157,10 +153,7 @@ class CruiseSampling:
                         x = length
                     if line:
                         u = x / seg_len
-                        if m == 3:  # spelt out on C doubles for 3 axes: the same operations (session 26)
-                            pos.append([q0 + u * d0, q1 + u * d1, q2 + u * d2])
-                        else:
-                            pos.append([start[a] + u * d[a] for a in range(m)])
+                        pos.append([start[a] + u * d[a] for a in range(m)])
                     else:
                         sc.append(x)
                 if not line:
