@@ -30,23 +30,10 @@ if TYPE_CHECKING:
 FEW = 6  # rows kept up to which plain floats beat numpy (a row ≈ 1 µs, numpy's sample ≈ 25 µs a call)
 
 
-@cython.ccall
-@cython.locals(i=cython.Py_ssize_t, t_next=cython.double, T=cython.double, base=cython.double, s=cython.double)
-def _row(pw: object, rows: list, i: int, t_next: float, T: float, base: float) -> tuple:
-    """Row i of the sample (its position along the block, speed, acceleration), made once on demand: the rows
-    a call needs are cached in `rows` (a plain list, no closure: compiled a direct C call, session 26)."""
-    r = rows[i]
-    if r is None:
-        s, v, a = pw.at(t_next + T * i)  # t = p.t_next + T * np.arange(n)
-        r = rows[i] = (s - base, v, a)
-    return r
-
-
 @cython.locals(T=cython.double, t_next=cython.double, base=cython.double, length=cython.double, x=cython.double,
                s=cython.double, u=cython.double, seg_len=cython.double, n=cython.Py_ssize_t, keep=cython.Py_ssize_t,
                lo=cython.Py_ssize_t, hi=cython.Py_ssize_t, mid=cython.Py_ssize_t, i=cython.Py_ssize_t,
-               m=cython.Py_ssize_t, k=cython.Py_ssize_t, x0=cython.double, x1=cython.double, x2=cython.double,
-               d0=cython.double, d1=cython.double, d2=cython.double)
+               m=cython.Py_ssize_t, k=cython.Py_ssize_t)
 def few_rows(pl: "Planner", p: _Plan, n: int) -> bool:
     """`Planner._sample(p, n)` for a path or ramp plan, when it keeps at most FEW rows or re-solves at the next
     block; False (nothing changed) where `_sample` must run."""
@@ -55,10 +42,18 @@ def few_rows(pl: "Planner", p: _Plan, n: int) -> bool:
     blocks = pl.blocks
     b = blocks[0]
     length = b.length
-    rows: list = [None] * n  # the rows made so far (`_row`), None where not yet
+    rows: dict[int, tuple[float, float, float]] = {}
+
+    @cython.locals(i=cython.Py_ssize_t, s=cython.double)
+    def row(i: int) -> tuple[float, float, float]:
+        r = rows.get(i)
+        if r is None:
+            s, v, a = pw.at(t_next + T * i)  # t = p.t_next + T * np.arange(n)
+            r = rows[i] = (s - base, v, a)
+        return r
 
     more = len(blocks) > 1 and blocks[1].kind == "path"
-    if more and _row(pw, rows, 0, t_next, T, base)[0] > length + 1e-12:
+    if more and row(0)[0] > length + 1e-12:
         if not (p.kind == "path" or (p.kind == "ramp" and not pl.held and p is not pl._fr_plan)):
             return False  # a ramp runs on into the next block without a solve: _sample's loop
         # _sample's re-solve at the block boundary, from the last emitted state
@@ -76,7 +71,7 @@ def few_rows(pl: "Planner", p: _Plan, n: int) -> bool:
         lo, hi = 0, n
         while lo < hi:
             mid = (lo + hi) >> 1
-            s = _row(pw, rows, mid, t_next, T, base)[0]
+            s = row(mid)[0]
             if x < s:
                 hi = mid
             else:
@@ -87,29 +82,18 @@ def few_rows(pl: "Planner", p: _Plan, n: int) -> bool:
     if keep > FEW or seg.kind != "line" or seg.length <= 0.0:
         return False
     p.t_next = t_next + T * keep if keep < n else (t_next + T * (n - 1)) + T
-    got = [_row(pw, rows, i, t_next, T, base) for i in range(keep)]
-    # seg.points(clip(s, 0.0, b.length)) of a line, per element; end − start element by element, the same
-    # float subtraction as numpy's (session 26: no numpy call for it)
+    got = [row(i) for i in range(keep)]
+    # seg.points(clip(s, 0.0, b.length)) of a line, per element
     start = seg.start.tolist()
-    end = seg.end.tolist()
+    d = (seg.end - seg.start).tolist()
     seg_len = seg.length
     m = len(start)
     pos = []
-    if m == 3:  # spelt out on C doubles for 3 axes (the same operations in the same order)
-        x0, x1, x2 = start
-        d0, d1, d2 = end[0] - x0, end[1] - x1, end[2] - x2
-        for i in range(keep):
-            s = got[i][0]
-            s = 0.0 if 0.0 >= s else s
-            u = (length if length <= s else s) / seg_len
-            pos.append([x0 + u * d0, x1 + u * d1, x2 + u * d2])
-    else:
-        d = [end[k] - start[k] for k in range(m)]
-        for i in range(keep):
-            s = got[i][0]
-            s = 0.0 if 0.0 >= s else s
-            u = (length if length <= s else s) / seg_len
-            pos.append([start[k] + u * d[k] for k in range(m)])
+    for r in got:
+        s = r[0]
+        s = 0.0 if 0.0 >= s else s
+        u = (length if length <= s else s) / seg_len
+        pos.append([start[k] + u * d[k] for k in range(m)])
     p.emitted = True
     pl._buf_pos = np.array(pos)
     pl._buf_vel = np.array([r[1] for r in got])
