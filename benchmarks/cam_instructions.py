@@ -2,7 +2,7 @@
 
 The run is bench_loop's CAM line: 5,000 blocks of benchmarks/bench_motion.cam_program on benches/mill-3axis.toml
 with a Parquet trace, through hil's BenchRunner in lock-step. Wall time on a shared 2-core machine moves by 10-20 %
-from one run to the next (session 25 read a 10 % regression into such noise); an instruction count is the same for
+from one run to the next (session 25 read a 10 % regression into such noise); an instruction count hardly moves for
 the same build and inputs whatever else the machine does (the child runs with PYTHONHASHSEED=0: string hashes
 move dict and set work between runs): the same build counted twice stays within ≈ 0.3 % of a run (perf28b saw 1.8k
 a block), so compare the functions a change touches, not only the totals. It prints:
