@@ -154,6 +154,8 @@ def home_mode(link: ChannelLink, ch: Channel, mm: ManualMotion) -> None:
     off = link.servo_off
     for i, a in enumerate(link.axes):
         if link._rising(m2(x, 320 + i)):
+            if link.mlc_axes >> i & 1:
+                continue  # the MLC's axis takes no manual command, a home trigger as a JOG (decision M26-29)
             if off >> i & 1:
                 servo_refused(link, ch, i, "homing")
             elif osc:

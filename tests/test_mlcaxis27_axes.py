@@ -283,3 +283,34 @@ def test_a_move_read_ahead_before_the_hand_back_is_refused_not_stepped(hil, tmp_
     xs = [float(row["X_cmd"]) for row in _rows(trace)]
     assert max(abs(b - a) for a, b in zip(xs, xs[1:])) / DT <= X_LIMITS[0]
     assert xs[-1] == 35.5
+
+
+HOME_SCRIPT = '''def main(machine):
+    mem = machine.mlc.mem
+    machine.mode("HOME")
+    machine.set("M21432")
+    machine.wait_until(lambda: machine.get("M31432") == 1, 1.0, "X switched")
+    mem.set_f32(21256, 10.0)
+    mem.set_f32(21288, 6000.0)
+    machine.set("M21448")
+    machine.cycle(2)
+    machine.wait_until(lambda: machine.get("M31448") == 1, 2.0, "X at 10")
+    machine.pulse(21320)  # M2x320: home X
+    machine.wait(1.0)
+    print(f"home trigger on the MLC axis: X {machine.command('X'):.4f}, homed {machine.get('M31336')}")
+    machine.set("M21432", False)
+    machine.wait_until(lambda: machine.get("M31432") == 0, 1.0, "X back")
+    machine.home("X")
+    print(f"homed as an NC axis again: X {machine.command('X'):.4f}, homed {machine.get('M31336')}")
+'''
+
+
+def test_a_home_trigger_of_an_mlc_axis_does_nothing_and_after_the_hand_back_it_homes(hil, tmp_path):
+    """Decision M26-29: HOME mode's trigger M2x320+i is a manual command like a JOG: the MLC's axis ignores it (it
+    was taken: M3x336 "homed" came ON while the MLC held X at 10); back with the NC, X homes to 0."""
+    script = tmp_path / "home.py"
+    script.write_text(HOME_SCRIPT)
+    r = hil("script", script, "--bench", ROOT / "benches" / "mill-3axis.toml")
+    assert r.code == 0, r.out + r.err
+    assert "home trigger on the MLC axis: X 10.0000, homed 0" in r.out, r.out
+    assert "homed as an NC axis again: X 0.0000, homed 1" in r.out.replace("X -0.0000", "X 0.0000"), r.out
