@@ -192,13 +192,28 @@ class Machine:
         raise ScriptError(f"{what} not reached within {timeout:g} s simulated")
 
     # ---- devices ---------------------------------------------------------------------------------
-    def get(self, address: str) -> int:
+    def get(self, address: str) -> int | float:
+        """A device's value; an App. B register pair as its width says (f32: the float, u32: both words), decision
+        B129."""
         from mlc.memory import DeviceError
 
         try:
-            return self.mlc.get(arg.text("machine.get", "address", address))
+            sig = self._pair(arg.text("machine.get", "address", address))
+            if sig is not None:
+                mem = self.mlc.mem
+                return mem.f32(sig.number) if sig.width == "f32" else mem.u32(sig.number)
+            return self.mlc.get(address)
         except DeviceError as exc:
             raise ScriptError(f"machine.get({address!r}): {exc}") from None
+
+    def _pair(self, address: str):  # -> mlc.signals.Signal | None
+        """The D device's signal where App. B makes it a two-word f32 or u32 (D2x256 MLC axis target, …), else None."""
+        from mlc.signals import resolve
+
+        if not address.strip().upper().startswith("D"):
+            return None
+        sig = resolve(address, self.x)
+        return sig if sig.width in ("f32", "u32") else None
 
     def set(self, address: str, value: int | bool = True) -> None:
         from mlc.memory import DeviceError
@@ -206,7 +221,17 @@ class Machine:
         if not isinstance(value, bool):  # a relay's True/False, or a number for a D device
             value = arg.number(f"machine.set({address!r}, …)", "value", value)
         try:
-            self.mlc.put(arg.text("machine.set", "address", address), int(value))
+            sig = self._pair(arg.text("machine.set", "address", address))
+            if sig is not None and sig.width == "f32":  # as `hil run --at set`: the float, both words (B129)
+                self.mlc.mem.set_f32(sig.number, float(value))
+                return
+            if value != int(value):  # int() dropped the fraction: D21256 = 30.5 became 30 in one word (B129)
+                raise ScriptError(f"machine.set({address!r}, {value!r}): the device holds an integer "
+                                  f"({sig.width if sig is not None else 'u16'})")
+            if sig is not None:
+                self.mlc.mem.set_u32(sig.number, int(value))
+                return
+            self.mlc.put(address, int(value))
         except DeviceError as exc:
             raise ScriptError(f"machine.set({address!r}, …): {exc}") from None
 

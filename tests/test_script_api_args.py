@@ -24,6 +24,8 @@ BAD_CALLS = [
     ("machine.spindle(float('nan'))", "machine.spindle: rpm nan must be a finite number"),
     ("machine.spindle_override(-5)", "machine.spindle_override: percent -5 must be a whole number 0-65535"),
     ("machine.set('D21006', float('nan'))", "machine.set('D21006', …): value nan must be a finite number"),
+    ("machine.set('D21006', 2.5)", "machine.set('D21006', 2.5): the device holds an integer (u16)"),
+    ("machine.set('D100', 7.25)", "machine.set('D100', 7.25): the device holds an integer (u16)"),
     ("machine.get('Q12')", "machine.get('Q12'): "),
     ("machine.pulse(21000, cycles=0)", "machine.pulse: cycles 0 must be a whole number >= 1"),
     ("machine.mode(3)", "machine.mode: mode 3 must be a string"),
@@ -52,3 +54,17 @@ def test_good_arguments_still_run(tmp_path, capsys):
     assert code == 0 and "Traceback" not in out.err, out
     x = next(ln for ln in out.out.splitlines() if ln.startswith("X ")).split()
     assert abs(float(x[3]) - float(x[1]) - 0.1) < 1e-6, x  # 10 detents × 10 × 0.001 mm
+
+
+def test_machine_set_writes_an_f32_register_as_the_float_and_get_reads_it_back(tmp_path, capsys):
+    """Decision B129: App. B's f32 pairs (D2x256 MLC axis target, D2x288 velocity) take the float in both words, as
+    `hil run --at set` writes them; `machine.set` wrote int(value) into the first word (30.5 -> 30: the MLC axis read
+    4.2e-44 mm) and `machine.get` read that word."""
+    script = tmp_path / "f32.py"
+    script.write_text("def main(machine):\n    machine.set('D21256', 30.5)\n    machine.set('D21288', -1200)\n"
+                      "    print('read back', machine.get('D21256'), machine.get('D21288'), "
+                      "machine.mlc.mem.f32(21256))\n")
+    code = main(["script", str(script)])
+    out = capsys.readouterr()
+    assert code == 0, out
+    assert "read back 30.5 -1200.0 30.5" in out.out, out.out

@@ -4,7 +4,7 @@
 
 X (axis 0: M21432, D21256/D21288) is switched to the MLC, moved to 30.5 absolute at 6000 mm/min, then 5 incremental,
 run in speed mode at 1200 mm/min for 0.5 s and stopped, and handed back to the NC, whose MDI G01 then starts from
-where the MLC left X. The f32 registers are written through the MLC's memory (`machine.mlc.mem.set_f32`).
+where the MLC left X. `machine.set` writes the f32 registers as floats (both words, decision bench B129).
 """
 
 X = 0  # the channel's axis index of X
@@ -14,19 +14,18 @@ TARGET, VELOCITY = 21256 + 2 * X, 21288 + 2 * X
 
 
 def main(machine):
-    mem = machine.mlc.mem
     machine.set(f"M{SWITCH}")
     t = machine.wait_until(lambda: machine.get(SWITCHED) == 1, 1.0, "X switched to the MLC")
     print(f"switched at t {t:.3f} s, X {machine.command('X'):.4f}")
-    mem.set_f32(TARGET, 30.5)
-    mem.set_f32(VELOCITY, 6000.0)
+    machine.set(f"D{TARGET}", 30.5)
+    machine.set(f"D{VELOCITY}", 6000.0)
     machine.set(f"M{TRIGGER}")
     machine.cycle(2)  # the MLC's scan sees the edge, M3x448 drops
     t = machine.wait_until(lambda: machine.get(REACHED) == 1, 5.0, "X at 30.5")
     print(f"absolute: X {machine.command('X'):.4f} after {t:.3f} s")
     machine.set(f"M{TRIGGER}", False)
     machine.set(f"M{INCREMENTAL}")
-    mem.set_f32(TARGET, 5.0)
+    machine.set(f"D{TARGET}", 5.0)
     machine.cycle()
     machine.set(f"M{TRIGGER}")
     machine.cycle(2)  # the MLC's scan sees the edge, M3x448 drops
@@ -34,7 +33,7 @@ def main(machine):
     print(f"incremental: X {machine.command('X'):.4f} after {t:.3f} s")
     machine.set(f"M{TRIGGER}", False)
     machine.set(f"M{SPEED}")
-    mem.set_f32(VELOCITY, -1200.0)
+    machine.set(f"D{VELOCITY}", -1200.0)
     machine.cycle()
     machine.set(f"M{TRIGGER}")
     machine.cycle(2)  # the MLC's scan sees the edge, M3x448 drops
