@@ -8,27 +8,16 @@ adds to every lock-step cycle that has no tap in it (a plain G01 active), timed 
 from __future__ import annotations
 
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT))  # this tree, not an installed one
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))  # this tree, not an installed one
 
-from hil.scripting import Machine, mlc_setup  # noqa: E402
-from hil.session import load_bench, make_link  # noqa: E402
+from benchmarks.cycle_parts import mill_machine as machine, report  # noqa: E402
 
 TAP = "G17 G90 G94 G00 X0. Y0. Z10.\nM03 S600\nG99 G84 X0. Y0. Z-15. R2. F900.\nG80 G00 Z10.\nM30\n"
 PITCH = 1.5
-
-
-def machine() -> Machine:
-    bench = load_bench(str(ROOT / "benches" / "mill-3axis.toml"), None, None)
-    mlc, _, _ = mlc_setup(bench, "lathe", None, 0.5)
-    m = Machine(bench, mlc, make_link(bench))
-    m.power_up()
-    return m
 
 
 def retraction() -> None:
@@ -69,29 +58,13 @@ def per_cycle_cost() -> None:
     m.wait_until(lambda: m.command("X") > 0.5, 5.0)
     link, mem, b2 = m.mlc.link, m.mlc.mem.m, 20000 + 1000 * m.x
 
-    def best(f, n: int = 200_000, rep: int = 7) -> float:
-        out = []
-        for _ in range(rep):
-            t = time.perf_counter_ns()
-            for _ in range(n):
-                f()
-            out.append((time.perf_counter_ns() - t) / n)
-        return min(out)
-
-    base = best(lambda: None)
-    parts = {
+    report({
         "M3x707 (Channel.rigid_tapping via getattr, nc_outputs)": lambda: 1 if getattr(ch, "rigid_tapping", False) else 0,
         "M2x080/M2x707 levels (nc_inputs)": lambda: mem[b2 + 80] or mem[b2 + 707] or link._tap_levels,
         "Channel.step: retraction test": lambda: ch._retract is not None,
         "Mlc.spindle_drive: retraction test": lambda: ch.tap_retraction if ch is not None else None,
         "spindle_command_rpm: status test": lambda: ch.tap.record is not None,
-    }
-    total = 0.0
-    for name, f in parts.items():
-        ns = best(f) - base
-        total += ns
-        print(f"  {name:58s} {ns:6.1f} ns")
-    print(f"  {'added per cycle':58s} {total:6.1f} ns")
+    }, width=58)
     m.close()
 
 

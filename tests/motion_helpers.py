@@ -100,3 +100,9 @@ def single_block_operator(stops: list) -> Callable:
             stops.append(ch.planner.position.copy())
             ch.cycle_start()
     return ctl
+
+
+def profile_time(length: float, v: float, a: float, j: float) -> float:
+    """A rest-to-rest jerk-limited move that reaches its cruise speed v (tangential a, j): a trapezoidal
+    acceleration, or a triangular one where v comes before a does (v·j < a²)."""
+    return length / v + (2.0 * (v / j) ** 0.5 if v * j < a * a else v / a + a / j)

@@ -22,6 +22,7 @@ from nc.motion.limits import AxisLimits, MotionConfig
 from nc.motion.offline import run as offline_run
 from nc.profiles import make_profile
 from nc.store import ProgramStore
+from tests.motion_helpers import profile_time
 
 # The mill bench with the position filter off (so a line's time is the raw profile's), and four groups.
 BENCH = """
@@ -53,12 +54,6 @@ limits.X = { acceleration = 2000.0 }
 """
 PROGRAM = ("G90 G01 X100. F6000.\nG05 P1\nX0\nG05 P0\nX100.\nG05 P2\nX0\nG05 P3\nX100.\nG05 P0\nX0\nM30\n")
 V, J = 100.0, 0.5 * 250000.0  # F6000 in mm/s; the tangential jerk budget of X
-
-
-def profile_time(length: float, v: float, a: float, j: float) -> float:
-    """A rest-to-rest jerk-limited move that reaches its cruise speed v (tangential a, j): a trapezoidal
-    acceleration, or a triangular one where v comes before a does (v·j < a²)."""
-    return length / v + (2.0 * (v / j) ** 0.5 if v * j < a * a else v / a + a / j)
 
 
 @pytest.fixture(scope="module")

@@ -20,6 +20,7 @@ from nc.motion.limits import AxisLimits, MotionConfig, MoveKindLimits
 from nc.motion.offline import run as offline_run
 from nc.profiles import make_profile
 from nc.store import ProgramStore
+from tests.motion_helpers import profile_time
 
 AXES = """
 [[axes]]
@@ -49,12 +50,6 @@ GROUPS = """
 """
 BENCH = HEAD + PARAMS + AXES + GROUPS
 PROGRAM = "G90 G00 X100.\nG01 X0 F6000.\nG05 P1\nG00 X100.\nG01 X0\nG05 P0\nG00 X100.\nM30\n"
-
-
-def profile_time(length: float, v: float, a: float, j: float) -> float:
-    """A rest-to-rest jerk-limited move reaching its cruise speed v with a trapezoidal acceleration."""
-    assert v * j >= a * a
-    return length / v + v / a + a / j
 
 
 def _peaks(r, axis: str, lines) -> dict:

@@ -96,12 +96,19 @@ def max_speed_at(v0: float, a0: float, d: float, a: float, j: float) -> float:
     """Upper bound of the speed any profile from (v0, a0) with acceleration ≤ a and jerk ≤ j can
     have after path length d: full jerk up to a, then a constant a (issue 18: a junction whose
     speed this does not exceed cannot bind a profile that starts here)."""
-    a0 = min(a0, a)
+    return fastest_state(v0, a0, d, a, j)[0]
+
+
+def fastest_state(v0: float, a0: float, d: float, a: float, j: float) -> tuple[float, float]:
+    """Speed and acceleration after path length d of `max_speed_at`'s profile from (v0, a0) (full jerk up to a, then
+    a constant a): the fastest any profile within a and j can be there, and (from a state below a) the highest
+    acceleration it can have there with that speed (decisions motion 84, 86: a corner's acceleration step)."""
+    a0 = a0 if a0 < a else a
     t1 = (a - a0) / j
     d1 = v0 * t1 + a0 * t1 * t1 / 2.0 + j * t1 ** 3 / 6.0
     if d >= d1:
         v1 = v0 + a0 * t1 + j * t1 * t1 / 2.0
-        return math.sqrt(v1 * v1 + 2.0 * a * (d - d1))
+        return math.sqrt(v1 * v1 + 2.0 * a * (d - d1)), a
     lo, hi = 0.0, t1  # the time d is reached in the jerk phase (distance grows with t)
     for _ in range(40):
         t = 0.5 * (lo + hi)
@@ -109,7 +116,7 @@ def max_speed_at(v0: float, a0: float, d: float, a: float, j: float) -> float:
             lo = t
         else:
             hi = t
-    return v0 + a0 * hi + j * hi * hi / 2.0
+    return v0 + a0 * hi + j * hi * hi / 2.0, a0 + j * hi
 
 
 _sqrt, _cbrt = math.sqrt, math.cbrt  # reach() runs ≈ 10 times per pushed block

@@ -39,7 +39,8 @@ from nc.alarm_table import PLANNING_STALL
 from nc.alarms import NcAlarm
 from nc.motion.limits import MotionConfig
 from nc.motion.block import Block
-from nc.motion.lookahead import CUT, MARGIN, RAPID, THREAD, Limits, backward, change_distance, max_speed_at, reach
+from nc.motion.lookahead import (CUT, MARGIN, RAPID, THREAD, Limits, backward, change_distance, fastest_state,
+                                 max_speed_at, reach)
 from nc.motion.path import Segment
 from nc.motion.plan_state import CHUNK, Setpoint, _near, _Plan
 from nc.motion.filter_ramps import HISTORY, FilterStops
@@ -62,27 +63,6 @@ from nc.moves import Move
 THROUGH = 16
 OPEN_CHUNK = 4  # cycles sampled at a time (CHUNK otherwise) while the queue cannot tell the jerk factor yet (the channel reads 4 blocks a cycle)
 MAX_SOLVES_PER_CYCLE = 1000  # plans one cycle may start and end before a sample is due (decisions B4)
-
-
-
-def fastest_state(v0: float, a0: float, d: float, a: float, j: float) -> tuple[float, float]:
-    """Speed and acceleration after path length d of `lookahead.max_speed_at`'s profile from (v0, a0) (full jerk up
-    to a, then a constant a): the fastest any profile within a and j can be there, and (from a state below a) the
-    highest acceleration it can have there with that speed (decision motion 84: a corner's acceleration step)."""
-    a0 = a0 if a0 < a else a
-    t1 = (a - a0) / j
-    d1 = v0 * t1 + a0 * t1 * t1 / 2.0 + j * t1 ** 3 / 6.0
-    if d >= d1:
-        v1 = v0 + a0 * t1 + j * t1 * t1 / 2.0
-        return math.sqrt(v1 * v1 + 2.0 * a * (d - d1)), a
-    lo, hi = 0.0, t1  # the time d is reached in the jerk phase (distance grows with t), as max_speed_at's
-    for _ in range(40):
-        t = 0.5 * (lo + hi)
-        if v0 * t + a0 * t * t / 2.0 + j * t ** 3 / 6.0 < d:
-            lo = t
-        else:
-            hi = t
-    return v0 + a0 * hi + j * hi * hi / 2.0, a0 + j * hi
 
 
 def feed_rpm(measured: float, command: float) -> tuple[float, bool]:
