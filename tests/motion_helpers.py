@@ -106,3 +106,18 @@ def profile_time(length: float, v: float, a: float, j: float) -> float:
     """A rest-to-rest jerk-limited move that reaches its cruise speed v (tangential a, j): a trapezoidal
     acceleration, or a triangular one where v comes before a does (v·j < a²)."""
     return length / v + (2.0 * (v / j) ** 0.5 if v * j < a * a else v / a + a / j)
+
+
+# benches/mill-3axis.toml's axes as bench-file text (tests that write their own bench around them)
+MILL_AXES = """
+[[axes]]
+name = "X"
+limits = { velocity = 500.0, acceleration = 5000.0, jerk = 250000.0 }
+[[axes]]
+name = "Y"
+limits = { velocity = 500.0, acceleration = 5000.0, jerk = 250000.0 }
+[[axes]]
+name = "Z"
+start = 100.0
+limits = { velocity = 300.0, acceleration = 3000.0, jerk = 150000.0 }
+"""

@@ -22,7 +22,7 @@ from nc.motion.limits import AxisLimits, MotionConfig
 from nc.motion.offline import run as offline_run
 from nc.profiles import make_profile
 from nc.store import ProgramStore
-from tests.motion_helpers import profile_time
+from tests.motion_helpers import MILL_AXES, profile_time
 
 # The mill bench with the position filter off (so a line's time is the raw profile's), and four groups.
 BENCH = """
@@ -31,17 +31,7 @@ profile = "nc5-mill"
 [params]
 "N1.036" = 0.0
 "N1.037" = 0.0
-[[axes]]
-name = "X"
-limits = { velocity = 500.0, acceleration = 5000.0, jerk = 250000.0 }
-[[axes]]
-name = "Y"
-limits = { velocity = 500.0, acceleration = 5000.0, jerk = 250000.0 }
-[[axes]]
-name = "Z"
-start = 100.0
-limits = { velocity = 300.0, acceleration = 3000.0, jerk = 150000.0 }
-
+""" + MILL_AXES + """
 [param_groups.1]                      # a lower X acceleration: the rest (filter off, no feed limit) the bench's
 limits.X = { acceleration = 2000.0 }
 

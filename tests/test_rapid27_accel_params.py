@@ -20,20 +20,8 @@ from nc.motion.limits import AxisLimits, MotionConfig, MoveKindLimits
 from nc.motion.offline import run as offline_run
 from nc.profiles import make_profile
 from nc.store import ProgramStore
-from tests.motion_helpers import profile_time
+from tests.motion_helpers import MILL_AXES as AXES, profile_time
 
-AXES = """
-[[axes]]
-name = "X"
-limits = { velocity = 500.0, acceleration = 5000.0, jerk = 250000.0 }
-[[axes]]
-name = "Y"
-limits = { velocity = 500.0, acceleration = 5000.0, jerk = 250000.0 }
-[[axes]]
-name = "Z"
-start = 100.0
-limits = { velocity = 300.0, acceleration = 3000.0, jerk = 150000.0 }
-"""
 # The position filter off, so a line's time and peaks are the raw profile's.
 HEAD = 'name = "mill-accel"\nprofile = "nc5-mill"\n[params]\n"N1.036" = 0.0\n"N1.037" = 0.0\n'
 PARAMS = """"N1.030" = 12000.0    # G00 200 mm/s
@@ -215,8 +203,13 @@ def test_independent_rapids_take_the_axis_rapid_limits():
     ('"N1.030" = "fast"\n', "params.N1.030", "must be a number"),
 ])
 def test_bad_values_are_bench_errors_naming_the_file_and_key(params, key, says):
+    _refused(HEAD + params + AXES, key, says)
+
+
+def _refused(text: str, key: str, says: str) -> None:
+    """The bench text is a bench error naming the file, the key and what is wrong."""
     with pytest.raises(BenchFileError) as e:
-        parse_bench(HEAD + params + AXES, "benches/accel.toml")
+        parse_bench(text, "benches/accel.toml")
     msg = str(e.value)
     assert f"benches/accel.toml: {key}: " in msg and says in msg, msg
 
@@ -227,10 +220,7 @@ def test_bad_values_are_bench_errors_naming_the_file_and_key(params, key, says):
     ('[param_groups.2]\n"N1.035" = 5000.0\n', "param_groups.2.N1.035", "within [0, 1000]"),
 ])
 def test_bad_group_values_are_bench_errors_naming_the_key(table, key, says):
-    with pytest.raises(BenchFileError) as e:
-        parse_bench(HEAD + AXES + table, "benches/accel.toml")
-    msg = str(e.value)
-    assert f"benches/accel.toml: {key}: " in msg and says in msg, msg
+    _refused(HEAD + AXES + table, key, says)
 
 
 def test_a_group_that_takes_away_the_speed_an_acceleration_time_needs_is_refused():
