@@ -40,6 +40,7 @@ try:
 except ImportError:  # run as Python without Cython: they do nothing
     from nc.motion import cython_shadow as cython
 
+_INF = math.inf  # a C double where compiled (shares.pxd): math.inf is a module attribute lookup
 # The most a solve raises the tangential jerk (2: the whole corner and curvature share).
 MAX_FACTOR = 2.0
 
@@ -94,9 +95,10 @@ RATIO_BOUND = 2.001
 
 
 @cython.locals(hi=cython.double, seen=cython.double, stop_s=cython.double, s_end=cython.double, vt=cython.double,
-               use=cython.double, top=cython.double, x=cython.double, m=cython.double, covered=cython.bint,
-               plain=cython.bint, stop=cython.bint, i=cython.Py_ssize_t, k=cython.Py_ssize_t, k_lo=cython.Py_ssize_t,
-               k_hi=cython.Py_ssize_t, q_lo=cython.Py_ssize_t, q_hi=cython.Py_ssize_t, b=Block, last=Block)
+               use=cython.double, top=cython.double, x=cython.double, m=cython.double, none=cython.double,
+               covered=cython.bint, plain=cython.bint, stop=cython.bint, i=cython.Py_ssize_t, k=cython.Py_ssize_t,
+               k_lo=cython.Py_ssize_t, k_hi=cython.Py_ssize_t, q_lo=cython.Py_ssize_t, q_hi=cython.Py_ssize_t,
+               n_pre=cython.Py_ssize_t, b=Block, last=Block, sc=list, vts=list, hist_s=list)
 def _scan(fc: "FilterCorners", blocks: Sequence["Block"], pos: float, run_end: float, reach: float,
           closed: bool, v_stop: float = -1.0) -> tuple[float, float] | None:
     """(largest vjunc / vbud, fastest vtop) over the junctions within `reach` of [pos, run_end];
@@ -110,13 +112,14 @@ def _scan(fc: "FilterCorners", blocks: Sequence["Block"], pos: float, run_end: f
     # The queue up to the first block past hi: a junction within hi has its next block there, so that
     # prefix's s_end answer _tolerance_free as the whole queue's do (~45 of ~100 blocks; issue 17). Its
     # length, not the list: _verdicts makes the list when it finds a verdict again (1 scan in 6, session 13).
-    n_pre = None  # the whole queue
+    n_pre = -1  # the whole queue
     # The fastest vtop of the blocks walked (up to the one the walk stops before, or at when it is an exact
     # stop), from 0.0 on. In the walk again (session 15): max() over map/islice of the deque, after it, cost
     # 2.5 µs more a scan than these two lines (fewer opcodes, but islice over a deque and attrgetter per block).
     seen = 0.0
     stop_s = run_end - 1e-9
-    for i, b in enumerate(blocks):  # each field read once (~50 blocks a scan, two scans a solve; issue 17)
+    i = 0  # b's index (a C counter compiled, not enumerate's int objects: session 27)
+    for b in blocks:  # each field read once (~50 blocks a scan, two scans a solve; issue 17)
         plain = b.scan_plain  # a path block, not an arc: the kind and segment tests below answer as they do here
         if not plain:
             seg = b.seg
@@ -136,13 +139,14 @@ def _scan(fc: "FilterCorners", blocks: Sequence["Block"], pos: float, run_end: f
         if b.vjunc <= 0.0 and b is not last and s_end >= stop_s:
             covered = True  # an exact stop (G09/G61, G00): the filter settles there
             break
+        i += 1
     if not covered and not (closed or last.s_end > hi):
         return UNKNOWN
     if WALK:
-        return _walk(fc, blocks, pos - reach, hi, seen, n_pre, v_stop)
+        return _walk(fc, blocks, pos - reach, hi, seen, None if n_pre < 0 else n_pre, v_stop)
     hist_s = fc._hist_s
-    k_lo = bisect_left(hist_s, pos - reach)
-    k_hi = bisect_right(hist_s, hi)
+    k_lo = _first_at_or_above(hist_s, pos - reach)  # bisect_left, bisect_right (session 27: on C doubles)
+    k_hi = _first_above(hist_s, hi)
     use = 0.0
     if k_hi > k_lo:
         # _walk's outcome from the junctions' kept verdicts (module doc of _verdicts): the walk goes from the
@@ -151,16 +155,16 @@ def _scan(fc: "FilterCorners", blocks: Sequence["Block"], pos: float, run_end: f
         sc = _verdicts(fc, blocks, k_lo, k_hi, n_pre)
         # max(fc._vt[k_lo:k_hi]) (the same value, session 15: `max` over ~90 floats was ~1.2 µs a scan): a sliding
         # maximum carried from the range the last scan read, when this one overlaps it and does not end before it
-        # (the junctions' vtops are fixed at the push; FilterCorners drops it with the junctions); else the slice's
+        # (the junctions' vtops are fixed at the push; FilterCorners drops it with the junctions); else the range's
         q = fc._vq
         q_lo, q_hi = fc._vq_at
-        if k_hi < q_hi and q_lo < k_hi:  # a shorter reach between two of the same (_speed_up): the slice
-            top = max(fc._vt[k_lo:k_hi])
+        vts = fc._vt
+        if k_hi < q_hi and q_lo < k_hi:  # a shorter reach between two of the same (_speed_up): the range's
+            top = _largest(vts, k_lo, k_hi)
         else:
             if not (q_lo < k_hi and k_lo < q_hi):  # nothing kept of this range: from its start
                 q.clear()
                 q_lo = q_hi = k_lo
-            vts = fc._vt
             for k in range(q_hi, k_hi):
                 x = vts[k]
                 while q and q[-1][1] <= x:
@@ -178,11 +182,18 @@ def _scan(fc: "FilterCorners", blocks: Sequence["Block"], pos: float, run_end: f
             fc._vq_at = (k_lo, k_hi)
         if top > seen:
             seen = top
-        m = max(sc)
+        # max(sc[k_lo:k_hi]) and the newest NONE in it, on C doubles (session 27: the builtins on the Python
+        # floats were a third of a scan)
+        m = _largest(sc, k_lo, k_hi)
         stop = v_stop >= 0.0 and seen <= v_stop
-        if m == NONE:
-            k = len(sc) - 1 - sc[::-1].index(NONE)
-            if stop and k + 1 < len(sc) and max(sc[k + 1:]) >= 1.0:
+        none = NONE
+        if m == none:
+            k = k_hi - 1  # the newest NONE (m is one)
+            x = sc[k]
+            while x != none:
+                k -= 1
+                x = sc[k]
+            if stop and k + 1 < k_hi and _largest(sc, k + 1, k_hi) >= 1.0:
                 return 1.0, seen
             return None
         if m >= 1.0 and stop:
@@ -201,21 +212,60 @@ SKIP = -1.0
 WALK = False  # True: _scan walks every junction as before the kept verdicts (the reference tests compare with)
 
 
+# The helpers below are C functions where compiled (their types in shares.pxd, session 27).
+def _largest(xs: list[float], lo: int, hi: int) -> float:
+    """max(xs[lo:hi]) of floats, lo < hi, as the builtin finds it: an item replaces the largest so far only where
+    it is greater (the first of equal ones kept, nan as max leaves it)."""
+    m = xs[lo]
+    for k in range(lo + 1, hi):
+        x = xs[k]
+        if x > m:
+            m = x
+    return m
+
+
+def _first_at_or_above(xs: list[float], x: float) -> int:
+    """bisect_left(xs, x) on floats, its comparisons as bisect makes them."""
+    lo, hi = 0, len(xs)
+    while lo < hi:
+        mid = (lo + hi) // 2
+        y = xs[mid]
+        if y < x:
+            lo = mid + 1
+        else:
+            hi = mid
+    return lo
+
+
+def _first_above(xs: list[float], x: float) -> int:
+    """bisect_right(xs, x) on floats, its comparisons as bisect makes them."""
+    lo, hi = 0, len(xs)
+    while lo < hi:
+        mid = (lo + hi) // 2
+        y = xs[mid]
+        if x < y:
+            hi = mid
+        else:
+            lo = mid + 1
+    return lo
+
+
 @cython.locals(n=cython.Py_ssize_t, d=cython.Py_ssize_t, ok_lo=cython.Py_ssize_t, ok_hi=cython.Py_ssize_t,
                k=cython.Py_ssize_t, i=cython.Py_ssize_t, n_ends=cython.Py_ssize_t, h=cython.Py_ssize_t, j=Block,
-               head=Block, vbud=cython.double, cap=cython.double, c2=cython.double, tcap=cython.double,
-               r=cython.double, sc=list, part=list, ends=list, hist=list)
-def _verdicts(fc: "FilterCorners", blocks: Sequence["Block"], k_lo: int, k_hi: int,
-              n_pre: int | None) -> list[float]:
+               b=Block, head=Block, vbud=cython.double, cap=cython.double, c2=cython.double, tcap=cython.double,
+               r=cython.double, s_j=cython.double, none=cython.double, skip=cython.double, sc=list, ends=list,
+               hist=list)
+def _verdicts(fc: "FilterCorners", blocks: Sequence["Block"], k_lo: int, k_hi: int, n_pre: int) -> list:
     """Each junction hist[k_lo:k_hi]'s verdict for _scan: NONE, SKIP or its use min(1, vjunc / vbud), kept in
     fc._sc between scans (issue 17, session 11: consecutive scans cover nearly the same ~90 junctions, and a
-    walk over them was the run's largest item). A verdict reads the junction's vjunc, vbud, vtol, vctol and cap
-    and its next block's cap; a push changes those only from fc._sc_dirty on (FilterCorners.window,
-    _tolerance: the stretch and tolerance windows behind the new junction, and the junction before it, whose
-    next block a corner blend trims), an override or dry run every cap (FilterCorners.touch), and a
-    solve the head block's (feed per revolution): the junctions up to the head's, whose next block is the head
-    or who are it, are found again when its cap is not the one they were found with. `n_pre`: the queue's blocks
-    up to the first one past the reach (None: the whole queue), whose s_end the tolerance verdict reads."""
+    walk over them was the run's largest item); returns fc._sc, found over [k_lo, k_hi). A verdict reads the
+    junction's vjunc, vbud, vtol, vctol and cap and its next block's cap; a push changes those only from
+    fc._sc_dirty on (FilterCorners.window, _tolerance: the stretch and tolerance windows behind the new junction,
+    and the junction before it, whose next block a corner blend trims), an override or dry run every cap
+    (FilterCorners.touch), and a solve the head block's (feed per revolution): the junctions up to the head's,
+    whose next block is the head or who are it, are found again when its cap is not the one they were found
+    with. `n_pre`: the queue's blocks up to the first one past the reach (−1: the whole queue), whose s_end the
+    tolerance verdict reads."""
     sc = fc._sc
     n = len(sc)
     d = fc._sc_dirty
@@ -227,57 +277,66 @@ def _verdicts(fc: "FilterCorners", blocks: Sequence["Block"], k_lo: int, k_hi: i
             ok_hi = d
     head = blocks[0]
     if head.cap != fc._sc_head:  # nan the first time
-        h = bisect_right(fc._hist_s, head.s_end)
+        h = _first_above(fc._hist_s, head.s_end)
         sc[:h] = [None] * h
         fc._sc_head = head.cap
         if ok_lo < h:
             ok_lo = h
-    part = sc[k_lo:k_hi]
     if ok_lo <= k_lo and k_hi <= ok_hi:
         fc._sc_ok = (ok_lo, ok_hi)
-        return part
-    if None not in part:
-        fc._sc_ok = _joined(ok_lo, ok_hi, k_lo, k_hi)
-        return part
-    fc._sc_ok = _joined(ok_lo, ok_hi, k_lo, k_hi)  # found below
+        return sc
+    fc._sc_ok = _joined(ok_lo, ok_hi, k_lo, k_hi)  # found below where not yet
+    k = k_lo  # the first verdict to find (a C walk compiled: `None in` and list.index on a slice were ~2.5k
+    while k < k_hi and sc[k] is not None:  # instructions a call, session 27)
+        k += 1
+    if k == k_hi:
+        return sc
     hist = fc._hist
     tol = fc.tol
-    ends = [b.s_end for b in islice(blocks, n_pre)]
+    ends = []  # [b.s_end for b in islice(blocks, n_pre)], each s_end read as a C double (session 27)
+    if n_pre != 0:
+        for b in blocks:
+            ends.append(b.s_end)
+            if len(ends) == n_pre:
+                break
     n_ends = len(ends)
-    k = k_lo + part.index(None)
-    i = bisect_right(ends, hist[k].s_end)
+    none, skip = NONE, SKIP
+    j = hist[k]
+    i = _first_above(ends, j.s_end)
     for k in range(k, k_hi):
         j = hist[k]
         if not j.scan_plain and j.seg is not None and j.seg.kind == "arc":  # scan_plain: a path block, no arc
-            sc[k] = NONE
+            sc[k] = none
             continue
         if j.du_n <= 1e-9:
-            sc[k] = SKIP
+            sc[k] = skip
             continue
         vbud = j.vbud
         if vbud <= 1e-12:
-            sc[k] = NONE
+            sc[k] = none
             continue
         if tol is not None:
             # _tolerance_free, its kept verdict inline; the next block is blocks[i] (j walks on in path order)
-            while i < n_ends and ends[i] <= j.s_end:
+            s_j = j.s_end
+            while i < n_ends and ends[i] <= s_j:
                 i += 1
             # _tolerance_free's kept verdict read first, inline (session 15: ~7 calls a scan that finds verdicts
             # again); blocks[i] is j's next block, i = bisect_right(ends, j.s_end) as _tolerance_free finds it
             if i < n_ends:
                 cap = j.cap
-                c2 = blocks[i].cap
+                b = blocks[i]
+                c2 = b.cap
                 if c2 > cap:
                     cap = c2
             else:
                 cap = j.vtop
             tcap = j.vtol if j.vtol < j.vctol else j.vctol
             if not (j.tf_ok if cap == j.tf_cap and tcap == j.tf_tcap else _tolerance_free(fc, j, blocks, ends)):
-                sc[k] = NONE
+                sc[k] = none
                 continue
         r = j.vjunc / vbud
-        sc[k] = SKIP if r != r else r if r < 1.0 else 1.0
-    return sc[k_lo:k_hi]
+        sc[k] = skip if r != r else r if r < 1.0 else 1.0
+    return sc
 
 
 def _joined(lo: float, hi: float, k_lo: int, k_hi: int) -> tuple[int, int]:
@@ -335,9 +394,9 @@ def _walk(fc: "FilterCorners", blocks: Sequence["Block"], lo: float, hi: float, 
     return use, seen
 
 
-@cython.locals(j=Block, k=cython.Py_ssize_t, cap=cython.double, c2=cython.double, tcap=cython.double,
-               unb=cython.double, x=cython.double, ok=cython.bint)
-def _tolerance_free(fc: "FilterCorners", j: "Block", blocks: Sequence["Block"], ends: Sequence[float]) -> bool:
+@cython.locals(j=Block, b=Block, k=cython.Py_ssize_t, cap=cython.double, c2=cython.double, tcap=cython.double,
+               unb=cython.double, x=cython.double, ok=cython.bint, ends=list)
+def _tolerance_free(fc: "FilterCorners", j: "Block", blocks: Sequence["Block"], ends: list[float]) -> bool:
     """Whether junction j keeps N1.053 with the raised jerk at the fastest its blocks may pass it.
 
     Its tolerance caps (the kernel windows' vtol, its corner alone vctol) were found with the
@@ -351,10 +410,11 @@ def _tolerance_free(fc: "FilterCorners", j: "Block", blocks: Sequence["Block"], 
         return True
     # the next block (its cap is the feed's): one step, it follows j in the queue (`ends`: the queue's
     # s_end, increasing)
-    k = bisect_right(ends, j.s_end)
+    k = _first_above(ends, j.s_end)
     if k < len(ends):
         cap = j.cap
-        c2 = blocks[k].cap
+        b = blocks[k]
+        c2 = b.cap
         if c2 > cap:  # max(j.cap, c2) spelt out (session 15)
             cap = c2
     else:
@@ -364,7 +424,7 @@ def _tolerance_free(fc: "FilterCorners", j: "Block", blocks: Sequence["Block"], 
     # the two it was found for; du_n, a, j and the tolerance are fixed once the junction is pushed.
     if cap == j.tf_cap and tcap == j.tf_tcap:
         return j.tf_ok
-    if tcap == math.inf or (j.viso > 0.0 and tcap <= j.viso):
+    if tcap == _INF or (j.viso > 0.0 and tcap <= j.viso):
         # (a corner alone in its windows crossed at no more than its proved cap keeps N1.053 with any jerk up to
         # MAX_FACTOR times the blocks': decision motion 73)
         ok = True
