@@ -49,7 +49,8 @@ if TYPE_CHECKING:
 
 
 @cython.locals(st=cython.double, pool=cython.double, t_w=cython.double, v_hi=cython.double, x=cython.double,
-               reach=cython.double, use=cython.double, seen=cython.double, f=cython.double, saturates=cython.bint)
+               reach=cython.double, use=cython.double, seen=cython.double, f=cython.double, saturates=cython.bint,
+               head=Block, tail=Block)
 def jerk_factor(cfg: MotionConfig, fc: "FilterCorners", blocks: Sequence["Block"], pos: float,
                 run_end: float, closed: bool) -> tuple[float, bool]:
     """Factor (1 … MAX_FACTOR) on the tangential jerk of a solve over path positions
@@ -59,11 +60,13 @@ def jerk_factor(cfg: MotionConfig, fc: "FilterCorners", blocks: Sequence["Block"
     pool = cfg.share_corner + cfg.share_curvature
     if st <= 0.0 or st + pool > 1.0 + 1e-9 or not blocks:
         return 1.0, False
-    if blocks[0].rapid and cfg.rapid_whole:  # a G00 on the axes' whole budget: no share to take (motion 93)
+    head = blocks[0]
+    tail = blocks[-1]
+    if head.rapid and cfg.rapid_whole:  # a G00 on the axes' whole budget: no share to take (motion 93)
         return 1.0, False
     t_w = fc.t_j
-    v_hi = blocks[0].vtop  # max() of the two, spelt out (no generator a scan, session 13)
-    x = blocks[-1].vtop
+    v_hi = head.vtop  # max() of the two, spelt out (no generator a scan, session 13)
+    x = tail.vtop
     if x > v_hi:
         v_hi = x
     # Whether a junction using its whole share (use 1) already makes the factor 1: then _scan may stop at
@@ -98,7 +101,8 @@ RATIO_BOUND = 2.001
                use=cython.double, top=cython.double, x=cython.double, m=cython.double, none=cython.double,
                covered=cython.bint, plain=cython.bint, stop=cython.bint, i=cython.Py_ssize_t, k=cython.Py_ssize_t,
                k_lo=cython.Py_ssize_t, k_hi=cython.Py_ssize_t, q_lo=cython.Py_ssize_t, q_hi=cython.Py_ssize_t,
-               n_pre=cython.Py_ssize_t, b=Block, last=Block, sc=list, vts=list, hist_s=list)
+               n_pre=cython.Py_ssize_t, b=Block, last=Block, sc=list, vts=list, hist_s=list, pos=cython.double,
+               run_end=cython.double, reach=cython.double, v_stop=cython.double)
 def _scan(fc: "FilterCorners", blocks: Sequence["Block"], pos: float, run_end: float, reach: float,
           closed: bool, v_stop: float = -1.0) -> tuple[float, float] | None:
     """(largest vjunc / vbud, fastest vtop) over the junctions within `reach` of [pos, run_end];
@@ -254,7 +258,7 @@ def _first_above(xs: list[float], x: float) -> int:
                k=cython.Py_ssize_t, i=cython.Py_ssize_t, n_ends=cython.Py_ssize_t, h=cython.Py_ssize_t, j=Block,
                b=Block, head=Block, vbud=cython.double, cap=cython.double, c2=cython.double, tcap=cython.double,
                r=cython.double, s_j=cython.double, none=cython.double, skip=cython.double, sc=list, ends=list,
-               hist=list)
+               hist=list, k_lo=cython.Py_ssize_t, k_hi=cython.Py_ssize_t, n_pre=cython.Py_ssize_t)
 def _verdicts(fc: "FilterCorners", blocks: Sequence["Block"], k_lo: int, k_hi: int, n_pre: int) -> list:
     """Each junction hist[k_lo:k_hi]'s verdict for _scan: NONE, SKIP or its use min(1, vjunc / vbud), kept in
     fc._sc between scans (issue 17, session 11: consecutive scans cover nearly the same ~90 junctions, and a
@@ -395,7 +399,7 @@ def _walk(fc: "FilterCorners", blocks: Sequence["Block"], lo: float, hi: float, 
 
 
 @cython.locals(j=Block, b=Block, k=cython.Py_ssize_t, cap=cython.double, c2=cython.double, tcap=cython.double,
-               unb=cython.double, x=cython.double, ok=cython.bint, ends=list)
+               unb=cython.double, x=cython.double, ok=cython.bint, tol=cython.double, ends=list)
 def _tolerance_free(fc: "FilterCorners", j: "Block", blocks: Sequence["Block"], ends: list[float]) -> bool:
     """Whether junction j keeps N1.053 with the raised jerk at the fastest its blocks may pass it.
 
@@ -408,6 +412,7 @@ def _tolerance_free(fc: "FilterCorners", j: "Block", blocks: Sequence["Block"], 
     took the CAM vertices 0.0002–0.0036 mm over N1.053."""
     if fc.tol is None:
         return True
+    tol = fc.tol  # a C double compiled (session 27)
     # the next block (its cap is the feed's): one step, it follows j in the queue (`ends`: the queue's
     # s_end, increasing)
     k = _first_above(ends, j.s_end)
@@ -437,12 +442,12 @@ def _tolerance_free(fc: "FilterCorners", j: "Block", blocks: Sequence["Block"], 
         # kernel sums (a numpy call per new (a, j) pair, i.e. per junction of a curve; issue 17).
         # Rounding is monotone, so the bounds give the verdict the exact expression gives.
         unb = fc.braking(j.du_n, j.a)
-        x = cap * (fc.tol - unb) / tcap
-        if x + unb > fc.tol:
+        x = cap * (tol - unb) / tcap
+        if x + unb > tol:
             ok = False
-        elif x + unb * RATIO_BOUND <= fc.tol:
+        elif x + unb * RATIO_BOUND <= tol:
             ok = True
         else:
-            ok = x + fc.braking_pair(j.du_n, j.a, j.j)[1] <= fc.tol
+            ok = x + fc.braking_pair(j.du_n, j.a, j.j)[1] <= tol
     j.tf_cap, j.tf_tcap, j.tf_ok = cap, tcap, ok
     return ok
