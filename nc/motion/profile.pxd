@@ -1,1 +1,17 @@
-# Types for nc/motion/profile.py where setup.py compiles it with Cython (issue 17, decision bench B115).
+# Types for nc/motion/profile.py where setup.py compiles it with Cython (issue 17, decision bench B115). A solve's
+# own steps are C functions (session 27, decision bench B140): the calls between them were Python calls, and the
+# phases' start times are summed on a C double in the order the .py sums them.
+cimport cython
+
+cdef tuple _calc(Py_ssize_t dofs)
+
+cdef tuple _one_dof(object interface, double p0, double v0, double a0, double p1, double v1, double v_max,
+                    double a_max, double j_max)
+
+cdef object _calculate(object otg, object inp, Py_ssize_t n)
+
+cdef object _of(object traj, object cls)
+
+@cython.locals(t=double, h=double, x=double, k=Py_ssize_t, pl=double, vl=double, al=double, jl=double, pe=double,
+               ve=double, ae=double, t0=list, p=list, v=list, a=list, j=list)
+cdef tuple _phases(object pr)

@@ -30,6 +30,8 @@ def clip(x: np.ndarray | float, lo: float, hi: float) -> np.ndarray | np.floatin
 
 
 _OK = (Result.Working, Result.Finished)
+# ruckig's control interfaces, read once (each read of an enum member through its class is ≈ 1k instructions)
+_POSITION, _VELOCITY = ControlInterface.Position, ControlInterface.Velocity
 _POOL: dict[int, tuple[Ruckig, InputParameter]] = {}  # one calculator per DoF count, never per cycle
 # The control interface `_one_dof` last set on the pooled 1-DoF input (with synchronisation Time and target
 # acceleration 0); `solve_axes` drops its entry where it sets those fields itself
@@ -58,22 +60,11 @@ class Piecewise:
 
     @classmethod
     def of(cls, traj: Trajectory) -> "Piecewise":
-        rows = [_phases(pr) for pr in traj.profiles[0]]
-        if len(rows) == 1:  # one DoF (every path solve): its columns as they are, no padding (issue 17)
-            return _OneDof(rows[0], float(traj.duration), float(traj.position_extrema[0].max))
-        n = max(len(r[0]) for r in rows)
-        arrs = []
-        for k in range(5):
-            m = np.empty((len(rows), n))
-            for i, r in enumerate(rows):
-                col = r[k]
-                m[i, : len(col)] = col
-                # pad with a copy of the final (resting) phase
-                m[i, len(col):] = col[-1] if k else np.inf
-            arrs.append(m)
-        return cls(arrs[0], arrs[1], arrs[2], arrs[3], arrs[4], float(traj.duration),
-                   float(traj.position_extrema[0].max))
+        return _of(traj, cls)
 
+    @cython.locals(dur=cython.double, low=cython.double, jk=cython.double, ak=cython.double, t_zero=cython.double,
+                   x=cython.double, tk=cython.double, tn=cython.double, k=cython.Py_ssize_t, n=cython.Py_ssize_t,
+                   t0=list, v=list, a=list, j=list)
     def v_min(self, dof: int = 0) -> float:
         """Lowest velocity anywhere on the profile: at a phase boundary, or inside a phase where
         the acceleration passes zero (v − a²/2j), which the boundaries alone miss."""
@@ -88,16 +79,29 @@ class Piecewise:
             _, t0, _, v, a, j = c
         else:
             t0, v, a, j = self.t0[dof].tolist(), self.v[dof].tolist(), self.a[dof].tolist(), self.j[dof].tolist()
-        t0 = [x if x < dur else dur for x in t0]
-        low = min(v)
-        for k in range(len(t0) - 1):
-            jk = j[k]
-            if jk != 0.0:
-                t_zero = -a[k] / jk
-                if 0.0 < t_zero < t0[k + 1] - t0[k]:
-                    x = v[k] - a[k] * a[k] / (2.0 * jk)
-                    if x < low:
-                        low = x
+        # min(v) as the builtin finds it, and the start times held to the duration as each is read (compiled: C
+        # loops on C doubles, session 27)
+        low = v[0]
+        for k in range(1, len(v)):
+            x = v[k]
+            if x < low:
+                low = x
+        n = len(t0)
+        if n > 1:
+            tn = t0[0]
+            tn = tn if tn < dur else dur
+            for k in range(n - 1):
+                tk = tn
+                tn = t0[k + 1]
+                tn = tn if tn < dur else dur
+                jk = j[k]
+                if jk != 0.0:
+                    ak = a[k]
+                    t_zero = -ak / jk
+                    if 0.0 < t_zero < tn - tk:
+                        x = v[k] - ak * ak / (2.0 * jk)
+                        if x < low:
+                            low = x
         self._vmin = (key, low)
         return low
 
@@ -107,7 +111,8 @@ class Piecewise:
 
     @cython.locals(t=cython.double, dur=cython.double, dt=cython.double, jk=cython.double, ak=cython.double,
                    vk=cython.double, k=cython.Py_ssize_t, lo=cython.Py_ssize_t, hi=cython.Py_ssize_t,
-                   mid=cython.Py_ssize_t, x=cython.double, pk=cython.double)
+                   mid=cython.Py_ssize_t, x=cython.double, pk=cython.double, c=tuple, t0=list, p=list, v=list,
+                   a=list, j=list)
     def at(self, t: float) -> tuple[float, float, float]:
         """sample(np.array([t])) of DoF 0 on plain floats: the same operations in the same order, so the same
         bits (numpy's maximum/minimum keep their first operand on a tie, searchsorted is bisect_right), without
@@ -184,9 +189,29 @@ class _OneDof(Piecewise):
         return self._rows[2][-1] if self._m is None else float(self._m[2, -1])
 
 
-@cython.locals(t=cython.double, h=cython.double, k=cython.Py_ssize_t, pl=cython.double, vl=cython.double,
-               al=cython.double, jl=cython.double, pe=cython.double, ve=cython.double, ae=cython.double)
+def _of(traj: Trajectory, cls: type) -> "Piecewise":
+    """Piecewise.of: a solve's Trajectory as its phases (a C function compiled, called directly by the solves)."""
+    rows = [_phases(pr) for pr in traj.profiles[0]]
+    if len(rows) == 1:  # one DoF (every path solve): its columns as they are, no padding (issue 17)
+        return _OneDof(rows[0], float(traj.duration), float(traj.position_extrema[0].max))
+    n = max(len(r[0]) for r in rows)
+    arrs = []
+    for k in range(5):
+        m = np.empty((len(rows), n))
+        for i, r in enumerate(rows):
+            col = r[k]
+            m[i, : len(col)] = col
+            # pad with a copy of the final (resting) phase
+            m[i, len(col):] = col[-1] if k else np.inf
+        arrs.append(m)
+    return cls(arrs[0], arrs[1], arrs[2], arrs[3], arrs[4], float(traj.duration),
+               float(traj.position_extrema[0].max))
+
+
 def _phases(pr) -> tuple[list, list, list, list, list]:
+    """One DoF's phases of a ruckig Profile as lists: (start times, p, v, a, j), the brake pre-phases first, the
+    final state last (a C function compiled, its types in profile.pxd: the floats ruckig gives are appended as
+    they are, the start times summed on a C double in the same order; session 27)."""
     t0, p, v, a, j = [], [], [], [], []
     t = 0.0
     # ruckig's fields are read once each: every read converts the whole array to a new list (issue 17)
@@ -194,19 +219,24 @@ def _phases(pr) -> tuple[list, list, list, list, list]:
     if b.duration > 0.0:
         bt, bp, bv, ba, bj = b.t, b.p, b.v, b.a, b.j
         for k in range(2):
-            if bt[k] > 0.0:
-                t0.append(t), p.append(bp[k]), v.append(bv[k]), a.append(ba[k]), j.append(bj[k])
-                t += bt[k]
-    pt = pr.t
-    ks = [k for k in range(7) if pt[k] > 0.0]  # the phases kept; gathered by comprehensions (session 12)
-    for k in ks:  # the start times summed in the same order
-        t0.append(t)
-        t += pt[k]
-    pp, pv, pa, pj = pr.p, pr.v, pr.a, pr.j
-    p += [pp[k] for k in ks]
-    v += [pv[k] for k in ks]
-    a += [pa[k] for k in ks]
-    j += [pj[k] for k in ks]
+            x = bt[k]
+            if x > 0.0:
+                t0.append(t)
+                p.append(bp[k])
+                v.append(bv[k])
+                a.append(ba[k])
+                j.append(bj[k])
+                t += x
+    pt, pp, pv, pa, pj = pr.t, pr.p, pr.v, pr.a, pr.j
+    for k in range(7):  # the phases kept, their start times summed in order
+        x = pt[k]
+        if x > 0.0:
+            t0.append(t)
+            p.append(pp[k])
+            v.append(pv[k])
+            a.append(pa[k])
+            j.append(pj[k])
+            t += x
     # The final state, integrated from the last phase (pf is not kept for velocity control).
     if len(t0) > 0:
         h = t - t0[-1]
@@ -216,7 +246,11 @@ def _phases(pr) -> tuple[list, list, list, list, list]:
         ae = al + h * jl
     else:
         pe, ve, ae = pp[0], pv[0], pa[0]
-    t0.append(t), p.append(pe), v.append(ve), a.append(ae), j.append(0.0)
+    t0.append(t)
+    p.append(pe)
+    v.append(ve)
+    a.append(ae)
+    j.append(0.0)
     return t0, p, v, a, j
 
 
@@ -266,18 +300,18 @@ def _calculate(otg: Ruckig, inp: InputParameter, n: int) -> Trajectory | None:
 def solve_position(p0: float, v0: float, a0: float, p1: float, v1: float, v_max: float, a_max: float,
                    j_max: float) -> Piecewise | None:
     """Time-optimal 1-DoF profile (p0, v0, a0) → (p1, v1, 0); None when ruckig cannot solve it."""
-    otg, inp = _one_dof(ControlInterface.Position, p0, v0, a0, p1, v1, 1e-9 if 1e-9 > v_max else v_max, a_max, j_max)
+    otg, inp = _one_dof(_POSITION, p0, v0, a0, p1, v1, 1e-9 if 1e-9 > v_max else v_max, a_max, j_max)
     traj = _calculate(otg, inp, 1)
-    return None if traj is None else Piecewise.of(traj)
+    return None if traj is None else _of(traj, Piecewise)
 
 
 def solve_velocity(p0: float, v0: float, a0: float, v1: float, a_max: float, j_max: float) -> Piecewise:
     """Jerk-limited change of velocity to v1 (ends with a = 0), e.g. a feed hold or override ramp."""
-    otg, inp = _one_dof(ControlInterface.Velocity, p0, v0, a0, p0, v1, max(abs(v0), abs(v1), 1e-9), a_max, j_max)
+    otg, inp = _one_dof(_VELOCITY, p0, v0, a0, p0, v1, max(abs(v0), abs(v1), 1e-9), a_max, j_max)
     traj = _calculate(otg, inp, 1)
     if traj is None:
         raise NcAlarm(0x0000, f"velocity ramp {v0:g} → {v1:g} mm/s cannot be planned")
-    return Piecewise.of(traj)
+    return _of(traj, Piecewise)
 
 
 def solve_axes(p0, v0, a0, p1, v_max, a_max, j_max, velocity: bool = False) -> Piecewise:
@@ -299,4 +333,4 @@ def solve_axes(p0, v0, a0, p1, v_max, a_max, j_max, velocity: bool = False) -> P
     traj = _calculate(otg, inp, n)
     if traj is None:
         raise NcAlarm(0x0000, "independent-axis rapid cannot be planned")
-    return Piecewise.of(traj)
+    return _of(traj, Piecewise)
