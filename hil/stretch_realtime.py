@@ -415,17 +415,8 @@ class RealTimeStretches:
         if z is not None and (len(z) != len(pl._zones.zones) or not all(map(is_, z, pl._zones.zones))):
             return False
         f = pl.filter
-        if f is not None:
-            fd, fs = f.__dict__, spec.saved_pl["f"]
-            if len(fd) != len(fs):
-                return False
-            for k, v in fd.items():
-                w = fs[k]
-                if k in ("_w1", "_w2"):  # the windows: the same rows
-                    if len(v) != len(w) or not all(map(is_, v, w)):
-                        return False
-                elif v is not w:
-                    return False
+        if f is not None and not f.same_state(spec.saved_pl["f"]):  # (its state bit for bit)
+            return False
         for drv, s0 in zip(self.drives, spec.saved_drives):
             dd = drv.__dict__
             if len(dd) != len(s0):

@@ -5,7 +5,6 @@ show; plain functions the `hil.stretch.Stretcher` and its real-time part share."
 from __future__ import annotations
 
 import sys
-from collections import deque
 from collections.abc import Callable
 from typing import Any
 
@@ -102,10 +101,8 @@ def _save_planner(pl: Planner, filt: bool = True) -> dict:
     if pl._zones is not None:  # the filter's share zones: sampling drops those it passed (ShareZones.lam)
         saved["zones"] = list(pl._zones.zones)
     f = pl.filter
-    if f is not None and filt:
-        fs = dict(f.__dict__)
-        fs["_w1"], fs["_w2"] = deque(f._w1, maxlen=f._w1.maxlen), deque(f._w2, maxlen=f._w2.maxlen)
-        saved["f"] = fs
+    if f is not None and filt:  # (one copy of the filter's buffer of doubles, decision bench B141)
+        saved["f"] = f.snapshot()
     return saved
 
 
@@ -136,11 +133,7 @@ def _restore_planner(pl: Planner, saved: dict) -> None:
         zones.clear()
         zones.extend(saved["zones"])
     if "f" in saved:
-        f = pl.filter
-        fs = dict(saved["f"])
-        fs["_w1"], fs["_w2"] = deque(fs["_w1"], maxlen=fs["_w1"].maxlen), deque(fs["_w2"], maxlen=fs["_w2"].maxlen)
-        f.__dict__.clear()
-        f.__dict__.update(fs)
+        pl.filter.restore(saved["f"])
 
 
 # Planner methods a refill calls when it ends a block or the plan, re-plans or stalls: a refill ahead stops there

@@ -10,6 +10,7 @@ from typing import Any, Callable
 double = float
 Py_ssize_t = int
 bint = bool
+compiled = False  # cython.compiled: run as Python
 
 
 def locals(**_types: Any) -> Callable[[Callable], Callable]:  # noqa: A001 (Cython's name)
