@@ -28,7 +28,7 @@ except ImportError:  # run as Python without Cython: they do nothing
 # LAST the last input row, S1 and S2 the two moving sums, REC the last three outputs (oldest first, the newest
 # the output), then the two windows as rings of n1 and n2 rows (`_h1`, `_h2` the oldest row of each).
 # Each operation is the IEEE one the former lists of Python floats made, in the same order.
-LAST, S1, S2, REC, W1 = 0, 2, 3, 4, 7
+LAST, S1, S2, REC, W1 = 0, 1, 2, 3, 6
 
 
 class PositionFilter:
