@@ -38,11 +38,13 @@ class Segment:
                 d: list[float]) -> "Segment":
         """A line from its start, end, length (math.dist) and unit direction worked out already (the run
         feed's `RunFeed.geom`, issue 17): the segment `of` makes from the same move, bit for bit."""
+        # the fields by position: a keyword call costs the generated __init__ a name match each (issue 17)
         if len(d) == 3:  # spelt out (once per push)
             d0, d1, d2 = d
-            return cls(axes, np.array(ls), np.array(le), length, "line", _dir=(d0, d1, d2),
-                       _cos=(abs(d0), abs(d1), abs(d2)))
-        return cls(axes, np.array(ls), np.array(le), length, "line", _dir=tuple(d), _cos=tuple([abs(x) for x in d]))
+            return cls(axes, np.array(ls), np.array(le), length, "line", 0, 0, (0.0, 0.0), 0.0, 0.0, 0.0, 0.0,
+                       (d0, d1, d2), (abs(d0), abs(d1), abs(d2)))
+        return cls(axes, np.array(ls), np.array(le), length, "line", 0, 0, (0.0, 0.0), 0.0, 0.0, 0.0, 0.0, tuple(d),
+                   tuple([abs(x) for x in d]))
 
     @classmethod
     def of(cls, move: Move, axes: tuple[str, ...]) -> "Segment":

@@ -5,6 +5,11 @@ from __future__ import annotations
 
 import numpy as np
 
+try:
+    import cython  # compiled: the types below (setup.py, decision bench B115; this module since bench B136)
+except ImportError:  # run as Python without Cython: they do nothing
+    from nc.motion import cython_shadow as cython
+
 from nc.motion.corner_blends import blend_block
 from nc.motion.block import Block
 from nc.motion.lookahead import change_distance
@@ -13,6 +18,7 @@ from nc.motion.lookahead import change_distance
 class CornerShares:
     """Methods of `nc.motion.planner.Planner` (its state is the planner's own: see that module's doc)."""
 
+    @cython.locals(prev=Block, b=Block, blk=Block, x=Block, top=cython.double)
     def _corner(self, prev: Block, b: Block) -> int:
         """The junction prev → b (prev.vjunc set): a corner blend between them where one is built
         (decisions motion 42, 45), or, under the filter, a hard junction where λ < 1 planned raw.
@@ -54,6 +60,7 @@ class CornerShares:
             self._need = max(self._need, self.lim.blend.window(self.blocks) + 1)
         return 1
 
+    @cython.locals(prev=Block, head=Block, room=cython.double)
     def _may_blend(self, prev: Block) -> bool:
         """Whether the tail may still give path to a corner blend (decision motion 42): a tolerance
         to blend within, no hold (its ramp runs on across blocks), and no profile that could be
@@ -71,6 +78,7 @@ class CornerShares:
         v = abs(self.v)
         return room >= change_distance(v if v > head.cap else head.cap, 0.0, self._a_lo, self._j_lo)  # max() spelt out
 
+    @cython.locals(b=Block)
     def _now(self) -> float:
         """Path position (Block.s_end's scale) of the last sample handed out."""
         if self.blocks:

@@ -32,6 +32,11 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+try:
+    import cython  # compiled: the types below (setup.py, decision bench B115; this module since bench B136)
+except ImportError:  # run as Python without Cython: they do nothing
+    from nc.motion import cython_shadow as cython
+
 from nc.motion.limits import MotionConfig
 from nc.moves import Move
 
@@ -64,8 +69,8 @@ PIN = 1e-6  # mm: a run's curve must meet its first and last vertex this closely
 FIT_TOL = 0.985  # of N1.053: the fit's own tolerance (the joints' shifts take < 3e-4 mm)
 
 
-@dataclass(slots=True)  # never changed in place, only replaced (slots: built on every push, frozen costs 2 µs)
-class Held:
+@dataclass  # never changed in place, only replaced; compiled, an extension type (spline_feed.pxd: built on every push,
+class Held:  # its generated __init__ as Python took half of `push`, bench B136), so no slots=True (Cython's takes none)
     """The moves a run holds back, the vertices behind them (already let through, for the next window) and
     whether the run is being fitted (False: a first move waits for the junction that decides)."""
 
@@ -102,24 +107,31 @@ class RunFeed:
         return cfg.fit_runs and (cfg.path_tolerance or 0.0) > 0.0
 
     # ---- the rules (plain floats: they run on every push, issue 17) ---------------------------------
+    @cython.locals(a0=cython.double, a1=cython.double, a2=cython.double, b0=cython.double, b1=cython.double,
+                   b2=cython.double, n=cython.double)
     def line(self, mv: Move) -> tuple[list[float], list[float], list[float]] | None:
         """(start point, end point, unit direction) of an eligible move, else None (kept in `geom`)."""
         if mv.kind != "line" or mv.per_rev or mv.exact_stop or mv.css is not None or not mv.feed \
                 or "G31" in mv.tags:
             return None
         ax, ms, me = self.axes, mv.start, mv.end
-        if len(ax) == 3:  # spelt out (once per push)
+        if len(ax) == 3:  # spelt out (once per push); float(): as Segment.of (compiled: the same double)
             x, y, z = ax
-            a = [float(ms.get(x, 0.0)), float(ms.get(y, 0.0)), float(ms.get(z, 0.0))]  # float(): as Segment.of
-            b = [float(me.get(x, 0.0)), float(me.get(y, 0.0)), float(me.get(z, 0.0))]
+            a0, a1, a2 = float(ms.get(x, 0.0)), float(ms.get(y, 0.0)), float(ms.get(z, 0.0))
+            b0, b1, b2 = float(me.get(x, 0.0)), float(me.get(y, 0.0)), float(me.get(z, 0.0))
+            a = [a0, a1, a2]
+            b = [b0, b1, b2]
+            n = math.dist(a, b)
+            if not 1e-6 < n <= MAX_LEN:
+                return None
+            u = [(b0 - a0) / n, (b1 - a1) / n, (b2 - a2) / n]
         else:
             a = [float(ms.get(x, 0.0)) for x in ax]
             b = [float(me.get(x, 0.0)) for x in ax]
-        n = math.dist(a, b)
-        if not 1e-6 < n <= MAX_LEN:
-            return None
-        u = [(b[0] - a[0]) / n, (b[1] - a[1]) / n, (b[2] - a[2]) / n] if len(ax) == 3 else \
-            [(q - p) / n for p, q in zip(a, b)]
+            n = math.dist(a, b)
+            if not 1e-6 < n <= MAX_LEN:
+                return None
+            u = [(q - p) / n for p, q in zip(a, b)]
         self.geom = (mv, a, b, n, u)
         return a, b, u
 
