@@ -56,45 +56,18 @@ class SoftLimits:
     def __post_init__(self) -> None:
         # axis -> the G10 L21 parameter names P1-P4 as `window` reads them, and the axis's scale (`_inside`)
         self._names: dict[str, tuple[str, str, str, str, float]] = {}
-        self._all: frozenset[str] = frozenset()  # every name in `_names`: one look for "no G10 L21 value set"
 
     def _keys(self, axis: str) -> tuple[str, str, str, str, float]:
         k = self._names[axis] = (f"soft limit 1 {axis}", f"soft limit 2 {axis}", f"soft limit 3 {axis}",
                                  f"soft limit 4 {axis}", 0.5 if axis in self.diameter_axes else 1.0)
-        self._all = self._all.union(k[:4])
         return k
 
     def _inside(self, move: Move) -> bool:
         """True when a line (rapid, thread) with the same axes at both ends stays inside both segments:
         `check` finds no alarm for it (issue 17: the channel asks for every move; `window`'s names
-        formatted and the path ranges built were some 10 us a move). False: not known, `check` decides.
-        While no G10 L21 value is set for an axis seen so far (the usual case: one look for all their names, bench
-        B136) only the bench's 1st segment is read; else `_inside_params` reads each axis's values."""
+        formatted and the path ranges built were some 10 us a move). False: not known, `check` decides."""
         start, end = move.start, move.end
-        if (move.kind == "arc" and move.center) or len(start) != len(end):
-            return False
-        if not self.params.keys().isdisjoint(self._all):
-            return self._inside_params(move)
-        first, disabled, names = self.first, self.disabled, self._names
-        for a, e in end.items():
-            if a not in start or a not in names:  # not at both ends (False there), or not seen yet: its names
-                return self._inside_params(move)
-            if a in disabled:
-                continue
-            w = first.get(a)
-            if w is None:
-                continue
-            lo, hi = w
-            s = start[a]
-            # max(s, e) and min(s, e) as `_path_ranges` takes them
-            if (hi is not None and (e if e > s else s) > hi + _EPS) or (lo is not None and (e if e < s else s) < lo - _EPS):
-                return False
-        return True
-
-    def _inside_params(self, move: Move) -> bool:
-        """`_inside` reading each axis's G10 L21 values (P1-P4)."""
-        start, end = move.start, move.end
-        if start.keys() != end.keys():
+        if (move.kind == "arc" and move.center) or start.keys() != end.keys():
             return False
         first, params, disabled, names = self.first, self.params, self.disabled, self._names
         for a, e in end.items():

@@ -103,3 +103,21 @@ def test_a_g10_l21_limit_set_after_moves_that_had_none_is_read() -> None:
     sl.params["soft limit 4 Y"] = -30.0  # G10 L21 P4 Y-30.: the 2nd segment
     alarm = sl.check(mv)
     assert alarm is not None and (alarm.code, alarm.axis) == (0x0A03, "Y")
+
+
+def test_an_axis_first_seen_after_others_has_its_g10_l21_limit_read() -> None:
+    """The quick answer keeps the G10 L21 names of the axes it has seen (`_names`; bench B136 tried looking for
+    all of them at once): a move on an axis none before it had (Z after X/Y moves) still reads that axis's P3,
+    set while the X/Y moves ran, and a move inside it passes."""
+    sl = SoftLimits({"X": (-300.0, 300.0), "Y": (-200.0, 200.0)}, {}, ())
+    xy = Move("line", 1, "X10. Y10.", {"X": 0.0, "Y": 0.0}, {"X": 10.0, "Y": 10.0}, {"X": 10.0, "Y": 10.0})
+    assert sl.check(xy) is None and sl.check(xy) is None
+    sl.params["soft limit 3 Z"] = 50.0  # G10 L21 P3 Z50.
+    assert sl.check(xy) is None
+    up = Move("line", 9, "Z60.", {"X": 10.0, "Y": 10.0, "Z": 0.0}, {"X": 10.0, "Y": 10.0, "Z": 60.0},
+              {"X": 10.0, "Y": 10.0, "Z": 60.0})
+    alarm = sl.check(up)
+    assert alarm is not None and (alarm.code, alarm.axis, alarm.line) == (0x0A03, "Z", 9)
+    low = Move("line", 10, "Z40.", {"X": 10.0, "Y": 10.0, "Z": 0.0}, {"X": 10.0, "Y": 10.0, "Z": 40.0},
+               {"X": 10.0, "Y": 10.0, "Z": 40.0})
+    assert sl.check(low) is None
