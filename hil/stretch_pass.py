@@ -30,7 +30,7 @@ from hil.stretch_state import _across, _restore_planner, _save_planner
 from nc.alarms import NcAlarm
 from nc.channel import READS_PER_CYCLE, Channel
 from nc.motion.planner import Planner
-from nc.motion.stretch import Samples, take_rows
+from nc.motion.stretch import Samples, take_parts
 from virtual_bus.drive_stretch import CspRun, CsvRun, Stretch
 
 PLAN_KINDS = ("path", "ramp", "cruise")
@@ -61,9 +61,9 @@ def no_reads(ch: Channel) -> bool:
         or (ch.single_block and bool(ch._block_moves))
 
 
-def _steps(ch: Channel, pl: Planner, limit: int, reads: bool) -> tuple[np.ndarray, np.ndarray | None, Samples] | None:
+def _steps(ch: Channel, pl: Planner, limit: int, reads: bool) -> tuple | None:
     """One planner step as Planner._step_path makes it before its take, then the rows that follow it with no feed
-    or refill between (at least one, at most `limit`), as `take_rows` hands them out (not filtered yet); None
+    or refill between (at least one, at most `limit`), as `take_parts` hands them out (not filtered yet); None
     where the step cannot be taken here (module doc: the caller puts the planner back)."""
     pl._before_take()
     p = pl.plan
@@ -74,11 +74,18 @@ def _steps(ch: Channel, pl: Planner, limit: int, reads: bool) -> tuple[np.ndarra
         limit = 1  # the next cycle reads: a feed comes between
     elif cruise:
         limit = _across(ch, pl, limit)
-    return take_rows(pl, limit, across=cruise)
+    return take_parts(pl, limit, cruise)
 
 
 class Pass:
-    """The NC pass of one stretch and its drive models, a part at a time (module doc)."""
+    """The NC pass of one stretch and its drive models, a part at a time (module doc).
+
+    What a part costs is fixed, not per row: a CAM program's part is a cycle or two (a refill every block that is
+    not a cruise's, a feed every fourth cycle), so the pass keeps per part only what it must (issue 17, decision
+    bench B137): the planner is saved once after each feed (the mark) and not before each refill (a step that
+    cannot be taken here, rare, puts it back to the mark and makes the steps since again, as a drive fault does);
+    the drives' targets are converted at a drive check, the planner's `output` set at the pass's end, and a
+    take's rows, lines and speeds are joined once in `samples()`."""
 
     def __init__(self, st: Any, ch: Channel, pl: Planner, rx0: list, saved_drives: list[dict],
                  soft: int | None = None) -> None:
@@ -87,7 +94,7 @@ class Pass:
         # next stretch can start there; one cannot start at a reading cycle)
         self.soft = soft
         self.rx0, self.saved_drives = rx0, saved_drives
-        self.parts: list[Samples] = []  # (their positions: the raw rows; the filtered ones are out_rows)
+        self.parts: list[tuple] = []  # each take's (lines, path speeds, move, moves) (take_parts)
         self.out_rows: list[list[float]] = []  # the filtered rows, `filtered` of them
         self.pending: list[tuple[np.ndarray, np.ndarray | None]] = []  # (raw rows, λ) not filtered yet
         self.raws: list[np.ndarray] = []  # every part's raw rows
@@ -96,6 +103,7 @@ class Pass:
         self.runs: list[CspRun | CsvRun] | None = None  # the drive models over the cycles driven (made at the first part)
         self.driven = 0  # cycles the drives were stepped through
         self.targets: list[list[int]] = [[rx.target_position] for rx in rx0[:st.n_axes]]
+        self.converted = 0  # filtered rows whose targets are in `targets` (after the pending one: `_convert`)
         # each axis's AxisScaling.to_counts factor and origin (the runner's: nothing in a pass shifts it)
         org = st.r.origin.tolist()
         self.to_counts = [(sc._cpu, org[i]) for i, sc in enumerate(st.r.scales[:st.n_axes])]
@@ -112,19 +120,25 @@ class Pass:
         m = self._run(n, n if self.soft is None else self.soft)
         for run in self.runs or ():
             run.finish()
+        if self.out_rows:  # the last filtered row, as step() leaves it (nothing in the pass reads it before)
+            self.pl.output = np.array(self.out_rows[-1])
         return m
 
     def _run(self, n: int, soft: int) -> int:
         ch, pl = self.ch, self.pl
         src = ahead(ch)
         fed_at = -1
+        reads = self.reads
+        # Planner.full's bounds (_feed_due inline: a call a part counts); nothing in a pass changes the depth
+        depth, fill_to = pl.depth, pl.depth + pl._batch
         # [rows, the planner then, parts then]: where a drive fault puts it back. The planner's save is the one the
         # next _group makes before its step (the same state: a feed's drive check flushed the filter), not one more
         self._mark = [0, None, 0]
         while self.rows < n:
-            if self.rows >= soft and not (self.reads and _feed_due(pl)):
+            due = reads and ((q := len(pl.blocks)) < depth or (pl._filling and q < fill_to))
+            if self.rows >= soft and not due:
                 break
-            if self.rows and self.reads and _feed_due(pl):  # this cycle's feed reads: the drives up to it first
+            if due and self.rows:  # this cycle's feed reads: the drives up to it first
                 stop = self._drive(self.rows + 1)
                 if stop is not None:
                     return self._back(stop)
@@ -145,70 +159,87 @@ class Pass:
 
     def _group(self, limit: int) -> bool:
         pl = self.pl
-        if pl._buf_done:
+        refill = pl._buf_done
+        if refill:
             # a refill reads the filter: at rest whether it settled, and a solve its state (a filter start or stop
             # is checked on a copy of it, decision motion 52)
             self._flush()
-        # what a step that cannot be taken here changed is put back; a buffered row of a solved plan changes
-        # nothing before take_rows accepts it
         mark = self._mark
-        steps = pl._buf_done or pl._buf_blk is not None
-        # (the mark's save puts the filter back too: a drive fault takes back the rows filtered since)
-        saved = _save(pl, mark[1] is None) if mark[1] is None or steps else None
-        if mark[1] is None:
-            mark[1] = saved
-        if not steps:
-            saved = None
+        if mark[1] is None:  # the first step after a feed (or the start): the planner saved, its filter too
+            mark[1] = _save(pl)
+        # a step that refills, or checks a cruise's next block, changes the planner before it is known whether it
+        # can be taken here; a buffered row of a solved plan changes nothing before take_parts accepts it
+        changes = refill or pl._buf_blk is not None
         try:
             got = _steps(self.ch, pl, limit, self.reads)
         except NcAlarm:  # the step raises: stepping raises it in its own cycle
             got = None
         if got is None:
-            if saved is not None:
-                _restore_planner(pl, saved)
+            if changes:  # the planner as before this step: from the mark, its steps since made again
+                self._rewind(self.rows)
             return False
-        raw, lam, smp = got
-        self.parts.append(smp)
+        raw, lam, lines, vel, mv, moves = got
+        self.parts.append((lines, vel, mv, moves))
         self.raws.append(raw)
         self.pending.append((raw, lam))
         self.rows += len(raw)
         return True
 
     def _flush(self) -> None:
-        """The rows taken since the last flush through the position filter at once (push_many gives what step()'s
-        push gives row by row), and the drives' targets from them."""
-        if not self.pending:
+        """The rows taken since the last flush through the position filter (push_many at once, push_rows row by
+        row: each gives what step()'s push gives row by row)."""
+        pending = self.pending
+        if not pending:
             return
-        pl, pending = self.pl, self.pending
+        self.pending = []
+        f = self.pl.filter
         if len(pending) == 1:  # (most flushes: a part of one take)
             raw, lam = pending[0]
-        else:
+            if f is not None and len(raw) >= FEW:
+                rows = f.push_many(raw, lam).tolist()
+            else:  # push_many's numpy costs ≈ 35 µs whatever the rows; push_rows ≈ 1.5 µs a row, the same bits
+                rows = raw.tolist()
+                if f is not None:
+                    rows = f.push_rows(rows, None if lam is None else lam.tolist())
+        elif f is not None and sum(len(r) for r, _ in pending) >= FEW:
             raw = np.concatenate([r for r, _ in pending])
             lam = None if all(lm is None for _, lm in pending) else \
                 np.concatenate([np.ones(len(r)) if lm is None else lm for r, lm in pending])
-        self.pending = []
-        f = pl.filter
-        if f is None:
-            rows = np.asarray(raw, dtype=float).tolist()
-        elif len(raw) < FEW:  # push_many's numpy costs ≈ 35 µs whatever the rows; push_rows ≈ 1.5 µs a row, the same bits
-            rows = f.push_rows(np.asarray(raw, dtype=float).tolist(), None if lam is None else lam.tolist())
-        else:
             rows = f.push_many(raw, lam).tolist()
-        pl.output = np.array(rows[-1])
+        else:
+            rows = []
+            for r, _ in pending:
+                rows += r.tolist()
+            if f is not None:
+                lams: list[float] | None = None
+                if any(lm is not None for _, lm in pending):
+                    lams = []
+                    for r, lm in pending:
+                        lams += [1.0] * len(r) if lm is None else lm.tolist()
+                rows = f.push_rows(rows, lams)
         self.out_rows += rows  # (an array once, in samples())
         self.filtered += len(rows)
-        if len(rows) == 1:  # (a reading cycle's part: one row)
+
+    def _convert(self) -> None:
+        """The drives' targets of the rows filtered since the last conversion (AxisScaling.to_counts, inline)."""
+        out, c = self.out_rows, self.converted
+        if c == len(out):
+            return
+        rows = out[c:] if c else out
+        if len(rows) == 1:
             row = rows[0]
             for i, (t, (cpu, o)) in enumerate(zip(self.targets, self.to_counts)):
                 t.append(round((row[i] - o) * cpu))
         else:
             for i, (t, (cpu, o)) in enumerate(zip(self.targets, self.to_counts)):
-                t += [round((row[i] - o) * cpu) for row in rows]  # AxisScaling.to_counts, inline (round: an int)
+                t += [round((row[i] - o) * cpu) for row in rows]  # (round: an int)
+        self.converted = len(out)
 
     def _drive(self, upto: int) -> int | None:
         """The drive models over cycles driven … upto-1 (cycle k steps to the setpoint of cycle k-1); the first
         cycle a drive or the bench's overspeed check would fault in, else None."""
         self._flush()
+        self._convert()
         if upto <= self.driven:
             return None
         a, r, n_axes = self.driven, self.st.r, self.st.n_axes
@@ -216,11 +247,11 @@ class Pass:
             dt = r.bench.cycle
             self.runs = [CspRun(d, rx, dt) if i < n_axes else CsvRun(d, rx, dt)
                          for i, (d, rx) in enumerate(zip(self.st.drives, self.rx0))]
-        runs = self.runs
+        runs, targets = self.runs, self.targets
         for i in range(len(runs)):
-            runs[i].step(self.targets[i][a:upto] if i < n_axes else upto - a)
+            runs[i].step(targets[i][a:upto] if i < n_axes else upto - a)
         self.driven = upto
-        m = min(run.out.done for run in runs)
+        m = min([run.out.done for run in runs])
         for i in range(n_axes):  # a few cycles a part: plain Python, not numpy calls
             lim, va = r._overspeed[i], runs[i].out.velocity_actual
             w = len(va)  # the cycles written: a still drive's later ones (CspRun.lag) repeat the last
@@ -233,22 +264,28 @@ class Pass:
                     m = max(a, w)
         return m if m < upto else None
 
-    def _back(self, stop: int) -> int:
-        """A drive faults in cycle `stop`: the stretch ends before it. The planner from the last save (after a
-        feed, or the start), its steps made again up to there; the drives stepped again from the start."""
+    def _rewind(self, stop: int) -> None:
+        """The planner from the mark's save (after the last feed, or the start), its steps made again up to row
+        `stop` (they are deterministic); the rows after it dropped."""
         rows, saved, nparts = self._mark
         assert saved is not None  # (a _group follows every mark before a drive check)
-        pl = self.pl
-        _restore_planner(pl, saved)  # (a mark is taken after a feed, whose drive check flushed the filter)
+        _restore_planner(self.pl, saved)  # (a mark is taken after a feed, whose drive check flushed the filter)
         del self.parts[nparts:]
         del self.raws[nparts:]
         self.pending = []
         self.rows = self.filtered = rows
         del self.out_rows[rows:]
-        for t in self.targets:
-            del t[rows + 1:]
+        if self.converted > rows:
+            self.converted = rows
+            for t in self.targets:
+                del t[rows + 1:]
         while self.rows < stop and self._group(stop - self.rows):
             pass
+
+    def _back(self, stop: int) -> int:
+        """A drive faults in cycle `stop`: the stretch ends before it. The planner from the last save (after a
+        feed, or the start), its steps made again up to there; the drives stepped again from the start."""
+        self._rewind(stop)
         self._redrive()
         return self.rows
 
@@ -262,10 +299,12 @@ class Pass:
     def samples(self) -> Samples:
         """The stretch's rows (filtered), with their raw positions (`Samples.raw`)."""
         self._flush()
+        self._convert()
         parts = self.parts
+        lines: list[int] = []
         moves: list[Any] = []
-        for p in parts:
-            moves += p.moves if p.moves is not None else [p.move] * len(p.lines)
-        return Samples(np.array(self.out_rows), [ln for p in parts for ln in p.lines],
-                       np.concatenate([p.path_velocity for p in parts]), parts[0].move, moves, np.concatenate(self.raws))
-
+        for ln, _, mv, mvs in parts:
+            lines += ln
+            moves += mvs if mvs is not None else [mv] * len(ln)
+        return Samples(np.array(self.out_rows), lines, np.concatenate([p[1] for p in parts]).astype(float, copy=False),
+                       parts[0][2], moves, np.concatenate(self.raws))

@@ -57,16 +57,30 @@ def take_rows(pl: Planner, n: int, across: bool = False,
               per_rev: bool = False) -> tuple[np.ndarray, np.ndarray | None, Samples] | None:
     """sample_stretch's planner part: the rows taken (the planner left as after their steps), their filter
     shares λ (None: 1 throughout) and their Samples, whose positions are the raw rows until the caller filters
-    them (hil/stretch_pass.py filters the rows of several takes at once)."""
+    them."""
+    got = take_parts(pl, n, across, per_rev)
+    if got is None:
+        return None
+    raw, lam, lines, vel, mv, moves = got
+    return raw, lam, Samples(raw, list(lines), np.array(vel, dtype=float), mv, moves)
+
+
+def take_parts(pl: Planner, n: int, across: bool = False, per_rev: bool = False) -> tuple | None:
+    """take_rows without its Samples: (raw rows, λ, lines, path speeds, move, moves), the rows and speeds views
+    of the planner's buffer (a refill makes new ones, nothing writes them in place). A stretch that runs the
+    NC's steps (hil/stretch_pass.py) takes a part every cycle or two on a CAM program and joins them once at its
+    end, so a part costs no dataclass and no copy (issue 17)."""
     if n <= 0 or pl._integrate_angle or pl._buf_done:
         return None
     blocks = pl.blocks
     mv = blocks[0].move if blocks else None
-    p = pl.plan
-    if p is not None and p.kind == "path" and mv is not None and mv.per_rev and not per_rev:
-        return None  # Planner._check_spindle re-plans it from the measured speed
-    if mv is not None and (mv.kind == "thread" or "G31" in mv.tags):
-        return None
+    if mv is not None:
+        if mv.per_rev and not per_rev:
+            p = pl.plan
+            if p is not None and p.kind == "path":
+                return None  # Planner._check_spindle re-plans it from the measured speed
+        if mv.kind == "thread" or "G31" in mv.tags:
+            return None
     i = pl._buf_i
     m = pl._cruise_rows(n) if across else min(n, pl._block_rows())
     if m <= 0:
@@ -74,14 +88,14 @@ def take_rows(pl: Planner, n: int, across: bool = False,
     j = i + m - 1
     raw = pl._buf_pos[i:i + m]
     moves = None
-    if pl._buf_blk is not None and pl._buf_blk[j] != pl._buf_popped:
-        blocks, off = pl.blocks, pl._buf_popped
-        moves = [blocks[k - off].move for k in pl._buf_blk[i:i + m]]
+    blk = pl._buf_blk
+    if blk is not None and blk[j] != pl._buf_popped:
+        off = pl._buf_popped
+        moves = [blocks[k - off].move for k in blk[i:i + m]]
     lam = pl.share_rows(i, m)  # the filter's share per row (decision motion 45)
     pl._buf_i = i + m
     pl._take(j)
-    return raw, lam, Samples(raw, list(pl._buf_line[i:i + m]), np.array(pl._buf_vel[i:i + m], dtype=float), mv,
-                             moves)
+    return raw, lam, pl._buf_line[i:i + m], pl._buf_vel[i:i + m], mv, moves
 
 
 def sample_per_rev(pl: Planner, n: int) -> Samples | None:
