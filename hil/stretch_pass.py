@@ -82,10 +82,9 @@ class Pass:
 
     What a part costs is fixed, not per row: a CAM program's part is a cycle or two (a refill every block that is
     not a cruise's, a feed every fourth cycle), so the pass keeps per part only what it must (issue 17, decision
-    bench B137): the planner is saved once after each feed (the mark) and not before each refill (a step that
-    cannot be taken here, rare, puts it back to the mark and makes the steps since again, as a drive fault does);
-    the drives' targets are converted at a drive check, the planner's `output` set at the pass's end, and a
-    take's rows, lines and speeds are joined once in `samples()`."""
+    bench B137): the drives' targets are converted at a drive check (not at each flush), the planner's `output` set
+    at the pass's end (nothing in the pass reads it), and a take's rows, lines and speeds are kept as the planner's
+    buffer has them (views, no Samples) and joined once in `samples()`."""
 
     def __init__(self, st: Any, ch: Channel, pl: Planner, rx0: list, saved_drives: list[dict],
                  soft: int | None = None) -> None:
@@ -165,18 +164,18 @@ class Pass:
             # is checked on a copy of it, decision motion 52)
             self._flush()
         mark = self._mark
-        if mark[1] is None:  # the first step after a feed (or the start): the planner saved, its filter too
-            mark[1] = _save(pl)
-        # a step that refills, or checks a cruise's next block, changes the planner before it is known whether it
-        # can be taken here; a buffered row of a solved plan changes nothing before take_parts accepts it
         changes = refill or pl._buf_blk is not None
+        if mark[1] is None:  # the first step after a feed (or the start): the planner saved, its filter too
+            mark[1] = saved = _save(pl)
+        else:
+            saved = _save(pl, False) if changes else None
         try:
             got = _steps(self.ch, pl, limit, self.reads)
         except NcAlarm:  # the step raises: stepping raises it in its own cycle
             got = None
         if got is None:
-            if changes:  # the planner as before this step: from the mark, its steps since made again
-                self._rewind(self.rows)
+            if changes:
+                _restore_planner(pl, saved)
             return False
         raw, lam, lines, vel, mv, moves = got
         self.parts.append((lines, vel, mv, moves))
@@ -264,9 +263,9 @@ class Pass:
                     m = max(a, w)
         return m if m < upto else None
 
-    def _rewind(self, stop: int) -> None:
-        """The planner from the mark's save (after the last feed, or the start), its steps made again up to row
-        `stop` (they are deterministic); the rows after it dropped."""
+    def _back(self, stop: int) -> int:
+        """A drive faults in cycle `stop`: the stretch ends before it. The planner from the last save (after a
+        feed, or the start), its steps made again up to there; the drives stepped again from the start."""
         rows, saved, nparts = self._mark
         assert saved is not None  # (a _group follows every mark before a drive check)
         _restore_planner(self.pl, saved)  # (a mark is taken after a feed, whose drive check flushed the filter)
@@ -281,11 +280,6 @@ class Pass:
                 del t[rows + 1:]
         while self.rows < stop and self._group(stop - self.rows):
             pass
-
-    def _back(self, stop: int) -> int:
-        """A drive faults in cycle `stop`: the stretch ends before it. The planner from the last save (after a
-        feed, or the start), its steps made again up to there; the drives stepped again from the start."""
-        self._rewind(stop)
         self._redrive()
         return self.rows
 
