@@ -172,3 +172,49 @@ def test_long_passes_end_before_a_cycle_that_reads_nothing(monkeypatch, tmp_path
     past = [(m, reads) for n, m, reads in ends if 40 <= m < n]  # ended by the rule (or by the program's end)
     assert len(past) > 10 and not any(reads for _, reads in past), past
     assert any(m > 40 for m, _ in past)  # some went on past PASS_CYCLES through reading cycles
+
+
+def _second_cycle_feeds(monkeypatch, refuse: bool) -> dict:
+    """Counts the passes whose first feed ran at their second cycle; `refuse`: the step after that feed is refused
+    (as a step a pass cannot take: the stretch ends before its cycle, which is stepped), and the passes that then
+    ended after one cycle."""
+    seen = {"fed": 0, "one": 0}
+    real_group, real_run = hil.stretch_pass.Pass._group, hil.stretch_pass.Pass.run
+
+    def group(self, limit):
+        if self.rows == 1 and self.feeds == 1:
+            seen["fed"] += 1
+            if refuse:
+                return False  # (before the step: nothing changed, as a step refused before its refill)
+        return real_group(self, limit)
+
+    def run(self, n):
+        m = real_run(self, n)
+        seen["one"] += m == 1 and self.feeds > 0
+        return m
+
+    monkeypatch.setattr(hil.stretch_pass.Pass, "_group", group)
+    monkeypatch.setattr(hil.stretch_pass.Pass, "run", run)
+    return seen
+
+
+def test_a_pass_feeds_from_its_second_cycle(monkeypatch, tmp_path):
+    """Decision B137: a pass that starts where its first step leaves the queue below its depth (its second cycle
+    reads) runs that feed itself. Before, feeds came from a pass's third cycle: such a pass ended after one cycle,
+    which was refused, and that cycle and the 3 reading cycles after it were stepped (20 of the 5,000-block CAM
+    program's 61 stepped cycles)."""
+    seen = _second_cycle_feeds(monkeypatch, refuse=False)
+    out, (stepped, stretched), counts = _both(monkeypatch, tmp_path, cam_program(1500))
+    assert compare(out[0], out[1]) == []
+    assert seen["fed"] >= 2 and seen["one"] == 0, seen
+
+
+def test_a_pass_that_ends_after_its_second_cycles_feed_plays_that_cycle(monkeypatch, tmp_path):
+    """B137: where the step after a pass's feed in its second cycle cannot be taken in the pass (here refused at
+    every such feed), the feed cannot be taken back: the pass is played as a stretch of one cycle and the next
+    cycle is stepped without its feed (`Channel._fed`). Every column equals stepping's."""
+    seen = _second_cycle_feeds(monkeypatch, refuse=True)
+    out, (stepped, stretched), counts = _both(monkeypatch, tmp_path, cam_program(1500))
+    assert compare(out[0], out[1]) == []
+    assert seen["fed"] >= 2 and seen["one"] == seen["fed"], seen
+    assert stretched.run.ok and not stretched.alarms
