@@ -268,9 +268,7 @@ class Stretcher(RealTimeStretches):
         ps = Pass(self, ch, pl, rx0, saved_drives, PASS_CYCLES)
         m = ps.run(n)
         self.feeds += ps.feeds
-        # feeds come from the second cycle on (B137): a pass of one cycle whose feed ran (its next step could not be
-        # taken here) is played, the feed kept for the next cycle (`Channel._fed`); one with no feed is put back
-        if m < 2 and not (m == 1 and ps.feeds):
+        if m < 2:  # (no feed ran: feeds come from the third cycle on)
             _restore_planner(pl, saved_pl)
             self._restore_drives(saved_drives)
             ch._fed = self._fed0

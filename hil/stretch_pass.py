@@ -141,7 +141,7 @@ class Pass:
                 stop = self._drive(self.rows + 1)
                 if stop is not None:
                     return self._back(stop)
-                if not may_read(ch, pl) or not src.peek(READS_PER_CYCLE):
+                if self.rows < 2 or not may_read(ch, pl) or not src.peek(READS_PER_CYCLE):
                     break
                 ch._feed_planner()  # plain moves only: it pushes them, nothing else changes
                 self.feeds, fed_at = self.feeds + 1, self.rows
