@@ -138,6 +138,35 @@ def test_the_collector_is_paused_until_the_cycles_and_left_as_the_caller_had_it(
     assert _python(code) == ["True", "True", "0", "True", "True", "0", "False", "0"]
 
 
+def test_a_lockstep_runs_young_collections_are_rare_and_the_callers_thresholds_come_back():
+    """Decision bench B150: while a lock-step run's cycles go, the collector stays on (a user's MLC or script that makes
+    reference cycles still has them collected) with its young threshold at 50,000 new containers, not CPython's 700:
+    the lathe demo's cycles meet no young collection where they met 3 (the CAM program's 72 and 6 middle ones). Afterwards the caller's thresholds are back,
+    whatever they were."""
+    code = "\n".join([
+        "import gc",
+        "import hil",
+        "from hil.runner import BenchRunner",
+        "seen, inside = [], [False]",
+        "gc.callbacks.append(lambda p, i: p == 'start' and inside[0] and seen.append(i['generation']))",
+        "run_events = BenchRunner.run_events",
+        "def spy(self, events, planner=None):",
+        "    print(gc.isenabled(), *gc.get_threshold())",
+        "    inside[0] = True",
+        "    try:",
+        "        return run_events(self, events, planner)",
+        "    finally:",
+        "        inside[0] = False",
+        "BenchRunner.run_events = spy",
+        "r = hil.run('examples/lathe_demo.nc')",
+        "print(r.run.ok, seen.count(0), *gc.get_threshold())",
+        "gc.set_threshold(1000, 5, 7)",
+        "hil.run('examples/lathe_demo.nc')",
+        "print(gc.isenabled(), *gc.get_threshold())"])
+    assert _python(code) == ["True", "50000", "10", "10", "True", "0", "700", "10", "10",
+                             "True", "50000", "5", "7", "True", "1000", "5", "7"]
+
+
 def test_the_checks_median_is_numpys():
     import numpy as np
 
