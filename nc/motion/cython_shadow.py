@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from typing import Any, Callable
 
+compiled = False  # Cython's own name (True, folded at compile time, where compiled)
 double = float
 Py_ssize_t = int
 bint = bool

@@ -26,6 +26,11 @@ try:
 except ImportError:  # run as Python without Cython: they do nothing
     from nc.motion import cython_shadow as cython
 
+if cython.compiled:  # C's sqrt and cbrt, the functions math.sqrt and math.cbrt call (session 27, decision bench B148)
+    from cython.cimports.libc.math import cbrt as _cbrt, sqrt as _c_sqrt
+else:
+    _cbrt, _c_sqrt = math.cbrt, math.sqrt
+
 from nc.motion.blending import FilterCorners
 from nc.motion.block import Block
 from nc.motion.limits import MotionConfig, acceleration, jerk_per_acc
@@ -51,6 +56,15 @@ def arc_coupling(cfg: MotionConfig) -> float:
 
 
 MARGIN = 0.98  # the passes plan with 98 % of the limits ruckig gets, so plans are never borderline
+_MARGIN = MARGIN  # C doubles where compiled (lookahead.pxd): a module global is a Python float in each product
+_INF = math.inf
+
+
+def _sqrt(x: float) -> float:
+    """math.sqrt on a C double where compiled (lookahead.pxd): the same C sqrt, and math.sqrt's ValueError below 0."""
+    if x < 0.0:
+        raise ValueError("math domain error")
+    return _c_sqrt(x)
 
 
 @cython.ccall
@@ -92,6 +106,7 @@ def reach(v0: float, length: float, a: float, j: float) -> float:
     return v0 + (0.0 if 0.0 > dv else dv)  # max(dv, 0.0)
 
 
+@cython.locals(v0=cython.double, a0=cython.double, d=cython.double, a=cython.double, j=cython.double)
 def max_speed_at(v0: float, a0: float, d: float, a: float, j: float) -> float:
     """Upper bound of the speed any profile from (v0, a0) with acceleration ≤ a and jerk ≤ j can
     have after path length d: full jerk up to a, then a constant a (issue 18: a junction whose
@@ -99,6 +114,10 @@ def max_speed_at(v0: float, a0: float, d: float, a: float, j: float) -> float:
     return fastest_state(v0, a0, d, a, j)[0]
 
 
+@cython.ccall
+@cython.locals(v0=cython.double, a0=cython.double, d=cython.double, a=cython.double, j=cython.double,
+               t1=cython.double, d1=cython.double, v1=cython.double, lo=cython.double, hi=cython.double,
+               t=cython.double, k=cython.Py_ssize_t)
 def fastest_state(v0: float, a0: float, d: float, a: float, j: float) -> tuple[float, float]:
     """Speed and acceleration after path length d of `max_speed_at`'s profile from (v0, a0) (full jerk up to a, then
     a constant a): the fastest any profile within a and j can be there, and (from a state below a) the highest
@@ -108,9 +127,10 @@ def fastest_state(v0: float, a0: float, d: float, a: float, j: float) -> tuple[f
     d1 = v0 * t1 + a0 * t1 * t1 / 2.0 + j * t1 ** 3 / 6.0
     if d >= d1:
         v1 = v0 + a0 * t1 + j * t1 * t1 / 2.0
-        return math.sqrt(v1 * v1 + 2.0 * a * (d - d1)), a
-    lo, hi = 0.0, t1  # the time d is reached in the jerk phase (distance grows with t)
-    for _ in range(40):
+        return _sqrt(v1 * v1 + 2.0 * a * (d - d1)), a
+    lo = 0.0  # the time d is reached in the jerk phase (distance grows with t)
+    hi = t1
+    for k in range(40):
         t = 0.5 * (lo + hi)
         if v0 * t + a0 * t * t / 2.0 + j * t ** 3 / 6.0 < d:
             lo = t
@@ -119,7 +139,6 @@ def fastest_state(v0: float, a0: float, d: float, a: float, j: float) -> tuple[f
     return v0 + a0 * hi + j * hi * hi / 2.0, a0 + j * hi
 
 
-_sqrt, _cbrt = math.sqrt, math.cbrt  # reach() runs ≈ 10 times per pushed block
 
 # What a block is, for its limits (Limits.block_limits): cutting (G01/G02/G03, cycles' feed moves, corner
 # blends, fitted spans), G00 rapid, or a thread (spindle-synchronised: neither parameter set, decision motion 90).
@@ -200,7 +219,8 @@ class Limits:
         return a, (x if x < j else j)
 
     @cython.locals(v=cython.double, a=cython.double, j=cython.double, x=cython.double, d=cython.double,
-                   vl=cython.double, al=cython.double, jl=cython.double, what=cython.Py_ssize_t)
+                   vl=cython.double, al=cython.double, jl=cython.double, what=cython.Py_ssize_t,
+                   st=cython.double, i=cython.Py_ssize_t, n=cython.Py_ssize_t, m=cython.Py_ssize_t)
     def block_limits(self, seg: Segment, short_ok: bool = False, what: int = CUT) -> tuple[float, float, float]:
         """(speed cap, tangential acceleration, tangential jerk) of a path segment. `short_ok`: no
         minimum duration (a line whose both ends are blends has no corner for it to protect). `what`: CUT,
@@ -213,9 +233,25 @@ class Limits:
                 if x < v:
                     v = x
             return v, a, j
-        v = a = j = math.inf
-        for d, vl, al, jl in zip(seg.direction_cosines(), self._v, self._acc, self._jerk):
+        v = a = j = _INF
+        # zip(direction cosines, _v, _acc, _jerk) as a C loop over the shortest (session 27: per block)
+        cos, vs, accs, jerks = seg.direction_cosines(), self._v, self._acc, self._jerk
+        n = len(cos)
+        m = len(vs)
+        if m < n:
+            n = m
+        m = len(accs)
+        if m < n:
+            n = m
+        m = len(jerks)
+        if m < n:
+            n = m
+        for i in range(n):
+            d = cos[i]
             if d > 1e-12:  # v = min(v, vl / d) etc., spelt out: this runs per axis of every block
+                vl = vs[i]
+                al = accs[i]
+                jl = jerks[i]
                 x = vl / d
                 if x < v:
                     v = x
@@ -225,13 +261,15 @@ class Limits:
                 x = jl / d
                 if x < j:
                     j = x
-        if v == math.inf:
+        if v == _INF:
             return 0.0, 1.0, 1.0
-        a *= cfg.share_tangential
-        j *= cfg.share_tangential
+        st = cfg.share_tangential
+        a *= st
+        j *= st
         if what == 0 and self.cut_on:  # CUT
             a, j = self.cut_caps(a, j)
-        if seg.kind == "arc" and seg.radius > 0.0:
+        kind = seg.kind
+        if kind == "arc" and seg.radius > 0.0:
             k = seg.arc_len / seg.length
             rc = seg.radius / max(k * k, 1e-12)  # radius of curvature of the (helical) path
             pa = min(self._acc[seg.i1], self._acc[seg.i2])
@@ -241,9 +279,9 @@ class Limits:
             # d/dt of the centripetal term couples tangential acceleration into jerk: 3·v·a_t/r, along
             # the normal n, square to the tangential part (j_t − v³/r²)·t: see arc_coupling.
             a = min(a, self._coupling * pj * rc / (3.0 * max(v, 1e-9)))
-        if self.blend is not None and seg.kind == "arc":
+        if kind == "arc" and self.blend is not None:
             v = min(v, self.blend.arc_speed(seg.radius))
-        if seg.kind == "blend":
+        if kind == "blend":
             v, a, j = self._blend_limits(seg, v, a, j)
         if not short_ok:
             x = seg.length / (cfg.min_segment_cycles * self.T)
@@ -289,7 +327,14 @@ class Limits:
         s1, s2 = b1.seg, b2.seg
         assert s1 is not None and s2 is not None
         v = b2.cap_hard if b2.cap_hard < b1.cap_hard else b1.cap_hard  # min(), as min() picks
-        t2, t1 = s2.tangent(False), s1.tangent(True)
+        # Segment.tangent's cached line direction read here (session 27: two Python calls per junction)
+        t2 = s2._dir
+        if t2 is None:
+            t2 = s2.tangent(False)
+        t1 = s1._dir
+        if t1 is None:
+            t1 = s1.tangent(True)
+        k1, k2 = s1.kind, s2.kind
         if len(t1) == 3:  # the common case spelt out (once per pushed block, issue 17)
             d0, d1, d2 = t2[0] - t1[0], t2[1] - t1[1], t2[2] - t1[2]
             dv = (d0, d1, d2)
@@ -300,17 +345,18 @@ class Limits:
             du = tuple([abs(d) for d in dv])
             sq_sum = sum([d * d for d in du])
         cfg = self.cfg
-        if self.blend is not None and not raw:
+        blend = self.blend
+        if blend is not None and not raw:
             b1.dv = dv
             b1.du = du
             b1.du_n = du_n = math.sqrt(sq_sum)
             if du_n > 1e-9:
-                lines = s1.kind == "line" and s2.kind == "line"
+                lines = k1 == "line" and k2 == "line"
                 a = b2.a if b2.a > b1.a else b1.a  # max(b1.a, b2.a) and min(v, vb, vc) spelt out (session 15)
-                b1.vbud, b1.vctol = vb, vc = self.blend.corner_caps(du, du_n, lines, a)
+                b1.vbud, b1.vctol = vb, vc = blend.corner_caps(du, du_n, lines, a)
                 b1.viso = 0.0
                 if lines:  # the proved cap of a corner alone in its windows, where it is higher (decision motion 73)
-                    vp = self.blend.isolated_cap(du_n, a, b2.j if b2.j > b1.j else b1.j, b1, b2)
+                    vp = blend.isolated_cap(du_n, a, b2.j if b2.j > b1.j else b1.j, b1, b2)
                     if vp > vc:
                         b1.viso = b1.vctol = vc = vp
                 if vb < v:
@@ -330,13 +376,13 @@ class Limits:
             v = min(v, cfg.share_corner * vj, cfg.share_corner * va)
             if cfg.path_tolerance is not None:
                 v = min(v, 4.0 * cfg.path_tolerance / (self.T * math.sqrt(sum(d * d for d in du))))
-        if s1.kind == "arc" or s2.kind == "arc":  # a line has no curvature: line-line skips this
+        if k1 == "arc" or k2 == "arc":  # a line has no curvature: line-line skips this
             dk = np.abs(s2.curvature_vector(False) - s1.curvature_vector(True))
             if float(dk.max()) > 1e-12:
                 m = dk > 1e-12
                 # A curvature jump steps the axis acceleration: in one cycle without the filter,
                 # spread over its first window T1 with it.
-                t = self.blend.t_a if self.blend is not None and not raw else self.T
+                t = blend.t_a if blend is not None and not raw else self.T
                 v = min(v, float(np.min(np.sqrt(0.4 * cfg.share_curvature * self.jerk[m] * t / dk[m]))))
         return 0.0 if 0.0 > v else v  # max(v, 0.0)
 
@@ -398,7 +444,7 @@ def backward(blocks: Sequence[Block], lo: int = 0, full: bool = False, depth: in
                 ad = nx_ad + nx_length
                 aa = nx_a if nx_a < nx_aa else nx_aa  # min(nx.anchor_a, nx.a)
                 aj = nx_j if nx_j < nx_aj else nx_aj
-            r = reach(av, ad, MARGIN * aa, MARGIN * aj)
+            r = reach(av, ad, _MARGIN * aa, _MARGIN * aj)
             v = r if r < local else local
         binding = v >= local - 1e-12
         if k > k_stop and binding and b.binding and -1e-12 <= v - b.vend <= 1e-12:
