@@ -11,7 +11,6 @@ compiled = False  # Cython's own name (True, folded at compile time, where compi
 double = float
 Py_ssize_t = int
 bint = bool
-compiled = False  # cython.compiled: run as Python
 
 
 def locals(**_types: Any) -> Callable[[Callable], Callable]:  # noqa: A001 (Cython's name)
