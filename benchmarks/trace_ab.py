@@ -8,6 +8,14 @@ columns included), the same end record, alarms, handshakes and final positions.
 
 Shortcuts compared: `mlc-on-change` (the lathe MLC's user scan skipped while nothing it read changed,
 mlc/on_change.py), `stretch` (quiet cycles a stretch at a time, hil/stretch.py; DELTAHIL_STRETCH=0 is off). Prints one line per run and per shortcut, exits 1 on any difference.
+
+    python benchmarks/trace_ab.py --writer [--callgrind] [TRACE.parquet ...]
+
+The Parquet writer's option sets (`WRITER_SETS`, bench decision B139) on the traces given (default: the CAM run of
+5,000 blocks and the lathe demo, made here): each trace's table written by pyarrow's writer with each set, in memory;
+prints the file's size, the best of 15 writes' wall time and, with --callgrind, the instructions of one write
+(valgrind: a child writing it 3 times less one writing it 0 times, after a first write as the trace's warm-up
+makes); exits 1 if a set's file does not read back to the same values, bit for bit.
 """
 
 from __future__ import annotations
@@ -120,7 +128,134 @@ def compare(a: tuple, b: tuple) -> list[str]:
     return out
 
 
+def _floats(schema, pick=lambda name: True) -> dict[str, str]:
+    return {f.name: "BYTE_STREAM_SPLIT" for f in schema if str(f.type) == "double" and pick(f.name)}
+
+
+def _with(schema, **kw) -> dict:
+    from hil.trace_parquet import writer_options
+
+    opts = writer_options(schema)
+    enc = {**(opts["column_encoding"] or {}), **kw.pop("column_encoding", {})}
+    return {**opts, **kw, "column_encoding": enc or None}
+
+
+# the writer's option sets compared by --writer: name -> options of pyarrow's ParquetWriter for a schema
+WRITER_SETS: dict[str, Callable] = {
+    "pq defaults (before B139)": lambda s: _with(s, use_dictionary=True, column_encoding={}) | {"column_encoding": None},
+    "no dictionary": lambda s: _with(s, use_dictionary=False) | {"column_encoding": None},
+    "B139": lambda s: _with(s),
+    "B139, byte_stream_split t, *_cmd": lambda s: _with(s, column_encoding=_floats(s, lambda c: c == "t" or
+                                                                                     c.endswith("_cmd"))),
+    "B139, byte_stream_split floats": lambda s: _with(s, column_encoding=_floats(s)),
+    "B139, zstd level -1": lambda s: _with(s, compression_level=-1),
+    "B139, zstd level 3": lambda s: _with(s, compression_level=3),
+    "B139, no statistics": lambda s: _with(s, write_statistics=False),
+}
+
+_CG_CHILD = """
+import sys, pyarrow as pa
+sys.path.insert(0, sys.argv[1])
+from benchmarks.trace_ab import WRITER_SETS, _write_with
+from hil.trace_parquet import _Writer
+import pyarrow._parquet as pqi
+r = pqi.ParquetReader(); r.open(sys.argv[2]); table = r.read_all()
+opts = WRITER_SETS[sys.argv[3]](table.schema)
+_write_with(table, opts)  # the first file's lazy set-up (a run's trace makes it in _warm_up)
+for _ in range(int(sys.argv[4])):
+    _write_with(table, opts)
+"""
+
+
+def _write_with(table, opts: dict):
+    """The file pyarrow's writer makes of the table with these options, in memory."""
+    import pyarrow as pa
+
+    from hil.trace_parquet import _Writer
+
+    buf = pa.BufferOutputStream()
+    w = _Writer(buf, table.schema, **opts)
+    w.write_table(table, row_group_size=None)
+    w.close()
+    return buf.getvalue()
+
+
+def _same_bits(a, b) -> bool:
+    """Two tables' schema (metadata included) and values equal bit for bit (NaN, -0.0), nulls in the same rows."""
+    import numpy as np
+    import pyarrow as pa
+
+    if not a.schema.equals(b.schema, check_metadata=True) or a.num_rows != b.num_rows:
+        return False
+    for x, y in zip(a.columns, b.columns):
+        x, y = x.combine_chunks(), y.combine_chunks()
+        if x.type == pa.float64():
+            if not (x.is_null().equals(y.is_null()) and np.array_equal(
+                    x.fill_null(0.0).to_numpy().view(np.int64), y.fill_null(0.0).to_numpy().view(np.int64))):
+                return False
+        elif not x.equals(y):
+            return False
+    return True
+
+
+def _instructions(trace: Path, name: str, writes: int) -> int:
+    import os
+    import subprocess
+
+    with tempfile.TemporaryDirectory() as d:
+        child, out = Path(d) / "child.py", Path(d) / "cg.out"
+        child.write_text(_CG_CHILD)
+        subprocess.run(["valgrind", "--tool=callgrind", f"--callgrind-out-file={out}", os.path.realpath(sys.executable),
+                        str(child), str(ROOT), str(trace), name, str(writes)], check=True, capture_output=True,
+                       env={**os.environ, "PYTHONHASHSEED": "0"})
+        return next(int(line.split()[1]) for line in out.read_text(errors="replace").splitlines()
+                    if line.startswith(("summary:", "totals:")))
+
+
+def writer(argv: list[str]) -> int:
+    """--writer: each option set on each trace (module docstring)."""
+    import time
+
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    callgrind = "--callgrind" in argv
+    traces = [Path(a) for a in argv if not a.startswith("--")]
+    bad = 0
+    with tempfile.TemporaryDirectory() as d:
+        if not traces:
+            cam = Path(d) / "cam5000.nc"
+            cam.write_text(cam_program(5000))
+            for name, program, kw in (("cam5000", cam, {"bench": MILL}), ("lathe_demo", ROOT / "examples" /
+                                                                          "lathe_demo.nc", {})):
+                traces.append(Path(d) / f"{name}.parquet")
+                run(str(program), trace=str(traces[-1]), check=False, **kw)
+        for trace in traces:
+            table = pq.ParquetFile(trace).read()
+            print(f"{trace.name}: {table.num_rows} rows, {table.num_columns} columns")
+            print(f"  {'option set':34s} {'bytes':>8s} {'ms':>6s} {'instructions':>13s}  values")
+            for name, make in WRITER_SETS.items():
+                opts = make(table.schema)
+                data = _write_with(table, opts)
+                best = min(_timed(time.perf_counter, _write_with, table, opts) for _ in range(15))
+                same = _same_bits(pq.ParquetFile(pa.BufferReader(data)).read(), table)
+                bad += not same
+                ir = ""
+                if callgrind:
+                    ir = f"{(_instructions(trace, name, 3) - _instructions(trace, name, 0)) // 3:,}"
+                print(f"  {name:34s} {data.size:8d} {best * 1e3:6.2f} {ir:>13s}  {'same' if same else 'DIFFERENT'}")
+    return 1 if bad else 0
+
+
+def _timed(clock: Callable[[], float], fn: Callable, *args) -> float:
+    t0 = clock()
+    fn(*args)
+    return clock() - t0
+
+
 def main(argv: list[str]) -> int:
+    if "--writer" in argv:
+        return writer(argv)
     quick = "--quick" in argv
     save = Path(argv[argv.index("--save") + 1]) if "--save" in argv else None
     against = Path(argv[argv.index("--against") + 1]) if "--against" in argv else None

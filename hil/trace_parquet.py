@@ -37,6 +37,10 @@ try:  # pyarrow's Parquet writer itself: pyarrow.parquet's module imports pyarro
     from pyarrow._parquet import ParquetWriter as _Writer
 except ImportError:  # a pyarrow without it: pyarrow.parquet's public writer
     _Writer = None
+try:  # and its reader, for the parts joined at the end of a run (B139)
+    from pyarrow._parquet import ParquetReader as _Reader
+except ImportError:
+    _Reader = None
 
 ROW_GROUP = 50_000  # rows per row group: ~50 s at 1 ms, a few MB in memory
 FLUSH_S = 2.0  # …or sooner, once this much wall time has passed (real-time runs lose at most this)
@@ -44,9 +48,24 @@ META_KEY = b"deltahil"
 SWITCH_S = 0.0002  # the GIL switch interval while a writer converts (CPython's default 5 ms: a whole period)
 TRANSPOSE = 256  # rows transposed by one zip (_by_column: ≈ 30 µs for a trace's 23 columns, within SWITCH_S)
 # what pq.write_table(table, where, compression="zstd") gives pyarrow's writer (pyarrow.parquet.core.ParquetWriter's
-# defaults), so the file is the one it writes (tests/test_trace_parquet_writer.py compares the bytes)
+# defaults), so the file is the one pq writes with these options (tests/test_trace_parquet_writer.py compares the
+# bytes); which columns are dictionary-encoded and which delta-encoded is writer_options' (B139)
 _OPTIONS = dict(version="2.6", use_dictionary=True, compression="zstd", write_statistics=True,
                 writer_engine_version="V2", data_page_version="1.0", use_compliant_nested_type=True, store_schema=True)
+_DICTIONARY_TYPES = (pa.string(), pa.uint16())  # alarm codes, statuswords: a handful of values, repeated
+
+
+def writer_options(schema: pa.Schema) -> dict[str, Any]:
+    """The writer's options for a trace of this schema, column by column (bench decision B139): a dictionary only
+    for the columns of a few repeated values (alarm codes, statuswords); the int64 columns (cycle, line, the MLC's
+    bits and words) delta-encoded (cycle counts up by one, line by small steps); the float64 quantities plain, as
+    zstd takes them. pyarrow's default, a dictionary for every column, hashed each of a CAM trace's ≈ 6,000 distinct
+    positions per column and made the file larger: 52 M instructions to write the CAM run's trace, 29 M this way
+    (benchmarks/trace_ab.py --writer). Every encoding here is in Parquet's format 2.6 and read by pyarrow, pandas,
+    polars and duckdb; the values read back are the same, bit for bit."""
+    delta = {f.name: "DELTA_BINARY_PACKED" for f in schema if f.type == pa.int64()}
+    return dict(_OPTIONS, use_dictionary=[f.name for f in schema if f.type in _DICTIONARY_TYPES],
+                column_encoding=delta or None)
 
 
 def _type_of(name: str, value: float | int | str | None) -> pa.DataType:
@@ -153,11 +172,12 @@ def write_table(table: pa.Table, where: str | Path | pa.NativeFile) -> None:
     (`pyarrow._parquet.ParquetWriter`, what pq's writer wraps), so that a run does not import pyarrow.parquet's
     module: it imports pyarrow.fs, and with it ssl and the S3/GCS/Azure/HDFS file systems, ≈ 10 ms of CPU in every
     `hil run --trace` (issue 17, bench decision B92). A pyarrow whose writer is missing or takes other arguments
-    writes through pq.write_table; as pq does, a file left by a failed write is removed."""
+    writes through pq.write_table; as pq does, a file left by a failed write is removed. The options are
+    writer_options' (B139): the file is the one pq.write_table writes with them."""
     if _Writer is not None:
         sink = str(where) if isinstance(where, (str, Path)) else where
         try:
-            writer = _Writer(sink, table.schema, **_OPTIONS)
+            writer = _Writer(sink, table.schema, **writer_options(table.schema))
         except TypeError:  # another pyarrow's signature (its arguments are bound before a file is opened)
             writer = None
         except Exception:
@@ -175,7 +195,36 @@ def write_table(table: pa.Table, where: str | Path | pa.NativeFile) -> None:
             return
     import pyarrow.parquet as pq
 
-    pq.write_table(table, where, compression="zstd")
+    pq.write_table(table, where, **writer_options(table.schema))
+
+
+def _open_writer(path: Path, schema: pa.Schema) -> Any:
+    """The writer of a run's parts joined into its trace: the parts' options (writer_options), through pyarrow's
+    writer class itself as write_table (pq's module imported only for a pyarrow without it)."""
+    if _Writer is not None:
+        try:
+            return _Writer(str(path), schema, **writer_options(schema))
+        except TypeError:  # another pyarrow's signature
+            pass
+    import pyarrow.parquet as pq
+
+    return pq.ParquetWriter(path, schema, **writer_options(schema))
+
+
+def _read_part(path: Path) -> pa.Table:
+    """A part as `pq.ParquetFile(path).read()` reads it (not pq.read_table: the dataset reader imports pandas, B48),
+    through pyarrow's reader class itself: pq's module would import pyarrow.fs, ≈ 10 ms of CPU at the end of every
+    run of more than one part (B92, B139)."""
+    if _Reader is not None:
+        try:
+            reader = _Reader()
+            reader.open(str(path))
+            return reader.read_all()
+        except TypeError:  # another pyarrow's signature
+            pass
+    import pyarrow.parquet as pq
+
+    return pq.ParquetFile(path).read()
 
 
 def _remove(sink: str | pa.NativeFile) -> None:
@@ -346,14 +395,14 @@ class ParquetTrace:
         if self._schema is None:  # no rows at all: still a valid file with the columns
             self._schema = pa.schema([(c, pa.float64()) for c in self.columns])
         schema = self._schema.with_metadata(self._metadata())
-        import pyarrow.parquet as pq  # (a run of more than one part: longer than FLUSH_S or ROW_GROUP rows)
-
         tmp = self.path.with_name(f".{self.path.name}.{os.getpid()}.tmp")
         try:
-            with pq.ParquetWriter(tmp, schema, compression="zstd") as writer:
+            writer = _open_writer(tmp, schema)  # (a run of more than one part: longer than FLUSH_S or ROW_GROUP rows)
+            try:
                 for part in sorted(self.parts.glob("*.parquet")):
-                    # ParquetFile.read, not pq.read_table: the dataset reader imports pandas (B48)
-                    writer.write_table(pq.ParquetFile(part).read().replace_schema_metadata(schema.metadata))
+                    writer.write_table(_read_part(part).replace_schema_metadata(schema.metadata), row_group_size=None)
+            finally:
+                writer.close()
             os.replace(tmp, self.path)
         finally:
             tmp.unlink(missing_ok=True)

@@ -1,6 +1,7 @@
 """A Parquet trace is written by pyarrow's writer class itself, without importing pyarrow.parquet's module and its
-file systems (bench decision B92): the file must be the one `pq.write_table(..., compression="zstd")` writes, byte
-for byte, with this pyarrow; a pyarrow whose writer is missing or takes other arguments writes through pq."""
+file systems (bench decision B92): the file must be the one `pq.write_table(..., compression="zstd")` writes with the
+trace's encodings (a dictionary for strings and statuswords, delta for int64, plain floats: B139), byte for byte,
+with this pyarrow; a pyarrow whose writer is missing or takes other arguments writes through pq."""
 
 from __future__ import annotations
 
@@ -35,7 +36,10 @@ def _table() -> pa.Table:
 
 def _pq_bytes(table: pa.Table, tmp_path: Path) -> bytes:
     ref = tmp_path / "ref.parquet"
-    pq.write_table(table, ref, compression="zstd")
+    names = table.column_names
+    pq.write_table(table, ref, compression="zstd",
+                   use_dictionary=[c for c in names if c in ("alarm", "X_sw")],
+                   column_encoding={c: "DELTA_BINARY_PACKED" for c in names if c == "line"} or None)
     return ref.read_bytes()
 
 
