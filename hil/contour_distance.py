@@ -94,24 +94,44 @@ def _run_moves(line: np.ndarray, moves: list[Move], lag_cycles: int):
     run_line = line[starts].astype(np.int64)
     lines = _unique(np.concatenate([run_line, np.array([m.line for m in moves], dtype=np.int64)]))
     run_lid = np.searchsorted(lines, run_line)
-    # each line's candidates: its moves and their neighbours (a move's corner may be blended)
+    # each line's candidates: its moves and their neighbours (a move's corner may be blended), as intervals of
+    # move indices: [j - 1, j + 1] about each of its moves j, and j's nearest moves with a path
     mv_lid = np.searchsorted(lines, np.array([m.line for m in moves], dtype=np.int64))
-    idx = np.arange(len(moves))
+    m_n = len(moves)
+    idx = np.arange(m_n)
     prev_path, next_path = _path_neighbours(moves)
-    nb = np.concatenate([idx - 1, idx, idx + 1, prev_path, next_path])
-    ok = (nb >= 0) & (nb < len(moves))
-    lm = _unique(np.tile(mv_lid, 5)[ok] * len(moves) + nb[ok])
-    lm_count = np.bincount(lm // len(moves), minlength=len(lines))
-    lm_first = np.cumsum(lm_count) - lm_count
+    iv_lo = np.concatenate([np.maximum(idx - 1, 0), prev_path, next_path])
+    iv_hi = np.concatenate([np.minimum(idx + 1, m_n - 1), prev_path, next_path])
+    ok = (iv_lo >= 0) & (iv_hi < m_n)
+    l_lo, l_hi = _merge(np.tile(mv_lid, 3)[ok], iv_lo[ok], iv_hi[ok], m_n)
+    li_line, l_lo, l_hi = l_lo // m_n, l_lo % m_n, l_hi % m_n
+    li_count = np.bincount(li_line, minlength=len(lines))
+    li_first = np.cumsum(li_count) - li_count
     feed_lids = _unique(mv_lid[[m.kind in FEED_KINDS for m in moves]])
     runs = np.flatnonzero(np.isin(run_lid, feed_lids))
     lo = np.searchsorted(starts, np.maximum(starts[runs] - lag_cycles, 0), side="right") - 1
-    owner, k = _ranges(runs - lo + 1)  # (run, window run) -> (run, line) -> (run, move), each once
+    owner, k = _ranges(runs - lo + 1)  # (run, window run) -> (run, line) -> (run, interval) -> (run, move)
     rl = _unique(runs[owner] * len(lines) + run_lid[lo[owner] + k])
-    r_of, l_of = rl // len(lines), rl % len(lines)
-    owner, k = _ranges(lm_count[l_of])
-    rm = _unique(r_of[owner] * len(moves) + lm[lm_first[l_of[owner]] + k] % len(moves))
-    return starts, ends, runs, rm // len(moves), rm % len(moves)
+    r_of, l_of = np.divmod(rl, len(lines))
+    owner, k = _ranges(li_count[l_of])
+    iv = li_first[l_of[owner]] + k
+    r_lo, r_hi = _merge(r_of[owner], l_lo[iv], l_hi[iv], m_n)  # each run's candidates: disjoint intervals
+    owner, k = _ranges(r_hi - r_lo + 1)
+    return (starts, ends, runs) + np.divmod(r_lo[owner] + k, m_n)
+
+
+def _merge(group: np.ndarray, lo: np.ndarray, hi: np.ndarray, size: int) -> tuple[np.ndarray, np.ndarray]:
+    """The union of each group's intervals [lo, hi] of 0 … size - 1, as disjoint intervals sorted by group and start,
+    their ends given as group·size + lo and group·size + hi (a group's keys stay below the next group's)."""
+    k_lo, k_hi = group * size + lo, group * size + hi
+    if len(k_lo) and not np.all(k_lo[1:] >= k_lo[:-1]):  # (a CAM program's runs, lines and moves come in order)
+        order = np.argsort(k_lo, kind="stable")
+        k_lo, k_hi = k_lo[order], k_hi[order]
+    reach = np.maximum.accumulate(k_hi)
+    new = np.ones(len(k_lo), dtype=bool)
+    new[1:] = k_lo[1:] > reach[:-1]  # past everything before it: a new interval
+    at = np.flatnonzero(new)
+    return k_lo[at], reach[np.append(at[1:] - 1, len(k_lo) - 1)] if len(at) else reach[:0]
 
 
 def _segments(moves: list[Move], need: np.ndarray, axes: list[str]):
@@ -129,8 +149,10 @@ def _segments(moves: list[Move], need: np.ndarray, axes: list[str]):
     first = np.cumsum(count) - count
     a, b = np.empty((int(count.sum()), len(key))), np.empty((int(count.sum()), len(key)))
     if lines:
-        st = np.array([[float(moves[j].start.get(x, 0.0)) for x in key] for j in lines]).reshape(len(lines), len(key))
-        en = np.array([[float(moves[j].end.get(x, 0.0)) for x in key] for j in lines]).reshape(len(lines), len(key))
+        # (flat, as float64: numpy converts an int coordinate as float() does)
+        st = np.array([moves[j].start.get(x, 0.0) for j in lines for x in key], dtype=np.float64)
+        en = np.array([moves[j].end.get(x, 0.0) for j in lines for x in key], dtype=np.float64)
+        st, en = st.reshape(len(lines), len(key)), en.reshape(len(lines), len(key))
         a[first[lines]], b[first[lines]] = st + 0.0 * (en - st), st + 1.0 * (en - st)
     for j, p in curves.items():
         a[first[j]:first[j] + count[j]], b[first[j]:first[j] + count[j]] = p[:-1], p[1:]
@@ -159,7 +181,7 @@ def contour_distances(act: np.ndarray, line: np.ndarray, moves: list[Move], axes
             dist[r0:r1] = np.minimum(dist[r0:r1], _distance_to_boxes(act[r0:r1], rapids, axes))
         keep = ~boxed[m_of]
         r_of, m_of = r_of[keep], m_of[keep]
-    a, b, seg_count, seg_first = _segments(moves, _unique(m_of), axes)
+    a, b, seg_count, seg_first = _segments(moves, np.flatnonzero(np.bincount(m_of, minlength=len(moves))), axes)
     ab = b - a
     ab2 = np.einsum("ij,ij->i", ab, ab)
     ab2 = np.where(ab2 > 0, ab2, 1.0)
@@ -170,7 +192,7 @@ def contour_distances(act: np.ndarray, line: np.ndarray, moves: list[Move], axes
     run_first = np.cumsum(per_run) - per_run
     # A long run (a lathe's arc, a long line) broadcasts its cycles against its segments as the
     # per-run loop did; the many short runs of a CAM program go as (cycle, segment) pairs at once.
-    long_runs = [r for r in runs.tolist() if ends[r] - starts[r] >= LONG_RUN and per_run[r]]
+    long_runs = runs[(ends[runs] - starts[runs] >= LONG_RUN) & (per_run[runs] > 0)].tolist()
     for r in long_runs:
         s = run_seg[run_first[r]:run_first[r] + per_run[r]]
         r0, r1 = int(starts[r]), int(ends[r])
@@ -180,21 +202,40 @@ def contour_distances(act: np.ndarray, line: np.ndarray, moves: list[Move], axes
         cyc_segs[starts[r]:ends[r]] = 0
     cycles = np.flatnonzero(cyc_segs)
     cum = np.cumsum(cyc_segs[cycles])
+    # per axis, contiguous: each pair's operands are gathered once, as 1-D arrays (a 2-D row gather and einsum over
+    # 3 axes cost numpy's general iterators; the CAM program's 283k pairs: 558 → ... M instructions, B139)
+    act_k = [np.ascontiguousarray(act[:, j]) for j in range(act.shape[1])]
+    a_k = [np.ascontiguousarray(a[:, j]) for j in range(a.shape[1])]
+    ab_k = [np.ascontiguousarray(ab[:, j]) for j in range(ab.shape[1])]
     b0 = 0
     while b0 < len(cycles):  # batches of whole cycles, about PAIRS_PER_BATCH pairs each
         base = cum[b0 - 1] if b0 else 0
         b1 = max(b0 + 1, int(np.searchsorted(cum, base + PAIRS_PER_BATCH, side="right")))
         cyc = cycles[b0:b1]
-        owner, k = _ranges(cyc_segs[cyc])
-        c = cyc[owner]
-        s = run_seg[run_first[cyc_run[c]] + k]
-        ap = act[c] - a[s]
-        u = np.clip(np.einsum("pk,pk->p", ap, ab[s]) / ab2[s], 0.0, 1.0)
-        d = ap - u[:, None] * ab[s]
-        d2 = np.minimum.reduceat(np.einsum("pk,pk->p", d, d), np.cumsum(cyc_segs[cyc]) - cyc_segs[cyc])
+        cnt = cyc_segs[cyc]
+        first = np.cumsum(cnt) - cnt  # each cycle's first pair
+        # a cycle's segments are its run's, run_seg[run_first[run]:][:per_run[run]], laid end to end
+        s = run_seg[np.arange(int(cnt.sum())) + np.repeat(run_first[cyc_run[cyc]] - first, cnt)]
+        ap = [np.repeat(x[cyc], cnt) - y[s] for x, y in zip(act_k, a_k)]
+        abs_ = [y[s] for y in ab_k]
+        u = _dot(ap, abs_, len(s))
+        u /= ab2[s]
+        np.clip(u, 0.0, 1.0, out=u)
+        d = [p - u * q for p, q in zip(ap, abs_)]
+        d2 = np.minimum.reduceat(_dot(d, d, len(s)), first)
         dist[cyc] = np.minimum(dist[cyc], np.sqrt(d2))
         b0 = b1
     return dist
+
+
+def _dot(x: list[np.ndarray], y: list[np.ndarray], n: int) -> np.ndarray:
+    """Σ x_k·y_k over the axes, pair by pair (n pairs), summed from the first axis on (as einsum's "pk,pk->p")."""
+    if not x:
+        return np.zeros(n)
+    out = x[0] * y[0]
+    for p, q in zip(x[1:], y[1:]):
+        out += p * q
+    return out
 
 
 def _broadcast(p: np.ndarray, a: np.ndarray, ab: np.ndarray, ab2: np.ndarray, chunk: int = 512) -> np.ndarray:

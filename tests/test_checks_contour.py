@@ -116,6 +116,19 @@ def test_every_cycle_has_the_distance_its_rule_gives(arcs, within, stalls):
     assert 0.002 < float(np.max(got)) < 0.0071
 
 
+@pytest.mark.parametrize("lag", [0, 1, 40])
+def test_the_candidates_are_the_rules_at_any_lag(lag):
+    """A run's candidates are gathered as intervals of moves merged run by run (B139): with no lag (the run's own
+    lines), one cycle, and a window of dozens of lines (overlapping neighbours, the loop's lines met again, the
+    zero-length blocks' neighbours), each cycle's distance is the plain rule's to the last bits."""
+    moves = zigzag(300, arcs=False, stalls=True)
+    act, line = trace_along(moves, seed=5)
+    got = contour_distances(act, line, moves, ["X", "Z"], lag, False)
+    want = reference(act, line, moves, lag)
+    assert np.all(got[-5:] == 0.0) and np.max(np.abs(got - want)) <= 1e-15
+    assert (float(np.max(got)) > 0.0071) == (lag < 5)  # the drive's 5 cycles of trail: within the rule's window
+
+
 def test_the_worst_cycle_is_named_with_its_line(tmp_path):
     moves = zigzag(120)
     act, line = trace_along(moves)
