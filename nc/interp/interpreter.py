@@ -15,7 +15,7 @@ from nc.alarm_table import ENDLESS_LOOP
 from nc.alarms import NcAlarm, internal_error
 from nc.budget import StatementBudget
 from nc.interp.corners import expand_corners
-from nc.interp.lean import NOTHING, LeanLane
+from nc.interp.lean import MISS, NOTHING, LeanLane
 from nc.interp.servo import ServoPort
 from nc.interp.state import Frames, ModalState
 from nc.interp.sysvars import SystemVariables
@@ -163,7 +163,7 @@ class Interpreter(ExecuteMixin, ReadingMixin, ModalMixin, MotionMixin, NonModalM
         lean = self._lean
         if lean is None:
             lean = self._lean = LeanLane(self)
-        take, nothing = lean.take, NOTHING
+        take, nothing, miss = lean.take, NOTHING, MISS
         cur = None  # the frame `blocks`, `count`, `parsed` and `name` are of (read again when it changes)
         while self.stack:
             if budget is not None and budget.used >= budget.limit:  # `spent`, without a property call a block
@@ -181,7 +181,7 @@ class Interpreter(ExecuteMixin, ReadingMixin, ModalMixin, MotionMixin, NonModalM
                 # has no plain lines
                 parsed = getattr(blocks, "parsed", None) or blocks.__getitem__
                 lean_unread = self.lean  # the frame's lines for the lean lane: looked up at its first plain line
-                raw_at = None
+                index = None
             pc = fr.pc
             if pc >= count:
                 if len(self.stack) == 1:
@@ -198,12 +198,22 @@ class Interpreter(ExecuteMixin, ReadingMixin, ModalMixin, MotionMixin, NonModalM
                 # a plain motion line in the plain state, run from its text (nc.interp.lean, issue 17)
                 if lean_unread:
                     lean_unread = False
-                    raw_at, refused = lean.lines(blocks)
-                if raw_at is not None and pc not in refused and (ev := take(fr, pc, raw_at(pc), limit)) is not None:
-                    last = self.block
-                    if ev is not nothing:
-                        yield ev  # type: ignore[misc]
-                    continue
+                    index, refused = lean.lines(blocks)
+                    if index is not None:
+                        text, starts, lengths, file_lines = index
+                if index is not None and pc not in refused:
+                    # the line's text and file line read here (`BlockList.raw`, `line`), and the shape of
+                    # the last line taken tried here: no call per line but the shape's own
+                    start = starts[pc]
+                    raw = text[start:start + lengths[pc]]
+                    shape = lean.last
+                    if shape is None or (ev := shape.run(lean, self, fr, pc, raw, limit, file_lines[pc])) is miss:
+                        ev = take(fr, pc, raw, limit, file_lines[pc])
+                    if ev is not None:
+                        last = self.block
+                        if ev is not nothing:
+                            yield ev  # type: ignore[misc]
+                        continue
                 block = blocks[pc]
             last = block
             # `_take_block`, inline: this runs for every block

@@ -89,15 +89,16 @@ class LeanLane:
         self.tables: object = None  # the code-call tables `g_ok` was found with
         self.g_ok = False
 
-    def lines(self, blocks: object) -> tuple[Callable[[int], str | None] | None, set[int]]:
-        """A block list's plain-line texts (`BlockList.raw`, None for a list of blocks) and the indexes
-        of its lines the lane never takes (`M99`, `T0101`, `G90 G54`: by their letters), which `_run`
-        runs on the general path without asking again (a macro's M99, 5,000 passes)."""
+    def lines(self, blocks: object) -> tuple[tuple | None, set[int]]:
+        """A block list's plain-line texts and file lines (`BlockList.text_index`, None for a list of
+        blocks) and the indexes of its lines the lane never takes (`M99`, `T0101`, `G90 G54`: by their
+        letters), which `_run` runs on the general path without asking again (a macro's M99, 5,000 passes)."""
         hit = self.refused.get(id(blocks))
         if hit is None or hit[0] is not blocks:  # the list is held: its id is not reused meanwhile
             if len(self.refused) >= 64:
                 self.refused.clear()
-            hit = self.refused[id(blocks)] = (blocks, getattr(blocks, "raw", None), set())
+            index = getattr(blocks, "text_index", None)
+            hit = self.refused[id(blocks)] = (blocks, None if index is None else index(), set())
         return hit[1], hit[2]
 
     def _g_ok(self) -> bool:
@@ -153,16 +154,12 @@ class LeanLane:
                 and not st.polar and ip.macro_modal is None and ip._three_point is None
                 and ip._angle_pending is None and not ip.corner_pending and _transforms(ip) is None)
 
-    def take(self, fr: "Frame", pc: int, raw: str, limit: int) -> object:
-        """Run the plain line `raw` at `fr.pc == pc`: its Move, NOTHING when it moved nothing, or None
-        (nothing done) when the general path must run it."""
-        shape = self.last
-        if shape is not None:  # a CAM run is mostly lines of one shape: tried first
-            ev = shape.run(self, self.ip, fr, pc, raw, limit)
-            if ev is not MISS:
-                return ev
-        # a line of another shape: its shape by its text (a line the lane refuses, `M99` of a macro
-        # called 5,000 times, is refused by one look-up), else by its letters
+    def take(self, fr: "Frame", pc: int, raw: str, limit: int, line: int) -> object:
+        """Run the plain line `raw` (file line `line`) at `fr.pc == pc`, one the shape of the last line
+        taken (`last`, which `_run` tries first: a CAM run is mostly lines of one shape) did not match:
+        its Move, NOTHING when it moved nothing, or None (nothing done) when the general path must run it."""
+        # its shape by its text (a line the lane refuses, `M99` of a macro called 5,000 times, is refused
+        # by one look-up), else by its letters
         shape = self.texts.get(raw, _UNSEEN)
         if shape is _UNSEEN:
             letters = tuple(c.upper() for c in _LETTER.findall(raw))
@@ -175,7 +172,7 @@ class LeanLane:
         if shape is None:
             self.lines(fr.program.blocks)[1].add(pc)  # never taken: `_run` no longer asks
             return None
-        ev = shape.run(self, self.ip, fr, pc, raw, limit)  # type: ignore[union-attr]
+        ev = shape.run(self, self.ip, fr, pc, raw, limit, line)  # type: ignore[union-attr]
         if ev is MISS:
             return None
         self.last = shape  # type: ignore[assignment]
@@ -201,7 +198,7 @@ def _compiled(letters: tuple[str, ...], g: int | None, f: int | None, programmed
     work (halved in diameter) + origin, refused out of +-1e9; the same refusals, then the same state."""
     words = dict(programmed)
     moved = bool(programmed)
-    src = ["def run(lane, ip, fr, pc, raw, limit):",
+    src = ["def run(lane, ip, fr, pc, raw, limit, line):",
            "    m = MATCH(raw)",
            "    if m is None:",
            "        return MISS  # another shape",
@@ -248,10 +245,12 @@ def _compiled(letters: tuple[str, ...], g: int | None, f: int | None, programmed
                     "        return None  # NaN, an infinity or |v| > 1e9: the general path's 0x120E"]
     src += ["    fr.pc = pc + 1",
             "    ip._executed += 1",
-            "    program = fr.program",
-            "    name = ip.program_name = program.name",
-            "    line = program.blocks.line(pc)",
-            "    ip.block = LineBlock(line, raw, SHAPE, vals)"]
+            "    name = ip.program_name = fr.program.name",
+            "    ip.block = b = NEW(LineBlock)  # LineBlock(line, raw, SHAPE, vals), without its __init__ frame",
+            "    b.line = line",
+            "    b.text = raw",
+            "    b._shape = SHAPE",
+            "    b._vals = vals"]
     if g is not None:
         src += [f"    st.groups[1] = float(vals[{g}])", "    st.motion = motion"]
     if f is not None:
@@ -274,7 +273,7 @@ def _compiled(letters: tuple[str, ...], g: int | None, f: int | None, programmed
                 "    ip.last_target = mv.work  # never changed in place (rebound by every block that moves)",
                 "    return mv"]
     space = {"_G_MOTION": _G_MOTION, "Word": Word, "Move": Move, "PLANES": PLANES, "NOTHING": NOTHING,
-             "LineBlock": LineBlock, "SHAPE": None, "MATCH": None, "MISS": MISS}
+             "LineBlock": LineBlock, "NEW": object.__new__, "SHAPE": None, "MATCH": None, "MISS": MISS}
     exec(compile("\n".join(src) + "\n", f"<lean line {''.join(letters)}>", "exec"), space)
     return space["run"]
 
@@ -292,12 +291,17 @@ class LineBlock(Block):
 
     __slots__ = ("_shape", "_vals")  # the shape and groups until the words are made, then None
 
+    # what every plain line has, as values of the class (they shadow Block's slots, read-only): no '/', no
+    # comment, no statement, and no ,C/,R/,A: one empty mapping for all (nothing writes a block's skip,
+    # comment, statement or comma but the parser and `_resolve`, on blocks of their own)
+    skip = False
+    comment = ""
+    stmt = None
+    comma = comma_expr = _NO_COMMA
+
     def __init__(self, line: int, text: str, shape: _Shape, vals: tuple[str, ...]) -> None:
-        self.line, self.text, self.skip, self.comment, self.stmt = line, text, False, "", None
-        # a plain line has no ,C/,R/,A: one empty mapping for all, read-only (nothing writes a block's comma
-        # but the parser and `_resolve`, on blocks of their own)
-        self.comma = self.comma_expr = _NO_COMMA  # type: ignore[assignment]
-        self._shape, self._vals = shape, vals
+        # a shape's `run` (`_compiled`) makes its LineBlock as this does, without calling it (no frame per line)
+        self.line, self.text, self._shape, self._vals = line, text, shape, vals
 
     def _read(self) -> None:
         shape, vals = self._shape, self._vals
