@@ -51,10 +51,16 @@ class Program:
 # A plain line that `_plain_block` reads without a doubt (no alarm possible): an optional leading
 # N of digits, then one-letter addresses other than N and O, each with a number of at most
 # MAX_DIGITS + 3 characters. Such lines are kept as text and read when the interpreter needs them.
-_WORD_OK = r"[A-MP-Za-mp-z](?=[-+.0-9]{1,12}(?![.0-9]))[+-]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)[ \t]*"
-_PLAIN_OK = re.compile(r"[ \t]*(?:[Nn]([0-9]{1,12})[ \t]*)?(?:" + _WORD_OK + ")*")
+# Written for the matcher (issue 17, decision bench B138; the lines it takes are those of session 22's
+# `[A-MP-Za-mp-z](?=[-+.0-9]{1,12}(?![.0-9]))[+-]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)[ \t]*`, which
+# tests/test_parse29_plain_form.py keeps): every repeat possessive (a plain line never needs a step back: a
+# number ends where the next letter, blank or the line's end is), and the number's length, which a whole
+# match only allows where the number is the whole run of [-+.0-9] after its letter, as "no 13 such
+# characters" (a third of `parse_program`'s time on a CAM program went to the matcher's backtracking marks)
+_WORD_OK = r"[A-MP-Za-mp-z](?![-+.0-9]{13})[+-]?+(?:[0-9]++\.?+[0-9]*+|\.[0-9]++)[ \t]*+"
+_PLAIN_OK = re.compile(r"[ \t]*+(?:[Nn]([0-9]{1,12}+)[ \t]*+)?+(?:" + _WORD_OK + ")*+")
 # `_PLAIN_OK` but for a blank line (no N, no word): a line `_parse` keeps as text
-_PLAIN_ITEM = re.compile(r"[ \t]*(?:[Nn]([0-9]{1,12})[ \t]*(?:" + _WORD_OK + ")*|(?:" + _WORD_OK + ")+)")
+_PLAIN_ITEM = re.compile(r"[ \t]*+(?:[Nn]([0-9]{1,12}+)[ \t]*+(?:" + _WORD_OK + ")*+|(?:" + _WORD_OK + ")++)")
 _CHUNK = 1 << 16  # characters of program text `_parse` reads at a time
 _CACHE_LIMIT = 4096  # parsed plain lines kept (loops and GOTO come back to them); then the cache starts over
 
@@ -244,7 +250,11 @@ _OTHER_BREAKS = re.compile("[\r\x0b\x0c\x1c\x1d\x1e\x85\u2028\u2029]")
 def _one_line_break(text: str) -> str:
     """`text` with its lines (as str.splitlines reads them) joined by "\n" alone: line numbers
     stay; the common file (only "\n") is returned as it is, not copied."""
-    if _OTHER_BREAKS.search(text) is None:
+    if text.isascii():  # known without a look at the text; then a search for each ASCII break (C's memchr)
+        if not ("\r" in text or "\x0b" in text or "\x0c" in text or "\x1c" in text or "\x1d" in text
+                or "\x1e" in text):
+            return text
+    elif _OTHER_BREAKS.search(text) is None:
         return text
     return "\n".join(text.splitlines())
 
