@@ -30,47 +30,50 @@ def expand_corners(interp: "InterpHost", events: Iterator[Event]) -> Iterator[Ev
     held: list[Event] = []  # M/S/T or dwell events of the next block, issued after the corner
     events = iter(events)
     while True:
+        if pending is None:
+            # no corner waits (the usual state): every event passes as it is but a joinable move whose
+            # block carries ,C/,R, which then waits (hot path: a for loop, a block without ,C/,R said
+            # without a call, `corner_pending` said once)
+            interp.corner_pending = False
+            for ev in events:
+                if ev is None:
+                    break
+                b = interp.block
+                if b is not None and b.comma and isinstance(ev, Move) and ev.kind in _JOINABLE \
+                        and (mark := _mark(interp, ev)) is not None:
+                    pending = (ev, mark[0], mark[1])
+                    break
+                yield ev
+            if pending is None:
+                break  # the stream ended
+            continue
         # while a corner waits for its motion block the interpreter reads block by block (no bulk run
         # reads past the block that joins it, or past its alarm): said before the next event is read
-        interp.corner_pending = pending is not None
+        interp.corner_pending = True
         ev = next(events, None)
         if ev is None:
             break
-        if type(ev) is Move and pending is None and ev.kind in _JOINABLE:  # the usual event, said first
-            b = interp.block  # a block without ,C/,R marks nothing: said without a call (hot path)
-            if b is None or not b.comma or (mark := _mark(interp, ev)) is None:
-                yield ev
-                continue
-            pending = (ev, mark[0], mark[1])
-            continue
-        if type(ev) is MoveList:  # a cycle's moves: through whole unless a corner waits, then one by one
-            if pending is None:
-                yield ev
-                continue
+        if type(ev) is MoveList:  # a cycle's moves: one by one while a corner waits
             events = chain(ev.moves(), events)
             continue
-        if type(ev) is MoveBatch:  # plain moves (no ,C/,R): through whole unless a corner waits for them
-            if pending is None:
-                yield ev
-                continue
+        if type(ev) is MoveBatch:  # plain moves (no ,C/,R): the first joins the corner
             yield from _corners_of(interp, ev.moves(), pending, held)
             pending, held = None, []
             continue
         if isinstance(ev, Move) and ev.kind in _JOINABLE:
-            b = interp.block  # a block without ,C/,R marks nothing: said without a call (hot path)
+            b = interp.block
             mark = None if b is None or not b.comma else _mark(interp, ev)
-            if pending is not None:
-                first, kind, value = pending
-                pending = None
-                yield from _join(interp, first, ev, kind, value)
-                yield from held
-                held = []
+            first, kind, value = pending
+            pending = None
+            yield from _join(interp, first, ev, kind, value)
+            yield from held
+            held = []
             if mark is not None:
                 pending = (ev, mark[0], mark[1])
                 continue
             yield ev
             continue
-        if pending is not None and not isinstance(ev, Busy):  # a Busy mark passes at once
+        if not isinstance(ev, Busy):  # a Busy mark passes at once
             if isinstance(ev, ProgramEnd):
                 _fail(pending)
             held.append(ev)

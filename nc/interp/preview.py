@@ -52,45 +52,62 @@ class PreviewWindow:
         # counts of the Moves and Syncs in buf, kept as events enter and leave (hot path: no rescans)
         moves = syncs = 0
         while True:
-            # read ahead until the window is full, a Sync arrives, or the program ends
-            while not done and moves <= depth and not syncs:
+            # read ahead until the window is full, a Sync arrives, or the program ends. A for loop (the
+            # stream's next event without a call of next()) that, once the window is full of Moves, hands
+            # out its oldest events until there is room and reads on (hot path: one event in, one out).
+            # Nothing is thrown into this generator: the `try` sees only the stream's alarms.
+            if not done and moves <= depth and not syncs:
                 try:
-                    ev = next(events)
-                except StopIteration:
-                    done = True
-                    break
+                    for ev in events:
+                        if type(ev) is Move:  # the usual event first (Move has no subclass)
+                            buf.append(ev)
+                            moves += 1
+                            while moves > depth:  # no Sync is in buf while reading
+                                out = buf.popleft()
+                                if type(out) is Move:
+                                    moves -= 1
+                                    self.executing = out
+                                else:
+                                    moves, syncs = self._left(out, moves, syncs)
+                                yield out
+                            continue
+                        if isinstance(ev, Busy):  # the statement budget is spent: the channel reads on next cycle
+                            yield ev
+                            continue
+                        buf.append(ev)
+                        if isinstance(ev, Move):
+                            moves += 1
+                        elif type(ev) is MoveBatch or type(ev) is MoveList:  # a run of plain moves (nc.interp.bulk,
+                            moves += len(ev)  # a cycle's) counts as its moves
+                        elif isinstance(ev, Sync):
+                            syncs += 1
+                        if moves > depth or syncs:
+                            break
+                    else:
+                        done = True  # the program ended
                 except Exception as exc:  # an alarm read ahead is raised when execution reaches it
                     failure = exc
                     done = True
-                    break
-                if type(ev) is Move:  # the usual event first (Move has no subclass)
-                    buf.append(ev)
-                    moves += 1
-                    continue
-                if isinstance(ev, Busy):  # the statement budget is spent: the channel reads on next cycle
-                    yield ev
-                    continue
-                buf.append(ev)
-                if isinstance(ev, Move):
-                    moves += 1
-                elif type(ev) is MoveBatch or type(ev) is MoveList:  # a run of plain moves (nc.interp.bulk,
-                    moves += len(ev)  # a cycle's) counts as its moves
-                elif isinstance(ev, Sync):
-                    syncs += 1
+                continue
             if not buf:
                 if failure is not None:
                     raise failure
                 return
             ev = buf.popleft()
-            if isinstance(ev, Move):
-                moves -= 1
-                self.executing = ev
-            elif type(ev) is MoveBatch:
-                moves -= len(ev)
-                self.executing = ev  # type: ignore[assignment]  # its .line/.block: the last move's
-            elif type(ev) is MoveList:
-                moves -= len(ev)
-                self.executing = ev.items[-1]
-            elif isinstance(ev, Sync):
-                syncs -= 1
+            moves, syncs = self._left(ev, moves, syncs)
             yield ev
+
+    def _left(self, ev: Event, moves: int, syncs: int) -> tuple[int, int]:
+        """The counts of Moves and Syncs in the window once `ev` has left it (the machine runs it now)."""
+        if isinstance(ev, Move):
+            moves -= 1
+            self.executing = ev
+        elif type(ev) is MoveBatch:
+            moves -= len(ev)
+            self.executing = ev  # type: ignore[assignment]  # its .line/.block: the last move's
+        elif type(ev) is MoveList:
+            moves -= len(ev)
+            self.executing = ev.items[-1]
+        elif isinstance(ev, Sync):
+            syncs -= 1
+        return moves, syncs
