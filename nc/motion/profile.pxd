@@ -12,6 +12,10 @@ cdef object _calculate(object otg, object inp, Py_ssize_t n)
 
 cdef object _of(object traj, object cls)
 
-@cython.locals(t=double, h=double, x=double, k=Py_ssize_t, pl=double, vl=double, al=double, jl=double, pe=double,
+@cython.locals(x=double, k=Py_ssize_t)
+cdef double _gather(double t, Py_ssize_t n, object pt, object pp, object pv, object pa, object pj, list t0, list p,
+                    list v, list a, list j) except? -1.0
+
+@cython.locals(t=double, h=double, pl=double, vl=double, al=double, jl=double, pe=double,
                ve=double, ae=double, t0=list, p=list, v=list, a=list, j=list)
 cdef tuple _phases(object pr)

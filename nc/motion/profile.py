@@ -208,6 +208,21 @@ def _of(traj: Trajectory, cls: type) -> "Piecewise":
                float(traj.position_extrema[0].max))
 
 
+def _gather(t: float, n: int, pt, pp, pv, pa, pj, t0: list, p: list, v: list, a: list, j: list) -> float:
+    """Append the first n of a ruckig profile's (or brake's) phases that last (t > 0) to the lists, each starting at
+    the time summed so far; the time after them."""
+    for k in range(n):
+        x = pt[k]
+        if x > 0.0:
+            t0.append(t)
+            p.append(pp[k])
+            v.append(pv[k])
+            a.append(pa[k])
+            j.append(pj[k])
+            t += x
+    return t
+
+
 def _phases(pr) -> tuple[list, list, list, list, list]:
     """One DoF's phases of a ruckig Profile as lists: (start times, p, v, a, j), the brake pre-phases first, the
     final state last (a C function compiled, its types in profile.pxd: the floats ruckig gives are appended as
@@ -217,26 +232,9 @@ def _phases(pr) -> tuple[list, list, list, list, list]:
     # ruckig's fields are read once each: every read converts the whole array to a new list (issue 17)
     b = pr.brake
     if b.duration > 0.0:
-        bt, bp, bv, ba, bj = b.t, b.p, b.v, b.a, b.j
-        for k in range(2):
-            x = bt[k]
-            if x > 0.0:
-                t0.append(t)
-                p.append(bp[k])
-                v.append(bv[k])
-                a.append(ba[k])
-                j.append(bj[k])
-                t += x
-    pt, pp, pv, pa, pj = pr.t, pr.p, pr.v, pr.a, pr.j
-    for k in range(7):  # the phases kept, their start times summed in order
-        x = pt[k]
-        if x > 0.0:
-            t0.append(t)
-            p.append(pp[k])
-            v.append(pv[k])
-            a.append(pa[k])
-            j.append(pj[k])
-            t += x
+        t = _gather(t, 2, b.t, b.p, b.v, b.a, b.j, t0, p, v, a, j)
+    pp, pv, pa = pr.p, pr.v, pr.a
+    t = _gather(t, 7, pr.t, pp, pv, pa, pr.j, t0, p, v, a, j)  # the phases kept, their start times summed in order
     # The final state, integrated from the last phase (pf is not kept for velocity control).
     if len(t0) > 0:
         h = t - t0[-1]
