@@ -96,7 +96,9 @@ class CruiseSampling:
                    duration=cython.double, length=cython.double, seg_len=cython.double, x=cython.double,
                    u=cython.double, k=cython.Py_ssize_t, nb=cython.Py_ssize_t, n=cython.Py_ssize_t,
                    i=cython.Py_ssize_t, a=cython.Py_ssize_t, m=cython.Py_ssize_t, rows=cython.Py_ssize_t,
-                   line=cython.bint)
+                   line=cython.bint, three=cython.bint, snap=cython.bint, q0=cython.double, q1=cython.double,
+                   q2=cython.double, e0=cython.double, e1=cython.double, e2=cython.double, d0=cython.double,
+                   d1=cython.double, d2=cython.double)
     def _sample_cruise(self, p: _Plan) -> None:
         """The rows of a cruise, whole blocks up to at least ROWS rows: each block as its own solve gives them
         (a constant-speed profile from s0 at the plan time t0, s = s0 + v·t, sampled a CHUNK at a time while
@@ -113,17 +115,32 @@ class CruiseSampling:
         carries: list[float] = []  # the plan time left over at the end of each block
         rows = 0
         end: list[float] = []  # the last block's end as floats
+        q0 = q1 = q2 = e0 = e1 = e2 = d0 = d1 = d2 = 0.0
         while True:
             b = blocks[k]
             seg = b.seg
             start = seg.start.tolist()
+            m = len(start)
+            three = m == 3
             # _near(seg.start, the last block's end) on the lists, and the snap (session 12: each block's points
-            # read once as floats)
-            if k and all(abs(q - r) <= 1e-6 + 1e-5 * abs(r) for q, r in zip(start, end)):
+            # read once as floats); 3 axes on C doubles (the same comparisons, issue 17, bench B151)
+            if three:
+                q0, q1, q2 = start
+                snap = (k > 0 and abs(q0 - e0) <= 1e-6 + 1e-5 * abs(e0) and abs(q1 - e1) <= 1e-6 + 1e-5 * abs(e1)
+                        and abs(q2 - e2) <= 1e-6 + 1e-5 * abs(e2))
+            else:
+                snap = k > 0 and all(abs(q - r) <= 1e-6 + 1e-5 * abs(r) for q, r in zip(start, end))
+            if snap:
                 seg.start = blocks[k - 1].seg.end.copy()
                 start = end
+                q0, q1, q2 = e0, e1, e2
             end = seg.end.tolist()
-            d = [e - q for e, q in zip(end, start)]  # seg.end - seg.start: the same float subtraction as numpy's
+            if three:
+                e0, e1, e2 = end
+                d0, d1, d2 = e0 - q0, e1 - q1, e2 - q2  # seg.end - seg.start: the same float subtraction
+                d = None
+            else:
+                d = [e - q for e, q in zip(end, start)]  # seg.end - seg.start: the same float subtraction as numpy's
             duration = (b.length - s0) / v  # ruckig's duration of this profile, to the bit
             while True:
                 n = int(math.floor((duration - t_next) / T + 1e-9)) + 1
@@ -137,7 +154,6 @@ class CruiseSampling:
                 length = b.length
                 line = seg.kind == "line" and seg.length > 0.0
                 seg_len = seg.length if line else 1.0
-                m = len(start)
                 sc = []
                 for i in range(n):
                     x = t_next + T * i
@@ -153,7 +169,10 @@ class CruiseSampling:
                         x = length
                     if line:
                         u = x / seg_len
-                        pos.append([start[a] + u * d[a] for a in range(m)])
+                        if three:
+                            pos.append([q0 + u * d0, q1 + u * d1, q2 + u * d2])
+                        else:
+                            pos.append([start[a] + u * d[a] for a in range(m)])
                     else:
                         sc.append(x)
                 if not line:
