@@ -42,6 +42,8 @@ from hil.runner import BenchRunner
 from hil.session import make_link
 from hil.trace import open_trace
 from nc.program import parse_program
+import hil.trace_parquet as tp
+tp.FLUSH_S = 1e9  # one part, as a run at full speed writes it: under callgrind a run is ~50x slower (B152)
 bench = load_bench_file(Path(sys.argv[1]) / "benches" / "mill-3axis.toml")
 text = cam_program(int(sys.argv[3]))
 for _ in range(int(sys.argv[2])):
