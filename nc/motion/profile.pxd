@@ -19,3 +19,6 @@ cdef double _gather(double t, Py_ssize_t n, object pt, object pp, object pv, obj
 @cython.locals(t=double, h=double, pl=double, vl=double, al=double, jl=double, pe=double,
                ve=double, ae=double, t0=list, p=list, v=list, a=list, j=list)
 cdef tuple _phases(object pr)
+
+@cython.locals(lo=Py_ssize_t, hi=Py_ssize_t, mid=Py_ssize_t, y=double)
+cpdef Py_ssize_t _first_above(list xs, double x) except -1

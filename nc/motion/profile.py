@@ -110,8 +110,8 @@ class Piecewise:
         return float(self.v[0][-1])
 
     @cython.locals(t=cython.double, dur=cython.double, dt=cython.double, jk=cython.double, ak=cython.double,
-                   vk=cython.double, k=cython.Py_ssize_t, lo=cython.Py_ssize_t, hi=cython.Py_ssize_t,
-                   mid=cython.Py_ssize_t, x=cython.double, pk=cython.double, c=tuple, t0=list, p=list, v=list,
+                   vk=cython.double, k=cython.Py_ssize_t,
+                   x=cython.double, pk=cython.double, c=tuple, t0=list, p=list, v=list,
                    a=list, j=list)
     def at(self, t: float) -> tuple[float, float, float]:
         """sample(np.array([t])) of DoF 0 on plain floats: the same operations in the same order, so the same
@@ -125,16 +125,7 @@ class Piecewise:
         _, t0, p, v, a, j = c
         t = 0.0 if 0.0 >= t else t
         t = dur if dur <= t else t
-        # bisect_right(t0, t) - 1, at least 0, its bisection spelt out (compiled: on C doubles)
-        lo, hi = 0, len(t0)
-        while lo < hi:
-            mid = (lo + hi) // 2
-            x = t0[mid]
-            if t < x:
-                hi = mid
-            else:
-                lo = mid + 1
-        k = lo - 1
+        k = _first_above(t0, t) - 1  # bisect_right(t0, t) - 1, at least 0 (compiled: on C doubles)
         if k < 0:
             k = 0
         x = t0[k]
@@ -206,6 +197,19 @@ def _of(traj: Trajectory, cls: type) -> "Piecewise":
         arrs.append(m)
     return cls(arrs[0], arrs[1], arrs[2], arrs[3], arrs[4], float(traj.duration),
                float(traj.position_extrema[0].max))
+
+
+def _first_above(xs: list[float], x: float) -> int:
+    """bisect_right(xs, x) on floats, its comparisons as bisect makes them."""
+    lo, hi = 0, len(xs)
+    while lo < hi:
+        mid = (lo + hi) // 2
+        y = xs[mid]
+        if x < y:
+            hi = mid
+        else:
+            lo = mid + 1
+    return lo
 
 
 def _gather(t: float, n: int, pt, pp, pv, pa, pj, t0: list, p: list, v: list, a: list, j: list) -> float:

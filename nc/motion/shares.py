@@ -34,6 +34,7 @@ from typing import TYPE_CHECKING
 
 from nc.motion.block import Block
 from nc.motion.limits import MotionConfig
+from nc.motion.profile import _first_above  # bisect_right on C doubles, shared with Piecewise.at
 
 try:
     import cython  # compiled: the types below (setup.py, decision bench B115)
@@ -238,19 +239,6 @@ def _first_at_or_above(xs: list[float], x: float) -> int:
             lo = mid + 1
         else:
             hi = mid
-    return lo
-
-
-def _first_above(xs: list[float], x: float) -> int:
-    """bisect_right(xs, x) on floats, its comparisons as bisect makes them."""
-    lo, hi = 0, len(xs)
-    while lo < hi:
-        mid = (lo + hi) // 2
-        y = xs[mid]
-        if x < y:
-            hi = mid
-        else:
-            lo = mid + 1
     return lo
 
 
