@@ -12,6 +12,7 @@ import pyarrow.parquet as pq
 import pytest
 
 from benchmarks.bench_vs_linuxcnc import cam_polyline
+import hil.runner
 from hil import api, fit_ahead
 from hil.bench_file import load_bench_file
 from hil.run_output import to_json
@@ -98,6 +99,10 @@ def test_a_real_time_run_takes_windows_from_the_child_and_reaps_it(monkeypatch, 
         return child
 
     monkeypatch.setattr(fit_ahead, "start", spy)
+    # The prefetch waits on the wall clock for the child's first windows (1 s in a run); a loaded CI machine took
+    # longer to fork and run the child that far, and the run on its fake clock then finished before any window came.
+    # It returns as soon as the child has them, so the longer bound costs nothing where the machine is quiet.
+    monkeypatch.setattr(hil.runner, "PREFETCH_S", 60.0)
     fake_clock(monkeypatch)
     rt, cols_rt = _run(monkeypatch, tmp_path, program_text, "auto", realtime=True)
     monkeypatch.setattr(fit_ahead, "start", start)
