@@ -5,6 +5,9 @@ cimport cython
 
 cdef tuple _calc(Py_ssize_t dofs)
 
+cdef inline bint _same(double x, double y)
+
+@cython.locals(w=list)
 cdef tuple _one_dof(object interface, double p0, double v0, double a0, double p1, double v1, double v_max,
                     double a_max, double j_max)
 

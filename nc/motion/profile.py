@@ -9,6 +9,7 @@ Never pass intermediate positions to ruckig: the community build sends those to 
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -42,6 +43,21 @@ def _calc(dofs: int) -> tuple[Ruckig, InputParameter]:
     if dofs not in _POOL:
         _POOL[dofs] = (Ruckig(dofs), InputParameter(dofs))
     return _POOL[dofs]
+
+
+# The floats `_one_dof` last wrote to the pooled 1-DoF input, in its order (p0, v0, a0, p1, v1, v_max, a_max, j_max):
+# a field holding the same double already is not written again (≈ 0.6k instructions a field through pybind, issue
+# 17, session 28). NaN where unknown: `_calculate`'s retries and `solve_axes` write those fields themselves.
+_WROTE: list[float] = [math.nan] * 8
+# One Trajectory per DoF count, filled by every calculate (as ruckig's own update() refills its output's): a solve
+# reads its phases out before the next (Trajectory(n) was ≈ 1.8k instructions a solve, session 28)
+_TRAJ: dict[int, Trajectory] = {}
+
+
+def _same(x: float, y: float) -> bool:
+    """x and y the same double: equal and not zero (−0.0 == 0.0: a zero is written again, 149 of the CAM program's
+    16,536 fields); NaN never the same."""
+    return x == y and x != 0.0
 
 
 @dataclass
@@ -156,12 +172,12 @@ class _OneDof(Piecewise):
     first use. A solve's plan is mostly sampled a row or two at a time, and np.array of its rows cost ≈ 2 µs a
     solve (issue 17, session 12); the lists hold the floats the arrays would (float64 both ways)."""
 
+    _m: np.ndarray | None = None  # the arrays, once made
+
     def __init__(self, rows: tuple[list, list, list, list, list], duration: float, p_max: float) -> None:
-        self._rows = rows
-        self._m: np.ndarray | None = None
+        self._rows = rows  # (_m and _vmin: None, the class's, until made)
         self.duration = duration
         self.p_max = p_max
-        self._vmin = None
         self._lists = (duration, *rows)  # what `at` makes of the arrays
 
     def _arr(self, k: int) -> np.ndarray:
@@ -265,14 +281,31 @@ def _one_dof(interface: ControlInterface, p0: float, v0: float, a0: float, p1: f
         inp.synchronization = Synchronization.Time
         inp.target_acceleration = [0.0]
         _MODE[1] = interface
-    inp.current_position = [p0]
-    inp.current_velocity = [v0]
-    inp.current_acceleration = [a0]
-    inp.target_position = [p1]
-    inp.target_velocity = [v1]
-    inp.max_velocity = [v_max]
-    inp.max_acceleration = [a_max]
-    inp.max_jerk = [j_max]
+    w = _WROTE
+    if not _same(p0, w[0]):
+        inp.current_position = [p0]
+        w[0] = p0
+    if not _same(v0, w[1]):
+        inp.current_velocity = [v0]
+        w[1] = v0
+    if not _same(a0, w[2]):
+        inp.current_acceleration = [a0]
+        w[2] = a0
+    if not _same(p1, w[3]):
+        inp.target_position = [p1]
+        w[3] = p1
+    if not _same(v1, w[4]):
+        inp.target_velocity = [v1]
+        w[4] = v1
+    if not _same(v_max, w[5]):
+        inp.max_velocity = [v_max]
+        w[5] = v_max
+    if not _same(a_max, w[6]):
+        inp.max_acceleration = [a_max]
+        w[6] = a_max
+    if not _same(j_max, w[7]):
+        inp.max_jerk = [j_max]
+        w[7] = j_max
     return otg, inp
 
 
@@ -282,16 +315,18 @@ def _calculate(otg: Ruckig, inp: InputParameter, n: int) -> Trajectory | None:
     v0 = a0²/2j + 1 ulp (velocity, decision motion 62). Two retries move off the boundary: the current
     accelerations 1e-12 nearer zero (the ramp neither reverses, as a lower jerk can by 1e-8 mm/s, nor steps the
     acceleration measurably), then the jerk 1 ppb lower as well."""
-    traj = Trajectory(n)
+    traj = _TRAJ.get(n)
+    if traj is None:
+        traj = _TRAJ[n] = Trajectory(n)
     try:
         return traj if otg.calculate(inp, traj) in _OK else None
     except Exception:  # ruckig.RuckigError
         pass
     a = [x * (1.0 - 1e-12) for x in inp.current_acceleration]
     j0 = list(inp.max_jerk)
+    _WROTE[2] = _WROTE[7] = math.nan  # written below: _one_dof writes them again
     for j in (j0, [x * (1.0 - 1e-9) for x in j0]):
         inp.current_acceleration, inp.max_jerk = a, j
-        traj = Trajectory(n)
         try:
             return traj if otg.calculate(inp, traj) in _OK else None
         except Exception:
@@ -321,6 +356,8 @@ def solve_axes(p0, v0, a0, p1, v_max, a_max, j_max, velocity: bool = False) -> P
     n = len(p0)
     otg, inp = _calc(n)
     _MODE.pop(n, None)  # _one_dof sets its fields again (a one-axis machine shares its input)
+    if n == 1:
+        _WROTE[:] = [math.nan] * 8
     inp.control_interface = ControlInterface.Velocity if velocity else ControlInterface.Position
     inp.synchronization = Synchronization.No
     inp.current_position = list(map(float, p0))
