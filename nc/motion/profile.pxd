@@ -7,6 +7,9 @@ cdef tuple _calc(Py_ssize_t dofs)
 
 cdef inline bint _same(double x, double y)
 
+cdef double _S0, _S1, _S2, _S3, _S4, _S5, _S6, _S7  # solve_position's last inputs
+cdef object _S_PW
+
 @cython.locals(w=list)
 cdef tuple _one_dof(object interface, double p0, double v0, double a0, double p1, double v1, double v_max,
                     double a_max, double j_max)

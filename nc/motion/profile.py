@@ -334,12 +334,27 @@ def _calculate(otg: Ruckig, inp: InputParameter, n: int) -> Trajectory | None:
     return None
 
 
+# solve_position's last inputs (p0, v0, a0, p1, v1, v_max as held, a_max, j_max: C doubles compiled) and its answer.
+# The same inputs again give the same answer (ruckig is a function of its input), and a path solve's profile is only
+# read once made (the planner writes to a ramp's duration and arrays, solve_velocity's), so the answer is given again
+# as it is: 320 of the CAM program's 2,067 path solves repeat the one before (session 28, decision bench B154).
+_S0 = _S1 = _S2 = _S3 = _S4 = _S5 = _S6 = _S7 = math.nan
+_S_PW: Piecewise | None = None
+
+
 def solve_position(p0: float, v0: float, a0: float, p1: float, v1: float, v_max: float, a_max: float,
                    j_max: float) -> Piecewise | None:
     """Time-optimal 1-DoF profile (p0, v0, a0) → (p1, v1, 0); None when ruckig cannot solve it."""
-    otg, inp = _one_dof(_POSITION, p0, v0, a0, p1, v1, 1e-9 if 1e-9 > v_max else v_max, a_max, j_max)
+    global _S0, _S1, _S2, _S3, _S4, _S5, _S6, _S7, _S_PW
+    v_max = 1e-9 if 1e-9 > v_max else v_max
+    if _same(p0, _S0) and _same(v0, _S1) and _same(a0, _S2) and _same(p1, _S3) and _same(v1, _S4) \
+            and _same(v_max, _S5) and _same(a_max, _S6) and _same(j_max, _S7):
+        return _S_PW
+    otg, inp = _one_dof(_POSITION, p0, v0, a0, p1, v1, v_max, a_max, j_max)
     traj = _calculate(otg, inp, 1)
-    return None if traj is None else _of(traj, Piecewise)
+    pw = None if traj is None else _of(traj, Piecewise)
+    _S0, _S1, _S2, _S3, _S4, _S5, _S6, _S7, _S_PW = p0, v0, a0, p1, v1, v_max, a_max, j_max, pw
+    return pw
 
 
 def solve_velocity(p0: float, v0: float, a0: float, v1: float, a_max: float, j_max: float) -> Piecewise:
