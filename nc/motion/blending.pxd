@@ -7,14 +7,23 @@ from nc.motion.block cimport Block
 
 cdef double _INF  # math.inf as a C constant (decision bench B134)
 
-# window's sliding maxima (decision bench B134): C methods, the entries in two lists read from `head` on
+# bisect_left on a list of floats in C (decision bench B153)
+@cython.locals(mid=Py_ssize_t)
+cdef Py_ssize_t _at_or_above(list xs, double x, Py_ssize_t lo, Py_ssize_t hi) except -1
+
+# window's sliding maxima (decision bench B134): C methods, the entries in two C buffers (array.array) read from
+# `head` to `n` (decision bench B153)
 cdef class _MaxQ:
-    cdef public list seqs, vals
-    cdef public Py_ssize_t head
+    cdef public long long[::1] seqs
+    cdef public double[::1] vals
+    cdef public Py_ssize_t head, n
+    @cython.locals(n=Py_ssize_t, i=Py_ssize_t, seqs=object, vals=object)
+    cdef int _grow(self) except -1
     @cython.locals(n=Py_ssize_t)
     cdef int push(self, Py_ssize_t seq, double x) except -1
+    @cython.locals(n=Py_ssize_t, i=Py_ssize_t)
     cdef int push_front(self, Py_ssize_t seq, double x) except -1
-    @cython.locals(h=Py_ssize_t)
+    @cython.locals(h=Py_ssize_t, n=Py_ssize_t, i=Py_ssize_t)
     cdef int drop(self, Py_ssize_t seq_m) except -1
     cdef double front(self) except? -1.0
 
@@ -32,6 +41,7 @@ cdef class FilterCorners:
     cdef public tuple _w_cum, _w_sj, _w_ba, _w_bj, _w_bmin
     cdef public Py_ssize_t _w_k1, _w_k2  # the last two caps `_taken` found (decision bench B134)
     cdef public double _w_c1, _w_c2
+    cdef public double _half, _g0, _tol_v  # kd.half, kd.g0, tol (inf: None) as C doubles (decision bench B153)
     cdef double _cap(self, Py_ssize_t m) except? -1.0
     cdef bint _taken(self, Py_ssize_t k) except -1
 

@@ -24,8 +24,8 @@ one window behind W's last junction, whose cap was computed over a sum that hold
 
 from __future__ import annotations
 
-import bisect
 import math
+from array import array
 from collections import deque
 from itertools import islice
 from collections.abc import Sequence
@@ -52,45 +52,81 @@ BULK = 4096
 
 
 
+def _at_or_above(xs: list[float], x: float, lo: int, hi: int) -> int:
+    """bisect.bisect_left(xs, x, lo, hi) on floats, its comparisons (xs[mid] < x) as bisect makes them: a C loop
+    where compiled (decision bench B153: the module function was a Python call, ~1.5k instructions, a push)."""
+    while lo < hi:
+        mid = (lo + hi) // 2
+        if xs[mid] < x:
+            lo = mid + 1
+        else:
+            hi = mid
+    return lo
+
+
 class _MaxQ:
-    """A sliding maximum: (sequence number, value) entries, values falling from the front, in two lists read from
-    `head` on (a cdef class with C methods where compiled, blending.pxd: the deque of tuples it replaces cost a
-    method call, a tuple and generic indexing per operation, decision bench B134)."""
+    """A sliding maximum: (sequence number, value) entries, values falling from the front, held in seqs[head:n],
+    vals[head:n] (a cdef class with C methods where compiled, blending.pxd: the deque of tuples it replaces cost a
+    method call, a tuple and generic indexing per operation, decision bench B134). The two are array.array buffers,
+    typed memoryviews where compiled (decision bench B153: the lists of boxed numbers were an append, a pop and a
+    float and an int object per entry); as Python they index to plain floats and ints."""
 
     def __init__(self) -> None:
-        self.seqs: list[int] = []
-        self.vals: list[float] = []
+        self.seqs = array("q", bytes(8 * 64))
+        self.vals = array("d", bytes(8 * 64))
         self.head = 0
+        self.n = 0
+
+    def _grow(self) -> None:
+        """Twice the room, the entries copied (a new buffer: one exporting its memory cannot be resized)."""
+        n = self.n
+        seqs = array("q", bytes(16 * n))
+        vals = array("d", bytes(16 * n))
+        for i in range(n):
+            seqs[i] = self.seqs[i]
+            vals[i] = self.vals[i]
+        self.seqs, self.vals = seqs, vals
 
     def push(self, seq: int, x: float) -> None:
         """Append (seq, x), dropping the entries at the back no larger than x."""
-        n = len(self.vals)
+        n = self.n
         while n > self.head and self.vals[n - 1] <= x:
-            self.vals.pop()
-            self.seqs.pop()
             n -= 1
-        self.vals.append(x)
-        self.seqs.append(seq)
+        self.n = n
+        if n == len(self.vals):  # (compiled: the memoryview's shape[0])
+            self._grow()
+        self.vals[n] = x
+        self.seqs[n] = seq
+        self.n = n + 1
 
     def push_front(self, seq: int, x: float) -> None:
         """Extend it backwards by an entry older than all it holds."""
-        if len(self.vals) == self.head or x > self.vals[self.head]:
+        if self.n == self.head or x > self.vals[self.head]:
             if self.head > 0:
                 self.head -= 1
                 self.seqs[self.head] = seq
                 self.vals[self.head] = x
             else:
-                self.seqs.insert(0, seq)
-                self.vals.insert(0, x)
+                n = self.n
+                if n == len(self.vals):  # (compiled: the memoryview's shape[0])
+                    self._grow()
+                for i in range(n, 0, -1):
+                    self.seqs[i] = self.seqs[i - 1]
+                    self.vals[i] = self.vals[i - 1]
+                self.seqs[0] = seq
+                self.vals[0] = x
+                self.n = n + 1
 
     def drop(self, seq_m: int) -> None:
         """Drop the entries older than seq_m from the front."""
-        h = self.head
-        while self.seqs[h] < seq_m:
+        h, n = self.head, self.n
+        while h < n and self.seqs[h] < seq_m:
             h += 1
-        if h >= 64 and 2 * h >= len(self.vals):  # the dropped entries' room, given back now and then
-            del self.seqs[:h]
-            del self.vals[:h]
+        if h >= 64 and 2 * h >= n:  # the dropped entries' room used again now and then
+            for i in range(h, n):
+                self.seqs[i - h] = self.seqs[i]
+                self.vals[i - h] = self.vals[i]
+            self.n = n - h
             h = 0
         self.head = h
 
@@ -118,6 +154,10 @@ class FilterCorners:
         self.tol = cfg.path_tolerance
         self.kd = KernelDeviation(n1, n2, cfg.cycle)
         self.cb = CornerBound(self.kd)  # the proved isolated-corner cap (decision motion 73)
+        # kd's half window and G(0), and the tolerance, as C doubles for `_tolerance`'s quick test (decision bench
+        # B153: attribute lookups on the KernelDeviation object and a boxed compare a push)
+        self._half, self._g0 = float(self.kd.half), float(self.kd.g0)
+        self._tol_v = math.inf if self.tol is None else float(self.tol)
         # G's table and np.interp's slopes between its points, for `_held_caps` (decision bench B133)
         gy, gg = self.kd._y, self.kd._g
         self._gy, self._gg = gy.copy(), gg.copy()
@@ -335,9 +375,12 @@ class FilterCorners:
             return 0
         h0 = self._h0
         last = len(hist)
-        prev = hist[-1].cum if last > h0 else self._zero
+        if last > h0:
+            b = hist[last - 1]  # (typed: its fields read as a Block's, not by attribute lookup, decision bench B153)
+            prev, sprev = b.cum, b.scum
+        else:
+            prev = sprev = self._zero
         du = j_new.du
-        sprev = hist[-1].scum if last > h0 else self._zero
         dv = j_new.dv
         if self._axes == 3:  # the common case spelt out (this runs once per pushed block)
             cum_j = (prev[0] + du[0], prev[1] + du[1], prev[2] + du[2], prev[3] + j_new.du_n)
@@ -361,7 +404,8 @@ class FilterCorners:
         # The junctions no scan reads any more (further behind the queue's head than twice the longest window: a
         # scan's reach behind its position is at most one) are dropped TRIM at a time (session 18: dropped 4,096
         # at a time, their blocks were freed in one push, a 13.9 ms cycle on the CAM program)
-        cut = bisect.bisect_left(hist_s, blocks[0].s_end - blocks[0].length - 2.0 * span_max, 0, h0)
+        b = blocks[0]
+        cut = _at_or_above(hist_s, b.s_end - b.length - 2.0 * span_max, 0, h0)  # bisect_left in C (B153)
         if cut >= TRIM:
             del hist[:cut]
             del hist_s[:cut]
@@ -583,7 +627,11 @@ class FilterCorners:
         sj, zero = self._w_sj, self._zero
         smax = [0.0] * axes
         for k in range(m - 1, last):
-            pk = hist[k].scum if k >= h0 and k >= m - 1 and (k > m - 1 or m > h0) else zero
+            if k >= h0 and (k > m - 1 or m > h0):  # (k >= m - 1 throughout)
+                b = hist[k]  # typed: scum read as a Block's field (decision bench B153)
+                pk = b.scum
+            else:
+                pk = zero
             for i in range(axes):
                 d = sj[i] - pk[i]
                 if d < 0.0:
@@ -635,7 +683,7 @@ class FilterCorners:
 
     @cython.locals(h0=cython.Py_ssize_t, last=cython.Py_ssize_t, s_j=cython.double, vt=cython.double,
                    half=cython.double, lo=cython.Py_ssize_t, k=cython.Py_ssize_t, x=cython.double, top=cython.double,
-                   hs=list, vts=list)
+                   hs=list, vts=list, i=cython.Py_ssize_t, y=cython.double)
     def _reach_back(self, h0: int, last: int, s_j: float, vt: float, half: float) -> tuple[int, float]:
         """`_tolerance`'s reach behind J: the junction walk
             lo = last
@@ -650,13 +698,17 @@ class FilterCorners:
         lo = last
         while lo > h0:
             x = 3.0 * vt * half
-            k = bisect.bisect_left(hs, s_j - x, h0, lo)  # about where the test turns; made exact below
+            k = _at_or_above(hs, s_j - x, h0, lo)  # about where the test turns; made exact below
             while k < lo and s_j - hs[k] > x:
                 k += 1
             while k > h0 and not s_j - hs[k - 1] > x:
                 k -= 1
             if k < lo:  # hist[k:lo] pass at vt, so with their own vtops too (the walk's vt only grows)
-                top = max(vts[k:lo])
+                top = vts[k]  # max(vts[k:lo]) as the builtin compares (item > the maximum so far), in C (B153)
+                for i in range(k + 1, lo):
+                    y = vts[i]
+                    if y > top:
+                        top = y
                 if top > vt:
                     vt = top
                 lo = k
@@ -673,7 +725,7 @@ class FilterCorners:
                    vt=cython.double, h=cython.double, k=cython.Py_ssize_t, axes=cython.Py_ssize_t,
                    sum_n=cython.double, lo=cython.Py_ssize_t, nseg=cython.Py_ssize_t, i=cython.Py_ssize_t,
                    i0=cython.Py_ssize_t, depth=cython.Py_ssize_t, lim=cython.double, c=cython.double, v=cython.double,
-                   vt_i=cython.double, t2sum=cython.double, b=Block, nx=Block, hist=list, seg=list)
+                   vt_i=cython.double, t2sum=cython.double, b=Block, nx=Block, bj=Block, hist=list, seg=list)
     def _tolerance(self, blocks: Sequence["Block"], v_hi: float) -> int:
         """Evaluate the deviation model (nc.motion.deviation) at the junctions within half a
         window (at the fastest speed nearby) behind the newest one J, with every junction known
@@ -682,20 +734,25 @@ class FilterCorners:
         before J came. Returns how many blocks from the tail need a new backward pass."""
         hist, h0 = self._hist, self._h0
         last = len(hist) - 1
-        s_j = hist[last].s_end
-        half = self.kd.half
-        vt = v_hi if v_hi > blocks[-1].vtop else blocks[-1].vtop
+        bj = hist[last]
+        s_j = bj.s_end
+        half = self._half
+        nx = blocks[-1]
+        vt = v_hi if v_hi > nx.vtop else nx.vtop
         h = vt * half
         # Cheap first: with G ≤ G(0) and unsigned steps, the deviation anywhere near J is at most
         # vt·G(0)·Σ|Δu| plus a braking term; within the tolerance and with no junction limited
         # within reach (whose caps would have to be lifted), nothing near J changes: the common
         # case on gentle curves, O(log n).
         if self._lim_s < s_j - 3.0 * h:
-            k = bisect.bisect_left(self._hist_s, s_j - 2.0 * h - 1e-12, h0, last + 1)
+            k = _at_or_above(self._hist_s, s_j - 2.0 * h - 1e-12, h0, last + 1)
             axes = self._axes
-            sum_n = hist[last].cum[axes] - (hist[k - 1].cum[axes] if k > h0 else 0.0)
-            # the braking term inline (`braking` without a jerk)
-            if vt * self.kd.g0 * sum_n + sum_n * self.amax * self.t2sum / 192.0 <= self.tol:
+            sum_n = bj.cum[axes]
+            if k > h0:
+                b = hist[k - 1]
+                sum_n = sum_n - b.cum[axes]
+            # the braking term inline (`braking` without a jerk); _g0, _tol_v: kd.g0 and tol as C doubles (B153)
+            if vt * self._g0 * sum_n + sum_n * self.amax * self.t2sum / 192.0 <= self._tol_v:
                 return 0
         lo, vt = self._reach_back(h0, last, s_j, vt, half)
         if lo < self._sc_dirty:
