@@ -34,8 +34,7 @@ cdef class FilterCorners:
     cdef public dict _boost
     cdef public list _hist, _hist_s, _vt, _sc
     cdef public Py_ssize_t _axes, _sc_dirty, _h0, _m, _seq0, _seq_v, _mono
-    cdef public double[::1] _gy, _gg, _gs  # (typed: no memoryview made of them a call, decision bench B153)
-    cdef public double[::1] _b_s, _b_room, _b_vb, _b_se, _b_ct, _b_rc  # `_held_caps`' scratch (B153)
+    cdef public object _gy, _gg, _gs
     # window's search state for _cap and _taken (decision bench B133)
     cdef public Py_ssize_t _w_last, _w_h0
     cdef public double _w_s_j, _w_top, _w_pad, _w_two_al, _w_t_w2, _w_v_hi
@@ -45,8 +44,6 @@ cdef class FilterCorners:
     cdef public double _half, _g0, _tol_v  # kd.half, kd.g0, tol (inf: None) as C doubles (decision bench B153)
     cdef double _cap(self, Py_ssize_t m) except? -1.0
     cdef bint _taken(self, Py_ssize_t k) except -1
-
-cdef double[::1] _scratch(double[::1] buf, Py_ssize_t n)
 
 # `_held_caps` and `_kernel_matrix` (decision bench B133): C loops over memoryviews, declared here as
 # nc.motion.cython_shadow has no memoryview types for the .py's decorators.

@@ -163,9 +163,6 @@ class FilterCorners:
         self._gy, self._gg = gy.copy(), gg.copy()
         self._gs = np.array([(float(gg[i + 1]) - float(gg[i])) / (float(gy[i + 1]) - float(gy[i]))
                              for i in range(len(gy) - 1)] or [0.0])
-        # `_held_caps`' scratch buffers (decision bench B153)
-        self._b_s, self._b_room, self._b_vb = np.empty(64), np.empty(64), np.empty(64)
-        self._b_se, self._b_ct, self._b_rc = np.empty(64), np.empty(64), np.empty(64)
         self._iso_k = 0.25 * self.cb.span * self.cb.span  # isolated_cap's quick test (s²)
         self._boost: dict[tuple[float, float], float] = {}  # braking's growth per (a, j)
         self.t2sum = t1 * t1 + t2 * t2
@@ -777,10 +774,8 @@ def _held_caps(fc: FilterCorners, blocks: Sequence[Block], lo: int, last: int, s
     hist, hs = fc._hist, fc._hist_s
     nseg = last + 1 - lo
     h = vt * half
-    # the C arrays below in fc's scratch buffers, grown as needed (decision bench B153: a numpy array and a
-    # memoryview of it each, ~2.5k instructions apiece a call); compiled, their slices are C memoryview slices
-    fc._b_s = _scratch(fc._b_s, nseg)
-    s = fc._b_s[:nseg]
+    sv = np.empty(nseg)
+    s = sv  # (compiled: a memoryview of sv)
     for i in range(nseg):
         s[i] = hs[lo + i]
     # The junctions near J and those evaluated: suffixes of hist[lo:] (s_end only grows)
@@ -794,8 +789,8 @@ def _held_caps(fc: FilterCorners, blocks: Sequence[Block], lo: int, last: int, s
         e0 -= 1
     ne, nn, axes = nseg - e0, nseg - n0, fc._axes
     tol, t2sum = fc.tol, fc.t2sum
-    fc._b_room = _scratch(fc._b_room, ne)
-    room = fc._b_room[:ne]
+    room_a = np.empty(ne)
+    room = room_a
     nl = 0  # junctions with room left
     for i in range(ne):
         b = hist[lo + e0 + i]
@@ -808,8 +803,8 @@ def _held_caps(fc: FilterCorners, blocks: Sequence[Block], lo: int, last: int, s
     if nl > 0:
         du_a = np.empty((nn, axes))
         du = du_a
-        fc._b_vb = _scratch(fc._b_vb, nn)
-        vb = fc._b_vb[:nn]
+        vb_a = np.empty(nn)
+        vb = vb_a
         for k in range(nn):
             b = hist[lo + n0 + k]
             dv = b.dv
@@ -817,15 +812,15 @@ def _held_caps(fc: FilterCorners, blocks: Sequence[Block], lo: int, last: int, s
                 du[k, a] = dv[a]
             vb[k] = b.vbase
         # KernelDeviation.deviation at the top speed for the junctions with room
-        fc._b_se = _scratch(fc._b_se, nl)
-        se = fc._b_se[:nl]
+        se_a = np.empty(nl)
+        se = se_a
         r = 0
         for i in range(ne):
             if room[i] > 0.0:
                 se[r] = s[e0 + i]
                 r += 1
         w_a = np.empty((nl, nn))
-        _kernel_matrix(w_a, se, s[n0:], vb, vt, fc._gy, fc._gg, fc._gs)
+        _kernel_matrix(w_a, se_a, sv[n0:], vb_a, vt, fc._gy, fc._gg, fc._gs)
         e = np.linalg.norm(w_a @ du_a, axis=1).tolist()
         r = 0
         for i in range(ne):
@@ -835,8 +830,7 @@ def _held_caps(fc: FilterCorners, blocks: Sequence[Block], lo: int, last: int, s
                     break
                 r += 1
         if not fits:  # caps from its first pass on (rare: about never on the CAM program)
-            caps = fc.kd.caps(np.asarray(s[e0:]), np.asarray(room), vt, np.asarray(s[n0:]), du_a,
-                              np.asarray(vb)).tolist()
+            caps = fc.kd.caps(sv[e0:], room_a, vt, sv[n0:], du_a, vb_a).tolist()
     lim = vt * (1.0 - 1e-9)
     for i in range(ne):
         if fits:
@@ -850,13 +844,12 @@ def _held_caps(fc: FilterCorners, blocks: Sequence[Block], lo: int, last: int, s
         if c < lim and b.s_end > fc._lim_s:
             fc._lim_s = b.s_end
     # Each junction near J: the least ctol of the junctions whose reach (min(ctol, vt)·half) holds it
-    fc._b_ct = _scratch(fc._b_ct, nseg)
-    ct = fc._b_ct[:nseg]
-    fc._b_rc = _scratch(fc._b_rc, nseg)
-    rc = fc._b_rc[:nseg]
+    ct_a = np.empty(nseg)
+    ct = ct_a
+    rc_a = np.empty(nseg)
+    rc = rc_a
     for k in range(nseg):
-        b = hist[lo + k]  # typed: ctol read as a Block's field (decision bench B153)
-        c = b.ctol
+        c = hist[lo + k].ctol
         rc[k] = (c if c < vt or c != c else vt) * half + 1e-12
         ct[k] = c
     depth = 0
@@ -890,11 +883,6 @@ def _held_caps(fc: FilterCorners, blocks: Sequence[Block], lo: int, last: int, s
                 if k > depth:
                     depth = k
     return depth
-
-
-def _scratch(buf: np.ndarray, n: int) -> np.ndarray:
-    """buf when it holds n values, else a new buffer twice that long (`_held_caps`' scratch, decision bench B153)."""
-    return buf if buf.shape[0] >= n else np.empty(2 * n)
 
 
 def _kernel_matrix(w: np.ndarray, s_rows: np.ndarray, s_all: np.ndarray, vb: np.ndarray, c: float, gy: np.ndarray,
