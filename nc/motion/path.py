@@ -10,11 +10,11 @@ import numpy as np
 from nc.interp.arcs import sweep
 from nc.moves import Move
 
+_NO_CENTER = (0.0, 0.0)
 
-@dataclass(slots=True)  # one per block (issue 17: slots make its construction and reads cheaper)
-class Segment:
-    """A line or a helical arc through the channel axes, parametrised by path length."""
 
+@dataclass
+class _Fields:  # Segment's constructor arguments, in order: the dataclasses that extend it take them as theirs
     axes: tuple[str, ...]
     start: np.ndarray
     end: np.ndarray
@@ -33,34 +33,133 @@ class Segment:
     _dir: tuple[float, ...] | None = None
     _cos: tuple[float, ...] | None = None  # |_dir|: the direction cosines, for the block limits
 
-    @classmethod
-    def line_of(cls, axes: tuple[str, ...], ls: list[float], le: list[float], length: float,
+
+class Segment:
+    """A line or a helical arc through the channel axes, parametrised by path length.
+
+    Compiled, an extension type (path.pxd, issue 17): one is made per block. Its end points are numpy arrays
+    (`start`, `end`) or lists of floats (`start_floats`, `end_floats`, never changed in place), each made from
+    the other when first read: a line from the run feed comes with lists, and the planner's per-block readers
+    (the cruise's rows) take lists, so most blocks never make an array (two `np.array` calls a block,
+    bench B156). The fields as `_Fields`' (ClothoidBlend and SplineSpan are dataclasses extending it)."""
+
+    __dataclass_fields__ = _Fields.__dataclass_fields__
+    __dataclass_params__ = _Fields.__dataclass_params__
+
+    def __init__(self, axes: tuple[str, ...], start: np.ndarray, end: np.ndarray, length: float, kind: str,
+                 i1: int = 0, i2: int = 0, center: tuple[float, float] = (0.0, 0.0), radius: float = 0.0,
+                 a0: float = 0.0, theta: float = 0.0, arc_len: float = 0.0,
+                 _dir: tuple[float, ...] | None = None, _cos: tuple[float, ...] | None = None) -> None:
+        self.axes = axes
+        self._pa = start
+        self._pb = end
+        self._fa = None
+        self._fb = None
+        self.length = length
+        self.kind = kind
+        self.i1 = i1
+        self.i2 = i2
+        self.center = center
+        self.radius = radius
+        self.a0 = a0
+        self.theta = theta
+        self.arc_len = arc_len
+        self._dir = _dir
+        self._cos = _cos
+
+    def __repr__(self) -> str:
+        return (f"{type(self).__name__}(axes={self.axes!r}, start={self.start!r}, end={self.end!r}, "
+                f"length={self.length!r}, kind={self.kind!r})")
+
+    @property
+    def start(self) -> np.ndarray:
+        if self._pa is None:
+            self._pa = np.array(self._fa)
+        return self._pa
+
+    @start.setter
+    def start(self, value: np.ndarray) -> None:
+        self._pa = value
+        self._fa = None
+
+    @property
+    def end(self) -> np.ndarray:
+        if self._pb is None:
+            self._pb = np.array(self._fb)
+        return self._pb
+
+    @end.setter
+    def end(self, value: np.ndarray) -> None:
+        self._pb = value
+        self._fb = None
+
+    @property
+    def start_floats(self) -> list[float]:
+        """`start.tolist()`, kept (the list is shared: never change it in place)."""
+        if self._fa is None:
+            self._fa = self._pa.tolist()
+        return self._fa
+
+    @start_floats.setter
+    def start_floats(self, value: list[float]) -> None:
+        self._fa = value
+        self._pa = None
+
+    @property
+    def end_floats(self) -> list[float]:
+        """`end.tolist()`, kept (the list is shared: never change it in place)."""
+        if self._fb is None:
+            self._fb = self._pb.tolist()
+        return self._fb
+
+    @staticmethod
+    def line_of(axes: tuple[str, ...], ls: list[float], le: list[float], length: float,
                 d: list[float]) -> "Segment":
         """A line from its start, end, length (math.dist) and unit direction worked out already (the run
-        feed's `RunFeed.geom`, issue 17): the segment `of` makes from the same move, bit for bit."""
-        # the fields by position: a keyword call costs the generated __init__ a name match each (issue 17)
+        feed's `RunFeed.geom`, issue 17): the segment `of` makes from the same move, bit for bit. The lists are
+        kept as they are (shared with the run feed's state: never changed in place)."""
+        seg = Segment.__new__(Segment)  # compiled: the type's slot alone, no __init__'s arguments to parse
+        seg.axes = axes
+        seg._pa = None
+        seg._pb = None
+        seg._fa = ls
+        seg._fb = le
+        seg.length = length
+        seg.kind = "line"
+        seg.i1 = 0
+        seg.i2 = 0
+        seg.center = _NO_CENTER
+        seg.radius = 0.0
+        seg.a0 = 0.0
+        seg.theta = 0.0
+        seg.arc_len = 0.0
         if len(d) == 3:  # spelt out (once per push)
             d0, d1, d2 = d
-            return cls(axes, np.array(ls), np.array(le), length, "line", 0, 0, (0.0, 0.0), 0.0, 0.0, 0.0, 0.0,
-                       (d0, d1, d2), (abs(d0), abs(d1), abs(d2)))
-        return cls(axes, np.array(ls), np.array(le), length, "line", 0, 0, (0.0, 0.0), 0.0, 0.0, 0.0, 0.0, tuple(d),
-                   tuple([abs(x) for x in d]))
+            seg._dir = (d0, d1, d2)
+            seg._cos = (abs(d0), abs(d1), abs(d2))
+        else:
+            seg._dir = tuple(d)
+            seg._cos = tuple([abs(x) for x in d])
+        return seg
 
     @classmethod
     def of(cls, move: Move, axes: tuple[str, ...]) -> "Segment":
         start, end = move.start, move.end
         ls = [float(start.get(a, 0.0)) for a in axes]
         le = [float(end.get(a, 0.0)) for a in axes]
-        # Python floats make float64 arrays: no dtype argument to parse (issue 17, once per block)
-        s = np.array(ls)
-        e = np.array(le)
         if move.kind != "arc" or move.center is None:
             length = math.dist(ls, le)
             if length > 0.0:
-                d = tuple([(q - p) / length for p, q in zip(ls, le)])
-                return cls(axes, s, e, length, "line", _dir=d, _cos=tuple([abs(x) for x in d]))
+                d = [(q - p) / length for p, q in zip(ls, le)]
+                if cls is Segment:
+                    return Segment.line_of(axes, ls, le, length, d)
+                return cls(axes, np.array(ls), np.array(le), length, "line", _dir=tuple(d),
+                           _cos=tuple([abs(x) for x in d]))
             d = (0.0,) * len(axes)
-            return cls(axes, s, e, length, "line", _dir=d, _cos=d)
+            return cls(axes, np.array(ls), np.array(le), length, "line", _dir=d, _cos=d)
+        # Python floats make float64 arrays: no dtype argument to parse (issue 17)
+        s = np.array(ls)
+        e = np.array(le)
         p1, p2 = move.plane
         i1, i2 = axes.index(p1), axes.index(p2)
         c = (move.center[p1], move.center[p2])

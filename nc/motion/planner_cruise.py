@@ -119,7 +119,7 @@ class CruiseSampling:
         while True:
             b = blocks[k]
             seg = b.seg
-            start = seg.start.tolist()
+            start = seg.start_floats  # a line from the run feed keeps its lists: no array (bench B156)
             m = len(start)
             three = m == 3
             # _near(seg.start, the last block's end) on the lists, and the snap (session 12: each block's points
@@ -131,10 +131,10 @@ class CruiseSampling:
             else:
                 snap = k > 0 and all(abs(q - r) <= 1e-6 + 1e-5 * abs(r) for q, r in zip(start, end))
             if snap:
-                seg.start = blocks[k - 1].seg.end.copy()
+                seg.start_floats = end  # blocks[k - 1].seg.end, as floats (lists are never changed in place)
                 start = end
                 q0, q1, q2 = e0, e1, e2
-            end = seg.end.tolist()
+            end = seg.end_floats
             if three:
                 e0, e1, e2 = end
                 d0, d1, d2 = e0 - q0, e1 - q1, e2 - q2  # seg.end - seg.start: the same float subtraction

@@ -84,8 +84,8 @@ def few_rows(pl: "Planner", p: _Plan, n: int) -> bool:
     p.t_next = t_next + T * keep if keep < n else (t_next + T * (n - 1)) + T
     got = [row(i) for i in range(keep)]
     # seg.points(clip(s, 0.0, b.length)) of a line, per element
-    start = seg.start.tolist()
-    d = (seg.end - seg.start).tolist()
+    start = seg.start_floats  # lists, no array (path.Segment, bench B156)
+    d = [e - q for e, q in zip(seg.end_floats, start)]  # seg.end - seg.start: the same float subtraction
     seg_len = seg.length
     m = len(start)
     pos = []
