@@ -9,6 +9,11 @@ from typing import TYPE_CHECKING, Callable
 
 import numpy as np
 
+try:
+    import cython  # compiled: the types below (setup.py, decision bench B115)
+except ImportError:  # run as Python without Cython: they do nothing
+    from nc.motion import cython_shadow as cython
+
 from nc.motion.block import Block
 from nc.motion.path import Segment
 from nc.motion.spline_feed import NOTHING, Held, RunFeed
@@ -17,6 +22,7 @@ from nc.moves import Move
 if TYPE_CHECKING:
     from nc.motion.spline_runs import SplineSpan
 
+_line_of = Segment.line_of  # one name to look up (per push)
 _span_limits: Callable | None = None  # nc.motion.spline_runs.span_limits, imported by the first span (bench B91)
 
 
@@ -60,6 +66,7 @@ class FittedRuns:
             self._held, out = self._runs.release(self._held)
             self._let_through(out)
 
+    @cython.locals(g=tuple, b=Block)
     def _feed_run(self, move: Move) -> None:
         self._held, out = self._runs.push(self._held, move)
         if len(out) == 1 and out[0][1] is None:  # the common case on programs not fitted: one move, as it is
@@ -67,7 +74,9 @@ class FittedRuns:
             if b is None or b.seg is None or b.seg.kind != "spline":
                 m = out[0][0]
                 g = self._runs.geom  # its geometry, when the run feed just worked it out (issue 17)
-                self._push(m, line=Segment.line_of(self.axes, *g[1:]) if g is not None and g[0] is m else None)
+                # positional: no keywords to match, no slice of g to unpack (bench B156)
+                self._push(m, None, _line_of(self.axes, g[1], g[2], g[3], g[4]) if g is not None and g[0] is m
+                           else None)
                 return
         self._let_through(out)
 

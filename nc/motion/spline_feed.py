@@ -69,6 +69,17 @@ PIN = 1e-6  # mm: a run's curve must meet its first and last vertex this closely
 FIT_TOL = 0.985  # of N1.053: the fit's own tolerance (the joints' shifts take < 3e-4 mm)
 
 
+_dist = math.dist  # one name to look up (per push)
+
+
+@cython.ccall
+@cython.returns(cython.double)
+@cython.locals(p=dict)
+def _get(p: dict[str, float], a: str) -> float:
+    """float(p.get(a, 0.0)) of a dict (compiled: the dict's own get, a C double back)."""
+    return float(p.get(a, 0.0))
+
+
 @dataclass  # never changed in place, only replaced; compiled, an extension type (spline_feed.pxd: built on every push,
 class Held:  # its generated __init__ as Python took half of `push`, bench B136), so no slots=True (Cython's takes none)
     """The moves a run holds back, the vertices behind them (already let through, for the next window) and
@@ -115,13 +126,13 @@ class RunFeed:
                 or "G31" in mv.tags:
             return None
         ax, ms, me = self.axes, mv.start, mv.end
-        if len(ax) == 3:  # spelt out (once per push); float(): as Segment.of (compiled: the same double)
-            x, y, z = ax
-            a0, a1, a2 = float(ms.get(x, 0.0)), float(ms.get(y, 0.0)), float(ms.get(z, 0.0))
-            b0, b1, b2 = float(me.get(x, 0.0)), float(me.get(y, 0.0)), float(me.get(z, 0.0))
+        if len(ax) == 3 and type(ms) is dict and type(me) is dict:  # spelt out (once per push); float(): as
+            x, y, z = ax  # Segment.of (compiled: the same double); dict.get, typed (bench B156)
+            a0, a1, a2 = _get(ms, x), _get(ms, y), _get(ms, z)
+            b0, b1, b2 = _get(me, x), _get(me, y), _get(me, z)
             a = [a0, a1, a2]
             b = [b0, b1, b2]
-            n = math.dist(a, b)
+            n = _dist(a, b)
             if not 1e-6 < n <= MAX_LEN:
                 return None
             u = [(b0 - a0) / n, (b1 - a1) / n, (b2 - a2) / n]
@@ -158,6 +169,7 @@ class RunFeed:
         return thr
 
     # ---- the stream ----------------------------------------------------------------------------
+    @cython.locals(st=Held, h=Held)
     def push(self, st: Held, mv: Move) -> tuple[Held, list[tuple[Move, SplineSpan | None]]]:
         """The held state after mv, and the moves let through (with their span, None: as a line)."""
         ln = self.line(mv)
@@ -166,8 +178,8 @@ class RunFeed:
             return st, out + [(mv, None)]
         a, end, u = ln
         du = None
-        if st.end is not None and math.dist(st.end, a) <= 1e-9:
-            du = math.dist(u, st.u)  # |Δu|
+        if st.end is not None and _dist(st.end, a) <= 1e-9:
+            du = _dist(u, st.u)  # |Δu|
             if du > SHARP:
                 du = None  # a sharp corner: the run ends at it
         if du is None:
@@ -182,8 +194,16 @@ class RunFeed:
         thr = self._pay.get(feed)  # _pay_step's cache read here (once per push)
         if du > (thr if thr is not None else self._pay_step(feed)):
             return Held(st.moves + (mv,), (), True, end=end, u=u), []
-        if not st.moves:  # the common case on programs not fitted
-            return Held((), (), False, end, u), [(mv, None)]
+        if not st.moves:  # the common case on programs not fitted: Held((), (), False, end, u) without its
+            h = Held.__new__(Held)  # __init__'s arguments to parse (compiled: the type's slot, bench B156)
+            h.moves = ()
+            h.behind = ()
+            h.fitting = False
+            h.end = end
+            h.u = u
+            h.tail = None
+            h.key = b""
+            return h, [(mv, None)]
         return Held(end=end, u=u), [(m, None) for m in st.moves] + [(mv, None)]
 
     def release(self, st: Held) -> tuple[Held, list[tuple[Move, SplineSpan | None]]]:
