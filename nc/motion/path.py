@@ -7,6 +7,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+try:
+    import cython  # compiled: the types below (setup.py, decision bench B115; this module since bench B136)
+except ImportError:  # run as Python without Cython: they do nothing
+    from nc.motion import cython_shadow as cython
+
 from nc.interp.arcs import sweep
 from nc.moves import Move
 
@@ -115,32 +120,8 @@ class Segment:
     @staticmethod
     def line_of(axes: tuple[str, ...], ls: list[float], le: list[float], length: float,
                 d: list[float]) -> "Segment":
-        """A line from its start, end, length (math.dist) and unit direction worked out already (the run
-        feed's `RunFeed.geom`, issue 17): the segment `of` makes from the same move, bit for bit. The lists are
-        kept as they are (shared with the run feed's state: never changed in place)."""
-        seg = Segment.__new__(Segment)  # compiled: the type's slot alone, no __init__'s arguments to parse
-        seg.axes = axes
-        seg._pa = None
-        seg._pb = None
-        seg._fa = ls
-        seg._fb = le
-        seg.length = length
-        seg.kind = "line"
-        seg.i1 = 0
-        seg.i2 = 0
-        seg.center = _NO_CENTER
-        seg.radius = 0.0
-        seg.a0 = 0.0
-        seg.theta = 0.0
-        seg.arc_len = 0.0
-        if len(d) == 3:  # spelt out (once per push)
-            d0, d1, d2 = d
-            seg._dir = (d0, d1, d2)
-            seg._cos = (abs(d0), abs(d1), abs(d2))
-        else:
-            seg._dir = tuple(d)
-            seg._cos = tuple([abs(x) for x in d])
-        return seg
+        """`line_segment` (kept as the class's own)."""
+        return line_segment(axes, ls, le, length, d)
 
     @classmethod
     def of(cls, move: Move, axes: tuple[str, ...]) -> "Segment":
@@ -152,7 +133,7 @@ class Segment:
             if length > 0.0:
                 d = [(q - p) / length for p, q in zip(ls, le)]
                 if cls is Segment:
-                    return Segment.line_of(axes, ls, le, length, d)
+                    return line_segment(axes, ls, le, length, d)
                 return cls(axes, np.array(ls), np.array(le), length, "line", _dir=tuple(d),
                            _cos=tuple([abs(x) for x in d]))
             d = (0.0,) * len(axes)
@@ -237,3 +218,35 @@ class Segment:
                 d[self.i1] = float(np.max(np.abs(np.sin(a)))) * k
                 d[self.i2] = float(np.max(np.abs(np.cos(a)))) * k
         return d
+
+
+@cython.locals(seg=Segment)
+def line_segment(axes: tuple[str, ...], ls: list[float], le: list[float], length: float,
+                 d: list[float]) -> Segment:
+    """A line from its start, end, length (math.dist) and unit direction worked out already (the run
+    feed's `RunFeed.geom`, issue 17): the segment `of` makes from the same move, bit for bit. The lists are
+    kept as they are (shared with the run feed's state: never changed in place)."""
+    seg = Segment.__new__(Segment)  # compiled: the type's slot alone, no __init__'s arguments to parse, and
+    # (typed) each field a store into its struct, not a setattr (bench B156)
+    seg.axes = axes
+    seg._pa = None
+    seg._pb = None
+    seg._fa = ls
+    seg._fb = le
+    seg.length = length
+    seg.kind = "line"
+    seg.i1 = 0
+    seg.i2 = 0
+    seg.center = _NO_CENTER
+    seg.radius = 0.0
+    seg.a0 = 0.0
+    seg.theta = 0.0
+    seg.arc_len = 0.0
+    if len(d) == 3:  # spelt out (once per push)
+        d0, d1, d2 = d
+        seg._dir = (d0, d1, d2)
+        seg._cos = (abs(d0), abs(d1), abs(d2))
+    else:
+        seg._dir = tuple(d)
+        seg._cos = tuple([abs(x) for x in d])
+    return seg

@@ -15,14 +15,14 @@ except ImportError:  # run as Python without Cython: they do nothing
     from nc.motion import cython_shadow as cython
 
 from nc.motion.block import Block
-from nc.motion.path import Segment
+from nc.motion.path import line_segment
 from nc.motion.spline_feed import NOTHING, Held, RunFeed
 from nc.moves import Move
 
 if TYPE_CHECKING:
     from nc.motion.spline_runs import SplineSpan
 
-_line_of = Segment.line_of  # one name to look up (per push)
+_line_of = line_segment  # one name to look up (per push)
 _span_limits: Callable | None = None  # nc.motion.spline_runs.span_limits, imported by the first span (bench B91)
 
 
