@@ -56,20 +56,62 @@ class SoftLimits:
     def __post_init__(self) -> None:
         # axis -> the G10 L21 parameter names P1-P4 as `window` reads them, and the axis's scale (`_inside`)
         self._names: dict[str, tuple[str, str, str, str, float]] = {}
+        self._all: set[str] = set()  # the names of all axes in `_names`, in one set
+        # `_inside`'s box: axis (those in `_names`) -> the bench's 1st segment widened by _EPS (+-inf where it
+        # has none), or False when params hold a G10 L21 value of any of these axes; found
+        # for the params, their length and the bench's segments it names (decisions bench B158)
+        self._box: dict[str, tuple[float, float]] | bool = False
+        self._box_of: tuple[object, int, object] | None = None
 
     def _keys(self, axis: str) -> tuple[str, str, str, str, float]:
         k = self._names[axis] = (f"soft limit 1 {axis}", f"soft limit 2 {axis}", f"soft limit 3 {axis}",
                                  f"soft limit 4 {axis}", 0.5 if axis in self.diameter_axes else 1.0)
+        self._all.update(k[:4])
+        self._box_of = None  # the box is found again with this axis
         return k
+
+    def _new_box(self) -> dict[str, tuple[float, float]] | bool:
+        params, first = self.params, self.first
+        self._box_of = (params, len(params), first)
+        if not params.keys().isdisjoint(self._all):
+            self._box = False
+        else:
+            box: dict[str, tuple[float, float]] = {}
+            for a in self._names:
+                lo, hi = first.get(a, (None, None))
+                box[a] = (-math.inf if lo is None else lo - _EPS, math.inf if hi is None else hi + _EPS)
+            self._box = box
+        return self._box
 
     def _inside(self, move: Move) -> bool:
         """True when a line (rapid, thread) with the same axes at both ends stays inside both segments:
         `check` finds no alarm for it (issue 17: the channel asks for every move; `window`'s names
         formatted and the path ranges built were some 10 us a move). False: not known, `check` decides."""
         start, end = move.start, move.end
-        if (move.kind == "arc" and move.center) or start.keys() != end.keys():
+        if (move.kind == "arc" and move.center) or len(start) != len(end):
             return False
-        first, params, disabled, names = self.first, self.params, self.disabled, self._names
+        first, params, disabled = self.first, self.params, self.disabled
+        box = self._box
+        of = self._box_of
+        if of is None or of[0] is not params or of[1] != len(params) or of[2] is not first:
+            box = self._new_box()
+        if box and not disabled:
+            # no G10 L21 value for any axis seen and no axis's 1st segment off (a CAM run's case, issue 17): the
+            # bench's 1st segment alone, both ends inside it (as the min and max of the two are below: a NaN end
+            # passes there too), without the loop's 12 look-ups. Each axis of `end` in `start` (as many): the same
+            # axes at both ends.
+            try:
+                for a, e in end.items():
+                    s = start[a]
+                    lo, hi = box[a]  # type: ignore[index]  # KeyError: an axis not seen, its names made below
+                    if s < lo or s > hi or e < lo or e > hi:
+                        return False
+                return True
+            except KeyError:
+                pass
+        if start.keys() != end.keys():
+            return False
+        names = self._names
         for a, e in end.items():
             s = start[a]
             mn = e if e < s else s  # min(s, e) and max(s, e) as `_path_ranges` takes them
