@@ -115,6 +115,40 @@ def test_csv_cycles_compiled_equal_their_source(n, cycles, want, tv, vel, every,
     assert outs[0] == outs[1]
 
 
+def _round_outcome(f, x):
+    try:
+        r = f(x)
+    except (ValueError, OverflowError) as exc:
+        return type(exc)
+    assert type(r) is int
+    return r
+
+
+# halves and their neighbours, where rounding to even and the fraction's exactness are decided
+_HALVES = [k / 2.0 for k in range(-9, 10)] + [math.nextafter(k / 2.0, d) for k in range(-9, 10) for d in (-9.0, 9.0)]
+_EDGES = [0.0, -0.0, 2.0 ** 52, -2.0 ** 52, 2.0 ** 52 - 0.5, -(2.0 ** 52) + 0.5, 2.0 ** 53 + 2.0, 1e300, -1e300,
+          math.inf, -math.inf, math.nan, 5e-324, -5e-324, math.nextafter(-0.5, 0.0), math.nextafter(0.5, 0.0)]
+
+
+@settings(max_examples=2000, deadline=None)
+@given(x=st.floats(allow_nan=True, allow_infinity=True) | st.sampled_from(_HALVES + _EDGES)
+       | st.integers(-2 ** 40, 2 ** 40).map(lambda k: k / 2.0))
+def test_nearest_is_round_for_every_double(x):
+    """The kernels' round() on C doubles (B161): the builtin's int for every double, halves to even, its error for NaN
+    and infinities; the source and the build alike."""
+    want = _round_outcome(round, x)
+    assert _round_outcome(PY.nearest, x) == want
+    assert _round_outcome(BUILT.nearest, x) == want
+
+
+@given(coulomb=st.floats(0.0, 1e6), vel=st.floats(allow_nan=True, allow_infinity=True))
+def test_the_friction_term_is_copysign_above_one_count_a_second(coulomb, vel):
+    want = math.copysign(coulomb, vel) if abs(vel) > 1 else 0.0
+    for mod in (PY, BUILT):
+        got = mod.coulomb_of(coulomb, vel)
+        assert struct.pack("<d", got) == struct.pack("<d", want)
+
+
 def test_a_build_older_than_its_source_is_not_run(tmp_path):
     src, built = tmp_path / "drive_kernel.py", tmp_path / "drive_kernel.cpython-311-x86_64-linux-gnu.so"
     src.write_text("")

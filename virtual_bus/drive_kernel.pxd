@@ -5,6 +5,7 @@ cimport cython
 
 cdef long SW_TARGET_REACHED
 cdef long RAW_MAX
+cdef double _EXACT
 
 @cython.locals(k=int, cmd=double, v_cmd=double, neg=double, inside=bint)
 cpdef tuple csp_substeps(int n, double h, double prev, double span, double kff_ff, double kp, double pos,
@@ -39,3 +40,8 @@ cpdef double repeat(object out, double t, double h, int n, bint csp, Py_ssize_t 
                pa=list, va=list, ta=list, sws=list)
 cpdef tuple at_speed(object out, Py_ssize_t cycles, double pos, double t, double command, double dp, double h,
                      int n, long every, object va_raw, object ta_raw, long base, bint slow, double origin)
+
+@cython.locals(f=double, d=double)
+cpdef object nearest(double x)
+
+cpdef double coulomb_of(double coulomb, double vel)
