@@ -8,7 +8,7 @@ from setuptools import Extension, setup
 # The planner's hot modules (decision bench B115): one unit, nc/motion/compiled.py's MODULES, in the same order.
 PLANNER = ["block", "blending", "lookahead", "shares", "planner",
            "profile", "sample_rows", "planner_cruise", "planner_runs", "smoothing", "planner_corners",
-           "spline_feed", "path"]
+           "spline_feed", "path", "share_zones"]
 KERNELS = ["virtual_bus/drive_kernel.py"] + [f"nc/motion/{name}.py" for name in PLANNER]
 
 

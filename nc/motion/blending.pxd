@@ -44,6 +44,9 @@ cdef class FilterCorners:
     cdef public double _half, _g0, _tol_v  # kd.half, kd.g0, tol (inf: None) as C doubles (decision bench B153)
     cdef double _cap(self, Py_ssize_t m) except? -1.0
     cdef bint _taken(self, Py_ssize_t k) except -1
+    # C calls from Limits.junction, once a pushed junction (session 28, decision bench B157)
+    cpdef tuple corner_caps(self, object du, double du_n, bint lines, double acc)
+    cpdef double isolated_cap(self, double du_n, double acc, double jerk, Block b1, Block b2) except? -1.0
 
 # `_held_caps` and `_kernel_matrix` (decision bench B133): C loops over memoryviews, declared here as
 # nc.motion.cython_shadow has no memoryview types for the .py's decorators.

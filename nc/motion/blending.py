@@ -235,8 +235,7 @@ class FilterCorners:
                 v = min(v, ba / d, bj / d)
         return v
 
-    @cython.locals(v=cython.double, d=cython.double, x=cython.double, du_n=cython.double, acc=cython.double,
-                   room=cython.double, lines=cython.bint)
+    @cython.locals(v=cython.double, d=cython.double, x=cython.double, room=cython.double)  # its arguments: blending.pxd
     def corner_caps(self, du: Sequence[float], du_n: float, lines: bool, acc: float) -> tuple[float, float]:
         """(corner_budget(du, lines), corner_tolerance(du_n, acc)): one call a pushed junction, 3 axes spelt out
         (issue 17; min(a, b) / d is min(a / d, b / d) exactly, so `_bmin` serves for the two budgets)."""

@@ -2,8 +2,27 @@
 # passes' constants are C doubles and their square root C's (session 27, decision bench B148): math.sqrt calls the
 # same C sqrt, and _sqrt raises its ValueError below 0.
 from nc.motion.block cimport Block
+from nc.motion.blending cimport FilterCorners
 
 cdef double _MARGIN
 cdef double _INF
 
 cdef double _sqrt(double x) except? -1.0
+
+cpdef double change_distance(double v0, double v1, double a, double j) except? -1.0
+
+# `Limits` an extension type (session 28, decision bench B157): the planner calls `junction` and `block_limits` once
+# a pushed block each as C calls, and they read the limits from a struct. Where the hot paths read a field it is
+# typed; the others stay Python objects (the values the .py stores, as they were).
+cdef class Limits:
+    cdef public object cfg, v, acc, jerk, rv, racc, rjerk
+    cdef public double T
+    cdef public tuple _v, _acc, _jerk, _corner_j, _corner_a, _rv, _racc, _rjerk
+    cdef public FilterCorners blend
+    cdef public object _coupling, cut_a, cut_js, line_a_lo, line_j_lo
+    cdef public bint cut_on
+    cdef public object rapid_whole, rapid_share, rapid_v, rapid_a, rapid_js
+    cpdef tuple block_limits(self, object seg, bint short_ok=*, Py_ssize_t what=*)
+    cpdef double junction(self, Block b1, Block b2, bint raw=*) except? -1.0
+
+cpdef backward(object blocks, Py_ssize_t lo=*, bint full=*, Py_ssize_t depth=*)

@@ -67,9 +67,7 @@ def _sqrt(x: float) -> float:
     return _c_sqrt(x)
 
 
-@cython.ccall
-@cython.returns(cython.double)
-@cython.locals(v0=cython.double, v1=cython.double, a=cython.double, j=cython.double, dv=cython.double)
+@cython.locals(dv=cython.double)  # a C function of C doubles where compiled: lookahead.pxd (session 28: cimported)
 def change_distance(v0: float, v1: float, a: float, j: float) -> float:
     """Path length a jerk-limited speed change v0 → v1 needs, zero acceleration at both ends."""
     dv = abs(v1 - v0)
@@ -219,7 +217,7 @@ class Limits:
         return a, (x if x < j else j)
 
     @cython.locals(v=cython.double, a=cython.double, j=cython.double, x=cython.double, d=cython.double,
-                   vl=cython.double, al=cython.double, jl=cython.double, what=cython.Py_ssize_t,
+                   vl=cython.double, al=cython.double, jl=cython.double,
                    st=cython.double, i=cython.Py_ssize_t, n=cython.Py_ssize_t, m=cython.Py_ssize_t)
     def block_limits(self, seg: Segment, short_ok: bool = False, what: int = CUT) -> tuple[float, float, float]:
         """(speed cap, tangential acceleration, tangential jerk) of a path segment. `short_ok`: no
@@ -315,10 +313,9 @@ class Limits:
         a = min(a, (cn * pj - v3 * dk) / (3.0 * max(v, 1e-9) * km))
         return v, a, min(j, ct * pj - v3 * km * km)
 
-    @cython.locals(b1=Block, b2=Block, v=cython.double, d0=cython.double, d1=cython.double, d2=cython.double,
+    @cython.locals(v=cython.double, d0=cython.double, d1=cython.double, d2=cython.double,
                    sq_sum=cython.double, du_n=cython.double, a=cython.double, vb=cython.double, vc=cython.double,
-                   vp=cython.double,
-                   lines=cython.bint)
+                   vp=cython.double, lines=cython.bint, blend=FilterCorners)
     def junction(self, b1: Block, b2: Block, raw: bool = False) -> float:
         """Highest speed at the junction b1 → b2. `raw`: as without the filter (a junction where its
         share λ is below 1, nc.motion.share_zones); the filter's fields of b1 are then left alone."""
@@ -349,7 +346,7 @@ class Limits:
         if blend is not None and not raw:
             b1.dv = dv
             b1.du = du
-            b1.du_n = du_n = math.sqrt(sq_sum)
+            b1.du_n = du_n = _sqrt(sq_sum)  # C's sqrt (sq_sum ≥ 0): math.sqrt's, without its lookup and call
             if du_n > 1e-9:
                 lines = k1 == "line" and k2 == "line"
                 a = b2.a if b2.a > b1.a else b1.a  # max(b1.a, b2.a) and min(v, vb, vc) spelt out (session 15)
@@ -375,7 +372,7 @@ class Limits:
                         va = x
             v = min(v, cfg.share_corner * vj, cfg.share_corner * va)
             if cfg.path_tolerance is not None:
-                v = min(v, 4.0 * cfg.path_tolerance / (self.T * math.sqrt(sum(d * d for d in du))))
+                v = min(v, 4.0 * cfg.path_tolerance / (self.T * math.sqrt(sum([d * d for d in du]))))  # no closure: cpdef
         if k1 == "arc" or k2 == "arc":  # a line has no curvature: line-line skips this
             dk = np.abs(s2.curvature_vector(False) - s1.curvature_vector(True))
             if float(dk.max()) > 1e-12:
@@ -387,8 +384,7 @@ class Limits:
         return 0.0 if 0.0 > v else v  # max(v, 0.0)
 
 
-@cython.locals(n=cython.Py_ssize_t, k=cython.Py_ssize_t, k_stop=cython.Py_ssize_t, lo=cython.Py_ssize_t,
-               depth=cython.Py_ssize_t, nx=Block, b=Block, nx_vend=cython.double, nx_binding=cython.bint,
+@cython.locals(n=cython.Py_ssize_t, k=cython.Py_ssize_t, k_stop=cython.Py_ssize_t, nx=Block, b=Block, nx_vend=cython.double, nx_binding=cython.bint,
                nx_cap=cython.double, nx_length=cython.double, nx_a=cython.double, nx_j=cython.double,
                nx_av=cython.double, nx_ad=cython.double, nx_aa=cython.double, nx_aj=cython.double,
                b_cap=cython.double, local=cython.double, v=cython.double, av=cython.double, ad=cython.double,

@@ -44,7 +44,7 @@ from nc.motion.lookahead import (CUT, MARGIN, RAPID, THREAD, Limits, backward, c
 from nc.motion.path import Segment
 from nc.motion.plan_state import CHUNK, Setpoint, _near, _Plan
 from nc.motion.filter_ramps import HISTORY, FilterStops
-from nc.motion.planner_corners import CornerShares
+from nc.motion.planner_corners import CornerShares, _corner_at
 from nc.motion.planner_cruise import CruiseSampling
 from nc.motion.planner_runs import FittedRuns
 from nc.motion.spline_feed import NOTHING
@@ -196,7 +196,7 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
             self._push(move)
 
     @cython.locals(b=Block, prev=Block, x=cython.double, added=cython.Py_ssize_t, need=cython.Py_ssize_t,
-                   w=cython.Py_ssize_t)
+                   w=cython.Py_ssize_t, pushed=cython.Py_ssize_t, lim=Limits, zones=ShareZones)
     def _push(self, move: Move, span: Segment | None = None, line: Segment | None = None) -> None:
         self._pushes += 1
         if span is not None:
@@ -205,7 +205,11 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
             b = self._block(move) if line is None else self._block(move, line)
         if b is None:
             return
-        blend = self.lim.blend
+        # The limits' junction, the corner and the share zones are C calls where compiled, on locals read once
+        # (session 28, decision bench B157)
+        lim = self.lim
+        blocks = self.blocks
+        blend = lim.blend
         if blend is not None:
             b.vtop = b.cap_hard
             if b.kind == "path" and not b.rapid and not b.move.per_rev:
@@ -214,33 +218,37 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
                     b.vtop = x
         self._update_cap(b)
         added = 1
-        if self.blocks:
-            prev = self.blocks[-1]
-            prev.vjunc = self.lim.junction(prev, b)
-            added += self._corner(prev, b)
-        self._path_s += b.length
-        b.s_end = self._path_s
-        if self._zones is not None:
-            self._zones.block(b.s_end - b.length, b.vtop)
+        if blocks:
+            prev = blocks[-1]
+            prev.vjunc = lim.junction(prev, b)
+            added += _corner_at(self, prev, b)
+        x = self._path_s + b.length  # after the corner: a blend gave path (it set _path_s)
+        self._path_s = x
+        b.s_end = x
+        zones = self._zones
+        if zones is not None:
+            zones.block(b.s_end - b.length, b.vtop)
         seg = b.seg
         b.scan_plain = b.kind == "path" and seg is not None and seg.kind != "arc"
-        self.blocks.append(b)
-        self.threads_queued += b.kind == "thread"
-        self._pushed += added
+        blocks.append(b)
+        if b.kind == "thread":  # `threads_queued += kind == "thread"`, read and written only where it changes
+            self.threads_queued += 1
         # Blocks pushed since the last pass never had one: the pass must reach past all of them.
+        pushed = self._pushed + added
+        self._pushed = pushed
         need = self._need + added  # max() spelt out here and below
-        if self._pushed > need:
-            need = self._pushed
+        if pushed > need:
+            need = pushed
         if blend is not None:
-            w = blend.window(self.blocks)
+            w = blend.window(blocks)
             if w > need:
                 need = w
         self._need = need
 
     def lookahead(self) -> None:
-        """Bring the queue's end speeds up to date (the backward pass the pushes owe)."""
+        """Bring the queue's end speeds up to date (the backward pass the pushes owe; a C call where compiled)."""
         if self._pushed:
-            backward(self.blocks, 0, depth=self._need)
+            backward(self.blocks, 0, False, self._need)
             self._pushed = self._need = 0
 
     @property
@@ -399,22 +407,25 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
         return Setpoint(self.position.copy(), self.line, float(self._buf_vel[i]), blk)
 
     # ---- planning -------------------------------------------------------------------------
+    @cython.locals(lim=Limits, what=cython.Py_ssize_t)
     def _block(self, move: Move, seg: Segment | None = None) -> Block | None:
         """The move's block; `seg`: its line segment when the run feed built it already."""
-        if move.kind == "dwell":
+        kind = move.kind  # read once (a Move's field: an attribute lookup each, session 28)
+        if kind == "dwell":
             return Block(move, "dwell", None, 0.0, 0.0, 1.0, 1.0, None)
         if seg is None:
             seg = Segment.of(move, self.axes)
         if seg.length < 1e-9:
             return None
-        if move.kind == "rapid" and self.cfg.rapid_independent:
+        if kind == "rapid" and self.cfg.rapid_independent:
             return Block(move, "indep", seg, seg.length, 0.0, 1.0, 1.0, None, rapid=True)
-        # G00 and cutting moves each under their own NC5 parameters (decision motion 90)
-        v, a, j = self.lim.block_limits(seg, False, RAPID if move.kind == "rapid" else
-                                        THREAD if move.kind == "thread" else CUT)
-        feed = None if move.kind == "rapid" else (move.feed or 0.0) / (1.0 if move.per_rev else 60.0)
-        kind = "thread" if move.kind == "thread" else "path"
-        return Block(move, kind, seg, seg.length, v, a, j, feed, move.kind == "rapid")  # the 9th field: rapid
+        # G00 and cutting moves each under their own NC5 parameters (decision motion 90); a C call where compiled
+        lim = self.lim
+        what = RAPID if kind == "rapid" else THREAD if kind == "thread" else CUT
+        v, a, j = lim.block_limits(seg, False, what)
+        feed = None if kind == "rapid" else (move.feed or 0.0) / (1.0 if move.per_rev else 60.0)
+        return Block(move, "thread" if kind == "thread" else "path", seg, seg.length, v, a, j, feed,
+                     kind == "rapid")  # the 9th field: rapid
 
     @cython.locals(b=Block, cap=cython.double, x=cython.double, feed=cython.double)
     def _update_cap(self, b: Block, rpm: float | None = None) -> float:

@@ -12,79 +12,26 @@ except ImportError:  # run as Python without Cython: they do nothing
 
 from nc.motion.corner_blends import blend_block
 from nc.motion.block import Block
-from nc.motion.lookahead import change_distance
+from nc.motion.lookahead import Limits, change_distance
+from nc.motion.share_zones import ShareZones
 
 
 class CornerShares:
     """Methods of `nc.motion.planner.Planner` (its state is the planner's own: see that module's doc)."""
 
-    @cython.locals(prev=Block, b=Block, blk=Block, x=Block, top=cython.double)
     def _corner(self, prev: Block, b: Block) -> int:
         """The junction prev → b (prev.vjunc set): a corner blend between them where one is built
         (decisions motion 42, 45), or, under the filter, a hard junction where λ < 1 planned raw.
-        Returns the blocks added (the blend: 1)."""
-        zones = self._zones
-        tol = self.cfg.path_tolerance or 0.0
-        if zones is not None and prev.vjunc <= 0.0:
-            zones.stop(prev.s_end)
-            return 0
-        blk = None
-        top = b.vtop if b.vtop > prev.vtop else prev.vtop  # max(prev.vtop, b.vtop)
-        if zones is not None and zones.inside(prev.s_end, top):
-            # λ stays below 1 here: not blended, the junction is taken as without the filter, and
-            # that is what a blend must beat
-            prev.vjunc = min(prev.vjunc, self.lim.junction(prev, b, raw=True))
-        if (self.lim.blend is None or zones is not None) and self._may_blend(prev):
-            if zones is None or zones.blend_allowed(prev.s_end - prev.length, top, self._now(),
-                                                    abs(self.v) < 1e-12 and self.plan is None):
-                blk = blend_block(self.lim, prev, b, tol)
-        if blk is None:
-            if zones is not None and (prev.du_n > 1e-9 or "arc" in (prev.seg.kind, b.seg.kind)):
-                if zones.hard(prev.s_end, top):
-                    prev.vjunc = min(prev.vjunc, self.lim.junction(prev, b, raw=True))
-            return 0
-        # Both lines gave path to it: the running lengths follow.
-        prev.s_end -= blk.seg.tlen
-        blk.s_end = prev.s_end + blk.length
-        self._path_s = blk.s_end
-        if zones is not None:
-            blk.vtop = min(blk.cap_hard, prev.vtop)
-            zones.add_blend(blk.s_end - blk.length, blk.s_end, max(prev.vtop, b.vtop))
-        for x in (prev, blk, b):
-            self._update_cap(x)
-        blk.scan_plain = blk.kind == "path" and blk.seg is not None and blk.seg.kind != "arc"  # as `_push` sets it
-        self.blocks.append(blk)
-        if self.lim.blend is not None:
-            # The filter's windows walk the queue and their junction history side by side: the junction
-            # prev → blend joins that history now, as any pushed block's does (b's comes with b).
-            self._need = max(self._need, self.lim.blend.window(self.blocks) + 1)
-        return 1
+        Returns the blocks added (the blend: 1). `_corner_at` (`Planner._push` calls that in C)."""
+        return _corner_at(self, prev, b)
 
-    @cython.locals(prev=Block, head=Block, room=cython.double)
     def _may_blend(self, prev: Block) -> bool:
-        """Whether the tail may still give path to a corner blend (decision motion 42): a tolerance
-        to blend within, no hold (its ramp runs on across blocks), and no profile that could be
-        caught by the shorter path: nothing planned yet, or the tail further beyond the active
-        block than any stop from its speed needs, at half the least tangential limits."""
-        tol = self.cfg.path_tolerance
-        if tol is None or tol <= 0.0 or self.held or self._stopping:
-            return False
-        if not self._started and self.plan is None:
-            return True
-        head = self.blocks[0]
-        if prev is head:
-            return False
-        room = prev.s_end - prev.length - head.s_end
-        v = abs(self.v)
-        return room >= change_distance(v if v > head.cap else head.cap, 0.0, self._a_lo, self._j_lo)  # max() spelt out
+        """Whether the tail may still give path to a corner blend (decision motion 42): `_blend_room`."""
+        return _blend_room(self, prev)
 
-    @cython.locals(b=Block)
     def _now(self) -> float:
         """Path position (Block.s_end's scale) of the last sample handed out."""
-        if self.blocks:
-            b = self.blocks[0]
-            self._share_s = b.s_end - b.length + (self.s if self._started else 0.0)
-        return self._share_s
+        return _path_now(self)
 
     def _share(self) -> float:
         """The filter's share λ at the present path position (nc.motion.share_zones)."""
@@ -96,7 +43,7 @@ class CornerShares:
             # once the filter has settled, where λ may change at once (a stop cuts the zones).
             lam = self._lam
         else:
-            lam = z.lam(self._now())
+            lam = z.lam(_path_now(self))
         self._lam = lam
         return lam
 
@@ -126,3 +73,81 @@ class CornerShares:
         if self._zones is None or not self._zones.zones:
             return None
         return np.full(n, self._share())
+
+
+@cython.locals(blk=Block, x=Block, top=cython.double, zones=ShareZones, lim=Limits)
+def _corner_at(pl: CornerShares, prev: Block, b: Block) -> int:
+    """The junction prev → b (prev.vjunc set): a corner blend between them where one is built
+    (decisions motion 42, 45), or, under the filter, a hard junction where λ < 1 planned raw.
+    Returns the blocks added (the blend: 1)."""
+    zones = pl._zones
+    if zones is not None and prev.vjunc <= 0.0:
+        zones.stop(prev.s_end)
+        return 0
+    blk = None
+    top = b.vtop if b.vtop > prev.vtop else prev.vtop  # max(prev.vtop, b.vtop)
+    lim = pl.lim
+    if zones is not None and zones.inside(prev.s_end, top):
+        # λ stays below 1 here: not blended, the junction is taken as without the filter, and
+        # that is what a blend must beat
+        prev.vjunc = min(prev.vjunc, lim.junction(prev, b, raw=True))
+    # `_may_blend` and `_now` as C calls (once a push each, session 28)
+    if (lim.blend is None or zones is not None) and _blend_room(pl, prev):
+        if zones is None or zones.blend_allowed(prev.s_end - prev.length, top, _path_now(pl),
+                                                abs(pl.v) < 1e-12 and pl.plan is None):
+            blk = blend_block(lim, prev, b, pl.cfg.path_tolerance or 0.0)
+    if blk is None:
+        if zones is not None and (prev.du_n > 1e-9 or "arc" in (prev.seg.kind, b.seg.kind)):
+            if zones.hard(prev.s_end, top):
+                prev.vjunc = min(prev.vjunc, lim.junction(prev, b, raw=True))
+        return 0
+    # Both lines gave path to it: the running lengths follow.
+    prev.s_end -= blk.seg.tlen
+    blk.s_end = prev.s_end + blk.length
+    pl._path_s = blk.s_end
+    if zones is not None:
+        blk.vtop = min(blk.cap_hard, prev.vtop)
+        zones.add_blend(blk.s_end - blk.length, blk.s_end, max(prev.vtop, b.vtop))
+    for x in (prev, blk, b):
+        pl._update_cap(x)
+    blk.scan_plain = blk.kind == "path" and blk.seg is not None and blk.seg.kind != "arc"  # as `_push` sets it
+    pl.blocks.append(blk)
+    if lim.blend is not None:
+        # The filter's windows walk the queue and their junction history side by side: the junction
+        # prev → blend joins that history now, as any pushed block's does (b's comes with b).
+        pl._need = max(pl._need, lim.blend.window(pl.blocks) + 1)
+    return 1
+
+
+# `_corner`'s helpers as C functions where compiled (planner_corners.pxd): a call to a method of the planner, a
+# Python class, is an attribute lookup and a Python call (once a push each, session 28, decision bench B157).
+@cython.locals(head=Block, room=cython.double, v=cython.double, tol=cython.double)
+def _blend_room(pl: CornerShares, prev: Block) -> bool:
+    """Whether the tail may still give path to a corner blend (decision motion 42): a tolerance
+    to blend within, no hold (its ramp runs on across blocks), and no profile that could be
+    caught by the shorter path: nothing planned yet, or the tail further beyond the active
+    block than any stop from its speed needs, at half the least tangential limits."""
+    x = pl.cfg.path_tolerance
+    if x is None:
+        return False
+    tol = x
+    if tol <= 0.0 or pl.held or pl._stopping:
+        return False
+    if not pl._started and pl.plan is None:
+        return True
+    head = pl.blocks[0]
+    if prev is head:
+        return False
+    room = prev.s_end - prev.length - head.s_end
+    v = abs(pl.v)
+    return room >= change_distance(v if v > head.cap else head.cap, 0.0, pl._a_lo, pl._j_lo)  # max() spelt out
+
+
+@cython.locals(b=Block)
+def _path_now(pl: CornerShares) -> float:
+    """Path position (Block.s_end's scale) of the last sample handed out."""
+    blocks = pl.blocks
+    if blocks:
+        b = blocks[0]
+        pl._share_s = b.s_end - b.length + (pl.s if pl._started else 0.0)
+    return pl._share_s
