@@ -24,5 +24,3 @@ cdef class Limits:
     cdef public object rapid_whole, rapid_share, rapid_v, rapid_a, rapid_js
     cpdef tuple block_limits(self, object seg, bint short_ok=*, Py_ssize_t what=*)
     cpdef double junction(self, Block b1, Block b2, bint raw=*) except? -1.0
-
-cpdef backward(object blocks, Py_ssize_t lo=*, bint full=*, Py_ssize_t depth=*)

@@ -384,7 +384,8 @@ class Limits:
         return 0.0 if 0.0 > v else v  # max(v, 0.0)
 
 
-@cython.locals(n=cython.Py_ssize_t, k=cython.Py_ssize_t, k_stop=cython.Py_ssize_t, nx=Block, b=Block, nx_vend=cython.double, nx_binding=cython.bint,
+@cython.locals(n=cython.Py_ssize_t, k=cython.Py_ssize_t, k_stop=cython.Py_ssize_t, lo=cython.Py_ssize_t,
+               depth=cython.Py_ssize_t, nx=Block, b=Block, nx_vend=cython.double, nx_binding=cython.bint,
                nx_cap=cython.double, nx_length=cython.double, nx_a=cython.double, nx_j=cython.double,
                nx_av=cython.double, nx_ad=cython.double, nx_aa=cython.double, nx_aj=cython.double,
                b_cap=cython.double, local=cython.double, v=cython.double, av=cython.double, ad=cython.double,

@@ -246,9 +246,9 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
         self._need = need
 
     def lookahead(self) -> None:
-        """Bring the queue's end speeds up to date (the backward pass the pushes owe; a C call where compiled)."""
+        """Bring the queue's end speeds up to date (the backward pass the pushes owe)."""
         if self._pushed:
-            backward(self.blocks, 0, False, self._need)
+            backward(self.blocks, 0, depth=self._need)
             self._pushed = self._need = 0
 
     @property
