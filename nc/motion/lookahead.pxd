@@ -2,7 +2,8 @@
 # passes' constants are C doubles and their square root C's (session 27, decision bench B148): math.sqrt calls the
 # same C sqrt, and _sqrt raises its ValueError below 0.
 from nc.motion.block cimport Block
-from nc.motion.blending cimport FilterCorners
+# as _FilterCorners: the module's name FilterCorners stays the Python class Limits makes (a test makes a subclass)
+from nc.motion.blending cimport FilterCorners as _FilterCorners
 
 cdef double _MARGIN
 cdef double _INF
@@ -18,7 +19,7 @@ cdef class Limits:
     cdef public object cfg, v, acc, jerk, rv, racc, rjerk
     cdef public double T
     cdef public tuple _v, _acc, _jerk, _corner_j, _corner_a, _rv, _racc, _rjerk
-    cdef public FilterCorners blend
+    cdef public _FilterCorners blend
     cdef public object _coupling, cut_a, cut_js, line_a_lo, line_j_lo
     cdef public bint cut_on
     cdef public object rapid_whole, rapid_share, rapid_v, rapid_a, rapid_js

@@ -32,6 +32,8 @@ else:
     _cbrt, _c_sqrt = math.cbrt, math.sqrt
 
 from nc.motion.blending import FilterCorners
+if not cython.compiled:  # junction's local type: lookahead.pxd cimports the extension type under this name
+    _FilterCorners = FilterCorners
 from nc.motion.block import Block
 from nc.motion.limits import MotionConfig, acceleration, jerk_per_acc
 from nc.motion.path import Segment
@@ -315,7 +317,7 @@ class Limits:
 
     @cython.locals(v=cython.double, d0=cython.double, d1=cython.double, d2=cython.double,
                    sq_sum=cython.double, du_n=cython.double, a=cython.double, vb=cython.double, vc=cython.double,
-                   vp=cython.double, lines=cython.bint, blend=FilterCorners)
+                   vp=cython.double, lines=cython.bint, blend=_FilterCorners)
     def junction(self, b1: Block, b2: Block, raw: bool = False) -> float:
         """Highest speed at the junction b1 → b2. `raw`: as without the filter (a junction where its
         share λ is below 1, nc.motion.share_zones); the filter's fields of b1 are then left alone."""
