@@ -93,7 +93,7 @@ class Pass:
         # next stretch can start there; one cannot start at a reading cycle)
         self.soft = soft
         self.rx0, self.saved_drives = rx0, saved_drives
-        self.parts: list[tuple] = []  # each take's (lines, path speeds, move, moves) (take_parts)
+        self.parts: list[tuple] = []  # each take's (raw rows, λ, lines, path speeds, move, moves) (take_parts)
         self.out_rows: list[list[float]] = []  # the filtered rows, `filtered` of them
         self.pending: list[tuple[np.ndarray, np.ndarray | None]] = []  # (raw rows, λ) not filtered yet
         self.raws: list[np.ndarray] = []  # every part's raw rows
@@ -108,6 +108,8 @@ class Pass:
         self.to_counts = [(sc._cpu, org[i]) for i, sc in enumerate(st.r.scales[:st.n_axes])]
         self.feeds = 0
         self.reads = not no_reads(ch)  # (constant over the stretch: its feeds read plain moves only)
+        # Planner.full's bounds (_feed_due inline); nothing in a pass changes the depth
+        self.depth, self.fill_to = pl.depth, pl.depth + pl._batch
 
     @property
     def outs(self) -> list[Stretch]:
@@ -128,8 +130,7 @@ class Pass:
         src = ahead(ch)
         fed_at = -1
         reads = self.reads
-        # Planner.full's bounds (_feed_due inline: a call a part counts); nothing in a pass changes the depth
-        depth, fill_to = pl.depth, pl.depth + pl._batch
+        depth, fill_to = self.depth, self.fill_to
         # [rows, the planner then, parts then]: where a drive fault puts it back. The planner's save is the one the
         # next _group makes before its step (the same state: a feed's drive check flushed the filter), not one more
         self._mark = [0, None, 0]
@@ -157,6 +158,8 @@ class Pass:
         return self.rows if stop is None else self._back(stop)
 
     def _group(self, limit: int) -> bool:
+        """One planner step and the rows after it (`_steps`, inline: a call a part counts); False where the step
+        cannot be taken here, the planner then as before it."""
         pl = self.pl
         refill = pl._buf_done
         if refill:
@@ -164,25 +167,63 @@ class Pass:
             # is checked on a copy of it, decision motion 52)
             self._flush()
         mark = self._mark
-        changes = refill or pl._buf_blk is not None
         if mark[1] is None:  # the first step after a feed (or the start): the planner saved, its filter too
-            mark[1] = saved = _save(pl)
-        else:
-            saved = _save(pl, False) if changes else None
+            mark[1] = _save(pl)
+        # A step that may change the planner (a refill, a cruise's next block) is not saved before it (issue 17,
+        # decision bench B159): the one refused (once a stretch) is undone from the mark's save, the steps since
+        # made again (`_rewind`; they are deterministic, as `_back` makes them)
+        changes = refill or pl._buf_blk is not None
+        got = None
         try:
-            got = _steps(self.ch, pl, limit, self.reads)
+            pl._before_take()
+            p = pl.plan
+            blocks = pl.blocks
+            if not pl._buf_done and p is not None and p.kind in PLAN_KINDS and blocks \
+                    and blocks[0].move.css is None:
+                cruise = pl._buf_blk is not None
+                if self.reads and ((q := len(blocks)) < self.depth or (pl._filling and q < self.fill_to)):
+                    limit = 1  # the next cycle reads: a feed comes between
+                elif cruise:
+                    limit = _across(self.ch, pl, limit)
+                got = take_parts(pl, limit, cruise)
         except NcAlarm:  # the step raises: stepping raises it in its own cycle
             got = None
         if got is None:
             if changes:
-                _restore_planner(pl, saved)
+                self._rewind()
             return False
-        raw, lam, lines, vel, mv, moves = got
-        self.parts.append((lines, vel, mv, moves))
+        raw = got[0]
+        self.parts.append(got)
         self.raws.append(raw)
-        self.pending.append((raw, lam))
+        self.pending.append((raw, got[1]))
         self.rows += len(raw)
         return True
+
+    def _rewind(self) -> None:
+        """The planner as before the step just refused: from the mark's save, the steps since made again (they
+        are deterministic; what they pushed through the filter is pushed again, the same rows)."""
+        rows = self.rows
+        if not self._cut_to_mark():
+            return  # the mark's save was taken before that very step
+        while self.rows < rows and self._group(rows - self.rows):
+            pass
+
+    def _cut_to_mark(self) -> bool:
+        """The planner, the rows and the parts as at the last mark; False where nothing was taken since."""
+        rows, saved, nparts = self._mark
+        assert saved is not None  # (a _group follows every mark)
+        _restore_planner(self.pl, saved)  # (a mark is taken after a feed, whose drive check flushed the filter)
+        moved = self.rows != rows
+        del self.parts[nparts:]
+        del self.raws[nparts:]
+        self.pending = []
+        self.rows = self.filtered = rows
+        del self.out_rows[rows:]
+        if self.converted > rows:
+            self.converted = rows
+            for t in self.targets:
+                del t[rows + 1:]
+        return moved
 
     def _flush(self) -> None:
         """The rows taken since the last flush through the position filter (push_many at once, push_rows row by
@@ -251,33 +292,23 @@ class Pass:
             runs[i].step(targets[i][a:upto] if i < n_axes else upto - a)
         self.driven = upto
         m = min([run.out.done for run in runs])
-        for i in range(n_axes):  # a few cycles a part: plain Python, not numpy calls
+        for i in range(n_axes):  # a few cycles a part: Python's max and min over a slice, not numpy calls
             lim, va = r._overspeed[i], runs[i].out.velocity_actual
             w = len(va)  # the cycles written: a still drive's later ones (CspRun.lag) repeat the last
-            for k in range(a, m if m <= w else w):
-                if abs(va[k]) > lim:
-                    m = k
-                    break
-            else:
-                if m > w and abs(va[-1]) > lim:
-                    m = max(a, w)
+            e = m if m <= w else w
+            if e > a:
+                part = va[a:e]
+                if max(part) > lim or -min(part) > lim:  # (one C pass; the cycle found only where one is over)
+                    m = next(k for k in range(a, e) if abs(va[k]) > lim)
+                    continue
+            if m > w and abs(va[-1]) > lim:
+                m = max(a, w)
         return m if m < upto else None
 
     def _back(self, stop: int) -> int:
         """A drive faults in cycle `stop`: the stretch ends before it. The planner from the last save (after a
         feed, or the start), its steps made again up to there; the drives stepped again from the start."""
-        rows, saved, nparts = self._mark
-        assert saved is not None  # (a _group follows every mark before a drive check)
-        _restore_planner(self.pl, saved)  # (a mark is taken after a feed, whose drive check flushed the filter)
-        del self.parts[nparts:]
-        del self.raws[nparts:]
-        self.pending = []
-        self.rows = self.filtered = rows
-        del self.out_rows[rows:]
-        if self.converted > rows:
-            self.converted = rows
-            for t in self.targets:
-                del t[rows + 1:]
+        self._cut_to_mark()
         while self.rows < stop and self._group(stop - self.rows):
             pass
         self._redrive()
@@ -297,8 +328,8 @@ class Pass:
         parts = self.parts
         lines: list[int] = []
         moves: list[Any] = []
-        for ln, _, mv, mvs in parts:
+        for _, _, ln, _, mv, mvs in parts:
             lines += ln
             moves += mvs if mvs is not None else [mv] * len(ln)
-        return Samples(np.array(self.out_rows), lines, np.concatenate([p[1] for p in parts]).astype(float, copy=False),
-                       parts[0][2], moves, np.concatenate(self.raws))
+        return Samples(np.array(self.out_rows), lines, np.concatenate([p[3] for p in parts]).astype(float, copy=False),
+                       parts[0][4], moves, np.concatenate(self.raws))
