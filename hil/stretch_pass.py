@@ -61,22 +61,6 @@ def no_reads(ch: Channel) -> bool:
         or (ch.single_block and bool(ch._block_moves))
 
 
-def _steps(ch: Channel, pl: Planner, limit: int, reads: bool) -> tuple | None:
-    """One planner step as Planner._step_path makes it before its take, then the rows that follow it with no feed
-    or refill between (at least one, at most `limit`), as `take_parts` hands them out (not filtered yet); None
-    where the step cannot be taken here (module doc: the caller puts the planner back)."""
-    pl._before_take()
-    p = pl.plan
-    if pl._buf_done or p is None or p.kind not in PLAN_KINDS or not pl.blocks or pl.blocks[0].move.css is not None:
-        return None
-    cruise = pl._buf_blk is not None
-    if reads and _feed_due(pl):
-        limit = 1  # the next cycle reads: a feed comes between
-    elif cruise:
-        limit = _across(ch, pl, limit)
-    return take_parts(pl, limit, cruise)
-
-
 class Pass:
     """The NC pass of one stretch and its drive models, a part at a time (module doc).
 
@@ -158,8 +142,9 @@ class Pass:
         return self.rows if stop is None else self._back(stop)
 
     def _group(self, limit: int) -> bool:
-        """One planner step and the rows after it (`_steps`, inline: a call a part counts); False where the step
-        cannot be taken here, the planner then as before it."""
+        """One planner step as Planner._step_path makes it before its take, then the rows that follow it with no
+        feed or refill between (at least one, at most `limit`), as `take_parts` hands them out (not filtered yet);
+        False where the step cannot be taken here (module doc), the planner then as before it."""
         pl = self.pl
         refill = pl._buf_done
         if refill:
