@@ -393,15 +393,17 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
         if self.spindle_command is not None:
             self._settle.update(float(self.spindle_rpm()), float(self.spindle_command()))
         self._before_take()
-        if self._buf_done and self.plan is None and self.blocks and self.blocks[0].kind == "thread" \
+        pos = self._buf_pos
+        i = self._buf_i
+        done = pos is None or i >= len(pos)  # `_buf_done`, read once
+        if done and self.plan is None and self.blocks and self.blocks[0].kind == "thread" \
                 and (self._thread is not None or self._settled):
             return self._thread_step()
-        if self._buf_done:  # standing still (idle, held, or waiting)
+        if done:  # standing still (idle, held, or waiting)
             self.v = self.a = 0.0
             blk = self.blocks[0].move if self._started and self.blocks else None
             return Setpoint(self.position.copy(), self.line, 0.0, blk)
-        i = self._buf_i
-        self._buf_i += 1
+        self._buf_i = i + 1
         self._take(i)
         blk = self.blocks[0].move if self.blocks else None
         return Setpoint(self.position.copy(), self.line, float(self._buf_vel[i]), blk)
@@ -514,32 +516,38 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
         self.held = False
         self.s = self.v = self.a = 0.0
 
+    # (n stays a Python int: absurd limits give a duration of more cycles than a C integer holds)
+    @cython.locals(T=cython.double, t_next=cython.double, duration=cython.double)
     def _refill(self) -> None:
+        # (`_buf_done` spelt out after a sample: what it read is the rows just sampled, issue 17)
         T = self.cfg.cycle
         for _ in range(MAX_SOLVES_PER_CYCLE):
-            if self.plan is None and not self._settled and self.at_rest:
-                return  # exact stop: the filtered setpoint reaches the point before anything starts
-            if self.plan is None:
-                self.plan = self._start_plan()
-                self._cont = None
-                if self.plan is None:
-                    return
             p = self.plan
+            if p is None:
+                if not self._settled and self.at_rest:
+                    return  # exact stop: the filtered setpoint reaches the point before anything starts
+                p = self._start_plan()
+                self.plan = p
+                self._cont = None
+                if p is None:
+                    return
             if p.kind == "cruise":
                 if not p.emitted:
                     self._sample_cruise(p)
-                    if not self._buf_done:
+                    if self._buf_i < len(self._buf_pos):  # (a cruise samples at least a row: never None)
                         return
                 self._end_plan(p)
                 continue
             if p.open and p.emitted and self._pushes > p.queued and not self.held:
                 self._replan()  # more of the path is known: the jerk factor may rise
                 continue
-            n = int(math.floor((p.duration - p.t_next) / T + 1e-9)) + 1
-            if p.t_next <= p.duration + 1e-12 and n > 0:
+            t_next, duration = p.t_next, p.duration
+            n = int(math.floor((duration - t_next) / T + 1e-9)) + 1
+            if t_next <= duration + 1e-12 and n > 0:
                 c = OPEN_CHUNK if p.open else CHUNK
                 self._sample(p, c if c < n else n)  # min(n, c)
-                if not self._buf_done:
+                pos = self._buf_pos
+                if pos is not None and self._buf_i < len(pos):
                     return
                 if self.plan is None:
                     continue  # re-solve at a block boundary
@@ -914,7 +922,7 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
                 # state (once per block), now that more of the queue may be known.
                 length = blocks[0].length
                 s_last = self.s
-                self._finish_block(keep_plan=True)
+                self._finish_block(True)
                 self.s = s_last - length
                 self.plan = None
                 # The state re-solved from is the last emitted sample (one cycle back) or, when
@@ -926,7 +934,7 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
             while len(blocks) > 1 and blocks[1].kind == "path" and s[0] > blocks[0].length + 1e-12:
                 p.base += blocks[0].length
                 s = s - blocks[0].length
-                self._finish_block(keep_plan=True)
+                self._finish_block(True)
             more = len(blocks) > 1 and blocks[1].kind == "path"
         if more:
             cut = int(np.searchsorted(s, blocks[0].length + 1e-12, side="right"))
@@ -957,7 +965,7 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
             d = p.target
             while len(self.blocks) > 1 and d > self.blocks[0].length + 1e-9:
                 d -= self.blocks[0].length
-                self._finish_block(keep_plan=True)
+                self._finish_block(True)
             b = self.blocks[0]
             self.s, self.v, self.a = b.length, p.pw.v_end(), 0.0
             self.position = b.seg.end.copy() if b.seg is not None else self.position
@@ -978,7 +986,7 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
             self.a = 0.0
             while len(self.blocks) > 1 and self.blocks[1].kind == "path" and self.s > self.blocks[0].length + 1e-12:
                 self.s -= self.blocks[0].length
-                self._finish_block(keep_plan=True)
+                self._finish_block(True)
             b = self.blocks[0] if self.blocks else None
             if b is not None and b.seg is not None:
                 self.s = min(self.s, b.length)
@@ -986,23 +994,33 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
             if abs(self.v) < 1e-9 and self._stopping:
                 self._flush()
 
+    @cython.locals(done=Block, keep_plan=cython.bint)
     def _finish_block(self, keep_plan: bool = False) -> None:
-        if self.blocks:
-            done = self.blocks.popleft()
-            self.threads_queued -= done.kind == "thread"
-            if done.seg is not None:
-                self._seg_hist = self._seg_hist[1 - HISTORY:] + (done.seg,)
+        # (the queue read once, the fields each written once: per block, issue 17)
+        blocks = self.blocks
+        if blocks:
+            done = blocks.popleft()
+            if done.kind == "thread":
+                self.threads_queued -= 1
+            seg = done.seg
+            if seg is not None:
+                self._seg_hist = self._seg_hist[1 - HISTORY:] + (seg,)
             if keep_plan:  # a path plan on into the next block (re-solved there), or the blocks after it
                 p = self.plan
                 if p is not None:
                     self._cont = (p, done.length) if p.kind == "path" and not p.open else None
-                elif self._cont is not None:
-                    self._cont = (self._cont[0], self._cont[1] + done.length)
-        self._started = False
-        if not keep_plan:
+                else:
+                    cont = self._cont
+                    if cont is not None:
+                        self._cont = (cont[0], cont[1] + done.length)
+        if keep_plan:
+            if blocks:
+                self._started = True
+                self.line = blocks[0].move.line
+            else:
+                self._started = False
+        else:
+            self._started = False
             self.s = 0.0
-        if self.blocks and not keep_plan:
-            self.line = self.blocks[0].move.line
-        if keep_plan and self.blocks:
-            self._started = True
-            self.line = self.blocks[0].move.line
+            if blocks:
+                self.line = blocks[0].move.line

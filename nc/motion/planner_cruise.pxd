@@ -1,2 +1,4 @@
 # Types for nc/motion/planner_cruise.py where setup.py compiles it with Cython (issue 17, decision bench B115).
 from nc.motion.block cimport Block
+
+cdef bint _cruises(Block b, double v) except -1

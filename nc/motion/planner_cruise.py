@@ -21,6 +21,17 @@ from nc.motion.plan_state import CHUNK, _Plan
 ROWS = 16
 
 
+def _cruises(b: Block, v: float) -> bool:
+    """A solve at b's start (or within b) from speed v at zero acceleration would cruise at v to b's end:
+    its run ends there (b's end speed is not below its cap), its cap is v, nothing re-plans it per cycle.
+    Not a corner blend (decision motion 45): measured, its solve does not give a cruise bit for bit.
+    (A C function compiled: asked per block of a cruise, issue 17.)"""
+    if not (b.kind == "path" and b.cap == v and b.vend >= v):
+        return False
+    mv = b.move
+    return not mv.per_rev and mv.css is None and "G31" not in mv.tags and b.seg.kind != "blend"
+
+
 class CruiseSampling:
     """Methods of `nc.motion.planner.Planner` (its state is the planner's own: see that module's doc)."""
 
@@ -38,12 +49,18 @@ class CruiseSampling:
     def _before_take(self) -> None:
         """What a step does before it takes its row: a cruise's next block checked again where a push came since
         (`_chain_ok`), the refill where the buffer ran out (a stretch makes these steps too, hil/stretch_pass.py)."""
-        if self._buf_blk is not None and not self._buf_done:
-            k = self._buf_blk[self._buf_i]
-            if k > self._buf_popped and (bad := self._chain_ok(self.plan, k)) <= k:
-                self._break_chain(bad)
-        if self._buf_done:
-            self._refill()
+        # (`_buf_done` spelt out, read once: a property call twice a step, issue 17)
+        pos = self._buf_pos
+        i = self._buf_i
+        if pos is not None and i < len(pos):
+            blk = self._buf_blk
+            if blk is None:
+                return
+            k = blk[i]
+            if k <= self._buf_popped or (bad := self._chain_ok(self.plan, k)) > k:
+                return
+            self._break_chain(bad)  # (it drops the buffer: the refill below)
+        self._refill()
 
     def _cruise_rows(self, n: int) -> int:
         """Of the next n buffer rows, how many a stretch may take across a cruise's blocks: those before the
@@ -61,21 +78,18 @@ class CruiseSampling:
 
     def _take(self, i: int) -> None:
         """The state after handing out buffer row i: a cruise's blocks before row i's are finished."""
-        if self._buf_blk is not None:
-            k = self._buf_blk[i]
+        blk = self._buf_blk
+        if blk is not None:
+            k = blk[i]
             while self._buf_popped < k:
-                self._finish_block(keep_plan=True)
+                self._finish_block(True)  # keep_plan (positional: a keyword call builds a dict)
                 self._buf_popped += 1
         self.position = self._buf_pos[i]
         self.line = self._buf_line[i]
         self.s, self.v, self.a = self._buf_state[i]
 
     def _cruising(self, b: Block, v: float) -> bool:
-        """A solve at b's start (or within b) from speed v at zero acceleration would cruise at v to b's end:
-        its run ends there (b's end speed is not below its cap), its cap is v, nothing re-plans it per cycle.
-        Not a corner blend (decision motion 45): measured, its solve does not give a cruise bit for bit."""
-        return (b.kind == "path" and b.cap == v and b.vend >= v and not b.move.per_rev and b.move.css is None
-                and "G31" not in b.move.tags and b.seg.kind != "blend")
+        return _cruises(b, v)
 
     def _cruise(self, b: Block, t0: float) -> _Plan | None:
         """Decision motion 44: at its cap, with zero acceleration, a run whose end speed is the cap solves to
@@ -88,7 +102,7 @@ class CruiseSampling:
         if self.held or self._stopping or self.a != 0.0 or v <= 0.0:
             return None
         self.lookahead()
-        if not self._cruising(b, v):
+        if not _cruises(b, v):
             return None
         return _Plan("cruise", None, math.inf, t0, queued=self._pushes)
 
@@ -98,7 +112,7 @@ class CruiseSampling:
                    i=cython.Py_ssize_t, a=cython.Py_ssize_t, m=cython.Py_ssize_t, rows=cython.Py_ssize_t,
                    line=cython.bint, three=cython.bint, snap=cython.bint, q0=cython.double, q1=cython.double,
                    q2=cython.double, e0=cython.double, e1=cython.double, e2=cython.double, d0=cython.double,
-                   d1=cython.double, d2=cython.double)
+                   d1=cython.double, d2=cython.double, carry=cython.double)
     def _sample_cruise(self, p: _Plan) -> None:
         """The rows of a cruise, whole blocks up to at least ROWS rows: each block as its own solve gives them
         (a constant-speed profile from s0 at the plan time t0, s = s0 + v·t, sampled a CHUNK at a time while
@@ -181,12 +195,13 @@ class CruiseSampling:
                 offs += [k] * n
                 lines += [b.move.line] * n
                 rows += n
-            p.carry = t_next - duration if t_next - duration > 1e-12 else t_next - duration + T
-            carries.append(p.carry)
-            p.last = k
-            if rows >= ROWS or k + 1 >= nb or not self._cruising(blocks[k + 1], v):
+            carry = t_next - duration if t_next - duration > 1e-12 else t_next - duration + T
+            carries.append(carry)
+            if rows >= ROWS or k + 1 >= nb or not _cruises(blocks[k + 1], v):
                 break
-            k, s0, t_next = k + 1, 0.0, p.carry
+            k, s0, t_next = k + 1, 0.0, carry
+        p.carry = carry  # (the plan's fields written once, for its last block)
+        p.last = k
         p.emitted = True
         self._buf_pos = np.array(pos) if pos else np.empty((0, len(self.axes)))
         self._buf_vel = np.full(rows, v)
@@ -204,8 +219,9 @@ class CruiseSampling:
         if p is None or p.kind != "cruise" or self._pushes == p.queued:
             return upto + 1
         self.lookahead()
-        for k in range(self._buf_popped + 1, upto + 1):
-            if not self._cruising(self.blocks[k - self._buf_popped], self.v):
+        popped, blocks, v = self._buf_popped, self.blocks, self.v
+        for k in range(popped + 1, upto + 1):
+            if not _cruises(blocks[k - popped], v):
                 return k
         return upto + 1
 
@@ -213,7 +229,7 @@ class CruiseSampling:
         """Block offset k does not cruise any more: the chain ends at the end of block k - 1, as that block's
         own plan would end there (`_end_plan`); the next refill solves block k."""
         while self._buf_popped < k - 1:
-            self._finish_block(keep_plan=True)
+            self._finish_block(True)
             self._buf_popped += 1
         self._carry = self._buf_carry[k - 1]
         self.position = self.blocks[0].seg.end.copy()

@@ -30,10 +30,22 @@ if TYPE_CHECKING:
 FEW = 6  # rows kept up to which plain floats beat numpy (a row ≈ 1 µs, numpy's sample ≈ 25 µs a call)
 
 
+def _row(rows: dict, pw: object, t: float, base: float, i: int) -> tuple[float, float, float]:
+    """Row i of the plan (its time t = p.t_next + T·i): `Piecewise.at`, less the plan's base, kept in `rows`
+    (the bisection's probes and the rows kept are asked for once each). A C function compiled (a closure a call
+    cost its scope and function objects, issue 17)."""
+    r = rows.get(i)
+    if r is None:
+        s, v, a = pw.at(t)  # t = p.t_next + T * np.arange(n)
+        r = rows[i] = (s - base, v, a)
+    return r
+
+
 @cython.locals(T=cython.double, t_next=cython.double, base=cython.double, length=cython.double, x=cython.double,
                s=cython.double, u=cython.double, seg_len=cython.double, n=cython.Py_ssize_t, keep=cython.Py_ssize_t,
                lo=cython.Py_ssize_t, hi=cython.Py_ssize_t, mid=cython.Py_ssize_t, i=cython.Py_ssize_t,
-               m=cython.Py_ssize_t, k=cython.Py_ssize_t)
+               m=cython.Py_ssize_t, k=cython.Py_ssize_t, q0=cython.double, q1=cython.double, q2=cython.double,
+               d0=cython.double, d1=cython.double, d2=cython.double)
 def few_rows(pl: "Planner", p: _Plan, n: int) -> bool:
     """`Planner._sample(p, n)` for a path or ramp plan, when it keeps at most FEW rows or re-solves at the next
     block; False (nothing changed) where `_sample` must run."""
@@ -43,23 +55,14 @@ def few_rows(pl: "Planner", p: _Plan, n: int) -> bool:
     b = blocks[0]
     length = b.length
     rows: dict[int, tuple[float, float, float]] = {}
-
-    @cython.locals(i=cython.Py_ssize_t, s=cython.double)
-    def row(i: int) -> tuple[float, float, float]:
-        r = rows.get(i)
-        if r is None:
-            s, v, a = pw.at(t_next + T * i)  # t = p.t_next + T * np.arange(n)
-            r = rows[i] = (s - base, v, a)
-        return r
-
     more = len(blocks) > 1 and blocks[1].kind == "path"
-    if more and row(0)[0] > length + 1e-12:
+    if more and _row(rows, pw, t_next + T * 0, base, 0)[0] > length + 1e-12:
         if not (p.kind == "path" or (p.kind == "ramp" and not pl.held and p is not pl._fr_plan)):
             return False  # a ramp runs on into the next block without a solve: _sample's loop
         # _sample's re-solve at the block boundary, from the last emitted state
         p.t_next = (t_next + T * (n - 1)) + T
         s_last = pl.s
-        pl._finish_block(keep_plan=True)
+        pl._finish_block(True)
         pl.s = s_last - length
         pl.plan = None
         pl._carry = T if p.emitted else t_next
@@ -71,7 +74,7 @@ def few_rows(pl: "Planner", p: _Plan, n: int) -> bool:
         lo, hi = 0, n
         while lo < hi:
             mid = (lo + hi) >> 1
-            s = row(mid)[0]
+            s = _row(rows, pw, t_next + T * mid, base, mid)[0]
             if x < s:
                 hi = mid
             else:
@@ -82,21 +85,36 @@ def few_rows(pl: "Planner", p: _Plan, n: int) -> bool:
     if keep > FEW or seg.kind != "line" or seg.length <= 0.0:
         return False
     p.t_next = t_next + T * keep if keep < n else (t_next + T * (n - 1)) + T
-    got = [row(i) for i in range(keep)]
-    # seg.points(clip(s, 0.0, b.length)) of a line, per element
-    start = seg.start_floats  # lists, no array (path.Segment, bench B156)
-    d = [e - q for e, q in zip(seg.end_floats, start)]  # seg.end - seg.start: the same float subtraction
+    # seg.points(clip(s, 0.0, b.length)) of a line, per element; seg.end - seg.start the same float subtraction
+    # as numpy's, on the lists (path.Segment's, bench B156; 3 axes on C doubles, as planner_cruise samples a cruise)
+    start = seg.start_floats
+    end = seg.end_floats
     seg_len = seg.length
     m = len(start)
+    q0 = q1 = q2 = d0 = d1 = d2 = 0.0
+    d = None
+    if m == 3:
+        q0, q1, q2 = start
+        d0, d1, d2 = end[0] - q0, end[1] - q1, end[2] - q2
+    else:
+        d = [e - q for e, q in zip(end, start)]
+    got = []
     pos = []
-    for r in got:
+    vel = []
+    for i in range(keep):
+        r = _row(rows, pw, t_next + T * i, base, i)
+        got.append(r)
+        vel.append(r[1])
         s = r[0]
         s = 0.0 if 0.0 >= s else s
         u = (length if length <= s else s) / seg_len
-        pos.append([start[k] + u * d[k] for k in range(m)])
+        if m == 3:
+            pos.append([q0 + u * d0, q1 + u * d1, q2 + u * d2])
+        else:
+            pos.append([start[k] + u * d[k] for k in range(m)])
     p.emitted = True
     pl._buf_pos = np.array(pos)
-    pl._buf_vel = np.array([r[1] for r in got])
+    pl._buf_vel = np.array(vel)
     pl._buf_line = [b.move.line] * keep
     pl._buf_i = 0
     pl._buf_state = got
