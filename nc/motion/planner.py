@@ -517,7 +517,7 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
         self.s = self.v = self.a = 0.0
 
     # (n stays a Python int: absurd limits give a duration of more cycles than a C integer holds)
-    @cython.locals(T=cython.double, t_next=cython.double, duration=cython.double, z=cython.double)
+    @cython.locals(T=cython.double, t_next=cython.double, duration=cython.double)
     def _refill(self) -> None:
         # (`_buf_done` spelt out after a sample: what it read is the rows just sampled, issue 17)
         T = self.cfg.cycle
@@ -542,8 +542,7 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
                 self._replan()  # more of the path is known: the jerk factor may rise
                 continue
             t_next, duration = p.t_next, p.duration
-            z = (duration - t_next) / T + 1e-9
-            n = int(z // 1.0) + 1  # math.floor(z): a float's floor division by 1 is its floor (a C call)
+            n = int(math.floor((duration - t_next) / T + 1e-9)) + 1
             if t_next <= duration + 1e-12 and n > 0:
                 c = OPEN_CHUNK if p.open else CHUNK
                 self._sample(p, c if c < n else n)  # min(n, c)

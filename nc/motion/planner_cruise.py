@@ -81,12 +81,9 @@ class CruiseSampling:
         blk = self._buf_blk
         if blk is not None:
             k = blk[i]
-            popped = self._buf_popped
-            if popped < k:
-                while popped < k:
-                    self._finish_block(True)  # keep_plan (positional: a keyword call builds a dict)
-                    popped += 1
-                self._buf_popped = popped
+            while self._buf_popped < k:
+                self._finish_block(True)  # keep_plan (positional: a keyword call builds a dict)
+                self._buf_popped += 1
         self.position = self._buf_pos[i]
         self.line = self._buf_line[i]
         self.s, self.v, self.a = self._buf_state[i]
@@ -162,8 +159,7 @@ class CruiseSampling:
                 d = [e - q for e, q in zip(end, start)]  # seg.end - seg.start: the same float subtraction as numpy's
             duration = (b.length - s0) / v  # ruckig's duration of this profile, to the bit
             while True:
-                x = (duration - t_next) / T + 1e-9
-                n = int(x // 1.0) + 1  # math.floor(x): a float's floor division by 1 is its floor (a C call)
+                n = int(math.floor((duration - t_next) / T + 1e-9)) + 1
                 if not (t_next <= duration + 1e-12 and n > 0):
                     break
                 if CHUNK < n:  # min(n, CHUNK)

@@ -22,7 +22,6 @@ try:
 except ImportError:  # run as Python without Cython: they do nothing
     from nc.motion import cython_shadow as cython
 
-from nc.motion.block import Block
 from nc.motion.plan_state import _Plan
 
 if TYPE_CHECKING:
@@ -46,7 +45,7 @@ def _row(rows: dict, pw: object, t: float, base: float, i: int) -> tuple[float, 
                s=cython.double, u=cython.double, seg_len=cython.double, n=cython.Py_ssize_t, keep=cython.Py_ssize_t,
                lo=cython.Py_ssize_t, hi=cython.Py_ssize_t, mid=cython.Py_ssize_t, i=cython.Py_ssize_t,
                m=cython.Py_ssize_t, k=cython.Py_ssize_t, q0=cython.double, q1=cython.double, q2=cython.double,
-               d0=cython.double, d1=cython.double, d2=cython.double, b=Block, nx=Block)
+               d0=cython.double, d1=cython.double, d2=cython.double)
 def few_rows(pl: "Planner", p: _Plan, n: int) -> bool:
     """`Planner._sample(p, n)` for a path or ramp plan, when it keeps at most FEW rows or re-solves at the next
     block; False (nothing changed) where `_sample` must run."""
@@ -56,10 +55,7 @@ def few_rows(pl: "Planner", p: _Plan, n: int) -> bool:
     b = blocks[0]
     length = b.length
     rows: dict[int, tuple[float, float, float]] = {}
-    more = False
-    if len(blocks) > 1:
-        nx = blocks[1]
-        more = nx.kind == "path"
+    more = len(blocks) > 1 and blocks[1].kind == "path"
     if more and _row(rows, pw, t_next + T * 0, base, 0)[0] > length + 1e-12:
         if not (p.kind == "path" or (p.kind == "ramp" and not pl.held and p is not pl._fr_plan)):
             return False  # a ramp runs on into the next block without a solve: _sample's loop
