@@ -122,9 +122,7 @@ class CruiseSampling:
         v = self.v
         blocks = self.blocks
         s0, t_next, k, nb = self.s, p.t_next, 0, len(blocks)
-        # the rows as plain floats, one after the other (a block's one or two: numpy's calls cost more), made an
-        # array once at the end: numpy's conversion of a list of row lists costs ≈ 2× a flat list's (issue 17)
-        flat: list[float] = []
+        pos: list[list[float]] = []  # rows as plain floats (a block's one or two: numpy's calls cost more)
         st: list[float] = []
         offs: list[int] = []
         lines: list[int] = []
@@ -186,15 +184,13 @@ class CruiseSampling:
                     if line:
                         u = x / seg_len
                         if three:
-                            flat.append(q0 + u * d0)
-                            flat.append(q1 + u * d1)
-                            flat.append(q2 + u * d2)
+                            pos.append([q0 + u * d0, q1 + u * d1, q2 + u * d2])
                         else:
-                            flat += [start[a] + u * d[a] for a in range(m)]
+                            pos.append([start[a] + u * d[a] for a in range(m)])
                     else:
                         sc.append(x)
                 if not line:
-                    flat += seg.points(np.array(sc)).ravel().tolist()
+                    pos += seg.points(np.array(sc)).tolist()
                 t_next = (t_next + T * (n - 1)) + T
                 offs += [k] * n
                 lines += [b.move.line] * n
@@ -207,10 +203,8 @@ class CruiseSampling:
         p.carry = carry  # (the plan's fields written once, for its last block)
         p.last = k
         p.emitted = True
-        self._buf_pos = np.array(flat).reshape(rows, m) if rows else np.empty((0, len(self.axes)))
-        vel = np.empty(rows)  # np.full(rows, v): its empty and fill without its Python-level wrapper
-        vel.fill(v)
-        self._buf_vel = vel
+        self._buf_pos = np.array(pos) if pos else np.empty((0, len(self.axes)))
+        self._buf_vel = np.full(rows, v)
         self._buf_line = lines
         self._buf_state = [(x, v, 0.0) for x in st]
         self._buf_blk = offs
