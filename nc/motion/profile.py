@@ -13,6 +13,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+import ruckig
 from ruckig import ControlInterface, InputParameter, Result, Ruckig, Synchronization, Trajectory
 
 try:
@@ -21,6 +22,7 @@ except ImportError:  # run as Python without Cython: they do nothing
     from nc.motion import cython_shadow as cython
 
 from nc.alarms import NcAlarm
+from nc.motion.compiled import direct_ruckig
 
 
 def clip(x: np.ndarray | float, lo: float, hi: float) -> np.ndarray | np.floating:
@@ -52,6 +54,15 @@ _WROTE: list[float] = [math.nan] * 8
 # One Trajectory per DoF count, filled by every calculate (as ruckig's own update() refills its output's): a solve
 # reads its phases out before the next (Trajectory(n) was ≈ 1.8k instructions a solve, session 28)
 _TRAJ: dict[int, Trajectory] = {}
+
+
+# ruckig's C++ called directly for the 1-DoF solves (nc/motion/ruckig_direct.pyx, decision bench B162): the same
+# calculation and read-back as _one_dof + _calculate + _of, without pybind (≈ 24k instructions a solve, session 28);
+# None (solved through the Python module) where it is not built, not current, built for another ruckig, or where
+# DELTAHIL_PYTHON_PLANNER=1. RUCKIG says which. Where it is taken, every 1-DoF solve goes through it (solve_axes with
+# one axis too): a velocity solve's p_max includes the final position the trajectory's solve before left (ruckig
+# keeps no pf for velocity control), so the 1-DoF solves share one trajectory in the same order either way.
+_DIRECT, RUCKIG = direct_ruckig(getattr(ruckig, "__version__", ""))
 
 
 def _same(x: float, y: float) -> bool:
@@ -350,25 +361,45 @@ def solve_position(p0: float, v0: float, a0: float, p1: float, v1: float, v_max:
     if _same(p0, _S0) and _same(v0, _S1) and _same(a0, _S2) and _same(p1, _S3) and _same(v1, _S4) \
             and _same(v_max, _S5) and _same(a_max, _S6) and _same(j_max, _S7):
         return _S_PW
-    otg, inp = _one_dof(_POSITION, p0, v0, a0, p1, v1, v_max, a_max, j_max)
-    traj = _calculate(otg, inp, 1)
-    pw = None if traj is None else _of(traj, Piecewise)
+    direct = _DIRECT
+    if direct is not None:
+        r = direct(False, p0, v0, a0, p1, v1, v_max, a_max, j_max)
+        pw = None if r is None else _OneDof(r[0], r[1], r[2])
+    else:
+        otg, inp = _one_dof(_POSITION, p0, v0, a0, p1, v1, v_max, a_max, j_max)
+        traj = _calculate(otg, inp, 1)
+        pw = None if traj is None else _of(traj, Piecewise)
     _S0, _S1, _S2, _S3, _S4, _S5, _S6, _S7, _S_PW = p0, v0, a0, p1, v1, v_max, a_max, j_max, pw
     return pw
 
 
 def solve_velocity(p0: float, v0: float, a0: float, v1: float, a_max: float, j_max: float) -> Piecewise:
     """Jerk-limited change of velocity to v1 (ends with a = 0), e.g. a feed hold or override ramp."""
-    otg, inp = _one_dof(_VELOCITY, p0, v0, a0, p0, v1, max(abs(v0), abs(v1), 1e-9), a_max, j_max)
-    traj = _calculate(otg, inp, 1)
-    if traj is None:
-        raise NcAlarm(0x0000, f"velocity ramp {v0:g} → {v1:g} mm/s cannot be planned")
-    return _of(traj, Piecewise)
+    v_max = max(abs(v0), abs(v1), 1e-9)
+    direct = _DIRECT
+    if direct is not None:
+        r = direct(True, p0, v0, a0, p0, v1, v_max, a_max, j_max)
+        if r is not None:
+            return _OneDof(r[0], r[1], r[2])
+    else:
+        otg, inp = _one_dof(_VELOCITY, p0, v0, a0, p0, v1, v_max, a_max, j_max)
+        traj = _calculate(otg, inp, 1)
+        if traj is not None:
+            return _of(traj, Piecewise)
+    raise NcAlarm(0x0000, f"velocity ramp {v0:g} → {v1:g} mm/s cannot be planned")
 
 
 def solve_axes(p0, v0, a0, p1, v_max, a_max, j_max, velocity: bool = False) -> Piecewise:
     """Every axis independently (no synchronisation) to rest at p1, or to v = 0 when `velocity`."""
     n = len(p0)
+    direct = _DIRECT
+    if n == 1 and direct is not None:  # as the path solves: one trajectory for every 1-DoF solve, in order (B162)
+        # (ruckig's synchronisation, Time there and None here, plays no part with one DoF)
+        r = direct(velocity, float(p0[0]), float(v0[0]), float(a0[0]), float(p1[0]), 0.0, float(v_max[0]),
+                   float(a_max[0]), float(j_max[0]))
+        if r is None:
+            raise NcAlarm(0x0000, "independent-axis rapid cannot be planned")
+        return _OneDof(r[0], r[1], r[2])
     otg, inp = _calc(n)
     _MODE.pop(n, None)  # _one_dof sets its fields again (a one-axis machine shares its input)
     if n == 1:
