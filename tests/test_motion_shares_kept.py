@@ -6,6 +6,7 @@ program of arcs, exact stops, a dwell and short corners (the arcs' and the stops
 from __future__ import annotations
 
 import math
+from bisect import bisect_left, bisect_right
 from pathlib import Path
 
 import numpy as np
@@ -43,13 +44,7 @@ def _run(text: str, overrides: dict[int, float], checked: list[int]) -> np.ndarr
     """The run's setpoints; every scan is made both ways and must agree (`checked`: scans, junctions read
     in the reaches, verdicts found again)."""
     scan = shares._scan
-    verdicts = shares._verdicts
     found = [0]
-
-    def counted(fc, blocks, k_lo, k_hi, prefix):
-        part = fc._sc[k_lo:k_hi]
-        found[0] += len(part) - (part.index(None) if None in part else len(part))
-        return verdicts(fc, blocks, k_lo, k_hi, prefix)
 
     def both(fc, blocks, pos, run_end, reach, closed, v_stop=-1.0):
         shares.WALK = True
@@ -57,6 +52,10 @@ def _run(text: str, overrides: dict[int, float], checked: list[int]) -> np.ndarr
             ref = scan(fc, blocks, pos, run_end, reach, closed, v_stop)
         finally:
             shares.WALK = False
+        # the verdicts the kept scan finds again: from the reach's first one not kept on
+        k_lo, k_hi = bisect_left(fc._hist_s, pos - reach), bisect_right(fc._hist_s, run_end + reach)
+        part = fc._sc[k_lo:k_hi]
+        found[0] += len(part) - (part.index(None) if None in part else len(part))
         got = scan(fc, blocks, pos, run_end, reach, closed, v_stop)
         assert got == ref
         checked[0] += 1
@@ -70,11 +69,11 @@ def _run(text: str, overrides: dict[int, float], checked: list[int]) -> np.ndarr
         if n in overrides:
             ch.planner.feed_override = overrides[n]
 
-    shares._scan, shares._verdicts = both, counted
+    shares.CHECK = both  # jerk_factor's scans go through `both` (the scan is a C call where compiled)
     try:
         st = run(events, cfg, {"X": 0.0, "Y": 0.0, "Z": 100.0}, on_cycle=on_cycle)
     finally:
-        shares._scan, shares._verdicts = scan, verdicts
+        shares.CHECK = None
     checked[2] = found[0]
     assert not st.alarms
     return st.positions

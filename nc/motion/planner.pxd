@@ -1,6 +1,13 @@
 # Types for nc/motion/planner.py where setup.py compiles it with Cython (issue 17, decision bench B115). `_push`
 # calls the junction model, the corner and the share zones in C (session 28, decision bench B157).
+cimport cython
+from nc.motion.blending cimport FilterCorners
 from nc.motion.block cimport Block
 from nc.motion.lookahead cimport Limits
 from nc.motion.planner_corners cimport _corner_at
 from nc.motion.share_zones cimport ShareZones
+from nc.motion.shares cimport jerk_factor
+
+# Planner._jerk_factor and _factor_over's work in C (session 29, decision bench B164)
+@cython.locals(start=double, span=double, zones=ShareZones, blend=FilterCorners)
+cdef tuple _factor_span(object planner, Limits lim, Block b, double s, double dist)

@@ -82,6 +82,22 @@ def replans(p: _Plan, rpm: float, settled: bool) -> bool:
     return not (abs(rpm - p.rpm) <= 0.02 * max(p.rpm, 1.0) and (not settled or p.settled))
 
 
+def _factor_span(planner: "Planner", lim: Limits, b: Block, s: float, dist: float) -> tuple[float, bool]:
+    """Planner._factor_over's work, a C function where compiled (planner.pxd; session 29, decision bench B164): each
+    of the planner's fields read once (a generic attribute read from compiled code, ~230 instructions), the share
+    zones and jerk_factor called in C."""
+    blend = lim.blend
+    if blend is None:
+        return 1.0, False
+    start = b.s_end - b.length
+    zones = planner._zones
+    if zones is not None:
+        span = blend.span_max
+        if zones.near(start + s - span, start + dist + span):
+            return 1.0, False  # λ < 1 there: the raw path keeps the tangential share (decision motion 45)
+    return jerk_factor(planner.cfg, blend, planner.blocks, start + s, start + dist, planner.closed)
+
+
 class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedRuns):
     # True: every block of a run starts a new solve, also where the run cruises at its cap (the reference
     # tests compare the cruise sampling against, decision motion 44)
@@ -774,19 +790,14 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
         """The tangential jerk factor for a solve from s in b, and whether the queue could not
         tell it yet (nc.motion.shares): over the longest run any solve from here may take (the
         extended one: a higher jerk only ends runs sooner)."""
-        if self.lim.blend is None:
+        lim = self.lim
+        if lim.blend is None:
             return 1.0, False
-        return self._factor_over(b, s, self._run_target(cap, True, cruise)[0])
+        return _factor_span(self, lim, b, s, self._run_target(cap, True, cruise)[0])
 
     def _factor_over(self, b: Block, s: float, dist: float) -> tuple[float, bool]:
         """`_jerk_factor` over a run from s in b to `dist` (measured from b's start)."""
-        blend = self.lim.blend
-        if blend is None:
-            return 1.0, False
-        start = b.s_end - b.length
-        if self._zones is not None and self._zones.near(start + s - blend.span_max, start + dist + blend.span_max):
-            return 1.0, False  # λ < 1 there: the raw path keeps the tangential share (decision motion 45)
-        return jerk_factor(self.cfg, blend, self.blocks, start + s, start + dist, self.closed)
+        return _factor_span(self, self.lim, b, s, dist)
 
     @cython.locals(b=Block, nx=Block, dist=cython.double, ra=cython.double, rj=cython.double, vmax=cython.double,
                    cap=cython.double, cap_lo=cython.double, x=cython.double, jf=cython.double,

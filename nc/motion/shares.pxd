@@ -16,3 +16,26 @@ cdef Py_ssize_t _first_at_or_above(list xs, double x) except -1
 
 
 cdef tuple _joined(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t k_lo, Py_ssize_t k_hi)
+
+# The scan's steps as C calls (session 29, decision bench B164): Python calls, their float arguments boxed and
+# unpacked each time, from the planner's `_factor_over` to jerk_factor, _scan, _verdicts and _tolerance_free. cpdef:
+# the tests call them from Python too; the planner cimports jerk_factor. _verdicts' NONE and SKIP stay the objects
+# stored in the verdict list (`none`, `skip`: no new float a store).
+@cython.locals(st=double, pool=double, t_w=double, v_hi=double, x=double, reach=double, use=double, seen=double,
+               f=double, saturates=bint, head=Block, tail=Block, v_stop=double)
+cpdef tuple jerk_factor(object cfg, object fc, object blocks, double pos, double run_end, bint closed)
+
+@cython.locals(hi=double, seen=double, stop_s=double, s_end=double, vt=double, use=double, top=double, x=double,
+               m=double, y=double, none=double, covered=bint, plain=bint, stop=bint, i=Py_ssize_t, k=Py_ssize_t,
+               k_lo=Py_ssize_t, k_hi=Py_ssize_t, q_lo=Py_ssize_t, q_hi=Py_ssize_t, n_pre=Py_ssize_t, b=Block,
+               last=Block, sc=list, vts=list, hist_s=list)
+cpdef object _scan(object fc, object blocks, double pos, double run_end, double reach, bint closed,
+                   double v_stop=*)
+
+@cython.locals(n=Py_ssize_t, d=Py_ssize_t, ok_lo=Py_ssize_t, ok_hi=Py_ssize_t, k=Py_ssize_t, i=Py_ssize_t,
+               n_ends=Py_ssize_t, h=Py_ssize_t, j=Block, b=Block, head=Block, vbud=double, cap=double, c2=double,
+               tcap=double, r=double, s_j=double, x=double, sc=list, ends=list, hist=list)
+cpdef list _verdicts(object fc, object blocks, Py_ssize_t k_lo, Py_ssize_t k_hi, Py_ssize_t n_pre)
+
+@cython.locals(b=Block, k=Py_ssize_t, cap=double, c2=double, tcap=double, unb=double, x=double, ok=bint, tol=double)
+cpdef bint _tolerance_free(object fc, Block j, object blocks, list ends) except -1

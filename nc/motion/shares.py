@@ -49,9 +49,7 @@ if TYPE_CHECKING:
     from nc.motion.blending import FilterCorners
 
 
-@cython.locals(st=cython.double, pool=cython.double, t_w=cython.double, v_hi=cython.double, x=cython.double,
-               reach=cython.double, use=cython.double, seen=cython.double, f=cython.double, saturates=cython.bint,
-               head=Block, tail=Block)
+# (types in shares.pxd: a cpdef function, called in C from the planner; session 29)
 def jerk_factor(cfg: MotionConfig, fc: "FilterCorners", blocks: Sequence["Block"], pos: float,
                 run_end: float, closed: bool) -> tuple[float, bool]:
     """Factor (1 … MAX_FACTOR) on the tangential jerk of a solve over path positions
@@ -74,9 +72,12 @@ def jerk_factor(cfg: MotionConfig, fc: "FilterCorners", blocks: Sequence["Block"
     # the first such junction once no block faster than v_hi lies in the reach (every other outcome of
     # its scan, None included, gives 1.0 too).
     saturates = (1.0 - pool) / st <= 1.0
+    check = CHECK
     for _ in range(4):  # the reach grows with the fastest block found inside it
         reach = v_hi * t_w
-        got = _scan(fc, blocks, pos, run_end, reach, closed, v_hi if saturates else -1.0)
+        v_stop = v_hi if saturates else -1.0
+        got = _scan(fc, blocks, pos, run_end, reach, closed, v_stop) if check is None \
+            else check(fc, blocks, pos, run_end, reach, closed, v_stop)
         if got is None:
             return 1.0, False
         if got is UNKNOWN:
@@ -93,17 +94,14 @@ def jerk_factor(cfg: MotionConfig, fc: "FilterCorners", blocks: Sequence["Block"
 
 
 UNKNOWN = (-1.0, -1.0)  # _scan: the queue ends before the reach does
+# A test's stand-in for _scan, which jerk_factor calls instead where set (tests/test_motion_shares_kept.py: _scan and
+# the helpers below are C functions where compiled, called in C; replacing the module's names reaches no call)
+CHECK = None
 # Above FilterCorners._boost_ratio's largest value (2: doubling the jerk at most doubles the speed-up) by
 # far more than its rounding: _tolerance_free's bound.
 RATIO_BOUND = 2.001
 
 
-@cython.locals(hi=cython.double, seen=cython.double, stop_s=cython.double, s_end=cython.double, vt=cython.double,
-               use=cython.double, top=cython.double, x=cython.double, m=cython.double, none=cython.double,
-               covered=cython.bint, plain=cython.bint, stop=cython.bint, i=cython.Py_ssize_t, k=cython.Py_ssize_t,
-               k_lo=cython.Py_ssize_t, k_hi=cython.Py_ssize_t, q_lo=cython.Py_ssize_t, q_hi=cython.Py_ssize_t,
-               n_pre=cython.Py_ssize_t, b=Block, last=Block, sc=list, vts=list, hist_s=list, pos=cython.double,
-               run_end=cython.double, reach=cython.double, v_stop=cython.double)
 def _scan(fc: "FilterCorners", blocks: Sequence["Block"], pos: float, run_end: float, reach: float,
           closed: bool, v_stop: float = -1.0) -> tuple[float, float] | None:
     """(largest vjunc / vbud, fastest vtop) over the junctions within `reach` of [pos, run_end];
@@ -172,13 +170,17 @@ def _scan(fc: "FilterCorners", blocks: Sequence["Block"], pos: float, run_end: f
                 q_lo = q_hi = k_lo
             for k in range(q_hi, k_hi):
                 x = vts[k]
-                while q and q[-1][1] <= x:
+                while q:
+                    y = q[-1][1]  # a C double compiled: compared with x without a float made of x each time
+                    if not y <= x:  # (not `y > x`: the same for nan)
+                        break
                     q.pop()
                 q.append((k, x))
             if k_lo < q_lo:  # older junctions join: one is kept where it is above all after it
                 for k in range(q_lo - 1, k_lo - 1, -1):
                     x = vts[k]
-                    if x > q[0][1]:
+                    y = q[0][1]
+                    if x > y:
                         q.appendleft((k, x))
             else:
                 while q[0][0] < k_lo:
@@ -242,11 +244,6 @@ def _first_at_or_above(xs: list[float], x: float) -> int:
     return lo
 
 
-@cython.locals(n=cython.Py_ssize_t, d=cython.Py_ssize_t, ok_lo=cython.Py_ssize_t, ok_hi=cython.Py_ssize_t,
-               k=cython.Py_ssize_t, i=cython.Py_ssize_t, n_ends=cython.Py_ssize_t, h=cython.Py_ssize_t, j=Block,
-               b=Block, head=Block, vbud=cython.double, cap=cython.double, c2=cython.double, tcap=cython.double,
-               r=cython.double, s_j=cython.double, none=cython.double, skip=cython.double, sc=list, ends=list,
-               hist=list, k_lo=cython.Py_ssize_t, k_hi=cython.Py_ssize_t, n_pre=cython.Py_ssize_t)
 def _verdicts(fc: "FilterCorners", blocks: Sequence["Block"], k_lo: int, k_hi: int, n_pre: int) -> list:
     """Each junction hist[k_lo:k_hi]'s verdict for _scan: NONE, SKIP or its use min(1, vjunc / vbud), kept in
     fc._sc between scans (issue 17, session 11: consecutive scans cover nearly the same ~90 junctions, and a
@@ -292,6 +289,7 @@ def _verdicts(fc: "FilterCorners", blocks: Sequence["Block"], k_lo: int, k_hi: i
             if len(ends) == n_pre:
                 break
     n_ends = len(ends)
+    # the codes as the list's objects, stored as they are (compiled, a C double stored is a new float each time)
     none, skip = NONE, SKIP
     j = hist[k]
     i = _first_above(ends, j.s_end)
@@ -310,7 +308,10 @@ def _verdicts(fc: "FilterCorners", blocks: Sequence["Block"], k_lo: int, k_hi: i
         if tol is not None:
             # _tolerance_free, its kept verdict inline; the next block is blocks[i] (j walks on in path order)
             s_j = j.s_end
-            while i < n_ends and ends[i] <= s_j:
+            while i < n_ends:
+                x = ends[i]  # a C double compiled (`ends[i] <= s_j` made a float of s_j each time)
+                if not x <= s_j:
+                    break
                 i += 1
             # _tolerance_free's kept verdict read first, inline (session 15: ~7 calls a scan that finds verdicts
             # again); blocks[i] is j's next block, i = bisect_right(ends, j.s_end) as _tolerance_free finds it
@@ -386,8 +387,6 @@ def _walk(fc: "FilterCorners", blocks: Sequence["Block"], lo: float, hi: float, 
     return use, seen
 
 
-@cython.locals(j=Block, b=Block, k=cython.Py_ssize_t, cap=cython.double, c2=cython.double, tcap=cython.double,
-               unb=cython.double, x=cython.double, ok=cython.bint, tol=cython.double, ends=list)
 def _tolerance_free(fc: "FilterCorners", j: "Block", blocks: Sequence["Block"], ends: list[float]) -> bool:
     """Whether junction j keeps N1.053 with the raised jerk at the fastest its blocks may pass it.
 
