@@ -1,6 +1,6 @@
 """The CAM program's NC work offline (issue 17): bench_loop's 5,000-block program on benches/mill-3axis.toml
 through the interpreter, channel and planner (`nc.motion.offline.run`), no bus. Prints the CPU a cycle of the
-whole run, of `Planner.push` a block and of the jerk-factor scans (`shares.jerk_factor`) a block, best of 3,
+whole run, of `Planner.push` a block and of the jerk-factor scans (`shares._scan`) a block, best of 3,
 and a digest of the setpoints (equal digests: the same setpoints bit for bit).
 
     python benchmarks/cam_planner_parts.py            # the figures
@@ -26,6 +26,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.append(str(ROOT))  # PYTHONPATH first: a tree it names is measured
 
 import nc.motion.planner as planner_mod  # noqa: E402
+import nc.motion.shares as shares  # noqa: E402
 from nc.motion.compiled import BUILD  # noqa: E402
 from benchmarks.bench_motion import cam_program  # noqa: E402
 from hil.bench_file import load_bench_file  # noqa: E402
@@ -39,23 +40,24 @@ _spent = {"push": 0.0, "jf": 0.0}
 
 
 def _wrap() -> None:
-    """CPU time spent in Planner.push and in the jerk-factor scans (≈ 1 µs a call of wrapper)."""
+    """CPU time spent in Planner.push and in the jerk-factor scans (≈ 1 µs a call of wrapper). The scans through
+    `shares.CHECK`: the planner calls jerk_factor, and it the scan, in C where compiled (decision bench B164)."""
     clock = time.process_time
-    push, jerk_factor = planner_mod.Planner.push, planner_mod.jerk_factor
+    push, scan = planner_mod.Planner.push, shares._scan
 
     def timed_push(self, move):
         t = clock()
         push(self, move)
         _spent["push"] += clock() - t
 
-    def timed_jf(*args):
+    def timed_scan(*args):
         t = clock()
-        out = jerk_factor(*args)
+        out = scan(*args)
         _spent["jf"] += clock() - t
         return out
 
     planner_mod.Planner.push = timed_push
-    planner_mod.jerk_factor = timed_jf
+    shares.CHECK = timed_scan
 
 
 def opcodes(n: int) -> None:
