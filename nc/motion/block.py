@@ -11,6 +11,11 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+try:
+    import cython  # compiled: the types below (setup.py, decision bench B115)
+except ImportError:  # run as Python without Cython: they do nothing
+    from nc.motion import cython_shadow as cython
+
 from nc.motion.path import Segment
 from nc.moves import Move
 
@@ -68,3 +73,35 @@ class Block:
     # A path block that is not an arc (the jerk-factor scan's walk reads this one field for the three it
     # tests, session 13): set as the block joins the queue; False means "test them" (nc.motion.shares._scan).
     scan_plain: bool = False
+
+
+@cython.locals(b=Block)
+def new_block(move: Move, kind: str, seg: Segment | None, length: float, cap_hard: float, a: float, j: float,
+              feed: float | None, rapid: bool) -> Block:
+    """`Block(move, kind, seg, length, cap_hard, a, j, feed, rapid)`. Compiled, a C call that fills the struct
+    from the type's slot, no __init__'s arguments to parse (one a pushed line, session 29, decision bench B166): the
+    fields not given are set to Block's defaults here too (tests/test_planner_feed.py compares every field)."""
+    if not cython.compiled:
+        return Block(move, kind, seg, length, cap_hard, a, j, feed, rapid)
+    b = Block.__new__(Block)  # doubles 0.0, objects None, flags False: the defaults of most fields
+    b.move = move
+    b.kind = kind
+    b.seg = seg
+    b.length = length
+    b.cap_hard = cap_hard
+    b.a = a
+    b.j = j
+    b.feed = feed
+    b.rapid = rapid
+    b.binding = True
+    b.cum = ()
+    b.dv = ()
+    b.scum = ()
+    b.vbase = math.inf
+    b.ctol = math.inf
+    b.vtol = math.inf
+    b.vbud = math.inf
+    b.vctol = math.inf
+    b.tf_cap = math.nan
+    b.tf_tcap = math.nan
+    return b

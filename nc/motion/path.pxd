@@ -19,3 +19,6 @@ cdef class Segment:
     cdef public object arc_len
     cdef public object _dir
     cdef public object _cos
+
+# a C call from the planner's run feed (session 29, decision bench B166)
+cpdef Segment line_segment(object axes, list ls, list le, object length, list d)

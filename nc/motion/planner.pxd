@@ -2,7 +2,8 @@
 # calls the junction model, the corner and the share zones in C (session 28, decision bench B157).
 cimport cython
 from nc.motion.blending cimport FilterCorners
-from nc.motion.block cimport Block
+from nc.motion.block cimport Block, new_block
+from nc.motion.path cimport Segment
 from nc.motion.lookahead cimport Limits
 from nc.motion.planner_corners cimport _corner_at
 from nc.motion.share_zones cimport ShareZones

@@ -38,7 +38,7 @@ except ImportError:  # run as Python without Cython: they do nothing
 from nc.alarm_table import PLANNING_STALL
 from nc.alarms import NcAlarm
 from nc.motion.limits import MotionConfig
-from nc.motion.block import Block
+from nc.motion.block import Block, new_block
 from nc.motion.lookahead import (CUT, MARGIN, RAPID, THREAD, Limits, backward, change_distance, fastest_state,
                                  max_speed_at, reach)
 from nc.motion.path import Segment
@@ -425,9 +425,15 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
         return Setpoint(self.position.copy(), self.line, float(self._buf_vel[i]), blk)
 
     # ---- planning -------------------------------------------------------------------------
-    @cython.locals(lim=Limits, what=cython.Py_ssize_t)
+    @cython.locals(lim=Limits, what=cython.Py_ssize_t, ln=Segment)
     def _block(self, move: Move, seg: Segment | None = None) -> Block | None:
         """The move's block; `seg`: its line segment when the run feed built it already."""
+        if seg is not None:  # the run feed's line: a G01 at a feed, not per revolution, longer than 1e-6 mm
+            # (RunFeed._line): no kind or field of the move to test again (session 29, decision bench B166)
+            ln = seg
+            lim = self.lim
+            v, a, j = lim.block_limits(ln, False, CUT)
+            return new_block(move, "path", ln, ln.length, v, a, j, move.feed / 60.0, False)
         kind = move.kind  # read once (a Move's field: an attribute lookup each, session 28)
         if kind == "dwell":
             return Block(move, "dwell", None, 0.0, 0.0, 1.0, 1.0, None)

@@ -22,7 +22,6 @@ from nc.moves import Move
 if TYPE_CHECKING:
     from nc.motion.spline_runs import SplineSpan
 
-_line_of = line_segment  # one name to look up (per push)
 _span_limits: Callable | None = None  # nc.motion.spline_runs.span_limits, imported by the first span (bench B91)
 
 
@@ -66,17 +65,27 @@ class FittedRuns:
             self._held, out = self._runs.release(self._held)
             self._let_through(out)
 
-    @cython.locals(g=tuple, b=Block)
+    @cython.locals(runs=RunFeed, b=Block, out=list)
     def _feed_run(self, move: Move) -> None:
-        self._held, out = self._runs.push(self._held, move)
-        if len(out) == 1 and out[0][1] is None:  # the common case on programs not fitted: one move, as it is
+        runs = self._runs
+        self._held = runs.feed(self._held, move)  # a C call where compiled (session 29, decision bench B166)
+        out = runs.out
+        if out is None:  # the common case on programs not fitted: the move as a line, its geometry just worked out
+            # a line after spans may have to start where their curve ended (`_from_curve`): only once a span went out
+            if runs.spans:
+                b = self.blocks[-1] if self.blocks else None
+                if b is not None and b.seg is not None and b.seg.kind == "spline":
+                    self._let_through([(move, None)])
+                    return
+            # positional: no keywords to match (bench B156); line_segment a C call where compiled (B166)
+            self._push(move, None, line_segment(self.axes, runs._ga, runs._gb, runs._gn, runs._gu))
+            return
+        if len(out) == 1 and out[0][1] is None:  # one move, as it is
             b = self.blocks[-1] if self.blocks else None
             if b is None or b.seg is None or b.seg.kind != "spline":
                 m = out[0][0]
-                g = self._runs.geom  # its geometry, when the run feed just worked it out (issue 17)
-                # positional: no keywords to match, no slice of g to unpack (bench B156)
-                self._push(m, None, _line_of(self.axes, g[1], g[2], g[3], g[4]) if g is not None and g[0] is m
-                           else None)
+                self._push(m, None, line_segment(self.axes, runs._ga, runs._gb, runs._gn, runs._gu)
+                           if runs._gm is m else None)
                 return
         self._let_through(out)
 

@@ -72,6 +72,27 @@ FIT_TOL = 0.985  # of N1.053: the fit's own tolerance (the joints' shifts take <
 _dist = math.dist  # one name to look up (per push)
 
 
+@cython.locals(p=list, q=list, p0=cython.double, p1=cython.double, p2=cython.double)
+def _joined(p: list[float], q: list[float]) -> bool:
+    """math.dist(p, q) <= 1e-9 (the same points: no call; compiled, C doubles compared)."""
+    if len(p) == 3 and len(q) == 3:
+        p0, p1, p2 = p
+        if p0 == q[0] and p1 == q[1] and p2 == q[2]:
+            return True
+    return _dist(p, q) <= 1e-9
+
+
+@cython.locals(p=list, q=list, d0=cython.double, d1=cython.double, d2=cython.double)
+def _step(p: list[float], q: list[float]) -> float:
+    """|p - q| as a plain sum of squares (3 axes), else math.dist: the caller compares it with a margin."""
+    if len(p) == 3 and len(q) == 3:
+        d0 = p[0] - q[0]
+        d1 = p[1] - q[1]
+        d2 = p[2] - q[2]
+        return math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+    return _dist(p, q)
+
+
 @cython.ccall
 @cython.returns(cython.double)
 @cython.locals(p=dict)
@@ -98,7 +119,10 @@ NOTHING = Held()
 
 
 class RunFeed:
-    """The fitting rules for one planner's configuration (its state is the planner's `_held`)."""
+    """The fitting rules for one planner's configuration (its state is the planner's `_held`).
+
+    Compiled, an extension type (spline_feed.pxd, session 29): the planner calls `feed` and `line` as C calls and
+    their fields are a struct's, not a dictionary's (bench B166)."""
 
     def __init__(self, cfg: MotionConfig, lim) -> None:
         self.tol = float(cfg.path_tolerance or 0.0)
@@ -107,24 +131,37 @@ class RunFeed:
         self.acc = cfg.share_tangential * float(lim.acc.min())
         self.corner_j = cfg.share_corner * float(min(lim._corner_j))
         self._pay: dict[float, float] = {}
-        # The last eligible move's geometry (move, start, end, length, unit direction): the planner's line
+        # The last eligible move's geometry (`geom`: move, start, end, length, unit direction): the planner's line
         # Segment of that move is built from it (the same floats as Segment.of's own, issue 17)
-        self.geom: tuple[Move, list[float], list[float], float, list[float]] | None = None
+        self._gm = None
         # Windows worked out ahead by another process (hil/fit_ahead.py, decision bench B86), or None
         self.memo: FitMemo | None = None
+        # What the last `feed` let through, None where it was the move alone as a line (its geometry in `geom`)
+        self.out: list[tuple[Move, SplineSpan | None]] | None = None
+        # A span was let through once: only then may the planner's last block be a curve a line must start on
+        self.spans = False
+
+    @property
+    def geom(self) -> tuple[Move, list[float], list[float], float, list[float]] | None:
+        """(move, start, end, length, unit direction) of the last eligible move `line` saw, or None."""
+        return None if self._gm is None else (self._gm, self._ga, self._gb, self._gn, self._gu)
 
     @staticmethod
     def enabled(cfg: MotionConfig) -> bool:
         return cfg.fit_runs and (cfg.path_tolerance or 0.0) > 0.0
 
     # ---- the rules (plain floats: they run on every push, issue 17) ---------------------------------
-    @cython.locals(a0=cython.double, a1=cython.double, a2=cython.double, b0=cython.double, b1=cython.double,
-                   b2=cython.double, n=cython.double)
     def line(self, mv: Move) -> tuple[list[float], list[float], list[float]] | None:
         """(start point, end point, unit direction) of an eligible move, else None (kept in `geom`)."""
+        return (self._ga, self._gb, self._gu) if self._line(mv) else None
+
+    @cython.locals(a0=cython.double, a1=cython.double, a2=cython.double, b0=cython.double, b1=cython.double,
+                   b2=cython.double, n=cython.double)
+    def _line(self, mv: Move) -> bool:
+        """`line`: True, and the geometry in `geom`'s fields, where mv is eligible (compiled: no tuple made)."""
         if mv.kind != "line" or mv.per_rev or mv.exact_stop or mv.css is not None or not mv.feed \
                 or "G31" in mv.tags:
-            return None
+            return False
         ax, ms, me = self.axes, mv.start, mv.end
         if len(ax) == 3 and type(ms) is dict and type(me) is dict:  # spelt out (once per push); float(): as
             x, y, z = ax  # Segment.of (compiled: the same double); dict.get, typed (bench B156)
@@ -134,17 +171,21 @@ class RunFeed:
             b = [b0, b1, b2]
             n = _dist(a, b)
             if not 1e-6 < n <= MAX_LEN:
-                return None
+                return False
             u = [(b0 - a0) / n, (b1 - a1) / n, (b2 - a2) / n]
         else:
             a = [float(ms.get(x, 0.0)) for x in ax]
             b = [float(me.get(x, 0.0)) for x in ax]
             n = math.dist(a, b)
             if not 1e-6 < n <= MAX_LEN:
-                return None
+                return False
             u = [(q - p) / n for p, q in zip(a, b)]
-        self.geom = (mv, a, b, n, u)
-        return a, b, u
+        self._gm = mv
+        self._ga = a
+        self._gb = b
+        self._gn = n
+        self._gu = u
+        return True
 
     def _vec(self, p: dict[str, float]) -> np.ndarray:
         return np.array([float(p.get(a, 0.0)) for a in self.axes])
@@ -169,31 +210,52 @@ class RunFeed:
         return thr
 
     # ---- the stream ----------------------------------------------------------------------------
-    @cython.locals(st=Held, h=Held)
     def push(self, st: Held, mv: Move) -> tuple[Held, list[tuple[Move, SplineSpan | None]]]:
         """The held state after mv, and the moves let through (with their span, None: as a line)."""
-        ln = self.line(mv)
-        if ln is None:
+        h = self.feed(st, mv)
+        out = self.out
+        return h, ([(mv, None)] if out is None else out)
+
+    @cython.locals(st=Held, h=Held, du=cython.double, thr=cython.double, exact=cython.bint)
+    def feed(self, st: Held, mv: Move) -> Held:
+        """`push` as the planner calls it: the held state after mv; what it let through in `out`, None where that
+        is mv alone, as a line (the common case on programs not fitted: no list, no tuple made)."""
+        self.out = None
+        if not self._line(mv):
             st, out = self.release(st)
-            return st, out + [(mv, None)]
-        a, end, u = ln
-        du = None
-        if st.end is not None and _dist(st.end, a) <= 1e-9:
-            du = _dist(u, st.u)  # |Δu|
-            if du > SHARP:
-                du = None  # a sharp corner: the run ends at it
-        if du is None:
+            self.out = out + [(mv, None)]
+            return st
+        a, end, u = self._ga, self._gb, self._gu
+        sharp = True  # no junction with the move before, or a sharp corner: the run ends at it
+        exact = False
+        du = 0.0
+        if st.end is not None and _joined(st.end, a):
+            # |Δu|: the plain sum of squares where it is clearly below the sharp corner's (it decides nothing
+            # there: math.dist's compensated sum differs from it by far less than the margin), else math.dist
+            du = _step(u, st.u)
+            if not du * (1.0 + 1e-9) < SHARP:
+                du = _dist(u, st.u)
+                exact = True
+            sharp = du > SHARP
+        if sharp:
             st, out = self.release(st)
-            return Held(moves=(mv,), end=end, u=u), out  # a first move: the next junction decides
+            self.out = out
+            return Held(moves=(mv,), end=end, u=u)  # a first move: the next junction decides
         if st.fitting:
             st = replace(st, moves=st.moves + (mv,), end=end, u=u)
             if len(st.moves) >= BATCH + AHEAD:
-                return self._fix(st, BATCH)
-            return st, []
+                st, self.out = self._fix(st, BATCH)
+                return st
+            self.out = []
+            return st
         feed = mv.feed or 0.0
-        thr = self._pay.get(feed)  # _pay_step's cache read here (once per push)
-        if du > (thr if thr is not None else self._pay_step(feed)):
-            return Held(st.moves + (mv,), (), True, end=end, u=u), []
+        got = self._pay.get(feed)  # _pay_step's cache read here (once per push)
+        thr = got if got is not None else self._pay_step(feed)
+        if not exact and not du * (1.0 + 1e-9) < thr:  # near the threshold: as math.dist has it
+            du = _dist(u, st.u)
+        if du > thr:
+            self.out = []
+            return Held(st.moves + (mv,), (), True, end=end, u=u)
         if not st.moves:  # the common case on programs not fitted: Held((), (), False, end, u) without its
             h = Held.__new__(Held)  # __init__'s arguments to parse (compiled: the type's slot, bench B156)
             h.moves = ()
@@ -203,8 +265,9 @@ class RunFeed:
             h.u = u
             h.tail = None
             h.key = b""
-            return h, [(mv, None)]
-        return Held(end=end, u=u), [(m, None) for m in st.moves] + [(mv, None)]
+            return h
+        self.out = [(m, None) for m in st.moves] + [(mv, None)]
+        return Held(end=end, u=u)
 
     def release(self, st: Held) -> tuple[Held, list[tuple[Move, SplineSpan | None]]]:
         """Everything held let through: the run fitted to its end."""
@@ -235,6 +298,7 @@ class RunFeed:
                 memo.put(key, cut)
         if cut is None:  # no fit within the tolerance, or the joint left it: as lines, the run ends
             return NOTHING, [(m, None) for m in moves]
+        self.spans = True  # (once: a line after a span may have to start on its curve, FittedRuns._from_curve)
         if end:  # the run ends on its vertex exactly (a plan's end takes seg.end)
             cut[-1].end = pts[-1].copy()
         out = [(m, sp) for i, m in enumerate(moves[:n]) for sp in cut[i * SPLIT:(i + 1) * SPLIT]]
