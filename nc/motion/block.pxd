@@ -39,6 +39,8 @@ cdef class Block:
     cdef public double trim0
     cdef public bint scan_plain
 
+cdef double _INF, _NAN
+
 # Block(...) as a C call (session 29, decision bench B166)
 cpdef Block new_block(object move, str kind, object seg, double length, double cap_hard, double a, double j,
                       object feed, bint rapid)

@@ -75,6 +75,10 @@ class Block:
     scan_plain: bool = False
 
 
+_INF = math.inf  # C constants where compiled (block.pxd): no module attribute to look up a block
+_NAN = math.nan
+
+
 @cython.locals(b=Block)
 def new_block(move: Move, kind: str, seg: Segment | None, length: float, cap_hard: float, a: float, j: float,
               feed: float | None, rapid: bool) -> Block:
@@ -97,11 +101,11 @@ def new_block(move: Move, kind: str, seg: Segment | None, length: float, cap_har
     b.cum = ()
     b.dv = ()
     b.scum = ()
-    b.vbase = math.inf
-    b.ctol = math.inf
-    b.vtol = math.inf
-    b.vbud = math.inf
-    b.vctol = math.inf
-    b.tf_cap = math.nan
-    b.tf_tcap = math.nan
+    b.vbase = _INF
+    b.ctol = _INF
+    b.vtol = _INF
+    b.vbud = _INF
+    b.vctol = _INF
+    b.tf_cap = _NAN
+    b.tf_tcap = _NAN
     return b

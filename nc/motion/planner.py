@@ -211,24 +211,61 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
         else:
             self._push(move)
 
+    @cython.locals(reads=cython.Py_ssize_t, taken=cython.Py_ssize_t, depth=cython.Py_ssize_t,
+                   limit=cython.Py_ssize_t, n=cython.Py_ssize_t, filling=cython.bint)
+    def push_plain(self, plain: deque[Move], reads: int) -> tuple[int, Move | None]:
+        """The channel's plain moves read ahead (nc.channel `_feed_planner`, hil.stretch_reads.Ahead): up to `reads`
+        of them pushed from `plain` while the queue is not `full` (tested before each, as the channel's loop did):
+        (how many, the last). One call a feed, not a `full` property and a `push` call from Python a move (session
+        29, decision bench B166); each move still goes through `push` (a test counts them there)."""
+        taken = 0
+        last = None
+        if reads <= 0 or not plain:
+            return 0, None
+        blocks = self.blocks
+        depth = self.depth
+        limit = depth + self._batch
+        filling = self._filling
+        while taken < reads and plain:
+            n = len(blocks)  # `full`, on locals (nothing a push runs reads `_filling`: written once, below)
+            if n >= limit:
+                filling = False
+            elif n < depth:
+                filling = True
+            if not filling:
+                break
+            last = plain.popleft()
+            self.push(last)
+            taken += 1
+        if filling != self._filling:
+            self._filling = filling
+        return taken, last
+
     @cython.locals(b=Block, prev=Block, x=cython.double, added=cython.Py_ssize_t, need=cython.Py_ssize_t,
-                   w=cython.Py_ssize_t, pushed=cython.Py_ssize_t, lim=Limits, zones=ShareZones)
+                   w=cython.Py_ssize_t, pushed=cython.Py_ssize_t, lim=Limits, zones=ShareZones, ln=Segment,
+                   cut_line=cython.bint)
     def _push(self, move: Move, span: Segment | None = None, line: Segment | None = None) -> None:
         self._pushes += 1
-        if span is not None:
+        lim = self.lim
+        cut_line = line is not None
+        if cut_line:  # the run feed's line (RunFeed._line: a G01 at a feed, not per revolution, longer than 1e-6
+            # mm): its block here, without `_block`'s tests of the move (session 29, decision bench B166)
+            ln = line
+            v, a, j = lim.block_limits(ln, False, CUT)
+            b = new_block(move, "path", ln, ln.length, v, a, j, move.feed / 60.0, False)
+        elif span is not None:
             b = self._span_block(move, span)
-        else:  # one argument when there is no line: benchmarks/bench_spline_bound.py patches _block(self, move)
-            b = self._block(move) if line is None else self._block(move, line)
+        else:  # one argument: benchmarks/bench_spline_bound.py patches _block(self, move)
+            b = self._block(move)
         if b is None:
             return
         # The limits' junction, the corner and the share zones are C calls where compiled, on locals read once
         # (session 28, decision bench B157)
-        lim = self.lim
         blocks = self.blocks
         blend = lim.blend
         if blend is not None:
             b.vtop = b.cap_hard
-            if b.kind == "path" and not b.rapid and not b.move.per_rev:
+            if cut_line or (b.kind == "path" and not b.rapid and not b.move.per_rev):
                 x = 1.5 * (self.dry_run_feed if self.dry_run else (b.feed or 0.0))
                 if x < b.cap_hard:  # min(cap_hard, x), spelt out (once per push)
                     b.vtop = x
@@ -244,8 +281,11 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
         zones = self._zones
         if zones is not None:
             zones.block(b.s_end - b.length, b.vtop)
-        seg = b.seg
-        b.scan_plain = b.kind == "path" and seg is not None and seg.kind != "arc"
+        if cut_line:
+            b.scan_plain = True
+        else:
+            seg = b.seg
+            b.scan_plain = b.kind == "path" and seg is not None and seg.kind != "arc"
         blocks.append(b)
         if b.kind == "thread":  # `threads_queued += kind == "thread"`, read and written only where it changes
             self.threads_queued += 1
@@ -425,15 +465,9 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
         return Setpoint(self.position.copy(), self.line, float(self._buf_vel[i]), blk)
 
     # ---- planning -------------------------------------------------------------------------
-    @cython.locals(lim=Limits, what=cython.Py_ssize_t, ln=Segment)
+    @cython.locals(lim=Limits, what=cython.Py_ssize_t)
     def _block(self, move: Move, seg: Segment | None = None) -> Block | None:
         """The move's block; `seg`: its line segment when the run feed built it already."""
-        if seg is not None:  # the run feed's line: a G01 at a feed, not per revolution, longer than 1e-6 mm
-            # (RunFeed._line): no kind or field of the move to test again (session 29, decision bench B166)
-            ln = seg
-            lim = self.lim
-            v, a, j = lim.block_limits(ln, False, CUT)
-            return new_block(move, "path", ln, ln.length, v, a, j, move.feed / 60.0, False)
         kind = move.kind  # read once (a Move's field: an attribute lookup each, session 28)
         if kind == "dwell":
             return Block(move, "dwell", None, 0.0, 0.0, 1.0, 1.0, None)

@@ -38,6 +38,11 @@ except ImportError:  # run as Python without Cython: they do nothing
     from nc.motion import cython_shadow as cython
 
 from nc.motion.limits import MotionConfig
+
+if cython.compiled:  # C's sqrt, the function math.sqrt calls (as nc.motion.lookahead, decision bench B148)
+    from cython.cimports.libc.math import sqrt as _c_sqrt
+else:
+    _c_sqrt = math.sqrt
 from nc.moves import Move
 
 if TYPE_CHECKING:
@@ -72,24 +77,29 @@ FIT_TOL = 0.985  # of N1.053: the fit's own tolerance (the joints' shifts take <
 _dist = math.dist  # one name to look up (per push)
 
 
-@cython.locals(p=list, q=list, p0=cython.double, p1=cython.double, p2=cython.double)
+@cython.locals(p=list, q=list, p0=cython.double, p1=cython.double, p2=cython.double, q0=cython.double,
+               q1=cython.double, q2=cython.double)
 def _joined(p: list[float], q: list[float]) -> bool:
     """math.dist(p, q) <= 1e-9 (the same points: no call; compiled, C doubles compared)."""
     if len(p) == 3 and len(q) == 3:
-        p0, p1, p2 = p
-        if p0 == q[0] and p1 == q[1] and p2 == q[2]:
+        p0, p1, p2 = p[0], p[1], p[2]
+        q0, q1, q2 = q[0], q[1], q[2]
+        if p0 == q0 and p1 == q1 and p2 == q2:
             return True
     return _dist(p, q) <= 1e-9
 
 
-@cython.locals(p=list, q=list, d0=cython.double, d1=cython.double, d2=cython.double)
+@cython.locals(p=list, q=list, d0=cython.double, d1=cython.double, d2=cython.double, p0=cython.double,
+               p1=cython.double, p2=cython.double, q0=cython.double, q1=cython.double, q2=cython.double)
 def _step(p: list[float], q: list[float]) -> float:
     """|p - q| as a plain sum of squares (3 axes), else math.dist: the caller compares it with a margin."""
     if len(p) == 3 and len(q) == 3:
-        d0 = p[0] - q[0]
-        d1 = p[1] - q[1]
-        d2 = p[2] - q[2]
-        return math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+        p0, p1, p2 = p[0], p[1], p[2]
+        q0, q1, q2 = q[0], q[1], q[2]
+        d0 = p0 - q0
+        d1 = p1 - q1
+        d2 = p2 - q2
+        return _c_sqrt(d0 * d0 + d1 * d1 + d2 * d2)  # (>= 0: no domain error to raise)
     return _dist(p, q)
 
 
