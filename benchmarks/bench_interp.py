@@ -143,13 +143,6 @@ def feed():
             return len(self.blocks) >= 8
         def push(self, move):
             self.blocks.append(move)
-        def push_plain(self, plain, reads):  # Planner.push_plain's loop (the channel hands it the plain moves)
-            taken, last = 0, None
-            while taken < reads and plain and not self.full:
-                last = plain.popleft()
-                self.push(last)
-                taken += 1
-            return taken, last
         def release_run(self):
             pass
     bench = load_bench_file("benches/mill-3axis.toml")

@@ -447,20 +447,13 @@ class Channel:
             # plain moves read ahead (hil.stretch_reads.Ahead: no G31, limits checked, no statement): the loop
             # below would only push them, with nothing else to check between two (issue 17)
             plain = src.plain
-            if not self.handed_back:  # no move to check against an axis the MLC hands back: the planner's loop
-                taken, last = pl.push_plain(plain, reads)  # (one call a feed, session 29, decision bench B166)
-                if taken:
-                    self._checked = last
-                    self._block_moves += taken
-                    reads -= taken
-            else:
-                while reads and plain and not pl.full:
-                    ev = self._checked = plain.popleft()
-                    if self.handed_back and self._read_ahead(ev):
-                        return
-                    pl.push(ev)
-                    self._block_moves += 1
-                    reads -= 1
+            while reads and plain and not pl.full:
+                ev = self._checked = plain.popleft()
+                if self.handed_back and self._read_ahead(ev):
+                    return
+                pl.push(ev)
+                self._block_moves += 1
+                reads -= 1
         while self.state is _RUNNING and self.end is None and not pl.full:
             if self._limit_alarm is not None:
                 if pl.idle:  # the legal moves before it have run out: the offending one never starts

@@ -1,13 +1,11 @@
-"""The feed side of the planner made cheaper (issue 17, decision bench B166): the channel's plain moves pushed by
-`Planner.push_plain` in one call a feed, the run feed's junction tests without `math.dist` where they decide
-nothing, and `new_block` in place of `Block(...)`. Each must decide exactly as what it replaces: the queue the
-same after a feed, the same junction verdict at the very threshold, every field of a block the same."""
+"""The feed side of the planner made cheaper (issue 17, decision bench B166): the run feed's junction tests without
+`math.dist` where they decide nothing, and `new_block` in place of `Block(...)`. Each must decide exactly as what
+it replaces: the same junction verdict at the very threshold, every field of a block the same."""
 
 from __future__ import annotations
 
 import dataclasses
 import math
-from collections import deque
 
 import numpy as np
 
@@ -28,55 +26,6 @@ def _cfg(**kw):
 def _line(p, q, feed=3000.0, line=1) -> Move:
     s, e = dict(zip(AX, map(float, p))), dict(zip(AX, map(float, q)))
     return Move("line", line, "", s, e, e, feed=feed, plane=("X", "Y"))
-
-
-def _cam(n: int) -> list[Move]:
-    """The issue-17 CAM curve (benchmarks.bench_motion.cam_program's points) as moves."""
-    rng = np.random.default_rng(3)
-    x, pts = 0.0, [(0.0, 0.0, 0.0)]
-    for _ in range(n):
-        x += float(rng.uniform(0.01, 0.1))
-        pts.append((x, 20.0 * math.sin(x / 40.0), 0.0))
-    return [_line(pts[k], pts[k + 1], line=k + 1) for k in range(n)]
-
-
-def test_push_plain_fills_the_queue_as_the_channels_loop_did():
-    """Four moves a feed, as the channel reads them, until the program is in: by the loop of `full` and `push` the
-    channel ran, and by `push_plain`. The same moves taken each feed, the same queue (every block's end speed after
-    the backward pass) and the same `full`, feed after feed, while the planner runs between the feeds."""
-    moves = _cam(400)
-    a, b = Planner(_cfg(), dict(zip(AX, (0.0, 0.0, 0.0)))), Planner(_cfg(), dict(zip(AX, (0.0, 0.0, 0.0))))
-    qa, qb = deque(moves), deque(moves)
-    feeds = 0
-    while qa or qb:
-        reads, took_a = 4, 0
-        while reads and qa and not a.full:
-            a.push(qa.popleft())
-            took_a += 1
-            reads -= 1
-        took_b, last = b.push_plain(qb, 4)
-        assert took_b == took_a and len(qa) == len(qb)
-        assert last is (moves[len(moves) - len(qb) - 1] if took_b else None)
-        assert a.full == b.full and a._filling == b._filling
-        for _ in range(3):
-            a.step()
-            b.step()
-        feeds += 1
-    a.lookahead()
-    b.lookahead()
-    assert [(x.vend, x.vjunc, x.cap) for x in a.blocks] == [(x.vend, x.vjunc, x.cap) for x in b.blocks]
-    assert np.array_equal(a.position, b.position)
-    assert feeds > 100  # the queue was full most feeds: push_plain stopped where `full` said so
-
-
-def test_push_plain_takes_nothing_from_a_full_queue_or_without_reads():
-    pl = Planner(_cfg(), dict(zip(AX, (0.0, 0.0, 0.0))))
-    q = deque(_cam(200))
-    assert pl.push_plain(q, 0) == (0, None) and len(q) == 200
-    while not pl.full:
-        pl.push(q.popleft())
-    left = len(q)
-    assert pl.push_plain(q, 4) == (0, None) and len(q) == left
 
 
 def _junction(u0, u1, feed):

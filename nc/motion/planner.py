@@ -211,36 +211,6 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
         else:
             self._push(move)
 
-    @cython.locals(reads=cython.Py_ssize_t, taken=cython.Py_ssize_t, depth=cython.Py_ssize_t,
-                   limit=cython.Py_ssize_t, n=cython.Py_ssize_t, filling=cython.bint)
-    def push_plain(self, plain: deque[Move], reads: int) -> tuple[int, Move | None]:
-        """The channel's plain moves read ahead (nc.channel `_feed_planner`, hil.stretch_reads.Ahead): up to `reads`
-        of them pushed from `plain` while the queue is not `full` (tested before each, as the channel's loop did):
-        (how many, the last). One call a feed, not a `full` property and a `push` call from Python a move (session
-        29, decision bench B166); each move still goes through `push` (a test counts them there)."""
-        taken = 0
-        last = None
-        if reads <= 0 or not plain:
-            return 0, None
-        blocks = self.blocks
-        depth = self.depth
-        limit = depth + self._batch
-        filling = self._filling
-        while taken < reads and plain:
-            n = len(blocks)  # `full`, on locals (nothing a push runs reads `_filling`: written once, below)
-            if n >= limit:
-                filling = False
-            elif n < depth:
-                filling = True
-            if not filling:
-                break
-            last = plain.popleft()
-            self.push(last)
-            taken += 1
-        if filling != self._filling:
-            self._filling = filling
-        return taken, last
-
     @cython.locals(b=Block, prev=Block, x=cython.double, added=cython.Py_ssize_t, need=cython.Py_ssize_t,
                    w=cython.Py_ssize_t, pushed=cython.Py_ssize_t, lim=Limits, zones=ShareZones, ln=Segment,
                    cut_line=cython.bint)
