@@ -30,6 +30,7 @@ import numpy as np
 from nc.motion.block import Block
 from nc.motion.lookahead import MARGIN, change_distance
 from nc.motion.plan_state import _Plan
+from nc.motion.planner_cruise import least_limits, plain_rest, tail_speed
 from nc.motion.profile import Piecewise, solve_position, solve_velocity
 from nc.motion.shares import MAX_FACTOR
 from nc.motion.smoothing import PositionFilter
@@ -132,7 +133,8 @@ class FilterStops:
         if rest is None:
             return None
         blocks = self.blocks
-        brake = change_distance(v, 0.0, MARGIN * min(x.a for x in blocks), MARGIN * min(x.j for x in blocks))
+        lo_a, lo_j = least_limits(blocks)  # min(x.a for x in blocks), min(x.j for x in blocks): compiled (bench B168)
+        brake = change_distance(v, 0.0, MARGIN * lo_a, MARGIN * lo_j)
         if rest <= brake + 2.0 * v * T:
             return self._filter_stop(s, v, a, cap, t0) if rest < v * (MAX_ROWS - 2 * self.filter.span) * T else None
         if abs(a) < 1e-12 and abs(v - cap) <= 1e-9 * cap and self._tail_speed(cap) >= v * (1.0 - 1e-9):
@@ -253,7 +255,7 @@ class FilterStops:
         return None
 
     def _stop_limits(self, scale: float, blocks) -> tuple[float, float]:
-        acc = min(b.a for b in blocks) / self.cfg.share_tangential * scale
+        acc = least_limits(blocks)[0] / self.cfg.share_tangential * scale  # min(b.a for b in blocks)
         return acc, acc / (2.0 * self.cfg.cycle)
 
     def _stop_rest(self, s: float) -> float | None:
@@ -265,22 +267,14 @@ class FilterStops:
             return None
         if self._zones is not None and self._zones.near(blocks[0].s_end - blocks[0].length - 1.0, blocks[-1].s_end):
             return None  # λ < 1 somewhere near: the raw path is not all filtered there
-        rest = -s
-        for k, b in enumerate(blocks):
-            if not self._plain(b) or (k + 1 < len(blocks) and b.vjunc <= 1e-9):
-                return None
-            rest += b.length
-        return rest
+        # for each block: not self._plain(b) or (not the last and b.vjunc <= 1e-9) -> None; else rest += b.length
+        # (compiled, bench B168)
+        lim = self.lim
+        return plain_rest(blocks, s, lim.rapid_whole, lim.cut_on)
 
     def _tail_speed(self, cap: float) -> float:
         """The least cap and junction speed from blocks[0] to the end of the queue."""
-        vmax = cap
-        blocks = self.blocks
-        for k, b in enumerate(blocks):
-            vmax = min(vmax, b.cap)
-            if k + 1 < len(blocks):
-                vmax = min(vmax, b.vjunc)
-        return vmax
+        return tail_speed(self.blocks, cap)  # compiled (bench B168)
 
     def _output_ok(self, pw: Piecewise, t0: float, rest: bool) -> bool:
         """The candidate's filtered output, every cycle of it (`rest`: and on until the filter settles),
