@@ -48,6 +48,18 @@ MAX_ROWS = 400  # raw cycles a checked plan may span (the check samples all of t
 GAIN = 3.0
 
 
+def seg_history(h: tuple) -> list:
+    """The last HISTORY finished segments of the chain `Planner._seg_hist` (`Planner._finish_block` adds one a block:
+    a 3-tuple a block where a tuple of the last 64 was copied twice a block, ~2k instructions, bench B168), oldest
+    first."""
+    out = []
+    while h and len(out) < HISTORY:
+        out.append(h[0])
+        h = h[1]
+    out.reverse()
+    return out
+
+
 def polyline_distance(q: np.ndarray, pts: np.ndarray) -> np.ndarray:
     """Distance of every row of q to the polyline through pts."""
     a, d = pts[:-1], np.diff(pts, axis=0)
@@ -113,7 +125,9 @@ class FilterStops:
     def _init_filter_stops(self) -> None:
         self._fs_tail: Block | None = None  # the queue's last block while a filter stop runs to it
         self._fs_limits = (0.0, 0.0, 0.0)  # its acceleration, jerk and top speed
-        self._seg_hist: tuple = ()  # rebound, never changed in place (hil.stretch_state copies the planner shallowly)
+        # the finished segments as a chain (segment, the chain before it, its length), () before the first: rebound,
+        # never changed in place (hil.stretch_state copies the planner shallowly); `seg_history` reads the last HISTORY
+        self._seg_hist: tuple = ()
         self._fr_plan: _Plan | None = None  # the filter start being executed
 
     def _filter_ramp(self, b: Block, s: float, v: float, a: float, cap: float, t0: float) -> _Plan | None:
@@ -327,7 +341,7 @@ class FilterStops:
     def _path_vertices(self, upto: float) -> tuple[np.ndarray, np.ndarray]:
         """The programmed path behind (the last HISTORY segments) and ahead up to path length `upto` from
         blocks[0]'s start, as a fine polyline, and its vertices (where one segment meets the next)."""
-        segs = list(self._seg_hist)
+        segs = seg_history(self._seg_hist)
         pos = 0.0
         for b in self.blocks:
             if pos > upto:

@@ -43,7 +43,7 @@ from nc.motion.lookahead import (CUT, MARGIN, RAPID, THREAD, Limits, backward, c
                                  max_speed_at, reach)
 from nc.motion.path import Segment
 from nc.motion.plan_state import CHUNK, Setpoint, _near, _Plan
-from nc.motion.filter_ramps import HISTORY, FilterStops
+from nc.motion.filter_ramps import HISTORY, FilterStops, seg_history
 from nc.motion.planner_corners import CornerShares, _corner_at
 from nc.motion.planner_cruise import CruiseSampling
 from nc.motion.planner_runs import FittedRuns
@@ -1022,7 +1022,7 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
             if abs(self.v) < 1e-9 and self._stopping:
                 self._flush()
 
-    @cython.locals(done=Block, keep_plan=cython.bint)
+    @cython.locals(done=Block, keep_plan=cython.bint, n=cython.Py_ssize_t)
     def _finish_block(self, keep_plan: bool = False) -> None:
         # (the queue read once, the fields each written once: per block, issue 17)
         blocks = self.blocks
@@ -1031,8 +1031,15 @@ class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedR
             if done.kind == "thread":
                 self.threads_queued -= 1
             seg = done.seg
-            if seg is not None:
-                self._seg_hist = self._seg_hist[1 - HISTORY:] + (seg,)
+            if seg is not None:  # onto the chain of finished segments (nc.motion.filter_ramps.seg_history)
+                h = self._seg_hist
+                n = h[2] + 1 if h else 1
+                if n > 2 * HISTORY:  # kept short: the last HISTORY - 1 as a new chain (the old one stays as it was)
+                    h, n = (), 1
+                    for x in seg_history(self._seg_hist)[1:]:
+                        h = (x, h, n)
+                        n += 1
+                self._seg_hist = (seg, h, n)
             if keep_plan:  # a path plan on into the next block (re-solved there), or the blocks after it
                 p = self.plan
                 if p is not None:
