@@ -30,7 +30,7 @@ from hil.stretch_state import _across, _restore_planner, _save_planner
 from nc.alarms import NcAlarm
 from nc.channel import READS_PER_CYCLE, Channel
 from nc.motion.planner import Planner
-from nc.motion.stretch import Samples, take_parts
+from nc.motion.stretch import Samples
 from virtual_bus.drive_stretch import CspRun, CsvRun, Stretch
 
 PLAN_KINDS = ("path", "ramp", "cruise")
@@ -146,8 +146,9 @@ class Pass:
         feed or refill between (at least one, at most `limit`), as `take_parts` hands them out (not filtered yet);
         False where the step cannot be taken here (module doc), the planner then as before it."""
         pl = self.pl
-        refill = pl._buf_done
-        if refill:
+        pos, i = pl._buf_pos, pl._buf_i
+        refill = pos is None or i >= len(pos)  # (Planner._buf_done, spelt out: a property call a part)
+        if refill and self.pending:
             # a refill reads the filter: at rest whether it settled, and a solve its state (a filter start or stop
             # is checked on a copy of it, decision motion 52)
             self._flush()
@@ -157,20 +158,12 @@ class Pass:
         # A step that may change the planner (a refill, a cruise's next block) is not saved before it (issue 17,
         # decision bench B159): the one refused (once a stretch) is undone from the mark's save, the steps since
         # made again (`_rewind`; they are deterministic, as `_back` makes them)
-        changes = refill or pl._buf_blk is not None
+        blk = pl._buf_blk
+        changes = refill or blk is not None
         got = None
         try:
             pl._before_take()
-            p = pl.plan
-            blocks = pl.blocks
-            if not pl._buf_done and p is not None and p.kind in PLAN_KINDS and blocks \
-                    and blocks[0].move.css is None:
-                cruise = pl._buf_blk is not None
-                if self.reads and ((q := len(blocks)) < self.depth or (pl._filling and q < self.fill_to)):
-                    limit = 1  # the next cycle reads: a feed comes between
-                elif cruise:
-                    limit = _across(self.ch, pl, limit)
-                got = take_parts(pl, limit, cruise)
+            got = self._take_part(pl, limit)
         except NcAlarm:  # the step raises: stepping raises it in its own cycle
             got = None
         if got is None:
@@ -183,6 +176,42 @@ class Pass:
         self.pending.append((raw, got[1]))
         self.rows += len(raw)
         return True
+
+    def _take_part(self, pl: Planner, limit: int) -> tuple | None:
+        """After the step's `_before_take`: `take_parts(pl, limit', cruise)` of a plan the pass samples, inline (a
+        part a cycle or two of a CAM program: its checks and calls once, not again in take_parts; issue 17, decision
+        bench B165), None where the pass cannot take it. limit' is 1 where the next cycle's feed reads, a cruise's
+        `_across` bound otherwise (the rows up to the first cycle whose feed would read)."""
+        pos, i = pl._buf_pos, pl._buf_i
+        p = pl.plan
+        blocks = pl.blocks
+        if pos is None or i >= len(pos) or p is None or p.kind not in PLAN_KINDS or not blocks \
+                or pl._integrate_angle:
+            return None
+        mv = blocks[0].move
+        if mv.css is not None or (mv.per_rev and p.kind == "path") or mv.kind == "thread" or "G31" in mv.tags:
+            return None  # (take_parts' refusals: a per-revolution path re-planned, a thread, G31)
+        blk = pl._buf_blk
+        if self.reads and ((q := len(blocks)) < self.depth or (pl._filling and q < self.fill_to)):
+            limit = 1  # the next cycle reads: a feed comes between
+        elif blk is not None:
+            limit = _across(self.ch, pl, limit)
+        if blk is None:  # (Planner._block_rows: the buffer's rows left)
+            m = min(limit, len(pos) - i)
+        else:
+            m = pl._cruise_rows(limit)
+        if m <= 0:
+            return None  # the next row starts the cruise's next block: step() finishes this one
+        j = i + m - 1
+        moves = None
+        if blk is not None and blk[j] != pl._buf_popped:
+            off = pl._buf_popped
+            moves = [blocks[k - off].move for k in blk[i:i + m]]
+        z = pl._zones  # the filter's share per row (decision motion 45); None (1 throughout) where no zone is left
+        lam = pl.share_rows(i, m) if z is not None and z.zones else None
+        pl._buf_i = i + m
+        pl._take(j)
+        return pos[i:i + m], lam, pl._buf_line[i:i + m], pl._buf_vel[i:i + m], mv, moves
 
     def _rewind(self) -> None:
         """The planner as before the step just refused: from the mark's save, the steps since made again (they
@@ -251,7 +280,15 @@ class Pass:
         if c == len(out):
             return
         rows = out[c:] if c else out
-        if len(rows) == 1:
+        if len(self.targets) == 3:  # (a mill: a row at a time, each axis spelt out; a comprehension an axis cost
+            # twice as much on a CAM pass's few rows a drive check, issue 17, decision bench B165)
+            (t0, t1, t2), ((c0, o0), (c1, o1), (c2, o2)) = self.targets, self.to_counts
+            a0, a1, a2 = t0.append, t1.append, t2.append
+            for row in rows:
+                a0(round((row[0] - o0) * c0))  # (round: an int)
+                a1(round((row[1] - o1) * c1))
+                a2(round((row[2] - o2) * c2))
+        elif len(rows) == 1:
             row = rows[0]
             for i, (t, (cpu, o)) in enumerate(zip(self.targets, self.to_counts)):
                 t.append(round((row[i] - o) * cpu))
@@ -263,8 +300,10 @@ class Pass:
     def _drive(self, upto: int) -> int | None:
         """The drive models over cycles driven … upto-1 (cycle k steps to the setpoint of cycle k-1); the first
         cycle a drive or the bench's overspeed check would fault in, else None."""
-        self._flush()
-        self._convert()
+        if self.pending:
+            self._flush()
+        if self.converted != len(self.out_rows):
+            self._convert()
         if upto <= self.driven:
             return None
         a, r, n_axes = self.driven, self.st.r, self.st.n_axes
