@@ -280,15 +280,7 @@ class Pass:
         if c == len(out):
             return
         rows = out[c:] if c else out
-        if len(self.targets) == 3:  # (a mill: a row at a time, each axis spelt out; a comprehension an axis cost
-            # twice as much on a CAM pass's few rows a drive check, issue 17, decision bench B165)
-            (t0, t1, t2), ((c0, o0), (c1, o1), (c2, o2)) = self.targets, self.to_counts
-            a0, a1, a2 = t0.append, t1.append, t2.append
-            for row in rows:
-                a0(round((row[0] - o0) * c0))  # (round: an int)
-                a1(round((row[1] - o1) * c1))
-                a2(round((row[2] - o2) * c2))
-        elif len(rows) == 1:
+        if len(rows) == 1:
             row = rows[0]
             for i, (t, (cpu, o)) in enumerate(zip(self.targets, self.to_counts)):
                 t.append(round((row[i] - o) * cpu))

@@ -1,7 +1,7 @@
 """A stretch over the NC's steps converts its filtered rows to the drives' target counts itself (hil/stretch_pass.py
-`Pass._convert`, a row at a time for three axes: decision bench B165). The counts must be the ones the stepped cycle
-writes to 0x607A (`AxisScaling.to_counts` of the position less the axis origin): rounded half to even, reversed
-axes negative, for every axis count."""
+`Pass._convert`, a drive check's new rows at once; decision bench B165 measured a mill's row-at-a-time variant and
+dropped it). The counts must be the ones the stepped cycle writes to 0x607A (`AxisScaling.to_counts` of the position
+less the axis origin): rounded half to even, reversed axes negative, for every axis count."""
 
 from __future__ import annotations
 
