@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import sys
 import time as _time
+from array import array
 from functools import reduce
 from itertools import accumulate, repeat
 from operator import add
@@ -337,6 +338,17 @@ def _round9(times: list[float]) -> list[float]:
     return [round(t, 9) for t in times]
 
 
+def _floats(counts: list[int]) -> np.ndarray:
+    """`np.array(counts, dtype=np.float64)` of a drive's feedback counts: the same doubles (each int to its nearest
+    double, as numpy's conversion makes it through a Python float), made through a C array of int64 and numpy's cast
+    (issue 17, decision bench B165: numpy's conversion of a list made a float object a value, ≈ 550 instructions;
+    this way ≈ 30). A value that is not an int within int64 (a float, a huge count) takes numpy's way, as before."""
+    try:
+        return np.frombuffer(array("q", counts), np.int64).astype(np.float64)
+    except (TypeError, OverflowError):
+        return np.array(counts, dtype=np.float64)
+
+
 def _rows(r: Any, outs: list[Stretch], k0: int, m: int, times: list[float], first_cycle: int, lines: list[int],
           positions: np.ndarray, timings: list[CycleTiming] | None = None) -> None:
     """The trace rows of cycles k0 … m-1, as BenchRunner._row makes them: the unit conversions over the columns
@@ -353,12 +365,12 @@ def _rows(r: Any, outs: list[Stretch], k0: int, m: int, times: list[float], firs
     cols: list = []
     for i, (sc, out) in enumerate(zip(scales, outs)):
         cpu, rpc = sc._cpu, sc._raw_per_cps
-        pa = np.array(out.position_actual[k0:m], dtype=np.float64)
-        va = np.array(out.velocity_actual[k0:m], dtype=np.float64)
-        tq = done(np.array(out.torque_actual[k0:m], dtype=np.float64) * sc.units.torque_percent)
+        pa = _floats(out.position_actual[k0:m])
+        va = _floats(out.velocity_actual[k0:m])
+        tq = done(_floats(out.torque_actual[k0:m]) * sc.units.torque_percent)
         if i < n_axes:  # AxisScaling.to_units, drive_to_velocity, torque_percent
             cols += [done(np.ascontiguousarray(positions[k0:m, i])), done(pa / cpu + org[i]), done(va / rpc / cpu), tq,
-                     done(np.array(out.following_error[k0:m], dtype=np.float64) / cpu), out.statusword[k0:m]]
+                     done(_floats(out.following_error[k0:m]) / cpu), out.statusword[k0:m]]
         else:  # drive_to_rpm of the command and the feedback, the angle mod 360
             cols += [[sc.drive_to_rpm(r.rx[i].target_velocity)] * cnt, done(va / rpc / cpu / sc.lead * 60.0),
                      done(np.remainder(pa / cpu, 360.0)), tq, out.statusword[k0:m]]

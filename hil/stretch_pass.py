@@ -21,6 +21,7 @@ stretch after a feed: lock-step, the basic MLC, the bulk part from the first cyc
 
 from __future__ import annotations
 
+from itertools import chain
 from typing import Any
 
 import numpy as np
@@ -347,5 +348,9 @@ class Pass:
         for _, _, ln, _, mv, mvs in parts:
             lines += ln
             moves += mvs if mvs is not None else [mv] * len(ln)
-        return Samples(np.array(self.out_rows), lines, np.concatenate([p[3] for p in parts]).astype(float, copy=False),
+        out = self.out_rows
+        # the rows as one flat run of floats: numpy's conversion of a list of row lists costs ≈ 4× (B165)
+        positions = np.fromiter(chain.from_iterable(out), np.float64, len(out) * len(out[0])).reshape(len(out), -1) \
+            if out else np.array(out)
+        return Samples(positions, lines, np.concatenate([p[3] for p in parts]).astype(float, copy=False),
                        parts[0][4], moves, np.concatenate(self.raws))
