@@ -67,9 +67,10 @@ def take_rows(pl: Planner, n: int, across: bool = False,
 
 def take_parts(pl: Planner, n: int, across: bool = False, per_rev: bool = False) -> tuple | None:
     """take_rows without its Samples: (raw rows, λ, lines, path speeds, move, moves), the rows and speeds views
-    of the planner's buffer (a refill makes new ones, nothing writes them in place). A stretch that runs the
-    NC's steps (hil/stretch_pass.py) takes a part every cycle or two on a CAM program and joins them once at its
-    end, so a part costs no dataclass and no copy (issue 17)."""
+    of the planner's buffer (a refill makes new ones, nothing writes them in place), so a part costs no dataclass
+    and no copy (issue 17). A stretch that runs the NC's steps takes the same parts with its own copy of these
+    checks, made once after its step (hil/stretch_pass.py `Pass._take_part`, decision bench B165): a change here
+    goes there too."""
     if n <= 0 or pl._integrate_angle or pl._buf_done:
         return None
     blocks = pl.blocks
