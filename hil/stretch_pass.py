@@ -181,8 +181,9 @@ class Pass:
     def _take_part(self, pl: Planner, limit: int) -> tuple | None:
         """After the step's `_before_take`: `take_parts(pl, limit', cruise)` of a plan the pass samples, inline (a
         part a cycle or two of a CAM program: its checks and calls once, not again in take_parts; issue 17, decision
-        bench B165; a change to take_parts goes here too), None where the pass cannot take it. limit' is 1 where the next cycle's feed reads, a cruise's
-        `_across` bound otherwise (the rows up to the first cycle whose feed would read)."""
+        bench B165; a change to take_parts goes here too), None where the pass cannot take it. limit' is 1 where
+        the next cycle's feed reads, a cruise's `_across` bound otherwise (the rows up to the first cycle whose feed
+        would read)."""
         pos, i = pl._buf_pos, pl._buf_i
         p = pl.plan
         blocks = pl.blocks
