@@ -260,17 +260,34 @@ def _compiled(letters: tuple[str, ...], g: int | None, f: int | None, programmed
     else:
         def cols(p: str) -> str:
             return "{" + ", ".join(f"{a!r}: {p}{i}" for i, a in enumerate(axes)) + "}"
+        # the Move made as Move(...) makes it, each of its fields set here (no __init__ frame with 23 arguments,
+        # issue 17); its start is the dict `position` was, which is rebound below and read nowhere else (no
+        # consumer changes a move's start or end in place)
         src += ["    ip.unit_locked = True",
+                "    mv = NEW(Move)",
                 "    if motion == 0:",
-                f"        mv = Move('rapid', line, raw, dict(position), {cols('m')}, {cols('w')}, None, None, None,"
-                " None, False, PLANES[st.plane], st.exact_stop_modal, None, 0.0, 0.0, 0.0, name)",
+                "        mv.kind = 'rapid'",
+                "        mv.feed = None",
+                "        mv.per_rev = False",
                 "    else:",
-                f"        mv = Move('line', line, raw, dict(position), {cols('m')}, {cols('w')}, None, None, mfeed,"
-                " None, st.per_rev, PLANES[st.plane], st.exact_stop_modal, None, 0.0, 0.0, 0.0, name)",
-                "    if st.css:",
-                "        mv.css = st.surface_speed",
+                "        mv.kind = 'line'",
+                "        mv.feed = mfeed",
+                "        mv.per_rev = st.per_rev",
+                "    mv.line = line",
+                "    mv.block = raw",
+                "    mv.start = position",
+                f"    mv.end = {cols('m')}",
+                f"    mv.work = work = {cols('w')}",
+                "    mv.center = mv.dir = mv.duration = mv.lead = mv.comp = None",
+                "    mv.plane = PLANES[st.plane]",
+                "    mv.exact_stop = st.exact_stop_modal",
+                "    mv.lead_change = mv.start_angle = mv.turns = mv.comp_radius = 0.0",
+                "    mv.program = name",
+                "    mv.tags = ()",
+                "    mv.tip = 0",
+                "    mv.css = st.surface_speed if st.css else None",
                 f"    ip.position = {cols('m')}",
-                "    ip.last_target = mv.work  # never changed in place (rebound by every block that moves)",
+                "    ip.last_target = work  # never changed in place (rebound by every block that moves)",
                 "    return mv"]
     space = {"_G_MOTION": _G_MOTION, "Word": Word, "Move": Move, "PLANES": PLANES, "NOTHING": NOTHING,
              "LineBlock": LineBlock, "NEW": object.__new__, "SHAPE": None, "MATCH": None, "MISS": MISS}
