@@ -15,7 +15,7 @@ caught even when both of its end points lie inside — so a move that would cros
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Iterable, Mapping
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 
 from nc.alarms import Alarm
@@ -62,16 +62,12 @@ class SoftLimits:
         # for the params, their length and the bench's segments it names (decisions bench B158)
         self._box: dict[str, tuple[float, float]] | bool = False
         self._box_of: tuple[object, int, object] | None = None
-        # `check`'s first test: (limits, move) -> True when a line with the box's axes at both ends stays inside
-        # it, found again with the box (`_box_test`); False: not known, `_inside` and the rest decide (issue 17)
-        self._fast: Callable[["SoftLimits", Move], bool] = _unknown
 
     def _keys(self, axis: str) -> tuple[str, str, str, str, float]:
         k = self._names[axis] = (f"soft limit 1 {axis}", f"soft limit 2 {axis}", f"soft limit 3 {axis}",
                                  f"soft limit 4 {axis}", 0.5 if axis in self.diameter_axes else 1.0)
         self._all.update(k[:4])
         self._box_of = None  # the box is found again with this axis
-        self._fast = _unknown
         return k
 
     def _new_box(self) -> dict[str, tuple[float, float]] | bool:
@@ -79,14 +75,12 @@ class SoftLimits:
         self._box_of = (params, len(params), first)
         if not params.keys().isdisjoint(self._all):
             self._box = False
-            self._fast = _unknown
         else:
             box: dict[str, tuple[float, float]] = {}
             for a in self._names:
                 lo, hi = first.get(a, (None, None))
                 box[a] = (-math.inf if lo is None else lo - _EPS, math.inf if hi is None else hi + _EPS)
             self._box = box
-            self._fast = _box_test(box, params, first) if box else _unknown
         return self._box
 
     def _inside(self, move: Move) -> bool:
@@ -143,7 +137,7 @@ class SoftLimits:
 
     def check(self, move: Move) -> Alarm | None:
         """The limit alarm this move would raise, or None when its whole path stays inside."""
-        if self._fast(self, move) or move.kind == "dwell" or self._inside(move):
+        if move.kind == "dwell" or self._inside(move):
             return None
         ranges = _path_ranges(move)
         for segment, code in ((1, 0x0A01), (2, 0x0A03)):
@@ -161,38 +155,6 @@ class SoftLimits:
                                        f"{value:.4f}, limit {lim:.4f} (machine coordinates); the move was not started",
                                  line=move.line, block=move.block, program=move.program, axis=axis)
         return None
-
-
-def _unknown(limits: SoftLimits, move: Move) -> bool:
-    return False
-
-
-def _box_test(box: dict[str, tuple[float, float]], params: Mapping[str, float], first: object
-              ) -> Callable[[SoftLimits, Move], bool]:
-    """`_inside`'s box test for these axes and bounds as straight-line code (issue 17: the channel checks every
-    move; the loop over the axes, the box's look-ups and the checks that the box still holds were most of a
-    check): True when `limits` still has the params (of the same length) and bench segments the box was found
-    for, no axis off, and the move is no arc with a centre, has exactly the box's axes at both ends and both
-    ends inside it (a NaN passes, as in `_inside`). False: not known."""
-    src = ["def test(limits, move):",
-           "    if limits.params is not PARAMS or len(PARAMS) != %d or limits.first is not FIRST or limits.disabled:"
-           % len(params),
-           "        return False",
-           "    start = move.start",
-           "    end = move.end",
-           f"    if len(end) != {len(box)} or len(start) != {len(box)} or (move.kind == 'arc' and move.center):",
-           "        return False",
-           "    try:"]
-    for a, (lo, hi) in box.items():
-        src += [f"        s = start[{a!r}]", f"        e = end[{a!r}]"]
-        tests = ([f"s < {lo!r}", f"e < {lo!r}"] if lo != -math.inf else []) \
-            + ([f"s > {hi!r}", f"e > {hi!r}"] if hi != math.inf else [])  # never true for an infinite bound
-        if tests:
-            src += [f"        if {' or '.join(tests)}:", "            return False"]
-    src += ["    except KeyError:", "        return False", "    return True"]
-    space = {"PARAMS": params, "FIRST": first}
-    exec(compile("\n".join(src) + "\n", "<soft limits box>", "exec"), space)
-    return space["test"]
 
 
 def _path_ranges(move: Move) -> dict[str, tuple[float, float]]:
