@@ -212,3 +212,23 @@ def test_a_bench_run_traces_the_same_with_the_lane(tmp_path, monkeypatch) -> Non
     assert [c for c in tables[0].column_names if not tables[0][c].equals(tables[1][c])] == []
     ends = {a: tables[0][f"{a}_cmd"][-1].as_py() for a in "XYZ"}
     assert ends == pytest.approx({"X": 1.0, "Y": 1.0, "Z": 2.0}, abs=1e-6)
+
+
+def test_a_lane_moves_points_are_its_own_when_the_position_is_changed_in_place() -> None:
+    """A lane line's Move starts at the dict that was the interpreter's position (no copy, bench B167): what the
+    channel (an M96 interrupt's stop) or the MLC writes into `Interpreter.position` in place after a move was read
+    changes neither that move's start or end nor those before it, and the next move starts where it was written,
+    as on the general path."""
+    ip = Interpreter(make_profile("nc5-mill"))
+    events = ip.run(parse_program("G90 G17 G94 G01 F3000\nX1. Y2.\nX3. Y4.\nX5. Y6.\nM30\n"), preview=False)
+    first = next(events)
+    second = next(events)
+    assert type(first) is Move and type(second) is Move and type(ip.block) is LineBlock  # the lane ran them
+    ip.position.update({"X": 2.5, "Y": 3.5})  # as nc/channel.py writes an interrupt's stop point
+    third = next(events)
+    assert (first.start, first.end) == ({"X": 0.0, "Y": 0.0, "Z": 0.0}, {"X": 1.0, "Y": 2.0, "Z": 0.0})
+    assert (second.start, second.end) == ({"X": 1.0, "Y": 2.0, "Z": 0.0}, {"X": 3.0, "Y": 4.0, "Z": 0.0})
+    assert (third.start, third.end) == ({"X": 2.5, "Y": 3.5, "Z": 0.0}, {"X": 5.0, "Y": 6.0, "Z": 0.0})
+    assert ip.position == {"X": 5.0, "Y": 6.0, "Z": 0.0} and ip.position is not third.end
+    third.start["X"] = -1.0  # a consumer's own change of a move's dict reaches no other move nor the interpreter
+    assert second.end == {"X": 3.0, "Y": 4.0, "Z": 0.0} and ip.position["X"] == 5.0
