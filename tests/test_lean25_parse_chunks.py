@@ -98,3 +98,15 @@ def test_the_first_malformed_line_raises_as_before() -> None:
     with pytest.raises(NcAlarm) as exc:
         parse_program(text, "p.nc")
     assert (exc.value.alarm.line, exc.value.alarm.block) == (3, "G1 X1. Q")
+
+
+@settings(max_examples=300, deadline=None)
+@given(lines=st.lists(LINES.filter(lambda s: "N" not in s and "n" not in s), max_size=40), final=st.booleans(),
+       chunk=st.sampled_from([8, 17, 64, 1 << 16]))
+def test_chunks_without_n_read_by_runs_give_what_line_by_line_gave(lines: list[str], final: bool, chunk: int) -> None:
+    """A chunk without N is read a run of plain lines at a time (`_PLAIN_RUN`, bench B167): blank, non-plain and
+    too-long-number lines anywhere in it, a last line with or without its line break."""
+    text = "\n".join(lines) + ("\n" if final and lines else "")
+    with patch.object(blocks_mod, "_CHUNK", chunk):
+        got = _read(lambda t: parse_program(t, "p.nc"), text)
+    assert got == _read(reference, text)

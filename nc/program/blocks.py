@@ -62,6 +62,9 @@ _WORD_OK = r"[A-MP-Za-mp-z](?![-+.0-9]{13})[+-]?+(?:[0-9]++\.?+[0-9]*+|\.[0-9]++
 _PLAIN_OK = re.compile(r"[ \t]*+(?:[Nn]([0-9]{1,12}+)[ \t]*+)?+(?:" + _WORD_OK + ")*+")
 # `_PLAIN_OK` but for a blank line (no N, no word): a line `_parse` keeps as text
 _PLAIN_ITEM = re.compile(r"[ \t]*+(?:[Nn]([0-9]{1,12}+)[ \t]*+(?:" + _WORD_OK + ")*+|(?:" + _WORD_OK + ")++)")
+# a run of `_PLAIN_ITEM` lines without N, each ended by its line break (or the text's end): what `_parse` reads of a
+# chunk without N in one call (a line `_PLAIN_ITEM` takes is one this takes: the same words, no "\n" in one)
+_PLAIN_RUN = re.compile(r"(?:[ \t]*+(?:" + _WORD_OK + r")++(?:\n|\Z))*+")
 _CHUNK = 1 << 16  # characters of program text `_parse` reads at a time
 _CACHE_LIMIT = 4096  # parsed plain lines kept (loops and GOTO come back to them); then the cache starts over
 
@@ -190,6 +193,7 @@ def _parse(text: str, name: str, number: int | None, start: int, stop: int | Non
     starts, lengths, n_items = blocks._starts, blocks._lengths, blocks._lines
     labels: dict[int, list[int]] = {}
     plain_ok = _PLAIN_ITEM.fullmatch
+    plain_run = _PLAIN_RUN.match
     stop = len(text) if stop is None else stop
     idx, pos = line0, start
     while pos < stop:  # a chunk at a time, not a list of all lines (a 1M-block program, issue 16)
@@ -207,18 +211,19 @@ def _parse(text: str, name: str, number: int | None, start: int, stop: int | Non
         if "N" in chunk or "n" in chunk:
             found = list(map(plain_ok, lines))
             odd = [i for i, m in enumerate(found) if m is None or m.lastindex]
-        else:  # no label: only whether each line is plain (no match object kept for the collector to walk, issue
-            # 17), the other lines found by C's `list.index`
-            plain = list(map(bool, map(plain_ok, lines)))
+        else:  # no label: a run of plain lines is matched in one call (`_PLAIN_RUN`: no match object per line,
+            # issue 17), ending at the start of the next line that is not plain
             odd = []
-            k = 0
-            try:
-                while True:
-                    k = plain.index(False, k)
-                    odd.append(k)
-                    k += 1
-            except ValueError:
-                pass
+            k, p, size, last = 0, 0, len(chunk), len(lines)
+            while k < last:
+                e = plain_run(chunk, p).end()
+                k += chunk.count("\n", p, e)
+                if e >= size:
+                    break
+                odd.append(k)
+                k += 1
+                if k < last:
+                    p = offsets[k] - pos
         done = 0  # lines of the chunk added or skipped
         for i in odd + [len(lines)]:
             if i > done:  # plain lines: kept as text, no block object per line; the run's numbers packed at
