@@ -42,6 +42,9 @@ cdef class FilterCorners:
     cdef public Py_ssize_t _w_k1, _w_k2  # the last two caps `_taken` found (decision bench B134)
     cdef public double _w_c1, _w_c2
     cdef public double _half, _g0, _tol_v  # kd.half, kd.g0, tol (inf: None) as C doubles (decision bench B153)
+    # `_held_caps`' scratch arrays and G's tables as typed memoryviews, kept between calls (decision bench B163)
+    cdef double[::1] _x_s, _x_room, _x_ct, _x_rc, _x_vb, _x_se, _x_rm, _x_e, _x_gy, _x_gg, _x_gs
+    cdef double[:, ::1] _x_du, _x_w
     cdef double _cap(self, Py_ssize_t m) except? -1.0
     cdef bint _taken(self, Py_ssize_t k) except -1
     # C calls from Limits.junction, once a pushed junction (session 28, decision bench B157)
@@ -49,16 +52,27 @@ cdef class FilterCorners:
     cpdef double isolated_cap(self, double du_n, double acc, double jerk, Block b1, Block b2) except? -1.0
 
 # `_held_caps` and `_kernel_matrix` (decision bench B133): C loops over memoryviews, declared here as
-# nc.motion.cython_shadow has no memoryview types for the .py's decorators.
+# nc.motion.cython_shadow has no memoryview types for the .py's decorators; their arrays FilterCorners' scratch, the
+# product with the steps and its norms `_deviations`' C loops, the least holding cap `_least_held`'s (B163)
 @cython.locals(hist=list, hs=list, nseg=Py_ssize_t, h=double, s=double[::1], t_near=double, t_ev=double,
                n0=Py_ssize_t, e0=Py_ssize_t, ne=Py_ssize_t, nn=Py_ssize_t, axes=Py_ssize_t, tol=double,
                t2sum=double, room=double[::1], nl=Py_ssize_t, i=Py_ssize_t, b=Block, nx=Block, rr=double,
                fits=bint, du=double[:, ::1], vb=double[::1], k=Py_ssize_t, a=Py_ssize_t, dv=tuple,
-               se=double[::1], c=double, r=Py_ssize_t, e=list, caps=list, v=double, x=double, lim=double,
-               ct=double[::1], rc=double[::1], depth=Py_ssize_t, i0=Py_ssize_t, inf=double, u=Py_ssize_t, su=double,
-               vt_i=double, far=double)
+               se=double[::1], rm=double[::1], w=double[:, ::1], e=double[::1], c=double, r=Py_ssize_t, caps=list,
+               v=double, lim=double, ct=double[::1], rc=double[::1], held=double[::1], depth=Py_ssize_t,
+               i0=Py_ssize_t, u=Py_ssize_t, vt_i=double, far=double)
 cdef Py_ssize_t _held_caps(FilterCorners fc, object blocks, Py_ssize_t lo, Py_ssize_t last, double s_j, double vt,
                            double half) except -1
+
+@cython.locals(nseg=Py_ssize_t, inf=double, u=Py_ssize_t, su=double, vt_i=double, k=Py_ssize_t, k0=Py_ssize_t,
+               x=double, c=double)
+cpdef int _least_held(double[::1] s, double[::1] ct, double[::1] rc, Py_ssize_t n0, double far,
+                      double[::1] held) except -1
+
+@cython.locals(nl=Py_ssize_t, nn=Py_ssize_t, axes=Py_ssize_t, n4=Py_ssize_t, r=Py_ssize_t, a=Py_ssize_t,
+               k=Py_ssize_t, q=double, p=double, l0=double, l1=double, l2=double, l3=double, l4=double, l5=double,
+               l6=double, l7=double)
+cpdef int _deviations(double[:, ::1] w, double[:, ::1] du, double[::1] e) except -1
 
 @cython.locals(ny=Py_ssize_t, ymax=double, inv=double, r=Py_ssize_t, k=Py_ssize_t, sr=double, x=double, g=double,
                j0=Py_ssize_t, v=double)

@@ -37,6 +37,9 @@ try:
 except ImportError:  # run as Python without Cython: they do nothing
     from nc.motion import cython_shadow as cython
 
+if cython.compiled:  # C's fma and sqrt for `_deviations`' C form (decision bench B163)
+    from cython.cimports.libc.math import fma as _fma, sqrt as _c_sqrt
+
 from nc.motion.block import Block
 from nc.motion.deviation import CornerBound, KernelDeviation
 from nc.motion.limits import MotionConfig
@@ -171,6 +174,8 @@ class FilterCorners:
         self.budget = tuple(min(ba, bj) for ba, bj in zip(self.budget_a, self.budget_j))
         self._axes = len(self.budget)
         self._zero = (0.0,) * (self._axes + 1)
+        self._scratch(64, 16, 64)  # `_held_caps`' arrays, grown as a call needs (decision bench B163)
+        self._x_gy, self._x_gg, self._x_gs = self._gy, self._gg, self._gs  # the same, typed memoryviews compiled
         # Junctions still inside some filter window, executed or not (for the sums).
         self._hist: list[Block] = []
         self._hist_s: list[float] = []  # their s_end, side by side: bisected without a key (issue 17)
@@ -185,6 +190,15 @@ class FilterCorners:
         amax = math.sqrt(sum(cfg.limit(a).max_acceleration ** 2 for a in cfg.axes))
         self.span_max = vmax * self.t_j + amax * self.t_j ** 2
         self.amax = amax
+
+    def _scratch(self, n: int, rows: int, cols: int) -> None:
+        """`_held_caps`' arrays with room for n junctions and a kernel matrix of rows × cols (decision bench B163:
+        typed memoryviews where compiled, kept from call to call, sliced to each call's sizes; a numpy array and a
+        memoryview made afresh were ≈ 2.4k instructions each, eight a call)."""
+        self._x_s, self._x_room, self._x_ct, self._x_rc = np.empty(n), np.empty(n), np.empty(n), np.empty(n)
+        self._x_vb, self._x_se, self._x_rm, self._x_e = np.empty(n), np.empty(n), np.empty(n), np.empty(n)
+        self._x_du = np.empty((n, self._axes))
+        self._x_w = np.empty((rows, cols))
 
     def _clear(self) -> None:
         self._hist.clear()
@@ -765,16 +779,18 @@ def _held_caps(fc: FilterCorners, blocks: Sequence[Block], lo: int, last: int, s
     form it had, one C loop an array (issue 17: ~60 numpy calls on arrays of ~50 ended in ~900k instructions a
     call). Each value is the same IEEE operation in the same order as the numpy form's elementwise one: np.interp's
     own arithmetic (slopes (g[j+1] − g[j]) / (y[j+1] − y[j]), then slope·(x − y[j]) + g[j]), np.minimum's and
-    np.abs'. What is no elementwise operation stays numpy's: the product with the steps (BLAS's summation order) and
-    its row norms, on the same matrices. `KernelDeviation.caps`' first pass tries the top speed at every junction
-    with room; where that deviates too far somewhere, caps itself runs (it tries the same first). The types are in
-    blending.pxd (memoryviews: nc.motion.cython_shadow has none). Returns how many blocks from the tail need a new
-    backward pass."""
+    np.abs'. The product with the steps and its row norms are `_deviations`: compiled, C loops in the order numpy's
+    BLAS sums them (decision bench B163); as Python, numpy's. `KernelDeviation.caps`' first pass tries the top speed
+    at every junction with room; where that deviates too far somewhere, caps itself runs (it tries the same first).
+    The arrays are FilterCorners' scratch (`_scratch`), sliced to the call's sizes; the types are in blending.pxd
+    (memoryviews: nc.motion.cython_shadow has none). Returns how many blocks from the tail need a new backward
+    pass."""
     hist, hs = fc._hist, fc._hist_s
     nseg = last + 1 - lo
+    if nseg > fc._x_s.shape[0]:
+        fc._scratch(2 * nseg, fc._x_w.shape[0], fc._x_w.shape[1])
     h = vt * half
-    sv = np.empty(nseg)
-    s = sv  # (compiled: a memoryview of sv)
+    s = fc._x_s[:nseg]
     for i in range(nseg):
         s[i] = hs[lo + i]
     # The junctions near J and those evaluated: suffixes of hist[lo:] (s_end only grows)
@@ -788,8 +804,7 @@ def _held_caps(fc: FilterCorners, blocks: Sequence[Block], lo: int, last: int, s
         e0 -= 1
     ne, nn, axes = nseg - e0, nseg - n0, fc._axes
     tol, t2sum = fc.tol, fc.t2sum
-    room_a = np.empty(ne)
-    room = room_a
+    room = fc._x_room[:ne]
     nl = 0  # junctions with room left
     for i in range(ne):
         b = hist[lo + e0 + i]
@@ -800,36 +815,37 @@ def _held_caps(fc: FilterCorners, blocks: Sequence[Block], lo: int, last: int, s
             nl += 1
     fits = True
     if nl > 0:
-        du_a = np.empty((nn, axes))
-        du = du_a
-        vb_a = np.empty(nn)
-        vb = vb_a
+        du = fc._x_du[:nn]
+        vb = fc._x_vb[:nn]
         for k in range(nn):
             b = hist[lo + n0 + k]
             dv = b.dv
             for a in range(axes):
                 du[k, a] = dv[a]
             vb[k] = b.vbase
-        # KernelDeviation.deviation at the top speed for the junctions with room
-        se_a = np.empty(nl)
-        se = se_a
+        # KernelDeviation.deviation at the top speed for the junctions with room (se), their rooms (rm)
+        se = fc._x_se[:nl]
+        rm = fc._x_rm[:nl]
         r = 0
         for i in range(ne):
             if room[i] > 0.0:
                 se[r] = s[e0 + i]
+                rm[r] = room[i]
                 r += 1
-        w_a = np.empty((nl, nn))
-        _kernel_matrix(w_a, se_a, sv[n0:], vb_a, vt, fc._gy, fc._gg, fc._gs)
-        e = np.linalg.norm(w_a @ du_a, axis=1).tolist()
-        r = 0
-        for i in range(ne):
-            if room[i] > 0.0:
-                if e[r] > room[i]:
-                    fits = False
-                    break
-                r += 1
-        if not fits:  # caps from its first pass on (rare: about never on the CAM program)
-            caps = fc.kd.caps(sv[e0:], room_a, vt, sv[n0:], du_a, vb_a).tolist()
+        if nl > fc._x_w.shape[0] or nn > fc._x_w.shape[1]:
+            fc._x_w = np.empty((nl if nl > fc._x_w.shape[0] else fc._x_w.shape[0],
+                                nn if nn > fc._x_w.shape[1] else fc._x_w.shape[1]))
+        w = fc._x_w[:nl, :nn]  # (rows nl of a wider matrix: its inner dimension stays contiguous)
+        _kernel_matrix(w, se, s[n0:], vb, vt, fc._x_gy, fc._x_gg, fc._x_gs)
+        e = fc._x_e[:nl]
+        _deviations(w, du, e)
+        for r in range(nl):
+            if e[r] > rm[r]:
+                fits = False
+                break
+        if not fits:  # caps from its first pass on (rare: about never on the CAM program), on fresh arrays as before
+            caps = fc.kd.caps(np.array(s[e0:]), np.array(room), vt, np.array(s[n0:]), np.array(du),
+                              np.array(vb)).tolist()
     lim = vt * (1.0 - 1e-9)
     for i in range(ne):
         if fits:
@@ -843,35 +859,21 @@ def _held_caps(fc: FilterCorners, blocks: Sequence[Block], lo: int, last: int, s
         if c < lim and b.s_end > fc._lim_s:
             fc._lim_s = b.s_end
     # Each junction near J: the least ctol of the junctions whose reach (min(ctol, vt)·half) holds it
-    ct_a = np.empty(nseg)
-    ct = ct_a
-    rc_a = np.empty(nseg)
-    rc = rc_a
+    ct = fc._x_ct[:nseg]
+    rc = fc._x_rc[:nseg]
     for k in range(nseg):
-        c = hist[lo + k].ctol
+        b = hist[lo + k]  # (typed: ctol read as a Block's field, decision bench B163)
+        c = b.ctol
         rc[k] = (c if c < vt or c != c else vt) * half + 1e-12
         ct[k] = c
     depth = 0
     i0 = nseg + 1 - len(blocks)  # hist[lo + i] is blocks[i - nseg - 1]: queued from i0 on
-    inf = math.inf
     far = vt * half + 1e-12  # no reach is longer (each rounding is monotonic): the junctions past it, on either
     # side (s sorted), are held by none
+    held = fc._x_e[:nseg]  # (e's room: read no more)
+    _least_held(s, ct, rc, n0, far, held)
     for u in range(n0, nseg):
-        su = s[u]
-        vt_i = inf
-        k = u
-        while k >= 0 and su - s[k] <= far:
-            k -= 1
-        for k in range(k + 1, nseg):
-            x = su - s[k]
-            if x < 0.0:
-                x = -x
-                if x > far:
-                    break
-            if x <= rc[k]:
-                c = ct[k]
-                if c < vt_i or c != c:
-                    vt_i = c
+        vt_i = held[u]
         b = hist[lo + u]
         b.vtol = vt_i
         if u >= i0:
@@ -884,12 +886,125 @@ def _held_caps(fc: FilterCorners, blocks: Sequence[Block], lo: int, last: int, s
     return depth
 
 
+@cython.boundscheck(False)
+@cython.wraparound(False)
+def _least_held(s: np.ndarray, ct: np.ndarray, rc: np.ndarray, n0: int, far: float, held: np.ndarray) -> int:
+    """held[u] for u in n0..: the least ct[k] over the junctions k whose reach rc[k] holds s[u] (|s[u] − s[k]| ≤
+    rc[k]; inf where none; nan kept), those further than `far` skipped (s sorted). The first junction within far
+    behind s[u] only moves on with u (s[u] − s[k] grows with s[u], each rounding being monotonic): a pointer, where
+    a walk back from u found it for each u before (decision bench B163). No bounds checks compiled: every index lies
+    in 0..len(s)."""
+    nseg = s.shape[0]
+    if ct.shape[0] < nseg or rc.shape[0] < nseg or held.shape[0] < nseg or n0 < 0:
+        raise ValueError("_least_held: ct, rc and held need a place per junction")
+    inf = math.inf
+    k0 = 0
+    for u in range(n0, nseg):
+        su = s[u]
+        vt_i = inf
+        while k0 <= u and not su - s[k0] <= far:  # (past u only where far < 0 or nan, as the walk started there)
+            k0 += 1
+        for k in range(k0, nseg):
+            x = su - s[k]
+            if x < 0.0:
+                x = -x
+                if x > far:
+                    break
+            if x <= rc[k]:
+                c = ct[k]
+                if c < vt_i or c != c:
+                    vt_i = c
+        held[u] = vt_i
+    return 0
+
+
+@cython.boundscheck(False)
+@cython.wraparound(False)
+def _deviations(w: np.ndarray, du: np.ndarray, e: np.ndarray) -> int:
+    """e[r] = np.linalg.norm(w @ du, axis=1)[r] bit for bit (decision bench B163). Compiled, C loops that sum as
+    numpy 2.4's matmul does here through OpenBLAS 0.3.31 on its SkylakeX kernels (the bench machine's; valgrind
+    reports a CPU without AVX-512, on which OpenBLAS runs its Haswell kernels and numpy sums otherwise):
+    - one row (nl = 1): numpy's gemv, OpenBLAS's dgemv_n for 2 or 3 rows: per 4 steps
+      t = t + fma(a_k, x_k, a_k+1·x_k+1) twice, then t = fma(a_k, x_k, t) for the rest;
+    - one step (nn = 1): numpy's own loop, 0 + w·du;
+    - else cblas_dgemm, M = axes, N = nl, K = nn: its small-matrix kernel (M·N·K ≤ 10⁶, dgemm_small_kernel_b0_nn):
+      K < 16, one fused multiply-add chain over the steps in order; K ≥ 16, eight chains (step k into chain k mod 8,
+      a last partial group of 8 adding +0 to the chains past it) summed ((0+1)+(2+3))+((4+5)+(6+7)) for the rows in
+      groups of four (r < nl rounded down to 4), ((0+4)+(2+6))+((1+5)+(3+7)) for the rest.
+    The norm: squares summed (x0² + x1²) + x2², then the square root (numpy's add.reduce over 3 columns).
+    Other sizes, 1 or over 3 axes, and the Python build: numpy itself on fresh arrays."""
+    nl, nn, axes = w.shape[0], w.shape[1], du.shape[1]
+    if du.shape[0] != nn or e.shape[0] < nl:
+        raise ValueError("_deviations: du must have a row per column of w, e a place per row")
+    if not cython.compiled or axes < 2 or axes > 3 or 3.0 * nl * nn > 1e6:
+        out = np.linalg.norm(np.array(w) @ np.array(du), axis=1)
+        for r in range(nl):
+            e[r] = out[r]
+        return 0
+    n4 = nl - nl % 4
+    for r in range(nl):
+        q = 0.0
+        for a in range(axes):
+            if nn == 1:
+                p = 0.0 + w[r, 0] * du[0, a]
+            elif nl == 1:
+                p = 0.0
+                k = 0
+                while k + 4 <= nn:
+                    p = p + _fma(du[k, a], w[r, k], du[k + 1, a] * w[r, k + 1])
+                    p = p + _fma(du[k + 2, a], w[r, k + 2], du[k + 3, a] * w[r, k + 3])
+                    k += 4
+                while k < nn:
+                    p = _fma(du[k, a], w[r, k], p)
+                    k += 1
+                p = 0.0 + p
+            elif nn < 16:
+                p = 0.0
+                for k in range(nn):
+                    p = _fma(du[k, a], w[r, k], p)
+            else:
+                l0 = l1 = l2 = l3 = l4 = l5 = l6 = l7 = 0.0
+                k = 0
+                while k + 8 <= nn:
+                    l0 = _fma(du[k, a], w[r, k], l0)
+                    l1 = _fma(du[k + 1, a], w[r, k + 1], l1)
+                    l2 = _fma(du[k + 2, a], w[r, k + 2], l2)
+                    l3 = _fma(du[k + 3, a], w[r, k + 3], l3)
+                    l4 = _fma(du[k + 4, a], w[r, k + 4], l4)
+                    l5 = _fma(du[k + 5, a], w[r, k + 5], l5)
+                    l6 = _fma(du[k + 6, a], w[r, k + 6], l6)
+                    l7 = _fma(du[k + 7, a], w[r, k + 7], l7)
+                    k += 8
+                if k < nn:  # the masked last group: the chains past the steps left add 0·0
+                    l0 = _fma(du[k, a], w[r, k], l0)
+                    l1 = _fma(du[k + 1, a], w[r, k + 1], l1) if k + 1 < nn else l1 + 0.0
+                    l2 = _fma(du[k + 2, a], w[r, k + 2], l2) if k + 2 < nn else l2 + 0.0
+                    l3 = _fma(du[k + 3, a], w[r, k + 3], l3) if k + 3 < nn else l3 + 0.0
+                    l4 = _fma(du[k + 4, a], w[r, k + 4], l4) if k + 4 < nn else l4 + 0.0
+                    l5 = _fma(du[k + 5, a], w[r, k + 5], l5) if k + 5 < nn else l5 + 0.0
+                    l6 = _fma(du[k + 6, a], w[r, k + 6], l6) if k + 6 < nn else l6 + 0.0
+                    l7 = l7 + 0.0
+                if r < n4:
+                    p = ((l0 + l1) + (l2 + l3)) + ((l4 + l5) + (l6 + l7))
+                else:
+                    p = ((l0 + l4) + (l2 + l6)) + ((l1 + l5) + (l3 + l7))
+            q = p * p if a == 0 else q + p * p
+        e[r] = _c_sqrt(q)
+    return 0
+
+
+@cython.boundscheck(False)
+@cython.wraparound(False)
 def _kernel_matrix(w: np.ndarray, s_rows: np.ndarray, s_all: np.ndarray, vb: np.ndarray, c: float, gy: np.ndarray,
                    gg: np.ndarray, gs: np.ndarray) -> None:
     """Fill w (rows × junctions) with `KernelDeviation.deviation`'s weighted steps at the speed c for every row,
     G(|(s_all[k] − s_rows[r]) / c|)·min(vb[k], c), G the table (gy, gg) as np.interp(..., right=0.0) reads it, gs its
-    slopes: the same IEEE operations as the numpy form, element by element (decision bench B133)."""
+    slopes: the same IEEE operations as the numpy form, element by element (decision bench B133). No bounds checks
+    compiled (decision bench B163): the sizes are checked once here."""
     ny = gy.shape[0]
+    if (ny < 1 or gg.shape[0] < ny or gs.shape[0] < ny - 1 or s_rows.shape[0] < w.shape[0]
+            or s_all.shape[0] < w.shape[1] or vb.shape[0] < w.shape[1]):
+        raise ValueError("_kernel_matrix: a table or a vector is shorter than the matrix it fills")
     ymax = gy[ny - 1]
     inv = (ny - 1) / ymax  # G's table is evenly spaced: a first guess of the index, made exact below
     for r in range(w.shape[0]):

@@ -23,3 +23,11 @@ def returns(_type: Any) -> Callable[[Callable], Callable]:
 
 def ccall(fn: Callable) -> Callable:
     return fn
+
+
+def boundscheck(_flag: bool) -> Callable[[Callable], Callable]:  # a directive compiled (decision bench B163)
+    return lambda fn: fn
+
+
+def wraparound(_flag: bool) -> Callable[[Callable], Callable]:
+    return lambda fn: fn

@@ -1,0 +1,144 @@
+"""The filter corners' deviations in C (decision bench B163): compiled, `_deviations` sums the product of the kernel
+matrix with the steps and its row norms in C loops, in the order numpy's matmul (OpenBLAS) and np.linalg.norm sum
+them on the bench machine. It must give np.linalg.norm(w @ du, axis=1) bit for bit on every shape `_held_caps` hands
+it (one row, one step, fewer and more than 16 steps, rows in and past groups of four; 2 and 3 axes): a deviation
+one ulp off could flip a junction's fit against its room, and the compiled planner's setpoints would leave its
+source's (tests/test_planner_compiled.py compares whole runs)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import nc.motion.compiled as compiled
+from nc.motion.blending import _deviations, _kernel_matrix, _least_held
+
+compiled_only = pytest.mark.skipif(compiled.BUILD != "compiled",
+                                   reason=f"the C form runs compiled only ({compiled.BUILD}); as Python it is numpy's")
+
+
+def _numpy_form(w: np.ndarray, du: np.ndarray) -> np.ndarray:
+    """What `_held_caps` computed before B163 (and KernelDeviation.deviation computes): fresh C-contiguous arrays."""
+    return np.linalg.norm(np.ascontiguousarray(w) @ np.ascontiguousarray(du), axis=1)
+
+
+def _c_form(w: np.ndarray, du: np.ndarray) -> np.ndarray:
+    e = np.full(w.shape[0], np.nan)
+    _deviations(w, du, e)
+    return e
+
+
+def _same_bits(a: np.ndarray, b: np.ndarray) -> bool:
+    return a.shape == b.shape and np.array_equal(a.view(np.uint64), b.view(np.uint64))
+
+
+@st.composite
+def _inputs(draw: st.DrawFn) -> tuple[np.ndarray, np.ndarray]:
+    """A kernel matrix (weights ≥ 0, zeros past the half window) and the steps (signed, spread over magnitudes so that
+    summing in another order changes the last bits)."""
+    nl = draw(st.sampled_from([1, 1, 2, 3, 4, 5, 7, 8, 9, 13, 23, 40]))
+    nn = draw(st.sampled_from([1, 2, 3, 4, 5, 7, 8, 9, 15, 16, 17, 23, 24, 31, 45, 64, 100, 257]))
+    axes = draw(st.sampled_from([2, 3, 3]))
+    rng = np.random.default_rng(draw(st.integers(0, 2**32 - 1)))
+    w = rng.uniform(0.0, 3.0, (nl, nn)) * 10.0 ** rng.integers(-3, 3, (nl, nn))
+    w[rng.random((nl, nn)) < 0.25] = 0.0
+    du = rng.uniform(-1.0, 1.0, (nn, axes)) * 10.0 ** rng.integers(-6, 1, (nn, axes))
+    du[rng.random((nn, axes)) < 0.1] = 0.0
+    return w, du
+
+
+@compiled_only
+@settings(max_examples=400, deadline=None)
+@given(_inputs())
+def test_deviations_are_numpys_bit_for_bit(case):
+    w, du = case
+    assert _same_bits(_c_form(w, du), _numpy_form(w, du))
+
+
+@compiled_only
+def test_differently_summed_forms_differ_here():
+    """The inputs above tell summation orders apart: a plain loop over the steps, in order, misses numpy's bits."""
+    rng = np.random.default_rng(5)
+    differ = 0
+    for _ in range(50):
+        w = rng.uniform(0.0, 3.0, (23, 45))
+        du = rng.uniform(-0.3, 0.3, (45, 3))
+        plain = np.empty((23, 3))
+        for r in range(23):
+            for a in range(3):
+                x = 0.0
+                for k in range(45):
+                    x += float(w[r, k]) * float(du[k, a])
+                plain[r, a] = x
+        differ += not _same_bits(np.linalg.norm(plain, axis=1), _numpy_form(w, du))
+    assert differ > 25
+
+
+@compiled_only
+def test_kernel_matrix_then_deviations_as_held_caps_uses_them():
+    """The matrix `_kernel_matrix` fills, then `_deviations` on it: KernelDeviation.deviation's bit for bit."""
+    from tests.test_filter_held_caps import _cases, _corners
+
+    fc = _corners()
+    rng = np.random.default_rng(19)
+    for s_rows, s_all, vb, c in _cases(fc):
+        du = rng.uniform(-0.3, 0.3, (len(s_all), 3))
+        w = np.empty((len(s_rows), len(s_all)))
+        _kernel_matrix(w, s_rows, s_all, vb, c, fc._gy, fc._gg, fc._gs)
+        ref = fc.kd.deviation(np.full(len(s_rows), c), s_rows, s_all, du, vb)
+        assert ref.min() > 0.0
+        assert _same_bits(_c_form(w, du), ref)
+
+
+@compiled_only
+def test_mismatched_sizes_are_refused():
+    with pytest.raises(ValueError):
+        _deviations(np.ones((2, 5)), np.ones((4, 3)), np.empty(2))
+    with pytest.raises(ValueError):
+        _deviations(np.ones((3, 5)), np.ones((5, 3)), np.empty(2))
+
+
+def _least_held_walk(s: list[float], ct: list[float], rc: list[float], n0: int, far: float) -> dict[int, float]:
+    """`_held_caps`' loop before B163: for each junction u, a walk back from u to the first junction within far."""
+    out = {}
+    for u in range(n0, len(s)):
+        su, vt_i, k = s[u], math.inf, u
+        while k >= 0 and su - s[k] <= far:
+            k -= 1
+        for k in range(k + 1, len(s)):
+            x = su - s[k]
+            if x < 0.0:
+                x = -x
+                if x > far:
+                    break
+            if x <= rc[k]:
+                c = ct[k]
+                if c < vt_i or c != c:
+                    vt_i = c
+        out[u] = vt_i
+    return out
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.integers(1, 60), st.integers(0, 2), st.sampled_from(["any", "negative", "inf", "nan", "zero"]),
+       st.integers(0, 2**32 - 1))
+def test_least_held_is_the_walks(n, digits, far_kind, seed):
+    """The least holding cap with the first junction within reach kept as a pointer (B163) is the walk's, equal
+    positions (rounded to `digits`), nan caps, and a negative, infinite or nan reach included."""
+    rng = np.random.default_rng(seed)
+    s = np.sort(np.round(rng.uniform(0.0, 10.0, n), digits))
+    ct = rng.uniform(0.0, 5.0, n)
+    ct[rng.random(n) < 0.1] = np.nan
+    rc = rng.uniform(0.0, 3.0, n)
+    far = {"any": float(rng.uniform(0.0, 4.0)), "negative": -0.5, "inf": math.inf, "nan": math.nan,
+           "zero": 0.0}[far_kind]
+    n0 = int(rng.integers(0, n))
+    held = np.full(n, -1.0)
+    _least_held(s, ct, rc, n0, far, held)
+    want = _least_held_walk(s.tolist(), ct.tolist(), rc.tolist(), n0, far)
+    got = {u: float(held[u]) for u in want}
+    assert all(got[u] == x or (got[u] != got[u] and x != x) for u, x in want.items()), (got, want)
