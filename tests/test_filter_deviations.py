@@ -7,15 +7,13 @@ source's (tests/test_planner_compiled.py compares whole runs)."""
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import nc.motion.compiled as compiled
-from nc.motion.blending import _deviations, _kernel_matrix, _least_held
+from nc.motion.blending import _deviations, _kernel_matrix
 
 compiled_only = pytest.mark.skipif(compiled.BUILD != "compiled",
                                    reason=f"the C form runs compiled only ({compiled.BUILD}); as Python it is numpy's")
@@ -101,44 +99,3 @@ def test_mismatched_sizes_are_refused():
     with pytest.raises(ValueError):
         _deviations(np.ones((3, 5)), np.ones((5, 3)), np.empty(2))
 
-
-def _least_held_walk(s: list[float], ct: list[float], rc: list[float], n0: int, far: float) -> dict[int, float]:
-    """`_held_caps`' loop before B163: for each junction u, a walk back from u to the first junction within far."""
-    out = {}
-    for u in range(n0, len(s)):
-        su, vt_i, k = s[u], math.inf, u
-        while k >= 0 and su - s[k] <= far:
-            k -= 1
-        for k in range(k + 1, len(s)):
-            x = su - s[k]
-            if x < 0.0:
-                x = -x
-                if x > far:
-                    break
-            if x <= rc[k]:
-                c = ct[k]
-                if c < vt_i or c != c:
-                    vt_i = c
-        out[u] = vt_i
-    return out
-
-
-@settings(max_examples=300, deadline=None)
-@given(st.integers(1, 60), st.integers(0, 2), st.sampled_from(["any", "negative", "inf", "nan", "zero"]),
-       st.integers(0, 2**32 - 1))
-def test_least_held_is_the_walks(n, digits, far_kind, seed):
-    """The least holding cap with the first junction within reach kept as a pointer (B163) is the walk's, equal
-    positions (rounded to `digits`), nan caps, and a negative, infinite or nan reach included."""
-    rng = np.random.default_rng(seed)
-    s = np.sort(np.round(rng.uniform(0.0, 10.0, n), digits))
-    ct = rng.uniform(0.0, 5.0, n)
-    ct[rng.random(n) < 0.1] = np.nan
-    rc = rng.uniform(0.0, 3.0, n)
-    far = {"any": float(rng.uniform(0.0, 4.0)), "negative": -0.5, "inf": math.inf, "nan": math.nan,
-           "zero": 0.0}[far_kind]
-    n0 = int(rng.integers(0, n))
-    held = np.full(n, -1.0)
-    _least_held(s, ct, rc, n0, far, held)
-    want = _least_held_walk(s.tolist(), ct.tolist(), rc.tolist(), n0, far)
-    got = {u: float(held[u]) for u in want}
-    assert all(got[u] == x or (got[u] != got[u] and x != x) for u, x in want.items()), (got, want)

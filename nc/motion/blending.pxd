@@ -64,10 +64,9 @@ cdef class FilterCorners:
 cdef Py_ssize_t _held_caps(FilterCorners fc, object blocks, Py_ssize_t lo, Py_ssize_t last, double s_j, double vt,
                            double half) except -1
 
-@cython.locals(nseg=Py_ssize_t, inf=double, u=Py_ssize_t, su=double, vt_i=double, k=Py_ssize_t, k0=Py_ssize_t,
-               x=double, c=double)
-cpdef int _least_held(double[::1] s, double[::1] ct, double[::1] rc, Py_ssize_t n0, double far,
-                      double[::1] held) except -1
+@cython.locals(nseg=Py_ssize_t, inf=double, u=Py_ssize_t, su=double, vt_i=double, k=Py_ssize_t, x=double, c=double)
+cdef int _least_held(double[::1] s, double[::1] ct, double[::1] rc, Py_ssize_t n0, double far,
+                     double[::1] held) except -1
 
 @cython.locals(nl=Py_ssize_t, nn=Py_ssize_t, axes=Py_ssize_t, n4=Py_ssize_t, r=Py_ssize_t, a=Py_ssize_t,
                k=Py_ssize_t, q=double, p=double, l0=double, l1=double, l2=double, l3=double, l4=double, l5=double,

@@ -890,21 +890,19 @@ def _held_caps(fc: FilterCorners, blocks: Sequence[Block], lo: int, last: int, s
 @cython.wraparound(False)
 def _least_held(s: np.ndarray, ct: np.ndarray, rc: np.ndarray, n0: int, far: float, held: np.ndarray) -> int:
     """held[u] for u in n0..: the least ct[k] over the junctions k whose reach rc[k] holds s[u] (|s[u] − s[k]| ≤
-    rc[k]; inf where none; nan kept), those further than `far` skipped (s sorted). The first junction within far
-    behind s[u] only moves on with u (s[u] − s[k] grows with s[u], each rounding being monotonic): a pointer, where
-    a walk back from u found it for each u before (decision bench B163). No bounds checks compiled: every index lies
-    in 0..len(s)."""
+    rc[k]; inf where none; nan kept), those further than `far` skipped (s sorted). No bounds checks compiled
+    (decision bench B163): every index lies in 0..len(s)."""
     nseg = s.shape[0]
     if ct.shape[0] < nseg or rc.shape[0] < nseg or held.shape[0] < nseg or n0 < 0:
         raise ValueError("_least_held: ct, rc and held need a place per junction")
     inf = math.inf
-    k0 = 0
     for u in range(n0, nseg):
         su = s[u]
         vt_i = inf
-        while k0 <= u and not su - s[k0] <= far:  # (past u only where far < 0 or nan, as the walk started there)
-            k0 += 1
-        for k in range(k0, nseg):
+        k = u
+        while k >= 0 and su - s[k] <= far:
+            k -= 1
+        for k in range(k + 1, nseg):
             x = su - s[k]
             if x < 0.0:
                 x = -x
