@@ -1,11 +1,16 @@
 """The filter corners' deviations in C (decision bench B163): compiled, `_deviations` sums the product of the kernel
 matrix with the steps and its row norms in C loops, in the order numpy's matmul (OpenBLAS) and np.linalg.norm sum
-them on the bench machine. It must give np.linalg.norm(w @ du, axis=1) bit for bit on every shape `_held_caps` hands
+them on this CPU (SkylakeX's or Haswell's kernels, probed at first use; elsewhere numpy itself). It must give np.linalg.norm(w @ du, axis=1) bit for bit on every shape `_held_caps` hands
 it (one row, one step, fewer and more than 16 steps, rows in and past groups of four; 2 and 3 axes): a deviation
 one ulp off could flip a junction's fit against its room, and the compiled planner's setpoints would leave its
 source's (tests/test_planner_compiled.py compares whole runs)."""
 
 from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -13,6 +18,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import nc.motion.compiled as compiled
+from nc.motion import blending
 from nc.motion.blending import _deviations, _kernel_matrix
 
 compiled_only = pytest.mark.skipif(compiled.BUILD != "compiled",
@@ -99,3 +105,103 @@ def test_mismatched_sizes_are_refused():
     with pytest.raises(ValueError):
         _deviations(np.ones((3, 5)), np.ones((5, 3)), np.empty(2))
 
+
+
+# The summation order is probed at first use (B163): the C loops run only in an order whose probes all give numpy's
+# bits; elsewhere `_deviations` calls numpy, as the Python build does.
+
+
+def test_the_order_taken_is_one_the_probe_accepts():
+    order = blending.deviation_order()
+    if compiled.BUILD != "compiled":
+        assert order == "numpy"
+    assert order in blending._ORDERS
+    for w, du in blending._probe_cases():
+        assert _same_bits(_c_form(w, du), _numpy_form(w, du))
+
+
+def _forced(order: str, w: np.ndarray, du: np.ndarray, monkeypatch: pytest.MonkeyPatch) -> np.ndarray:
+    monkeypatch.setattr(blending, "_dev_order", blending._ORDERS.index(order))
+    return _c_form(w, du)
+
+
+@compiled_only
+def test_the_probe_tells_the_orders_apart(monkeypatch):
+    """SkylakeX's and Haswell's orders differ somewhere on the probe set in each branch where they sum differently
+    (one row; 16 steps and more), so the probe takes the right one on either CPU."""
+    one_row, many_steps = 0, 0
+    for w, du in blending._probe_cases():
+        differ = not _same_bits(_forced("SkylakeX", w, du, monkeypatch), _forced("Haswell", w, du, monkeypatch))
+        one_row += differ and w.shape[0] == 1
+        many_steps += differ and w.shape[0] > 1 and w.shape[1] >= 16
+    assert one_row >= 2 and many_steps >= 3
+
+
+@compiled_only
+def test_no_order_matching_numpy_calls_numpy(monkeypatch):
+    """A BLAS that sums in neither order (here: a reference one ulp off on its first row): the probe keeps no C
+    order, and `_deviations` gives numpy's bits."""
+    real = blending._numpy_deviations
+
+    def off_by_an_ulp(w, du):
+        out = real(w, du)
+        out[0] = np.nextafter(out[0], np.inf)
+        return out
+
+    monkeypatch.setattr(blending, "_numpy_deviations", off_by_an_ulp)
+    monkeypatch.setattr(blending, "_dev_order", -1)
+    assert blending.deviation_order() == "numpy"
+    monkeypatch.setattr(blending, "_numpy_deviations", real)
+    rng = np.random.default_rng(31)
+    for nl, nn in ((1, 9), (4, 1), (5, 9), (6, 21), (9, 40)):
+        w, du = rng.uniform(0.0, 3.0, (nl, nn)), rng.uniform(-1.0, 1.0, (nn, 3))
+        assert _same_bits(_c_form(w, du), _numpy_form(w, du))
+
+
+_HASWELL_RUN = """
+import numpy as np
+from nc.motion import blending
+rng = np.random.default_rng(163)
+same = 0
+for i in range(600):
+    nl = int(rng.choice([1, 1, 2, 3, 4, 5, 7, 9, 13, 23, 40]))
+    nn = int(rng.choice([1, 2, 3, 5, 7, 9, 15, 16, 17, 23, 31, 45, 64, 100, 255, 256, 257, 300, 513, 700]))
+    axes = int(rng.choice([2, 3]))
+    w = rng.uniform(0.0, 3.0, (nl, nn)) * 10.0 ** rng.integers(-3, 3, (nl, nn))
+    w[rng.random((nl, nn)) < 0.25] = 0.0
+    du = rng.uniform(-1.0, 1.0, (nn, axes)) * 10.0 ** rng.integers(-6, 1, (nn, axes))
+    e = np.full(nl, np.nan)
+    blending._deviations(w, du, e)
+    same += np.array_equal(e.view(np.uint64), np.linalg.norm(w @ du, axis=1).view(np.uint64))
+print(blending.deviation_order(), same)
+"""
+
+
+def _haswell_forcible() -> str:
+    """Why OPENBLAS_CORETYPE=Haswell would not pick OpenBLAS's Haswell kernels here ('' where it does)."""
+    try:
+        blas = np.show_config(mode="dicts")["Build Dependencies"]["blas"]
+    except (KeyError, TypeError):
+        return "numpy does not report its BLAS"
+    if blas.get("name", "").find("openblas") < 0 or "DYNAMIC_ARCH" not in blas.get("openblas configuration", ""):
+        return f"numpy's BLAS is no OpenBLAS built with DYNAMIC_ARCH ({blas.get('name')})"
+    try:
+        flags = next(line for line in open("/proc/cpuinfo") if line.startswith("flags")).split()
+    except (OSError, StopIteration):
+        return "no /proc/cpuinfo"
+    return "" if {"avx2", "fma"} <= set(flags) else "the CPU has no AVX2 and FMA"
+
+
+@compiled_only
+def test_on_haswell_kernels_the_haswell_order_is_numpys():
+    """With numpy's OpenBLAS forced onto its Haswell kernels (those Haswell, Zen and valgrind's CPU run), the probe
+    takes the Haswell order and `_deviations` gives numpy's bits on 600 random shapes (one row, one step, K blocks
+    past 256)."""
+    why = _haswell_forcible()
+    if why:
+        pytest.skip(why)
+    root = Path(__file__).resolve().parents[1]
+    env = dict(os.environ, OPENBLAS_CORETYPE="Haswell")
+    out = subprocess.run([sys.executable, "-c", _HASWELL_RUN], cwd=root, env=env, capture_output=True, text=True,
+                         check=True).stdout.split()
+    assert out == ["Haswell", "600"]

@@ -68,10 +68,14 @@ cdef Py_ssize_t _held_caps(FilterCorners fc, object blocks, Py_ssize_t lo, Py_ss
 cdef int _least_held(double[::1] s, double[::1] ct, double[::1] rc, Py_ssize_t n0, double far,
                      double[::1] held) except -1
 
-@cython.locals(nl=Py_ssize_t, nn=Py_ssize_t, axes=Py_ssize_t, n4=Py_ssize_t, r=Py_ssize_t, a=Py_ssize_t,
-               k=Py_ssize_t, q=double, p=double, l0=double, l1=double, l2=double, l3=double, l4=double, l5=double,
-               l6=double, l7=double)
+@cython.locals(nl=Py_ssize_t, nn=Py_ssize_t, axes=Py_ssize_t, order=int, r=Py_ssize_t)
 cpdef int _deviations(double[:, ::1] w, double[:, ::1] du, double[::1] e) except -1
+
+# its C loops, in the summation order probed (`_probe_order`, decision bench B163)
+@cython.locals(nl=Py_ssize_t, nn=Py_ssize_t, axes=Py_ssize_t, n4=Py_ssize_t, r=Py_ssize_t, a=Py_ssize_t,
+               k=Py_ssize_t, k0=Py_ssize_t, kb=Py_ssize_t, q=double, p=double, t=double, l0=double, l1=double,
+               l2=double, l3=double, l4=double, l5=double, l6=double, l7=double)
+cdef int _c_deviations(double[:, ::1] w, double[:, ::1] du, double[::1] e, int order) except -1
 
 @cython.locals(ny=Py_ssize_t, ymax=double, inv=double, r=Py_ssize_t, k=Py_ssize_t, sr=double, x=double, g=double,
                j0=Py_ssize_t, v=double)

@@ -916,35 +916,130 @@ def _least_held(s: np.ndarray, ct: np.ndarray, rc: np.ndarray, n0: int, far: flo
     return 0
 
 
-@cython.boundscheck(False)
-@cython.wraparound(False)
+# `_deviations`' summation orders (decision bench B163): which one numpy's BLAS uses here is probed at first use.
+_ORDERS = ("numpy", "SkylakeX", "Haswell")  # index = the code `_dev_order` holds; 0: numpy is called
+_dev_order = -1  # not probed yet
+
+
+def _numpy_deviations(w: np.ndarray, du: np.ndarray) -> np.ndarray:
+    """What `_deviations` must give: np.linalg.norm(w @ du, axis=1) on fresh C-contiguous arrays (the probe's
+    reference; KernelDeviation.deviation computes the same)."""
+    return np.linalg.norm(np.array(w) @ np.array(du), axis=1)
+
+
+def _probe_cases() -> list:
+    """A fixed set of (w, du) reaching each branch of the C orders: one row (steps in fours and a tail), one step,
+    K = steps < 16, ≥ 16 with rows before and past the last group of four and a masked last group of eight, over 256
+    and over 512 (OpenBLAS's K blocks on Haswell), 2 and 3 axes. Values spread over magnitudes, signed, some zero; in
+    the one-row cases of one magnitude, the steps' signs alternating: their sums cancel, so that a product rounded
+    before it is added (or not) shows in the last bits (tests/test_filter_deviations.py checks that every pair of
+    orders differs on the set, in each branch)."""
+    # Weyl sequences (fractional parts of multiples of irrationals): as spread as random draws in the last bits,
+    # without numpy.random (its first generator costs ≈ 20 ms)
+    i = np.arange(1.0, 1811.0)
+    frac = (i * 0.6180339887498949) % 1.0
+    spread = frac * 10.0 ** (np.floor((i * 0.4142135623730951) % 1.0 * 6.0) - 3.0)  # 10⁻³ to 10²
+    spread_w = 3.0 * spread
+    spread_w[(i * 0.7320508075688772) % 1.0 < 0.2] = 0.0
+    cases = []
+    for nl, nn, axes in ((1, 30, 3), (1, 22, 2), (1, 7, 3), (1, 13, 3), (4, 1, 3), (5, 9, 3), (3, 13, 2),
+                         (6, 21, 3), (9, 40, 2), (5, 300, 3), (2, 600, 2)):
+        if nl == 1:
+            w = 1.0 + frac[nn:2 * nn]
+            du = 0.5 + 0.5 * frac[nn + 7:nn + 7 + nn * axes]
+        else:
+            w = spread_w[:nl * nn]
+            du = spread[7:7 + nn * axes].copy()
+        du = du.reshape(nn, axes)
+        du[1::2] = -du[1::2]
+        cases.append((w.reshape(nl, nn), du))
+    return cases
+
+
+def _probe_order() -> int:
+    """The first C order whose results on `_probe_cases` are `_numpy_deviations`' bit for bit, 0 (numpy) where none
+    is or the module runs as Python (≈ 0.2 ms, once a process)."""
+    if not cython.compiled:
+        return 0
+    cases = _probe_cases()
+    for order in range(1, len(_ORDERS)):
+        for w, du in cases:
+            e = np.empty(w.shape[0])
+            _c_deviations(w, du, e, order)
+            if not np.array_equal(e.view(np.uint64), _numpy_deviations(w, du).view(np.uint64)):
+                break
+        else:
+            return order
+    return 0
+
+
+def deviation_order() -> str:
+    """The summation order `_deviations` takes in this process ("SkylakeX", "Haswell": its C loops; "numpy": numpy
+    itself, as the Python build), probed at the first call (decision bench B163)."""
+    global _dev_order
+    if _dev_order < 0:
+        _dev_order = _probe_order()
+    return _ORDERS[_dev_order]
+
+
 def _deviations(w: np.ndarray, du: np.ndarray, e: np.ndarray) -> int:
-    """e[r] = np.linalg.norm(w @ du, axis=1)[r] bit for bit (decision bench B163). Compiled, C loops that sum as
-    numpy 2.4's matmul does here through OpenBLAS 0.3.31 on its SkylakeX kernels (the bench machine's; valgrind
-    reports a CPU without AVX-512, on which OpenBLAS runs its Haswell kernels and numpy sums otherwise):
-    - one row (nl = 1): numpy's gemv, OpenBLAS's dgemv_n for 2 or 3 rows: per 4 steps
-      t = t + fma(a_k, x_k, a_k+1·x_k+1) twice, then t = fma(a_k, x_k, t) for the rest;
-    - one step (nn = 1): numpy's own loop, 0 + w·du;
-    - else cblas_dgemm, M = axes, N = nl, K = nn: its small-matrix kernel (M·N·K ≤ 10⁶, dgemm_small_kernel_b0_nn):
-      K < 16, one fused multiply-add chain over the steps in order; K ≥ 16, eight chains (step k into chain k mod 8,
-      a last partial group of 8 adding +0 to the chains past it) summed ((0+1)+(2+3))+((4+5)+(6+7)) for the rows in
-      groups of four (r < nl rounded down to 4), ((0+4)+(2+6))+((1+5)+(3+7)) for the rest.
-    The norm: squares summed (x0² + x1²) + x2², then the square root (numpy's add.reduce over 3 columns).
-    Other sizes, 1 or over 3 axes, and the Python build: numpy itself on fresh arrays."""
+    """e[r] = np.linalg.norm(w @ du, axis=1)[r] bit for bit (decision bench B163): compiled, `_c_deviations`' C
+    loops in the order numpy's BLAS sums here, where the probe (`deviation_order`) found one; else, as the Python
+    build, numpy itself on fresh arrays. Sizes past a single-threaded BLAS call (a gemv of over 9,215 values, a gemm
+    of over 262,144 products: OpenBLAS may split those between threads) and 1 or over 3 axes: numpy too."""
     nl, nn, axes = w.shape[0], w.shape[1], du.shape[1]
     if du.shape[0] != nn or e.shape[0] < nl:
         raise ValueError("_deviations: du must have a row per column of w, e a place per row")
-    if not cython.compiled or axes < 2 or axes > 3 or 3.0 * nl * nn > 1e6:
-        out = np.linalg.norm(np.array(w) @ np.array(du), axis=1)
+    order = _dev_order
+    if order < 0 and cython.compiled:
+        deviation_order()
+        order = _dev_order
+    if (order <= 0 or axes < 2 or axes > 3 or (nl == 1 and axes * nn >= 9216)
+            or (nl > 1 and axes * nl * nn > 262144)):
+        out = _numpy_deviations(w, du)
         for r in range(nl):
             e[r] = out[r]
         return 0
+    return _c_deviations(w, du, e, order)
+
+
+@cython.boundscheck(False)
+@cython.wraparound(False)
+def _c_deviations(w: np.ndarray, du: np.ndarray, e: np.ndarray, order: int) -> int:
+    """e[r] = the norm of row r of w @ du summed as numpy 2.4's matmul does through OpenBLAS 0.3.31 (compiled only;
+    the sizes checked by `_deviations`), with M = axes, N = nl, K = nn in BLAS's terms, on its kernels for
+    - order 1, SkylakeX (the bench machine's):
+      one row: numpy's gemv, OpenBLAS's dgemv_n for 2 or 3 rows: per 4 steps t = t + fma(a_k, x_k, a_k+1·x_k+1)
+      twice, then t = fma(a_k, x_k, t) for the rest;
+      else cblas_dgemm's small-matrix kernel (dgemm_small_kernel_b0_nn): K < 16, one fused multiply-add chain over
+      the steps in order; K ≥ 16, eight chains (step k into chain k mod 8, a last partial group of 8 adding +0 to
+      the chains past it) summed ((0+1)+(2+3))+((4+5)+(6+7)) for the rows in groups of four (r < nl rounded down to
+      4), ((0+4)+(2+6))+((1+5)+(3+7)) for the rest;
+    - order 2, Haswell (Zen; valgrind's CPU, without AVX-512):
+      one row: the same dgemv_n, built without fused multiply-adds: per 4 steps t = t + (a_k·x_k + a_k+1·x_k+1)
+      twice, then t = t + a_k·x_k;
+      else the packed gemm kernel: one fused multiply-add chain over the steps in order, in K blocks (K over 256:
+      two halves, the first rounded up to 4, or blocks of 256 while K ≥ 512 is left), each added to the sum;
+    - one step, either: numpy's own loop, 0 + w·du.
+    The norm: squares summed (x0² + x1²) + x2², then the square root (numpy's add.reduce over 3 columns)."""
+    nl, nn, axes = w.shape[0], w.shape[1], du.shape[1]
     n4 = nl - nl % 4
     for r in range(nl):
         q = 0.0
         for a in range(axes):
             if nn == 1:
                 p = 0.0 + w[r, 0] * du[0, a]
+            elif nl == 1 and order == 2:
+                p = 0.0
+                k = 0
+                while k + 4 <= nn:
+                    p = p + (du[k, a] * w[r, k] + du[k + 1, a] * w[r, k + 1])
+                    p = p + (du[k + 2, a] * w[r, k + 2] + du[k + 3, a] * w[r, k + 3])
+                    k += 4
+                while k < nn:
+                    p = p + du[k, a] * w[r, k]
+                    k += 1
+                p = 0.0 + p
             elif nl == 1:
                 p = 0.0
                 k = 0
@@ -956,6 +1051,20 @@ def _deviations(w: np.ndarray, du: np.ndarray, e: np.ndarray) -> int:
                     p = _fma(du[k, a], w[r, k], p)
                     k += 1
                 p = 0.0 + p
+            elif order == 2:
+                p = 0.0
+                k0 = 0
+                while k0 < nn:
+                    kb = nn - k0  # the K block, as OpenBLAS's level-3 driver cuts it (GEMM_Q 256, unroll 4)
+                    if kb >= 512:
+                        kb = 256
+                    elif kb > 256:
+                        kb = (kb // 2 + 3) // 4 * 4
+                    t = 0.0
+                    for k in range(k0, k0 + kb):
+                        t = _fma(du[k, a], w[r, k], t)
+                    p = p + t
+                    k0 += kb
             elif nn < 16:
                 p = 0.0
                 for k in range(nn):
