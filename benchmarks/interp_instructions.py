@@ -50,15 +50,20 @@ elif go:
 """
 
 
-def count(tree: str, blocks: int, mode: str, go: bool) -> int:
-    with tempfile.TemporaryDirectory() as d:
-        out = subprocess.run(["valgrind", "--tool=callgrind", f"--callgrind-out-file={d}/cg.out", sys.executable,
-                              "-c", CHILD, tree, str(blocks), mode, "1" if go else "0"],
-                             capture_output=True, text=True, env=dict(os.environ, PYTHONHASHSEED="0"), check=True)
+def collected(valgrind_args: list[str], child_args: list[str]) -> int:
+    """Instructions callgrind counts running CHILD-like code (`child_args` after the interpreter), with PYTHONHASHSEED=0
+    (benchmarks/interp_layers.py counts through it too)."""
+    out = subprocess.run(["valgrind", "--tool=callgrind", *valgrind_args, sys.executable, "-c", *child_args],
+                         capture_output=True, text=True, env=dict(os.environ, PYTHONHASHSEED="0"), check=True)
     m = re.search(r"Collected : (\d+)", out.stderr)
     if m is None:
-        raise SystemExit(f"callgrind printed no count for {tree}:\n{out.stderr[-2000:]}")
+        raise SystemExit(f"callgrind printed no count for {child_args[1:2]}:\n{out.stderr[-2000:]}")
     return int(m.group(1))
+
+
+def count(tree: str, blocks: int, mode: str, go: bool) -> int:
+    with tempfile.TemporaryDirectory() as d:
+        return collected([f"--callgrind-out-file={d}/cg.out"], [CHILD, tree, str(blocks), mode, "1" if go else "0"])
 
 
 def main() -> None:

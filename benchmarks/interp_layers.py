@@ -21,14 +21,14 @@ Usage: python benchmarks/interp_layers.py [--tree DIR] [--against DIR] [--blocks
 from __future__ import annotations
 
 import argparse
-import os
-import re
 import shutil
-import subprocess
 import sys
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))
+from benchmarks.interp_instructions import collected  # noqa: E402  (the tree's, run as a script)
+
 LAYERS = ("line", "raw", "stream", "check", "parse")
 
 CHILD = """
@@ -75,13 +75,8 @@ elif layer == "parse":
 
 
 def count(tree: str, blocks: int, layer: str) -> int:
-    out = subprocess.run(["valgrind", "--tool=callgrind", "--callgrind-out-file=/dev/null", "--collect-atstart=no",
-                          "--toggle-collect=functools_reduce", sys.executable, "-c", CHILD, tree, str(blocks), layer],
-                         capture_output=True, text=True, env=dict(os.environ, PYTHONHASHSEED="0"), check=True)
-    m = re.search(r"Collected : (\d+)", out.stderr)
-    if m is None:
-        raise SystemExit(f"callgrind printed no count for {tree}:\n{out.stderr[-2000:]}")
-    return int(m.group(1))
+    return collected(["--callgrind-out-file=/dev/null", "--collect-atstart=no", "--toggle-collect=functools_reduce"],
+                     [CHILD, tree, str(blocks), layer])
 
 
 def main() -> None:
