@@ -7,9 +7,8 @@ from nc.motion.block cimport Block
 
 cdef double _INF  # math.inf as a C constant (decision bench B134)
 
-# bisect_left on a list of floats in C (decision bench B153)
-@cython.locals(mid=Py_ssize_t)
-cdef Py_ssize_t _at_or_above(list xs, double x, Py_ssize_t lo, Py_ssize_t hi) except -1
+# bisect_left on a list of floats in C (decision bench B153), nc.motion.profile's (shared with nc.motion.shares)
+from nc.motion.profile cimport _at_or_above
 
 # window's sliding maxima (decision bench B134): C methods, the entries in two C buffers (array.array) read from
 # `head` to `n` (decision bench B153)

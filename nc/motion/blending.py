@@ -43,6 +43,7 @@ if cython.compiled:  # C's fma and sqrt for `_deviations`' C form (decision benc
 from nc.motion.block import Block
 from nc.motion.deviation import CornerBound, KernelDeviation
 from nc.motion.limits import MotionConfig
+from nc.motion.profile import _at_or_above  # bisect_left on C doubles, shared with nc.motion.shares
 from nc.motion.shares import MAX_FACTOR
 
 _INF = math.inf  # a C double where compiled (blending.pxd): math.inf is a module attribute lookup
@@ -52,19 +53,6 @@ USAGE_SCALE = 4.0  # below this many times the top speed a junction's budget use
 # 18 (every junction before _h0 once 4,096 were), whose cut nc.motion.shares still answers by (FilterCorners._seq_v)
 TRIM = 32
 BULK = 4096
-
-
-
-def _at_or_above(xs: list[float], x: float, lo: int, hi: int) -> int:
-    """bisect.bisect_left(xs, x, lo, hi) on floats, its comparisons (xs[mid] < x) as bisect makes them: a C loop
-    where compiled (decision bench B153: the module function was a Python call, ~1.5k instructions, a push)."""
-    while lo < hi:
-        mid = (lo + hi) // 2
-        if xs[mid] < x:
-            lo = mid + 1
-        else:
-            hi = mid
-    return lo
 
 
 class _MaxQ:

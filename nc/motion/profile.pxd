@@ -28,3 +28,6 @@ cdef tuple _phases(object pr)
 
 @cython.locals(lo=Py_ssize_t, hi=Py_ssize_t, mid=Py_ssize_t, y=double)
 cpdef Py_ssize_t _first_above(list xs, double x) except -1
+
+@cython.locals(mid=Py_ssize_t, y=double)
+cpdef Py_ssize_t _at_or_above(list xs, double x, Py_ssize_t lo, Py_ssize_t hi) except -1

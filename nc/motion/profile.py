@@ -239,6 +239,20 @@ def _first_above(xs: list[float], x: float) -> int:
     return lo
 
 
+def _at_or_above(xs: list[float], x: float, lo: int, hi: int) -> int:
+    """bisect_left(xs, x, lo, hi) on floats, its comparisons (xs[mid] < x) as bisect makes them: a C loop where
+    compiled (decision bench B153; nc.motion.blending's junction history and nc.motion.shares' scan both search with
+    it)."""
+    while lo < hi:
+        mid = (lo + hi) // 2
+        y = xs[mid]
+        if y < x:
+            lo = mid + 1
+        else:
+            hi = mid
+    return lo
+
+
 def _gather(t: float, n: int, pt, pp, pv, pa, pj, t0: list, p: list, v: list, a: list, j: list) -> float:
     """Append the first n of a ruckig profile's (or brake's) phases that last (t > 0) to the lists, each starting at
     the time summed so far; the time after them."""

@@ -4,15 +4,13 @@
 # nc.motion.blending imports MAX_FACTOR from here, so shares' import would import it half-made.
 cimport cython
 from nc.motion.block cimport Block
-from nc.motion.profile cimport _first_above
+from nc.motion.profile cimport _at_or_above, _first_above
 
 cdef double _INF  # math.inf as a C constant
 
 @cython.locals(x=double, m=double, k=Py_ssize_t)
 cdef double _largest(list xs, Py_ssize_t lo, Py_ssize_t hi) except? -1.0
 
-@cython.locals(lo=Py_ssize_t, hi=Py_ssize_t, mid=Py_ssize_t, y=double)
-cdef Py_ssize_t _first_at_or_above(list xs, double x) except -1
 
 
 cdef tuple _joined(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t k_lo, Py_ssize_t k_hi)

@@ -34,7 +34,7 @@ from typing import TYPE_CHECKING
 
 from nc.motion.block import Block
 from nc.motion.limits import MotionConfig
-from nc.motion.profile import _first_above  # bisect_right on C doubles, shared with Piecewise.at
+from nc.motion.profile import _at_or_above, _first_above  # bisect_left/right on C doubles (shared)
 
 try:
     import cython  # compiled: the types below (setup.py, decision bench B115)
@@ -148,7 +148,7 @@ def _scan(fc: "FilterCorners", blocks: Sequence["Block"], pos: float, run_end: f
     if WALK:
         return _walk(fc, blocks, pos - reach, hi, seen, None if n_pre < 0 else n_pre, v_stop)
     hist_s = fc._hist_s
-    k_lo = _first_at_or_above(hist_s, pos - reach)  # bisect_left, bisect_right (session 27: on C doubles)
+    k_lo = _at_or_above(hist_s, pos - reach, 0, len(hist_s))  # bisect_left, bisect_right (session 27: on C doubles)
     k_hi = _first_above(hist_s, hi)
     use = 0.0
     if k_hi > k_lo:
@@ -229,19 +229,6 @@ def _largest(xs: list[float], lo: int, hi: int) -> float:
         if x > m:
             m = x
     return m
-
-
-def _first_at_or_above(xs: list[float], x: float) -> int:
-    """bisect_left(xs, x) on floats, its comparisons as bisect makes them."""
-    lo, hi = 0, len(xs)
-    while lo < hi:
-        mid = (lo + hi) // 2
-        y = xs[mid]
-        if y < x:
-            lo = mid + 1
-        else:
-            hi = mid
-    return lo
 
 
 def _verdicts(fc: "FilterCorners", blocks: Sequence["Block"], k_lo: int, k_hi: int, n_pre: int) -> list:
