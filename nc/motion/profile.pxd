@@ -31,3 +31,13 @@ cpdef Py_ssize_t _first_above(list xs, double x) except -1
 
 @cython.locals(mid=Py_ssize_t, y=double)
 cpdef Py_ssize_t _at_or_above(list xs, double x, Py_ssize_t lo, Py_ssize_t hi) except -1
+
+# Piecewise.at's steps as C functions (session 29, decision bench B169): sample_rows takes the lists once and probes
+# on C doubles; cpdef so sample_rows imports them as Python too (run without Cython).
+cpdef tuple _lists0(object pw)
+
+@cython.locals(dt=double, jk=double, ak=double, vk=double, pk=double, x=double, k=Py_ssize_t)
+cpdef double _pos_at(double t, double dur, list t0, list p, list v, list a, list j) except? -1.0
+
+@cython.locals(dt=double, jk=double, ak=double, vk=double, pk=double, x=double, k=Py_ssize_t)
+cpdef tuple _row_at(double t, double base, double dur, list t0, list p, list v, list a, list j)

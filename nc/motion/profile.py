@@ -136,29 +136,14 @@ class Piecewise:
         """DoF 0's velocity at the end of its last phase."""
         return float(self.v[0][-1])
 
-    @cython.locals(t=cython.double, dur=cython.double, dt=cython.double, jk=cython.double, ak=cython.double,
-                   vk=cython.double, k=cython.Py_ssize_t,
-                   x=cython.double, pk=cython.double, c=tuple, t0=list, p=list, v=list,
-                   a=list, j=list)
+    @cython.locals(c=tuple)
     def at(self, t: float) -> tuple[float, float, float]:
         """sample(np.array([t])) of DoF 0 on plain floats: the same operations in the same order, so the same
         bits (numpy's maximum/minimum keep their first operand on a tie, searchsorted is bisect_right), without
-        ~25 numpy calls on 1-element arrays (issue 17: the planner samples a block's one or two rows at a time)."""
-        c = self._lists
-        dur = self.duration
-        if c is None or c[0] != dur:  # the ramp fallback stretches duration and t0 after the solve
-            c = self._lists = (dur, self.t0[0].tolist(), self.p[0].tolist(), self.v[0].tolist(),
-                               self.a[0].tolist(), self.j[0].tolist())
-        _, t0, p, v, a, j = c
-        t = 0.0 if 0.0 >= t else t
-        t = dur if dur <= t else t
-        k = _first_above(t0, t) - 1  # bisect_right(t0, t) - 1, at least 0 (compiled: on C doubles)
-        if k < 0:
-            k = 0
-        x = t0[k]
-        dt = t - x
-        jk, ak, vk, pk = j[k], a[k], v[k], p[k]
-        return (pk + dt * (vk + dt * (ak / 2.0 + dt * jk / 6.0)), vk + dt * (ak + dt * jk / 2.0), ak + dt * jk)
+        ~25 numpy calls on 1-element arrays (issue 17: the planner samples a block's one or two rows at a time).
+        The work is `_row_at` (compiled: a C function, which sample_rows calls without this method call)."""
+        c = _lists0(self)
+        return _row_at(t, 0.0, c[0], c[1], c[2], c[3], c[4], c[5])  # (x − 0.0 is x, bit for bit)
 
     def sample(self, t: np.ndarray, dof: int = 0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(position, velocity, acceleration) of one DoF at times t (clamped to [0, duration])."""
@@ -175,6 +160,47 @@ class Piecewise:
         vel = v + dt * (a + dt * j / 2.0)
         acc = a + dt * j
         return pos, vel, acc
+
+
+def _lists0(pw: Piecewise) -> tuple:
+    """DoF 0's phases as plain lists (duration, t0, p, v, a, j), remade where the duration changed since (the ramp
+    fallback stretches duration and t0 after the solve): `at`'s first step, taken once by sample_rows for all its
+    probes (issue 17, session 29, decision bench B169)."""
+    c = pw._lists
+    dur = pw.duration
+    if c is None or c[0] != dur:
+        c = pw._lists = (dur, pw.t0[0].tolist(), pw.p[0].tolist(), pw.v[0].tolist(), pw.a[0].tolist(),
+                         pw.j[0].tolist())
+    return c
+
+
+def _pos_at(t: float, dur: float, t0: list, p: list, v: list, a: list, j: list) -> float:
+    """`_row_at(t, 0.0, …)[0]`: the position alone, the same operations (sample_rows' bisection probes; compiled a
+    C function on C doubles, nothing boxed)."""
+    t = 0.0 if 0.0 >= t else t
+    t = dur if dur <= t else t
+    k = _first_above(t0, t) - 1  # bisect_right(t0, t) - 1, at least 0
+    if k < 0:
+        k = 0
+    x = t0[k]
+    dt = t - x
+    jk, ak, vk, pk = j[k], a[k], v[k], p[k]
+    return pk + dt * (vk + dt * (ak / 2.0 + dt * jk / 6.0))
+
+
+def _row_at(t: float, base: float, dur: float, t0: list, p: list, v: list, a: list,
+            j: list) -> tuple[float, float, float]:
+    """`Piecewise.at(t)` on its lists (from `_lists0`), the position less base: (s − base, v, a)."""
+    t = 0.0 if 0.0 >= t else t
+    t = dur if dur <= t else t
+    k = _first_above(t0, t) - 1  # bisect_right(t0, t) - 1, at least 0 (compiled: on C doubles)
+    if k < 0:
+        k = 0
+    x = t0[k]
+    dt = t - x
+    jk, ak, vk, pk = j[k], a[k], v[k], p[k]
+    return ((pk + dt * (vk + dt * (ak / 2.0 + dt * jk / 6.0))) - base, vk + dt * (ak + dt * jk / 2.0),
+            ak + dt * jk)
 
 
 class _OneDof(Piecewise):

@@ -23,6 +23,7 @@ except ImportError:  # run as Python without Cython: they do nothing
     from nc.motion import cython_shadow as cython
 
 from nc.motion.plan_state import _Plan
+from nc.motion.profile import _lists0, _pos_at, _row_at  # Piecewise.at's steps (C functions compiled)
 
 if TYPE_CHECKING:
     from nc.motion.planner import Planner
@@ -30,22 +31,12 @@ if TYPE_CHECKING:
 FEW = 6  # rows kept up to which plain floats beat numpy (a row ≈ 1 µs, numpy's sample ≈ 25 µs a call)
 
 
-def _row(rows: dict, pw: object, t: float, base: float, i: int) -> tuple[float, float, float]:
-    """Row i of the plan (its time t = p.t_next + T·i): `Piecewise.at`, less the plan's base, kept in `rows`
-    (the bisection's probes and the rows kept are asked for once each). A C function compiled (a closure a call
-    cost its scope and function objects, issue 17)."""
-    r = rows.get(i)
-    if r is None:
-        s, v, a = pw.at(t)  # t = p.t_next + T * np.arange(n)
-        r = rows[i] = (s - base, v, a)
-    return r
-
-
 @cython.locals(T=cython.double, t_next=cython.double, base=cython.double, length=cython.double, x=cython.double,
                s=cython.double, u=cython.double, seg_len=cython.double, n=cython.Py_ssize_t, keep=cython.Py_ssize_t,
                lo=cython.Py_ssize_t, hi=cython.Py_ssize_t, mid=cython.Py_ssize_t, i=cython.Py_ssize_t,
                m=cython.Py_ssize_t, k=cython.Py_ssize_t, q0=cython.double, q1=cython.double, q2=cython.double,
-               d0=cython.double, d1=cython.double, d2=cython.double)
+               d0=cython.double, d1=cython.double, d2=cython.double, dur=cython.double, c=tuple, t0=list,
+               pp=list, vv=list, aa=list, jj=list)
 def few_rows(pl: "Planner", p: _Plan, n: int) -> bool:
     """`Planner._sample(p, n)` for a path or ramp plan, when it keeps at most FEW rows or re-solves at the next
     block; False (nothing changed) where `_sample` must run."""
@@ -54,9 +45,13 @@ def few_rows(pl: "Planner", p: _Plan, n: int) -> bool:
     blocks = pl.blocks
     b = blocks[0]
     length = b.length
-    rows: dict[int, tuple[float, float, float]] = {}
+    # Row i (time t_next + T·i) is `pw.at(t)` less base: its lists taken once here, and each probe the position
+    # alone on C doubles (a Python call of `at` a probe, boxed floats and a memo dict, were ≈ 1k instructions each,
+    # session 29, decision bench B169). A row asked for twice is computed twice: the same operations, the same bits.
+    c = _lists0(pw)
+    dur, t0, pp, vv, aa, jj = c[0], c[1], c[2], c[3], c[4], c[5]
     more = len(blocks) > 1 and blocks[1].kind == "path"
-    if more and _row(rows, pw, t_next + T * 0, base, 0)[0] > length + 1e-12:
+    if more and _pos_at(t_next + T * 0, dur, t0, pp, vv, aa, jj) - base > length + 1e-12:
         if not (p.kind == "path" or (p.kind == "ramp" and not pl.held and p is not pl._fr_plan)):
             return False  # a ramp runs on into the next block without a solve: _sample's loop
         # _sample's re-solve at the block boundary, from the last emitted state
@@ -74,7 +69,7 @@ def few_rows(pl: "Planner", p: _Plan, n: int) -> bool:
         lo, hi = 0, n
         while lo < hi:
             mid = (lo + hi) >> 1
-            s = _row(rows, pw, t_next + T * mid, base, mid)[0]
+            s = _pos_at(t_next + T * mid, dur, t0, pp, vv, aa, jj) - base
             if x < s:
                 hi = mid
             else:
@@ -102,7 +97,7 @@ def few_rows(pl: "Planner", p: _Plan, n: int) -> bool:
     pos = []
     vel = []
     for i in range(keep):
-        r = _row(rows, pw, t_next + T * i, base, i)
+        r = _row_at(t_next + T * i, base, dur, t0, pp, vv, aa, jj)
         got.append(r)
         vel.append(r[1])
         s = r[0]
