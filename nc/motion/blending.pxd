@@ -49,6 +49,8 @@ cdef class FilterCorners:
     # C calls from Limits.junction, once a pushed junction (session 28, decision bench B157)
     cpdef tuple corner_caps(self, object du, double du_n, bint lines, double acc)
     cpdef double isolated_cap(self, double du_n, double acc, double jerk, Block b1, Block b2) except? -1.0
+    # window's tolerance walk, a C call from it (decision bench B171)
+    cpdef Py_ssize_t _tolerance(self, object blocks, double v_hi) except -1
 
 # `_held_caps` and `_kernel_matrix` (decision bench B133): C loops over memoryviews, declared here as
 # nc.motion.cython_shadow has no memoryview types for the .py's decorators; their arrays FilterCorners' scratch, the

@@ -344,7 +344,9 @@ class FilterCorners:
                    depth=cython.Py_ssize_t, s_j=cython.double, span_max=cython.double, t_w=cython.double,
                    top=cython.double, t_w2=cython.double, pad=cython.double, two_al=cython.double, v_hi=cython.double,
                    c=cython.double, c_bud=cython.double, c2=cython.double, lines=cython.bint, fast=cython.bint,
-                   hist=list, hist_s=list, acc_q=_MaxQ, top_q=_MaxQ, len_q=_MaxQ)
+                   hist=list, hist_s=list, acc_q=_MaxQ, top_q=_MaxQ, len_q=_MaxQ, a0=cython.double,
+                   a1=cython.double, a2=cython.double, a3=cython.double, d0=cython.double, d1=cython.double,
+                   d2=cython.double)
     def window(self, blocks: Sequence["Block"]) -> int:
         """Cap the junctions within one filter window behind the newest junction J (the end of
         blocks[-2]); returns how many blocks from the tail need a new backward pass.
@@ -384,8 +386,14 @@ class FilterCorners:
         du = j_new.du
         dv = j_new.dv
         if self._axes == 3:  # the common case spelt out (this runs once per pushed block)
-            cum_j = (prev[0] + du[0], prev[1] + du[1], prev[2] + du[2], prev[3] + j_new.du_n)
-            sj = (sprev[0] + dv[0], sprev[1] + dv[1], sprev[2] + dv[2])
+            # (each item read into a C double first: the sums are C additions of the same doubles, not four generic
+            # float-object additions, decision bench B171)
+            a0, a1, a2, a3 = prev[0], prev[1], prev[2], prev[3]
+            d0, d1, d2 = du[0], du[1], du[2]
+            cum_j = (a0 + d0, a1 + d1, a2 + d2, a3 + j_new.du_n)
+            a0, a1, a2 = sprev[0], sprev[1], sprev[2]
+            d0, d1, d2 = dv[0], dv[1], dv[2]
+            sj = (a0 + d0, a1 + d1, a2 + d2)
         else:
             cum_j = tuple([p + d for p, d in zip(prev, du + (j_new.du_n,))])  # (lists: no closure scope a push)
             sj = tuple([p + d for p, d in zip(sprev, dv)])
@@ -512,7 +520,7 @@ class FilterCorners:
             # The sums over the whole stretch bound the filter's acceleration and jerk from
             # above; the windows themselves (at the speed they are crossed) are far less on a
             # curve, where consecutive windows hold nearly the same signed sum.
-            c2, c_bud = self._refine(hist, h0, last, c, top, budget_a, budget_j)
+            c2, c_bud = _refined(self, hist, h0, last, c, top, budget_a, budget_j)  # (a C call, not `_refine`'s: B171)
             if c2 > c:
                 c = c2
                 while m > h0 and s_j - hist[m - 1].s_end <= c * t_w + pad:
@@ -520,7 +528,7 @@ class FilterCorners:
         elif c < USAGE_SCALE * top:
             # Capped by nothing, but the share the corners use (vjunc / vbud, nc.motion.shares) is
             # read from the signed windows: the unsigned sums overstate it on a curve.
-            c_bud = max(c, self._refine(hist, h0, last, top, top, budget_a, budget_j)[1])
+            c_bud = max(c, _refined(self, hist, h0, last, top, top, budget_a, budget_j)[1])
         depth = self._tolerance(blocks, v_hi) if self.tol is not None else 0
         if m < self._sc_dirty:
             self._sc_dirty = m  # the walks below lower vbud (and vjunc) over hist[m..last]
@@ -582,7 +590,9 @@ class FilterCorners:
                    si=cython.double, x=cython.double, d=cython.double, sg=cython.double, ja=cython.double,
                    base=tuple, pk=tuple, last=cython.Py_ssize_t, h0=cython.Py_ssize_t, axes=cython.Py_ssize_t,
                    hist=list, cum_j=tuple, sj=tuple, bmin=tuple, budget_a=tuple, budget_j=tuple, cj=cython.double,
-                   bm=cython.double, b=Block)
+                   bm=cython.double, b=Block, y=cython.double, s0=cython.double, s1=cython.double,
+                   s2=cython.double, g0=cython.double, g1=cython.double, g2=cython.double, q0=cython.double,
+                   q1=cython.double, q2=cython.double)
     def _cap(self, m: int) -> float:
         """`window`'s cap from the junctions hist[m..last] (inf when there are none): per axis, the
         acceleration budget over the largest signed sum of any run of them that ends at J,
@@ -597,32 +607,81 @@ class FilterCorners:
             base = self._zero
         cum_j, bmin, axes = self._w_cum, self._w_bmin, self._axes
         # (base typed: the differences below are C subtractions of the same doubles, no float objects; _INF a C
-        # constant, not math's attribute a call: decision bench B134)
+        # constant, not math's attribute a call: decision bench B134. Each tuple item is read into a C double
+        # before it meets another: `cj - base[0]` boxed cj and `sj[i] - pk[i]` made a float object a junction and
+        # axis, the largest in a Python list, decision bench B171)
         c = _INF  # first from the unsigned sums: a lower bound of the signed cap
         if axes == 3:  # spelt out: ~3 calls a push (issue 17)
-            cj, bm = cum_j[0], bmin[0]
-            si = cj - base[0]
+            cj, bm, x = cum_j[0], bmin[0], base[0]
+            si = cj - x
             if si > 1e-12:
                 c = bm / si
-            cj, bm = cum_j[1], bmin[1]
-            si = cj - base[1]
+            cj, bm, x = cum_j[1], bmin[1], base[1]
+            si = cj - x
             if si > 1e-12:
                 x = bm / si
                 if x < c:
                     c = x
-            cj, bm = cum_j[2], bmin[2]
-            si = cj - base[2]
+            cj, bm, x = cum_j[2], bmin[2], base[2]
+            si = cj - x
             if si > 1e-12:
                 x = bm / si
                 if x < c:
                     c = x
-        else:
-            for i in range(axes):
-                si = cum_j[i] - base[i]
+            if c >= self._w_v_hi:
+                return c  # no junction of the stretch runs as fast: the signed sums change nothing
+            sj, zero = self._w_sj, self._zero
+            g0, g1, g2 = sj[0], sj[1], sj[2]
+            s0 = s1 = s2 = 0.0  # the largest |signed sum| per axis
+            for k in range(m - 1, last):
+                if k >= h0 and (k > m - 1 or m > h0):  # (k >= m - 1 throughout)
+                    b = hist[k]  # typed: scum read as a Block's field (decision bench B153)
+                    pk = b.scum
+                else:
+                    pk = zero
+                q0, q1, q2 = pk[0], pk[1], pk[2]
+                d = g0 - q0
+                if d < 0.0:
+                    d = -d
+                if d > s0:
+                    s0 = d
+                d = g1 - q1
+                if d < 0.0:
+                    d = -d
+                if d > s1:
+                    s1 = d
+                d = g2 - q2
+                if d < 0.0:
+                    d = -d
+                if d > s2:
+                    s2 = d
+            budget_a, budget_j = self._w_ba, self._w_bj
+            c = _INF
+            for i in range(3):
+                cj, x = cum_j[i], base[i]
+                si = cj - x
                 if si > 1e-12:
-                    x = bmin[i] / si
-                    if x < c:
-                        c = x
+                    sg = s0 if i == 0 else (s1 if i == 1 else s2)
+                    ja = si if si < 2.0 * sg else 2.0 * sg
+                    if ja > 1e-12:
+                        y = budget_j[i]
+                        x = y / ja
+                        if x < c:
+                            c = x
+                    if sg > 1e-12:
+                        y = budget_a[i]
+                        x = y / sg
+                        if x < c:
+                            c = x
+            return c
+        for i in range(axes):
+            cj, x = cum_j[i], base[i]
+            si = cj - x
+            if si > 1e-12:
+                bm = bmin[i]
+                x = bm / si
+                if x < c:
+                    c = x
         if c >= self._w_v_hi:
             return c  # no junction of the stretch runs as fast: the signed sums change nothing
         sj, zero = self._w_sj, self._zero
@@ -634,7 +693,8 @@ class FilterCorners:
             else:
                 pk = zero
             for i in range(axes):
-                d = sj[i] - pk[i]
+                x, y = sj[i], pk[i]
+                d = x - y
                 if d < 0.0:
                     d = -d
                 if d > smax[i]:
@@ -642,16 +702,19 @@ class FilterCorners:
         budget_a, budget_j = self._w_ba, self._w_bj
         c = _INF
         for i in range(axes):
-            si = cum_j[i] - base[i]
+            cj, x = cum_j[i], base[i]
+            si = cj - x
             if si > 1e-12:
                 sg = smax[i]
                 ja = si if si < 2.0 * sg else 2.0 * sg
                 if ja > 1e-12:
-                    x = budget_j[i] / ja
+                    y = budget_j[i]
+                    x = y / ja
                     if x < c:
                         c = x
                 if sg > 1e-12:
-                    x = budget_a[i] / sg
+                    y = budget_a[i]
+                    x = y / sg
                     if x < c:
                         c = x
         return c
