@@ -27,7 +27,6 @@ from __future__ import annotations
 import math
 from array import array
 from collections import deque
-from itertools import islice
 from collections.abc import Sequence
 
 import numpy as np
@@ -551,7 +550,11 @@ class FilterCorners:
                 stop = m if m > lo_q else lo_q
                 mono = self._mono - seq0
                 lim = mono if mono > stop else stop
-                for b in islice(reversed(blocks), 2, last - lim + 2):  # hist[last - 1] down to hist[lim]
+                # hist[last - 1] down to hist[lim]: blocks[-3] back, the queue and the history side by side (each
+                # queued block joined the history as it became blocks[-2]; lim >= lo_q). Read from the list, not
+                # through islice(reversed(deque)): ≈ 2k instructions a push less, decision bench B171
+                for k in range(last - 1, lim - 1, -1):
+                    b = hist[k]
                     if b.vbud > c_bud:
                         b.vbud = c_bud
                     else:
