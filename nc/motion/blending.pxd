@@ -10,6 +10,9 @@ cdef double _INF  # math.inf as a C constant (decision bench B134)
 # bisect_left on a list of floats in C (decision bench B153), nc.motion.profile's (shared with nc.motion.shares)
 from nc.motion.profile cimport _at_or_above
 
+@cython.locals(ja=double, x=double)
+cdef inline double _axis_cap(double si, double sg, double bj, double ba, double c)
+
 # window's sliding maxima (decision bench B134): C methods, the entries in two C buffers (array.array) read from
 # `head` to `n` (decision bench B153)
 cdef class _MaxQ:

@@ -54,6 +54,22 @@ TRIM = 32
 BULK = 4096
 
 
+def _axis_cap(si: float, sg: float, bj: float, ba: float, c: float) -> float:
+    """`FilterCorners._cap`'s bound of one axis: c lowered to the jerk budget bj over the jerk the stretch asks (si,
+    at most twice the signed sum sg) and to the acceleration budget ba over sg (a C function where compiled: the
+    3-axis case and the general one both call it)."""
+    ja = si if si < 2.0 * sg else 2.0 * sg
+    if ja > 1e-12:
+        x = bj / ja
+        if x < c:
+            c = x
+    if sg > 1e-12:
+        x = ba / sg
+        if x < c:
+            c = x
+    return c
+
+
 class _MaxQ:
     """A sliding maximum: (sequence number, value) entries, values falling from the front, held in seqs[head:n],
     vals[head:n] (a cdef class with C methods where compiled, blending.pxd: the deque of tuples it replaces cost a
@@ -664,18 +680,7 @@ class FilterCorners:
                 cj, x = cum_j[i], base[i]
                 si = cj - x
                 if si > 1e-12:
-                    sg = s0 if i == 0 else (s1 if i == 1 else s2)
-                    ja = si if si < 2.0 * sg else 2.0 * sg
-                    if ja > 1e-12:
-                        y = budget_j[i]
-                        x = y / ja
-                        if x < c:
-                            c = x
-                    if sg > 1e-12:
-                        y = budget_a[i]
-                        x = y / sg
-                        if x < c:
-                            c = x
+                    c = _axis_cap(si, s0 if i == 0 else (s1 if i == 1 else s2), budget_j[i], budget_a[i], c)
             return c
         for i in range(axes):
             cj, x = cum_j[i], base[i]
@@ -708,18 +713,7 @@ class FilterCorners:
             cj, x = cum_j[i], base[i]
             si = cj - x
             if si > 1e-12:
-                sg = smax[i]
-                ja = si if si < 2.0 * sg else 2.0 * sg
-                if ja > 1e-12:
-                    y = budget_j[i]
-                    x = y / ja
-                    if x < c:
-                        c = x
-                if sg > 1e-12:
-                    y = budget_a[i]
-                    x = y / sg
-                    if x < c:
-                        c = x
+                c = _axis_cap(si, smax[i], budget_j[i], budget_a[i], c)
         return c
 
     @cython.locals(k=cython.Py_ssize_t, c=cython.double, d=cython.double, top=cython.double, t_w=cython.double)
