@@ -31,7 +31,7 @@ from hil.stretch_state import _across, _restore_planner, _save_planner
 from nc.alarms import NcAlarm
 from nc.channel import READS_PER_CYCLE, Channel
 from nc.motion.planner import Planner
-from nc.motion.stretch import Samples
+from nc.motion.stretch import Samples, cut_rows, refuses
 from virtual_bus.drive_stretch import CspRun, CsvRun, Stretch
 
 PLAN_KINDS = ("path", "ramp", "cruise")
@@ -179,11 +179,10 @@ class Pass:
         return True
 
     def _take_part(self, pl: Planner, limit: int) -> tuple | None:
-        """After the step's `_before_take`: `take_parts(pl, limit', cruise)` of a plan the pass samples, inline (a
-        part a cycle or two of a CAM program: its checks and calls once, not again in take_parts; issue 17, decision
-        bench B165; a change to take_parts goes here too), None where the pass cannot take it. limit' is 1 where
-        the next cycle's feed reads, a cruise's `_across` bound otherwise (the rows up to the first cycle whose feed
-        would read)."""
+        """After the step's `_before_take`: `take_parts(pl, limit', cruise)` of a plan the pass samples, its checks
+        made once here (a part is a cycle or two of a CAM program; issue 17, decision bench B165), the rows taken by
+        the same `refuses` and `cut_rows`; None where the pass cannot take it. limit' is 1 where the next cycle's
+        feed reads, a cruise's `_across` bound otherwise (the rows up to the first cycle whose feed would read)."""
         pos, i = pl._buf_pos, pl._buf_i
         p = pl.plan
         blocks = pl.blocks
@@ -191,29 +190,18 @@ class Pass:
                 or pl._integrate_angle:
             return None
         mv = blocks[0].move
-        if mv.css is not None or (mv.per_rev and p.kind == "path") or mv.kind == "thread" or "G31" in mv.tags:
-            return None  # (take_parts' refusals: a per-revolution path re-planned, a thread, G31)
+        if mv.css is not None or refuses(pl, mv):
+            return None
         blk = pl._buf_blk
         if self.reads and ((q := len(blocks)) < self.depth or (pl._filling and q < self.fill_to)):
             limit = 1  # the next cycle reads: a feed comes between
         elif blk is not None:
             limit = _across(self.ch, pl, limit)
-        if blk is None:  # (Planner._block_rows: the buffer's rows left)
-            m = min(limit, len(pos) - i)
-        else:
-            m = pl._cruise_rows(limit)
+        # (Planner._block_rows outside a cruise: the buffer's rows left)
+        m = min(limit, len(pos) - i) if blk is None else pl._cruise_rows(limit)
         if m <= 0:
             return None  # the next row starts the cruise's next block: step() finishes this one
-        j = i + m - 1
-        moves = None
-        if blk is not None and blk[j] != pl._buf_popped:
-            off = pl._buf_popped
-            moves = [blocks[k - off].move for k in blk[i:i + m]]
-        z = pl._zones  # the filter's share per row (decision motion 45); None (1 throughout) where no zone is left
-        lam = pl.share_rows(i, m) if z is not None and z.zones else None
-        pl._buf_i = i + m
-        pl._take(j)
-        return pos[i:i + m], lam, pl._buf_line[i:i + m], pl._buf_vel[i:i + m], mv, moves
+        return cut_rows(pl, i, m, mv)
 
     def _rewind(self) -> None:
         """The planner as before the step just refused: from the mark's save, the steps since made again (they

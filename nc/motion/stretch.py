@@ -68,30 +68,41 @@ def take_rows(pl: Planner, n: int, across: bool = False,
 def take_parts(pl: Planner, n: int, across: bool = False, per_rev: bool = False) -> tuple | None:
     """take_rows without its Samples: (raw rows, λ, lines, path speeds, move, moves), the rows and speeds views
     of the planner's buffer (a refill makes new ones, nothing writes them in place), so a part costs no dataclass
-    and no copy (issue 17). A stretch that runs the NC's steps takes the same parts with its own copy of these
-    checks, made once after its step (hil/stretch_pass.py `Pass._take_part`, decision bench B165): a change here
-    goes there too."""
+    and no copy (issue 17). A stretch that runs the NC's steps asks `refuses` and takes with `cut_rows` itself,
+    once after its step (hil/stretch_pass.py `Pass._take_part`, decision bench B165)."""
     if n <= 0 or pl._integrate_angle or pl._buf_done:
         return None
     blocks = pl.blocks
     mv = blocks[0].move if blocks else None
-    if mv is not None:
-        if mv.per_rev and not per_rev:
-            p = pl.plan
-            if p is not None and p.kind == "path":
-                return None  # Planner._check_spindle re-plans it from the measured speed
-        if mv.kind == "thread" or "G31" in mv.tags:
-            return None
+    if mv is not None and refuses(pl, mv, per_rev):
+        return None
     i = pl._buf_i
     m = pl._cruise_rows(n) if across else min(n, pl._block_rows())
     if m <= 0:
         return None  # the next row starts the cruise's next block: step() finishes this one
+    return cut_rows(pl, i, m, mv)
+
+
+def refuses(pl: Planner, mv: Move, per_rev: bool = False) -> bool:
+    """Whether a stretch may not take rows of the front block's move: a feed-per-revolution path (unless the caller
+    samples per revolution: Planner._check_spindle re-plans it from the measured speed), a thread, G31."""
+    if mv.per_rev and not per_rev:
+        p = pl.plan
+        if p is not None and p.kind == "path":
+            return True
+    return mv.kind == "thread" or "G31" in mv.tags
+
+
+def cut_rows(pl: Planner, i: int, m: int, mv: Move | None) -> tuple:
+    """Take the buffer's rows i … i + m − 1 (the planner left as after their steps): (raw rows, λ, lines, path
+    speeds, mv, the move of each row where they cross into a cruise's next block, else None)."""
     j = i + m - 1
     raw = pl._buf_pos[i:i + m]
     moves = None
     blk = pl._buf_blk
     if blk is not None and blk[j] != pl._buf_popped:
         off = pl._buf_popped
+        blocks = pl.blocks
         moves = [blocks[k - off].move for k in blk[i:i + m]]
     lam = pl.share_rows(i, m)  # the filter's share per row (decision motion 45)
     pl._buf_i = i + m
