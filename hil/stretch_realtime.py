@@ -185,7 +185,7 @@ class RealTimeStretches:
             return  # standing, or a cruise across blocks: no refill where it ends
         pos, pl.position = pl.position, last_raw
         try:
-            before = dict(pl.__dict__)
+            before = pl.state()
             sig = _signature(ch)
             fill = self._refill_ahead(r, ch, pl)
         finally:
@@ -201,9 +201,8 @@ class RealTimeStretches:
         if early is not None and kind == "run":
             fill, before, sig = early
             p, p0, q0 = fill[0], fill[1], fill[5]
-            d, q = pl.__dict__, pl.blocks
-            if (pl.plan is p and (p is None or p.__dict__ == p0) and len(d) == len(before)
-                    and all(d.get(k) is v for k, v in before.items()) and len(q) == len(q0)
+            q = pl.blocks
+            if (pl.plan is p and (p is None or p.__dict__ == p0) and pl.same_state(before) and len(q) == len(q0)
                     and all(a is b for a, b in zip(q, q0)) and _signature(ch) == sig):
                 self.fills_early += 1
                 return fill
@@ -233,15 +232,14 @@ class RealTimeStretches:
         if fill is None:
             return None
         p, p0, s1, p1, _, q0, q1 = fill
-        s0 = dict(pl.__dict__)
+        s0 = pl.state()
         sig = _signature(ch)
 
         def step(channel: Channel) -> Setpoint:
-            d, q = pl.__dict__, pl.blocks
+            q = pl.blocks
             if (_signature(channel) == sig and pl.plan is p and (p is None or p.__dict__ == p0)
-                    and len(q) == len(q0) and all(a is b for a, b in zip(q, q0)) and len(d) == len(s0)
-                    and all(d.get(k) is v for k, v in s0.items())):
-                d.update(s1)
+                    and len(q) == len(q0) and all(a is b for a, b in zip(q, q0)) and pl.same_state(s0)):
+                pl.update_state(s1)
                 if p is not None:
                     p.__dict__.update(p1)
                 if q1 is not None:  # the refill finished blocks: the queue as it left it (the same deque)
@@ -267,7 +265,7 @@ class RealTimeStretches:
             # sampling snaps the next blocks' starts (it changes blocks in place)
         if self._quiet(r, ch) != "run":
             return None
-        s0, p0, q0 = dict(pl.__dict__), dict(p.__dict__) if p is not None else None, list(pl.blocks)
+        s0, p0, q0 = pl.state(), dict(p.__dict__) if p is not None else None, list(pl.blocks)
         guards = ("_no_progress",) if across else _NOT_AHEAD
         for name in guards:
             setattr(pl, name, _not_ahead)
@@ -284,11 +282,10 @@ class RealTimeStretches:
         finally:
             for name in guards:
                 delattr(pl, name)
-            pl.__dict__.update(feedback)
+            pl.update_state(feedback)
         rows = pl._block_rows() if ok else 0
-        s1, p1, q1 = dict(pl.__dict__), dict(p.__dict__) if p is not None else None, list(pl.blocks)
-        pl.__dict__.clear()
-        pl.__dict__.update(s0)
+        s1, p1, q1 = pl.state(), dict(p.__dict__) if p is not None else None, list(pl.blocks)
+        pl.restore(s0)
         if p is not None:
             p.__dict__.clear()
             p.__dict__.update(p0)
@@ -403,8 +400,7 @@ class RealTimeStretches:
     def _same(self, spec: _Start, r: Any, ch: Channel, pl: Planner) -> bool:
         if _signature(ch) != spec.sig:
             return False
-        d, a = pl.__dict__, spec.saved_pl["pl"]
-        if len(d) != len(a) or not _all_same(d, a):
+        if not pl.same_state(spec.saved_pl["pl"]):  # its C fields too (nc.motion.plan_core, B172)
             return False
         q = pl.blocks
         if len(q) != len(spec.blocks) or not all(map(is_, q, spec.blocks)):

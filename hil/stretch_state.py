@@ -95,7 +95,7 @@ def _save_planner(pl: Planner, filt: bool = True) -> dict:
     """What sample_stretch changes: the planner's own fields, its position filter's state and share zones (and
     its queue, of which a stretch across a cruise's blocks finishes some). `filt` False: not the filter's state
     (a step that does not filter: hil/stretch_pass.py)."""
-    saved: dict[str, Any] = {"pl": dict(pl.__dict__)}
+    saved: dict[str, Any] = {"pl": pl.state()}  # its C fields too (nc.motion.plan_core, B172)
     if pl._buf_blk is not None:
         saved["blocks"] = list(pl.blocks)
     if pl._zones is not None:  # the filter's share zones: sampling drops those it passed (ShareZones.lam)
@@ -111,7 +111,7 @@ def _refilled(fill: tuple) -> Callable[[Planner, int], Samples | None]:
     p, _, s1, p1, *_ = fill
 
     def sampler(pl: Planner, n: int) -> Samples | None:
-        pl.__dict__.update(s1)
+        pl.update_state(s1)
         p.__dict__.update(p1)
         return sample_stretch(pl, n)
 
@@ -119,8 +119,7 @@ def _refilled(fill: tuple) -> Callable[[Planner, int], Samples | None]:
 
 
 def _restore_planner(pl: Planner, saved: dict) -> None:
-    pl.__dict__.clear()
-    pl.__dict__.update(saved["pl"])
+    pl.restore(saved["pl"])
     if "blocks" in saved:  # the same deque (the channel's view of the planner holds it)
         pl.blocks.clear()
         pl.blocks.extend(saved["blocks"])

@@ -24,7 +24,7 @@ from tests.conftest import ROOT
 def _state(pl) -> tuple:
     """What a restore must give back, each part copied (identity of the queue's blocks, the plan's fields)."""
     f = pl.filter
-    return (dict(pl.__dict__), list(pl.blocks), pl.plan, None if pl.plan is None else dict(pl.plan.__dict__),
+    return (pl.state(), list(pl.blocks), pl.plan, None if pl.plan is None else dict(pl.plan.__dict__),
             None if pl._zones is None else list(pl._zones.zones), None if f is None else f.snapshot())
 
 

@@ -42,6 +42,7 @@ from nc.motion.block import Block, new_block
 from nc.motion.lookahead import (CUT, MARGIN, RAPID, THREAD, Limits, backward, change_distance, fastest_state,
                                  max_speed_at, reach)
 from nc.motion.path import Segment
+from nc.motion.plan_core import PlanCore
 from nc.motion.plan_state import CHUNK, Setpoint, _near, _Plan
 from nc.motion.filter_ramps import HISTORY, FilterStops, seg_history
 from nc.motion.planner_corners import CornerShares, _corner_at
@@ -98,7 +99,9 @@ def _factor_span(planner: "Planner", lim: Limits, b: Block, s: float, dist: floa
     return jerk_factor(planner.cfg, blend, planner.blocks, start + s, start + dist, planner.closed)
 
 
-class Planner(CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedRuns):
+class Planner(PlanCore, CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedRuns):
+    # (PlanCore first: where compiled an extension type holding the hot fields in C, nc.motion.plan_core; its
+    # state()/restore() save and restore every field, bench B172)
     # True: every block of a run starts a new solve, also where the run cruises at its cap (the reference
     # tests compare the cruise sampling against, decision motion 44)
     per_block = False
