@@ -15,7 +15,7 @@ from setuptools.command.build_ext import build_ext
 # The planner's hot modules (decision bench B115): one unit, nc/motion/compiled.py's MODULES, in the same order.
 PLANNER = ["block", "blending", "lookahead", "shares", "planner",
            "profile", "sample_rows", "planner_cruise", "planner_runs", "smoothing", "planner_corners",
-           "spline_feed", "path", "share_zones"]
+           "spline_feed", "path", "share_zones", "plan_core"]
 KERNELS = ["virtual_bus/drive_kernel.py"] + [f"nc/motion/{name}.py" for name in PLANNER]
 
 

@@ -56,6 +56,7 @@ from mlc.machine import Mlc
 from mlc.spindle_axis import SPINDLE
 from nc.channel import Channel, RunState
 from nc.motion.planner import Planner, Setpoint, feed_rpm, replans
+from nc.motion.plan_core import state_field  # the saved position (the C fields, bench B172)
 from nc.motion.stretch import Samples, sample_per_rev, sample_stretch, settle_stretch, stand_stretch
 from virtual_bus.drive import Cia402Drive
 from virtual_bus.drive_stretch import Stretch, can_stretch, csp_stretch, csv_stretch
@@ -317,9 +318,9 @@ class Stretcher(RealTimeStretches):
         # The MLC exchange reads the planner's own position (M3x352+i, axis at 0) before the cycle's step: the
         # raw sample of the cycle before, as it stood in stepping (sample_stretch moved it to the last one).
         if smp.raw is not None:  # a stretch over the planner's steps (B27): the rows it took
-            raw = [saved_pl["pl"]["position"], *smp.raw[:m - 1]]
+            raw = [state_field(saved_pl["pl"], "position"), *smp.raw[:m - 1]]
         else:
-            raw = [saved_pl["pl"]["position"], *pl._buf_pos[pl._buf_i - m:pl._buf_i - 1]] \
+            raw = [state_field(saved_pl["pl"], "position"), *pl._buf_pos[pl._buf_i - m:pl._buf_i - 1]] \
                 if self._sampler not in (stand_stretch, _stand_queued) else [pl.position] * m
         last_raw = pl.position
         k = 0

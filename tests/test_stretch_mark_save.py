@@ -17,6 +17,7 @@ from hil.runner import BenchRunner
 from hil.session import make_link
 from hil.stretch_state import _restore_planner
 from hil.trace import open_trace
+from nc.motion.plan_core import state_fields
 from nc.program import parse_program
 from tests.conftest import ROOT
 
@@ -24,7 +25,7 @@ from tests.conftest import ROOT
 def _state(pl) -> tuple:
     """What a restore must give back, each part copied (identity of the queue's blocks, the plan's fields)."""
     f = pl.filter
-    return (pl.state(), list(pl.blocks), pl.plan, None if pl.plan is None else dict(pl.plan.__dict__),
+    return (state_fields(pl.state()), list(pl.blocks), pl.plan, None if pl.plan is None else dict(pl.plan.__dict__),
             None if pl._zones is None else list(pl._zones.zones), None if f is None else f.snapshot())
 
 

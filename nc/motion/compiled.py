@@ -28,7 +28,7 @@ from pathlib import Path
 PACKAGE = "nc.motion"
 MODULES = ("block", "blending", "lookahead", "shares", "planner",  # setup.py's PLANNER, in the same order
            "profile", "sample_rows", "planner_cruise", "planner_runs", "smoothing", "planner_corners",
-           "spline_feed", "path", "share_zones")
+           "spline_feed", "path", "share_zones", "plan_core")
 ENV = "DELTAHIL_PYTHON_PLANNER"
 SLACK = 5.0  # s: pip extracting a wheel writes a source a moment after its build (virtual_bus/kernels.py)
 HERE = Path(__file__).resolve().parent

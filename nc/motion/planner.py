@@ -207,6 +207,7 @@ class Planner(PlanCore, CruiseSampling, CornerShares, ThreadStepping, FilterStop
         self._init_runs()
 
     # ---- queue ----------------------------------------------------------------------------
+    @cython.locals(self=PlanCore)
     def push(self, move: Move) -> None:
         self._closed = False  # the `closed` setter's whole work for False (once per push)
         if self._runs is not None:  # runs of short lines are held back and fitted (nc.motion.spline_feed)
@@ -214,7 +215,7 @@ class Planner(PlanCore, CruiseSampling, CornerShares, ThreadStepping, FilterStop
         else:
             self._push(move)
 
-    @cython.locals(b=Block, prev=Block, x=cython.double, added=cython.Py_ssize_t, need=cython.Py_ssize_t,
+    @cython.locals(self=PlanCore, b=Block, prev=Block, x=cython.double, added=cython.Py_ssize_t, need=cython.Py_ssize_t,
                    w=cython.Py_ssize_t, pushed=cython.Py_ssize_t, lim=Limits, zones=ShareZones, ln=Segment,
                    cut_line=cython.bint)
     def _push(self, move: Move, span: Segment | None = None, line: Segment | None = None) -> None:
@@ -274,6 +275,7 @@ class Planner(PlanCore, CruiseSampling, CornerShares, ThreadStepping, FilterStop
                 need = w
         self._need = need
 
+    @cython.locals(self=PlanCore)
     def lookahead(self) -> None:
         """Bring the queue's end speeds up to date (the backward pass the pushes owe)."""
         if self._pushed:
@@ -289,6 +291,7 @@ class Planner(PlanCore, CruiseSampling, CornerShares, ThreadStepping, FilterStop
         return self.blocks[0] if self._started and self.blocks else None
 
     @property
+    @cython.locals(self=PlanCore)
     def full(self) -> bool:
         n = len(self.blocks)
         if n >= self.depth + self._batch:
@@ -307,14 +310,17 @@ class Planner(PlanCore, CruiseSampling, CornerShares, ThreadStepping, FilterStop
         return self.held and self.plan is None and self._buf_done and self.at_rest and self._settled
 
     @property
+    @cython.locals(self=PlanCore)
     def _settled(self) -> bool:
         return self.filter is None or self.filter.settled
 
     @property
+    @cython.locals(self=PlanCore)
     def at_rest(self) -> bool:
         return abs(self.v) < 1e-9 and not np.any(self._axis_v)
 
     @property
+    @cython.locals(self=PlanCore)
     def _buf_done(self) -> bool:
         return self._buf_pos is None or self._buf_i >= len(self._buf_pos)
 
@@ -394,6 +400,7 @@ class Planner(PlanCore, CruiseSampling, CornerShares, ThreadStepping, FilterStop
         self._axis_a[:] = 0.0
 
     # ---- per cycle ------------------------------------------------------------------------
+    @cython.locals(self=PlanCore)
     def step(self) -> Setpoint:
         f = self.filter
         if f is None:
@@ -415,6 +422,7 @@ class Planner(PlanCore, CruiseSampling, CornerShares, ThreadStepping, FilterStop
         self.output = sp.positions
         return sp
 
+    @cython.locals(self=PlanCore)
     def _step_path(self) -> Setpoint:
         if self._integrate_angle:
             self._sim_angle += self.spindle_rpm() * 6.0 * self.cfg.cycle
@@ -458,7 +466,7 @@ class Planner(PlanCore, CruiseSampling, CornerShares, ThreadStepping, FilterStop
         return Block(move, "thread" if kind == "thread" else "path", seg, seg.length, v, a, j, feed,
                      kind == "rapid")  # the 9th field: rapid
 
-    @cython.locals(b=Block, cap=cython.double, x=cython.double, feed=cython.double)
+    @cython.locals(self=PlanCore, b=Block, cap=cython.double, x=cython.double, feed=cython.double)
     def _update_cap(self, b: Block, rpm: float | None = None) -> float:
         if b.kind != "path" and b.kind != "thread":
             b.cap = 0.0
@@ -495,6 +503,7 @@ class Planner(PlanCore, CruiseSampling, CornerShares, ThreadStepping, FilterStop
         self._pushed = self._need = 0
         self._replan()
 
+    @cython.locals(self=PlanCore)
     def _replan(self) -> None:
         """Drop the sampled-ahead cycles and plan again from the last emitted state."""
         if self.plan is None and self._buf_done:
@@ -509,6 +518,7 @@ class Planner(PlanCore, CruiseSampling, CornerShares, ThreadStepping, FilterStop
         self._cont = None
         self._carry = self.cfg.cycle
 
+    @cython.locals(self=PlanCore)
     def per_rev_plan(self) -> _Plan | None:
         """The running plan when it is a feed-per-revolution path, which each step checks against the measured
         spindle speed (`_check_spindle`); None otherwise."""
@@ -517,6 +527,7 @@ class Planner(PlanCore, CruiseSampling, CornerShares, ThreadStepping, FilterStop
             return None
         return p
 
+    @cython.locals(self=PlanCore)
     def _check_spindle(self) -> None:
         p = self.per_rev_plan()
         if p is None:
@@ -546,7 +557,7 @@ class Planner(PlanCore, CruiseSampling, CornerShares, ThreadStepping, FilterStop
         self.s = self.v = self.a = 0.0
 
     # (n stays a Python int: absurd limits give a duration of more cycles than a C integer holds)
-    @cython.locals(T=cython.double, t_next=cython.double, duration=cython.double)
+    @cython.locals(self=PlanCore, T=cython.double, t_next=cython.double, duration=cython.double)
     def _refill(self) -> None:
         # (`_buf_done` spelt out after a sample: what it read is the rows just sampled, issue 17)
         T = self.cfg.cycle
@@ -596,6 +607,7 @@ class Planner(PlanCore, CruiseSampling, CornerShares, ThreadStepping, FilterStop
                       line=mv.line if mv else None, block=mv.block if mv else None,
                       program=mv.program if mv else None)
 
+    @cython.locals(self=PlanCore)
     def _start_plan(self) -> _Plan | None:
         """Plan from the current state; None when there is nothing to do (idle or held at rest)."""
         T = self.cfg.cycle
@@ -637,6 +649,7 @@ class Planner(PlanCore, CruiseSampling, CornerShares, ThreadStepping, FilterStop
     def _spindle_starting(self) -> bool:
         return self.spindle_command is not None and abs(self.spindle_command()) > 0.0
 
+    @cython.locals(self=PlanCore)
     def _plan_path(self, b: Block, t0: float) -> _Plan | None:
         s, v, a = self.s, self.v, self.a
         rpm, settled = self._feed_rpm() if b.move.per_rev else (0.0, False)
@@ -740,6 +753,7 @@ class Planner(PlanCore, CruiseSampling, CornerShares, ThreadStepping, FilterStop
         return _Plan("path", pw, pw.duration, t0, target=dist, rpm=rpm, settled=settled, open=unknown,
                      queued=self._pushes)
 
+    @cython.locals(self=PlanCore)
     def _kept(self, s: float, v: float, a: float, t0: float) -> _Plan | None:
         """The profile the last path plan followed, on from the state it left at the block boundary where it was
         to be solved again, when that solve missed: ruckig, solving from a state on its own time-optimal profile
@@ -762,6 +776,7 @@ class Planner(PlanCore, CruiseSampling, CornerShares, ThreadStepping, FilterStop
         pw = later(pw, t)  # its clock from the state on, as a solve's from its start state
         return _Plan("path", pw, pw.duration, t0, base, end, p.rpm, p.settled, queued=self._pushes)
 
+    @cython.locals(self=PlanCore)
     def _speed_up(self, b: Block, s: float, v: float, a: float, cap: float, cruise: float, dist: float,
                   v1: float, ra: float, rj: float, t0: float) -> _Plan | None:
         """A run whose jerk stays low because of what lies near its end (decision motion 39) may
@@ -785,6 +800,7 @@ class Planner(PlanCore, CruiseSampling, CornerShares, ThreadStepping, FilterStop
             return None
         return _Plan("ramp", pw, pw.duration, t0, 0.0, cap)
 
+    @cython.locals(self=PlanCore)
     def _run_through(self, b: Block, s: float, v: float, cap: float, cruise: float,
                      f: float, through: float) -> tuple[float, float, float, float, float] | None:
         """The extended run carried on through blocks whose cap is a little lower than b's (the cap of a
@@ -806,6 +822,7 @@ class Planner(PlanCore, CruiseSampling, CornerShares, ThreadStepping, FilterStop
                 f = 1.0 if unknown else g
         return dist, v1, ra, rj * f, vmax
 
+    @cython.locals(self=PlanCore)
     def _jerk_factor(self, b: Block, s: float, cap: float, cruise: float) -> tuple[float, bool]:
         """The tangential jerk factor for a solve from s in b, and whether the queue could not
         tell it yet (nc.motion.shares): over the longest run any solve from here may take (the
@@ -815,11 +832,13 @@ class Planner(PlanCore, CruiseSampling, CornerShares, ThreadStepping, FilterStop
             return 1.0, False
         return _factor_span(self, lim, b, s, self._run_target(cap, True, cruise)[0])
 
+    @cython.locals(self=PlanCore)
     def _factor_over(self, b: Block, s: float, dist: float) -> tuple[float, bool]:
         """`_jerk_factor` over a run from s in b to `dist` (measured from b's start)."""
         return _factor_span(self, self.lim, b, s, dist)
 
-    @cython.locals(b=Block, nx=Block, dist=cython.double, ra=cython.double, rj=cython.double, vmax=cython.double,
+    @cython.locals(self=PlanCore, b=Block, nx=Block, dist=cython.double, ra=cython.double, rj=cython.double,
+                   vmax=cython.double,
                    cap=cython.double, cap_lo=cython.double, x=cython.double, jf=cython.double,
                    cruise_from=cython.double, k=cython.Py_ssize_t, extend=cython.bint, through=cython.double)
     # (k_max stays a Python int: absurd limits give a look-ahead depth beyond a C integer, test_harden_budgets)
@@ -876,6 +895,7 @@ class Planner(PlanCore, CruiseSampling, CornerShares, ThreadStepping, FilterStop
         self._end_cap = -1.0
         return dist, vmax if vmax < b.vend else b.vend, ra, rj * jf, vmax  # b is the queue's last block
 
+    @cython.locals(self=PlanCore)
     def _unbound(self, b: Block, nx: Block, dist: float, ra: float, rj: float) -> bool:
         """The junction b → nx, `dist` from blocks[0]'s start, that no profile from the present state within ra
         and rj reaches faster than its end speed: it cannot bind the run (issue 18). Under the filter a tangent
@@ -915,6 +935,7 @@ class Planner(PlanCore, CruiseSampling, CornerShares, ThreadStepping, FilterStop
             pw = solve_axes(self.position, self._axis_v, self._axis_a, b.seg.end, vmax, lim.racc, lim.rjerk)
         return _Plan("indep", pw, pw.duration, t0)
 
+    @cython.locals(self=PlanCore)
     def _sample(self, p: _Plan, n: int) -> None:
         T = self.cfg.cycle
         self._buf_blk = None
@@ -982,6 +1003,7 @@ class Planner(PlanCore, CruiseSampling, CornerShares, ThreadStepping, FilterStop
         self._buf_i = 0
         self._buf_state = list(zip(s.tolist(), v.tolist(), a.tolist()))
 
+    @cython.locals(self=PlanCore)
     def _end_plan(self, p: _Plan) -> None:
         T = self.cfg.cycle
         if p.kind == "cruise":  # its last block ends here as that block's own path plan would end it
@@ -1025,7 +1047,7 @@ class Planner(PlanCore, CruiseSampling, CornerShares, ThreadStepping, FilterStop
             if abs(self.v) < 1e-9 and self._stopping:
                 self._flush()
 
-    @cython.locals(done=Block, keep_plan=cython.bint, n=cython.Py_ssize_t)
+    @cython.locals(self=PlanCore, done=Block, keep_plan=cython.bint, n=cython.Py_ssize_t)
     def _finish_block(self, keep_plan: bool = False) -> None:
         # (the queue read once, the fields each written once: per block, issue 17)
         blocks = self.blocks

@@ -2,6 +2,7 @@
 # `_corner` and its helpers are C functions (`Planner._push` calls `_corner_at` in C), and they call the share zones,
 # the junction model and `change_distance` in C (session 28, decision bench B157).
 from nc.motion.block cimport Block
+from nc.motion.plan_core cimport PlanCore
 from nc.motion.lookahead cimport Limits, change_distance
 from nc.motion.share_zones cimport ShareZones
 

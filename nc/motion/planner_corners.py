@@ -12,6 +12,7 @@ except ImportError:  # run as Python without Cython: they do nothing
 
 from nc.motion.corner_blends import blend_block
 from nc.motion.block import Block
+from nc.motion.plan_core import PlanCore  # the planner's C fields where compiled (bench B172)
 from nc.motion.lookahead import Limits, change_distance
 from nc.motion.share_zones import ShareZones
 
@@ -33,6 +34,7 @@ class CornerShares:
         """Path position (Block.s_end's scale) of the last sample handed out."""
         return _path_now(self)
 
+    @cython.locals(self=PlanCore)
     def _share(self) -> float:
         """The filter's share λ at the present path position (nc.motion.share_zones)."""
         z = self._zones
@@ -47,6 +49,7 @@ class CornerShares:
         self._lam = lam
         return lam
 
+    @cython.locals(self=PlanCore)
     def share_rows(self, i: int, m: int) -> np.ndarray | None:
         """λ of buffer rows i … i + m − 1 as step() would take them one by one (`_share` after `_take`), for a
         stretch's push_many (nc.motion.stretch); None where λ is 1 throughout (no zone left)."""

@@ -13,6 +13,7 @@ except ImportError:  # run as Python without Cython: they do nothing
     from nc.motion import cython_shadow as cython
 
 from nc.motion.block import Block
+from nc.motion.plan_core import PlanCore  # the planner's C fields where compiled (bench B172)
 from nc.motion.plan_state import CHUNK, _Plan
 
 # Rows a cruise samples at a refill: whole blocks until at least this many. Its cost is per block (~45 blocks for
@@ -96,6 +97,7 @@ def least_limits(blocks: object) -> tuple[float, float]:
 class CruiseSampling:
     """Methods of `nc.motion.planner.Planner` (its state is the planner's own: see that module's doc)."""
 
+    @cython.locals(self=PlanCore)
     def _block_rows(self) -> int:
         """Buffer rows left that lie in blocks[0] (a stretch stays within one block: nc.motion.stretch)."""
         i, n = self._buf_i, 0 if self._buf_pos is None else len(self._buf_pos)
@@ -107,6 +109,7 @@ class CruiseSampling:
             j += 1
         return j - i
 
+    @cython.locals(self=PlanCore)
     def _before_take(self) -> None:
         """What a step does before it takes its row: a cruise's next block checked again where a push came since
         (`_chain_ok`), the refill where the buffer ran out (a stretch makes these steps too, hil/stretch_pass.py)."""
@@ -123,6 +126,7 @@ class CruiseSampling:
             self._break_chain(bad)  # (it drops the buffer: the refill below)
         self._refill()
 
+    @cython.locals(self=PlanCore)
     def _cruise_rows(self, n: int) -> int:
         """Of the next n buffer rows, how many a stretch may take across a cruise's blocks: those before the
         first block whose own solve would no longer cruise (`_chain_ok`, with the queue as it stands)."""
@@ -137,6 +141,7 @@ class CruiseSampling:
                 m -= 1
         return m
 
+    @cython.locals(self=PlanCore)
     def _take(self, i: int) -> None:
         """The state after handing out buffer row i: a cruise's blocks before row i's are finished."""
         blk = self._buf_blk
@@ -152,6 +157,7 @@ class CruiseSampling:
     def _cruising(self, b: Block, v: float) -> bool:
         return _cruises(b, v)
 
+    @cython.locals(self=PlanCore)
     def _cruise(self, b: Block, t0: float) -> _Plan | None:
         """Decision motion 44: at its cap, with zero acceleration, a run whose end speed is the cap solves to
         constant speed to the end of its block, and so does the next block's solve while the same holds there.
@@ -167,7 +173,7 @@ class CruiseSampling:
             return None
         return _Plan("cruise", None, math.inf, t0, queued=self._pushes)
 
-    @cython.locals(b=Block, T=cython.double, v=cython.double, s0=cython.double, t_next=cython.double,
+    @cython.locals(self=PlanCore, b=Block, T=cython.double, v=cython.double, s0=cython.double, t_next=cython.double,
                    duration=cython.double, length=cython.double, seg_len=cython.double, x=cython.double,
                    u=cython.double, k=cython.Py_ssize_t, nb=cython.Py_ssize_t, n=cython.Py_ssize_t,
                    i=cython.Py_ssize_t, a=cython.Py_ssize_t, m=cython.Py_ssize_t, rows=cython.Py_ssize_t,
@@ -273,6 +279,7 @@ class CruiseSampling:
         self._buf_i = 0
         self._buf_carry = carries
 
+    @cython.locals(self=PlanCore)
     def _chain_ok(self, p: _Plan | None, upto: int) -> int:
         """The first block offset up to `upto` (where a cruise's next row lies) whose own solve would no longer
         cruise: a push since the chain was sampled changed its end speed (the same check `_cruise` makes, at
@@ -286,6 +293,7 @@ class CruiseSampling:
                 return k
         return upto + 1
 
+    @cython.locals(self=PlanCore)
     def _break_chain(self, k: int) -> None:
         """Block offset k does not cruise any more: the chain ends at the end of block k - 1, as that block's
         own plan would end there (`_end_plan`); the next refill solves block k."""

@@ -15,6 +15,7 @@ except ImportError:  # run as Python without Cython: they do nothing
     from nc.motion import cython_shadow as cython
 
 from nc.motion.block import Block
+from nc.motion.plan_core import PlanCore  # the planner's C fields where compiled (bench B172)
 from nc.motion.path import line_segment
 from nc.motion.spline_feed import NOTHING, Held, RunFeed
 from nc.moves import Move
@@ -44,11 +45,13 @@ class FittedRuns:
         self._held = NOTHING
 
     @property
+    @cython.locals(self=PlanCore)
     def closed(self) -> bool:
         """The channel says no move comes before the queue has run out to rest: a held run ends (is let through)."""
         return self._closed
 
     @closed.setter
+    @cython.locals(self=PlanCore)
     def closed(self, value: bool) -> None:
         self._closed = value
         if value and self._held.moves:
@@ -65,7 +68,7 @@ class FittedRuns:
             self._held, out = self._runs.release(self._held)
             self._let_through(out)
 
-    @cython.locals(runs=RunFeed, b=Block, out=list)
+    @cython.locals(self=PlanCore, runs=RunFeed, b=Block, out=list)
     def _feed_run(self, move: Move) -> None:
         runs = self._runs
         self._held = runs.feed(self._held, move)  # a C call where compiled (session 29, decision bench B166)
@@ -89,6 +92,7 @@ class FittedRuns:
                 return
         self._let_through(out)
 
+    @cython.locals(self=PlanCore)
     def _let_through(self, out: list[tuple[Move, SplineSpan | None]]) -> None:
         spans = [sp for _, sp in out if sp is not None]
         zones = self._zones
