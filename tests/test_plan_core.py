@@ -68,3 +68,26 @@ def test_update_state_sets_the_named_fields_and_keeps_the_others():
     assert not pl.same_state(saved)
     pl.restore(saved)
     assert not hasattr(pl, "extra") and pl.same_state(saved)
+
+
+def test_every_c_field_is_saved_in_its_place():
+    """plan_core.pxd, FIELDS and `_fields`/`_set_fields` name the same fields in the same order: a field declared in
+    the .pxd but missing from the state API would not be saved (a stretch's restore would leave it as the stretch
+    left it), and two names swapped would restore one field's value into the other."""
+    import re
+    from pathlib import Path
+
+    import nc.motion.plan_core as pc
+    declared = re.findall(r"^\s+cdef public \w+ (\w+)\s*$", (Path(pc.__file__).parent / "plan_core.pxd").read_text(),
+                          re.M)
+    assert declared == list(FIELDS)
+    pl = _planner()
+    # each field a distinct value of its own type (the C types: double, count, flag, object)
+    values = tuple(float(k) + 0.5 if k < len(pc.DOUBLES) else
+                   (k if name not in ("_started", "held", "_stopping", "dry_run", "_closed", "_filling",
+                                       "_integrate_angle") else bool(k % 2)) if k < len(pc.DOUBLES) + len(pc.COUNTS)
+                   else object() for k, name in enumerate(FIELDS))
+    pl._set_fields(values)
+    got = {name: getattr(pl, name) for name in FIELDS}
+    assert all(_equal(got[name], v) for name, v in zip(FIELDS, values))
+    assert all(_equal(a, b) for a, b in zip(pl._fields(), values))
