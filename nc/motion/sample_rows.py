@@ -22,6 +22,7 @@ try:
 except ImportError:  # run as Python without Cython: they do nothing
     from nc.motion import cython_shadow as cython
 
+from nc.motion.block import Block
 from nc.motion.plan_state import _Plan
 from nc.motion.profile import _lists0, _pos_at, _row_at  # Piecewise.at's steps (C functions compiled)
 
@@ -29,6 +30,27 @@ if TYPE_CHECKING:
     from nc.motion.planner import Planner
 
 FEW = 6  # rows kept up to which plain floats beat numpy (a row ≈ 1 µs, numpy's sample ≈ 25 µs a call)
+SLAB = 1024  # rows of a `_Slab`
+
+
+class _Slab:
+    """Rows for `few_rows`' buffers (session 30, decision bench B180): `np.array` of its row lists cost ≈ 7k
+    instructions for two rows of three axes and ≈ 3k for their speeds (numpy discovers the nesting and packs each
+    float), a slice of a slab made once ≈ 1.3k. The rows are written once, from C doubles (memoryviews compiled),
+    and handed out as consecutive slices that never overlap; a full slab is replaced by a new one, and the old one
+    lives on as long as a buffer sliced from it does. So each buffer is its own rows, as a fresh array's were: the
+    same shape, dtype (float64), C order and values; only `.base` (the slab) differs, which nothing reads."""
+
+    def __init__(self, m: int) -> None:
+        self.m = m
+        self.pos = np.empty((SLAB, m))
+        self.vel = np.empty(SLAB)
+        self._pv = self.pos  # (typed memoryviews where compiled, sample_rows.pxd)
+        self._vv = self.vel
+        self.at = 0
+
+
+_slab = _Slab(3)
 
 
 @cython.locals(T=cython.double, t_next=cython.double, base=cython.double, length=cython.double, x=cython.double,
@@ -36,7 +58,7 @@ FEW = 6  # rows kept up to which plain floats beat numpy (a row ≈ 1 µs, numpy
                lo=cython.Py_ssize_t, hi=cython.Py_ssize_t, mid=cython.Py_ssize_t, i=cython.Py_ssize_t,
                m=cython.Py_ssize_t, k=cython.Py_ssize_t, q0=cython.double, q1=cython.double, q2=cython.double,
                d0=cython.double, d1=cython.double, d2=cython.double, dur=cython.double, c=tuple, t0=list,
-               pp=list, vv=list, aa=list, jj=list)
+               pp=list, vv=list, aa=list, jj=list, b=Block, sl=_Slab, at=cython.Py_ssize_t)
 def few_rows(pl: "Planner", p: _Plan, n: int) -> bool:
     """`Planner._sample(p, n)` for a path or ramp plan, when it keeps at most FEW rows or re-solves at the next
     block; False (nothing changed) where `_sample` must run."""
@@ -93,23 +115,30 @@ def few_rows(pl: "Planner", p: _Plan, n: int) -> bool:
         d0, d1, d2 = end[0] - q0, end[1] - q1, end[2] - q2
     else:
         d = [e - q for e, q in zip(end, start)]
+    global _slab
+    sl = _slab
+    if sl.m != m or sl.at + keep > SLAB:
+        sl = _slab = _Slab(m)
+    at = sl.at
     got = []
-    pos = []
-    vel = []
     for i in range(keep):
         r = _row_at(t_next + T * i, base, dur, t0, pp, vv, aa, jj)
         got.append(r)
-        vel.append(r[1])
+        sl._vv[at + i] = r[1]
         s = r[0]
         s = 0.0 if 0.0 >= s else s
         u = (length if length <= s else s) / seg_len
         if m == 3:
-            pos.append([q0 + u * d0, q1 + u * d1, q2 + u * d2])
+            sl._pv[at + i, 0] = q0 + u * d0
+            sl._pv[at + i, 1] = q1 + u * d1
+            sl._pv[at + i, 2] = q2 + u * d2
         else:
-            pos.append([start[k] + u * d[k] for k in range(m)])
+            for k in range(m):
+                sl._pv[at + i, k] = start[k] + u * d[k]
+    sl.at = at + keep
     p.emitted = True
-    pl._buf_pos = np.array(pos)
-    pl._buf_vel = np.array(vel)
+    pl._buf_pos = sl.pos[at:at + keep]  # (rows of their own: never overlapping another buffer's, `_Slab`)
+    pl._buf_vel = sl.vel[at:at + keep]
     pl._buf_line = [b.move.line] * keep
     pl._buf_i = 0
     pl._buf_state = got
