@@ -1,4 +1,4 @@
-"""few_rows' buffers as rows of a slab (nc.motion.sample_rows `_Slab`, decision bench B180): on a dense CAM program
+"""few_rows' buffers as rows of a slab (nc.motion.sample_rows `_Slab`, decision bench B175): on a dense CAM program
 planned offline with a slab of 8 rows (a new slab every few blocks), the setpoints are the default slab's bit for
 bit, and every buffer few_rows handed out is its own rows: float64, C order, (rows, axes) and (rows,), never
 overlapping another buffer, and still holding at the end of the run the values it had when the planner took it."""

@@ -5,7 +5,7 @@ cimport cython
 from nc.motion.profile cimport _lists0, _pos_at, _row_at
 from nc.motion.block cimport Block
 
-# few_rows' buffers, rows of a slab written from C doubles (session 30, decision bench B180)
+# few_rows' buffers, rows of a slab written from C doubles (session 30, decision bench B175)
 cdef class _Slab:
     cdef public Py_ssize_t m, at
     cdef public object pos, vel

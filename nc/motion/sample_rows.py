@@ -34,7 +34,7 @@ SLAB = 1024  # rows of a `_Slab`
 
 
 class _Slab:
-    """Rows for `few_rows`' buffers (session 30, decision bench B180): `np.array` of its row lists cost ≈ 7k
+    """Rows for `few_rows`' buffers (session 30, decision bench B175): `np.array` of its row lists cost ≈ 7k
     instructions for two rows of three axes and ≈ 3k for their speeds (numpy discovers the nesting and packs each
     float), a slice of a slab made once ≈ 1.3k. The rows are written once, from C doubles (memoryviews compiled),
     and handed out as consecutive slices that never overlap; a full slab is replaced by a new one, and the old one
