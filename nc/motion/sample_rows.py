@@ -120,6 +120,7 @@ def few_rows(pl: "Planner", p: _Plan, n: int) -> bool:
     if sl.m != m or sl.at + keep > SLAB:
         sl = _slab = _Slab(m)
     at = sl.at
+    sl.at = at + keep  # (the rows claimed before any call: another planner's few_rows takes the next ones)
     got = []
     for i in range(keep):
         r = _row_at(t_next + T * i, base, dur, t0, pp, vv, aa, jj)
@@ -135,7 +136,6 @@ def few_rows(pl: "Planner", p: _Plan, n: int) -> bool:
         else:
             for k in range(m):
                 sl._pv[at + i, k] = start[k] + u * d[k]
-    sl.at = at + keep
     p.emitted = True
     pl._buf_pos = sl.pos[at:at + keep]  # (rows of their own: never overlapping another buffer's, `_Slab`)
     pl._buf_vel = sl.vel[at:at + keep]
