@@ -15,7 +15,7 @@ caught even when both of its end points lie inside — so a move that would cros
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
 
 from nc.alarms import Alarm
@@ -62,6 +62,9 @@ class SoftLimits:
         # for the params, their length and the bench's segments it names (decisions bench B158)
         self._box: dict[str, tuple[float, float]] | bool = False
         self._box_of: tuple[object, int, object] | None = None
+        # `check`'s first test: (params, their length, first, the box's test as straight-line code), made with the
+        # box (`_new_box`), None while there is none (decisions bench B173)
+        self._fast: tuple[object, int, object, Callable[[dict, dict], bool]] | None = None
 
     def _keys(self, axis: str) -> tuple[str, str, str, str, float]:
         k = self._names[axis] = (f"soft limit 1 {axis}", f"soft limit 2 {axis}", f"soft limit 3 {axis}",
@@ -73,6 +76,7 @@ class SoftLimits:
     def _new_box(self) -> dict[str, tuple[float, float]] | bool:
         params, first = self.params, self.first
         self._box_of = (params, len(params), first)
+        self._fast = None
         if not params.keys().isdisjoint(self._all):
             self._box = False
         else:
@@ -81,6 +85,7 @@ class SoftLimits:
                 lo, hi = first.get(a, (None, None))
                 box[a] = (-math.inf if lo is None else lo - _EPS, math.inf if hi is None else hi + _EPS)
             self._box = box
+            self._fast = (params, len(params), first, _box_test(box))
         return self._box
 
     def _inside(self, move: Move) -> bool:
@@ -137,7 +142,21 @@ class SoftLimits:
 
     def check(self, move: Move) -> Alarm | None:
         """The limit alarm this move would raise, or None when its whole path stays inside."""
-        if move.kind == "dwell" or self._inside(move):
+        kind = move.kind
+        if kind == "dwell":
+            return None
+        fast = self._fast
+        if fast is not None and kind != "arc" and not self.disabled:
+            # a line inside the box (`_inside`'s first case, a CAM run's every move): one call of straight-line
+            # code while the params and the bench's segments are those the box was found for (issue 17)
+            params = self.params
+            try:
+                if fast[0] is params and fast[1] == len(params) and fast[2] is self.first \
+                        and fast[3](move.start, move.end):
+                    return None
+            except KeyError:  # as many axes, not the box's: `_inside` decides
+                pass
+        if self._inside(move):
             return None
         ranges = _path_ranges(move)
         for segment, code in ((1, 0x0A01), (2, 0x0A03)):
@@ -155,6 +174,19 @@ class SoftLimits:
                                        f"{value:.4f}, limit {lim:.4f} (machine coordinates); the move was not started",
                                  line=move.line, block=move.block, program=move.program, axis=axis)
         return None
+
+
+def _box_test(box: dict[str, tuple[float, float]]) -> Callable[[dict, dict], bool]:
+    """`_inside`'s box test for these axes as straight-line code: True when both ends hold exactly the box's axes,
+    each inside (the bounds as literals). False is "not known" (a NaN, another axis set): `_inside` decides."""
+    def lit(v: float) -> str:
+        return "1e999" if v == math.inf else "-1e999" if v == -math.inf else repr(v)
+    terms = [f"len(s) == {len(box)} == len(e)"]
+    for p in "se":
+        terms += [f"{lit(lo)} <= {p}[{a!r}] <= {lit(hi)}" for a, (lo, hi) in box.items()]
+    space: dict = {}
+    exec(compile("def inside(s, e):\n    return " + " and ".join(terms) + "\n", "<soft-limit box>", "exec"), space)
+    return space["inside"]
 
 
 def _path_ranges(move: Move) -> dict[str, tuple[float, float]]:

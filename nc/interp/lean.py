@@ -33,6 +33,7 @@ from types import MappingProxyType
 from typing import TYPE_CHECKING, Any
 
 from nc.interp.gcodes import lookup
+from nc.interp.lean_run import streamed
 from nc.interp.records import _transforms
 from nc.interp.state import PLANES
 from nc.moves import Move
@@ -59,7 +60,7 @@ class _Shape:
     """The letters of a line in order and what each is: one compiled pattern reads a line of that
     shape (a CAM run is mostly one shape)."""
 
-    __slots__ = ("match", "letters", "n", "g", "f", "axes", "run")
+    __slots__ = ("match", "letters", "n", "g", "f", "axes", "run", "stream")
 
     def __init__(self, letters: tuple[str, ...], n: bool, g: int | None, f: int | None,
                  axes: tuple[tuple[str, int], ...], run: Callable[..., object]) -> None:
@@ -68,12 +69,14 @@ class _Shape:
         self.match = re.compile(body).fullmatch
         self.letters, self.n, self.g, self.f, self.axes = letters, n, g, f, axes
         self.run = run  # `_compiled`: the line of this shape run, straight-line code
+        self.stream: Callable[..., object] | None = None  # `lean_run.streamed`: the lines after it (a shape that moves)
 
 
 class LeanLane:
     """The lane of one interpreter (its axes and code-call tables decide the shapes it takes)."""
 
-    __slots__ = ("ip", "shapes", "texts", "refused", "last", "axes", "diameter", "g_codes", "tables", "g_ok")
+    __slots__ = ("ip", "shapes", "texts", "refused", "last", "axes", "diameter", "g_codes", "tables", "g_ok", "retry",
+                 "runs")
 
     def __init__(self, ip: "Interpreter") -> None:
         self.ip = ip
@@ -88,6 +91,8 @@ class LeanLane:
         self.g_codes = lookup(ip.profile, 0.0) == (1, "G00") and lookup(ip.profile, 1.0) == (1, "G01")
         self.tables: object = None  # the code-call tables `g_ok` was found with
         self.g_ok = False
+        self.retry = 0  # `lean_run`: the program counter below which a run is not tried again (a chunk it refused)
+        self.runs = 0  # chunks `lean_run` has read (tests see the runs were taken)
 
     def lines(self, blocks: object) -> tuple[tuple | None, set[int]]:
         """A block list's plain-line texts and file lines (`BlockList.text_index`, None for a list of
@@ -144,6 +149,9 @@ class LeanLane:
         shape = _Shape(letters, bool(letters) and letters[0] == "N", g, f, tuple(axes),
                        _compiled(letters, g, f, tuple(axes), self.ip.axes, self.diameter))
         shape.run.__globals__.update(SHAPE=shape, MATCH=shape.match)  # the LineBlock's words are read from SHAPE
+        if axes:
+            shape.stream = streamed(letters, g, f, tuple(axes), self.ip.axes, self.diameter,
+                                    dict(shape.run.__globals__))
         return shape
 
     def _eligible(self) -> bool:

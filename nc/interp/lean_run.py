@@ -1,0 +1,179 @@
+"""The lean lane's runs (issue 17, decisions bench B173): the lines after a plain line of one shape, read in one pass.
+
+A CAM program is thousands of lines of one shape (`X.. Y..`). `nc.interp.lean` runs each as a call from the
+program counter: the counter's checks, the call, one regular-expression match, its groups and two `float` calls a
+line. Once a line of a shape has run there and its Move is handed out, the shape's `stream` (built here once per
+shape and profile, as its `run` is) reads the next lines in chunks of CHUNK: two `str.translate` calls over the
+chunk's text (its letters alone must be the shape's, line after line; its numbers alone, split, are every word's
+number), `map(float)` a column's values; then it hands the Moves out one by one, each made, and the interpreter's
+state left, as the shape's `run` makes and leaves them for that line (the same code, line by line: the lean lane
+on and off give the same events and the same state at every event, tests/test_lean33_runs.py).
+
+Before each line it asks what the program counter and `run` ask: the frame on top and its counter where the last
+line left them (an M96 interrupt, a `--at` event, a macro call change them), no interrupt pending, no corner
+waiting, the statement budget not spent, the block limit not reached, the plain state and work origin kept
+(`Interpreter._lean_origin`: cleared by every block the general path runs, a system variable written, a run begun)
+and, for a shape with G, the code-call tables `LeanLane.g_ok` was found with. Anything else stops the run at that
+line, before anything of it is done: the program counter takes it as before (block by block, or the lean lane's
+`run`). A chunk is taken only when each of its items is a plain line of its own, one line break apart, of the
+shape, with a decimal point in every axis word and every axis inside +-1e9 (else its lines run one by one, as
+before: a line of another shape, N8.018's rule for a word without a point, 0x120E at its line).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+CHUNK = 64  # lines a `findall` reads: a run interrupted mid-chunk has read at most this many lines for nothing
+# A chunk of plain lines (nc.program.blocks `_PLAIN_ITEM`: an optional N, then words, each a letter and its number
+# with nothing between, blanks around) seen two ways: its letters alone, upper case, a line break after each line
+# but the last (SKELETON), and its numbers alone (NUMBERS: every letter a blank), each word's number a run of
+# [-+.0-9] (the lean lane's `_NUM`: the run after its letter)
+_LOWER = "abcdefghijklmnopqrstuvwxyz"
+SKELETON = str.maketrans(_LOWER, _LOWER.upper(), "-+.0123456789 \t")
+NUMBERS = str.maketrans(_LOWER + _LOWER.upper(), " " * 52)
+
+
+def streamed(letters: tuple[str, ...], g: int | None, f: int | None, programmed: tuple[tuple[str, int], ...],
+             axes: tuple[str, ...], diameter: frozenset[str] | tuple[str, ...], space: dict) -> Callable[..., object]:
+    """The run generator of a shape that moves (`programmed` not empty): `lean._compiled`'s line, step for step,
+    over the lines of a chunk (`space`: the names `_compiled`'s code reads)."""
+    words = dict(programmed)
+    src = ["def stream(lane, ip, fr, pc, limit, text, starts, lengths, file_lines, count, budget):",
+           "    origin = ip._lean_origin",
+           "    if origin is None:",
+           "        return",
+           "    st = ip.state",
+           "    stack = ip.stack",
+           "    name = fr.program.name"]
+    for i, a in enumerate(axes):
+        src.append(f"    o{i} = origin[{a!r}]")
+    src += ["    while True:",
+            "        n = count - pc",
+            "        if n > CHUNK:",
+            "            n = CHUNK",
+            "        if n < 2:",
+            "            return",
+            "        end = pc + n",
+            "        s0 = starts[pc]",
+            "        e1 = starts[end - 1] + lengths[end - 1]",
+            "        # each item a plain line of its own (start >= 0), one line break after the other",
+            "        if min(starts[pc:end]) < 0 or e1 - s0 != sum(lengths[pc:end]) + n - 1:",
+            "            lane.retry = end",
+            "            return",
+            "        chunk = text[s0:e1]",
+            "        # the letters of every line, in order, nothing else (the words' numbers out, blanks out, upper case)",
+            "        if chunk.translate(SKELETON) != (EXPECT if n == CHUNK else '\\n'.join([LETTERS] * n)):",
+            "            lane.retry = end  # not all of this shape: line by line up to there",
+            "            return",
+            "        nums = chunk.translate(NUMBERS).split()  # each word's number, line after line",
+            f"        if len(nums) != n * {len(letters)}:",
+            "            lane.retry = end",
+            "            return",
+            "        raws = chunk.split('\\n')",
+            "        fl = file_lines[pc:end]"]
+    k_all = len(letters)
+    # a line's numbers as a tuple, as the shape's match gives them (LineBlock reads its words from it)
+    src.append(f"        found = list(zip(*[iter(nums)] * {k_all}))")
+    cols = []
+    for a, k in programmed:
+        src += [f"        t_{a} = nums[{k}::{k_all}]",
+                f"        if ''.join(t_{a}).count('.') != n:  # N8.018: a point in every axis word (one at most)",
+                "            lane.retry = end",
+                "            return",
+                f"        c_{a} = list(map(float, t_{a}))"]
+        cols.append(a)
+    if f is not None:
+        src.append(f"        c_F = list(map(float, nums[{f}::{k_all}]))")
+        cols.append("F")
+    if g is not None:
+        src.append(f"        c_G = nums[{g}::{k_all}]")
+        cols.append("G")
+    for i, a in enumerate(axes):
+        if a in words:  # the chunk's extremes inside +-1e9, so is every line's (`run`'s check: x -> x + o is monotone)
+            half = " / 2.0" if a in diameter else ""
+            src += [f"        if not (-1e9 <= min(c_{a}){half} + o{i} and max(c_{a}){half} + o{i} <= 1e9):",
+                    "            lane.retry = end  # line by line: the general path's 0x120E at its line",
+                    "            return"]
+    src += ["        lane.runs += 1",
+            f"        for vals, raw, line, {', '.join('v_' + c for c in cols)} in zip(found, raws, fl, "
+            f"{', '.join('c_' + c for c in cols)}):",
+            "            if (ip._lean_origin is not origin or fr.pc != pc or stack[-1] is not fr or ip._interrupt_pending",
+            "                    or ip.corner_pending or ip._executed >= limit",
+            "                    or (budget is not None and budget.used >= budget.limit)):",
+            "                return  # the program counter takes this line"]
+    if g is None:
+        src.append("            motion = st.motion")
+    else:
+        src += ["            motion = _G_MOTION.get(v_G)",
+                "            if motion is None or ip._call_tables is not lane.tables or not lane.g_ok:",
+                "                return"]
+    if f is None:
+        src.append("            feed = st.feed")
+    else:
+        src += ["            feed = v_F",
+                "            if feed < 0:",
+                "                return"]
+    src.append("            position = ip.position")
+    for i, a in enumerate(axes):
+        if a in words:
+            src.append(f"            w{i} = v_{a}")
+        elif a in diameter:
+            src.append(f"            w{i} = (position.get({a!r}, 0.0) - o{i}) * 2.0")
+        else:
+            src.append(f"            w{i} = position.get({a!r}, 0.0) - o{i}")
+    src += ["            if motion == 1:",
+            "                if feed is None or feed == 0.0:",
+            "                    return",
+            "                mfeed = feed * 1.0"]
+    for i, a in enumerate(axes):
+        src.append(f"            m{i} = " + (f"w{i} / 2.0 + o{i}" if a in diameter else f"w{i} + o{i}"))
+        if a not in words:
+            src += [f"            if not -1e9 <= m{i} <= 1e9:",
+                    "                return"]
+
+    def dct(p: str) -> str:
+        return "{" + ", ".join(f"{a!r}: {p}{i}" for i, a in enumerate(axes)) + "}"
+    src += ["            pc += 1",
+            "            fr.pc = pc",
+            "            ip._executed += 1",
+            "            ip.program_name = name",
+            "            ip.block = b = NEW(LineBlock)",
+            "            b.line = line",
+            "            b.text = raw",
+            "            b._shape = SHAPE",
+            "            b._vals = vals"]
+    if g is not None:
+        src += ["            st.groups[1] = float(v_G)", "            st.motion = motion"]
+    if f is not None:
+        src.append("            st.feed = feed")
+    src += ["            ip.unit_locked = True",
+            "            mv = NEW(Move)",
+            "            if motion == 0:",
+            "                mv.kind = 'rapid'",
+            "                mv.feed = None",
+            "                mv.per_rev = False",
+            "            else:",
+            "                mv.kind = 'line'",
+            "                mv.feed = mfeed",
+            "                mv.per_rev = st.per_rev",
+            "            mv.line = line",
+            "            mv.block = raw",
+            "            mv.start = position",
+            f"            mv.end = end_ = {dct('m')}",
+            f"            mv.work = work = {dct('w')}",
+            "            mv.center = mv.dir = mv.duration = mv.lead = mv.comp = None",
+            "            mv.plane = PLANES[st.plane]",
+            "            mv.exact_stop = st.exact_stop_modal",
+            "            mv.lead_change = mv.start_angle = mv.turns = mv.comp_radius = 0.0",
+            "            mv.program = name",
+            "            mv.tags = ()",
+            "            mv.tip = 0",
+            "            mv.css = st.surface_speed if st.css else None",
+            "            ip.position = {**end_}  # a copy (cloned: half the cost of building it)",
+            "            ip.last_target = work",
+            "            yield mv"]
+    space = dict(space, CHUNK=CHUNK, SKELETON=SKELETON, NUMBERS=NUMBERS, LETTERS="".join(letters),
+                 EXPECT="\n".join(["".join(letters)] * CHUNK))
+    exec(compile("\n".join(src) + "\n", f"<lean run {''.join(letters)}>", "exec"), space)
+    return space["stream"]
