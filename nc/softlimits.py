@@ -71,6 +71,7 @@ class SoftLimits:
                                  f"soft limit 4 {axis}", 0.5 if axis in self.diameter_axes else 1.0)
         self._all.update(k[:4])
         self._box_of = None  # the box is found again with this axis
+        self._fast = None
         return k
 
     def _new_box(self) -> dict[str, tuple[float, float]] | bool:

@@ -37,12 +37,14 @@ def moves(draw) -> Move:
 
 
 def _full(sl: SoftLimits, mv: Move):
-    """`check` without the quick answer."""
+    """`check` without the quick answers (`_inside`, and the box's straight-line test made with it)."""
     sl._inside = lambda move: False  # type: ignore[method-assign]
+    fast, sl._fast = sl._fast, None
     try:
         return sl.check(mv)
     finally:
         del sl._inside
+        sl._fast = fast
 
 
 def _same_alarm(sl: SoftLimits, mv: Move) -> None:

@@ -22,7 +22,7 @@ before: a line of another shape, N8.018's rule for a word without a point, 0x120
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 
 CHUNK = 64  # lines a `findall` reads: a run interrupted mid-chunk has read at most this many lines for nothing
 # A chunk of plain lines (nc.program.blocks `_PLAIN_ITEM`: an optional N, then words, each a letter and its number
@@ -32,6 +32,30 @@ CHUNK = 64  # lines a `findall` reads: a run interrupted mid-chunk has read at m
 _LOWER = "abcdefghijklmnopqrstuvwxyz"
 SKELETON = str.maketrans(_LOWER, _LOWER.upper(), "-+.0123456789 \t")
 NUMBERS = str.maketrans(_LOWER + _LOWER.upper(), " " * 52)
+
+
+def chunk_at(text: str, starts: Sequence[int], lengths: Sequence[int], pc: int, count: int, letters: str, k: int,
+             expect: str) -> tuple[int, str, list[str]] | None:
+    """The longest chunk of CHUNK, CHUNK / 2, ... (at least 2) lines from item `pc` that are plain lines of their own, one
+    line break apart, of the shape whose letters are `letters` (`k` of them; `expect` those of CHUNK lines): (its
+    number of lines, its text, every word's number in order), or None."""
+    n = count - pc
+    if n > CHUNK:
+        n = CHUNK
+    while n >= 2:
+        end = pc + n
+        s0 = starts[pc]
+        e1 = starts[end - 1] + lengths[end - 1]
+        # each item a plain line of its own (start >= 0), one line break after the other
+        if min(starts[pc:end]) >= 0 and e1 - s0 == sum(lengths[pc:end]) + n - 1:
+            chunk = text[s0:e1]
+            # the letters of every line, in order, nothing else (the numbers and blanks out, upper case)
+            if chunk.translate(SKELETON) == (expect if n == CHUNK else "\n".join([letters] * n)):
+                nums = chunk.translate(NUMBERS).split()  # each word's number, line after line
+                if len(nums) == n * k:
+                    return n, chunk, nums
+        n //= 2  # a shorter run (the program's last lines of this shape before a block of another)
+    return None
 
 
 def streamed(letters: tuple[str, ...], g: int | None, f: int | None, programmed: tuple[tuple[str, int], ...],
@@ -49,27 +73,12 @@ def streamed(letters: tuple[str, ...], g: int | None, f: int | None, programmed:
     for i, a in enumerate(axes):
         src.append(f"    o{i} = origin[{a!r}]")
     src += ["    while True:",
-            "        n = count - pc",
-            "        if n > CHUNK:",
-            "            n = CHUNK",
-            "        if n < 2:",
+            f"        got = CHUNK_AT(text, starts, lengths, pc, count, {''.join(letters)!r}, {len(letters)}, EXPECT)",
+            "        if got is None:",
+            "            lane.retry = pc + CHUNK  # not of this shape: line by line up to there",
             "            return",
+            "        n, chunk, nums = got",
             "        end = pc + n",
-            "        s0 = starts[pc]",
-            "        e1 = starts[end - 1] + lengths[end - 1]",
-            "        # each item a plain line of its own (start >= 0), one line break after the other",
-            "        if min(starts[pc:end]) < 0 or e1 - s0 != sum(lengths[pc:end]) + n - 1:",
-            "            lane.retry = end",
-            "            return",
-            "        chunk = text[s0:e1]",
-            "        # the letters of every line, in order, nothing else (the words' numbers out, blanks out, upper case)",
-            "        if chunk.translate(SKELETON) != (EXPECT if n == CHUNK else '\\n'.join([LETTERS] * n)):",
-            "            lane.retry = end  # not all of this shape: line by line up to there",
-            "            return",
-            "        nums = chunk.translate(NUMBERS).split()  # each word's number, line after line",
-            f"        if len(nums) != n * {len(letters)}:",
-            "            lane.retry = end",
-            "            return",
             "        raws = chunk.split('\\n')",
             "        fl = file_lines[pc:end]"]
     k_all = len(letters)
@@ -79,7 +88,7 @@ def streamed(letters: tuple[str, ...], g: int | None, f: int | None, programmed:
     for a, k in programmed:
         src += [f"        t_{a} = nums[{k}::{k_all}]",
                 f"        if ''.join(t_{a}).count('.') != n:  # N8.018: a point in every axis word (one at most)",
-                "            lane.retry = end",
+                "            lane.retry = pc + CHUNK",
                 "            return",
                 f"        c_{a} = list(map(float, t_{a}))"]
         cols.append(a)
@@ -93,7 +102,7 @@ def streamed(letters: tuple[str, ...], g: int | None, f: int | None, programmed:
         if a in words:  # the chunk's extremes inside +-1e9, so is every line's (`run`'s check: x -> x + o is monotone)
             half = " / 2.0" if a in diameter else ""
             src += [f"        if not (-1e9 <= min(c_{a}){half} + o{i} and max(c_{a}){half} + o{i} <= 1e9):",
-                    "            lane.retry = end  # line by line: the general path's 0x120E at its line",
+                    "            lane.retry = pc + CHUNK  # line by line: the general path's 0x120E at its line",
                     "            return"]
     src += ["        lane.runs += 1",
             f"        for vals, raw, line, {', '.join('v_' + c for c in cols)} in zip(found, raws, fl, "
@@ -173,7 +182,6 @@ def streamed(letters: tuple[str, ...], g: int | None, f: int | None, programmed:
             "            ip.position = {**end_}  # a copy (cloned: half the cost of building it)",
             "            ip.last_target = work",
             "            yield mv"]
-    space = dict(space, CHUNK=CHUNK, SKELETON=SKELETON, NUMBERS=NUMBERS, LETTERS="".join(letters),
-                 EXPECT="\n".join(["".join(letters)] * CHUNK))
+    space = dict(space, CHUNK=CHUNK, CHUNK_AT=chunk_at, EXPECT="\n".join(["".join(letters)] * CHUNK))
     exec(compile("\n".join(src) + "\n", f"<lean run {''.join(letters)}>", "exec"), space)
     return space["stream"]
