@@ -178,15 +178,19 @@ class SoftLimits:
 
 
 def _box_test(box: dict[str, tuple[float, float]]) -> Callable[[dict, dict], bool]:
-    """`_inside`'s box test for these axes as straight-line code: True when both ends hold exactly the box's axes,
-    each inside (the bounds as literals). False is "not known" (a NaN, another axis set): `_inside` decides."""
+    """`_inside`'s box test for these axes as straight-line code: True when both ends hold as many axes as the box,
+    each inside it (a NaN passes, as `_inside`'s loop lets it: `check` finds no alarm for it either; an axis of
+    another name raises KeyError). The bounds are literals, each test one compare-and-branch. False is "not known":
+    `_inside` decides."""
     def lit(v: float) -> str:
         return "1e999" if v == math.inf else "-1e999" if v == -math.inf else repr(v)
-    terms = [f"len(s) == {len(box)} == len(e)"]
+    src = ["def inside(s, e):", f"    if len(s) != {len(box)} or len(e) != {len(box)}:", "        return False"]
     for p in "se":
-        terms += [f"{lit(lo)} <= {p}[{a!r}] <= {lit(hi)}" for a, (lo, hi) in box.items()]
+        for a, (lo, hi) in box.items():
+            src += [f"    v = {p}[{a!r}]", f"    if v < {lit(lo)} or v > {lit(hi)}:", "        return False"]
+    src.append("    return True")
     space: dict = {}
-    exec(compile("def inside(s, e):\n    return " + " and ".join(terms) + "\n", "<soft-limit box>", "exec"), space)
+    exec(compile("\n".join(src) + "\n", "<soft-limit box>", "exec"), space)
     return space["inside"]
 
 

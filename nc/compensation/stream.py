@@ -285,12 +285,16 @@ def disabled() -> Iterator[None]:
         _ENABLED.pop()
 
 
-def compensate(events: Iterable[Event], profile: object | None = None) -> Iterator[Event]:
-    """Wrap an event stream; moves without `comp` pass through unchanged and in order."""
+def compensate(events: Iterable[Event], profile: object | None = None, passing: object | None = None) -> Iterator[Event]:
+    """Wrap an event stream; moves without `comp` pass through unchanged and in order. `passing` (nc.interp.preview's
+    `Passing`) is given the Compensator: the preview window reads the lean lane's runs past this stage while it is
+    idle."""
     if not _ENABLED[-1]:
         yield from events
         return
     comp = Compensator()
+    if passing is not None:
+        passing.comp = comp  # type: ignore[attr-defined]
     for ev in events:
         # idle and not compensated: push would hand the event back as it is (issue 16: a lathe cycle's
         # thousands of moves pass here)

@@ -16,6 +16,7 @@ from nc.alarms import NcAlarm, internal_error
 from nc.budget import StatementBudget
 from nc.interp.corners import expand_corners
 from nc.interp.lean import MISS, NOTHING, LeanLane
+from nc.interp.preview import Passing, PreviewWindow
 from nc.interp.servo import ServoPort
 from nc.interp.state import Frames, ModalState
 from nc.interp.sysvars import SystemVariables
@@ -122,17 +123,17 @@ class Interpreter(ExecuteMixin, ReadingMixin, ModalMixin, MotionMixin, NonModalM
         self.position.update(machine)
 
     def run(self, program: Program, *, preview: bool = True) -> Iterator[Event]:
-        events: Iterator[Event] = expand_corners(self, self._run(program))
+        passing = Passing() if preview else None  # what the preview window may read past the stages
+        events: Iterator[Event] = expand_corners(self, self._run(program, passing))
         comp = _compensation()
         if comp is not None:
-            events = comp(events, self.profile)
+            events = comp(events, self.profile, passing)
         if preview:
-            from nc.interp.preview import PreviewWindow
-            events = iter(PreviewWindow(self, events, int(self.profile.param("preview depth", 8))))
+            events = iter(PreviewWindow(self, events, int(self.profile.param("preview depth", 8)), passing))
         return events
 
     # ---- the program counter -----------------------------------------------------------------
-    def _run(self, program: Program) -> Iterator[Event]:
+    def _run(self, program: Program, passing: Passing | None = None) -> Iterator[Event]:
         """The program counter, with a bug in the interpreter reported as 0x0000 at the block it was reading (the
         guide's standard: an internal error names the file, line and block too), not without a place. One
         generator (the guard was a second one around it, a frame resumed a block: issue 17, decisions bench B173)."""
@@ -209,8 +210,14 @@ class Interpreter(ExecuteMixin, ReadingMixin, ModalMixin, MotionMixin, NonModalM
                                 # (nc.interp.lean_run, issue 17): until one is not, or anything may differ
                                 if bulk is None and (stream := lean.last.stream) is not None \
                                         and (pc := fr.pc) >= lean.retry:
-                                    yield from stream(lean, self, fr, pc, limit, text, starts, lengths, file_lines,
+                                    lean_run = stream(lean, self, fr, pc, limit, text, starts, lengths, file_lines,
                                                       count, budget)
+                                    if passing is None:
+                                        yield from lean_run
+                                    else:  # the preview window may read it past the stages (nc.interp.preview)
+                                        passing.stream = lean_run
+                                        yield from lean_run  # at once done when the window has read it to its end
+                                        passing.stream = None
                                     last = self.block
                             continue
                     block = blocks[pc]

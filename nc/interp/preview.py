@@ -14,6 +14,7 @@ from collections import deque
 from collections.abc import Iterator
 from typing import TYPE_CHECKING
 
+from nc.alarms import NcAlarm, internal_error
 from nc.interp.records import PreviewRecord
 from nc.moves import Busy, Event, Move, MoveBatch, MoveList, Sync
 
@@ -21,10 +22,26 @@ if TYPE_CHECKING:  # pragma: no cover
     from nc.interp.host import InterpHost
 
 
+class Passing:
+    """What the preview window may read past the corner and compensation stages (issue 17, decisions bench B173): the
+    lean lane's run the program counter hands out (`stream`, nc.interp.lean_run: plain Moves without ,C/,R or radius
+    compensation, each made as the interpreter stands after it), and the compensator of the stream (`comp`, None
+    without one). While no corner waits and the compensator holds nothing, both stages would only pass such a Move
+    on: the window reads the run itself (three generator frames less a Move), and once the run is done the stages
+    read on from where they stand (the program counter's `yield from` of a finished run returns at once)."""
+
+    __slots__ = ("stream", "comp")
+
+    def __init__(self) -> None:
+        self.stream: Iterator[Move] | None = None
+        self.comp: object = None
+
+
 class PreviewWindow:
-    def __init__(self, interp: "InterpHost", events: Iterator[Event], depth: int) -> None:
+    def __init__(self, interp: "InterpHost", events: Iterator[Event], depth: int, passing: Passing | None = None) -> None:
         self.interp = interp
         self.events = events
+        self.passing = passing
         self.depth = max(0, depth)
         self.buf: deque[Event] = deque()
         self.executing: Move | None = None  # the motion block the machine is running now
@@ -49,6 +66,7 @@ class PreviewWindow:
         done = False
         failure: Exception | None = None
         buf, events, depth = self.buf, self.events, self.depth
+        interp, passing = self.interp, self.passing
         # counts of the Moves and Syncs in buf, kept as events enter and leave (hot path: no rescans)
         moves = syncs = 0
         while True:
@@ -70,6 +88,26 @@ class PreviewWindow:
                                 else:
                                     moves, syncs = self._left(out, moves, syncs)
                                 yield out
+                            if passing is not None and (run := passing.stream) is not None \
+                                    and not interp.corner_pending \
+                                    and ((comp := passing.comp) is None or (comp.pending is None and comp.out_pos is None)):
+                                # the lean lane's run, read past the stages (`Passing`): the same steps a Move
+                                try:
+                                    for ev in run:
+                                        buf.append(ev)
+                                        moves += 1
+                                        while moves > depth:
+                                            out = buf.popleft()
+                                            if type(out) is Move:
+                                                moves -= 1
+                                                self.executing = out
+                                            else:
+                                                moves, syncs = self._left(out, moves, syncs)
+                                            yield out
+                                except Exception as exc:  # a bug: 0x0000 at the block, as the program counter says it
+                                    b = interp.block
+                                    raise NcAlarm(0x0000, internal_error(exc).message, line=getattr(b, "line", None),
+                                                  block=getattr(b, "text", None), program=interp.program_name) from exc
                             continue
                         if isinstance(ev, Busy):  # the statement budget is spent: the channel reads on next cycle
                             yield ev
