@@ -4,8 +4,10 @@ block by block leaves it: the event, the position, the last target, the program 
 block, the program, the modal state, the # variables. Runs of one shape (N, G, F, lower case, blanks, tabs) of up to
 200 lines meet what stops a run: a line of another shape, a word without a point, a block the parser keeps (a
 comment, '/'), a macro call, a variable or offset written by the program or from outside between two events, a
-mode change, an alarm, a statement budget, an M96 interrupt through a channel. `SoftLimits.check`'s box test
-(straight-line code) gives the full check's alarm on a run of moves checked one after the other."""
+mode change, radius compensation and its cancel, a ,C/,R corner, an alarm, a statement budget, an M96 interrupt
+through a channel; with and without the preview window (which reads a run past the corner and compensation stages
+while both are idle). `SoftLimits.check`'s box test (straight-line code) gives the full check's alarm on a run of
+moves checked one after the other."""
 
 from __future__ import annotations
 
@@ -96,7 +98,9 @@ def run_of_one_shape(draw) -> list[str]:
 
 BETWEEN = ["G91", "G90", "G55", "G54", "G10 L2 P1 X0.5 Y-0.25", "#100 = #5001 + #4001", "#1 = #1 + 0.5",
            "X#1 Y2.", "(a comment)", "X1. Y2. (why)", "/X3. Y3.", "", "G65 P9000 A1.", "M98 P9001", "G1 X3000000000.",
-           "F-1", "G0", "G1 F2000", "G61", "G64", "N7 G1 X1. F800", "G04 P10", "M3 S500", "X5 Y5", "G10 L2 P2 Z1."]
+           "F-1", "G0", "G1 F2000", "G61", "G64", "N7 G1 X1. F800", "G04 P10", "M3 S500", "X5 Y5", "G10 L2 P2 Z1.",
+           "G10 L12 P1 R2.\nG41 D1 X10. Y10.\nX20.\nG40 X0 Y0", "G10 L12 P1 R2.\nG42 D1 X5. Y5.\nG40",
+           "X10. Y10. ,C1.", "X20. Y10. ,R2.", "G17", "G18\nG17"]
 
 
 @st.composite
@@ -154,6 +158,15 @@ def test_a_word_without_a_point_mid_run_is_read_by_n8018() -> None:
     trace, alarm, _ = _same("O1000\nG90 G1 F2000\n" + "\n".join(lines) + "\nM30\n")
     assert alarm is None
     assert [s[0] for e, s in trace if e.startswith("Move(")][50] == {"X": 0.007, "Y": 0.007, "Z": 0.0}
+
+
+@pytest.mark.parametrize("before", ["G10 L12 P1 R2.\nG41 D1 X10. Y10.\nX20.\nG40 X0 Y0",
+                                    "G10 L12 P1 R2.\nG42 D1 X5. Y5.\nG40", "Y0.125 ,C0.01", "Y0.125 ,R0.01"])
+def test_runs_right_after_compensation_or_a_corner_through_the_preview_window(before: str) -> None:
+    """The lines right after a G40 (the compensator still holds the cancel move) or a ,C/,R block (its corner waits
+    for the next move) are not read past the stages: the events and the state at each are stepping's."""
+    trace, alarm, runs = _same("O1000\nG90 G17 G1 F2000\n" + before + "\n" + _cam(150) + "\nM30\n", preview=True)
+    assert alarm is None and runs > 0 and sum(e.startswith("Move(") for e, _ in trace) >= 150
 
 
 def test_through_a_channel_with_an_m96_interrupt_same_setpoints() -> None:
