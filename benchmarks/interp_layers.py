@@ -7,7 +7,7 @@ one of these through `functools.reduce`, and callgrind counts only inside `funct
 instruction for the same tree (interp_instructions.py's difference of two children moves by a few hundred a block):
 
 - `line`: the lean lane's line runner alone (`<lean line XY>`'s `run`), called on each line of the program;
-- `raw`: the interpreter's generator (`Interpreter._guarded`), every event taken;
+- `raw`: the interpreter's generator (`Interpreter._guarded`: `_run` since B173, its guard and the lean lane's runs in it), every event taken;
 - `stream`: `Interpreter.run` (+ the corner and compensation stages and the preview window), as the channel reads it;
 - `check`: `stream` and `SoftLimits.check` of each move (a bench's 1st segments), as hil's stretch reads do;
 - `parse`: `parse_program` of the program's text.

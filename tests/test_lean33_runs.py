@@ -132,6 +132,15 @@ def test_a_cam_program_reads_its_lines_in_runs_with_stepping_state() -> None:
     assert runs >= 1000 // 64  # the runs read them (a chunk of 64 lines at a time)
 
 
+def test_a_subprogram_called_twice_is_read_in_runs_both_times() -> None:
+    """A chunk refused at the subprogram's end (its M99) does not keep the next call from runs at its start."""
+    sub = "M30\nO9002\n" + _cam(150) + "\nM99\n"
+    once = _same("O1000\nG90 G1 F2000\nM98 P9002\n" + sub, preview=True)
+    trace, alarm, runs = _same("O1000\nG90 G1 F2000\nM98 P9002\nG10 L2 P1 X1.\nM98 P9002\n" + sub, preview=True)
+    assert alarm is None and sum(e.startswith("Move(") for e, _ in trace) == 300
+    assert once[2] >= 3 and runs == 2 * once[2]  # as many chunks the second time
+
+
 def test_an_offset_written_from_outside_mid_chunk_stops_the_run_there() -> None:
     """G54 X (#22002) written after the 70th move: the 71st line and after are read with the new origin, as
     stepping reads them; the run read the first lines."""

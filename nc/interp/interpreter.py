@@ -209,7 +209,7 @@ class Interpreter(ExecuteMixin, ReadingMixin, ModalMixin, MotionMixin, NonModalM
                                 # the lines after it of the same shape read in one pass, handed out Move by Move
                                 # (nc.interp.lean_run, issue 17): until one is not, or anything may differ
                                 if bulk is None and (stream := lean.last.stream) is not None \
-                                        and (pc := fr.pc) >= lean.retry:
+                                        and (pc := fr.pc) not in lean.retry:
                                     lean_run = stream(lean, self, fr, pc, limit, text, starts, lengths, file_lines,
                                                       count, budget)
                                     if passing is None:

@@ -22,7 +22,8 @@ would refuse or treat otherwise (F < 0, a cutting move without F, a target out o
 alarm at the same block. Unlike nc.interp.bulk (runs of lines as one `MoveBatch` for `hil path`),
 it yields Move by Move, so the channel's look-ahead, statement budget, M96 and the preview window
 see the same events at the same moments. tests/test_interp_lean.py and tests/test_lean25_equivalence.py
-compare both paths.
+compare both paths. The lines after one this lane ran, of the same shape, are read a chunk at a time by the shape's
+`stream` (nc.interp.lean_run, decisions bench B173: the same Moves and state, line by line).
 """
 
 from __future__ import annotations
@@ -91,7 +92,8 @@ class LeanLane:
         self.g_codes = lookup(ip.profile, 0.0) == (1, "G00") and lookup(ip.profile, 1.0) == (1, "G01")
         self.tables: object = None  # the code-call tables `g_ok` was found with
         self.g_ok = False
-        self.retry = 0  # `lean_run`: the program counter below which a run is not tried again (a chunk it refused)
+        self.retry = range(0)  # `lean_run`: the lines a run is not tried at (after a chunk it refused; an M99 loop
+        # or another call of the program starts below them and tries again)
         self.runs = 0  # chunks `lean_run` has read (tests see the runs were taken)
 
     def lines(self, blocks: object) -> tuple[tuple | None, set[int]]:

@@ -75,7 +75,7 @@ def streamed(letters: tuple[str, ...], g: int | None, f: int | None, programmed:
     src += ["    while True:",
             f"        got = CHUNK_AT(text, starts, lengths, pc, count, {''.join(letters)!r}, {len(letters)}, EXPECT)",
             "        if got is None:",
-            "            lane.retry = pc + CHUNK  # not of this shape: line by line up to there",
+            "            lane.retry = range(pc, pc + CHUNK)  # not of this shape: line by line up to there",
             "            return",
             "        n, chunk, nums = got",
             "        end = pc + n",
@@ -88,7 +88,7 @@ def streamed(letters: tuple[str, ...], g: int | None, f: int | None, programmed:
     for a, k in programmed:
         src += [f"        t_{a} = nums[{k}::{k_all}]",
                 f"        if ''.join(t_{a}).count('.') != n:  # N8.018: a point in every axis word (one at most)",
-                "            lane.retry = pc + CHUNK",
+                "            lane.retry = range(pc, pc + CHUNK)",
                 "            return",
                 f"        c_{a} = list(map(float, t_{a}))"]
         cols.append(a)
@@ -102,7 +102,7 @@ def streamed(letters: tuple[str, ...], g: int | None, f: int | None, programmed:
         if a in words:  # the chunk's extremes inside +-1e9, so is every line's (`run`'s check: x -> x + o is monotone)
             half = " / 2.0" if a in diameter else ""
             src += [f"        if not (-1e9 <= min(c_{a}){half} + o{i} and max(c_{a}){half} + o{i} <= 1e9):",
-                    "            lane.retry = pc + CHUNK  # line by line: the general path's 0x120E at its line",
+                    "            lane.retry = range(pc, pc + CHUNK)  # line by line: the general path's 0x120E at its line",
                     "            return"]
     src += ["        lane.runs += 1",
             f"        for vals, raw, line, {', '.join('v_' + c for c in cols)} in zip(found, raws, fl, "
