@@ -23,7 +23,6 @@ from nc.budget import StatementBudget
 from nc.interp import Interpreter
 from nc.moves import Busy, Move
 from nc.profiles import make_profile
-from nc.program.blocks import parse_program
 from nc.softlimits import SoftLimits
 from nc.store import ProgramStore
 from tests.test_lean25_equivalence import _setpoints
