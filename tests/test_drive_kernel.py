@@ -97,6 +97,46 @@ def test_csp_cycles_compiled_equal_their_source(n, steps, window, lim, bw, start
     assert outs[0] == outs[1]
 
 
+@settings(max_examples=150, deadline=None)
+@given(n=st.integers(1, 4), steps=st.lists(st.integers(-3000, 3000), min_size=1, max_size=40),
+       cut=st.integers(0, 40), bound=st.sampled_from([math.inf, 40.0, 300.0, 900.0]))
+def test_csp_cycles_keep_the_first_cycle_over_the_bench_overspeed_bound(n, steps, cut, bound):
+    """The bench's overspeed check (App. A 0x0602) reads 0x606C: csp_cycles keeps the first cycle whose velocity is
+    above `Stretch.limit` (`over_at`, -1: none) over parts stepped one after the other, as a pass steps them
+    (hil/stretch_pass.py, decision bench B178); the source, and the build where there is one."""
+    targets, x = [], 0
+    for s in steps:
+        x += s if s % 5 else 0  # (stops: still cycles, written as a repeat)
+        targets.append(x)
+    consts = _csp_consts(n, 1e9, (-math.inf, math.inf), 1500.0)
+    for mod in (PY, BUILT):
+        out = Stretch(limit=bound)
+        state, still = (-17.0, 0.0, 0.0, -17.0, None, 0.0, 0.0), None
+        for part in (targets[:cut], targets[cut:]):
+            state, still, ok = mod.csp_cycles(part, consts, state, still, out)
+            assert ok
+        va = out.velocity_actual
+        assert len(va) == len(targets)
+        assert out.over_at == next((k for k, v in enumerate(va) if abs(v) > bound), -1)
+
+
+def test_an_axis_speeding_up_is_over_the_bound_from_its_first_fast_cycle():
+    """A ramp of 0, 100, … 1,500 counts a cycle, stepped in two parts: 0x606C climbs past a bound of 300 once, and
+    `over_at` is that cycle (in the second part), for the source and the build alike."""
+    targets, x = [], 0
+    for k in range(16):
+        x += 100 * k
+        targets.append(x)
+    consts = _csp_consts(4, 1e9, (-math.inf, math.inf), 1500.0)
+    for mod in (PY, BUILT):
+        out = Stretch(limit=300.0)
+        state, still, _ = mod.csp_cycles(targets[:5], consts, (-17.0, 0.0, 0.0, -17.0, None, 0.0, 0.0), None, out)
+        assert out.over_at == -1 and max(map(abs, out.velocity_actual)) <= 300
+        mod.csp_cycles(targets[5:], consts, state, still, out)
+        first = next(k for k, v in enumerate(out.velocity_actual) if abs(v) > 300)
+        assert first > 5 and out.over_at == first
+
+
 @needs_build
 @settings(max_examples=150, deadline=None)
 @given(n=st.integers(1, 6), cycles=st.integers(1, 400), want=st.floats(-2e6, 2e6), tv=st.floats(-2e6, 2e6),

@@ -21,7 +21,8 @@ cpdef tuple csv_substeps(int n, double h, double ramp, double want, double tv, d
                pos=double, vel=double, t=double, command=double, acc=double, torque=double, over=double,
                ok=bint, rep=Py_ssize_t, target=double, prev=double, ff_vel=double, kff_ff=double, span=double,
                c_pos=double, c_vel=double, c_t=double, cmd=double, inside=bint, c_acc=double,
-               gap=double, moved=bint, pa=list, va=list, ta=list, fe=list, sws=list)
+               gap=double, moved=bint, pa=list, va=list, ta=list, fe=list, sws=list, lim=double, first=Py_ssize_t,
+               v_raw=long)
 cpdef tuple csp_cycles(object targets, tuple consts, tuple state, object still, object out)
 
 @cython.locals(n=int, h=double, max_cps=double, alpha=double, rad=double, reached_v=double, origin=double,

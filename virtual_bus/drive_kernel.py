@@ -97,8 +97,9 @@ def csv_substeps(n: int, h: float, ramp: float, want: float, tv: float, pos: flo
 
 def csp_cycles(targets: Sequence[int], consts: tuple, state: tuple, still: object, out: object
                ) -> tuple[tuple, object, bool]:
-    """CspRun.step's loop: one cycle per target, feedback appended to `out`'s columns; stops before a cycle that
-    would fault (a limit switch, the following error window, overspeed: exchange() takes it). Returns (state,
+    """CspRun.step's loop: one cycle per target, feedback appended to `out`'s columns (and `out.over_at` set: the
+    first cycle above `out.limit`); stops before a cycle that would fault (a limit switch, the following error
+    window, overspeed: exchange() takes it). Returns (state,
     the target of a cycle that left the drive as it found it or None, whether it ran to the end)."""
     (n, h, max_cps, alpha, rad, reached_v, kp, kff, window, origin, k_raw, t_pct, inertia, viscous, coulomb, rated,
      lo, hi, base, dt, limited) = consts
@@ -106,6 +107,10 @@ def csp_cycles(targets: Sequence[int], consts: tuple, state: tuple, still: objec
     pa, va, ta, fe, sws = out.position_actual, out.velocity_actual, out.torque_actual, out.following_error, \
         out.statusword
     over = 1.2 * max_cps
+    # the bench's overspeed bound (App. A 0x0602, `Stretch.limit`): the first cycle whose 0x606C is above it is
+    # kept in `Stretch.over_at`, so a caller stepping a part at a time (hil/stretch_pass.py) does not scan them
+    lim = out.limit
+    first = out.over_at
     ok = True
     rep = 0  # still cycles not written yet: a run of them is written at once (repeat)
     for tgt in targets:
@@ -136,12 +141,16 @@ def csp_cycles(targets: Sequence[int], consts: tuple, state: tuple, still: objec
         sws.append(base | SW_TARGET_REACHED if abs(vel) < reached_v and abs(gap) < 10 else base)
         pa.append(nearest(pos + origin))  # (round of a float: an int)
         raw = nearest(vel * k_raw)
-        va.append(raw if -RAW_MAX <= raw <= RAW_MAX else max(-RAW_MAX, min(RAW_MAX, raw)))
+        v_raw = raw if -RAW_MAX <= raw <= RAW_MAX else max(-RAW_MAX, min(RAW_MAX, raw))
+        va.append(v_raw)
+        if first < 0 and (v_raw > lim or -v_raw > lim):
+            first = len(va) - 1  # (a still cycle repeats the last one: never the first above the bound)
         ta.append(nearest(torque * 0.1 / t_pct))
         fe.append(nearest(gap))
         still = tgt if before is not None and same(before, (pos, vel, command, prev_target, acc, torque)) else None
     if rep:
         t = repeat(out, t, h, n, True, rep)
+    out.over_at = first
     return (pos, vel, t, command, prev_target, acc, torque), still, ok
 
 

@@ -34,6 +34,10 @@ class Stretch:
     following_error: list[int] = field(default_factory=list)
     statusword: list[int] = field(default_factory=list)
     last: TxPdo | None = None
+    # the bench's overspeed bound on 0x606C (App. A 0x0602; inf: none) and the first cycle above it (-1: none),
+    # which drive_kernel.csp_cycles keeps as it writes the cycles (a pass checks it a part at a time)
+    limit: float = math.inf
+    over_at: int = -1
 
 
 def can_stretch(drive: Cia402Drive, rx: RxPdo, mode: int = 8) -> bool:
