@@ -33,6 +33,7 @@ from nc.channel import READS_PER_CYCLE, Channel
 from nc.motion.planner import Planner
 from nc.motion.stretch import Samples, cut_rows, refuses
 from virtual_bus.drive_stretch import CspRun, CsvRun, Stretch
+from virtual_bus.kernels import drive_kernel
 
 PLAN_KINDS = ("path", "ramp", "cruise")
 FEW = 12  # rows below which the filter takes them one by one (Pass._flush)
@@ -265,14 +266,7 @@ class Pass:
         out, c = self.out_rows, self.converted
         if c == len(out):
             return
-        rows = out[c:] if c else out
-        if len(rows) == 1:
-            row = rows[0]
-            for i, (t, (cpu, o)) in enumerate(zip(self.targets, self.to_counts)):
-                t.append(round((row[i] - o) * cpu))
-        else:
-            for i, (t, (cpu, o)) in enumerate(zip(self.targets, self.to_counts)):
-                t += [round((row[i] - o) * cpu) for row in rows]  # (round: an int)
+        drive_kernel.to_counts(out, c, self.to_counts, self.targets)  # (the drive kernel: round() on C doubles)
         self.converted = len(out)
 
     def _drive(self, upto: int) -> int | None:

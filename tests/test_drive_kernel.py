@@ -202,3 +202,18 @@ def test_a_build_older_than_its_source_is_not_run(tmp_path):
     assert kernels.build_of(str(built), str(src)).startswith("python (the compiled build is older")
     assert kernels.build_of(str(src), str(src)).startswith("python (not compiled")
     assert kernels.build_of(None, str(src)).startswith("python (not compiled")
+
+
+@settings(max_examples=300, deadline=None)
+@given(rows=st.lists(st.lists(finite | st.sampled_from(_HALVES), min_size=3, max_size=3), min_size=1, max_size=8),
+       c=st.integers(0, 8), cpu=st.sampled_from([256.0, 1e4 / 3.0, -128000.0, 1.0]),
+       origin=st.sampled_from([0.0, 12.5, -3.25]))
+def test_to_counts_are_the_axis_scalings_rounded_counts(rows, c, cpu, origin):
+    """A stretch's 0x607A targets (B178): round((x - origin) × counts per unit) of each axis's setpoints from row c
+    on, appended to the targets so far, halves to even; the source and the build alike."""
+    scales = [(cpu, origin), (-cpu, -origin), (cpu * 2.0, origin)]
+    want = [[7] + [round((r[i] - o) * k) for r in rows[c:]] for i, (k, o) in enumerate(scales)]
+    for mod in (PY, BUILT):
+        targets = [[7], [7], [7]]
+        mod.to_counts(rows, c, scales, targets)
+        assert targets == want

@@ -7,6 +7,9 @@ cdef long SW_TARGET_REACHED
 cdef long RAW_MAX
 cdef double _EXACT
 
+@cython.locals(i=Py_ssize_t, k=Py_ssize_t, cpu=double, o=double, t=list)
+cpdef to_counts(list rows, Py_ssize_t c, list scales, list targets)
+
 @cython.locals(k=int, cmd=double, v_cmd=double, neg=double, inside=bint)
 cpdef tuple csp_substeps(int n, double h, double prev, double span, double kff_ff, double kp, double pos,
                          double vel, double t, double max_cps, double alpha, bint limited, double lo, double hi)

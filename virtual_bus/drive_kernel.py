@@ -13,7 +13,8 @@ the source (`virtual_bus.kernels` says which one runs).
 - `csp_cycles` / `csv_cycles`: a stretch's cycles of CspRun.step / CsvRun.step (virtual_bus/drive_stretch.py): the
   sub-steps, the supervision's two tests, the torque and the feedback columns, cycle after cycle;
 - `repeat`, `at_speed`, `same`: a cycle repeated, a spindle at its speed, two states equal bit for bit;
-- `nearest`, `coulomb_of`: Python's round() and the friction term on C doubles (no Python call a value compiled).
+- `nearest`, `coulomb_of`: Python's round() and the friction term on C doubles (no Python call a value compiled);
+- `to_counts`: the drives' target counts of a stretch's setpoints (AxisScaling.to_counts, with `nearest`).
 """
 
 from __future__ import annotations
@@ -46,6 +47,19 @@ def coulomb_of(coulomb: float, vel: float) -> float:
     if abs(vel) > 1:
         return abs(coulomb) if vel > 0.0 else -abs(coulomb)
     return 0.0
+
+
+def to_counts(rows: list, c: int, scales: list, targets: list) -> None:
+    """Each axis's 0x607A targets of the setpoints rows[c:] (lists of floats, an axis a column), appended to its list
+    in `targets`: AxisScaling.to_counts's round((x - origin) × counts per unit), `nearest` on C doubles, with
+    `scales` each axis's (counts per unit, origin) (a stretch over the NC's steps converts a part's rows at once,
+    hil/stretch_pass.py `Pass._convert`: a round() call and a list comprehension an axis were ≈ 400 instructions a
+    value, decision bench B178)."""
+    for i in range(len(targets)):
+        cpu, o = scales[i]
+        t = targets[i]
+        for k in range(c, len(rows)):
+            t.append(nearest((rows[k][i] - o) * cpu))
 
 
 def csp_substeps(n: int, h: float, prev: float, span: float, kff_ff: float, kp: float, pos: float, vel: float,
@@ -151,6 +165,7 @@ def csp_cycles(targets: Sequence[int], consts: tuple, state: tuple, still: objec
     if rep:
         t = repeat(out, t, h, n, True, rep)
     out.over_at = first
+    out.done = len(pa)  # (CspRun.step settles its still cycles before: every cycle stepped is written)
     return (pos, vel, t, command, prev_target, acc, torque), still, ok
 
 

@@ -106,14 +106,14 @@ class CspRun:
         if not targets or not self.ok:
             return
         still = self.still
-        if still is not None and targets[0] == still and list(targets).count(still) == len(targets):
+        if still is not None and targets[0] == still \
+                and (targets if type(targets) is list else list(targets)).count(still) == len(targets):
             self.lag += len(targets)  # a standing axis (Z in an XY contour): no set-up, no loop, written later
             self.out.done += len(targets)
             return
         if self.lag:
             self._settle()
         self.state, self.still, self.ok = drive_kernel.csp_cycles(targets, self.consts, self.state, still, self.out)
-        self.out.done = len(self.out.position_actual)
 
     def _settle(self) -> None:
         """The still cycles counted (`lag`) written: the cycle that left the drive as it found it (_same), again."""
