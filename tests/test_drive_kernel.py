@@ -103,7 +103,7 @@ def test_csp_cycles_compiled_equal_their_source(n, steps, window, lim, bw, start
 def test_csp_cycles_keep_the_first_cycle_over_the_bench_overspeed_bound(n, steps, cut, bound):
     """The bench's overspeed check (App. A 0x0602) reads 0x606C: csp_cycles keeps the first cycle whose velocity is
     above `Stretch.limit` (`over_at`, -1: none) over parts stepped one after the other, as a pass steps them
-    (hil/stretch_pass.py, decision bench B178); the source, and the build where there is one."""
+    (hil/stretch_pass.py, decision bench B174); the source, and the build where there is one."""
     targets, x = [], 0
     for s in steps:
         x += s if s % 5 else 0  # (stops: still cycles, written as a repeat)
@@ -209,7 +209,7 @@ def test_a_build_older_than_its_source_is_not_run(tmp_path):
        c=st.integers(0, 8), cpu=st.sampled_from([256.0, 1e4 / 3.0, -128000.0, 1.0]),
        origin=st.sampled_from([0.0, 12.5, -3.25]))
 def test_to_counts_are_the_axis_scalings_rounded_counts(rows, c, cpu, origin):
-    """A stretch's 0x607A targets (B178): round((x - origin) × counts per unit) of each axis's setpoints from row c
+    """A stretch's 0x607A targets (B174): round((x - origin) × counts per unit) of each axis's setpoints from row c
     on, appended to the targets so far, halves to even; the source and the build alike."""
     scales = [(cpu, origin), (-cpu, -origin), (cpu * 2.0, origin)]
     want = [[7] + [round((r[i] - o) * k) for r in rows[c:]] for i, (k, o) in enumerate(scales)]

@@ -54,7 +54,7 @@ def to_counts(rows: list, c: int, scales: list, targets: list) -> None:
     in `targets`: AxisScaling.to_counts's round((x - origin) × counts per unit), `nearest` on C doubles, with
     `scales` each axis's (counts per unit, origin) (a stretch over the NC's steps converts a part's rows at once,
     hil/stretch_pass.py `Pass._convert`: a round() call and a list comprehension an axis were ≈ 400 instructions a
-    value, decision bench B178)."""
+    value, decision bench B174)."""
     for i in range(len(targets)):
         cpu, o = scales[i]
         t = targets[i]
