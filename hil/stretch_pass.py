@@ -81,8 +81,7 @@ class Pass:
         self.rx0, self.saved_drives = rx0, saved_drives
         self.parts: list[tuple] = []  # each take's (raw rows, λ, lines, path speeds, move, moves) (take_parts)
         self.out_rows: list[list[float]] = []  # the filtered rows, `filtered` of them
-        self.pending: list[tuple[np.ndarray, np.ndarray | None]] = []  # (raw rows, λ) not filtered yet
-        self.raws: list[np.ndarray] = []  # every part's raw rows
+        self.pend = 0  # parts[pend:] are not filtered yet (their raw rows and λ: a part's first two)
         self.filtered = 0
         self.rows = 0
         self.runs: list[CspRun | CsvRun] | None = None  # the drive models over the cycles driven (made at the first part)
@@ -150,7 +149,7 @@ class Pass:
         pl = self.pl
         pos, i = pl._buf_pos, pl._buf_i
         refill = pos is None or i >= len(pos)  # (Planner._buf_done, spelt out: a property call a part)
-        if refill and self.pending:
+        if refill and self.pend < len(self.parts):
             # a refill reads the filter: at rest whether it settled, and a solve its state (a filter start or stop
             # is checked on a copy of it, decision motion 52)
             self._flush()
@@ -160,49 +159,42 @@ class Pass:
         # A step that may change the planner (a refill, a cruise's next block) is not saved before it (issue 17,
         # decision bench B159): the one refused (once a stretch) is undone from the mark's save, the steps since
         # made again (`_rewind`; they are deterministic, as `_back` makes them)
-        blk = pl._buf_blk
-        changes = refill or blk is not None
+        changes = refill or pl._buf_blk is not None
         got = None
         try:
             pl._before_take()
-            got = self._take_part(pl, limit)
+            # `take_parts(pl, limit', cruise)` of a plan the pass samples, its checks made once here (a part is a
+            # cycle or two of a CAM program; issue 17, decision bench B165), the rows taken by the same `refuses`
+            # and `cut_rows`; none where the pass cannot take them. limit' is 1 where the next cycle's feed reads, a
+            # cruise's `_across` bound otherwise (the rows up to the first cycle whose feed would read). Inline, not
+            # a method of its own: a call and the planner's fields read again a part (B178)
+            pos, i, p, blocks = pl._buf_pos, pl._buf_i, pl.plan, pl.blocks
+            if pos is not None and i < len(pos) and p is not None and p.kind in PLAN_KINDS and blocks \
+                    and not pl._integrate_angle:
+                mv = blocks[0].move
+                if mv.css is None and not refuses(pl, mv):
+                    blk = pl._buf_blk
+                    if self.reads and ((q := len(blocks)) < self.depth or (pl._filling and q < self.fill_to)):
+                        limit = 1  # the next cycle reads: a feed comes between
+                    elif blk is not None:
+                        limit = _across(self.ch, pl, limit)
+                    if blk is None:  # (Planner._block_rows outside a cruise: the buffer's rows left)
+                        m = len(pos) - i
+                        if limit < m:
+                            m = limit
+                    else:
+                        m = pl._cruise_rows(limit)
+                    if m > 0:  # (else the next row starts the cruise's next block: step() finishes this one)
+                        got = cut_rows(pl, i, m, mv)
         except NcAlarm:  # the step raises: stepping raises it in its own cycle
             got = None
         if got is None:
             if changes:
                 self._rewind()
             return False
-        raw = got[0]
         self.parts.append(got)
-        self.raws.append(raw)
-        self.pending.append((raw, got[1]))
-        self.rows += len(raw)
+        self.rows += len(got[0])
         return True
-
-    def _take_part(self, pl: Planner, limit: int) -> tuple | None:
-        """After the step's `_before_take`: `take_parts(pl, limit', cruise)` of a plan the pass samples, its checks
-        made once here (a part is a cycle or two of a CAM program; issue 17, decision bench B165), the rows taken by
-        the same `refuses` and `cut_rows`; None where the pass cannot take it. limit' is 1 where the next cycle's
-        feed reads, a cruise's `_across` bound otherwise (the rows up to the first cycle whose feed would read)."""
-        pos, i = pl._buf_pos, pl._buf_i
-        p = pl.plan
-        blocks = pl.blocks
-        if pos is None or i >= len(pos) or p is None or p.kind not in PLAN_KINDS or not blocks \
-                or pl._integrate_angle:
-            return None
-        mv = blocks[0].move
-        if mv.css is not None or refuses(pl, mv):
-            return None
-        blk = pl._buf_blk
-        if self.reads and ((q := len(blocks)) < self.depth or (pl._filling and q < self.fill_to)):
-            limit = 1  # the next cycle reads: a feed comes between
-        elif blk is not None:
-            limit = _across(self.ch, pl, limit)
-        # (Planner._block_rows outside a cruise: the buffer's rows left)
-        m = min(limit, len(pos) - i) if blk is None else pl._cruise_rows(limit)
-        if m <= 0:
-            return None  # the next row starts the cruise's next block: step() finishes this one
-        return cut_rows(pl, i, m, mv)
 
     def _rewind(self) -> None:
         """The planner as before the step just refused: from the mark's save, the steps since made again (they
@@ -220,8 +212,7 @@ class Pass:
         _restore_planner(self.pl, saved)  # (a mark is taken after a feed, whose drive check flushed the filter)
         moved = self.rows != rows
         del self.parts[nparts:]
-        del self.raws[nparts:]
-        self.pending = []
+        self.pend = nparts
         self.rows = self.filtered = rows
         del self.out_rows[rows:]
         if self.converted > rows:
@@ -233,34 +224,39 @@ class Pass:
     def _flush(self) -> None:
         """The rows taken since the last flush through the position filter (push_many at once, push_rows row by
         row: each gives what step()'s push gives row by row)."""
-        pending = self.pending
-        if not pending:
+        parts, k = self.parts, self.pend
+        n = len(parts)
+        if k == n:
             return
-        self.pending = []
+        self.pend = n
         f = self.pl.filter
-        if len(pending) == 1:  # (most flushes: a part of one take)
-            raw, lam = pending[0]
+        if k == n - 1:  # (most flushes: a part of one take)
+            raw, lam = parts[k][0], parts[k][1]
             if f is not None and len(raw) >= FEW:
                 rows = f.push_many(raw, lam).tolist()
             else:  # push_many's numpy costs ≈ 35 µs whatever the rows; push_rows ≈ 1.5 µs a row, the same bits
                 rows = raw.tolist()
                 if f is not None:
                     rows = f.push_rows(rows, None if lam is None else lam.tolist())
-        elif f is not None and sum(len(r) for r, _ in pending) >= FEW:
-            raw = np.concatenate([r for r, _ in pending])
-            lam = None if all(lm is None for _, lm in pending) else \
-                np.concatenate([np.ones(len(r)) if lm is None else lm for r, lm in pending])
+            self.out_rows += rows  # (an array once, in samples())
+            self.filtered += len(rows)
+            return
+        pending = parts[k:]
+        if f is not None and sum(len(p[0]) for p in pending) >= FEW:
+            raw = np.concatenate([p[0] for p in pending])
+            lam = None if all(p[1] is None for p in pending) else \
+                np.concatenate([np.ones(len(p[0])) if p[1] is None else p[1] for p in pending])
             rows = f.push_many(raw, lam).tolist()
         else:
             rows = []
-            for r, _ in pending:
-                rows += r.tolist()
+            for p in pending:
+                rows += p[0].tolist()
             if f is not None:
                 lams: list[float] | None = None
-                if any(lm is not None for _, lm in pending):
+                if any(p[1] is not None for p in pending):
                     lams = []
-                    for r, lm in pending:
-                        lams += [1.0] * len(r) if lm is None else lm.tolist()
+                    for p in pending:
+                        lams += [1.0] * len(p[0]) if p[1] is None else p[1].tolist()
                 rows = f.push_rows(rows, lams)
         self.out_rows += rows  # (an array once, in samples())
         self.filtered += len(rows)
@@ -276,7 +272,7 @@ class Pass:
     def _drive(self, upto: int) -> int | None:
         """The drive models over cycles driven … upto-1 (cycle k steps to the setpoint of cycle k-1); the first
         cycle a drive or the bench's overspeed check would fault in, else None."""
-        if self.pending:
+        if self.pend < len(self.parts):
             self._flush()
         if self.converted != len(self.out_rows):
             self._convert()
@@ -348,4 +344,4 @@ class Pass:
         positions = np.fromiter(chain.from_iterable(out), np.float64, len(out) * len(out[0])).reshape(len(out), -1) \
             if out else np.array(out)
         return Samples(positions, lines, np.concatenate([p[3] for p in parts]).astype(float, copy=False),
-                       parts[0][4], moves, np.concatenate(self.raws))
+                       parts[0][4], moves, np.concatenate([p[0] for p in parts]))

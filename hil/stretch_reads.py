@@ -83,7 +83,11 @@ class Ahead:
             except Exception as e:  # StopIteration, an alarm: handed out as the feed would meet it
                 exc = e
             used = budget.used if budget is not None else 0
-            if exc is None and not used and _plain(ev, ch):
+            # a move the feed only pushes: no G31, thread, feed per revolution or G96, inside the soft limits (checked
+            # now, right after reading it, where the feed checks it in stepping); inline, a call less an event (B178)
+            if exc is None and not used and type(ev) is Move and ev.kind in PLAIN_KINDS and not ev.per_rev \
+                    and ev.css is None and "G31" not in ev.tags \
+                    and (ch.soft_limits is None or ch.soft_limits.check(ev) is None):
                 plain.append(ev)  # type: ignore[arg-type]
             else:
                 self.tail = (ev, exc, used, budget.peak if budget is not None else 0)
@@ -92,14 +96,6 @@ class Ahead:
         if saved is not None:
             budget.used, budget.peak = saved  # type: ignore[union-attr]
         return ok
-
-
-def _plain(ev: Event | None, ch: Channel) -> bool:
-    """A move the feed only pushes: no G31, thread, feed per revolution or G96, inside the soft limits (checked
-    now, right after reading it, where the feed checks it in stepping)."""
-    if type(ev) is not Move or ev.kind not in PLAIN_KINDS or ev.per_rev or ev.css is not None or "G31" in ev.tags:
-        return False
-    return ch.soft_limits is None or ch.soft_limits.check(ev) is None
 
 
 def ahead(ch: Channel) -> Ahead:
