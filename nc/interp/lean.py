@@ -34,7 +34,7 @@ from types import MappingProxyType
 from typing import TYPE_CHECKING, Any
 
 from nc.interp.gcodes import lookup
-from nc.interp.lean_run import streamed
+from nc.interp.lean_run import axes_dict, move_lines, streamed
 from nc.interp.records import _transforms
 from nc.interp.state import PLANES
 from nc.moves import Move
@@ -268,35 +268,9 @@ def _compiled(letters: tuple[str, ...], g: int | None, f: int | None, programmed
     if not moved:
         src.append("    return NOTHING")
     else:
-        def cols(p: str) -> str:
-            return "{" + ", ".join(f"{a!r}: {p}{i}" for i, a in enumerate(axes)) + "}"
-        # the Move made as Move(...) makes it, each of its fields set here (no __init__ frame with 23 arguments,
-        # issue 17); its start is the dict `position` was, which is rebound below and read nowhere else (no
-        # consumer changes a move's start or end in place)
-        src += ["    ip.unit_locked = True",
-                "    mv = NEW(Move)",
-                "    if motion == 0:",
-                "        mv.kind = 'rapid'",
-                "        mv.feed = None",
-                "        mv.per_rev = False",
-                "    else:",
-                "        mv.kind = 'line'",
-                "        mv.feed = mfeed",
-                "        mv.per_rev = st.per_rev",
-                "    mv.line = line",
-                "    mv.block = raw",
-                "    mv.start = position",
-                f"    mv.end = {cols('m')}",
-                f"    mv.work = work = {cols('w')}",
-                "    mv.center = mv.dir = mv.duration = mv.lead = mv.comp = None",
-                "    mv.plane = PLANES[st.plane]",
-                "    mv.exact_stop = st.exact_stop_modal",
-                "    mv.lead_change = mv.start_angle = mv.turns = mv.comp_radius = 0.0",
-                "    mv.program = name",
-                "    mv.tags = ()",
-                "    mv.tip = 0",
-                "    mv.css = st.surface_speed if st.css else None",
-                f"    ip.position = {cols('m')}",
+        # its start is the dict `position` was, rebound below (nc.interp.lean_run.move_lines)
+        src += move_lines("    ", axes)
+        src += [f"    ip.position = {axes_dict(axes, 'm')}",
                 "    ip.last_target = work  # never changed in place (rebound by every block that moves)",
                 "    return mv"]
     space = {"_G_MOTION": _G_MOTION, "Word": Word, "Move": Move, "PLANES": PLANES, "NOTHING": NOTHING,

@@ -58,6 +58,43 @@ def chunk_at(text: str, starts: Sequence[int], lengths: Sequence[int], pc: int, 
     return None
 
 
+def axes_dict(axes: Sequence[str], p: str) -> str:
+    """The source of the dict of the axes' values `p0`, `p1`, ... (`{'X': m0, 'Y': m1}`)."""
+    return "{" + ", ".join(f"{a!r}: {p}{i}" for i, a in enumerate(axes)) + "}"
+
+
+def move_lines(pad: str, axes: Sequence[str]) -> list[str]:
+    """The source of a line's Move, made as Move(...) makes it, each of its fields set (no __init__ frame with 23
+    arguments, issue 17), indented by `pad`: the lean lane's `run` (nc.interp.lean) and a run's `stream` make it
+    alike. Its end (the axes' `m0`, `m1`, ...) is also bound to `end_` and its work coordinates to `work`. Its start
+    is the dict `position` was, which the caller rebinds and nothing else reads (no consumer changes a move's start
+    or end in place)."""
+    return [pad + x for x in (
+        "ip.unit_locked = True",
+        "mv = NEW(Move)",
+        "if motion == 0:",
+        "    mv.kind = 'rapid'",
+        "    mv.feed = None",
+        "    mv.per_rev = False",
+        "else:",
+        "    mv.kind = 'line'",
+        "    mv.feed = mfeed",
+        "    mv.per_rev = st.per_rev",
+        "mv.line = line",
+        "mv.block = raw",
+        "mv.start = position",
+        f"mv.end = end_ = {axes_dict(axes, 'm')}",
+        f"mv.work = work = {axes_dict(axes, 'w')}",
+        "mv.center = mv.dir = mv.duration = mv.lead = mv.comp = None",
+        "mv.plane = PLANES[st.plane]",
+        "mv.exact_stop = st.exact_stop_modal",
+        "mv.lead_change = mv.start_angle = mv.turns = mv.comp_radius = 0.0",
+        "mv.program = name",
+        "mv.tags = ()",
+        "mv.tip = 0",
+        "mv.css = st.surface_speed if st.css else None")]
+
+
 def streamed(letters: tuple[str, ...], g: int | None, f: int | None, programmed: tuple[tuple[str, int], ...],
              axes: tuple[str, ...], diameter: frozenset[str] | tuple[str, ...], space: dict) -> Callable[..., object]:
     """The run generator of a shape that moves (`programmed` not empty): `lean._compiled`'s line, step for step,
@@ -141,8 +178,6 @@ def streamed(letters: tuple[str, ...], g: int | None, f: int | None, programmed:
             src += [f"            if not -1e9 <= m{i} <= 1e9:",
                     "                return"]
 
-    def dct(p: str) -> str:
-        return "{" + ", ".join(f"{a!r}: {p}{i}" for i, a in enumerate(axes)) + "}"
     src += ["            pc += 1",
             "            fr.pc = pc",
             "            ip._executed += 1",
@@ -156,30 +191,8 @@ def streamed(letters: tuple[str, ...], g: int | None, f: int | None, programmed:
         src += ["            st.groups[1] = float(v_G)", "            st.motion = motion"]
     if f is not None:
         src.append("            st.feed = feed")
-    src += ["            ip.unit_locked = True",
-            "            mv = NEW(Move)",
-            "            if motion == 0:",
-            "                mv.kind = 'rapid'",
-            "                mv.feed = None",
-            "                mv.per_rev = False",
-            "            else:",
-            "                mv.kind = 'line'",
-            "                mv.feed = mfeed",
-            "                mv.per_rev = st.per_rev",
-            "            mv.line = line",
-            "            mv.block = raw",
-            "            mv.start = position",
-            f"            mv.end = end_ = {dct('m')}",
-            f"            mv.work = work = {dct('w')}",
-            "            mv.center = mv.dir = mv.duration = mv.lead = mv.comp = None",
-            "            mv.plane = PLANES[st.plane]",
-            "            mv.exact_stop = st.exact_stop_modal",
-            "            mv.lead_change = mv.start_angle = mv.turns = mv.comp_radius = 0.0",
-            "            mv.program = name",
-            "            mv.tags = ()",
-            "            mv.tip = 0",
-            "            mv.css = st.surface_speed if st.css else None",
-            "            ip.position = {**end_}  # a copy (cloned: half the cost of building it)",
+    src += move_lines("            ", axes)
+    src += ["            ip.position = {**end_}  # a copy (cloned: half the cost of building it)",
             "            ip.last_target = work",
             "            yield mv"]
     space = dict(space, CHUNK=CHUNK, CHUNK_AT=chunk_at, EXPECT="\n".join(["".join(letters)] * CHUNK))
