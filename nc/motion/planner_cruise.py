@@ -15,6 +15,7 @@ except ImportError:  # run as Python without Cython: they do nothing
 from nc.motion.block import Block
 from nc.motion.plan_core import PlanCore  # the planner's C fields where compiled (bench B172)
 from nc.motion.plan_state import CHUNK, _Plan
+from nc.motion.sample_rows import slab_rows  # a cruise's buffers as slab rows (bench B176)
 
 # Rows a cruise samples at a refill: whole blocks until at least this many. Its cost is per block (~45 blocks for
 # 64 rows on the CAM program: 0.2-0.7 ms in one cycle, a real-time cycle's spike); the chain goes on at the next
@@ -270,8 +271,10 @@ class CruiseSampling:
         p.carry = carry  # (the plan's fields written once, for its last block)
         p.last = k
         p.emitted = True
-        self._buf_pos = np.array(pos) if pos else np.empty((0, len(self.axes)))
-        self._buf_vel = np.full(rows, v)
+        if pos:
+            self._buf_pos, self._buf_vel = slab_rows(pos, len(pos[0]), rows, v)  # np.array(pos), np.full(rows, v)
+        else:
+            self._buf_pos, self._buf_vel = np.empty((0, len(self.axes))), np.full(rows, v)
         self._buf_line = lines
         self._buf_state = [(x, v, 0.0) for x in st]
         self._buf_blk = offs

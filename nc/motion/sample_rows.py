@@ -23,6 +23,7 @@ except ImportError:  # run as Python without Cython: they do nothing
     from nc.motion import cython_shadow as cython
 
 from nc.motion.block import Block
+from nc.motion.plan_core import PlanCore  # the planner's C fields where compiled (bench B172)
 from nc.motion.plan_state import _Plan
 from nc.motion.profile import _lists0, _pos_at, _row_at  # Piecewise.at's steps (C functions compiled)
 
@@ -58,10 +59,11 @@ _slab = _Slab(3)
                lo=cython.Py_ssize_t, hi=cython.Py_ssize_t, mid=cython.Py_ssize_t, i=cython.Py_ssize_t,
                m=cython.Py_ssize_t, k=cython.Py_ssize_t, q0=cython.double, q1=cython.double, q2=cython.double,
                d0=cython.double, d1=cython.double, d2=cython.double, dur=cython.double, c=tuple, t0=list,
-               pp=list, vv=list, aa=list, jj=list, b=Block, sl=_Slab, at=cython.Py_ssize_t)
+               pp=list, vv=list, aa=list, jj=list, b=Block, sl=_Slab, at=cython.Py_ssize_t, pl=PlanCore)
 def few_rows(pl: "Planner", p: _Plan, n: int) -> bool:
     """`Planner._sample(p, n)` for a path or ramp plan, when it keeps at most FEW rows or re-solves at the next
-    block; False (nothing changed) where `_sample` must run."""
+    block; False (nothing changed) where `_sample` must run. Compiled, `pl` is typed `PlanCore` (its fields read
+    as C fields, not generic look-ups) and the planner calls this in C (sample_rows.pxd; session 30, bench B176)."""
     T = pl.cfg.cycle
     t_next, base, pw = p.t_next, p.base, p.pw
     blocks = pl.blocks
@@ -143,3 +145,24 @@ def few_rows(pl: "Planner", p: _Plan, n: int) -> bool:
     pl._buf_i = 0
     pl._buf_state = got
     return True
+
+
+def slab_rows(pos: list, m: int, rows: int, v: float) -> tuple:
+    """A cruise's buffers (`Planner._sample_cruise`; session 30, decision bench B176): `np.array(pos)` of its
+    `rows` row lists of `m` floats and `np.full(rows, v)` as slices of a `_Slab` (as `few_rows`' buffers, bench
+    B175): numpy's discovery of the nesting and a float packed at a time cost more than the copy of the doubles.
+    The same shape, dtype, C order and values; rows beyond a slab's take numpy's arrays, as before."""
+    global _slab
+    if rows > SLAB:
+        return np.array(pos), np.full(rows, v)
+    sl = _slab
+    if sl.m != m or sl.at + rows > SLAB:
+        sl = _slab = _Slab(m)
+    at = sl.at
+    sl.at = at + rows  # (claimed before any call, as few_rows does)
+    for i in range(rows):
+        r = pos[i]
+        for k in range(m):
+            sl._pv[at + i, k] = r[k]
+        sl._vv[at + i] = v
+    return sl.pos[at:at + rows], sl.vel[at:at + rows]
