@@ -5,7 +5,6 @@ from nc.motion.blending cimport FilterCorners
 from nc.motion.block cimport Block, new_block
 from nc.motion.path cimport Segment
 from nc.motion.plan_core cimport PlanCore
-from nc.motion.sample_rows cimport few_rows
 from nc.motion.lookahead cimport Limits
 from nc.motion.planner_corners cimport _corner_at
 from nc.motion.share_zones cimport ShareZones

@@ -4,7 +4,6 @@ cimport cython
 # Piecewise.at's steps, called in C (session 29, decision bench B169)
 from nc.motion.profile cimport _lists0, _pos_at, _row_at
 from nc.motion.block cimport Block
-from nc.motion.plan_core cimport PlanCore
 
 # few_rows' buffers, rows of a slab written from C doubles (session 30, decision bench B175)
 cdef class _Slab:
@@ -12,9 +11,6 @@ cdef class _Slab:
     cdef public object pos, vel
     cdef double[:, ::1] _pv
     cdef double[::1] _vv
-
-# the planner's call of few_rows in C, its fields C fields (session 30, decision bench B176)
-cpdef bint few_rows(PlanCore pl, object p, Py_ssize_t n) except -1
 
 # a cruise's buffers as slab rows (Planner._sample_cruise, session 30, decision bench B176)
 @cython.locals(sl=_Slab, at=Py_ssize_t, i=Py_ssize_t, k=Py_ssize_t, r=list)

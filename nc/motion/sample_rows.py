@@ -23,7 +23,6 @@ except ImportError:  # run as Python without Cython: they do nothing
     from nc.motion import cython_shadow as cython
 
 from nc.motion.block import Block
-from nc.motion.plan_core import PlanCore  # the planner's C fields where compiled (bench B172)
 from nc.motion.plan_state import _Plan
 from nc.motion.profile import _lists0, _pos_at, _row_at  # Piecewise.at's steps (C functions compiled)
 
@@ -59,11 +58,10 @@ _slab = _Slab(3)
                lo=cython.Py_ssize_t, hi=cython.Py_ssize_t, mid=cython.Py_ssize_t, i=cython.Py_ssize_t,
                m=cython.Py_ssize_t, k=cython.Py_ssize_t, q0=cython.double, q1=cython.double, q2=cython.double,
                d0=cython.double, d1=cython.double, d2=cython.double, dur=cython.double, c=tuple, t0=list,
-               pp=list, vv=list, aa=list, jj=list, b=Block, sl=_Slab, at=cython.Py_ssize_t, pl=PlanCore)
+               pp=list, vv=list, aa=list, jj=list, b=Block, sl=_Slab, at=cython.Py_ssize_t)
 def few_rows(pl: "Planner", p: _Plan, n: int) -> bool:
     """`Planner._sample(p, n)` for a path or ramp plan, when it keeps at most FEW rows or re-solves at the next
-    block; False (nothing changed) where `_sample` must run. Compiled, `pl` is typed `PlanCore` (its fields read
-    as C fields, not generic look-ups) and the planner calls this in C (sample_rows.pxd; session 30, bench B176)."""
+    block; False (nothing changed) where `_sample` must run."""
     T = pl.cfg.cycle
     t_next, base, pw = p.t_next, p.base, p.pw
     blocks = pl.blocks
