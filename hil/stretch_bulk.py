@@ -16,8 +16,8 @@ here when every cycle of it would do exactly this, and `bulk_cycles` does it onc
 from __future__ import annotations
 
 import sys
+from struct import error as _struct_error, pack as _pack
 import time as _time
-from array import array
 from functools import reduce
 from itertools import accumulate, repeat
 from operator import add
@@ -340,12 +340,14 @@ def _round9(times: list[float]) -> list[float]:
 
 def _floats(counts: list[int]) -> np.ndarray:
     """`np.array(counts, dtype=np.float64)` of a drive's feedback counts: the same doubles (each int to its nearest
-    double, as numpy's conversion makes it through a Python float), made through a C array of int64 and numpy's cast
-    (issue 17, decision bench B165: numpy's conversion of a list made a float object a value, ≈ 550 instructions;
-    this way ≈ 30). A value that is not an int within int64 (a float, a huge count) takes numpy's way, as before."""
+    double, as numpy's conversion makes it through a Python float), made through the int64 bytes `struct` packs and
+    numpy's cast (issue 17, decision bench B165: numpy's conversion of a list made a float object a value, ≈ 550
+    instructions; decision bench B180: `array("q", …)` parsed each int through PyArg_Parse's format, ≈ 280 under
+    callgrind, struct's `q` ≈ 140). A value that is not an int within int64 (a float, a huge count) takes numpy's
+    way, as before."""
     try:
-        return np.frombuffer(array("q", counts), np.int64).astype(np.float64)
-    except (TypeError, OverflowError):
+        return np.frombuffer(_pack(f"{len(counts)}q", *counts), np.int64).astype(np.float64)
+    except _struct_error:  # not an integer, or out of int64's range
         return np.array(counts, dtype=np.float64)
 
 

@@ -2,7 +2,7 @@
 the drives' feedback counts for the trace's columns (hil/stretch_bulk.py `_floats`) and the pass's filtered rows
 (hil/stretch_pass.py `Pass.samples`). The trace must hold the same doubles, bit for bit, as numpy's conversion made
 them: a count beyond 2^53 rounded to the nearest double, and what is not an int within int64 (a float, a huge count)
-converted as before. The CAM program stretched against stepped, column by column, is tests/test_stretch_cam.py."""
+converted as before (B180: the int64 bytes now made by `struct`, not `array`). The CAM program stretched against stepped, column by column, is tests/test_stretch_cam.py."""
 
 from __future__ import annotations
 
@@ -18,6 +18,9 @@ from hil.stretch_bulk import _floats
     [True, False, 7],  # bools count as 1 and 0
     [1.5, 2, -0.25],  # a float among them: numpy's way
     [2**70, 1],  # beyond int64: numpy's way
+    [2**63, -(2**63) - 1, 0],  # just outside int64 either side: numpy's way
+    [np.int64(-5), np.int32(7), np.uint8(255)],  # numpy's integers (an index, as an int)
+    [np.uint64(2**64 - 1), 3],  # a numpy integer beyond int64: numpy's way
     [],
 ])
 def test_counts_are_numpys_doubles(counts: list) -> None:
