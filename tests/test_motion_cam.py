@@ -85,6 +85,7 @@ def test_ramps_take_the_jerk_the_corners_leave(points, bound):
     assert st.time <= bound + 1e-9, st.time
 
 
+@pytest.mark.slow  # ≈ 11 s: CI stays under 20 min (run with -m slow; session 30)
 def test_the_2000_segment_cam_polyline_keeps_the_tolerance():
     """The benchmark's whole random-corner polyline (bench_vs_linuxcnc: 2 000 segments): a raised
     jerk near the vertices the tolerance slows took two of them to 0.0202 mm (decision 39's first

@@ -35,7 +35,8 @@ def both(events_of, start: dict[str, float], monkeypatch) -> list[tuple[Stream, 
     return out
 
 
-@pytest.mark.parametrize("make", [lambda: chord_circle(10.0), lambda: chord_circle(5.0), cam_polyline, cam_surface])
+@pytest.mark.parametrize("make", [lambda: chord_circle(10.0), lambda: chord_circle(5.0), cam_polyline,
+                                  pytest.param(cam_surface, marks=pytest.mark.slow)])  # ≈ 11 s: -m slow
 def test_cruise_gives_the_per_block_setpoints(make, monkeypatch):
     prog = make()
     (ref, ref_solves), (new, new_solves) = both(lambda: moves(prog), dict(zip("XYZ", START)), monkeypatch)

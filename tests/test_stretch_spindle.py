@@ -49,6 +49,7 @@ def turn(tmp_path):
     return str(p)
 
 
+@pytest.mark.slow  # ≈ 10–26 s each: CI stays under 20 min (run with -m slow; session 30)
 def test_the_part_program_in_stretches_equals_stepping(monkeypatch, tmp_path):
     a, b, r = _both(monkeypatch, tmp_path, PART)
     assert compare(a, b) == []
@@ -61,7 +62,8 @@ def test_the_part_program_in_stretches_equals_stepping(monkeypatch, tmp_path):
 @pytest.mark.parametrize("events", [
     [],
     ["t=1.2:set D21026=80", "t=1.9:set D21026=100"],  # spindle override inside a G96/G99 cut: the feed re-plans
-    ["t=1.5:feed-hold", "t=1.8:cycle-start", "t=2.4:set D21002=60"],  # hold, resume, feed override
+    pytest.param(["t=1.5:feed-hold", "t=1.8:cycle-start", "t=2.4:set D21002=60"],  # hold, resume, feed override
+                 marks=pytest.mark.slow),
     ["Z<-6:set D21026=120", "line=16:set D21026=90"],  # by position and line (G97 S900, feed per revolution)
 ])
 def test_g96_and_feed_per_revolution_stretched_equal_stepped(monkeypatch, tmp_path, turn, events):
@@ -72,6 +74,7 @@ def test_g96_and_feed_per_revolution_stretched_equal_stepped(monkeypatch, tmp_pa
         assert [c for c in b[0]["event"] if c]
 
 
+@pytest.mark.slow  # ≈ 10–26 s each: CI stays under 20 min (run with -m slow; session 30)
 def test_the_machine_after_a_g96_stretch_is_the_stepped_one(monkeypatch, turn):
     """What a stretch ends in (MLC memory, scan counts, clocks, settle count, setpoints) is what stepping reaches
     at the same cycle, with a G96 speed and a feed per revolution running."""
@@ -105,8 +108,9 @@ M30
     [],
     ["t=4.0:reset"],  # inside the first G76 pass: the chain brakes on along the thread (motion 63)
     ["t=13.5:estop"],  # inside a pass: the drives brake on their own ramps
-    ["t=1.2:set D21026=80", "t=5.6:feed-hold", "t=6.0:cycle-start"],  # override and hold inside threads
-    ["t=0.95:set D21026=120", "Z<-10:feed-hold", "t=9:cycle-start"],
+    pytest.param(["t=1.2:set D21026=80", "t=5.6:feed-hold", "t=6.0:cycle-start"],  # override and hold inside threads
+                 marks=pytest.mark.slow),
+    pytest.param(["t=0.95:set D21026=120", "Z<-10:feed-hold", "t=9:cycle-start"], marks=pytest.mark.slow),
 ])
 def test_thread_chains_in_stretches_equal_stepping(monkeypatch, tmp_path, events):
     """B104: a spindle-locked chain's cycles go in stretches, its setpoints stepped on the spindle feedback worked
@@ -118,6 +122,7 @@ def test_thread_chains_in_stretches_equal_stepping(monkeypatch, tmp_path, events
     assert r.run.stretched > 0.75 * r.run.cycles  # before B103/B104: none (every pass and return stepped)
 
 
+@pytest.mark.slow  # ≈ 10–26 s each: CI stays under 20 min (run with -m slow; session 30)
 def test_the_machine_after_a_thread_stretch_is_the_stepped_one(monkeypatch, tmp_path):
     p = tmp_path / "threads.nc"
     p.write_text(THREADS)
