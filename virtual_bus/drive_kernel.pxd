@@ -7,6 +7,15 @@ cdef long SW_TARGET_REACHED
 cdef long RAW_MAX
 cdef double _EXACT
 
+# the feedback columns of a stretch (virtual_bus/drive_stretch.py re-exports it): typed fields, which the kernels
+# read and write as C fields (decision bench B196)
+cdef class Stretch:
+    cdef public Py_ssize_t done
+    cdef public list position_actual, velocity_actual, torque_actual, following_error, statusword
+    cdef public object last
+    cdef public double limit
+    cdef public Py_ssize_t over_at
+
 @cython.locals(i=Py_ssize_t, k=Py_ssize_t, cpu=double, o=double, t=list)
 cpdef to_counts(list rows, Py_ssize_t c, list scales, list targets)
 
@@ -25,8 +34,8 @@ cpdef tuple csv_substeps(int n, double h, double ramp, double want, double tv, d
                ok=bint, rep=Py_ssize_t, target=double, prev=double, ff_vel=double, kff_ff=double, span=double,
                c_pos=double, c_vel=double, c_t=double, cmd=double, inside=bint, c_acc=double,
                gap=double, moved=bint, pa=list, va=list, ta=list, fe=list, sws=list, lim=double, first=Py_ssize_t,
-               v_raw=long)
-cpdef tuple csp_cycles(object targets, tuple consts, tuple state, object still, object out)
+               v_raw=long, neg=double, has_prev=bint, last_target=double, k=int)
+cpdef tuple csp_cycles(object targets, tuple consts, tuple state, object still, Stretch out)
 
 @cython.locals(n=int, h=double, max_cps=double, alpha=double, rad=double, reached_v=double, origin=double,
                ramp=double, want=double, every=long, k_raw=double, t_pct=double, inertia=double, viscous=double,
@@ -35,14 +44,14 @@ cpdef tuple csp_cycles(object targets, tuple consts, tuple state, object still, 
                c=Py_ssize_t, v_cmd=double, c_acc=double, c_torque=double, done=Py_ssize_t, c_pos=double,
                c_vel=double, c_t=double, c_tv=double, cmd=double, edge=bint, moved=bint,
                pa=list, va=list, ta=list, sws=list)
-cpdef tuple csv_cycles(Py_ssize_t cycles, tuple consts, tuple state, bint still, object out)
+cpdef tuple csv_cycles(Py_ssize_t cycles, tuple consts, tuple state, bint still, Stretch out)
 
 @cython.locals(_k=Py_ssize_t)
-cpdef double repeat(object out, double t, double h, int n, bint csp, Py_ssize_t times) except? -1.0
+cpdef double repeat(Stretch out, double t, double h, int n, bint csp, Py_ssize_t times) except? -1.0
 
 @cython.locals(done=Py_ssize_t, c_pos=double, c_t=double, cmd=double, edge=bint, _k=int, new_pos=double,
                pa=list, va=list, ta=list, sws=list)
-cpdef tuple at_speed(object out, Py_ssize_t cycles, double pos, double t, double command, double dp, double h,
+cpdef tuple at_speed(Stretch out, Py_ssize_t cycles, double pos, double t, double command, double dp, double h,
                      int n, long every, object va_raw, object ta_raw, long base, bint slow, double origin)
 
 @cython.locals(f=double, d=double)

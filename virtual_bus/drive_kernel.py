@@ -109,7 +109,30 @@ def csv_substeps(n: int, h: float, ramp: float, want: float, tv: float, pos: flo
     return cmd, pos, vel, t, tv, edge
 
 
-def csp_cycles(targets: Sequence[int], consts: tuple, state: tuple, still: object, out: object
+class Stretch:
+    """Feedback per cycle of the cycles done (`done` ≤ len(targets)); `last` is the last cycle's TxPdo (re-exported
+    by virtual_bus/drive_stretch.py). Here, not there, so that the compiled kernel reads and writes its fields as
+    typed C fields (drive_kernel.pxd; a generic attribute look-up ≈ 170 instructions, 9 a csp_cycles call: issue 17,
+    decision bench B196)."""
+
+    def __init__(self, done: int = 0, position_actual: list[int] | None = None,
+                 velocity_actual: list[int] | None = None, torque_actual: list[int] | None = None,
+                 following_error: list[int] | None = None, statusword: list[int] | None = None,
+                 last: object = None, limit: float = math.inf, over_at: int = -1) -> None:
+        self.done = done
+        self.position_actual = [] if position_actual is None else position_actual
+        self.velocity_actual = [] if velocity_actual is None else velocity_actual
+        self.torque_actual = [] if torque_actual is None else torque_actual
+        self.following_error = [] if following_error is None else following_error
+        self.statusword = [] if statusword is None else statusword
+        self.last = last
+        # the bench's overspeed bound on 0x606C (App. A 0x0602; inf: none) and the first cycle above it (-1: none),
+        # which csp_cycles keeps as it writes the cycles (a pass checks it a part at a time)
+        self.limit = limit
+        self.over_at = over_at
+
+
+def csp_cycles(targets: Sequence[int], consts: tuple, state: tuple, still: object, out: Stretch
                ) -> tuple[tuple, object, bool]:
     """CspRun.step's loop: one cycle per target, feedback appended to `out`'s columns (and `out.over_at` set: the
     first cycle above `out.limit`); stops before a cycle that would fault (a limit switch, the following error
@@ -121,36 +144,54 @@ def csp_cycles(targets: Sequence[int], consts: tuple, state: tuple, still: objec
     pa, va, ta, fe, sws = out.position_actual, out.velocity_actual, out.torque_actual, out.following_error, \
         out.statusword
     over = 1.2 * max_cps
+    neg = -max_cps
     # the bench's overspeed bound (App. A 0x0602, `Stretch.limit`): the first cycle whose 0x606C is above it is
     # kept in `Stretch.over_at`, so a caller stepping a part at a time (hil/stretch_pass.py) does not scan them
     lim = out.limit
     first = out.over_at
+    # the last target as a C double (`has_prev`: there is one), boxed once at the end: not a float object a cycle
+    has_prev = prev_target is not None
+    last_target = prev_target if has_prev else 0.0
     ok = True
     rep = 0  # still cycles not written yet: a run of them is written at once (repeat)
     for tgt in targets:
-        if tgt == still:  # the same target again after a cycle that changed nothing: the same cycle, the time on
-            rep += 1
+        if still is not None and tgt == still:  # the same target again after a cycle that changed nothing: the same
+            rep += 1  # cycle, the time on
             continue
         if rep:
             t = repeat(out, t, h, n, True, rep)
             rep = 0
         target = float(tgt) - origin
-        prev = prev_target if prev_target is not None else command
+        prev = last_target if has_prev else command
         ff_vel = (target - prev) / dt
         kff_ff = kff * ff_vel
         span = target - prev
-        cmd, c_pos, c_vel, c_t, inside = csp_substeps(n, h, prev, span, kff_ff, kp, pos, vel, t, max_cps, alpha,
-                                                      limited, lo, hi)
+        # csp_substeps, inline (the same operations in the same order): its tuple of five made and taken apart a
+        # cycle was ≈ 400 instructions compiled (issue 17, decision bench B196)
+        cmd = prev
+        c_pos, c_vel, c_t = pos, vel, t
+        inside = True
+        for k in range(1, n + 1):
+            cmd = prev + span * k / n
+            v_cmd = kff_ff + kp * (cmd - c_pos)
+            if not neg <= v_cmd <= max_cps:
+                v_cmd = max(neg, min(max_cps, v_cmd))
+            if v_cmd != c_vel:
+                c_vel += (v_cmd - c_vel) * alpha
+            c_pos = c_pos + c_vel * h
+            if limited and not lo < c_pos < hi:
+                inside = False
+            c_t += h
         if not inside or abs(cmd - c_pos) > window or abs(c_vel) > over:
             ok = False
             break
-        moved = not (c_pos == pos and c_vel == vel and target == prev_target)
-        before = None if moved else (pos, vel, command, prev_target, acc, torque)
+        moved = not (c_pos == pos and c_vel == vel and has_prev and target == last_target)
+        before = None if moved else (pos, vel, command, last_target, acc, torque)
         c_acc = (c_vel - vel) / dt
         # Cia402Drive.step's torque of an energised drive (0.1 % of rated), DriveUnits.velocity_to_raw
         torque = (inertia * c_acc * rad + viscous * c_vel * rad
                   + coulomb_of(coulomb, c_vel)) / rated * 1000.0
-        pos, vel, t, command, acc, prev_target = c_pos, c_vel, c_t, cmd, c_acc, target
+        pos, vel, t, command, acc, last_target, has_prev = c_pos, c_vel, c_t, cmd, c_acc, target, True
         gap = command - pos
         sws.append(base | SW_TARGET_REACHED if abs(vel) < reached_v and abs(gap) < 10 else base)
         pa.append(nearest(pos + origin))  # (round of a float: an int)
@@ -161,15 +202,15 @@ def csp_cycles(targets: Sequence[int], consts: tuple, state: tuple, still: objec
             first = len(va) - 1  # (a still cycle repeats the last one: never the first above the bound)
         ta.append(nearest(torque * 0.1 / t_pct))
         fe.append(nearest(gap))
-        still = tgt if before is not None and same(before, (pos, vel, command, prev_target, acc, torque)) else None
+        still = tgt if before is not None and same(before, (pos, vel, command, last_target, acc, torque)) else None
     if rep:
         t = repeat(out, t, h, n, True, rep)
     out.over_at = first
     out.done = len(pa)  # (CspRun.step settles its still cycles before: every cycle stepped is written)
-    return (pos, vel, t, command, prev_target, acc, torque), still, ok
+    return (pos, vel, t, command, last_target if has_prev else None, acc, torque), still, ok
 
 
-def csv_cycles(cycles: int, consts: tuple, state: tuple, still: bool, out: object) -> tuple[tuple, bool, bool]:
+def csv_cycles(cycles: int, consts: tuple, state: tuple, still: bool, out: Stretch) -> tuple[tuple, bool, bool]:
     """CsvRun.step's loop: `cycles` cycles of a CSV drive at its 0x60FF speed; stops before a cycle that would
     latch the encoder index or overspeed. Returns (state, whether the last cycle left the drive as it found it,
     whether it ran to the end)."""
@@ -222,7 +263,7 @@ def csv_cycles(cycles: int, consts: tuple, state: tuple, still: bool, out: objec
     return (pos, vel, t, command, tv, acc, torque), still, ok
 
 
-def repeat(out: object, t: float, h: float, n: int, csp: bool, times: int) -> float:
+def repeat(out: Stretch, t: float, h: float, n: int, csp: bool, times: int) -> float:
     """The last cycle's feedback `times` more times (`same`), and the time after their n sub-steps each (summed one
     sub-step at a time, as they sum it)."""
     for col in (out.statusword, out.position_actual, out.velocity_actual, out.torque_actual):
@@ -234,7 +275,7 @@ def repeat(out: object, t: float, h: float, n: int, csp: bool, times: int) -> fl
     return t
 
 
-def at_speed(out: object, cycles: int, pos: float, t: float, command: float, dp: float, h: float, n: int,
+def at_speed(out: Stretch, cycles: int, pos: float, t: float, command: float, dp: float, h: float, n: int,
              every: int, va_raw: int, ta_raw: int, base: int, slow: bool, origin: float
              ) -> tuple[int, float, float, float]:
     """csv_cycles' cycles of a spindle at its speed: each sub-step moves the position by dp (its velocity × h, the

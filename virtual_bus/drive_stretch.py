@@ -13,31 +13,15 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, field
 
 from fieldbus.cia402 import SW_FOLLOWING, State
 from fieldbus.pdo import RxPdo, TxPdo
 from virtual_bus.kernels import drive_kernel
 from virtual_bus.drive import AL_FORWARD_LIMIT, AL_REVERSE_LIMIT, _STATUS_BASE, Cia402Drive, DriveParams
 
+Stretch = drive_kernel.Stretch  # the feedback of a stretch's cycles (typed fields where the kernel is compiled, B196)
+
 ENABLE_HELD = 0x0F  # controlword bits 0-3 (and not 7) of enable operation
-
-
-@dataclass
-class Stretch:
-    """Feedback per cycle of the cycles done (`done` ≤ len(targets)); `last` is the last cycle's TxPdo."""
-
-    done: int = 0
-    position_actual: list[int] = field(default_factory=list)
-    velocity_actual: list[int] = field(default_factory=list)
-    torque_actual: list[int] = field(default_factory=list)
-    following_error: list[int] = field(default_factory=list)
-    statusword: list[int] = field(default_factory=list)
-    last: TxPdo | None = None
-    # the bench's overspeed bound on 0x606C (App. A 0x0602; inf: none) and the first cycle above it (-1: none),
-    # which drive_kernel.csp_cycles keeps as it writes the cycles (a pass checks it a part at a time)
-    limit: float = math.inf
-    over_at: int = -1
 
 
 def can_stretch(drive: Cia402Drive, rx: RxPdo, mode: int = 8) -> bool:
