@@ -16,7 +16,7 @@ cdef class Stretch:
     cdef public double limit
     cdef public Py_ssize_t over_at
 
-@cython.locals(i=Py_ssize_t, k=Py_ssize_t, cpu=double, o=double, t=list, x=double)
+@cython.locals(i=Py_ssize_t, k=Py_ssize_t, cpu=double, o=double, t=list)
 cpdef to_counts(list rows, Py_ssize_t c, list scales, list targets)
 
 @cython.locals(k=int, cmd=double, v_cmd=double, neg=double, inside=bint)

@@ -59,8 +59,7 @@ def to_counts(rows: list, c: int, scales: list, targets: list) -> None:
         cpu, o = scales[i]
         t = targets[i]
         for k in range(c, len(rows)):
-            x = rows[k][i]  # (a C double compiled: the arithmetic on doubles, not on float objects, B197)
-            t.append(nearest((x - o) * cpu))
+            t.append(nearest((rows[k][i] - o) * cpu))
 
 
 def csp_substeps(n: int, h: float, prev: float, span: float, kff_ff: float, kp: float, pos: float, vel: float,
