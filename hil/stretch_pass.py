@@ -85,6 +85,7 @@ class Pass:
         self.filtered = 0
         self.rows = 0
         self.runs: list[CspRun | CsvRun] | None = None  # the drive models over the cycles driven (made at the first part)
+        self.cores: list = []  # what drive_kernel.drive_parts steps of them (_make_runs)
         self.driven = 0  # cycles the drives were stepped through
         self.targets: list[list[int]] = [[rx.target_position] for rx in rx0[:st.n_axes]]
         self.converted = 0  # filtered rows whose targets are in `targets` (after the pending one: `_convert`)
@@ -278,23 +279,13 @@ class Pass:
             self._convert()
         if upto <= self.driven:
             return None
-        a, n_axes = self.driven, self.st.n_axes
-        runs = self.runs
-        if runs is None:
-            runs = self.runs = self._make_runs()
-        targets = self.targets
+        if self.runs is None:
+            self.runs = self._make_runs()
+        # each drive over cycles driven … upto-1 (the drive kernel's loop over the drives, CspCore's parts: B198);
         # the first cycle a drive stops before (its `done`) or whose 0x606C is above the bench's bound (its
-        # `over_at`, kept by the drive kernel as it writes the cycles: none before `a`, or an earlier part ended
-        # there); a still drive's cycles not written yet (CspRun.lag) repeat its last
-        m = upto
-        for i in range(len(runs)):
-            run = runs[i]
-            run.step(targets[i][a:upto] if i < n_axes else upto - a)
-            out = run.out
-            if out.done < m:
-                m = out.done
-            if 0 <= out.over_at < m:
-                m = out.over_at
+        # `over_at`, kept by the drive kernel as it writes the cycles: none before `driven`, or an earlier part
+        # ended there); a still drive's cycles not written yet (CspCore.lag) repeat its last
+        m = drive_kernel.drive_parts(self.cores, self.targets, self.driven, upto, self.st.n_axes)
         self.driven = upto
         return m if m < upto else None
 
@@ -311,6 +302,8 @@ class Pass:
             else:
                 run = CsvRun(d, rx, dt)
             runs.append(run)
+        # what the drive kernel steps: a CSP axis's CspCore, else the run (decision bench B198)
+        self.cores = [run.core if type(run) is CspRun and run.core is not None else run for run in runs]
         return runs
 
     def _back(self, stop: int) -> int:

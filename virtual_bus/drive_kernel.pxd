@@ -27,15 +27,39 @@ cpdef tuple csp_substeps(int n, double h, double prev, double span, double kff_f
 cpdef tuple csv_substeps(int n, double h, double ramp, double want, double tv, double pos, double vel, double t,
                          double max_cps, double alpha, long every)
 
-@cython.locals(n=int, h=double, max_cps=double, alpha=double, rad=double, reached_v=double, kp=double, kff=double,
-               window=double, origin=double, k_raw=double, t_pct=double, inertia=double, viscous=double,
-               coulomb=double, rated=double, lo=double, hi=double, base=long, dt=double, limited=bint,
-               pos=double, vel=double, t=double, command=double, acc=double, torque=double, over=double,
-               ok=bint, rep=Py_ssize_t, target=double, prev=double, ff_vel=double, kff_ff=double, span=double,
-               c_pos=double, c_vel=double, c_t=double, cmd=double, inside=bint, c_acc=double,
-               gap=double, moved=bint, pa=list, va=list, ta=list, fe=list, sws=list, lim=double, first=Py_ssize_t,
-               v_raw=long, neg=double, has_prev=bint, last_target=double, k=int)
 cpdef tuple csp_cycles(object targets, tuple consts, tuple state, object still, Stretch out)
+
+# a CSP drive between the parts of a stretch (decision bench B198): its constants and state as C fields
+cdef class CspCore:
+    cdef public int n
+    cdef public double h, max_cps, alpha, rad, reached_v, kp, kff, window, origin, k_raw, t_pct, inertia, viscous
+    cdef public double coulomb, rated, lo, hi, dt
+    cdef public long base
+    cdef public bint limited
+    cdef public double pos, vel, t, command, last_target, acc, torque
+    cdef public bint has_prev, ok
+    cdef public object still
+    cdef public Py_ssize_t lag
+    cdef public Stretch out
+
+    cpdef set_state(self, tuple state)
+    cpdef tuple state(self)
+    @cython.locals(k=Py_ssize_t)
+    cpdef step(self, list targets, Py_ssize_t a, Py_ssize_t b)
+    cpdef settle(self)
+    @cython.locals(n=int, h=double, max_cps=double, alpha=double, rad=double, reached_v=double, kp=double, kff=double,
+                   window=double, origin=double, k_raw=double, t_pct=double, inertia=double, viscous=double,
+                   coulomb=double, rated=double, lo=double, hi=double, base=long, dt=double, limited=bint,
+                   pos=double, vel=double, t=double, command=double, acc=double, torque=double, over=double,
+                   ok=bint, rep=Py_ssize_t, target=double, prev=double, ff_vel=double, kff_ff=double, span=double,
+                   c_pos=double, c_vel=double, c_t=double, cmd=double, inside=bint, c_acc=double,
+                   gap=double, moved=bint, pa=list, va=list, ta=list, fe=list, sws=list, lim=double, first=Py_ssize_t,
+                   v_raw=long, neg=double, has_prev=bint, last_target=double, k=int, j=Py_ssize_t, out=Stretch,
+                   v_cmd=double)
+    cpdef bint cycles(self, list targets, Py_ssize_t a, Py_ssize_t b) except? False
+
+@cython.locals(m=Py_ssize_t, i=Py_ssize_t, core=CspCore, out=Stretch)
+cpdef Py_ssize_t drive_parts(list runs, list targets, Py_ssize_t a, Py_ssize_t upto, Py_ssize_t n_axes) except? -1
 
 @cython.locals(n=int, h=double, max_cps=double, alpha=double, rad=double, reached_v=double, origin=double,
                ramp=double, want=double, every=long, k_raw=double, t_pct=double, inertia=double, viscous=double,

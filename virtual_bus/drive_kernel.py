@@ -134,80 +134,171 @@ class Stretch:
 
 def csp_cycles(targets: Sequence[int], consts: tuple, state: tuple, still: object, out: Stretch
                ) -> tuple[tuple, object, bool]:
-    """CspRun.step's loop: one cycle per target, feedback appended to `out`'s columns (and `out.over_at` set: the
-    first cycle above `out.limit`); stops before a cycle that would fault (a limit switch, the following error
-    window, overspeed: exchange() takes it). Returns (state,
-    the target of a cycle that left the drive as it found it or None, whether it ran to the end)."""
-    (n, h, max_cps, alpha, rad, reached_v, kp, kff, window, origin, k_raw, t_pct, inertia, viscous, coulomb, rated,
-     lo, hi, base, dt, limited) = consts
-    pos, vel, t, command, prev_target, acc, torque = state
-    pa, va, ta, fe, sws = out.position_actual, out.velocity_actual, out.torque_actual, out.following_error, \
-        out.statusword
-    over = 1.2 * max_cps
-    neg = -max_cps
-    # the bench's overspeed bound (App. A 0x0602, `Stretch.limit`): the first cycle whose 0x606C is above it is
-    # kept in `Stretch.over_at`, so a caller stepping a part at a time (hil/stretch_pass.py) does not scan them
-    lim = out.limit
-    first = out.over_at
-    # the last target as a C double (`has_prev`: there is one), boxed once at the end: not a float object a cycle
-    has_prev = prev_target is not None
-    last_target = prev_target if has_prev else 0.0
-    ok = True
-    rep = 0  # still cycles not written yet: a run of them is written at once (repeat)
-    for tgt in targets:
-        if still is not None and tgt == still:  # the same target again after a cycle that changed nothing: the same
-            rep += 1  # cycle, the time on
-            continue
+    """CspRun.step's loop (`CspCore.cycles`) over `targets` from `state`: one cycle per target, feedback appended to
+    `out`'s columns (and `out.over_at` set: the first cycle above `out.limit`); stops before a cycle that would fault
+    (a limit switch, the following error window, overspeed: exchange() takes it). Returns (state, the target of a
+    cycle that left the drive as it found it or None, whether it ran to the end)."""
+    core = CspCore(consts, state, out)
+    core.still = still
+    ok = core.cycles(targets if type(targets) is list else list(targets), 0, len(targets))
+    return core.state(), core.still, ok
+
+
+class CspCore:
+    """A CSP drive's constants and state between the parts a stretch steps it over (virtual_bus/drive_stretch.py
+    `CspRun`, hil/stretch_pass.py): typed C fields where compiled (drive_kernel.pxd), so a part costs its cycles, not
+    a tuple of 21 constants and one of 7 state values taken apart and made again, nor a Python call (issue 17,
+    decision bench B198). `consts`: the sub-step factors, gains, units, load, the limit switches' range and whether
+    one is set (CspRun); `state`: position, velocity, time, command, last target (None: none yet), acceleration,
+    torque. `still`: the target of a cycle that left the drive as it found it (None: not so); `lag`: still cycles
+    counted in out.done, not written yet; `ok` False once a part stopped before a faulting cycle."""
+
+    def __init__(self, consts: tuple, state: tuple, out: Stretch) -> None:
+        (self.n, self.h, self.max_cps, self.alpha, self.rad, self.reached_v, self.kp, self.kff, self.window,
+         self.origin, self.k_raw, self.t_pct, self.inertia, self.viscous, self.coulomb, self.rated, self.lo, self.hi,
+         self.base, self.dt, self.limited) = consts
+        self.set_state(state)
+        self.out = out
+        self.still = None
+        self.ok = True
+        self.lag = 0
+
+    def set_state(self, state: tuple) -> None:
+        prev_target: object
+        self.pos, self.vel, self.t, self.command, prev_target, self.acc, self.torque = state
+        # the last target as a C double (`has_prev`: there is one), boxed only by state(): not a float object a cycle
+        self.has_prev = prev_target is not None
+        self.last_target = prev_target if prev_target is not None else 0.0
+
+    def state(self) -> tuple:
+        """(position, velocity, time, command, last target or None, acceleration, torque)."""
+        return (self.pos, self.vel, self.t, self.command, self.last_target if self.has_prev else None, self.acc,
+                self.torque)
+
+    def step(self, targets: list, a: int, b: int) -> None:
+        """The cycles of targets[a:b], one per target; stops (for good) before a cycle that would fault."""
+        if b <= a or not self.ok:
+            return
+        still = self.still
+        if still is not None:
+            k = a
+            while k < b and targets[k] == still:
+                k += 1
+            if k == b:  # a standing axis (Z in an XY contour): no loop, written later (settle)
+                self.lag += b - a
+                self.out.done += b - a
+                return
+        if self.lag:
+            self.settle()
+        self.ok = self.cycles(targets, a, b)
+
+    def settle(self) -> None:
+        """The still cycles counted (`lag`) written: the cycle that left the drive as it found it (_same), again, its
+        time summed on."""
+        self.t = repeat(self.out, self.t, self.h, self.n, True, self.lag)
+        self.out.done = len(self.out.position_actual)
+        self.lag = 0
+
+    def cycles(self, targets: list, a: int, b: int) -> bool:
+        """The cycles of targets[a:b] (the still cycles' repeat included); False where it stopped before a cycle
+        that would fault."""
+        n, h, max_cps, alpha, rad, reached_v = self.n, self.h, self.max_cps, self.alpha, self.rad, self.reached_v
+        kp, kff, window, origin, k_raw, t_pct = self.kp, self.kff, self.window, self.origin, self.k_raw, self.t_pct
+        inertia, viscous, coulomb, rated = self.inertia, self.viscous, self.coulomb, self.rated
+        lo, hi, base, dt, limited = self.lo, self.hi, self.base, self.dt, self.limited
+        pos, vel, t, command, acc, torque = self.pos, self.vel, self.t, self.command, self.acc, self.torque
+        has_prev, last_target, still = self.has_prev, self.last_target, self.still
+        out = self.out
+        pa, va, ta, fe, sws = out.position_actual, out.velocity_actual, out.torque_actual, out.following_error, \
+            out.statusword
+        over = 1.2 * max_cps
+        neg = -max_cps
+        # the bench's overspeed bound (App. A 0x0602, `Stretch.limit`): the first cycle whose 0x606C is above it is
+        # kept in `Stretch.over_at`, so a caller stepping a part at a time (hil/stretch_pass.py) does not scan them
+        lim = out.limit
+        first = out.over_at
+        ok = True
+        rep = 0  # still cycles not written yet: a run of them is written at once (repeat)
+        for j in range(a, b):
+            tgt = targets[j]
+            if still is not None and tgt == still:  # the same target again after a cycle that changed nothing: the
+                rep += 1  # same cycle, the time on
+                continue
+            if rep:
+                t = repeat(out, t, h, n, True, rep)
+                rep = 0
+            target = float(tgt) - origin
+            prev = last_target if has_prev else command
+            ff_vel = (target - prev) / dt
+            kff_ff = kff * ff_vel
+            span = target - prev
+            # csp_substeps, inline (the same operations in the same order): its tuple of five made and taken apart
+            # a cycle was ≈ 400 instructions compiled (issue 17, decision bench B196)
+            cmd = prev
+            c_pos, c_vel, c_t = pos, vel, t
+            inside = True
+            for k in range(1, n + 1):
+                cmd = prev + span * k / n
+                v_cmd = kff_ff + kp * (cmd - c_pos)
+                if not neg <= v_cmd <= max_cps:
+                    v_cmd = max(neg, min(max_cps, v_cmd))
+                if v_cmd != c_vel:
+                    c_vel += (v_cmd - c_vel) * alpha
+                c_pos = c_pos + c_vel * h
+                if limited and not lo < c_pos < hi:
+                    inside = False
+                c_t += h
+            if not inside or abs(cmd - c_pos) > window or abs(c_vel) > over:
+                ok = False
+                break
+            moved = not (c_pos == pos and c_vel == vel and has_prev and target == last_target)
+            before = None if moved else (pos, vel, command, last_target, acc, torque)
+            c_acc = (c_vel - vel) / dt
+            # Cia402Drive.step's torque of an energised drive (0.1 % of rated), DriveUnits.velocity_to_raw
+            torque = (inertia * c_acc * rad + viscous * c_vel * rad
+                      + coulomb_of(coulomb, c_vel)) / rated * 1000.0
+            pos, vel, t, command, acc, last_target, has_prev = c_pos, c_vel, c_t, cmd, c_acc, target, True
+            gap = command - pos
+            sws.append(base | SW_TARGET_REACHED if abs(vel) < reached_v and abs(gap) < 10 else base)
+            pa.append(nearest(pos + origin))  # (round of a float: an int)
+            raw = nearest(vel * k_raw)
+            v_raw = raw if -RAW_MAX <= raw <= RAW_MAX else max(-RAW_MAX, min(RAW_MAX, raw))
+            va.append(v_raw)
+            if first < 0 and (v_raw > lim or -v_raw > lim):
+                first = len(va) - 1  # (a still cycle repeats the last one: never the first above the bound)
+            ta.append(nearest(torque * 0.1 / t_pct))
+            fe.append(nearest(gap))
+            still = tgt if before is not None and same(before, (pos, vel, command, last_target, acc, torque)) \
+                else None
         if rep:
             t = repeat(out, t, h, n, True, rep)
-            rep = 0
-        target = float(tgt) - origin
-        prev = last_target if has_prev else command
-        ff_vel = (target - prev) / dt
-        kff_ff = kff * ff_vel
-        span = target - prev
-        # csp_substeps, inline (the same operations in the same order): its tuple of five made and taken apart a
-        # cycle was ≈ 400 instructions compiled (issue 17, decision bench B196)
-        cmd = prev
-        c_pos, c_vel, c_t = pos, vel, t
-        inside = True
-        for k in range(1, n + 1):
-            cmd = prev + span * k / n
-            v_cmd = kff_ff + kp * (cmd - c_pos)
-            if not neg <= v_cmd <= max_cps:
-                v_cmd = max(neg, min(max_cps, v_cmd))
-            if v_cmd != c_vel:
-                c_vel += (v_cmd - c_vel) * alpha
-            c_pos = c_pos + c_vel * h
-            if limited and not lo < c_pos < hi:
-                inside = False
-            c_t += h
-        if not inside or abs(cmd - c_pos) > window or abs(c_vel) > over:
-            ok = False
-            break
-        moved = not (c_pos == pos and c_vel == vel and has_prev and target == last_target)
-        before = None if moved else (pos, vel, command, last_target, acc, torque)
-        c_acc = (c_vel - vel) / dt
-        # Cia402Drive.step's torque of an energised drive (0.1 % of rated), DriveUnits.velocity_to_raw
-        torque = (inertia * c_acc * rad + viscous * c_vel * rad
-                  + coulomb_of(coulomb, c_vel)) / rated * 1000.0
-        pos, vel, t, command, acc, last_target, has_prev = c_pos, c_vel, c_t, cmd, c_acc, target, True
-        gap = command - pos
-        sws.append(base | SW_TARGET_REACHED if abs(vel) < reached_v and abs(gap) < 10 else base)
-        pa.append(nearest(pos + origin))  # (round of a float: an int)
-        raw = nearest(vel * k_raw)
-        v_raw = raw if -RAW_MAX <= raw <= RAW_MAX else max(-RAW_MAX, min(RAW_MAX, raw))
-        va.append(v_raw)
-        if first < 0 and (v_raw > lim or -v_raw > lim):
-            first = len(va) - 1  # (a still cycle repeats the last one: never the first above the bound)
-        ta.append(nearest(torque * 0.1 / t_pct))
-        fe.append(nearest(gap))
-        still = tgt if before is not None and same(before, (pos, vel, command, last_target, acc, torque)) else None
-    if rep:
-        t = repeat(out, t, h, n, True, rep)
-    out.over_at = first
-    out.done = len(pa)  # (CspRun.step settles its still cycles before: every cycle stepped is written)
-    return (pos, vel, t, command, last_target if has_prev else None, acc, torque), still, ok
+        out.over_at = first
+        out.done = len(pa)  # (step settles its still cycles before: every cycle stepped is written)
+        self.pos, self.vel, self.t, self.command, self.acc, self.torque = pos, vel, t, command, acc, torque
+        self.has_prev, self.last_target, self.still = has_prev, last_target, still
+        return ok
+
+
+def drive_parts(runs: list, targets: list, a: int, upto: int, n_axes: int) -> int:
+    """hil/stretch_pass.py `Pass._drive`'s loop: each drive over cycles a … upto-1 (a `CspCore` over its axis's
+    targets[i][a:upto], else a CsvRun, or a CspRun that cannot stretch, by its own step); the first cycle a drive
+    stops before (its `done`) or whose 0x606C is above the bench's bound (its `over_at`), else upto (decision bench
+    B198: a Python call and a list slice a drive a part were most of a part's drive cost)."""
+    m = upto
+    for i in range(len(runs)):
+        run = runs[i]
+        if type(run) is CspCore:
+            core = run
+            core.step(targets[i], a, upto)
+            out = core.out
+        else:
+            run.step(targets[i][a:upto] if i < n_axes else upto - a)
+            out = run.out
+        if out.done < m:
+            m = out.done
+        if 0 <= out.over_at < m:
+            m = out.over_at
+    return m
 
 
 def csv_cycles(cycles: int, consts: tuple, state: tuple, still: bool, out: Stretch) -> tuple[tuple, bool, bool]:

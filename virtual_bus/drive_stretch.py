@@ -60,57 +60,54 @@ class CspRun:
     def __init__(self, drive: Cia402Drive, rx: RxPdo, dt: float) -> None:
         self.drive, self.rx, self.dt = drive, rx, dt
         self.out = Stretch()
-        # still cycles stepped and counted in out.done but not written yet (`_settle`): a standing axis's parts
-        # (Z through an XY contour, ≈ 1,400 parts of 1-10 cycles in the CAM program) cost a count, not a call each
-        self.lag = 0
-        self.ok = can_stretch(drive, rx)
-        if not self.ok:
+        # the drive's constants and state from part to part, and the part's loop (drive_kernel.CspCore, typed C
+        # fields where compiled: decision bench B198); None where the drive cannot stretch
+        self.core: drive_kernel.CspCore | None = None
+        if not can_stretch(drive, rx):
             return
         p = drive.params
         units, cpr = p.units, p.counts_per_rev
-        self.model = _model(p, dt)
-        self.gains = (p.kp, p.kff, p.following_error_window, drive.modes.origin)
-        self.units = (units.raw_per_count_per_s(cpr), units.torque_percent)  # velocity_to_raw, 0x6077
-        self.load = (p.inertia, p.viscous, p.coulomb, p.rated_torque)
+        model = _model(p, dt)
+        gains = (p.kp, p.kff, p.following_error_window, drive.modes.origin)
+        k_units = (units.raw_per_count_per_s(cpr), units.torque_percent)  # velocity_to_raw, 0x6077
+        load = (p.inertia, p.viscous, p.coulomb, p.rated_torque)
         # limit switches (Cia402Drive._limit): a cycle that would reach one is left to exchange(); short of them
         # the limited drive's sub-steps are the plain ones
-        self.limits = (float(p.negative_limit) if p.negative_limit is not None else -math.inf,
-                       float(p.positive_limit) if p.positive_limit is not None else math.inf)
-        self.state = (drive.position, drive.velocity, drive.time, drive.command, drive._prev_target,
-                      drive.acceleration, drive.torque)
-        self.still: int | None = None  # the target of a cycle that left the drive as it found it (_same)
-        lo, hi = self.limits
-        # drive_kernel.csp_cycles' constants in one tuple (a CAM pass steps a drive every few cycles: its set-up
-        # counts): the sub-step factors, gains, units, load, the limit switches' range and whether one is set
-        self.consts = (*self.model, *self.gains, *self.units, *self.load, lo, hi,
-                       _STATUS_BASE[State.OPERATION_ENABLED] | SW_FOLLOWING, dt, lo > -math.inf or hi < math.inf)
+        lo = float(p.negative_limit) if p.negative_limit is not None else -math.inf
+        hi = float(p.positive_limit) if p.positive_limit is not None else math.inf
+        # the sub-step factors, gains, units, load, the limit switches' range and whether one is set
+        consts = (*model, *gains, *k_units, *load, lo, hi, _STATUS_BASE[State.OPERATION_ENABLED] | SW_FOLLOWING, dt,
+                  lo > -math.inf or hi < math.inf)
+        state = (drive.position, drive.velocity, drive.time, drive.command, drive._prev_target, drive.acceleration,
+                 drive.torque)
+        self.core = drive_kernel.CspCore(consts, state, self.out)
+
+    @property
+    def ok(self) -> bool:
+        """The drive can stretch and no part stopped before a faulting cycle."""
+        return self.core is not None and self.core.ok
+
+    @property
+    def still(self) -> int | None:
+        """The target of a cycle that left the drive as it found it (drive_kernel.same), None: not so."""
+        return None if self.core is None else self.core.still
 
     def step(self, targets: Sequence[int]) -> None:
-        """The next cycles, one per target; stops (for good) before a cycle that would fault."""
-        if not targets or not self.ok:
-            return
-        still = self.still
-        if still is not None and targets[0] == still \
-                and (targets if type(targets) is list else list(targets)).count(still) == len(targets):
-            self.lag += len(targets)  # a standing axis (Z in an XY contour): no set-up, no loop, written later
-            self.out.done += len(targets)
-            return
-        if self.lag:
-            self._settle()
-        self.state, self.still, self.ok = drive_kernel.csp_cycles(targets, self.consts, self.state, still, self.out)
-
-    def _settle(self) -> None:
-        """The still cycles counted (`lag`) written: the cycle that left the drive as it found it (_same), again."""
-        _stand(self, self.lag, True)
-        self.lag = 0
+        """The next cycles, one per target; stops (for good) before a cycle that would fault. A standing axis's
+        parts (Z through an XY contour, ≈ 1,400 parts of 1-10 cycles in the CAM program) cost a count, written
+        later (CspCore.lag)."""
+        if self.core is not None:
+            self.core.step(targets if type(targets) is list else list(targets), 0, len(targets))
 
     def finish(self) -> Stretch:
         """The drive's state after the last cycle stepped, and that cycle's TxPdo (`out.last`)."""
-        if self.lag:
-            self._settle()
-        out = self.out
+        core, out = self.core, self.out
+        if core is None:
+            return out
+        if core.lag:
+            core.settle()
         if out.position_actual:
-            pos, vel, t, command, prev_target, acc, torque = self.state
+            pos, vel, t, command, prev_target, acc, torque = core.state()
             self.drive._prev_target = prev_target
             _finish(self.drive, self.rx, out, pos, vel, t, command, acc, torque)
         return out
@@ -169,9 +166,9 @@ class CsvRun:
         return out
 
 
-def _stand(run: "CspRun | CsvRun", cycles: int, csp: bool) -> None:
-    """A still drive's next cycles (`lag`, written by CspRun._settle, CsvRun.finish): its feedback repeated, its time
-    summed on."""
+def _stand(run: "CsvRun", cycles: int, csp: bool) -> None:
+    """A still drive's next cycles (`lag`, written by CsvRun.finish; a CSP drive's by CspCore.settle): its feedback
+    repeated, its time summed on."""
     n, h = run.model[0], run.model[1]
     state = run.state
     out = run.out
