@@ -37,6 +37,7 @@ from virtual_bus.kernels import drive_kernel
 
 PLAN_KINDS = ("path", "ramp", "cruise")
 FEW = 12  # rows below which the filter takes them one by one (Pass._flush)
+REMARK = 4  # parts between two marks of a pass that reads nothing (Pass._group, decision bench B199)
 
 
 def _save(pl: Planner, filt: bool = True) -> dict:
@@ -157,6 +158,13 @@ class Pass:
         mark = self._mark
         if mark[1] is None:  # the first step after a feed (or the start): the planner saved, its filter too
             mark[1] = _save(pl)
+        elif refill and not self.reads and len(self.parts) - mark[2] >= REMARK and self._drive(self.rows) is None:
+            # No feed moves the mark in a pass that reads nothing (a program's tail): a refused step replayed every
+            # refill since the pass's start (a CAM program's last pass: 29 parts, ≈ 1 % of its run). A mark before
+            # a refill every REMARK parts instead (issue 17, decision bench B199), where the drives ran without a
+            # fault up to it (as a feed's check: a fault found later is after it; one found here is found again
+            # at the pass's end, its drive stopped, and `_back` cuts from the mark before)
+            self._mark = mark = [self.rows, _save(pl), len(self.parts)]
         # A step that may change the planner (a refill, a cruise's next block) is not saved before it (issue 17,
         # decision bench B159): the one refused (once a stretch) is undone from the mark's save, the steps since
         # made again (`_rewind`; they are deterministic, as `_back` makes them)
