@@ -217,3 +217,40 @@ def test_to_counts_are_the_axis_scalings_rounded_counts(rows, c, cpu, origin):
         targets = [[7], [7], [7]]
         mod.to_counts(rows, c, scales, targets)
         assert targets == want
+
+
+@settings(max_examples=150, deadline=None)
+@given(n=st.integers(1, 6), steps=st.lists(st.integers(-3000, 3000), min_size=1, max_size=60),
+       cuts=st.lists(st.integers(0, 60), max_size=6), window=st.sampled_from([5e3, 1e9]),
+       bound=st.sampled_from([math.inf, 300.0]))
+def test_a_drive_stepped_in_parts_by_drive_parts_equals_one_csp_cycles(n, steps, cuts, window, bound):
+    """A pass's drives a part at a time (hil/stretch_pass.py through `drive_parts`, decision bench B198): a CSP axis's
+    CspCore over the parts its feeds cut, standing runs counted and written later, gives every cycle's feedback,
+    the state, the first cycle over the bench's bound and where a fault stops it as csp_cycles over all the targets
+    at once; the source, and the build where there is one."""
+    targets, x = [-17], 0
+    for s in steps:
+        x += s if s % 3 else 0  # (stops: still cycles, a standing axis's lag)
+        targets.append(x)
+    consts = _csp_consts(n, window, (-math.inf, math.inf), 1500.0)
+    state = (-17.0, 0.0, 0.0, -17.0, None, 0.0, 0.0)
+    bounds = sorted({0, len(targets), *(min(c, len(targets)) for c in cuts)})
+    got = []
+    for mod in (PY, BUILT):
+        once = Stretch(limit=bound)
+        want_state, _, want_ok = mod.csp_cycles(targets, consts, state, None, once)
+        out = Stretch(limit=bound)
+        core = mod.CspCore(consts, state, out)
+        stops = [mod.drive_parts([core], [targets], a, b, 1) for a, b in zip(bounds, bounds[1:])]
+        if core.lag:
+            core.settle()
+        cols = [(c.position_actual, c.velocity_actual, c.torque_actual, c.following_error, c.statusword, c.over_at)
+                for c in (once, out)]
+        assert cols[0] == cols[1] and core.ok == want_ok
+        assert _bits(core.state()) == _bits(want_state)
+        # each part's answer: the first cycle a drive stopped before or went over the bound, else the part's end
+        first = min(len(once.position_actual), once.over_at if once.over_at >= 0 else len(targets))
+        assert [s if s < b else None for s, b in zip(stops, bounds[1:])] == \
+            [first if first < b else None for b in bounds[1:]]
+        got.append(cols[1])
+    assert got[0] == got[1]
