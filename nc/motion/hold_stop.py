@@ -17,7 +17,9 @@ from collections.abc import Iterable
 import numpy as np
 
 from nc.motion.block import Block
-from nc.motion.profile import Piecewise, _OneDof
+from nc.motion.profile import Piecewise
+# the kept profile's checks: C functions where the planner is compiled (session 31, decision bench B184)
+from nc.motion.profile import fits_queue, later, peak_speed, time_at  # noqa: F401  (re-exported)
 
 SAMPLES = 256  # points of the ramp's speed over its path: only read when a hold is planned
 
@@ -45,23 +47,6 @@ def _phases(pw: Piecewise) -> tuple[list[float], list[float], list[float], list[
     return pw._lists[1:]
 
 
-def time_at(pw: Piecewise, x: float, lo: float = 0.0) -> float:
-    """The time at or after lo the profile reaches position x (its position rising from lo to its end): Newton
-    steps on the position, bisection where one leaves the bracket."""
-    hi = pw.duration
-    t = lo
-    for _ in range(60):
-        p, v, _ = pw.at(t)
-        if p < x:
-            lo = t
-        else:
-            hi = t
-        if abs(p - x) <= 1e-13 or hi - lo <= 1e-15:
-            break
-        t = t - (p - x) / v if v > 1e-12 else -1.0
-        if not lo < t < hi:
-            t = 0.5 * (lo + hi)
-    return t
 
 
 def brakes_below(pw: Piecewise, s: float, dist: float, blocks: Iterable[Block]) -> bool:
@@ -87,42 +72,3 @@ def brakes_below(pw: Piecewise, s: float, dist: float, blocks: Iterable[Block]) 
                     return False
         b = nx
     return True
-
-
-def peak_speed(pw: Piecewise, t: float) -> float:
-    """The highest speed of the profile from time t on: at a phase's ends or where its acceleration passes zero."""
-    t0, _, _, a, j = _phases(pw)
-    dur = pw.duration
-    top = max(pw.at(t)[1], pw.at(dur)[1])
-    for k in range(len(t0)):
-        lo, hi = max(t0[k], t), min(t0[k + 1] if k + 1 < len(t0) else dur, dur)
-        if lo >= hi:
-            continue
-        top = max(top, pw.at(hi)[1])
-        if j[k] != 0.0 and lo < t0[k] - a[k] / j[k] < hi:
-            top = max(top, pw.at(t0[k] - a[k] / j[k])[1])
-    return top
-
-
-def fits_queue(pw: Piecewise, t: float, end: float, blocks: Iterable[Block]) -> bool:
-    """True when a path profile followed from time t still fits the queue up to `end` (the path position in
-    blocks[0]): `end` a junction whose planned end speed (`vend`) allows the profile's end speed, and no speed
-    of it from t on above a cap of the blocks or a junction speed before `end` (decision motion 83: a profile
-    kept where its re-solve in the next block missed)."""
-    top = peak_speed(pw, t) * (1.0 - 1e-9) - 1e-12
-    at = 0.0
-    for b in blocks:
-        if b.kind != "path" or b.cap < top:
-            return False
-        at += b.length
-        if abs(at - end) <= 1e-9:
-            return pw.v_end() <= b.vend * (1.0 + 1e-9) + 1e-12
-        if at > end or b.vjunc < top:
-            return False
-    return False
-
-
-def later(pw: Piecewise, t: float) -> Piecewise:
-    """A path profile from time t on, its clock starting there (its phases before t start at negative times)."""
-    t0, p, v, a, j = _phases(pw)
-    return _OneDof(([x - t for x in t0], p, v, a, j), pw.duration - t, pw.p_max)

@@ -5,6 +5,7 @@ from nc.motion.blending cimport FilterCorners
 from nc.motion.block cimport Block, new_block
 from nc.motion.path cimport Segment
 from nc.motion.plan_core cimport PlanCore
+from nc.motion.profile cimport fits_queue, later, time_at  # the kept profile's checks in C (session 31, bench B184)
 from nc.motion.lookahead cimport Limits
 from nc.motion.planner_corners cimport _corner_at
 from nc.motion.share_zones cimport ShareZones

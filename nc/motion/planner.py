@@ -50,8 +50,8 @@ from nc.motion.planner_cruise import CruiseSampling
 from nc.motion.planner_runs import FittedRuns
 from nc.motion.spline_feed import NOTHING
 from nc.motion.planner_thread import ThreadStepping
-from nc.motion.hold_stop import brakes_below, crosses_too_fast, fits_queue, later, time_at
-from nc.motion.profile import clip, solve_axes, solve_position, solve_velocity
+from nc.motion.hold_stop import brakes_below, crosses_too_fast
+from nc.motion.profile import clip, fits_queue, later, solve_axes, solve_position, solve_velocity, time_at
 from nc.motion.sample_rows import few_rows
 from nc.motion.share_zones import ShareZones
 from nc.motion.shares import MAX_FACTOR, jerk_factor
@@ -753,7 +753,8 @@ class Planner(PlanCore, CruiseSampling, CornerShares, ThreadStepping, FilterStop
         return _Plan("path", pw, pw.duration, t0, target=dist, rpm=rpm, settled=settled, open=unknown,
                      queued=self._pushes)
 
-    @cython.locals(self=PlanCore)
+    @cython.locals(self=PlanCore, done=cython.double, base=cython.double, x=cython.double, t=cython.double,
+                   ps=cython.double, pv=cython.double, pa=cython.double, end=cython.double)
     def _kept(self, s: float, v: float, a: float, t0: float) -> _Plan | None:
         """The profile the last path plan followed, on from the state it left at the block boundary where it was
         to be solved again, when that solve missed: ruckig, solving from a state on its own time-optimal profile

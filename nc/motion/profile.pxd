@@ -2,6 +2,7 @@
 # own steps are C functions (session 27, decision bench B140): the calls between them were Python calls, and the
 # phases' start times are summed on a C double in the order the .py sums them.
 cimport cython
+from nc.motion.block cimport Block
 
 cdef tuple _calc(Py_ssize_t dofs)
 
@@ -41,3 +42,17 @@ cpdef double _pos_at(double t, double dur, list t0, list p, list v, list a, list
 
 @cython.locals(dt=double, jk=double, ak=double, vk=double, pk=double, x=double, k=Py_ssize_t)
 cpdef tuple _row_at(double t, double base, double dur, list t0, list p, list v, list a, list j)
+
+# A kept profile's checks as C functions (nc.motion.hold_stop re-exports them; session 31, decision bench B184)
+@cython.locals(c=tuple, hi=double, t=double, ps=double, vs=double, r=tuple, i=Py_ssize_t)
+cpdef double time_at(object pw, double x, double lo=*) except? -1.0
+
+@cython.locals(c=tuple, t0=list, a=list, j=list, dur=double, top=double, x=double, lo=double, hi=double, tz=double,
+               jk=double, k=Py_ssize_t, n=Py_ssize_t)
+cpdef double peak_speed(object pw, double t) except? -1.0
+
+@cython.locals(top=double, at=double, b=Block)
+cpdef bint fits_queue(object pw, double t, double end, object blocks) except -1
+
+@cython.locals(c=tuple, t0=list)
+cpdef object later(object pw, double t)

@@ -22,6 +22,7 @@ except ImportError:  # run as Python without Cython: they do nothing
     from nc.motion import cython_shadow as cython
 
 from nc.alarms import NcAlarm
+from nc.motion.block import Block
 from nc.motion.compiled import direct_ruckig
 
 
@@ -231,6 +232,88 @@ class _OneDof(Piecewise):
 
     def v_end(self) -> float:
         return self._rows[2][-1] if self._m is None else float(self._m[2, -1])
+
+
+# A kept profile's checks (Planner._kept, decisions motion 83, 85), nc.motion.hold_stop's: on the lists `at` reads
+# (`_lists0`), each probe `_row_at` (a C call where compiled: ≈ 60k instructions a kept check as Python calls of
+# `at` and reads of Block fields, session 31, decision bench B184). The same operations in the same order.
+def time_at(pw: Piecewise, x: float, lo: float = 0.0) -> float:
+    """The time at or after lo the profile reaches position x (its position rising from lo to its end): Newton
+    steps on the position, bisection where one leaves the bracket."""
+    c = _lists0(pw)
+    hi = pw.duration
+    t = lo
+    for i in range(60):
+        r = _row_at(t, 0.0, c[0], c[1], c[2], c[3], c[4], c[5])  # pw.at(t)
+        ps = r[0]
+        vs = r[1]
+        if ps < x:
+            lo = t
+        else:
+            hi = t
+        if abs(ps - x) <= 1e-13 or hi - lo <= 1e-15:
+            break
+        t = t - (ps - x) / vs if vs > 1e-12 else -1.0
+        if not lo < t < hi:
+            t = 0.5 * (lo + hi)
+    return t
+
+
+def peak_speed(pw: Piecewise, t: float) -> float:
+    """The highest speed of the profile from time t on: at a phase's ends or where its acceleration passes zero."""
+    c = _lists0(pw)  # (pw.at(0.0)'s lists: the phases)
+    t0, a, j = c[1], c[4], c[5]
+    dur = pw.duration
+    top = _row_at(t, 0.0, c[0], c[1], c[2], c[3], c[4], c[5])[1]
+    x = _row_at(dur, 0.0, c[0], c[1], c[2], c[3], c[4], c[5])[1]
+    if x > top:  # max(top, x), spelt out below too (max keeps the first of equal ones)
+        top = x
+    n = len(t0)
+    for k in range(n):
+        lo = t0[k]
+        if t > lo:
+            lo = t
+        hi = t0[k + 1] if k + 1 < n else dur
+        if dur < hi:
+            hi = dur
+        if lo >= hi:
+            continue
+        x = _row_at(hi, 0.0, c[0], c[1], c[2], c[3], c[4], c[5])[1]
+        if x > top:
+            top = x
+        jk = j[k]
+        if jk != 0.0:
+            tz = t0[k] - a[k] / jk
+            if lo < tz < hi:
+                x = _row_at(tz, 0.0, c[0], c[1], c[2], c[3], c[4], c[5])[1]
+                if x > top:
+                    top = x
+    return top
+
+
+def fits_queue(pw: Piecewise, t: float, end: float, blocks) -> bool:
+    """True when a path profile followed from time t still fits the queue up to `end` (the path position in
+    blocks[0]): `end` a junction whose planned end speed (`vend`) allows the profile's end speed, and no speed
+    of it from t on above a cap of the blocks or a junction speed before `end` (decision motion 83: a profile
+    kept where its re-solve in the next block missed)."""
+    top = peak_speed(pw, t) * (1.0 - 1e-9) - 1e-12
+    at = 0.0
+    for b in blocks:
+        if b.kind != "path" or b.cap < top:
+            return False
+        at += b.length
+        if abs(at - end) <= 1e-9:
+            return pw.v_end() <= b.vend * (1.0 + 1e-9) + 1e-12
+        if at > end or b.vjunc < top:
+            return False
+    return False
+
+
+def later(pw: Piecewise, t: float) -> Piecewise:
+    """A path profile from time t on, its clock starting there (its phases before t start at negative times)."""
+    c = _lists0(pw)
+    t0 = c[1]
+    return _OneDof(([x - t for x in t0], c[2], c[3], c[4], c[5]), pw.duration - t, pw.p_max)
 
 
 def _of(traj: Trajectory, cls: type) -> "Piecewise":
