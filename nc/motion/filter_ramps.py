@@ -61,11 +61,22 @@ def seg_history(h: tuple) -> list:
 
 
 def polyline_distance(q: np.ndarray, pts: np.ndarray) -> np.ndarray:
-    """Distance of every row of q to the polyline through pts."""
+    """Distance of every row of q to the polyline through pts.
+
+    Summed over the axes one (rows, segments) array at a time: numpy's sum over a last axis of three, ((0 + x0) + x1)
+    + x2, spelt out, so the same doubles (tests/test_filter_ramps31.py), where its (rows, segments, 3) arrays ran
+    numpy's loops three elements at a time (≈ 10k instructions a row, a CAM program's final stop check: session 31,
+    decision bench B185)."""
     a, d = pts[:-1], np.diff(pts, axis=0)
     l2 = np.maximum((d * d).sum(1), 1e-30)
-    t = np.clip(((q[:, None, :] - a[None]) * d[None]).sum(2) / l2, 0.0, 1.0)
-    return np.sqrt((((a[None] + t[..., None] * d[None]) - q[:, None, :]) ** 2).sum(2)).min(1)
+    dot = np.zeros((len(q), len(a)))
+    for k in range(q.shape[1]):
+        dot = dot + (q[:, k, None] - a[None, :, k]) * d[None, :, k]
+    t = np.clip(dot / l2, 0.0, 1.0)
+    e2 = np.zeros((len(q), len(a)))
+    for k in range(q.shape[1]):
+        e2 = e2 + ((a[None, :, k] + t * d[None, :, k]) - q[:, k, None]) ** 2
+    return np.sqrt(e2).min(1)
 
 
 CRAWL = tuple(range(0, 17, 2))  # cycles a start from a slow junction may wait at its speed (tried in turn)
