@@ -14,3 +14,7 @@ from nc.motion.shares cimport jerk_factor
 # Planner._jerk_factor and _factor_over's work in C (session 29, decision bench B164)
 @cython.locals(start=double, span=double, zones=ShareZones, blend=FilterCorners)
 cdef tuple _factor_span(object planner, Limits lim, Block b, double s, double dist)
+
+# Planner._start_plan's `_near` on the segment's kept floats, a C loop (session 31, decision bench B186)
+@cython.locals(k=Py_ssize_t, x=double, y=double)
+cdef bint _near_floats(list a, list b) except -1

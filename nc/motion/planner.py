@@ -43,7 +43,7 @@ from nc.motion.lookahead import (CUT, MARGIN, RAPID, THREAD, Limits, backward, c
                                  max_speed_at, reach)
 from nc.motion.path import Segment
 from nc.motion.plan_core import PlanCore
-from nc.motion.plan_state import CHUNK, Setpoint, _near, _Plan
+from nc.motion.plan_state import CHUNK, Setpoint, _Plan
 from nc.motion.filter_ramps import HISTORY, FilterStops, seg_history
 from nc.motion.planner_corners import CornerShares, _corner_at
 from nc.motion.planner_cruise import CruiseSampling
@@ -81,6 +81,17 @@ def replans(p: _Plan, rpm: float, settled: bool) -> bool:
     stay up to 2 % low (E-N11); only once: under G96 the command moves every cycle (motion decisions 30).
     (A stretch asks it for each of its cycles, hil/stretch.py.)"""
     return not (abs(rpm - p.rpm) <= 0.02 * max(p.rpm, 1.0) and (not settled or p.settled))
+
+
+def _near_floats(a: list, b: list) -> bool:
+    """`plan_state._near` on two points' floats: every |x - y| <= 1e-6 + 1e-5·|y| (a C loop where compiled, planner.pxd;
+    session 31, decision bench B186)."""
+    for k in range(min(len(a), len(b))):
+        x = a[k]
+        y = b[k]
+        if not abs(x - y) <= 1e-6 + 1e-5 * abs(y):
+            return False
+    return True
 
 
 def _factor_span(planner: "Planner", lim: Limits, b: Block, s: float, dist: float) -> tuple[float, bool]:
@@ -607,7 +618,7 @@ class Planner(PlanCore, CruiseSampling, CornerShares, ThreadStepping, FilterStop
                       line=mv.line if mv else None, block=mv.block if mv else None,
                       program=mv.program if mv else None)
 
-    @cython.locals(self=PlanCore)
+    @cython.locals(self=PlanCore, b=Block)
     def _start_plan(self) -> _Plan | None:
         """Plan from the current state; None when there is nothing to do (idle or held at rest)."""
         T = self.cfg.cycle
@@ -619,8 +630,10 @@ class Planner(PlanCore, CruiseSampling, CornerShares, ThreadStepping, FilterStop
                 self._started = True
                 self.s = 0.0
                 self.line = b.move.line
-                if b.seg is not None and _near(b.seg.start, self.position):
-                    b.seg.start = self.position.copy()
+                seg = b.seg
+                # `_near(seg.start, position)` on the floats the segment keeps (no array made from them to compare)
+                if seg is not None and _near_floats(seg.start_floats, self.position.tolist()):
+                    seg.start = self.position.copy()
             if b.kind == "dwell":
                 if self.held:
                     return None
@@ -636,7 +649,9 @@ class Planner(PlanCore, CruiseSampling, CornerShares, ThreadStepping, FilterStop
             if self.s >= b.length - 1e-12 and abs(self.v) < 1e-9:
                 self._finish_block()
                 continue
-            if not self.per_block and not self._deferred():
+            # `not self._deferred()` spelt out (its fields are C fields where compiled; a Python call of filter_ramps)
+            if not self.per_block and not ((self._fs_tail is not None and self._fs_tail is self.blocks[-1])
+                                           or (self._fr_plan is not None and self._fr_plan is self.plan)):
                 cruise = self._cruise(b, t0)
                 if cruise is not None:
                     return cruise
