@@ -47,8 +47,6 @@ def _phases(pw: Piecewise) -> tuple[list[float], list[float], list[float], list[
     return pw._lists[1:]
 
 
-
-
 def brakes_below(pw: Piecewise, s: float, dist: float, blocks: Iterable[Block]) -> bool:
     """True when a braking solve (path position from s in blocks[0] to dist, its acceleration nowhere above
     zero) crosses every junction before dist no faster than the junction and the block after it allow (its
