@@ -6,6 +6,9 @@ cimport cython
 from nc.motion.block cimport Block
 
 cdef double _INF  # math.inf as a C constant (decision bench B134)
+cdef double _NAN  # math.nan, the same (decision bench B187)
+cdef double USAGE_SCALE  # window's constants as C ones (decision bench B188: a Python global read boxed a
+cdef Py_ssize_t _BULK  # number and compared objects a push)
 
 # bisect_left on a list of floats in C (decision bench B153), nc.motion.profile's (shared with nc.motion.shares)
 from nc.motion.profile cimport _at_or_above
@@ -31,8 +34,11 @@ cdef class _MaxQ:
 
 cdef class FilterCorners:
     cdef public double t_a, t_j, t2sum, _iso_k, _arc_k, span_max, amax, _sc_head, _lim_s, _arc_s
-    cdef public object tol, kd, cb, _vq, _bud
+    cdef public object tol, kd, cb, _vq
     cdef public tuple budget_a, budget_j, budget_al, budget_jl, _bmin, budget, _zero, _sc_ok, _vq_at, _maxima
+    cdef public object _bud_b  # the last window's share (decision bench B188): J's block or None, ...
+    cdef public Py_ssize_t _bud_seq  # ... its stretch's first sequence number ...
+    cdef public double _bud_c  # ... and c_bud
     cdef public dict _boost
     cdef public list _hist, _hist_s, _vt, _sc
     cdef public Py_ssize_t _axes, _sc_dirty, _h0, _m, _seq0, _seq_v, _mono
@@ -47,6 +53,9 @@ cdef class FilterCorners:
     # `_held_caps`' scratch arrays and G's tables as typed memoryviews, kept between calls (decision bench B163)
     cdef double[::1] _x_s, _x_room, _x_ct, _x_rc, _x_vb, _x_se, _x_rm, _x_e, _x_gy, _x_gg, _x_gs
     cdef double[:, ::1] _x_du, _x_w
+    # `_refined`'s scratch, the same way (decision bench B187)
+    cdef double[::1] _r_s, _r_vb, _r_al, _r_vt, _r_ba, _r_bj
+    cdef double[:, ::1] _r_du, _r_pre, _r_sums
     cdef double _cap(self, Py_ssize_t m) except? -1.0
     cdef bint _taken(self, Py_ssize_t k) except -1
     # C calls from Limits.junction, once a pushed junction (session 28, decision bench B157)
@@ -86,10 +95,11 @@ cdef int _c_deviations(double[:, ::1] w, double[:, ::1] du, double[::1] e, int o
 cpdef void _kernel_matrix(double[:, ::1] w, double[::1] s_rows, double[::1] s_all, double[::1] vb, double c,
                           double[::1] gy, double[::1] gg, double[::1] gs)
 
-# `_refined` and its helpers (decision bench B133)
+# `_refined` and its helpers (decision bench B133; scratch arrays, counts stepped on, B187)
 @cython.locals(t1=double, t2=double, s_j=double, lo=Py_ssize_t, reach=double, n=Py_ssize_t, axes=Py_ssize_t,
                s=double[::1], vb=double[::1], du=double[:, ::1], al=double[::1], vt=double[::1], i=Py_ssize_t,
-               k=Py_ssize_t, b=Block, dv=tuple, best=double, bud=double, nxt=double, v=double)
+               k=Py_ssize_t, b=Block, dv=tuple, best=double, bud=double, nxt=double, v=double, ba=double[::1],
+               bj=double[::1], pre=double[:, ::1], sums=double[:, ::1])
 cdef tuple _refined(FilterCorners fc, list hist, Py_ssize_t h0, Py_ssize_t last, double c, double top,
                     tuple budget_a, tuple budget_j)
 
@@ -99,14 +109,18 @@ cdef double _cap_at(double v, double t1, double t2, double s_j, double[::1] s, d
                     double[::1] al, double[::1] vt, double[::1] ba, double[::1] bj, double[:, ::1] pre,
                     double[:, ::1] sums) except? -1.0
 
-@cython.locals(w1=double, w2=double, top=double, k=Py_ssize_t, i=Py_ssize_t, e=double)
+@cython.locals(w1=double, w2=double, top=double, k=Py_ssize_t, i=Py_ssize_t, e=double, f=double, x=double,
+               a0=Py_ssize_t, a1=Py_ssize_t, a2=Py_ssize_t, b0=Py_ssize_t, b1=Py_ssize_t, b2=Py_ssize_t,
+               c0=Py_ssize_t, c1=Py_ssize_t, c2=Py_ssize_t, d0=Py_ssize_t, d1=Py_ssize_t, d2=Py_ssize_t)
 cdef int _window_sums(double vw, double t1, double t2, double s_j, double[::1] s, double[:, ::1] pre,
                       double[:, ::1] sums, Py_ssize_t row) except -1
 
-@cython.locals(x=double, i0=Py_ssize_t, i1=Py_ssize_t, i2=Py_ssize_t, k=Py_ssize_t, mid=double, a=double, d=double,
-               q=double)
-cdef int _window_at(double e, double s_j, double top, double w1, double w2, double[::1] s, double[:, ::1] pre,
-                    double[:, ::1] sums, Py_ssize_t row) except -1
+@cython.locals(k=Py_ssize_t, mid=double, a=double, d=double, q=double)
+cdef int _window_max(double[:, ::1] pre, double[:, ::1] sums, Py_ssize_t row, Py_ssize_t i0, Py_ssize_t i1,
+                     Py_ssize_t i2) except -1
+
+@cython.locals(n=Py_ssize_t)
+cdef Py_ssize_t _count_from(double[::1] s, double x, Py_ssize_t k) except -1
 
 @cython.locals(lo=Py_ssize_t, hi=Py_ssize_t, mid=Py_ssize_t)
 cdef Py_ssize_t _count_at_or_below(double[::1] s, double x) except -1

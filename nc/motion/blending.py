@@ -36,8 +36,10 @@ try:
 except ImportError:  # run as Python without Cython: they do nothing
     from nc.motion import cython_shadow as cython
 
-if cython.compiled:  # C's fma and sqrt for `_deviations`' C form (decision bench B163)
+if cython.compiled:  # C's fma and sqrt for `_deviations`' C form (decision bench B163) and `_cap_at` (B187)
     from cython.cimports.libc.math import fma as _fma, sqrt as _c_sqrt
+else:
+    _c_sqrt = math.sqrt
 
 from nc.motion.block import Block
 from nc.motion.deviation import CornerBound, KernelDeviation
@@ -46,12 +48,14 @@ from nc.motion.profile import _at_or_above  # bisect_left on C doubles, shared w
 from nc.motion.shares import MAX_FACTOR
 
 _INF = math.inf  # a C double where compiled (blending.pxd): math.inf is a module attribute lookup
+_NAN = math.nan  # the same (decision bench B187), math.nan's bits
 
 USAGE_SCALE = 4.0  # below this many times the top speed a junction's budget use is worth refining
 # The junction history's front: TRIM junctions dropped at a time once no scan reads them; BULK the drop before session
 # 18 (every junction before _h0 once 4,096 were), whose cut nc.motion.shares still answers by (FilterCorners._seq_v)
 TRIM = 32
 BULK = 4096
+_BULK = BULK  # a C constant where compiled (blending.pxd, decision bench B188); the name tests read stays
 
 
 def _axis_cap(si: float, sg: float, bj: float, ba: float, c: float) -> float:
@@ -178,6 +182,9 @@ class FilterCorners:
         self._axes = len(self.budget)
         self._zero = (0.0,) * (self._axes + 1)
         self._scratch(64, 16, 64)  # `_held_caps`' arrays, grown as a call needs (decision bench B163)
+        self._r_scratch(64)  # `_refined`'s, the same (decision bench B187)
+        self._r_ba, self._r_bj = np.empty(self._axes), np.empty(self._axes)
+        self._r_sums = np.empty((4, self._axes))
         self._x_gy, self._x_gg, self._x_gs = self._gy, self._gg, self._gs  # the same, typed memoryviews compiled
         # Junctions still inside some filter window, executed or not (for the sums).
         self._hist: list[Block] = []
@@ -203,6 +210,13 @@ class FilterCorners:
         self._x_du = np.empty((n, self._axes))
         self._x_w = np.empty((rows, cols))
 
+    def _r_scratch(self, n: int) -> None:
+        """`_refined`'s arrays with room for n junctions (decision bench B187: kept from call to call, as
+        `_scratch`'s)."""
+        self._r_s, self._r_vb, self._r_al, self._r_vt = np.empty(n), np.empty(n), np.empty(n), np.empty(n)
+        self._r_du = np.empty((n, self._axes))
+        self._r_pre = np.empty((n + 1, self._axes))
+
     def _clear(self) -> None:
         self._hist.clear()
         self._hist_s.clear()
@@ -225,9 +239,12 @@ class FilterCorners:
         self._seq_v = 0  # ... and where a drop of every junction before _h0 once it passed BULK would have cut
         self._lim_s = -math.inf  # path position of the newest junction the tolerance limits
         self._arc_s = -math.inf  # path position where the newest arc block ends
-        # The last window's budget share, for the next one: (J's block, sequence number of the
-        # stretch's first junction, c_bud). Every queued junction of that stretch has vbud <= c_bud.
-        self._bud: tuple["Block", int, float] | None = None
+        # The last window's budget share, for the next one: J's block (None: none yet), sequence number of the
+        # stretch's first junction, c_bud. Every queued junction of that stretch has vbud <= c_bud. (Three C
+        # fields, not a tuple of a Block, an int and a float made a push: decision bench B188.)
+        self._bud_b: Block | None = None
+        self._bud_seq = 0
+        self._bud_c = 0.0
         # Sequence number from which the queued junctions' vbud rise (older <= newer) up to J (issue 17): a walk that
         # lowers them to a cap, newest first, stops at the first one already at or below it.
         self._mono = 0
@@ -361,7 +378,8 @@ class FilterCorners:
                    c=cython.double, c_bud=cython.double, c2=cython.double, lines=cython.bint, fast=cython.bint,
                    hist=list, hist_s=list, acc_q=_MaxQ, top_q=_MaxQ, len_q=_MaxQ, a0=cython.double,
                    a1=cython.double, a2=cython.double, a3=cython.double, d0=cython.double, d1=cython.double,
-                   d2=cython.double)
+                   d2=cython.double, bud_seq=cython.Py_ssize_t, bud_c=cython.double, budget_a=tuple,
+                   budget_j=tuple, s_h=cython.double)
     def window(self, blocks: Sequence["Block"]) -> int:
         """Cap the junctions within one filter window behind the newest junction J (the end of
         blocks[-2]); returns how many blocks from the tail need a new backward pass.
@@ -421,9 +439,11 @@ class FilterCorners:
         self._vt.append(j_new.vtop)
         self._sc.append(None)
         span_max = self.span_max
-        while s_j - hist_s[h0] > span_max:
+        s_h = hist_s[h0]  # (each read into a C double first: no float object a test, decision bench B188)
+        while s_j - s_h > span_max:
             h0 += 1
-        if h0 + self._seq0 - self._seq_v > BULK:
+            s_h = hist_s[h0]
+        if h0 + self._seq0 - self._seq_v > _BULK:
             self._seq_v = self._seq0 + h0  # where the bulk drop would have cut (nc.motion.shares reads it)
         # The junctions no scan reads any more (further behind the queue's head than twice the longest window: a
         # scan's reach behind its position is at most one) are dropped TRIM at a time (session 18: dropped 4,096
@@ -487,7 +507,10 @@ class FilterCorners:
         # Every junction a window ending at J charges lies within span_max behind J, so the
         # blocks it spans (and the tail's) are lines when the newest arc ended before that.
         lines = self._arc_s < s_j - span_max
-        budget_a, budget_j = (self.budget_al, self.budget_jl) if lines else (self.budget_a, self.budget_j)
+        if lines:  # (two assignments, not a tuple made and unpacked a push: decision bench B188)
+            budget_a, budget_j = self.budget_al, self.budget_jl
+        else:
+            budget_a, budget_j = self.budget_a, self.budget_j
         # The search's state for `_cap` and `_taken` (C fields: a closure scope, two function objects and a dict a
         # push were ≈ 5k instructions, decision bench B133)
         self._w_last, self._w_h0, self._w_s_j, self._w_top = last, h0, s_j, top
@@ -549,7 +572,10 @@ class FilterCorners:
             self._sc_dirty = m  # the walks below lower vbud (and vjunc) over hist[m..last]
         fast = c >= top_q.front()  # no junction of the stretch can run as fast as this cap
         seq_m = self._seq0 + m
-        bud, self._bud = self._bud, (j_new, seq_m, c_bud)
+        bud_b, bud_seq, bud_c = self._bud_b, self._bud_seq, self._bud_c
+        self._bud_b = j_new
+        self._bud_seq = seq_m
+        self._bud_c = c_bud
         if fast:
             # Only the budgets' share falls: the queued junctions hist[m..last] (blocks[-2] back),
             # without the bookkeeping the caps' backward-pass depth needs below (issue 17).
@@ -557,8 +583,8 @@ class FilterCorners:
             lo_q = last + 2 - len(blocks)  # hist[lo_q] is blocks[0]'s junction: the oldest still queued
             if j_new.vbud > c_bud:
                 j_new.vbud = c_bud
-            if not (bud is not None and seq_m >= bud[1] and c_bud >= bud[2] and len(blocks) > 2
-                    and blocks[-3] is bud[0]):
+            if not (bud_b is not None and seq_m >= bud_seq and c_bud >= bud_c and len(blocks) > 2
+                    and blocks[-3] is bud_b):
                 # (Else the last window's stretch holds all of this one's junctions but J, at vbud <= its share
                 # <= this one's: only J's can fall, issue 17.) The walk goes from the newest back and stops at
                 # the first junction at or below c_bud within the rising run (`_mono`): the older ones there
@@ -580,7 +606,11 @@ class FilterCorners:
                         b.vbud = c_bud
                 if mono < m:
                     self._mono = seq0 + m  # hist[m..] rise still (min with c_bud keeps the order); before m: not known
-            if last - 1 < lo_q or j_new.vbud < hist[last - 1].vbud:
+            if last - 1 < lo_q:
+                self._mono = seq0 + last
+                return depth
+            b = hist[last - 1]  # (typed: vbud read as a Block's field, not by attribute lookup, decision bench B188)
+            if j_new.vbud < b.vbud:
                 self._mono = seq0 + last  # J is below the junction before it: the rising run starts again at J
             return depth
         k = 2
@@ -726,7 +756,8 @@ class FilterCorners:
         c = self._cap(k + 1)
         self._w_k2, self._w_c2 = self._w_k1, self._w_c1
         self._w_k1, self._w_c1 = k + 1, c
-        d = self._w_s_j - self._hist_s[k]
+        d = self._hist_s[k]  # (read into a C double first: a float object less, decision bench B188)
+        d = self._w_s_j - d
         top, t_w = self._w_top, self.t_j
         if (c if c < top else top) * t_w + self._w_pad < d:
             return False
@@ -1199,7 +1230,8 @@ def _refined(fc: FilterCorners, hist: list[Block], h0: int, last: int, c: float,
     """`FilterCorners._refine` in C loops (decision bench B133: it was numpy on the stretch's few hundred junctions,
     ~1.2M instructions a call): each value the same IEEE operation as its numpy form's, np.cumsum's running sums
     in their order, np.searchsorted(side="right") as the count of positions at or below, np.minimum's, np.maximum's
-    and np.max's nan propagation."""
+    and np.max's nan propagation. The arrays are FilterCorners' scratch (`_r_*`, grown as a call needs), sliced to
+    the call's sizes (decision bench B187: nine numpy arrays made afresh a call were ≈ 30k instructions)."""
     t1, t2 = fc.t_a, fc.t_j - fc.t_a
     s_j = hist[last].s_end
     lo = last
@@ -1207,12 +1239,12 @@ def _refined(fc: FilterCorners, hist: list[Block], h0: int, last: int, c: float,
     while lo > h0 and s_j - hist[lo - 1].s_end <= reach:
         lo -= 1
     n, axes = last + 1 - lo, fc._axes
-    s_a, vb_a = np.empty(n), np.empty(n)
-    du_a = np.empty((n, axes))
+    if n > fc._r_s.shape[0]:
+        fc._r_scratch(2 * n)
+    s, vb, du = fc._r_s[:n], fc._r_vb[:n], fc._r_du[:n]
     # The blocks between the stretch's junctions: on one of length L whose junctions are crossed at <= v the
     # profile reaches at most sqrt(v² + a·L) (speeding up from one, braking to the other), and its vtop
-    al_a, vt_a = np.empty(n - 1), np.empty(n - 1)
-    s, vb, du, al, vt = s_a, vb_a, du_a, al_a, vt_a
+    al, vt = fc._r_al[:n - 1], fc._r_vt[:n - 1]
     for i in range(n):
         b = hist[lo + i]
         s[i] = b.s_end
@@ -1225,16 +1257,18 @@ def _refined(fc: FilterCorners, hist: list[Block], h0: int, last: int, c: float,
         if i > 0:
             al[i - 1] = b.a * b.length
             vt[i - 1] = b.vtop
-    ba_a, bj_a = np.array(budget_a, dtype=float), np.array(budget_j, dtype=float)
-    pre_a = np.empty((n + 1, axes))
-    sums_a = np.empty((4, axes))  # sa, sd, then one window's pair
+    ba, bj = fc._r_ba, fc._r_bj
+    for k in range(axes):
+        ba[k] = budget_a[k]
+        bj[k] = budget_j[k]
+    pre, sums = fc._r_pre[:n + 1], fc._r_sums  # sums: sa, sd, then one window's pair
     best = c
-    bud = nxt = _cap_at(c, t1, t2, s_j, s_a, vb_a, du_a, al_a, vt_a, ba_a, bj_a, pre_a, sums_a)
+    bud = nxt = _cap_at(c, t1, t2, s_j, s, vb, du, al, vt, ba, bj, pre, sums)
     v = top if top < nxt else nxt  # min(nxt, top)
     for _ in range(3):
         if v <= best * (1.0 + 1e-6):
             break
-        nxt = _cap_at(v, t1, t2, s_j, s_a, vb_a, du_a, al_a, vt_a, ba_a, bj_a, pre_a, sums_a)
+        nxt = _cap_at(v, t1, t2, s_j, s, vb, du, al, vt, ba, bj, pre, sums)
         if nxt >= v * (1.0 - 1e-9):  # v meets the budgets with its own windows
             best, bud = v, nxt
             v = top if top < nxt else nxt
@@ -1249,7 +1283,9 @@ def _cap_at(v: float, t1: float, t2: float, s_j: float, s: np.ndarray, vb: np.nd
     """v scaled to the budgets (≥ v: v meets them with its own windows): per axis the budget over the largest
     |Σ v_i·Δu_i| over T1 windows (sums[0]) and over their differences (sums[1]), the windows taken at v and at up
     to the highest speed the profile may reach between the junctions (decision motion 82: two corners around a
-    short block it speeds up on fell in one window pair), the sums there and halfway there counting too."""
+    short block it speeds up on fell in one window pair), the sums there and halfway there counting too. (C's
+    sqrt, inf and nan compiled: math's attribute and call a junction were ≈ 400 instructions, decision bench B187;
+    sqrt is correctly rounded in both.)"""
     n, axes = du.shape[0], du.shape[1]
     for k in range(axes):  # pre: zeros, then the running sums of min(vb, v)·du (np.cumsum's order)
         pre[0, k] = 0.0
@@ -1261,10 +1297,10 @@ def _cap_at(v: float, t1: float, t2: float, s_j: float, s: np.ndarray, vb: np.nd
     _window_sums(v, t1, t2, s_j, s, pre, sums, 0)
     peak = v
     if al.shape[0] > 0:
-        peak = -math.inf
+        peak = -_INF
         for i in range(al.shape[0]):
             q = v * v + al[i]
-            r = math.sqrt(q) if q >= 0.0 else math.nan
+            r = _c_sqrt(q) if q >= 0.0 else _NAN
             x = vt[i]
             r = x if x < r or x != x else r  # np.minimum(vt, ·)
             if r > peak or r != r:
@@ -1278,14 +1314,14 @@ def _cap_at(v: float, t1: float, t2: float, s_j: float, s: np.ndarray, vb: np.nd
                 for j in range(2):
                     x, r = sums[j, k], sums[j + 2, k]
                     sums[j, k] = x if x >= r or x != x else r
-    ca, cd = math.inf, math.inf  # the least of where(sa > 1e-12, ba / sa, inf), np.min's nan kept; the same for sd
+    ca, cd = _INF, _INF  # the least of where(sa > 1e-12, ba / sa, inf), np.min's nan kept; the same for sd
     for k in range(axes):
         x = sums[0, k]
-        r = ba[k] / x if x > 1e-12 else math.inf
+        r = ba[k] / x if x > 1e-12 else _INF
         if r < ca or r != r:
             ca = r
         x = sums[1, k]
-        r = bj[k] / x if x > 1e-12 else math.inf
+        r = bj[k] / x if x > 1e-12 else _INF
         if r < cd or r != r:
             cd = r
     return v * (cd if cd < ca else ca)  # min(ca, cd)
@@ -1295,30 +1331,58 @@ def _window_sums(vw: float, t1: float, t2: float, s_j: float, s: np.ndarray, pre
                  row: int) -> int:
     """sums[row] and sums[row + 1]: per axis the largest |Σ| over T1 windows (path vw·T1) ending at every
     position where a sum may change (J, each junction plus a window, and just before), within one window pair
-    after J, and the largest |difference| of it and the T1 window T2 before."""
+    after J, and the largest |difference| of it and the T1 window T2 before.
+
+    Each window's three ends are counted (np.searchsorted(side="right")) by stepping on from the count of the same
+    end of the window before it in its series (decision bench B187: a bisection each, ≈ 360 instructions a
+    window): the four series (s[i] + w1, that less 1e-9, that plus w2, that less 1e-9) and the ends they give
+    (e, e − w1, e − w1 − w2) never fall as i grows (s sorted, each IEEE rounding monotonic), so the count steps
+    only forward; J's own window is bisected."""
     w1, w2 = vw * t1, vw * t2
     top = s_j + w1 + w2
     for k in range(pre.shape[1]):
-        sums[row, k] = -math.inf
-        sums[row + 1, k] = -math.inf
-    _window_at(s_j, s_j, top, w1, w2, s, pre, sums, row)
+        sums[row, k] = -_INF
+        sums[row + 1, k] = -_INF
+    if s_j >= s_j and s_j <= top:  # the window ending at J (nan: none)
+        x = s_j - w1
+        _window_max(pre, sums, row, _count_at_or_below(s, s_j), _count_at_or_below(s, x),
+                    _count_at_or_below(s, x - w2))
+    a0 = a1 = a2 = b0 = b1 = b2 = c0 = c1 = c2 = d0 = d1 = d2 = 0  # each series' three counts so far
     for i in range(s.shape[0]):
         e = s[i] + w1
-        _window_at(e, s_j, top, w1, w2, s, pre, sums, row)
-        _window_at(e - 1e-9, s_j, top, w1, w2, s, pre, sums, row)
+        if e >= s_j and e <= top:
+            x = e - w1
+            a0 = _count_from(s, e, a0)
+            a1 = _count_from(s, x, a1)
+            a2 = _count_from(s, x - w2, a2)
+            _window_max(pre, sums, row, a0, a1, a2)
+        f = e - 1e-9
+        if f >= s_j and f <= top:
+            x = f - w1
+            b0 = _count_from(s, f, b0)
+            b1 = _count_from(s, x, b1)
+            b2 = _count_from(s, x - w2, b2)
+            _window_max(pre, sums, row, b0, b1, b2)
         e = e + w2
-        _window_at(e, s_j, top, w1, w2, s, pre, sums, row)
-        _window_at(e - 1e-9, s_j, top, w1, w2, s, pre, sums, row)
+        if e >= s_j and e <= top:
+            x = e - w1
+            c0 = _count_from(s, e, c0)
+            c1 = _count_from(s, x, c1)
+            c2 = _count_from(s, x - w2, c2)
+            _window_max(pre, sums, row, c0, c1, c2)
+        f = e - 1e-9
+        if f >= s_j and f <= top:
+            x = f - w1
+            d0 = _count_from(s, f, d0)
+            d1 = _count_from(s, x, d1)
+            d2 = _count_from(s, x - w2, d2)
+            _window_max(pre, sums, row, d0, d1, d2)
     return 0
 
 
-def _window_at(e: float, s_j: float, top: float, w1: float, w2: float, s: np.ndarray, pre: np.ndarray,
-               sums: np.ndarray, row: int) -> int:
-    """The window ending at path position e, when J ≤ e ≤ top, into the maxima sums[row], sums[row + 1]."""
-    if not (e >= s_j and e <= top):
-        return 0
-    x = e - w1
-    i0, i1, i2 = _count_at_or_below(s, e), _count_at_or_below(s, x), _count_at_or_below(s, x - w2)
+def _window_max(pre: np.ndarray, sums: np.ndarray, row: int, i0: int, i1: int, i2: int) -> int:
+    """The window whose ends hold i0, i1 and i2 junctions (its end, its T1 start, the start of the T1 window T2
+    before) into the maxima sums[row], sums[row + 1]."""
     for k in range(pre.shape[1]):
         mid = pre[i1, k]
         a = pre[i0, k] - mid
@@ -1331,6 +1395,15 @@ def _window_at(e: float, s_j: float, top: float, w1: float, w2: float, s: np.nda
         if q == q and (d > q or d != d):
             sums[row + 1, k] = d
     return 0
+
+
+def _count_from(s: np.ndarray, x: float, k: int) -> int:
+    """`_count_at_or_below(s, x)` for s sorted, given that it is at least k: stepped on from k (the same test as
+    the bisection's: nan counts every position)."""
+    n = s.shape[0]
+    while k < n and not x < s[k]:
+        k += 1
+    return k
 
 
 def _count_at_or_below(s: np.ndarray, x: float) -> int:
