@@ -35,7 +35,7 @@ cdef class _MaxQ:
 cdef class FilterCorners:
     cdef public double t_a, t_j, t2sum, _iso_k, _arc_k, span_max, amax, _sc_head, _lim_s, _arc_s
     cdef public object tol, kd, cb, _vq
-    cdef public tuple budget_a, budget_j, budget_al, budget_jl, _bmin, budget, _zero, _sc_ok, _vq_at, _maxima
+    cdef public tuple budget_a, budget_j, budget_al, budget_jl, _bmin, budget, _sc_ok, _vq_at, _maxima
     cdef public object _bud_b  # the last window's share (decision bench B188): J's block or None, ...
     cdef public Py_ssize_t _bud_seq  # ... its stretch's first sequence number ...
     cdef public double _bud_c  # ... and c_bud
@@ -46,8 +46,13 @@ cdef class FilterCorners:
     # window's search state for _cap and _taken (decision bench B133)
     cdef public Py_ssize_t _w_last, _w_h0
     cdef public double _w_s_j, _w_top, _w_pad, _w_two_al, _w_t_w2, _w_v_hi
-    cdef public tuple _w_cum, _w_sj, _w_ba, _w_bj, _w_bmin
+    cdef public tuple _w_ba, _w_bj, _w_bmin
     cdef public Py_ssize_t _w_k1, _w_k2  # the last two caps `_taken` found (decision bench B134)
+    # the junctions' running sums, rows beside _hist (decision bench B189)
+    cdef double[::1] _cs
+    cdef Py_ssize_t _csw, _cs_off
+    @cython.locals(cw=Py_ssize_t, off=Py_ssize_t, n=Py_ssize_t, i=Py_ssize_t, cs=double[::1], src=double[::1])
+    cdef int _cs_room(self, Py_ssize_t last) except -1
     cdef public double _w_c1, _w_c2
     cdef public double _half, _g0, _tol_v  # kd.half, kd.g0, tol (inf: None) as C doubles (decision bench B153)
     # `_held_caps`' scratch arrays and G's tables as typed memoryviews, kept between calls (decision bench B163)

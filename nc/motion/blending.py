@@ -180,7 +180,12 @@ class FilterCorners:
         # One window of T1+T2 for both sums: a T1 window lies inside it.
         self.budget = tuple(min(ba, bj) for ba, bj in zip(self.budget_a, self.budget_j))
         self._axes = len(self.budget)
-        self._zero = (0.0,) * (self._axes + 1)
+        # The junctions' running sums, a row each beside _hist (row k + _cs_off for hist[k]): Σ|Δu| per axis and
+        # Σ|Δu| norms (`cum`), then the signed Σ Δu per axis (`scum`), C doubles (decision bench B189: they were two
+        # tuples of float objects on each Block, made a push and read as objects)
+        self._csw = 2 * self._axes + 1
+        self._cs = array("d", bytes(8 * self._csw * 256))
+        self._cs_off = 0
         self._scratch(64, 16, 64)  # `_held_caps`' arrays, grown as a call needs (decision bench B163)
         self._r_scratch(64)  # `_refined`'s, the same (decision bench B187)
         self._r_ba, self._r_bj = np.empty(self._axes), np.empty(self._axes)
@@ -217,8 +222,25 @@ class FilterCorners:
         self._r_du = np.empty((n, self._axes))
         self._r_pre = np.empty((n + 1, self._axes))
 
+    def _cs_room(self, last: int) -> int:
+        """Room in `_cs` for hist[last]'s row: the rows still held (hist[0:last]) moved to the front, into a
+        buffer twice as large where they would fill over half of it (a new one: a buffer exporting its memory
+        cannot be resized, see `_MaxQ._grow`)."""
+        cw, off = self._csw, self._cs_off
+        n = len(self._cs)  # (compiled: the memoryview's shape[0])
+        if 2 * (last + 1) * cw > n:
+            n = 4 * (last + 1) * cw
+        cs = array("d", bytes(8 * n))  # (compiled: a typed memoryview, the copy a C loop: blending.pxd)
+        src = self._cs
+        for i in range(last * cw):
+            cs[i] = src[off * cw + i]
+        self._cs = cs
+        self._cs_off = 0
+        return 0
+
     def _clear(self) -> None:
         self._hist.clear()
+        self._cs_off = 0  # (no rows held)
         self._hist_s.clear()
         # nc.motion.shares' per-junction verdicts, beside _hist (issue 17, session 11): `_vt` their vtop (fixed at
         # the push), `_sc` the scan's verdict (None: to be found again), `_sc_dirty` the first index whose inputs
@@ -379,7 +401,8 @@ class FilterCorners:
                    hist=list, hist_s=list, acc_q=_MaxQ, top_q=_MaxQ, len_q=_MaxQ, a0=cython.double,
                    a1=cython.double, a2=cython.double, a3=cython.double, d0=cython.double, d1=cython.double,
                    d2=cython.double, bud_seq=cython.Py_ssize_t, bud_c=cython.double, budget_a=tuple,
-                   budget_j=tuple, s_h=cython.double)
+                   budget_j=tuple, s_h=cython.double, cw=cython.Py_ssize_t, co=cython.Py_ssize_t,
+                   cp=cython.Py_ssize_t, i=cython.Py_ssize_t)
     def window(self, blocks: Sequence["Block"]) -> int:
         """Cap the junctions within one filter window behind the newest junction J (the end of
         blocks[-2]); returns how many blocks from the tail need a new backward pass.
@@ -411,27 +434,44 @@ class FilterCorners:
             return 0
         h0 = self._h0
         last = len(hist)
-        if last > h0:
-            b = hist[last - 1]  # (typed: its fields read as a Block's, not by attribute lookup, decision bench B153)
-            prev, sprev = b.cum, b.scum
-        else:
-            prev = sprev = self._zero
+        # J's running sums, a row of `_cs` (decision bench B189: two tuples and seven float objects a push before)
+        cw = self._csw
+        if (last + self._cs_off + 1) * cw > len(self._cs):  # (compiled: the memoryview's shape[0])
+            self._cs_room(last)
+        co = (last + self._cs_off) * cw
+        cp = co - cw  # the junction before J's row, where there is one within reach
         du = j_new.du
         dv = j_new.dv
         if self._axes == 3:  # the common case spelt out (this runs once per pushed block)
-            # (each item read into a C double first: the sums are C additions of the same doubles, not four generic
-            # float-object additions, decision bench B171)
-            a0, a1, a2, a3 = prev[0], prev[1], prev[2], prev[3]
+            # (each item read into a C double first: the sums are C additions of the same doubles, decision bench
+            # B171)
+            if last > h0:
+                a0, a1, a2, a3 = self._cs[cp], self._cs[cp + 1], self._cs[cp + 2], self._cs[cp + 3]
+            else:
+                a0 = a1 = a2 = a3 = 0.0
             d0, d1, d2 = du[0], du[1], du[2]
-            cum_j = (a0 + d0, a1 + d1, a2 + d2, a3 + j_new.du_n)
-            a0, a1, a2 = sprev[0], sprev[1], sprev[2]
+            self._cs[co] = a0 + d0
+            self._cs[co + 1] = a1 + d1
+            self._cs[co + 2] = a2 + d2
+            self._cs[co + 3] = a3 + j_new.du_n
+            if last > h0:
+                a0, a1, a2 = self._cs[cp + 4], self._cs[cp + 5], self._cs[cp + 6]
+            else:
+                a0 = a1 = a2 = 0.0
             d0, d1, d2 = dv[0], dv[1], dv[2]
-            sj = (a0 + d0, a1 + d1, a2 + d2)
+            self._cs[co + 4] = a0 + d0
+            self._cs[co + 5] = a1 + d1
+            self._cs[co + 6] = a2 + d2
         else:
-            cum_j = tuple([p + d for p, d in zip(prev, du + (j_new.du_n,))])  # (lists: no closure scope a push)
-            sj = tuple([p + d for p, d in zip(sprev, dv)])
-        j_new.cum = cum_j
-        j_new.scum = sj
+            for i in range(cw):  # cum's axes and norm, then scum's axes: the same additions
+                a0 = self._cs[cp + i] if last > h0 else 0.0
+                if i < self._axes:
+                    d0 = du[i]
+                elif i == self._axes:
+                    d0 = j_new.du_n
+                else:
+                    d0 = dv[i - self._axes - 1]
+                self._cs[co + i] = a0 + d0
         hist.append(j_new)
         s_j = j_new.s_end
         hist_s = self._hist_s
@@ -466,6 +506,7 @@ class FilterCorners:
                 self._vq.clear()
                 self._vq_at = (0, 0)
             self._seq0 += cut
+            self._cs_off += cut  # (the sums' rows stay where they are: `_cs_room` moves them when it must)
             self._m -= cut
             last -= cut  # J's index, and its sequence number seq0 + last, stay the same
             h0 -= cut
@@ -515,7 +556,7 @@ class FilterCorners:
         # push were ≈ 5k instructions, decision bench B133)
         self._w_last, self._w_h0, self._w_s_j, self._w_top = last, h0, s_j, top
         self._w_pad, self._w_two_al, self._w_t_w2, self._w_v_hi = pad, two_al, t_w2, v_hi
-        self._w_cum, self._w_sj, self._w_ba, self._w_bj = cum_j, sj, budget_a, budget_j
+        self._w_ba, self._w_bj = budget_a, budget_j
         self._w_bmin = self._bmin[0 if lines else 1]
         self._w_k1 = self._w_k2 = -1
         m0 = m
@@ -637,58 +678,58 @@ class FilterCorners:
 
     @cython.locals(m=cython.Py_ssize_t, k=cython.Py_ssize_t, i=cython.Py_ssize_t, c=cython.double,
                    si=cython.double, x=cython.double, d=cython.double, sg=cython.double, ja=cython.double,
-                   base=tuple, pk=tuple, last=cython.Py_ssize_t, h0=cython.Py_ssize_t, axes=cython.Py_ssize_t,
-                   hist=list, cum_j=tuple, sj=tuple, bmin=tuple, budget_a=tuple, budget_j=tuple, cj=cython.double,
-                   bm=cython.double, b=Block, y=cython.double, s0=cython.double, s1=cython.double,
+                   last=cython.Py_ssize_t, h0=cython.Py_ssize_t, axes=cython.Py_ssize_t, bmin=tuple, budget_a=tuple,
+                   budget_j=tuple, bm=cython.double, y=cython.double, s0=cython.double, s1=cython.double,
                    s2=cython.double, g0=cython.double, g1=cython.double, g2=cython.double, q0=cython.double,
-                   q1=cython.double, q2=cython.double)
+                   q1=cython.double, q2=cython.double, cw=cython.Py_ssize_t, off=cython.Py_ssize_t,
+                   oj=cython.Py_ssize_t, ob=cython.Py_ssize_t, o=cython.Py_ssize_t, x0=cython.double,
+                   x1=cython.double, x2=cython.double, held=cython.bint)
     def _cap(self, m: int) -> float:
         """`window`'s cap from the junctions hist[m..last] (inf when there are none): per axis, the
         acceleration budget over the largest signed sum of any run of them that ends at J,
         the jerk budget over the smaller of their unsigned sum and twice that."""
-        last, h0, hist = self._w_last, self._w_h0, self._hist
+        last, h0 = self._w_last, self._w_h0
         if m > last:
             return _INF
-        if m > h0:
-            b = hist[m - 1]
-            base = b.cum
-        else:
-            base = self._zero
-        cum_j, bmin, axes = self._w_cum, self._w_bmin, self._axes
-        # (base typed: the differences below are C subtractions of the same doubles, no float objects; _INF a C
-        # constant, not math's attribute a call: decision bench B134. Each tuple item is read into a C double
-        # before it meets another: `cj - base[0]` boxed cj and `sj[i] - pk[i]` made a float object a junction and
-        # axis, the largest in a Python list, decision bench B171)
+        # The running sums are rows of `_cs` (decision bench B189): J's (oj) and the one before the stretch (ob)
+        # where it is within reach (held), else zeros; read as C doubles, the same differences as the tuples' were
+        # (each item read into a C double before it meets another, decision bench B171; _INF a C constant, B134)
+        cw, off = self._csw, self._cs_off
+        oj = (last + off) * cw
+        held = m > h0
+        ob = (m - 1 + off) * cw if held else 0
+        bmin, axes = self._w_bmin, self._axes
         c = _INF  # first from the unsigned sums: a lower bound of the signed cap
         if axes == 3:  # spelt out: ~3 calls a push (issue 17)
-            cj, bm, x = cum_j[0], bmin[0], base[0]
-            si = cj - x
+            x0 = self._cs[ob] if held else 0.0
+            x1 = self._cs[ob + 1] if held else 0.0
+            x2 = self._cs[ob + 2] if held else 0.0
+            bm = bmin[0]
+            si = self._cs[oj] - x0
             if si > 1e-12:
                 c = bm / si
-            cj, bm, x = cum_j[1], bmin[1], base[1]
-            si = cj - x
+            bm = bmin[1]
+            si = self._cs[oj + 1] - x1
             if si > 1e-12:
                 x = bm / si
                 if x < c:
                     c = x
-            cj, bm, x = cum_j[2], bmin[2], base[2]
-            si = cj - x
+            bm = bmin[2]
+            si = self._cs[oj + 2] - x2
             if si > 1e-12:
                 x = bm / si
                 if x < c:
                     c = x
             if c >= self._w_v_hi:
                 return c  # no junction of the stretch runs as fast: the signed sums change nothing
-            sj, zero = self._w_sj, self._zero
-            g0, g1, g2 = sj[0], sj[1], sj[2]
+            g0, g1, g2 = self._cs[oj + 4], self._cs[oj + 5], self._cs[oj + 6]
             s0 = s1 = s2 = 0.0  # the largest |signed sum| per axis
             for k in range(m - 1, last):
                 if k >= h0 and (k > m - 1 or m > h0):  # (k >= m - 1 throughout)
-                    b = hist[k]  # typed: scum read as a Block's field (decision bench B153)
-                    pk = b.scum
+                    o = (k + off) * cw + 4
+                    q0, q1, q2 = self._cs[o], self._cs[o + 1], self._cs[o + 2]
                 else:
-                    pk = zero
-                q0, q1, q2 = pk[0], pk[1], pk[2]
+                    q0 = q1 = q2 = 0.0
                 d = g0 - q0
                 if d < 0.0:
                     d = -d
@@ -707,14 +748,14 @@ class FilterCorners:
             budget_a, budget_j = self._w_ba, self._w_bj
             c = _INF
             for i in range(3):
-                cj, x = cum_j[i], base[i]
-                si = cj - x
+                x = (x0 if i == 0 else (x1 if i == 1 else x2))
+                si = self._cs[oj + i] - x
                 if si > 1e-12:
                     c = _axis_cap(si, s0 if i == 0 else (s1 if i == 1 else s2), budget_j[i], budget_a[i], c)
             return c
         for i in range(axes):
-            cj, x = cum_j[i], base[i]
-            si = cj - x
+            x = self._cs[ob + i] if held else 0.0
+            si = self._cs[oj + i] - x
             if si > 1e-12:
                 bm = bmin[i]
                 x = bm / si
@@ -722,26 +763,30 @@ class FilterCorners:
                     c = x
         if c >= self._w_v_hi:
             return c  # no junction of the stretch runs as fast: the signed sums change nothing
-        sj, zero = self._w_sj, self._zero
         smax = [0.0] * axes
         for k in range(m - 1, last):
             if k >= h0 and (k > m - 1 or m > h0):  # (k >= m - 1 throughout)
-                b = hist[k]  # typed: scum read as a Block's field (decision bench B153)
-                pk = b.scum
+                o = (k + off) * cw + axes + 1
+                for i in range(axes):
+                    x, y = self._cs[oj + axes + 1 + i], self._cs[o + i]
+                    d = x - y
+                    if d < 0.0:
+                        d = -d
+                    if d > smax[i]:
+                        smax[i] = d
             else:
-                pk = zero
-            for i in range(axes):
-                x, y = sj[i], pk[i]
-                d = x - y
-                if d < 0.0:
-                    d = -d
-                if d > smax[i]:
-                    smax[i] = d
+                for i in range(axes):
+                    x, y = self._cs[oj + axes + 1 + i], 0.0
+                    d = x - y
+                    if d < 0.0:
+                        d = -d
+                    if d > smax[i]:
+                        smax[i] = d
         budget_a, budget_j = self._w_ba, self._w_bj
         c = _INF
         for i in range(axes):
-            cj, x = cum_j[i], base[i]
-            si = cj - x
+            x = self._cs[ob + i] if held else 0.0
+            si = self._cs[oj + i] - x
             if si > 1e-12:
                 c = _axis_cap(si, smax[i], budget_j[i], budget_a[i], c)
         return c
@@ -839,10 +884,9 @@ class FilterCorners:
         if self._lim_s < s_j - 3.0 * h:
             k = _at_or_above(self._hist_s, s_j - 2.0 * h - 1e-12, h0, last + 1)
             axes = self._axes
-            sum_n = bj.cum[axes]
+            sum_n = self._cs[(last + self._cs_off) * self._csw + axes]  # J's Σ|Δu| norm (its cum[axes])
             if k > h0:
-                b = hist[k - 1]
-                sum_n = sum_n - b.cum[axes]
+                sum_n = sum_n - self._cs[(k - 1 + self._cs_off) * self._csw + axes]
             # the braking term inline (`braking` without a jerk); _g0, _tol_v: kd.g0 and tol as C doubles (B153)
             if vt * self._g0 * sum_n + sum_n * self.amax * self.t2sum / 192.0 <= self._tol_v:
                 return 0
