@@ -49,8 +49,8 @@ cdef class FilterCorners:
     cdef public tuple _w_ba, _w_bj, _w_bmin
     cdef public Py_ssize_t _w_k1, _w_k2  # the last two caps `_taken` found (decision bench B134)
     # the junctions' running sums, rows beside _hist (decision bench B189)
-    cdef double[::1] _cs
-    cdef Py_ssize_t _csw, _cs_off
+    cdef public double[::1] _cs  # (public: tests/test_filter_running_sums.py reads the rows)
+    cdef public Py_ssize_t _csw, _cs_off
     @cython.locals(cw=Py_ssize_t, off=Py_ssize_t, n=Py_ssize_t, i=Py_ssize_t, cs=double[::1], src=double[::1])
     cdef int _cs_room(self, Py_ssize_t last) except -1
     cdef public double _w_c1, _w_c2
