@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from itertools import islice
 
 import numpy as np
 
@@ -170,6 +169,10 @@ class Limits:
         self.cut_a = acceleration(cut.speed, cut.acc_time)
         self.cut_js = jerk_per_acc(cut.scurve_time)
         self.cut_on = self.cut_a < math.inf or self.cut_js < math.inf
+        # the shortest a block may last, min_segment_cycles cycles (block_limits' cap length / this; a C double where
+        # compiled, session 31: the product of two Python floats a block)
+        self._min_dur = cfg.min_segment_cycles * self.T
+        self._share_t = cfg.share_tangential  # block_limits' (a C double where compiled)
         # The least tangential acceleration and jerk of any line (a cutting one, under N1.034/N1.035): the braking
         # Planner._may_blend allows for (half of these) must not assume more.
         self.line_a_lo = min(cfg.share_tangential * float(self.acc.min()), self.cut_a)
@@ -220,7 +223,8 @@ class Limits:
 
     @cython.locals(v=cython.double, a=cython.double, j=cython.double, x=cython.double, d=cython.double,
                    vl=cython.double, al=cython.double, jl=cython.double,
-                   st=cython.double, i=cython.Py_ssize_t, n=cython.Py_ssize_t, m=cython.Py_ssize_t)
+                   st=cython.double, i=cython.Py_ssize_t, n=cython.Py_ssize_t, m=cython.Py_ssize_t,
+                   length=cython.double, sg=Segment)
     def block_limits(self, seg: Segment, short_ok: bool = False, what: int = CUT) -> tuple[float, float, float]:
         """(speed cap, tangential acceleration, tangential jerk) of a path segment. `short_ok`: no
         minimum duration (a line whose both ends are blends has no corner for it to protect). `what`: CUT,
@@ -229,13 +233,18 @@ class Limits:
         if what == 1:  # RAPID (a C int compared with a C constant where compiled)
             v, a, j = self._rapid_block(seg)
             if not short_ok:
-                x = seg.length / (cfg.min_segment_cycles * self.T)
+                length = seg.length
+                x = length / self._min_dur
                 if x < v:
                     v = x
             return v, a, j
         v = a = j = _INF
+        sg = seg  # typed where compiled: its fields read from C (session 31, bench B181)
         # zip(direction cosines, _v, _acc, _jerk) as a C loop over the shortest (session 27: per block)
-        cos, vs, accs, jerks = seg.direction_cosines(), self._v, self._acc, self._jerk
+        cos = sg._cos  # Segment.direction_cosines()'s kept tuple, read here (session 31: a Python call a block)
+        if cos is None:
+            cos = sg.direction_cosines()
+        vs, accs, jerks = self._v, self._acc, self._jerk
         n = len(cos)
         m = len(vs)
         if m < n:
@@ -263,12 +272,12 @@ class Limits:
                     j = x
         if v == _INF:
             return 0.0, 1.0, 1.0
-        st = cfg.share_tangential
+        st = self._share_t
         a *= st
         j *= st
         if what == 0 and self.cut_on:  # CUT
             a, j = self.cut_caps(a, j)
-        kind = seg.kind
+        kind = sg.kind
         if kind == "arc" and seg.radius > 0.0:
             k = seg.arc_len / seg.length
             rc = seg.radius / max(k * k, 1e-12)  # radius of curvature of the (helical) path
@@ -284,7 +293,8 @@ class Limits:
         if kind == "blend":
             v, a, j = self._blend_limits(seg, v, a, j)
         if not short_ok:
-            x = seg.length / (cfg.min_segment_cycles * self.T)
+            length = sg.length
+            x = length / self._min_dur
             if x < v:  # min(v, x) spelt out (session 15)
                 v = x
         return v, a, j
@@ -317,7 +327,7 @@ class Limits:
 
     @cython.locals(v=cython.double, d0=cython.double, d1=cython.double, d2=cython.double,
                    sq_sum=cython.double, du_n=cython.double, a=cython.double, vb=cython.double, vc=cython.double,
-                   vp=cython.double, lines=cython.bint, blend=_FilterCorners)
+                   vp=cython.double, lines=cython.bint, blend=_FilterCorners, s1=Segment, s2=Segment)
     def junction(self, b1: Block, b2: Block, raw: bool = False) -> float:
         """Highest speed at the junction b1 → b2. `raw`: as without the filter (a junction where its
         share λ is below 1, nc.motion.share_zones); the filter's fields of b1 are then left alone."""
@@ -386,12 +396,7 @@ class Limits:
         return 0.0 if 0.0 > v else v  # max(v, 0.0)
 
 
-@cython.locals(n=cython.Py_ssize_t, k=cython.Py_ssize_t, k_stop=cython.Py_ssize_t, lo=cython.Py_ssize_t,
-               depth=cython.Py_ssize_t, nx=Block, b=Block, nx_vend=cython.double, nx_binding=cython.bint,
-               nx_cap=cython.double, nx_length=cython.double, nx_a=cython.double, nx_j=cython.double,
-               nx_av=cython.double, nx_ad=cython.double, nx_aa=cython.double, nx_aj=cython.double,
-               b_cap=cython.double, local=cython.double, v=cython.double, av=cython.double, ad=cython.double,
-               aa=cython.double, aj=cython.double, r=cython.double, binding=cython.bint)
+# (types in lookahead.pxd: a cpdef function, which Planner.lookahead calls in C; session 31, decision bench B181)
 def backward(blocks: Sequence[Block], lo: int = 0, full: bool = False, depth: int = 0) -> None:
     """Backward pass from the queue tail (which ends at rest) down to index lo.
 
@@ -423,7 +428,11 @@ def backward(blocks: Sequence[Block], lo: int = 0, full: bool = False, depth: in
     nx_aa = nx.anchor_a
     nx_aj = nx.anchor_j
     k_stop = n if full else depth - 2  # the pass may stop past k_stop (k + 2 > depth), never when `full`
-    for k, b in enumerate(islice(it, n - 1 - lo)):
+    m = n - 1 - lo  # enumerate(islice(it, m)) as a C counter (session 31: islice's and enumerate's objects a step)
+    k = 0
+    for b in it:
+        if k >= m:
+            break
         b_cap = b.cap
         local = b.vjunc  # min(b.vjunc, b.cap, nx.cap)
         if b_cap < local:
@@ -458,3 +467,4 @@ def backward(blocks: Sequence[Block], lo: int = 0, full: bool = False, depth: in
         nx_length = b.length
         nx_a = b.a
         nx_j = b.j
+        k += 1

@@ -6,7 +6,7 @@ from nc.motion.block cimport Block, new_block
 from nc.motion.path cimport Segment
 from nc.motion.plan_core cimport PlanCore
 from nc.motion.profile cimport fits_queue, later, time_at  # the kept profile's checks in C (session 31, bench B184)
-from nc.motion.lookahead cimport Limits
+from nc.motion.lookahead cimport Limits, backward
 from nc.motion.planner_corners cimport _corner_at
 from nc.motion.share_zones cimport ShareZones
 from nc.motion.shares cimport jerk_factor
@@ -18,3 +18,7 @@ cdef tuple _factor_span(object planner, Limits lim, Block b, double s, double di
 # Planner._start_plan's `_near` on the segment's kept floats, a C loop (session 31, decision bench B186)
 @cython.locals(k=Py_ssize_t, x=double, y=double)
 cdef bint _near_floats(list a, list b) except -1
+
+# Planner._update_cap's work in C, the push's call (session 31, decision bench B181)
+@cython.locals(cap=double, x=double, feed=double)
+cdef double _cap_of(PlanCore self, Block b, object rpm) except? -1.0

@@ -110,6 +110,36 @@ def _factor_span(planner: "Planner", lim: Limits, b: Block, s: float, dist: floa
     return jerk_factor(planner.cfg, blend, planner.blocks, start + s, start + dist, planner.closed)
 
 
+def _cap_of(self: "Planner", b: Block, rpm: float | None) -> float:
+    """Planner._update_cap's work, a C function where compiled (planner.pxd; session 31, decision bench B181): the
+    push calls it once a block, and a Python method call from compiled code was ≈ 320 instructions of its ≈ 500."""
+    if b.kind != "path" and b.kind != "thread":
+        b.cap = 0.0
+        return 0.0
+    # min(cap, x) spelt out `x if x < cap else cap` (min keeps the first of equal ones; ~3 a push, session 15)
+    cap = b.cap_hard
+    if b.rapid:
+        if self._rapid_ovr > 0.0:
+            cap = cap * self._rapid_ovr
+        else:
+            x = self.cfg.slow_rapid
+            cap = x if x < cap else cap
+    elif self.dry_run:
+        x = self.dry_run_feed * self._feed_ovr
+        cap = x if x < cap else cap
+    else:
+        feed = b.feed or 0.0
+        if b.move.per_rev:
+            feed *= abs(rpm if rpm is not None else self.spindle_rpm()) / 60.0
+        x = feed * self._feed_ovr
+        cap = x if x < cap else cap
+    x = b.vtop
+    if x > 0.0 and x < cap:
+        cap = x  # the filter windows were sized with it (dry run switched on later)
+    b.cap = cap
+    return cap
+
+
 class Planner(PlanCore, CruiseSampling, CornerShares, ThreadStepping, FilterStops, FittedRuns):
     # (PlanCore first: where compiled an extension type holding the hot fields in C, nc.motion.plan_core; its
     # state()/restore() save and restore every field, bench B172)
@@ -254,7 +284,7 @@ class Planner(PlanCore, CruiseSampling, CornerShares, ThreadStepping, FilterStop
                 x = 1.5 * (self.dry_run_feed if self.dry_run else (b.feed or 0.0))
                 if x < b.cap_hard:  # min(cap_hard, x), spelt out (once per push)
                     b.vtop = x
-        self._update_cap(b)
+        _cap_of(self, b, None)  # `_update_cap`'s work as a C call where compiled (bench B181)
         added = 1
         if blocks:
             prev = blocks[-1]
@@ -290,7 +320,7 @@ class Planner(PlanCore, CruiseSampling, CornerShares, ThreadStepping, FilterStop
     def lookahead(self) -> None:
         """Bring the queue's end speeds up to date (the backward pass the pushes owe)."""
         if self._pushed:
-            backward(self.blocks, 0, depth=self._need)
+            backward(self.blocks, 0, False, self._need)  # a C call where compiled (lookahead.pxd, bench B181)
             self._pushed = self._need = 0
 
     @property
@@ -477,33 +507,10 @@ class Planner(PlanCore, CruiseSampling, CornerShares, ThreadStepping, FilterStop
         return Block(move, "thread" if kind == "thread" else "path", seg, seg.length, v, a, j, feed,
                      kind == "rapid")  # the 9th field: rapid
 
-    @cython.locals(self=PlanCore, b=Block, cap=cython.double, x=cython.double, feed=cython.double)
     def _update_cap(self, b: Block, rpm: float | None = None) -> float:
-        if b.kind != "path" and b.kind != "thread":
-            b.cap = 0.0
-            return 0.0
-        # min(cap, x) spelt out `x if x < cap else cap` (min keeps the first of equal ones; ~3 a push, session 15)
-        cap = b.cap_hard
-        if b.rapid:
-            if self._rapid_ovr > 0.0:
-                cap = cap * self._rapid_ovr
-            else:
-                x = self.cfg.slow_rapid
-                cap = x if x < cap else cap
-        elif self.dry_run:
-            x = self.dry_run_feed * self._feed_ovr
-            cap = x if x < cap else cap
-        else:
-            feed = b.feed or 0.0
-            if b.move.per_rev:
-                feed *= abs(rpm if rpm is not None else self.spindle_rpm()) / 60.0
-            x = feed * self._feed_ovr
-            cap = x if x < cap else cap
-        x = b.vtop
-        if x > 0.0 and x < cap:
-            cap = x  # the filter windows were sized with it (dry run switched on later)
-        b.cap = cap
-        return cap
+        """Block b's speed cap (b.cap) from its feed, the overrides and dry run; `rpm`: the spindle speed feed per
+        revolution uses (None: the measured one)."""
+        return _cap_of(self, b, rpm)
 
     def _limits_changed(self) -> None:
         for b in self.blocks:
