@@ -43,9 +43,8 @@ else:
 
 from nc.motion.block import Block
 from nc.motion.deviation import CornerBound, KernelDeviation
-from nc.motion.limits import MotionConfig
+from nc.motion.limits import MAX_FACTOR, MotionConfig  # (not from nc.motion.shares: it cimports FilterCorners, B182)
 from nc.motion.profile import _at_or_above  # bisect_left on C doubles, shared with nc.motion.shares
-from nc.motion.shares import MAX_FACTOR
 
 _INF = math.inf  # a C double where compiled (blending.pxd): math.inf is a module attribute lookup
 _NAN = math.nan  # the same (decision bench B187), math.nan's bits

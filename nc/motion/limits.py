@@ -5,6 +5,10 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
+# The most a solve raises the tangential jerk (2: the whole corner and curvature share; decision motion 39). Here, not
+# in nc.motion.shares whose constant it is (it imports it from here): nc.motion.blending uses it and shares cimports
+# blending's FilterCorners where compiled, so blending must not import shares (session 31, decision bench B182).
+MAX_FACTOR = 2.0
 
 @dataclass(frozen=True)
 class AxisLimits:

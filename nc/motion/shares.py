@@ -33,7 +33,7 @@ from itertools import islice
 from typing import TYPE_CHECKING
 
 from nc.motion.block import Block
-from nc.motion.limits import MotionConfig
+from nc.motion.limits import MAX_FACTOR, MotionConfig  # MAX_FACTOR: the most a solve raises the tangential jerk
 from nc.motion.profile import _at_or_above, _first_above  # bisect_left/right on C doubles (shared)
 
 try:
@@ -42,8 +42,6 @@ except ImportError:  # run as Python without Cython: they do nothing
     from nc.motion import cython_shadow as cython
 
 _INF = math.inf  # a C double where compiled (shares.pxd): math.inf is a module attribute lookup
-# The most a solve raises the tangential jerk (2: the whole corner and curvature share).
-MAX_FACTOR = 2.0
 
 if TYPE_CHECKING:
     from nc.motion.blending import FilterCorners
