@@ -39,6 +39,8 @@ class Ahead:
         self.plain: deque[Move] = deque()
         # the event after them: (event, the exception reading it raised, budget used and peak after it)
         self.tail: tuple[Event | None, Exception | None, int, int] | None = None
+        # (the soft limits' box test, the end of the last move it found inside): `peek`'s test of the next move's end
+        self._inside: tuple[object, dict | None] = (None, None)
 
     def __iter__(self) -> "Ahead":
         return self
@@ -72,6 +74,16 @@ class Ahead:
         budget = ch.statement_budget
         saved = (budget.used, budget.peak) if budget is not None else None
         source = self.source
+        # the soft limits' box test, found once for the reads (SoftLimits.line_test: valid while the params keep
+        # their length), then one call a line or rapid, of its end alone where its start equals the end of the last
+        # move that test found inside (a program's lines: the start is the last end); `check` where it does not
+        # answer (B193)
+        limits = ch.soft_limits
+        box = limits.line_test() if limits is not None else None
+        test, end_test, params, n_params = box if box is not None else (None, None, None, -1)
+        last_test, last_end = self._inside
+        if last_test is not test:
+            last_end = None
         ok = True
         while len(plain) < k:
             if budget is not None:
@@ -85,14 +97,24 @@ class Ahead:
             used = budget.used if budget is not None else 0
             # a move the feed only pushes: no G31, thread, feed per revolution or G96, inside the soft limits (checked
             # now, right after reading it, where the feed checks it in stepping); inline, a call less an event (B178)
-            if exc is None and not used and type(ev) is Move and ev.kind in PLAIN_KINDS and not ev.per_rev \
-                    and ev.css is None and "G31" not in ev.tags \
-                    and (ch.soft_limits is None or ch.soft_limits.check(ev) is None):
-                plain.append(ev)  # type: ignore[arg-type]
-            else:
-                self.tail = (ev, exc, used, budget.peak if budget is not None else 0)
-                ok = False
-                break
+            if exc is None and not used and type(ev) is Move and (kind := ev.kind) in PLAIN_KINDS and not ev.per_rev \
+                    and ev.css is None and "G31" not in ev.tags:
+                if limits is None:
+                    plain.append(ev)
+                    continue
+                if test is not None and kind != "arc" and len(params) == n_params:  # type: ignore[arg-type]
+                    end = ev.end
+                    if end_test(end) if ev.start == last_end else test(ev.start, end):  # type: ignore[misc]
+                        last_end = end
+                        plain.append(ev)
+                        continue
+                if limits.check(ev) is None:
+                    plain.append(ev)
+                    continue
+            self.tail = (ev, exc, used, budget.peak if budget is not None else 0)
+            ok = False
+            break
+        self._inside = (test, last_end)
         if saved is not None:
             budget.used, budget.peak = saved  # type: ignore[union-attr]
         return ok

@@ -64,7 +64,8 @@ class SoftLimits:
         self._box_of: tuple[object, int, object] | None = None
         # `check`'s first test: (params, their length, first, the box's test as straight-line code), made with the
         # box (`_new_box`), None while there is none (decisions bench B173)
-        self._fast: tuple[object, int, object, Callable[[dict, dict], bool]] | None = None
+        # and the test of an end alone (`line_test`)
+        self._fast: tuple[object, int, object, Callable[[dict, dict], bool], Callable[[dict], bool]] | None = None
 
     def _keys(self, axis: str) -> tuple[str, str, str, str, float]:
         k = self._names[axis] = (f"soft limit 1 {axis}", f"soft limit 2 {axis}", f"soft limit 3 {axis}",
@@ -86,7 +87,7 @@ class SoftLimits:
                 lo, hi = first.get(a, (None, None))
                 box[a] = (-math.inf if lo is None else lo - _EPS, math.inf if hi is None else hi + _EPS)
             self._box = box
-            self._fast = (params, len(params), first, _box_test(box))
+            self._fast = (params, len(params), first, *_box_test(box))
         return self._box
 
     def _inside(self, move: Move) -> bool:
@@ -141,6 +142,19 @@ class SoftLimits:
                 return False
         return True
 
+    def line_test(self) -> tuple[Callable[[dict, dict], bool], Callable[[dict], bool], Mapping[str, float], int] | None:
+        """`check`'s first test for a run of reads (hil.stretch_reads.Ahead.peek, issue 17, decisions bench B193):
+        (the box's straight-line test of a start and an end, its test of an end alone, the params, their length) while
+        that test is `check`'s first one (the params, their length and the bench's segments those the box was found
+        for, no axis's 1st segment off), None when `check` must decide. A line or rapid it answers True for is one
+        `check` finds no alarm for, as long as the params keep that length (a G10 L21 value adds a key: the box no
+        longer holds); so is one whose start equals an end the test of an end found inside. False is "not known"."""
+        fast = self._fast
+        params = self.params
+        if fast is None or self.disabled or fast[0] is not params or fast[1] != len(params) or fast[2] is not self.first:
+            return None
+        return fast[3], fast[4], params, fast[1]
+
     def check(self, move: Move) -> Alarm | None:
         """The limit alarm this move would raise, or None when its whole path stays inside."""
         kind = move.kind
@@ -177,21 +191,27 @@ class SoftLimits:
         return None
 
 
-def _box_test(box: dict[str, tuple[float, float]]) -> Callable[[dict, dict], bool]:
+def _box_test(box: dict[str, tuple[float, float]]) -> tuple[Callable[[dict, dict], bool], Callable[[dict], bool]]:
     """`_inside`'s box test for these axes as straight-line code: True when both ends hold as many axes as the box,
     each inside it (a NaN passes, as `_inside`'s loop lets it: `check` finds no alarm for it either; an axis of
-    another name raises KeyError). The bounds are literals, each test one compare-and-branch. False is "not known":
+    another name is "not known" too). The bounds are literals, each test one compare-and-branch. False is "not known":
     `_inside` decides."""
     def lit(v: float) -> str:
         return "1e999" if v == math.inf else "-1e999" if v == -math.inf else repr(v)
-    src = ["def inside(s, e):", f"    if len(s) != {len(box)} or len(e) != {len(box)}:", "        return False"]
+    src = ["def inside(s, e):", f"    if len(s) != {len(box)} or len(e) != {len(box)}:", "        return False",
+           "    try:", "        pass"]
     for p in "se":
         for a, (lo, hi) in box.items():
-            src += [f"    v = {p}[{a!r}]", f"    if v < {lit(lo)} or v > {lit(hi)}:", "        return False"]
-    src.append("    return True")
+            src += [f"        v = {p}[{a!r}]", f"        if v < {lit(lo)} or v > {lit(hi)}:", "            return False"]
+    src += ["    except KeyError:  # an axis of another name", "        return False", "    return True"]
+    # the same test of an end alone (`end_inside`): a move whose start is the end of one found inside needs no more
+    src += ["def end_inside(e):", f"    if len(e) != {len(box)}:", "        return False", "    try:", "        pass"]
+    for a, (lo, hi) in box.items():
+        src += [f"        v = e[{a!r}]", f"        if v < {lit(lo)} or v > {lit(hi)}:", "            return False"]
+    src += ["    except KeyError:", "        return False", "    return True"]
     space: dict = {}
     exec(compile("\n".join(src) + "\n", "<soft-limit box>", "exec"), space)
-    return space["inside"]
+    return space["inside"], space["end_inside"]
 
 
 def _path_ranges(move: Move) -> dict[str, tuple[float, float]]:
