@@ -85,20 +85,20 @@ class Ahead:
         if last_test is not test:
             last_end = None
         ok = True
+        if budget is not None:
+            budget.used = 0  # a cycle's budget opens before its first read (a plain move leaves it at 0 for the next)
         while len(plain) < k:
-            if budget is not None:
-                budget.used = 0  # a cycle's budget opens before its first read
-            ev: Event | None = None
-            exc: Exception | None = None
             try:
                 ev = next(source)
             except Exception as e:  # StopIteration, an alarm: handed out as the feed would meet it
-                exc = e
-            used = budget.used if budget is not None else 0
-            # a move the feed only pushes: no G31, thread, feed per revolution or G96, inside the soft limits (checked
-            # now, right after reading it, where the feed checks it in stepping); inline, a call less an event (B178)
-            if exc is None and not used and type(ev) is Move and (kind := ev.kind) in PLAIN_KINDS and not ev.per_rev \
-                    and ev.css is None and "G31" not in ev.tags:
+                self.tail = (None, e, budget.used if budget is not None else 0, budget.peak if budget is not None else 0)
+                ok = False
+                break
+            # a move the feed only pushes: no G31, thread, feed per revolution or G96, generated without a statement,
+            # inside the soft limits (checked now, right after reading it, where the feed checks it in stepping);
+            # inline, a call less an event (B178)
+            if type(ev) is Move and (kind := ev.kind) in PLAIN_KINDS and not ev.per_rev and ev.css is None \
+                    and "G31" not in ev.tags and (budget is None or not budget.used):
                 if limits is None:
                     plain.append(ev)
                     continue
@@ -111,7 +111,7 @@ class Ahead:
                 if limits.check(ev) is None:
                     plain.append(ev)
                     continue
-            self.tail = (ev, exc, used, budget.peak if budget is not None else 0)
+            self.tail = (ev, None, budget.used if budget is not None else 0, budget.peak if budget is not None else 0)
             ok = False
             break
         self._inside = (test, last_end)

@@ -199,13 +199,14 @@ def _box_test(box: dict[str, tuple[float, float]]) -> tuple[Callable[[dict, dict
     def lit(v: float) -> str:
         return "1e999" if v == math.inf else "-1e999" if v == -math.inf else repr(v)
     src = ["def inside(s, e):", f"    if len(s) != {len(box)} or len(e) != {len(box)}:", "        return False",
-           "    try:", "        pass"]
+           "    try:"] + ([] if box else ["        pass"])
     for p in "se":
         for a, (lo, hi) in box.items():
             src += [f"        v = {p}[{a!r}]", f"        if v < {lit(lo)} or v > {lit(hi)}:", "            return False"]
     src += ["    except KeyError:  # an axis of another name", "        return False", "    return True"]
     # the same test of an end alone (`end_inside`): a move whose start is the end of one found inside needs no more
-    src += ["def end_inside(e):", f"    if len(e) != {len(box)}:", "        return False", "    try:", "        pass"]
+    src += ["def end_inside(e):", f"    if len(e) != {len(box)}:", "        return False", "    try:"]
+    src += [] if box else ["        pass"]
     for a, (lo, hi) in box.items():
         src += [f"        v = e[{a!r}]", f"        if v < {lit(lo)} or v > {lit(hi)}:", "            return False"]
     src += ["    except KeyError:", "        return False", "    return True"]
