@@ -10,10 +10,12 @@ instruction for the same tree (interp_instructions.py's difference of two childr
 - `raw`: the interpreter's generator (`Interpreter._guarded`: `_run` since B173, its guard and the lean lane's runs in it), every event taken;
 - `stream`: `Interpreter.run` (+ the corner and compensation stages and the preview window), as the channel reads it;
 - `check`: `stream` and `SoftLimits.check` of each move (a bench's 1st segments), as hil's stretch reads do;
+- `peek`: `check`'s events read as hil's stretches read them (hil/stretch_reads.py `Ahead.peek`, 4 at a time, with a
+  statement budget and the soft limits, on a stand-in channel holding them), each peeked move then dropped;
 - `parse`: `parse_program` of the program's text.
 
-Prints instructions a block per layer (a later layer includes the earlier ones but `line` and `parse`). Asserts
-nothing; without valgrind it says so (decision bench B167).
+Prints instructions a block per layer (a later layer includes the earlier ones but `line` and `parse`; `peek`
+includes `stream`). Asserts nothing; without valgrind it says so (decision bench B167).
 
 Usage: python benchmarks/interp_layers.py [--tree DIR] [--against DIR] [--blocks N] [--layers raw,check,...]
 """
@@ -29,7 +31,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 from benchmarks.interp_instructions import collected  # noqa: E402  (the tree's, run as a script)
 
-LAYERS = ("line", "raw", "stream", "check", "parse")
+LAYERS = ("line", "raw", "stream", "check", "peek", "parse")
 
 CHILD = """
 import functools, gc, operator, sys
@@ -69,6 +71,17 @@ elif layer == "check":
         if type(ev) is Move:
             check(ev)
     reduce(checked, ip.run(program), None)
+elif layer == "peek":
+    import types
+    from hil.stretch_reads import Ahead
+    from nc.budget import StatementBudget
+    ch = types.SimpleNamespace(statement_budget=StatementBudget(), soft_limits=limits, _checked=None)
+    ahead = Ahead(ip.run(program), ch)
+    def peeked(_, __):
+        plain = ahead.plain
+        while ahead.peek(4):
+            plain.clear()
+    reduce(peeked, [None], None)
 elif layer == "parse":
     reduce(lambda _, t: parse_program(t), [text], None)
 """
