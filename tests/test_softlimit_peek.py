@@ -108,3 +108,30 @@ def test_a_start_equal_to_an_end_found_inside_needs_its_end_alone() -> None:
               ch)
     b._inside = a._inside  # the last end found inside before the change
     assert not b.peek(4) and b.tail[0].line == 4
+
+
+def test_a_read_that_runs_a_statement_or_raises_ends_the_peek_with_the_budget_it_left() -> None:
+    """Each read opens a cycle's budget (0 used): a move generated without a statement is plain, the first one whose
+    generation spent the budget (a macro statement) is the tail with the count it left, and an alarm raised reading
+    is the tail too; after the peek the budget stands as before it."""
+    budget = StatementBudget()
+    budget.used, budget.peak = 5, 7  # a cycle's count before the peek
+
+    def source() -> Iterator[Move]:
+        for k in range(1, 4):
+            if k == 3:
+                budget.spend()
+                budget.spend()
+            yield Move("line", k, f"G1 X{k}.", {"X": k - 1.0}, {"X": float(k)}, {"X": float(k)}, feed=1000.0)
+        raise RuntimeError("the interpreter's alarm")
+
+    ch = SimpleNamespace(statement_budget=budget, soft_limits=None, _checked=None)
+    a = Ahead(source(), ch)
+    assert not a.peek(4)
+    assert [m.line for m in a.plain] == [1, 2]
+    ev, exc, used, peak = a.tail
+    assert ev.line == 3 and exc is None and used == 2 and peak == 7
+    assert (budget.used, budget.peak) == (5, 7)
+    assert [next(a).line for _ in range(3)] == [1, 2, 3]  # the tail handed out after the plain ones
+    assert budget.used == 2  # as generating it left it
+    assert not a.peek(4) and a.tail[0] is None and isinstance(a.tail[1], RuntimeError)
