@@ -12,6 +12,9 @@ cdef class _Slab:
     cdef double[:, ::1] _pv
     cdef double[::1] _vv
 
+# the slab rows a caller writes (few_rows, slab_rows), claimed in C
+cdef _Slab _claim(Py_ssize_t m, Py_ssize_t rows)
+
 # a cruise's buffers as slab rows (Planner._sample_cruise, session 30, decision bench B176)
 @cython.locals(sl=_Slab, at=Py_ssize_t, i=Py_ssize_t, k=Py_ssize_t, r=list)
 cpdef tuple slab_rows(list pos, Py_ssize_t m, Py_ssize_t rows, double v)

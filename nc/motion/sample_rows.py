@@ -53,6 +53,18 @@ class _Slab:
 _slab = _Slab(3)
 
 
+def _claim(m: int, rows: int) -> _Slab:
+    """The slab whose rows `at - rows` … `at - 1` are now the caller's (`rows` <= SLAB): the current one, or a new
+    one where it holds another axis count or too few rows left. Claimed before the caller writes or calls anything,
+    so that another planner's few_rows or cruise takes the rows after them."""
+    global _slab
+    sl = _slab
+    if sl.m != m or sl.at + rows > SLAB:
+        sl = _slab = _Slab(m)
+    sl.at += rows
+    return sl
+
+
 @cython.locals(T=cython.double, t_next=cython.double, base=cython.double, length=cython.double, x=cython.double,
                s=cython.double, u=cython.double, seg_len=cython.double, n=cython.Py_ssize_t, keep=cython.Py_ssize_t,
                lo=cython.Py_ssize_t, hi=cython.Py_ssize_t, mid=cython.Py_ssize_t, i=cython.Py_ssize_t,
@@ -115,12 +127,8 @@ def few_rows(pl: "Planner", p: _Plan, n: int) -> bool:
         d0, d1, d2 = end[0] - q0, end[1] - q1, end[2] - q2
     else:
         d = [e - q for e, q in zip(end, start)]
-    global _slab
-    sl = _slab
-    if sl.m != m or sl.at + keep > SLAB:
-        sl = _slab = _Slab(m)
-    at = sl.at
-    sl.at = at + keep  # (the rows claimed before any call: another planner's few_rows takes the next ones)
+    sl = _claim(m, keep)
+    at = sl.at - keep
     got = []
     for i in range(keep):
         r = _row_at(t_next + T * i, base, dur, t0, pp, vv, aa, jj)
@@ -150,14 +158,10 @@ def slab_rows(pos: list, m: int, rows: int, v: float) -> tuple:
     `rows` row lists of `m` floats and `np.full(rows, v)` as slices of a `_Slab` (as `few_rows`' buffers, bench
     B175): numpy's discovery of the nesting and a float packed at a time cost more than the copy of the doubles.
     The same shape, dtype, C order and values; rows beyond a slab's take numpy's arrays, as before."""
-    global _slab
     if rows > SLAB:
         return np.array(pos), np.full(rows, v)
-    sl = _slab
-    if sl.m != m or sl.at + rows > SLAB:
-        sl = _slab = _Slab(m)
-    at = sl.at
-    sl.at = at + rows  # (claimed before any call, as few_rows does)
+    sl = _claim(m, rows)
+    at = sl.at - rows
     for i in range(rows):
         r = pos[i]
         for k in range(m):
