@@ -95,6 +95,54 @@ def least_limits(blocks: object) -> tuple[float, float]:
     return lo_a, lo_j
 
 
+@cython.locals(pl=PlanCore, k=cython.Py_ssize_t)
+def _take_row(pl: object, i: int) -> int:
+    """`CruiseSampling._take(i)`: the state after handing out buffer row i, a cruise's blocks before row i's
+    finished (a C function compiled: called by `cut_rows` a stretch's part and by `Planner._step_path`)."""
+    blk = pl._buf_blk
+    if blk is not None:
+        k = blk[i]
+        while pl._buf_popped < k:
+            pl._finish_block(True)  # keep_plan (positional: a keyword call builds a dict)
+            pl._buf_popped += 1
+    pl.position = pl._buf_pos[i]
+    pl.line = pl._buf_line[i]
+    pl.s, pl.v, pl.a = pl._buf_state[i]
+    return 0
+
+
+# A stretch's part (nc.motion.stretch, hil/stretch_pass.py `Pass._group`): here where they run compiled, typed on
+# the planner's C fields (issue 17, session 31, decision bench B190; as Python they were ≈ 11k instructions a
+# part, ≈ 2,600 parts a CAM run). nc.motion.stretch imports them under the same names.
+@cython.locals(pl=PlanCore)
+def refuses(pl: object, mv: object, per_rev: bool = False) -> bool:
+    """Whether a stretch may not take rows of the front block's move: a feed-per-revolution path (unless the caller
+    samples per revolution: Planner._check_spindle re-plans it from the measured speed), a thread, G31."""
+    if mv.per_rev and not per_rev:
+        p = pl.plan
+        if p is not None and p.kind == "path":
+            return True
+    return mv.kind == "thread" or "G31" in mv.tags
+
+
+@cython.locals(pl=PlanCore, i=cython.Py_ssize_t, m=cython.Py_ssize_t, j=cython.Py_ssize_t, off=cython.Py_ssize_t)
+def cut_rows(pl: object, i: int, m: int, mv: object) -> tuple:
+    """Take the buffer's rows i … i + m − 1 (the planner left as after their steps): (raw rows, λ, lines, path
+    speeds, mv, the move of each row where they cross into a cruise's next block, else None)."""
+    j = i + m - 1
+    raw = pl._buf_pos[i:i + m]
+    moves = None
+    blk = pl._buf_blk
+    if blk is not None and blk[j] != pl._buf_popped:
+        off = pl._buf_popped
+        blocks = pl.blocks
+        moves = [blocks[k - off].move for k in blk[i:i + m]]
+    lam = pl.share_rows(i, m)  # the filter's share per row (decision motion 45)
+    pl._buf_i = i + m
+    _take_row(pl, j)
+    return raw, lam, pl._buf_line[i:i + m], pl._buf_vel[i:i + m], mv, moves
+
+
 class CruiseSampling:
     """Methods of `nc.motion.planner.Planner` (its state is the planner's own: see that module's doc)."""
 
@@ -142,18 +190,9 @@ class CruiseSampling:
                 m -= 1
         return m
 
-    @cython.locals(self=PlanCore)
     def _take(self, i: int) -> None:
         """The state after handing out buffer row i: a cruise's blocks before row i's are finished."""
-        blk = self._buf_blk
-        if blk is not None:
-            k = blk[i]
-            while self._buf_popped < k:
-                self._finish_block(True)  # keep_plan (positional: a keyword call builds a dict)
-                self._buf_popped += 1
-        self.position = self._buf_pos[i]
-        self.line = self._buf_line[i]
-        self.s, self.v, self.a = self._buf_state[i]
+        _take_row(self, i)
 
     def _cruising(self, b: Block, v: float) -> bool:
         return _cruises(b, v)

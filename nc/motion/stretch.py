@@ -22,6 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from nc.motion.planner import Planner
+from nc.motion.planner_cruise import cut_rows, refuses  # a part's take, compiled (issue 17, decision bench B190)
 from nc.motion.threading import SETTLE_BAND, SETTLE_MIN_RPM
 from nc.moves import Move
 
@@ -81,33 +82,6 @@ def take_parts(pl: Planner, n: int, across: bool = False, per_rev: bool = False)
     if m <= 0:
         return None  # the next row starts the cruise's next block: step() finishes this one
     return cut_rows(pl, i, m, mv)
-
-
-def refuses(pl: Planner, mv: Move, per_rev: bool = False) -> bool:
-    """Whether a stretch may not take rows of the front block's move: a feed-per-revolution path (unless the caller
-    samples per revolution: Planner._check_spindle re-plans it from the measured speed), a thread, G31."""
-    if mv.per_rev and not per_rev:
-        p = pl.plan
-        if p is not None and p.kind == "path":
-            return True
-    return mv.kind == "thread" or "G31" in mv.tags
-
-
-def cut_rows(pl: Planner, i: int, m: int, mv: Move | None) -> tuple:
-    """Take the buffer's rows i … i + m − 1 (the planner left as after their steps): (raw rows, λ, lines, path
-    speeds, mv, the move of each row where they cross into a cruise's next block, else None)."""
-    j = i + m - 1
-    raw = pl._buf_pos[i:i + m]
-    moves = None
-    blk = pl._buf_blk
-    if blk is not None and blk[j] != pl._buf_popped:
-        off = pl._buf_popped
-        blocks = pl.blocks
-        moves = [blocks[k - off].move for k in blk[i:i + m]]
-    lam = pl.share_rows(i, m)  # the filter's share per row (decision motion 45)
-    pl._buf_i = i + m
-    pl._take(j)
-    return raw, lam, pl._buf_line[i:i + m], pl._buf_vel[i:i + m], mv, moves
 
 
 def sample_per_rev(pl: Planner, n: int) -> Samples | None:
