@@ -53,6 +53,7 @@ class _Slab:
 _slab = _Slab(3)
 
 
+@cython.locals(sl=_Slab)
 def _claim(m: int, rows: int) -> _Slab:
     """The slab whose rows `at - rows` … `at - 1` are now the caller's (`rows` <= SLAB): the current one, or a new
     one where it holds another axis count or too few rows left. Claimed before the caller writes or calls anything,
