@@ -130,17 +130,23 @@ def cut_rows(pl: object, i: int, m: int, mv: object) -> tuple:
     """Take the buffer's rows i … i + m − 1 (the planner left as after their steps): (raw rows, λ, lines, path
     speeds, mv, the move of each row where they cross into a cruise's next block, else None)."""
     j = i + m - 1
-    raw = pl._buf_pos[i:i + m]
+    pos, vel, lines = pl._buf_pos, pl._buf_vel, pl._buf_line
+    if i != 0 or m != len(pos):
+        pos, vel, lines = pos[i:i + m], vel[i:i + m], lines[i:i + m]
+    # (else the whole buffer: its own arrays and list, whose rows nothing writes again, not views of all of them:
+    # a numpy slice costs ≈ 1k instructions; nearly half the parts of a CAM run, bench B191)
     moves = None
     blk = pl._buf_blk
     if blk is not None and blk[j] != pl._buf_popped:
         off = pl._buf_popped
         blocks = pl.blocks
         moves = [blocks[k - off].move for k in blk[i:i + m]]
-    lam = pl.share_rows(i, m)  # the filter's share per row (decision motion 45)
+    # the filter's share per row (decision motion 45); None without share zones, share_rows' own first test (its
+    # Python call ≈ 600 instructions a part)
+    lam = None if pl._zones is None else pl.share_rows(i, m)
     pl._buf_i = i + m
     _take_row(pl, j)
-    return raw, lam, pl._buf_line[i:i + m], pl._buf_vel[i:i + m], mv, moves
+    return pos, lam, lines, vel, mv, moves
 
 
 class CruiseSampling:
