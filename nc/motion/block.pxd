@@ -23,10 +23,8 @@ cdef class Block:
     cdef public double s_end
     cdef public object du
     cdef public double du_n
-    cdef public tuple cum
     cdef public double vtop
     cdef public tuple dv
-    cdef public tuple scum
     cdef public double vbase
     cdef public double ctol
     cdef public double vtol

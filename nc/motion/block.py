@@ -44,7 +44,6 @@ class Block:
     s_end: float = 0.0
     du: tuple[float, ...] | None = None
     du_n: float = 0.0
-    cum: tuple[float, ...] = ()  # running Σ|Δu| per axis and Σ|Δu| norms up to this junction
     vtop: float = 0.0  # the fastest this block can ever run (feed × the top override, or its geometric cap)
     # Path tolerance under the filter (nc.motion.deviation): the signed tangent step at the end
     # junction, the junction speed without the tolerance, the speed the deviation model allows
@@ -52,7 +51,6 @@ class Block:
     # holds this one (vjunc = min(vbase, vtol); vtol is replaced, not only lowered, as the
     # windows fill).
     dv: tuple[float, ...] = ()
-    scum: tuple[float, ...] = ()  # running signed Σ Δu per axis up to this junction
     vbase: float = math.inf
     ctol: float = math.inf
     vtol: float = math.inf
@@ -98,9 +96,7 @@ def new_block(move: Move, kind: str, seg: Segment | None, length: float, cap_har
     b.feed = feed
     b.rapid = rapid
     b.binding = True
-    b.cum = ()
     b.dv = ()
-    b.scum = ()
     b.vbase = _INF
     b.ctol = _INF
     b.vtol = _INF
