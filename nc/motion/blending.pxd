@@ -114,11 +114,14 @@ cdef double _cap_at(double v, double t1, double t2, double s_j, double[::1] s, d
                     double[::1] al, double[::1] vt, double[::1] ba, double[::1] bj, double[:, ::1] pre,
                     double[:, ::1] sums) except? -1.0
 
-@cython.locals(w1=double, w2=double, top=double, k=Py_ssize_t, i=Py_ssize_t, e=double, f=double, x=double,
-               a0=Py_ssize_t, a1=Py_ssize_t, a2=Py_ssize_t, b0=Py_ssize_t, b1=Py_ssize_t, b2=Py_ssize_t,
-               c0=Py_ssize_t, c1=Py_ssize_t, c2=Py_ssize_t, d0=Py_ssize_t, d1=Py_ssize_t, d2=Py_ssize_t)
+@cython.locals(w1=double, w2=double, top=double, k=Py_ssize_t, i=Py_ssize_t, e=double, x=double,
+               ends="Py_ssize_t[::1]")
 cdef int _window_sums(double vw, double t1, double t2, double s_j, double[::1] s, double[:, ::1] pre,
                       double[:, ::1] sums, Py_ssize_t row) except -1
+
+@cython.locals(x=double)
+cdef int _series_window(double e, double s_j, double top, double w1, double w2, double[::1] s, double[:, ::1] pre,
+                        double[:, ::1] sums, Py_ssize_t row, Py_ssize_t[::1] ends, Py_ssize_t c) except -1
 
 @cython.locals(k=Py_ssize_t, mid=double, a=double, d=double, q=double)
 cdef int _window_max(double[:, ::1] pre, double[:, ::1] sums, Py_ssize_t row, Py_ssize_t i0, Py_ssize_t i1,

@@ -1390,36 +1390,27 @@ def _window_sums(vw: float, t1: float, t2: float, s_j: float, s: np.ndarray, pre
         x = s_j - w1
         _window_max(pre, sums, row, _count_at_or_below(s, s_j), _count_at_or_below(s, x),
                     _count_at_or_below(s, x - w2))
-    a0 = a1 = a2 = b0 = b1 = b2 = c0 = c1 = c2 = d0 = d1 = d2 = 0  # each series' three counts so far
+    ends = np.zeros(12, dtype=np.intp)  # each series' three counts so far (its own three slots)
     for i in range(s.shape[0]):
         e = s[i] + w1
-        if e >= s_j and e <= top:
-            x = e - w1
-            a0 = _count_from(s, e, a0)
-            a1 = _count_from(s, x, a1)
-            a2 = _count_from(s, x - w2, a2)
-            _window_max(pre, sums, row, a0, a1, a2)
-        f = e - 1e-9
-        if f >= s_j and f <= top:
-            x = f - w1
-            b0 = _count_from(s, f, b0)
-            b1 = _count_from(s, x, b1)
-            b2 = _count_from(s, x - w2, b2)
-            _window_max(pre, sums, row, b0, b1, b2)
+        _series_window(e, s_j, top, w1, w2, s, pre, sums, row, ends, 0)
+        _series_window(e - 1e-9, s_j, top, w1, w2, s, pre, sums, row, ends, 3)
         e = e + w2
-        if e >= s_j and e <= top:
-            x = e - w1
-            c0 = _count_from(s, e, c0)
-            c1 = _count_from(s, x, c1)
-            c2 = _count_from(s, x - w2, c2)
-            _window_max(pre, sums, row, c0, c1, c2)
-        f = e - 1e-9
-        if f >= s_j and f <= top:
-            x = f - w1
-            d0 = _count_from(s, f, d0)
-            d1 = _count_from(s, x, d1)
-            d2 = _count_from(s, x - w2, d2)
-            _window_max(pre, sums, row, d0, d1, d2)
+        _series_window(e, s_j, top, w1, w2, s, pre, sums, row, ends, 6)
+        _series_window(e - 1e-9, s_j, top, w1, w2, s, pre, sums, row, ends, 9)
+    return 0
+
+
+def _series_window(e: float, s_j: float, top: float, w1: float, w2: float, s: np.ndarray, pre: np.ndarray,
+                   sums: np.ndarray, row: int, ends: np.ndarray, c: int) -> int:
+    """The window ending at e (if within J's pair of windows) into the maxima, its three ends counted on from the
+    series' counts ends[c], ends[c + 1], ends[c + 2] (`_window_sums`: they never fall along a series)."""
+    if e >= s_j and e <= top:
+        x = e - w1
+        ends[c] = _count_from(s, e, ends[c])
+        ends[c + 1] = _count_from(s, x, ends[c + 1])
+        ends[c + 2] = _count_from(s, x - w2, ends[c + 2])
+        _window_max(pre, sums, row, ends[c], ends[c + 1], ends[c + 2])
     return 0
 
 
