@@ -14,14 +14,13 @@ Usage: python benchmarks/peek_in_run.py [--tree DIR] [--against DIR] [--blocks N
 from __future__ import annotations
 
 import argparse
-import os
-import re
 import shutil
-import subprocess
 import sys
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))
+from benchmarks.interp_instructions import collected  # noqa: E402  (the tree's, run as a script)
 
 CHILD = r'''
 import functools, gc, os, sys, tempfile
@@ -52,13 +51,9 @@ run()
 
 
 def count(tree: str, blocks: int) -> int:
-    out = subprocess.run(["valgrind", "--tool=callgrind", "--callgrind-out-file=/dev/null", "--collect-atstart=no",
-                          "--toggle-collect=functools_reduce", sys.executable, "-c", CHILD, tree, str(blocks)],
-                         capture_output=True, text=True, env=dict(os.environ, PYTHONHASHSEED="0"), check=True)
-    m = re.search(r"Collected : (\d+)", out.stderr)
-    if m is None:
-        raise SystemExit(f"callgrind printed no count:\n{out.stderr[-2000:]}")
-    return int(m.group(1))
+    """Instructions callgrind counts inside `Ahead.peek` over the second run (interp_instructions.collected)."""
+    return collected(["--callgrind-out-file=/dev/null", "--collect-atstart=no", "--toggle-collect=functools_reduce"],
+                     [CHILD, tree, str(blocks)])
 
 
 def main() -> None:
