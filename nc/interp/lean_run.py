@@ -109,7 +109,12 @@ def streamed(letters: tuple[str, ...], g: int | None, f: int | None, programmed:
            "    name = fr.program.name"]
     for i, a in enumerate(axes):
         src.append(f"    o{i} = origin[{a!r}]")
-    src += ["    while True:",
+    # the run's one LineBlock, each line's written into it (B200: a LineBlock made and freed a line was 1.5k of the
+    # stream's 18.5k instructions a CAM block). Nothing holds `Interpreter.block` past the next line but the run's
+    # own checks stop it first (an M96 program's saved block, `_run`'s `last` once the run is done)
+    src += ["    b = NEW(LineBlock)",
+            "    b._shape = SHAPE",
+            "    while True:",
             f"        got = CHUNK_AT(text, starts, lengths, pc, count, {''.join(letters)!r}, {len(letters)}, EXPECT)",
             "        if got is None:",
             "            lane.retry = range(pc, pc + CHUNK)  # not of this shape: line by line up to there",
@@ -182,10 +187,9 @@ def streamed(letters: tuple[str, ...], g: int | None, f: int | None, programmed:
             "            fr.pc = pc",
             "            ip._executed += 1",
             "            ip.program_name = name",
-            "            ip.block = b = NEW(LineBlock)",
+            "            ip.block = b  # the run's LineBlock, this line's (its words read again from `_vals` when asked)",
             "            b.line = line",
             "            b.text = raw",
-            "            b._shape = SHAPE",
             "            b._vals = vals"]
     if g is not None:
         src += ["            st.groups[1] = float(v_G)", "            st.motion = motion"]
