@@ -7,7 +7,9 @@ shape and profile, as its `run` is) reads the next lines in chunks of CHUNK: two
 chunk's text (its letters alone must be the shape's, line after line; its numbers alone, split, are every word's
 number), `map(float)` a column's values; then it hands the Moves out one by one, each made, and the interpreter's
 state left, as the shape's `run` makes and leaves them for that line (the same code, line by line: the lean lane
-on and off give the same events and the same state at every event, tests/test_lean33_runs.py).
+on and off give the same events and the same state at every event, tests/test_lean33_runs.py). One thing differs:
+a run's lines are written into one LineBlock of its own (decisions bench B200), so `Interpreter.block` is the same
+object, read as each line's block, from one line of a run to the next (a caller keeps `block.plain()`).
 
 Before each line it asks what the program counter and `run` ask: the frame on top and its counter where the last
 line left them (an M96 interrupt, a `--at` event, a macro call change them), no interrupt pending, no corner
