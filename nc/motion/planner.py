@@ -110,6 +110,58 @@ def _factor_span(planner: "Planner", lim: Limits, b: Block, s: float, dist: floa
     return jerk_factor(planner.cfg, blend, planner.blocks, start + s, start + dist, planner.closed)
 
 
+# Planner._run_target's work, called in C from `_plan_path` and `_jerk_factor` (session 31, decision bench B204): the
+# Python-visible call, `self.lookahead()` (its body spelt out) and the loop's test on a Python int k_max were ≈ 0.8k a
+# block. (k_max stays a Python int: absurd limits give a look-ahead depth beyond a C integer, test_harden_budgets;
+# the loop compares k with it clamped to 2**62, a depth no deque reaches.)
+KMAX_C = 2 ** 62
+
+
+def _target_run(self: "Planner", cap: float, extend: bool, cruise_from: float, jf: float, through: float,
+                limit: int) -> tuple[float, float, float, float, float]:
+    if self._pushed:  # self.lookahead(), spelt out
+        backward(self.blocks, 0, False, self._need)
+        self._pushed = self._need = 0
+    it = iter(self.blocks)  # the queue walked in order (a deque indexes in O(k)); b is blocks[k], nx blocks[k + 1]
+    b = next(it)
+    dist, ra, rj = b.length, b.a, b.j
+    vmax = cap
+    cap_lo = cap - 1e-9
+    k_max = limit if limit else 2 * self.depth
+    kmax = k_max if k_max < KMAX_C else KMAX_C  # min(k_max, 2**62): k never gets there
+    for k, nx in enumerate(it):
+        if nx.kind != "path" or nx.cap < cap_lo or b.vend <= 0.0 or k >= kmax \
+                or (b.vend >= vmax - 1e-9 and dist >= cruise_from):
+            # (asked here, once a call: the loop's own test stays as it was for every other solve)
+            if not (through <= nx.cap < cap_lo and nx.kind == "path" and b.vend > 0.0 and k < kmax
+                    and not (b.vend >= vmax - 1e-9 and dist >= cruise_from)):
+                self._end_cap = nx.cap if nx.kind == "path" else -1.0
+                return dist, vmax if vmax < b.vend else b.vend, ra, rj * jf, vmax  # min(b.vend, vmax)
+            if nx.cap < vmax:  # a lower cap `through` goes on past: it holds the whole run (motion 77)
+                vmax = nx.cap
+        if b.vjunc < cap_lo:
+            if b.binding and self._unbound(b, nx, dist, ra, rj * jf):
+                # Not reachable faster than it allows from the present state (a rising
+                # chain of caps behind a corner): it cannot bind, and a profile that ended
+                # there at zero acceleration would only lose time.
+                pass
+            elif not extend or b.binding:
+                return dist, vmax if vmax < b.vend else b.vend, ra, rj * jf, vmax  # min(b.vend, vmax)
+            else:
+                if b.vjunc < vmax:  # min(vmax, b.vjunc)
+                    vmax = b.vjunc
+        dist += nx.length
+        x = nx.a  # ra = min(ra, nx.a) and rj = min(rj, nx.j), spelt out
+        if x < ra:
+            ra = x
+        x = nx.j
+        if x < rj:
+            rj = x
+        b = nx
+    self._end_cap = -1.0
+    return dist, vmax if vmax < b.vend else b.vend, ra, rj * jf, vmax  # b is the queue's last block
+
+
 def _cap_of(self: "Planner", b: Block, rpm: float | None) -> float:
     """Planner._update_cap's work, a C function where compiled (planner.pxd; session 31, decision bench B181): the
     push calls it once a block, and a Python method call from compiled code was ≈ 320 instructions of its ≈ 500."""
@@ -582,7 +634,9 @@ class Planner(PlanCore, CruiseSampling, CornerShares, ThreadStepping, FilterStop
         for _ in range(MAX_SOLVES_PER_CYCLE):
             p = self.plan
             if p is None:
-                if not self._settled and self.at_rest:
+                # `not self._settled and self.at_rest`, the two properties spelt out (Python calls compiled, bench B204)
+                f = self.filter
+                if f is not None and not f.settled and abs(self.v) < 1e-9 and not np.any(self._axis_v):
                     return  # exact stop: the filtered setpoint reaches the point before anything starts
                 p = self._start_plan()
                 self.plan = p
@@ -702,7 +756,8 @@ class Planner(PlanCore, CruiseSampling, CornerShares, ThreadStepping, FilterStop
                 # faster than it allows (a corner, the queue's end): it cannot stop sooner, so the plan's own
                 # profile to that junction goes on (within the limits, no reversal) and the stop follows from
                 # there (motion 63)
-                dist, v1, ra, rj, vmax = self._run_target(max(cap, v, 1e-9), jf=self._jf)  # the running plan's jerk
+                # the running plan's jerk
+                dist, v1, ra, rj, vmax = _target_run(self, max(cap, v, 1e-9), False, math.inf, self._jf, math.inf, 0)
                 to = solve_position(s, v, a, dist, v1, vmax, ra, rj)
                 if to is not None and to.p_max <= dist + 1e-7 and to.v_min() >= -1e-7:
                     return _Plan("path", to, to.duration, t0, target=dist, queued=self._pushes)
@@ -717,7 +772,7 @@ class Planner(PlanCore, CruiseSampling, CornerShares, ThreadStepping, FilterStop
             for extend in (0, 1, 2):
                 check = None
                 if extend < 2:
-                    dist, v1, ra, rj, vmax = self._run_target(cap, extend == 1, cruise, f)
+                    dist, v1, ra, rj, vmax = _target_run(self, cap, extend == 1, cruise, f, math.inf, 0)
                 else:  # neither met: on through lower caps the braking state does not reach (motion 77)
                     # (with this solve's own factor only: a cruise leaves self._jf as it was, decision 44)
                     # (only where the extended run ended at such a cap: 12 of 211 that got here in 3000 CAM blocks)
@@ -836,7 +891,7 @@ class Planner(PlanCore, CruiseSampling, CornerShares, ThreadStepping, FilterStop
         the caller checks the solve against junction by junction instead, with the plain jerk (factor 1: always
         within the shares; the scan over the longer run cost 1 % of the CAM program's instructions, for 15 of 176
         such solves met there)."""
-        dist, v1, ra, rj, vmax = self._run_target(cap, True, cruise, 1.0, through, 0 if through > 0.0 else THROUGH)
+        dist, v1, ra, rj, vmax = _target_run(self, cap, True, cruise, 1.0, through, 0 if through > 0.0 else THROUGH)
         if through == 0.0 and v > max_speed_at(v1, 0.0, dist - s, ra, rj):
             return None  # no profile brakes from v to v1 there (time reversed, none reaches v): 56 of 176 in CAM
         if f > 1.0 and through > 0.0:  # (through every lower cap: the plain jerk, no scan; rarely met, motion 83)
@@ -853,18 +908,13 @@ class Planner(PlanCore, CruiseSampling, CornerShares, ThreadStepping, FilterStop
         lim = self.lim
         if lim.blend is None:
             return 1.0, False
-        return _factor_span(self, lim, b, s, self._run_target(cap, True, cruise)[0])
+        return _factor_span(self, lim, b, s, _target_run(self, cap, True, cruise, 1.0, math.inf, 0)[0])
 
     @cython.locals(self=PlanCore)
     def _factor_over(self, b: Block, s: float, dist: float) -> tuple[float, bool]:
         """`_jerk_factor` over a run from s in b to `dist` (measured from b's start)."""
         return _factor_span(self, self.lim, b, s, dist)
 
-    @cython.locals(self=PlanCore, b=Block, nx=Block, dist=cython.double, ra=cython.double, rj=cython.double,
-                   vmax=cython.double,
-                   cap=cython.double, cap_lo=cython.double, x=cython.double, jf=cython.double,
-                   cruise_from=cython.double, k=cython.Py_ssize_t, extend=cython.bint, through=cython.double)
-    # (k_max stays a Python int: absurd limits give a look-ahead depth beyond a C integer, test_harden_budgets)
     def _run_target(self, cap: float, extend: bool = False, cruise_from: float = math.inf,
                     jf: float = 1.0, through: float = math.inf, limit: int = 0) -> tuple[float, float, float, float, float]:
         """(distance, end speed, acceleration, jerk, top speed) of the run that starts with blocks[0].
@@ -879,44 +929,7 @@ class Planner(PlanCore, CruiseSampling, CornerShares, ThreadStepping, FilterStop
         than `cap` but not below `through` (the speed the present state reaches) does not end the run; the
         top speed drops to its cap instead (`_run_through`, decision motion 77).
         """
-        self.lookahead()
-        it = iter(self.blocks)  # the queue walked in order (a deque indexes in O(k)); b is blocks[k], nx blocks[k + 1]
-        b = next(it)
-        dist, ra, rj = b.length, b.a, b.j
-        vmax = cap
-        cap_lo = cap - 1e-9
-        k_max = limit if limit else 2 * self.depth
-        for k, nx in enumerate(it):
-            if nx.kind != "path" or nx.cap < cap_lo or b.vend <= 0.0 or k >= k_max \
-                    or (b.vend >= vmax - 1e-9 and dist >= cruise_from):
-                # (asked here, once a call: the loop's own test stays as it was for every other solve)
-                if not (through <= nx.cap < cap_lo and nx.kind == "path" and b.vend > 0.0 and k < k_max
-                        and not (b.vend >= vmax - 1e-9 and dist >= cruise_from)):
-                    self._end_cap = nx.cap if nx.kind == "path" else -1.0
-                    return dist, vmax if vmax < b.vend else b.vend, ra, rj * jf, vmax  # min(b.vend, vmax)
-                if nx.cap < vmax:  # a lower cap `through` goes on past: it holds the whole run (motion 77)
-                    vmax = nx.cap
-            if b.vjunc < cap_lo:
-                if b.binding and self._unbound(b, nx, dist, ra, rj * jf):
-                    # Not reachable faster than it allows from the present state (a rising
-                    # chain of caps behind a corner): it cannot bind, and a profile that ended
-                    # there at zero acceleration would only lose time.
-                    pass
-                elif not extend or b.binding:
-                    return dist, vmax if vmax < b.vend else b.vend, ra, rj * jf, vmax  # min(b.vend, vmax)
-                else:
-                    if b.vjunc < vmax:  # min(vmax, b.vjunc)
-                        vmax = b.vjunc
-            dist += nx.length
-            x = nx.a  # ra = min(ra, nx.a) and rj = min(rj, nx.j), spelt out
-            if x < ra:
-                ra = x
-            x = nx.j
-            if x < rj:
-                rj = x
-            b = nx
-        self._end_cap = -1.0
-        return dist, vmax if vmax < b.vend else b.vend, ra, rj * jf, vmax  # b is the queue's last block
+        return _target_run(self, cap, extend, cruise_from, jf, through, limit)  # a C call where compiled (bench B204)
 
     @cython.locals(self=PlanCore)
     def _unbound(self, b: Block, nx: Block, dist: float, ra: float, rj: float) -> bool:

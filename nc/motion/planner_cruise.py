@@ -12,6 +12,11 @@ try:
 except ImportError:  # run as Python without Cython: they do nothing
     from nc.motion import cython_shadow as cython
 
+if cython.compiled:  # C's floor, the function math.floor calls on a float (session 31, decision bench B204)
+    from cython.cimports.libc.math import floor as _c_floor
+else:
+    _c_floor = math.floor
+
 from nc.motion.block import Block
 from nc.motion.plan_core import PlanCore  # the planner's C fields where compiled (bench B172)
 from nc.motion.plan_state import CHUNK, _Plan
@@ -225,7 +230,7 @@ class CruiseSampling:
                    i=cython.Py_ssize_t, a=cython.Py_ssize_t, m=cython.Py_ssize_t, rows=cython.Py_ssize_t,
                    line=cython.bint, three=cython.bint, snap=cython.bint, q0=cython.double, q1=cython.double,
                    q2=cython.double, e0=cython.double, e1=cython.double, e2=cython.double, d0=cython.double,
-                   d1=cython.double, d2=cython.double, carry=cython.double)
+                   d1=cython.double, d2=cython.double, carry=cython.double, y=cython.double, f=cython.double)
     def _sample_cruise(self, p: _Plan) -> None:
         """The rows of a cruise, whole blocks up to at least ROWS rows: each block as its own solve gives them
         (a constant-speed profile from s0 at the plan time t0, s = s0 + v·t, sampled a CHUNK at a time while
@@ -270,11 +275,15 @@ class CruiseSampling:
                 d = [e - q for e, q in zip(end, start)]  # seg.end - seg.start: the same float subtraction as numpy's
             duration = (b.length - s0) / v  # ruckig's duration of this profile, to the bit
             while True:
-                n = int(math.floor((duration - t_next) / T + 1e-9)) + 1
-                if not (t_next <= duration + 1e-12 and n > 0):
+                # n = int(math.floor(y)) + 1, the rows left, on C's floor (n > 0: f >= 0; min(n, CHUNK): f >= CHUNK);
+                # math.floor only where it raises (y not finite), as it did
+                y = (duration - t_next) / T + 1e-9
+                f = _c_floor(y)
+                if f - f != 0.0:
+                    n = int(math.floor(y)) + 1
+                if not (t_next <= duration + 1e-12 and f >= 0.0):
                     break
-                if CHUNK < n:  # min(n, CHUNK)
-                    n = CHUNK
+                n = CHUNK if f >= CHUNK else int(f) + 1
                 # t = t_next + T·arange(n), s = s0 + clip(t, 0, duration)·v and a line's points at clip(s, 0,
                 # length) element by element: the same operations, so the same bits (nc.motion.sample_rows);
                 # loops, not comprehensions, so that compiled the floats stay C doubles
@@ -282,6 +291,7 @@ class CruiseSampling:
                 line = seg.kind == "line" and seg.length > 0.0
                 seg_len = seg.length if line else 1.0
                 sc = []
+                ko, lo = k, b.move.line  # each row's block offset and line, appended with the row (not `+= [k] * n`)
                 for i in range(n):
                     x = t_next + T * i
                     if 0.0 >= x:
@@ -290,6 +300,8 @@ class CruiseSampling:
                         x = duration
                     x = s0 + x * v
                     st.append(x)
+                    offs.append(ko)
+                    lines.append(lo)
                     if 0.0 >= x:
                         x = 0.0
                     if length <= x:
@@ -305,8 +317,6 @@ class CruiseSampling:
                 if not line:
                     pos += seg.points(np.array(sc)).tolist()
                 t_next = (t_next + T * (n - 1)) + T
-                offs += [k] * n
-                lines += [b.move.line] * n
                 rows += n
             carry = t_next - duration if t_next - duration > 1e-12 else t_next - duration + T
             carries.append(carry)

@@ -9,6 +9,8 @@ C++ (libruckig.a and the headers of the ruckig that setup.py found) and reads th
 nc/motion/compiled.py uses it only where the ruckig imported at run time is that version.
 """
 
+from cpython.list cimport PyList_New, PyList_SET_ITEM
+from cpython.ref cimport Py_INCREF
 from libcpp cimport bool as cbool
 
 cdef extern from "ruckig_direct.hpp" namespace "deltahil":
@@ -45,10 +47,14 @@ def reset() -> None:
 
 
 cdef list _row(double* xs, int n):
-    cdef list out = []
+    # the list sized once and each float set in place, not appended (session 31, decision bench B204)
+    cdef list out = PyList_New(n)
+    cdef object x
     cdef int k
     for k in range(n):
-        out.append(xs[k])
+        x = xs[k]
+        Py_INCREF(x)  # PyList_SET_ITEM steals the reference that `x` keeps
+        PyList_SET_ITEM(out, k, x)
     return out
 
 
