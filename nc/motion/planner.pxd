@@ -23,7 +23,7 @@ cdef bint _near_floats(list a, list b) except -1
 @cython.locals(cap=double, x=double, feed=double)
 cdef double _cap_of(PlanCore self, Block b, object rpm) except? -1.0
 
-# Planner._run_target's work in C, called so from `_plan_path`, `_run_through` and `_jerk_factor` (session 31, bench B204)
+# Planner._run_target's work in C, called so from `_plan_path`, `_run_through` and `_jerk_factor` (session 31, B204)
 @cython.locals(b=Block, nx=Block, dist=double, ra=double, rj=double, vmax=double, cap_lo=double, x=double,
                k=Py_ssize_t, kmax=Py_ssize_t)
 cdef tuple _target_run(PlanCore self, double cap, bint extend, double cruise_from, double jf, double through,
