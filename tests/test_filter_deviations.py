@@ -205,3 +205,25 @@ def test_on_haswell_kernels_the_haswell_order_is_numpys():
     out = subprocess.run([sys.executable, "-c", _HASWELL_RUN], cwd=root, env=env, capture_output=True, text=True,
                          check=True).stdout.split()
     assert out == ["Haswell", "600"]
+
+
+@compiled_only
+def test_rows_with_a_leading_band_of_zeros_as_numpy():
+    """B202: `_c_deviations` starts a row's chains after its leading zeros (the kernel's band behind half a window):
+    rows whose band ends before, at and past groups of eight steps, -0.0 in it, a band that ends at the last step,
+    and a step that is not finite inside a band (0·inf: the nan numpy gives) — numpy's deviations bit for bit."""
+    rng = np.random.default_rng(202)
+    for nn in (5, 15, 16, 17, 40, 300, 600):
+        for axes in (2, 3):
+            nl = 13
+            w = rng.uniform(0.0, 3.0, (nl, nn)) * 10.0 ** rng.integers(-3, 3, (nl, nn))
+            du = rng.uniform(-1.0, 1.0, (nn, axes)) * 10.0 ** rng.integers(-6, 1, (nn, axes))
+            bands = [0, 1, 7, 8, 9, 15, 16, 17, nn // 2, nn - 1, nn, 3, 24]
+            for r, kz in enumerate(bands):
+                w[r, :min(kz, nn)] = 0.0
+            w[2, :3] = -0.0
+            assert _same_bits(_c_form(w, du), _numpy_form(w, du))
+            du[min(5, nn - 1), axes - 1] = np.inf  # inside the bands of rows 2.. : their deviation is a nan
+            with np.errstate(invalid="ignore"):
+                ref = _numpy_form(w, du)
+            assert np.isnan(ref[3]) and _same_bits(_c_form(w, du), ref)

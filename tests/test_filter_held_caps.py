@@ -166,3 +166,45 @@ def test_refine_is_the_numpy_forms_bit_for_bit():
             assert got == ref
             seen.add("raised" if got[0] > c else "kept")
     assert seen == {"raised", "kept"}  # both outcomes of the search compared
+
+
+def test_kernel_matrix_rows_in_any_order_and_a_band_of_zeros():
+    """B202: `_kernel_matrix` carries the band behind half a window from one row to the next while the rows' path
+    positions do not fall; rows out of order (and equal) must still give the numpy form's matrix bit for bit."""
+    fc = _corners()
+    for s_rows, s_all, vb, c in _cases(fc):
+        for rows in (s_rows[::-1].copy(), np.concatenate([s_rows[4:], s_rows[:4], s_rows[2:3]])):
+            w = np.empty((len(rows), len(s_all)))
+            _kernel_matrix(w, rows, s_all, vb, c, fc._gy, fc._gg, fc._gs)
+            ref = _numpy_form(fc, rows, s_all, vb, c)
+            assert (w == 0.0).any()
+            assert np.array_equal(w.view(np.uint64), ref.view(np.uint64))
+
+
+def test_least_held_is_the_least_cap_over_the_reaches_that_hold_each_junction():
+    """B202: `_least_held` steps its first junction within reach on from one junction to the next; each result is
+    the least ct over the junctions k with |s[u] − s[k]| ≤ rc[k] (and ≤ far), inf where none, a nan kept."""
+    import importlib.util
+
+    # a cdef function where compiled: its source run as Python (the same steps; the compiled run's setpoints are
+    # tests/test_planner_compiled.py's)
+    spec = importlib.util.spec_from_file_location("blending_source", Path(__file__).resolve().parent.parent / "nc"
+                                                  / "motion" / "blending.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    _least_held = mod._least_held
+    rng = np.random.default_rng(203)
+    for n, far in ((40, 3.0), (60, 0.5), (25, 100.0)):
+        s = np.sort(rng.uniform(0.0, 20.0, n))
+        s[10] = s[9]  # two junctions at one place
+        rc = rng.uniform(0.0, far, n)
+        ct = rng.uniform(1.0, 9.0, n)
+        ct[7] = np.nan
+        n0 = n // 3
+        held = np.full(n, -1.0)
+        _least_held(s, ct, rc, n0, far, held)
+        for u in range(n0, n):
+            d = np.abs(s[u] - s)
+            near = [ct[k] for k in range(n) if d[k] <= rc[k] and d[k] <= far]
+            want = np.nan if any(np.isnan(near)) else min(near, default=np.inf)
+            assert held[u] == want or (np.isnan(want) and np.isnan(held[u])), u
