@@ -209,8 +209,8 @@ def test_on_haswell_kernels_the_haswell_order_is_numpys():
 
 @compiled_only
 def test_rows_with_a_leading_band_of_zeros_as_numpy():
-    """B202: `_c_deviations` starts a row's chains after its leading zeros (the kernel's band behind half a window):
-    rows whose band ends before, at and past groups of eight steps, -0.0 in it, a band that ends at the last step,
+    """Rows with leading zeros (the kernel's band behind half a window; B202 measured skipping it, which must keep
+    this): bands that end before, at and past groups of eight steps, -0.0 in one, one that ends at the last step,
     and a step that is not finite inside a band (0·inf: the nan numpy gives) — numpy's deviations bit for bit."""
     rng = np.random.default_rng(202)
     for nn in (5, 15, 16, 17, 40, 300, 600):

@@ -169,8 +169,8 @@ def test_refine_is_the_numpy_forms_bit_for_bit():
 
 
 def test_kernel_matrix_rows_in_any_order_and_a_band_of_zeros():
-    """B202: `_kernel_matrix` carries the band behind half a window from one row to the next while the rows' path
-    positions do not fall; rows out of order (and equal) must still give the numpy form's matrix bit for bit."""
+    """Rows out of order (and equal) give the numpy form's matrix bit for bit, zeros beyond half a window included
+    (B202 measured carrying that band from one row to the next while the rows' positions do not fall)."""
     fc = _corners()
     for s_rows, s_all, vb, c in _cases(fc):
         for rows in (s_rows[::-1].copy(), np.concatenate([s_rows[4:], s_rows[:4], s_rows[2:3]])):
@@ -182,8 +182,8 @@ def test_kernel_matrix_rows_in_any_order_and_a_band_of_zeros():
 
 
 def test_least_held_is_the_least_cap_over_the_reaches_that_hold_each_junction():
-    """B202: `_least_held` steps its first junction within reach on from one junction to the next; each result is
-    the least ct over the junctions k with |s[u] − s[k]| ≤ rc[k] (and ≤ far), inf where none, a nan kept."""
+    """Each result of `_least_held` is the least ct over the junctions k with |s[u] − s[k]| ≤ rc[k] (and ≤ far), inf
+    where none, a nan kept (two junctions at one place; B202 measured stepping its first junction on instead)."""
     import importlib.util
 
     # a cdef function where compiled: its source run as Python (the same steps; the compiled run's setpoints are

@@ -82,8 +82,7 @@ cdef class FilterCorners:
 cdef Py_ssize_t _held_caps(FilterCorners fc, object blocks, Py_ssize_t lo, Py_ssize_t last, double s_j, double vt,
                            double half) except -1
 
-@cython.locals(nseg=Py_ssize_t, inf=double, u=Py_ssize_t, su=double, vt_i=double, k=Py_ssize_t, k0=Py_ssize_t,
-               x=double, c=double)
+@cython.locals(nseg=Py_ssize_t, inf=double, u=Py_ssize_t, su=double, vt_i=double, k=Py_ssize_t, x=double, c=double)
 cdef int _least_held(double[::1] s, double[::1] ct, double[::1] rc, Py_ssize_t n0, double far,
                      double[::1] held) except -1
 
@@ -93,12 +92,11 @@ cpdef int _deviations(double[:, ::1] w, double[:, ::1] du, double[::1] e) except
 # its C loops, in the summation order probed (`_probe_order`, decision bench B163)
 @cython.locals(nl=Py_ssize_t, nn=Py_ssize_t, axes=Py_ssize_t, n4=Py_ssize_t, r=Py_ssize_t, a=Py_ssize_t,
                k=Py_ssize_t, k0=Py_ssize_t, kb=Py_ssize_t, q=double, p=double, t=double, l0=double, l1=double,
-               l2=double, l3=double, l4=double, l5=double, l6=double, l7=double, kf=Py_ssize_t, kz=Py_ssize_t,
-               x=double)
+               l2=double, l3=double, l4=double, l5=double, l6=double, l7=double)
 cdef int _c_deviations(double[:, ::1] w, double[:, ::1] du, double[::1] e, int order) except -1
 
 @cython.locals(ny=Py_ssize_t, ymax=double, inv=double, r=Py_ssize_t, k=Py_ssize_t, sr=double, x=double, g=double,
-               j0=Py_ssize_t, v=double, kz=Py_ssize_t, sp=double)
+               j0=Py_ssize_t, v=double)
 cpdef void _kernel_matrix(double[:, ::1] w, double[::1] s_rows, double[::1] s_all, double[::1] vb, double c,
                           double[::1] gy, double[::1] gg, double[::1] gs)
 

@@ -1018,17 +1018,13 @@ def _least_held(s: np.ndarray, ct: np.ndarray, rc: np.ndarray, n0: int, far: flo
     if ct.shape[0] < nseg or rc.shape[0] < nseg or held.shape[0] < nseg or n0 < 0:
         raise ValueError("_least_held: ct, rc and held need a place per junction")
     inf = math.inf
-    k0 = 0  # the first k within far behind s[u]: never moves back as u advances (s sorted, each rounding monotonic)
     for u in range(n0, nseg):
         su = s[u]
         vt_i = inf
-        if not far >= 0.0:
-            k = u + 1  # (as the walk back from u ended at once: nan or a negative reach)
-        else:
-            while su - s[k0] > far:  # (stops at k0 = u at the latest: su - s[u] is 0)
-                k0 += 1
-            k = k0
-        for k in range(k, nseg):
+        k = u
+        while k >= 0 and su - s[k] <= far:
+            k -= 1
+        for k in range(k + 1, nseg):
             x = su - s[k]
             if x < 0.0:
                 x = -x
@@ -1147,24 +1143,10 @@ def _c_deviations(w: np.ndarray, du: np.ndarray, e: np.ndarray, order: int) -> i
       else the packed gemm kernel: one fused multiply-add chain over the steps in order, in K blocks (K over 256:
       two halves, the first rounded up to 4, or blocks of 256 while K ≥ 512 is left), each added to the sum;
     - one step, either: numpy's own loop, 0 + w·du.
-    The norm: squares summed (x0² + x1²) + x2², then the square root (numpy's add.reduce over 3 columns).
-    A row's leading zeros (the kernel's band beyond half a window behind the row's junction; the steps finite there)
-    are skipped where a chain starts (decision bench B202): a chain of ±0·finite from 0 stays ±0, so the chain that
-    starts after them differs at most in a zero's sign, which neither a sum with a number nor a square keeps."""
+    The norm: squares summed (x0² + x1²) + x2², then the square root (numpy's add.reduce over 3 columns)."""
     nl, nn, axes = w.shape[0], w.shape[1], du.shape[1]
     n4 = nl - nl % 4
-    kf = 0  # the steps finite up to kf (0·inf is a nan: no chain skips past a step that is not)
-    while kf < nn:
-        x = du[kf, 0]
-        for a in range(1, axes):
-            x = x + du[kf, a]
-        if x - x != 0.0:  # inf or nan somewhere (x - x is 0 for a finite x; a finite sum that overflows stops too)
-            break
-        kf += 1
     for r in range(nl):
-        kz = 0  # row r's leading zeros (-0.0 == 0.0 too) over finite steps
-        while kz < kf and w[r, kz] == 0.0:
-            kz += 1
         q = 0.0
         for a in range(axes):
             if nn == 1:
@@ -1201,17 +1183,17 @@ def _c_deviations(w: np.ndarray, du: np.ndarray, e: np.ndarray, order: int) -> i
                     elif kb > 256:
                         kb = (kb // 2 + 3) // 4 * 4
                     t = 0.0
-                    for k in range(k0 if k0 > kz else kz, k0 + kb):
+                    for k in range(k0, k0 + kb):
                         t = _fma(du[k, a], w[r, k], t)
                     p = p + t
                     k0 += kb
             elif nn < 16:
                 p = 0.0
-                for k in range(kz, nn):
+                for k in range(nn):
                     p = _fma(du[k, a], w[r, k], p)
             else:
                 l0 = l1 = l2 = l3 = l4 = l5 = l6 = l7 = 0.0
-                k = kz - kz % 8  # (step k goes into chain k mod 8: whole groups of eight skipped)
+                k = 0
                 while k + 8 <= nn:
                     l0 = _fma(du[k, a], w[r, k], l0)
                     l1 = _fma(du[k + 1, a], w[r, k + 1], l1)
@@ -1254,25 +1236,9 @@ def _kernel_matrix(w: np.ndarray, s_rows: np.ndarray, s_all: np.ndarray, vb: np.
         raise ValueError("_kernel_matrix: a table or a vector is shorter than the matrix it fills")
     ymax = gy[ny - 1]
     inv = (ny - 1) / ymax  # G's table is evenly spaced: a first guess of the index, made exact below
-    # The columns behind row r beyond G's table (right=0.0 there), kz of them from the first: with c > 0 and the
-    # rows' s not falling, they stay beyond it for the rows after (each rounding monotonic), so the search for the
-    # band goes on from where it ended (decision bench B202); their w is the same 0.0·min(vb, c) as below.
-    kz = 0
-    sp = -_INF
     for r in range(w.shape[0]):
         sr = s_rows[r]
-        if not (sr >= sp and c > 0.0):
-            kz = 0
-        sp = sr
-        while kz < w.shape[1] and c > 0.0:
-            x = (s_all[kz] - sr) / c
-            if not (x < 0.0 and -x > ymax):
-                break
-            kz += 1
-        for k in range(kz):
-            v = vb[k]
-            w[r, k] = 0.0 * (v if v < c or v != v else c)
-        for k in range(kz, w.shape[1]):
+        for k in range(w.shape[1]):
             x = (s_all[k] - sr) / c
             if x < 0.0:
                 x = -x
